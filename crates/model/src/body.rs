@@ -1,0 +1,89 @@
+//! Rigid bodies and handles.
+
+use serde::{Deserialize, Serialize};
+
+/// Handle of a body inside a [`crate::System`] (its index, in insertion order).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct BodyHandle(pub usize);
+
+/// What a joint or force attaches to: the fixed ground frame or a body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum BodyRef {
+    /// The inertial frame. Local points on ground are global points.
+    Ground,
+    /// A moving body.
+    Body(BodyHandle),
+}
+
+impl From<BodyHandle> for BodyRef {
+    fn from(h: BodyHandle) -> Self {
+        BodyRef::Body(h)
+    }
+}
+
+impl BodyRef {
+    /// The body index, or `None` for ground.
+    pub fn index(self) -> Option<usize> {
+        match self {
+            BodyRef::Ground => None,
+            BodyRef::Body(h) => Some(h.0),
+        }
+    }
+}
+
+/// A planar rigid body: mass, centroidal moment of inertia, and an initial state (a guess that
+/// [`crate::System::consistent_state`] projects onto the constraints).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Body {
+    /// Unique name.
+    pub name: String,
+    /// Mass (> 0).
+    pub mass: f64,
+    /// Moment of inertia about the centre of mass (> 0).
+    pub inertia: f64,
+    /// Initial `(x, y, theta)` of the centre of mass and body frame.
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Initial `(xdot, ydot, thetadot)`.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+}
+
+impl Body {
+    /// A body with the given name, unit mass and inertia, at the origin, at rest.
+    pub fn new(name: impl Into<String>) -> Self {
+        Body {
+            name: name.into(),
+            mass: 1.0,
+            inertia: 1.0,
+            position: [0.0; 3],
+            velocity: [0.0; 3],
+        }
+    }
+    /// Sets the mass.
+    pub fn mass(mut self, m: f64) -> Self {
+        self.mass = m;
+        self
+    }
+    /// Sets the centroidal moment of inertia.
+    pub fn inertia(mut self, j: f64) -> Self {
+        self.inertia = j;
+        self
+    }
+    /// A uniform slender rod of mass `m` and length `l` (inertia `m l^2 / 12`).
+    pub fn rod(mut self, m: f64, l: f64) -> Self {
+        self.mass = m;
+        self.inertia = m * l * l / 12.0;
+        self
+    }
+    /// Sets the initial position `(x, y, theta)`.
+    pub fn position(mut self, x: f64, y: f64, theta: f64) -> Self {
+        self.position = [x, y, theta];
+        self
+    }
+    /// Sets the initial velocity `(xdot, ydot, thetadot)`.
+    pub fn velocity(mut self, vx: f64, vy: f64, omega: f64) -> Self {
+        self.velocity = [vx, vy, omega];
+        self
+    }
+}

@@ -1,0 +1,89 @@
+//! The one error type of `mbd-model`.
+
+use thiserror::Error;
+
+/// Everything that can go wrong when building, loading or evaluating a model.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ModelError {
+    /// An element refers to a body that does not exist.
+    #[error("{element} refers to unknown body '{body}'")]
+    UnknownBody {
+        /// The joint or force that refers to it.
+        element: String,
+        /// The name (or handle) that could not be resolved.
+        body: String,
+    },
+    /// Two bodies, joints or forces share a name.
+    #[error("duplicate {kind} name '{name}'")]
+    DuplicateName {
+        /// "body", "joint" or "force".
+        kind: &'static str,
+        /// The repeated name.
+        name: String,
+    },
+    /// A parameter is out of range or not finite.
+    #[error("{element}: parameter '{parameter}' = {value} is invalid: {reason}")]
+    InvalidParameter {
+        /// The body, joint or force at fault.
+        element: String,
+        /// The parameter name.
+        parameter: &'static str,
+        /// The value given.
+        value: f64,
+        /// What is required.
+        reason: &'static str,
+    },
+    /// A joint connects a body to itself (or ground to ground).
+    #[error("joint '{joint}' attaches body '{body}' to itself")]
+    SameBody {
+        /// The joint.
+        joint: String,
+        /// The body named twice.
+        body: String,
+    },
+    /// The constraint Jacobian is rank deficient.
+    #[error("redundant constraints: equation {equation} is a combination of others; joints involved: {joints:?}")]
+    Redundant {
+        /// The first dependent constraint equation (by name).
+        equation: String,
+        /// The joints whose equations are linearly dependent.
+        joints: Vec<String>,
+    },
+    /// Newton projection onto the constraint manifold failed.
+    #[error("initial state cannot be projected onto the constraints: residual {residual:e} after {iterations} iterations (worst equation: {equation})")]
+    Projection {
+        /// Max-norm residual when it stopped.
+        residual: f64,
+        /// Iterations done.
+        iterations: usize,
+        /// The equation with the largest residual.
+        equation: String,
+    },
+    /// A vector or matrix argument has the wrong size.
+    #[error("{what}: expected length {expected}, got {got}")]
+    Dimension {
+        /// The argument.
+        what: &'static str,
+        /// Required size.
+        expected: usize,
+        /// Given size.
+        got: usize,
+    },
+    /// The model has no moving body.
+    #[error("the model has no bodies")]
+    Empty,
+    /// A model file could not be read or parsed.
+    #[error("model file ({format}): {message}")]
+    Parse {
+        /// "json" or "toml" (or "io").
+        format: &'static str,
+        /// The parser's message.
+        message: String,
+    },
+    /// A configuration where the constraint Jacobian loses rank (e.g. a singular slider-crank).
+    #[error("singular configuration: constraint Jacobian is rank deficient (joints {joints:?})")]
+    Singular {
+        /// The joints involved.
+        joints: Vec<String>,
+    },
+}

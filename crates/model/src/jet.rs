@@ -1,0 +1,429 @@
+//! Forward-mode differentiation for joint and force equations.
+//!
+//! Every joint and force element is written once, generically over [`Scalar`], as a function of
+//! the six absolute coordinates of the (at most two) bodies it connects. Evaluating it with
+//!
+//! * `f64` gives the value,
+//! * [`DirJet`] gives the value, the gradient and the first and second derivatives along a chosen
+//!   direction `v` (so `v^T H v` — the quadratic velocity term of the acceleration right-hand side
+//!   `gamma` — without forming the Hessian),
+//! * [`HessJet`] gives the value, the gradient and the full 6x6 Hessian,
+//!
+//! so the Jacobian, `gamma` and the Hessians are exact (to round-off) and consistent with the
+//! equation by construction. Finite-difference tests check them all.
+
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// Number of local variables of one element: `(x, y, theta)` of body a, then of body b.
+pub const NV: usize = 6;
+
+/// The arithmetic an element equation needs.
+pub trait Scalar:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Neg<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+{
+    /// A constant (zero derivatives).
+    fn cst(v: f64) -> Self;
+    /// `(sin x, cos x)`.
+    fn sin_cos(self) -> (Self, Self);
+    /// Square root (the caller keeps the argument positive).
+    fn sqrt(self) -> Self;
+    /// The value part.
+    fn val(self) -> f64;
+}
+
+impl Scalar for f64 {
+    #[inline(always)]
+    fn cst(v: f64) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        f64::sin_cos(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn val(self) -> f64 {
+        self
+    }
+}
+
+/// Value, gradient (6 local variables) and first/second derivative along one direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirJet {
+    /// Value.
+    pub v: f64,
+    /// Gradient with respect to the 6 local variables.
+    pub g: [f64; NV],
+    /// First derivative along the seeded direction (`g . dir`).
+    pub d1: f64,
+    /// Second derivative along the seeded direction (`dir^T H dir`).
+    pub d2: f64,
+}
+
+impl DirJet {
+    /// Independent variable number `i` with value `x` and direction component `dir`.
+    #[inline(always)]
+    pub fn var(i: usize, x: f64, dir: f64) -> Self {
+        let mut g = [0.0; NV];
+        g[i] = 1.0;
+        DirJet {
+            v: x,
+            g,
+            d1: dir,
+            d2: 0.0,
+        }
+    }
+    #[inline(always)]
+    fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
+        let mut g = [0.0; NV];
+        for k in 0..NV {
+            g[k] = df * self.g[k];
+        }
+        DirJet {
+            v: f,
+            g,
+            d1: df * self.d1,
+            d2: ddf * self.d1 * self.d1 + df * self.d2,
+        }
+    }
+}
+
+impl Add for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        let mut g = self.g;
+        for k in 0..NV {
+            g[k] += o.g[k];
+        }
+        DirJet {
+            v: self.v + o.v,
+            g,
+            d1: self.d1 + o.d1,
+            d2: self.d2 + o.d2,
+        }
+    }
+}
+impl Sub for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        let mut g = self.g;
+        for k in 0..NV {
+            g[k] -= o.g[k];
+        }
+        DirJet {
+            v: self.v - o.v,
+            g,
+            d1: self.d1 - o.d1,
+            d2: self.d2 - o.d2,
+        }
+    }
+}
+impl Mul for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        let mut g = [0.0; NV];
+        for k in 0..NV {
+            g[k] = self.g[k] * o.v + o.g[k] * self.v;
+        }
+        DirJet {
+            v: self.v * o.v,
+            g,
+            d1: self.d1 * o.v + self.v * o.d1,
+            d2: self.d2 * o.v + 2.0 * self.d1 * o.d1 + self.v * o.d2,
+        }
+    }
+}
+impl Neg for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self * -1.0
+    }
+}
+impl Add<f64> for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, c: f64) -> Self {
+        self.v += c;
+        self
+    }
+}
+impl Sub<f64> for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(mut self, c: f64) -> Self {
+        self.v -= c;
+        self
+    }
+}
+impl Mul<f64> for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, c: f64) -> Self {
+        let mut g = self.g;
+        for x in g.iter_mut() {
+            *x *= c;
+        }
+        DirJet {
+            v: self.v * c,
+            g,
+            d1: self.d1 * c,
+            d2: self.d2 * c,
+        }
+    }
+}
+impl Scalar for DirJet {
+    #[inline(always)]
+    fn cst(v: f64) -> Self {
+        DirJet {
+            v,
+            g: [0.0; NV],
+            d1: 0.0,
+            d2: 0.0,
+        }
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (self.chain(s, c, -s), self.chain(c, -s, -c))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let r = self.v.sqrt();
+        self.chain(r, 0.5 / r, -0.25 / (r * self.v))
+    }
+    #[inline(always)]
+    fn val(self) -> f64 {
+        self.v
+    }
+}
+
+/// Value, gradient and full Hessian with respect to the 6 local variables.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HessJet {
+    /// Value.
+    pub v: f64,
+    /// Gradient.
+    pub g: [f64; NV],
+    /// Hessian (symmetric).
+    pub h: [[f64; NV]; NV],
+}
+
+impl HessJet {
+    /// Independent variable number `i` with value `x`.
+    #[inline(always)]
+    pub fn var(i: usize, x: f64) -> Self {
+        let mut g = [0.0; NV];
+        g[i] = 1.0;
+        HessJet {
+            v: x,
+            g,
+            h: [[0.0; NV]; NV],
+        }
+    }
+    #[inline(always)]
+    fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
+        let mut out = HessJet {
+            v: f,
+            g: [0.0; NV],
+            h: [[0.0; NV]; NV],
+        };
+        for i in 0..NV {
+            out.g[i] = df * self.g[i];
+            for j in 0..NV {
+                out.h[i][j] = ddf * self.g[i] * self.g[j] + df * self.h[i][j];
+            }
+        }
+        out
+    }
+}
+
+impl Add for HessJet {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, o: Self) -> Self {
+        self.v += o.v;
+        for i in 0..NV {
+            self.g[i] += o.g[i];
+            for j in 0..NV {
+                self.h[i][j] += o.h[i][j];
+            }
+        }
+        self
+    }
+}
+impl Sub for HessJet {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self + o * -1.0
+    }
+}
+impl Mul for HessJet {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        let mut out = HessJet {
+            v: self.v * o.v,
+            g: [0.0; NV],
+            h: [[0.0; NV]; NV],
+        };
+        for i in 0..NV {
+            out.g[i] = self.g[i] * o.v + o.g[i] * self.v;
+            for j in 0..NV {
+                out.h[i][j] = self.h[i][j] * o.v
+                    + o.h[i][j] * self.v
+                    + self.g[i] * o.g[j]
+                    + o.g[i] * self.g[j];
+            }
+        }
+        out
+    }
+}
+impl Neg for HessJet {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self * -1.0
+    }
+}
+impl Add<f64> for HessJet {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, c: f64) -> Self {
+        self.v += c;
+        self
+    }
+}
+impl Sub<f64> for HessJet {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(mut self, c: f64) -> Self {
+        self.v -= c;
+        self
+    }
+}
+impl Mul<f64> for HessJet {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(mut self, c: f64) -> Self {
+        self.v *= c;
+        for i in 0..NV {
+            self.g[i] *= c;
+            for j in 0..NV {
+                self.h[i][j] *= c;
+            }
+        }
+        self
+    }
+}
+impl Scalar for HessJet {
+    #[inline(always)]
+    fn cst(v: f64) -> Self {
+        HessJet {
+            v,
+            g: [0.0; NV],
+            h: [[0.0; NV]; NV],
+        }
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (self.chain(s, c, -s), self.chain(c, -s, -c))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let r = self.v.sqrt();
+        self.chain(r, 0.5 / r, -0.25 / (r * self.v))
+    }
+    #[inline(always)]
+    fn val(self) -> f64 {
+        self.v
+    }
+}
+
+/// A point fixed in a body frame, in global coordinates: `r + A(theta) s`.
+#[inline(always)]
+pub fn point<T: Scalar>(q: &[T; 3], s: [f64; 2]) -> [T; 2] {
+    let (sn, cs) = q[2].sin_cos();
+    [q[0] + cs * s[0] - sn * s[1], q[1] + sn * s[0] + cs * s[1]]
+}
+
+/// A direction fixed in a body frame, in global coordinates: `A(theta) u`.
+#[inline(always)]
+pub fn direction<T: Scalar>(q: &[T; 3], u: [f64; 2]) -> [T; 2] {
+    let (sn, cs) = q[2].sin_cos();
+    [cs * u[0] - sn * u[1], sn * u[0] + cs * u[1]]
+}
+
+/// Dot product of two planar vectors.
+#[inline(always)]
+pub fn dot<T: Scalar>(a: [T; 2], b: [T; 2]) -> T {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+/// `b - a` for planar vectors.
+#[inline(always)]
+pub fn sub2<T: Scalar>(b: [T; 2], a: [T; 2]) -> [T; 2] {
+    [b[0] - a[0], b[1] - a[1]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn f<T: Scalar>(x: [T; 6]) -> T {
+        let p = point(&[x[0], x[1], x[2]], [0.3, -0.2]);
+        let q = point(&[x[3], x[4], x[5]], [-0.1, 0.4]);
+        let d = sub2(q, p);
+        dot(d, d).sqrt() * x[2] + x[0] * x[4]
+    }
+
+    #[test]
+    fn jets_match_finite_differences() {
+        let x0 = [0.1, -0.3, 0.7, 1.2, 0.4, -0.5];
+        let dir = [0.3, -0.1, 0.9, 0.2, -0.6, 0.5];
+        let dj: [DirJet; 6] = std::array::from_fn(|i| DirJet::var(i, x0[i], dir[i]));
+        let hj: [HessJet; 6] = std::array::from_fn(|i| HessJet::var(i, x0[i]));
+        let d = f(dj);
+        let h = f(hj);
+        let e = 1e-5;
+        for i in 0..6 {
+            let mut xp = x0;
+            let mut xm = x0;
+            xp[i] += e;
+            xm[i] -= e;
+            let fd = (f(xp) - f(xm)) / (2.0 * e);
+            assert!((fd - d.g[i]).abs() < 1e-8, "grad {i}");
+            assert!((fd - h.g[i]).abs() < 1e-8, "grad {i}");
+            let gp = f(std::array::from_fn(|k| HessJet::var(k, xp[k]))).g;
+            let gm = f(std::array::from_fn(|k| HessJet::var(k, xm[k]))).g;
+            for j in 0..6 {
+                let fd2 = (gp[j] - gm[j]) / (2.0 * e);
+                assert!((fd2 - h.h[i][j]).abs() < 1e-7, "hess {i} {j}");
+            }
+        }
+        let mut vhv = 0.0;
+        for i in 0..6 {
+            for j in 0..6 {
+                vhv += dir[i] * h.h[i][j] * dir[j];
+            }
+        }
+        assert!((vhv - d.d2).abs() < 1e-12);
+        let gd: f64 = (0..6).map(|i| d.g[i] * dir[i]).sum();
+        assert!((gd - d.d1).abs() < 1e-14);
+    }
+}
