@@ -1,1 +1,72 @@
-pub fn x(){}
+//! # mbd-solve
+//!
+//! The solver core of `mbd`: what every integrator shares.
+//!
+//! * [`Integrator`]: the trait a solver implements (`step(system, state, h)`), with [`State`]
+//!   (`t`, `q`, `v`) and [`StepStats`].
+//! * [`run`]: the fixed-step run loop from `state.t` to `t_end`, with [`Observer`]s
+//!   ([`Recorder`], [`Every`], closures) that can stream samples instead of keeping them.
+//! * [`Newton`]: damped Newton on a [`NewtonProblem`] with an error that reports time, residual
+//!   and iterations.
+//! * [`AccelerationSolver`]: the index-1 solve `[[M, Phi_q^T], [Phi_q, 0]] [a; lambda] = [Q; gamma]`
+//!   (faer Cholesky of the Schur complement), and [`Projector`] for post-step projection.
+//! * [`ButcherTableau`] (methods as data) and [`ExplicitRk`], an allocation-free explicit
+//!   Runge-Kutta stepper with embedded error estimates and a [`StepController`].
+//! * [`quadrature`]: Gauss-Legendre rules and Lagrange bases for any number of points.
+//!
+//! A minimal integrator (semi-implicit Euler on the index-1 form) driven by the run loop:
+//!
+//! ```
+//! use mbd_model::models;
+//! use mbd_solve::{run, AccelerationSolver, Integrator, Recorder, RunConfig, SolveError, State, StepStats};
+//! use mbd_model::System;
+//!
+//! struct SymplecticEuler { acc: AccelerationSolver, a: Vec<f64>, lambda: Vec<f64> }
+//! impl Integrator for SymplecticEuler {
+//!     fn name(&self) -> String { "symplectic Euler".into() }
+//!     fn step(&mut self, sys: &System, s: &mut State, h: f64) -> Result<StepStats, SolveError> {
+//!         self.acc.solve(sys, s.q.as_slice(), s.v.as_slice(), s.t, &mut self.a, &mut self.lambda)?;
+//!         for i in 0..s.v.len() { s.v[i] += h * self.a[i]; s.q[i] += h * s.v[i]; }
+//!         Ok(StepStats { rhs_evals: 1, ..Default::default() })
+//!     }
+//! }
+//!
+//! let sys = models::pendulum(1.0, 1.0, 0.1, 9.81)?;
+//! let mut state = State::consistent(&sys, 0.0)?;
+//! let mut integ = SymplecticEuler {
+//!     acc: AccelerationSolver::new(&sys),
+//!     a: vec![0.0; sys.n_coords()],
+//!     lambda: vec![0.0; sys.n_constraints()],
+//! };
+//! let mut rec = Recorder::new();
+//! let stats = run(&mut integ, &sys, &mut state, RunConfig { t_end: 1.0, h: 0.01 }, &mut rec)?;
+//! assert_eq!(stats.steps, 100);
+//! assert_eq!(rec.len(), 101);
+//! assert!((state.t - 1.0).abs() < 1e-15);
+//! # Ok::<(), SolveError>(())
+//! ```
+#![warn(missing_docs)]
+
+mod accel;
+mod error;
+mod integrator;
+pub mod linalg;
+mod newton;
+mod projection;
+pub mod quadrature;
+mod state;
+mod tableau;
+
+pub use accel::AccelerationSolver;
+pub use error::SolveError;
+pub use integrator::{
+    run, step_count, Every, Flow, Integrator, NoObserver, Observer, Recorder, RunConfig, RunStats,
+    StepStats,
+};
+pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
+pub use projection::{ProjectionSettings, ProjectionStats, Projector};
+pub use state::State;
+pub use tableau::{ButcherTableau, ExplicitRk, StepController};
+
+pub use mbd_model;
+pub use nalgebra;

@@ -1,0 +1,91 @@
+//! The one error type of `mbd-solve` (and the error solver crates return).
+
+use mbd_model::ModelError;
+use thiserror::Error;
+
+/// Everything that can go wrong while integrating.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SolveError {
+    /// The step size is not positive and finite.
+    #[error("step size h = {h} is invalid: it must be positive and finite")]
+    InvalidStep {
+        /// The step size given.
+        h: f64,
+    },
+    /// The time interval is empty, reversed or not finite.
+    #[error("time interval [{t0}, {t_end}] is invalid: {reason}")]
+    InvalidInterval {
+        /// Start.
+        t0: f64,
+        /// End.
+        t_end: f64,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// A setting is out of range.
+    #[error("parameter '{parameter}' = {value} is invalid: {reason}")]
+    InvalidParameter {
+        /// The setting.
+        parameter: &'static str,
+        /// Its value.
+        value: f64,
+        /// What is required.
+        reason: &'static str,
+    },
+    /// Newton's method did not converge.
+    #[error(
+        "Newton failed at t = {t}: residual {residual:e} after {iterations} iterations ({context})"
+    )]
+    Newton {
+        /// Time of the step (its start).
+        t: f64,
+        /// Max-norm residual when it stopped.
+        residual: f64,
+        /// Iterations done.
+        iterations: usize,
+        /// Which solve (e.g. "symplectic stage equations").
+        context: String,
+    },
+    /// A matrix that must be invertible is (numerically) singular.
+    #[error("singular {what} at t = {t} (equation/pivot: {detail})")]
+    Singular {
+        /// Time.
+        t: f64,
+        /// Which matrix.
+        what: &'static str,
+        /// The equation or pivot at fault.
+        detail: String,
+    },
+    /// A vector has the wrong length for the system.
+    #[error("{what}: expected length {expected}, got {got}")]
+    Dimension {
+        /// Which vector.
+        what: &'static str,
+        /// Required length.
+        expected: usize,
+        /// Given length.
+        got: usize,
+    },
+    /// The state became NaN or infinite.
+    #[error("non-finite {what} at t = {t}")]
+    NonFinite {
+        /// Time.
+        t: f64,
+        /// Which quantity.
+        what: &'static str,
+    },
+    /// The model does not support what the solver needs.
+    #[error("unsupported model: {0}")]
+    Unsupported(String),
+    /// An observer asked to abort with an error.
+    #[error("observer error at t = {t}: {message}")]
+    Observer {
+        /// Time.
+        t: f64,
+        /// Its message.
+        message: String,
+    },
+    /// An error from the model.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}

@@ -1,0 +1,177 @@
+//! Allocation-free projection of a state onto the position and velocity constraints
+//! (minimum `M`-norm corrections), for post-step stabilisation.
+
+use crate::error::SolveError;
+use crate::linalg::DenseCholesky;
+use mbd_model::System;
+use nalgebra::DMatrix;
+
+/// Settings of [`Projector`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProjectionSettings {
+    /// Target `||Phi||_inf`.
+    pub tol: f64,
+    /// Iteration limit of the position projection.
+    pub max_iter: usize,
+}
+
+impl Default for ProjectionSettings {
+    fn default() -> Self {
+        ProjectionSettings {
+            tol: 1e-14,
+            max_iter: 20,
+        }
+    }
+}
+
+/// Projects `q` onto `Phi(q, t) = 0` by Newton with the minimum `M`-norm correction
+/// `dq = -M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T)^-1 Phi` and `v` onto `Phi_q v + Phi_t = 0` by the
+/// `M`-orthogonal projection.
+#[derive(Debug)]
+pub struct Projector {
+    /// Settings.
+    pub settings: ProjectionSettings,
+    jac: DMatrix<f64>,
+    chol: DenseCholesky,
+    r: Vec<f64>,
+}
+
+/// What a projection did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ProjectionStats {
+    /// Newton iterations of the position projection.
+    pub iterations: usize,
+    /// Final `||Phi||_inf`.
+    pub residual: f64,
+}
+
+impl Projector {
+    /// A workspace for `sys`.
+    pub fn new(sys: &System, settings: ProjectionSettings) -> Self {
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        Projector {
+            settings,
+            jac: DMatrix::zeros(m, n),
+            chol: DenseCholesky::new(m),
+            r: vec![0.0; m],
+        }
+    }
+
+    fn factor(&mut self, sys: &System, q: &[f64], t: f64) -> Result<(), SolveError> {
+        sys.phi_q(q, &mut self.jac);
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let minv = sys.inv_mass_diag();
+        {
+            let j = &self.jac;
+            let mut s = self.chol.matrix_mut();
+            for c in 0..m {
+                for r in c..m {
+                    let mut acc = 0.0;
+                    for k in 0..n {
+                        acc += j[(r, k)] * minv[k] * j[(c, k)];
+                    }
+                    s[(r, c)] = acc;
+                }
+            }
+        }
+        self.chol.factor_in_place().map_err(|e| {
+            let i = match e {
+                crate::linalg::FactorError::Singular(i)
+                | crate::linalg::FactorError::NotPositiveDefinite(i) => i,
+            };
+            SolveError::Singular {
+                t,
+                what: "projection matrix Phi_q M^-1 Phi_q^T",
+                detail: sys.equation_name(i),
+            }
+        })
+    }
+
+    /// `x -= M^-1 Phi_q^T S^-1 r` with `r` in `self.r`.
+    fn correct(&mut self, sys: &System, x: &mut [f64]) {
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        self.chol.solve_in_place(&mut self.r);
+        let minv = sys.inv_mass_diag();
+        for k in 0..n {
+            let mut acc = 0.0;
+            for r in 0..m {
+                acc += self.jac[(r, k)] * self.r[r];
+            }
+            x[k] -= minv[k] * acc;
+        }
+    }
+
+    /// Projects positions in place.
+    pub fn project_positions(
+        &mut self,
+        sys: &System,
+        q: &mut [f64],
+        t: f64,
+    ) -> Result<ProjectionStats, SolveError> {
+        let m = sys.n_constraints();
+        if m == 0 {
+            return Ok(ProjectionStats::default());
+        }
+        let mut stats = ProjectionStats::default();
+        for it in 0..=self.settings.max_iter {
+            sys.phi(q, t, &mut self.r);
+            let res = self.r.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
+            stats.residual = res;
+            if !res.is_finite() {
+                return Err(SolveError::NonFinite {
+                    t,
+                    what: "constraint residual in projection",
+                });
+            }
+            if res <= self.settings.tol {
+                return Ok(stats);
+            }
+            if it == self.settings.max_iter {
+                break;
+            }
+            self.factor(sys, q, t)?;
+            self.correct(sys, q);
+            stats.iterations += 1;
+        }
+        // accept a residual at the round-off floor of the configuration
+        if stats.residual <= 1e3 * self.settings.tol {
+            return Ok(stats);
+        }
+        Err(SolveError::Newton {
+            t,
+            residual: stats.residual,
+            iterations: stats.iterations,
+            context: "position projection".into(),
+        })
+    }
+
+    /// Projects velocities in place (at positions `q`, assumed on the manifold).
+    pub fn project_velocities(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &mut [f64],
+        t: f64,
+    ) -> Result<(), SolveError> {
+        if sys.n_constraints() == 0 {
+            return Ok(());
+        }
+        self.factor(sys, q, t)?;
+        sys.phi_dot(q, v, t, &mut self.r);
+        self.correct(sys, v);
+        Ok(())
+    }
+
+    /// Projects both positions and velocities.
+    pub fn project(
+        &mut self,
+        sys: &System,
+        q: &mut [f64],
+        v: &mut [f64],
+        t: f64,
+    ) -> Result<ProjectionStats, SolveError> {
+        let s = self.project_positions(sys, q, t)?;
+        self.project_velocities(sys, q, v, t)?;
+        Ok(s)
+    }
+}

@@ -1,0 +1,85 @@
+//! The state every integrator advances.
+
+use crate::error::SolveError;
+use mbd_model::{ConsistentState, System};
+use nalgebra::DVector;
+
+/// Time, positions and velocities of a system.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    /// Time.
+    pub t: f64,
+    /// Positions (length `n`).
+    pub q: DVector<f64>,
+    /// Velocities (length `n`).
+    pub v: DVector<f64>,
+}
+
+impl State {
+    /// A state from parts (checked against the system's size).
+    pub fn new(
+        sys: &System,
+        t: f64,
+        q: DVector<f64>,
+        v: DVector<f64>,
+    ) -> Result<State, SolveError> {
+        let n = sys.n_coords();
+        if q.len() != n {
+            return Err(SolveError::Dimension {
+                what: "q",
+                expected: n,
+                got: q.len(),
+            });
+        }
+        if v.len() != n {
+            return Err(SolveError::Dimension {
+                what: "v",
+                expected: n,
+                got: v.len(),
+            });
+        }
+        if !t.is_finite() || q.iter().chain(v.iter()).any(|x| !x.is_finite()) {
+            return Err(SolveError::NonFinite {
+                t,
+                what: "initial state",
+            });
+        }
+        Ok(State { t, q, v })
+    }
+
+    /// The consistent initial state of the system's stored guess at time `t0` (projected onto
+    /// the position and velocity constraints).
+    pub fn consistent(sys: &System, t0: f64) -> Result<State, SolveError> {
+        let c: ConsistentState = sys.consistent_state(t0)?;
+        Ok(State {
+            t: t0,
+            q: c.q,
+            v: c.v,
+        })
+    }
+
+    /// Checks the lengths against a system.
+    pub fn check(&self, sys: &System) -> Result<(), SolveError> {
+        let n = sys.n_coords();
+        if self.q.len() != n {
+            return Err(SolveError::Dimension {
+                what: "state.q",
+                expected: n,
+                got: self.q.len(),
+            });
+        }
+        if self.v.len() != n {
+            return Err(SolveError::Dimension {
+                what: "state.v",
+                expected: n,
+                got: self.v.len(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Whether every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        self.t.is_finite() && self.q.iter().chain(self.v.iter()).all(|x| x.is_finite())
+    }
+}
