@@ -49,6 +49,7 @@
 
 mod accel;
 mod error;
+mod index1;
 mod integrator;
 pub mod linalg;
 mod newton;
@@ -59,6 +60,7 @@ mod tableau;
 
 pub use accel::AccelerationSolver;
 pub use error::SolveError;
+pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{
     run, step_count, Every, Flow, Integrator, NoObserver, Observer, Recorder, RunConfig, RunStats,
     StepStats,

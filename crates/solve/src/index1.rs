@@ -1,0 +1,240 @@
+//! Explicit Runge-Kutta on the index-1 form `q' = v, v' = a(q, v, t)`, for any tableau, with
+//! optional Baumgarte stabilisation and post-step projection. It is the engine of the RK4
+//! baseline (`mbd-rk4`) and, with a high-order tableau and a small step plus projection, an
+//! independent reference solver for the other methods.
+
+use crate::accel::AccelerationSolver;
+use crate::error::SolveError;
+use crate::integrator::{Integrator, StepStats};
+use crate::projection::{ProjectionSettings, Projector};
+use crate::state::State;
+use crate::tableau::{ButcherTableau, ExplicitRk};
+use mbd_model::System;
+
+/// Settings of [`Index1Rk`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Index1Options {
+    /// Baumgarte parameters `(alpha, beta)`: the acceleration constraint becomes
+    /// `Phi_q a = gamma - 2 alpha Phidot - beta^2 Phi`. `None` (default) = off.
+    pub baumgarte: Option<(f64, f64)>,
+    /// Project `(q, v)` onto the constraints after every step (default off).
+    pub projection: Option<ProjectionSettings>,
+}
+
+impl Default for Index1Options {
+    fn default() -> Self {
+        Index1Options {
+            baumgarte: None,
+            projection: None,
+        }
+    }
+}
+
+/// Explicit RK on the index-1 equations, allocation-free per step.
+#[derive(Debug)]
+pub struct Index1Rk {
+    rk: ExplicitRk,
+    acc: AccelerationSolver,
+    projector: Option<Projector>,
+    options: Index1Options,
+    y: Vec<f64>,
+    a: Vec<f64>,
+    lambda: Vec<f64>,
+    phi: Vec<f64>,
+    phid: Vec<f64>,
+    n: usize,
+}
+
+impl Index1Rk {
+    /// A solver for `sys` with the given tableau and options.
+    pub fn new(
+        sys: &System,
+        tableau: ButcherTableau,
+        options: Index1Options,
+    ) -> Result<Self, SolveError> {
+        if let Some((a, b)) = options.baumgarte {
+            if !(a.is_finite() && b.is_finite() && a >= 0.0 && b >= 0.0) {
+                return Err(SolveError::InvalidParameter {
+                    parameter: "baumgarte (alpha, beta)",
+                    value: if a.is_finite() && a >= 0.0 { b } else { a },
+                    reason: "must be non-negative and finite",
+                });
+            }
+        }
+        if let Some(p) = &options.projection {
+            if !(p.tol > 0.0 && p.tol.is_finite()) {
+                return Err(SolveError::InvalidParameter {
+                    parameter: "projection.tol",
+                    value: p.tol,
+                    reason: "must be positive and finite",
+                });
+            }
+        }
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        Ok(Index1Rk {
+            rk: ExplicitRk::new(tableau, 2 * n)?,
+            acc: AccelerationSolver::new(sys),
+            projector: options.projection.map(|p| Projector::new(sys, p)),
+            options,
+            y: vec![0.0; 2 * n],
+            a: vec![0.0; n],
+            lambda: vec![0.0; m],
+            phi: vec![0.0; m],
+            phid: vec![0.0; m],
+            n,
+        })
+    }
+
+    /// The tableau.
+    pub fn tableau(&self) -> &ButcherTableau {
+        &self.rk.tableau
+    }
+
+    /// The options.
+    pub fn options(&self) -> &Index1Options {
+        &self.options
+    }
+
+    /// The accelerations and multipliers of the last right-hand-side evaluation.
+    pub fn last_acceleration(&self) -> (&[f64], &[f64]) {
+        (&self.a, &self.lambda)
+    }
+}
+
+impl Integrator for Index1Rk {
+    fn name(&self) -> String {
+        let mut s = self.rk.tableau.name.to_string();
+        if let Some((a, b)) = self.options.baumgarte {
+            s += &format!(" + Baumgarte({a}, {b})");
+        }
+        if self.options.projection.is_some() {
+            s += " + projection";
+        }
+        s
+    }
+
+    fn order(&self) -> Option<u32> {
+        Some(self.rk.tableau.order)
+    }
+
+    fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        state.check(sys)?;
+        if !(h.is_finite() && h > 0.0) {
+            return Err(SolveError::InvalidStep { h });
+        }
+        let n = self.n;
+        self.y[..n].copy_from_slice(state.q.as_slice());
+        self.y[n..].copy_from_slice(state.v.as_slice());
+        let acc = &mut self.acc;
+        let (a, lambda, phi, phid) = (&mut self.a, &mut self.lambda, &mut self.phi, &mut self.phid);
+        let baum = self.options.baumgarte;
+        let mut evals = 0;
+        let mut f = |t: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
+            let (q, v) = y.split_at(n);
+            sys.forces_into(q, v, t, &mut acc.forces);
+            sys.phi_q_gamma(q, v, t, &mut acc.phi_q, &mut acc.gamma);
+            if let Some((al, be)) = baum {
+                sys.phi(q, t, phi);
+                sys.phi_dot(q, v, t, phid);
+                for k in 0..phi.len() {
+                    acc.gamma[k] -= 2.0 * al * phid[k] + be * be * phi[k];
+                }
+            }
+            if !acc.gamma.is_empty() {
+                acc.finish(sys, t, a, lambda)?;
+            } else {
+                let minv = sys.inv_mass_diag();
+                for i in 0..n {
+                    a[i] = minv[i] * acc.forces[i];
+                }
+            }
+            dy[..n].copy_from_slice(v);
+            dy[n..].copy_from_slice(a);
+            evals += 1;
+            Ok(())
+        };
+        self.rk.step(&mut f, state.t, &mut self.y, h)?;
+        state.q.as_mut_slice().copy_from_slice(&self.y[..n]);
+        state.v.as_mut_slice().copy_from_slice(&self.y[n..]);
+        state.t += h;
+        let mut stats = StepStats {
+            rhs_evals: evals,
+            ..Default::default()
+        };
+        if let Some(p) = &mut self.projector {
+            let s = p.project(sys, state.q.as_mut_slice(), state.v.as_mut_slice(), state.t)?;
+            stats.newton_iterations = s.iterations;
+            stats.residual = s.residual;
+        }
+        Ok(stats)
+    }
+}
+
+/// Samples of a reference solution on a uniform grid.
+#[derive(Clone, Debug)]
+pub struct ReferenceTrajectory {
+    /// What produced it, e.g. "DOPRI5 + projection, h/64".
+    pub method: String,
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// Positions at the sample times.
+    pub q: Vec<Vec<f64>>,
+    /// Velocities at the sample times.
+    pub v: Vec<Vec<f64>>,
+}
+
+/// Integrates `state0` with `tableau` on the index-1 form with projection after every step, at
+/// step `h / substeps`, and samples positions and velocities every `h` for `n_steps` steps
+/// (`n_steps + 1` samples including the initial state). With DOPRI5 and `substeps` of 16 or
+/// more it is an accurate reference independent of the method being checked.
+pub fn reference_trajectory(
+    sys: &System,
+    state0: &State,
+    h: f64,
+    n_steps: usize,
+    substeps: usize,
+    tableau: ButcherTableau,
+) -> Result<ReferenceTrajectory, SolveError> {
+    if substeps == 0 {
+        return Err(SolveError::InvalidParameter {
+            parameter: "substeps",
+            value: 0.0,
+            reason: "must be at least 1",
+        });
+    }
+    if !(h.is_finite() && h > 0.0) {
+        return Err(SolveError::InvalidStep { h });
+    }
+    let name = format!("{} + projection, h/{}", tableau.name, substeps);
+    let mut rk = Index1Rk::new(
+        sys,
+        tableau,
+        Index1Options {
+            baumgarte: None,
+            projection: Some(ProjectionSettings::default()),
+        },
+    )?;
+    let mut s = state0.clone();
+    let mut out = ReferenceTrajectory {
+        method: name,
+        t: Vec::with_capacity(n_steps + 1),
+        q: Vec::with_capacity(n_steps + 1),
+        v: Vec::with_capacity(n_steps + 1),
+    };
+    let t0 = s.t;
+    let hs = h / substeps as f64;
+    out.t.push(s.t);
+    out.q.push(s.q.as_slice().to_vec());
+    out.v.push(s.v.as_slice().to_vec());
+    for k in 1..=n_steps {
+        for j in 1..=substeps {
+            rk.step(sys, &mut s, hs)?;
+            s.t = t0 + (k - 1) as f64 * h + j as f64 * hs;
+        }
+        s.t = t0 + k as f64 * h;
+        out.t.push(s.t);
+        out.q.push(s.q.as_slice().to_vec());
+        out.v.push(s.v.as_slice().to_vec());
+    }
+    Ok(out)
+}
