@@ -1,0 +1,45 @@
+//! # mbd-analysis
+//!
+//! What the papers measure, for any solver of `mbd`:
+//!
+//! * [`RunMeasures`] (paper C): `e(H)`, `MRE(H)`, `e(Phi)`, `e(Phidot)`, `e(Phiddot)`, accumulated
+//!   online by [`MeasureObserver`] (no trajectory kept) or from a stored [`Trajectory`];
+//! * [`TrajectoryErrors`] (paper A): `E|dx|`, `E|dy|`, `E|dH|`, their signed means and
+//!   `dW = E[dx] + E[dy]`, against a reference sampled at other times (interpolated to fourth
+//!   order);
+//! * [`fit_order`]: the convergence order (least-squares slope and local orders, dropping points
+//!   at the round-off floor);
+//! * [`TimeSeries`] and [`CsvObserver`]: CSV/JSON output.
+//!
+//! ```
+//! use mbd_analysis::{fit_order, MeasureObserver};
+//! use mbd_model::models;
+//! use mbd_solve::{run, ButcherTableau, Index1Options, Index1Rk, RunConfig, State};
+//!
+//! let sys = models::pendulum(1.0, 1.0, 0.3, 9.81)?;
+//! let mut errs = vec![];
+//! let hs = [0.04, 0.02, 0.01];
+//! for &h in &hs {
+//!     let mut s = State::consistent(&sys, 0.0)?;
+//!     let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
+//!     let mut obs = MeasureObserver::new(&sys, true);
+//!     run(&mut rk, &sys, &mut s, RunConfig { t_end: 2.0, h }, &mut obs)?;
+//!     errs.push(obs.measures().e_h);
+//! }
+//! let fit = fit_order(&hs, &errs, 1e-14)?;
+//! assert!((fit.order - 4.0).abs() < 0.5, "{fit:?}");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![warn(missing_docs)]
+
+mod error;
+mod measures;
+mod order;
+mod output;
+mod trajectory;
+
+pub use error::AnalysisError;
+pub use measures::{measure_trajectory, MeasureObserver, RunMeasures};
+pub use order::{fit_order, OrderFit};
+pub use output::{CsvObserver, TimeSeries};
+pub use trajectory::{position_error_at, trajectory_errors, Trajectory, TrajectoryErrors};

@@ -1,0 +1,57 @@
+//! Hot loops allocate nothing: counts heap allocations during steps with a counting allocator.
+
+use mbd::model::models;
+use mbd::rk4::{Rk4, Rk4Options};
+use mbd::solve::{Integrator, State};
+use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { SysAlloc.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { SysAlloc.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { SysAlloc.realloc(p, l, n) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn count_step_allocations<I: Integrator>(mut integ: I, sys: &mbd::model::System) -> usize {
+    let mut s = State::consistent(sys, 0.0).unwrap();
+    integ.step(sys, &mut s, 0.01).unwrap(); // warm-up
+    let before = ALLOCS.load(Ordering::SeqCst);
+    for _ in 0..100 {
+        integ.step(sys, &mut s, 0.01).unwrap();
+    }
+    ALLOCS.load(Ordering::SeqCst) - before
+}
+
+#[test]
+fn rk4_steps_allocate_nothing() {
+    let sys = models::manipulator().unwrap();
+    assert_eq!(
+        count_step_allocations(Rk4::new(&sys, Rk4Options::plain()).unwrap(), &sys),
+        0
+    );
+    assert_eq!(
+        count_step_allocations(Rk4::new(&sys, Rk4Options::projected()).unwrap(), &sys),
+        0
+    );
+    assert_eq!(
+        count_step_allocations(
+            Rk4::new(&sys, Rk4Options::baumgarte(5.0, 5.0)).unwrap(),
+            &sys
+        ),
+        0
+    );
+}
