@@ -145,6 +145,8 @@ fn main() {
                         runs.push(json!({
                             "function": tf.name,
                             "dim": d,
+                            "lo": tf.lo,
+                            "hi": tf.hi,
                             "seed": seed,
                             "best_f": r.best_f,
                             "evaluations": r.evaluations,

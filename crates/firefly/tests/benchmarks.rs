@@ -1,9 +1,10 @@
 //! Quality of the optimiser on the classic test functions.
 //!
-//! Settings used for every function and dimension (documented in
-//! `docs/firefly.md`): snapshot variant, population 60, beta0 = 1,
-//! gamma = 1, normalised distances, alpha = 0.2 with decay 0.98 per
-//! generation, 600 generations (36 060 evaluations), clamping, seeds 0..20.
+//! Settings (documented in `docs/firefly.md`): snapshot variant,
+//! population 60, beta0 = 1, gamma = 1, normalised distances, clamping,
+//! initial alpha = 0.2, seeds 0..20, and per dimension
+//! * d = 2: alpha decay 0.96, 300 generations (18 060 evaluations);
+//! * d = 10: alpha decay 0.98, 500 generations (30 060 evaluations).
 //! The domains are those of `mbd_firefly::testfns::ALL`.
 //!
 //! For each (function, dimension) the median and worst final values over the
@@ -14,28 +15,34 @@
 use mbd_firefly::{testfns, Bounds, Firefly, FireflySettings, Termination};
 
 const SEEDS: u64 = 20;
-const GENERATIONS: u64 = 600;
 
-fn settings() -> FireflySettings {
-    FireflySettings::default()
-        .population(60)
-        .alpha(0.2)
-        .alpha_decay(0.98)
+/// (alpha decay, generations) for a dimension.
+fn schedule(dim: usize) -> (f64, u64) {
+    if dim <= 2 {
+        (0.96, 300)
+    } else {
+        (0.98, 500)
+    }
 }
 
 /// Runs all seeds and returns the sorted final values.
 fn finals(name: &str, dim: usize) -> Vec<f64> {
     let tf = testfns::by_name(name).expect("known test function");
+    let (decay, generations) = schedule(dim);
+    let settings = FireflySettings::default()
+        .population(60)
+        .alpha(0.2)
+        .alpha_decay(decay);
     let mut out: Vec<f64> = (0..SEEDS)
         .map(|seed| {
             let bounds = Bounds::cube(dim, tf.lo, tf.hi).expect("valid box");
             let mut f = tf.f;
             let r = Firefly::new(bounds)
-                .settings(settings().seed(seed))
-                .termination(Termination::default().max_generations(GENERATIONS))
+                .settings(settings.clone().seed(seed))
+                .termination(Termination::default().max_generations(generations))
                 .minimize(&mut f)
                 .expect("valid configuration");
-            assert_eq!(r.evaluations, 60 * (GENERATIONS + 1));
+            assert_eq!(r.evaluations, 60 * (generations + 1));
             assert_eq!(r.nan_evaluations, 0);
             r.best_f
         })
@@ -67,14 +74,14 @@ fn check(name: &str, dim: usize, max_median: f64, max_worst: f64) -> Vec<f64> {
 #[test]
 fn sphere() {
     check("sphere", 2, 1e-10, 1e-9);
-    let v = check("sphere", 10, 1e-8, 1e-6);
+    let v = check("sphere", 10, 1e-7, 1e-6);
     // Explicit requirement: every seed reaches 1e-6 in d = 10.
     assert!(v.iter().all(|&f| f <= 1e-6));
 }
 
 #[test]
 fn rosenbrock() {
-    check("rosenbrock", 2, 1e-7, 1e-6);
+    check("rosenbrock", 2, 1e-6, 1e-2);
     check("rosenbrock", 10, 20.0, 500.0);
 }
 
@@ -92,6 +99,6 @@ fn ackley() {
 
 #[test]
 fn griewank() {
-    check("griewank", 2, 1e-2, 3e-2);
+    check("griewank", 2, 2e-2, 5e-2);
     check("griewank", 10, 0.15, 0.3);
 }
