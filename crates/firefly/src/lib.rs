@@ -11,12 +11,13 @@
 //! use mbd_firefly::{Bounds, Firefly, FireflySettings, Termination};
 //!
 //! # fn main() -> Result<(), mbd_firefly::FireflyError> {
-//! let sphere = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>();
+//! // Closures need the argument type spelled out.
+//! let mut sphere = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>();
 //! let bounds = Bounds::cube(3, -5.0, 5.0)?;
 //! let result = Firefly::new(bounds)
 //!     .settings(FireflySettings::default().population(30).alpha(0.2).alpha_decay(0.95).seed(42))
 //!     .termination(Termination::default().max_generations(300).target(1e-10))
-//!     .minimize(&mut { sphere })?;
+//!     .minimize(&mut sphere)?;
 //! assert!(result.best_f <= 1e-10);
 //! println!("{:?} after {} evaluations", result.best_x, result.evaluations);
 //!

@@ -190,6 +190,13 @@ impl Swarm {
         settings.validate()?;
         let n = settings.population;
         let d = bounds.dim();
+        if n.checked_mul(d).is_none() {
+            return Err(FireflyError::InvalidParameter {
+                name: "population",
+                value: n as f64,
+                requirement: "such that population * dimension fits in usize",
+            });
+        }
         check_initial(bounds, n, initial)?;
 
         let lo = bounds.lo().to_vec();

@@ -5,6 +5,7 @@
 //! initial alpha = 0.2, seeds 0..20, and per dimension
 //! * d = 2: alpha decay 0.96, 300 generations (18 060 evaluations);
 //! * d = 10: alpha decay 0.98, 500 generations (30 060 evaluations).
+//!
 //! The domains are those of `mbd_firefly::testfns::ALL`.
 //!
 //! For each (function, dimension) the median and worst final values over the

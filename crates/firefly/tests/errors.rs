@@ -296,3 +296,11 @@ fn parallel_entry_point_validates_too() {
         FireflyError::InvalidParameter { name: "gamma", .. }
     ));
 }
+
+#[test]
+fn absurd_population_is_rejected_not_allocated() {
+    assert_param(
+        bad_settings(FireflySettings::default().population(usize::MAX)),
+        "population",
+    );
+}
