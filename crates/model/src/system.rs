@@ -590,6 +590,41 @@ impl System {
         }
     }
 
+    /// `Phi_q` and the Jacobian of the velocity constraint with respect to `q`,
+    /// `(Phi_q v)_q = d/dq (Phi_q(q) v)` (m x n; row `k` is `v^T Hess(Phi_k)`), in one pass.
+    /// Together they form the Jacobian `[[Phi_q, 0], [(Phi_q v)_q, Phi_q]]` of the first-order
+    /// constraints `(Phi, Phi_q v + Phi_t)` in `(q, v)` (`Phi_qt = 0` for every joint, so
+    /// `Phi_t` adds nothing). Exact (Hessian jets), both outputs overwritten.
+    pub fn phi_q_dot_jacobian(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        phi_q: &mut DMatrix<f64>,
+        out: &mut DMatrix<f64>,
+    ) {
+        phi_q.fill(0.0);
+        out.fill(0.0);
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let qa = Self::loc_hess(q, at.a, 0);
+            let qb = Self::loc_hess(q, at.b, 3);
+            let va = Self::loc_f64(v, at.a);
+            let vb = Self::loc_f64(v, at.b);
+            let vl = [va[0], va[1], va[2], vb[0], vb[1], vb[2]];
+            let mut e = [HessJet::cst(0.0); 3];
+            j.eval(&qa, &qb, &mut e);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                self.scatter_row(ji, o + k, &e[k].g, phi_q);
+                let mut row = [0.0; NV];
+                for (r, x) in row.iter_mut().enumerate() {
+                    *x = (0..NV).map(|c| e[k].h[r][c] * vl[c]).sum();
+                }
+                self.scatter_row(ji, o + k, &row, out);
+            }
+        }
+    }
+
     /// `gamma(q, v, t)` alone.
     pub fn gamma(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         for (ji, j) in self.joints.iter().enumerate() {
@@ -854,5 +889,89 @@ impl System {
             v[3 * i] + w * (-s * local[0] - c * local[1]),
             v[3 * i + 1] + w * (c * local[0] - s * local[1]),
         )
+    }
+}
+
+#[cfg(test)]
+mod phi_q_dot_jacobian_tests {
+    use crate::{models, Body, BodyRef, Coordinate, Joint, SystemBuilder, TimeFunction};
+    use nalgebra::DMatrix;
+
+    fn all_joint_kinds() -> crate::System {
+        let mut b = SystemBuilder::new();
+        let b1 = b.add_body(Body::new("b1").rod(1.0, 1.0).position(0.3, -0.2, 0.4));
+        let b2 = b.add_body(Body::new("b2").rod(2.0, 0.7).position(1.1, 0.5, -0.9));
+        let b3 = b.add_body(Body::new("b3").rod(0.5, 0.4).position(-0.6, 1.3, 2.1));
+        let b4 = b.add_body(Body::new("b4").rod(0.8, 0.9).position(0.2, 2.0, -0.3));
+        b.add_joint(Joint::revolute(
+            "r",
+            BodyRef::Ground,
+            [0.1, 0.2],
+            b1,
+            [-0.5, 0.1],
+        ));
+        b.add_joint(Joint::distance("d", b1, [0.5, 0.0], b2, [-0.3, 0.2], 0.8));
+        b.add_joint(Joint::prismatic(
+            "p",
+            b2,
+            [0.1, 0.0],
+            b3,
+            [0.0, 0.1],
+            [1.0, 0.5],
+            0.2,
+        ));
+        b.add_joint(Joint::weld("w", b3, [0.2, 0.0], b4, [-0.4, 0.1], 0.3));
+        b.add_joint(Joint::absolute("a", b4, [0.3, 0.0], Coordinate::Y, 1.0));
+        b.add_joint(Joint::angle_driver(
+            "drv",
+            BodyRef::Ground,
+            b2,
+            TimeFunction::linear(0.1, 2.0),
+        ));
+        b.build().unwrap()
+    }
+
+    #[test]
+    fn matches_finite_differences_of_phi_q_v() {
+        let systems = [
+            all_joint_kinds(),
+            models::slider_crank().unwrap(),
+            models::four_bar().unwrap(),
+            models::manipulator().unwrap(),
+        ];
+        for sys in &systems {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let q: Vec<f64> = (0..n)
+                .map(|i| 0.3 + 0.17 * i as f64 - 0.05 * (i * i) as f64)
+                .collect();
+            let v: Vec<f64> = (0..n).map(|i| 1.3 - 0.41 * i as f64).collect();
+            let mut jq = DMatrix::zeros(m, n);
+            let mut d = DMatrix::zeros(m, n);
+            sys.phi_q_dot_jacobian(&q, &v, &mut jq, &mut d);
+            let mut jref = DMatrix::zeros(m, n);
+            sys.phi_q(&q, &mut jref);
+            assert!((&jq - &jref).amax() < 1e-15);
+            let eps = 1e-6;
+            let mut jp = DMatrix::zeros(m, n);
+            let mut jm = DMatrix::zeros(m, n);
+            let vv = nalgebra::DVector::from_column_slice(&v);
+            for c in 0..n {
+                let mut qp = q.clone();
+                let mut qm = q.clone();
+                qp[c] += eps;
+                qm[c] -= eps;
+                sys.phi_q(&qp, &mut jp);
+                sys.phi_q(&qm, &mut jm);
+                let fd = (&jp * &vv - &jm * &vv) / (2.0 * eps);
+                for r in 0..m {
+                    assert!(
+                        (fd[r] - d[(r, c)]).abs() < 1e-8,
+                        "row {r} col {c}: fd {} exact {}",
+                        fd[r],
+                        d[(r, c)]
+                    );
+                }
+            }
+        }
     }
 }
