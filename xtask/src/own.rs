@@ -1,0 +1,317 @@
+//! The project's own experiments: convergence orders of every solver, work-precision on the
+//! manipulator, long-time energy behaviour.
+
+use crate::plot::{Figure, Series};
+use crate::report::{fmt_e, num, Claim, Ctx, Experiment, FigureRef, Part, Section, Table};
+use mbd_analysis::{fit_order, MeasureObserver};
+use mbd_model::{models, System};
+use mbd_rk4::{Rk4, Rk4Options};
+use mbd_solve::{
+    reference_trajectory, run, ButcherTableau, Integrator, NoObserver, RunConfig, SolveError, State,
+};
+use serde_json::json;
+use std::time::Instant;
+
+/// A solver entry: name, nominal order, constructor.
+pub struct SolverSpec {
+    /// Display name.
+    pub name: &'static str,
+    /// Nominal convergence order.
+    pub order: f64,
+    /// Builds the integrator for a system.
+    pub make: fn(&System) -> Result<Box<dyn Integrator>, SolveError>,
+}
+
+/// Every solver of the project, as compared in the own experiments.
+pub fn solvers() -> Vec<SolverSpec> {
+    vec![
+        SolverSpec {
+            name: "RK4 (index-1, plain)",
+            order: 4.0,
+            make: |s| Ok(Box::new(Rk4::new(s, Rk4Options::plain())?)),
+        },
+        SolverSpec {
+            name: "RK4 (index-1, projection)",
+            order: 4.0,
+            make: |s| Ok(Box::new(Rk4::new(s, Rk4Options::projected())?)),
+        },
+    ]
+}
+
+fn problems() -> Vec<(&'static str, System)> {
+    let mut v = Vec::new();
+    if let Ok(s) = models::pendulum(1.0, 1.0, 1.0, 9.81) {
+        v.push(("single pendulum", s));
+    }
+    if let Ok(s) = models::manipulator() {
+        v.push(("manipulator", s));
+    }
+    v
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// Reference at `t_end` from DOPRI5 + projection with a small step (independent of every solver
+/// compared).
+fn reference_q(sys: &System, t_end: f64, h: f64) -> Result<Vec<f64>, String> {
+    let s0 = State::consistent(sys, 0.0).map_err(|e| e.to_string())?;
+    let n = (t_end / h).round() as usize;
+    let r = reference_trajectory(sys, &s0, h, n, 1, ButcherTableau::dopri5())
+        .map_err(|e| e.to_string())?;
+    r.q.last()
+        .cloned()
+        .ok_or_else(|| "empty reference".to_string())
+}
+
+fn solve_to(
+    sys: &System,
+    spec: &SolverSpec,
+    t_end: f64,
+    h: f64,
+) -> Result<(Vec<f64>, f64), String> {
+    let mut s = State::consistent(sys, 0.0).map_err(|e| e.to_string())?;
+    let mut integ = (spec.make)(sys).map_err(|e| e.to_string())?;
+    let t = Instant::now();
+    run(
+        &mut integ,
+        sys,
+        &mut s,
+        RunConfig { t_end, h },
+        &mut NoObserver,
+    )
+    .map_err(|e| format!("{}: {e}", spec.name))?;
+    Ok((s.q.as_slice().to_vec(), t.elapsed().as_secs_f64()))
+}
+
+fn orders(ctx: &Ctx) -> Result<Section, String> {
+    let mut sec = Section::default();
+    let t_end = 1.0;
+    let hs: Vec<f64> = if ctx.quick {
+        vec![0.02, 0.01, 0.005]
+    } else {
+        vec![0.02, 0.01, 0.005, 0.0025, 0.00125]
+    };
+    sec.setting(
+        "error",
+        "max-norm of positions at t = 1 s against DOPRI5 + projection at h = 1e-4",
+    );
+    sec.setting("step sizes", format!("{hs:?}"));
+    let mut table = Table::new(
+        "Measured convergence orders (least-squares slope; local orders of consecutive pairs)",
+        &["solver", "problem", "nominal", "fitted", "local orders"],
+    );
+    let mut rows = Vec::new();
+    let mut fig = Figure::new(
+        "Convergence: position error at t = 1 s",
+        "step size h [s]",
+        "max position error [m or rad]",
+    )
+    .log(true, true);
+    for (pname, sys) in problems() {
+        let qref = reference_q(&sys, t_end, 1e-4)?;
+        for spec in solvers() {
+            let mut errs = Vec::new();
+            for &h in &hs {
+                let (q, _) = solve_to(&sys, &spec, t_end, h)?;
+                errs.push(max_diff(&q, &qref));
+            }
+            let fit = fit_order(&hs, &errs, 1e-12)
+                .map_err(|e| format!("{} on {pname}: {e}", spec.name))?;
+            table.row(vec![
+                spec.name.into(),
+                pname.into(),
+                format!("{}", spec.order),
+                format!("{:.2}", fit.order),
+                fit.local
+                    .iter()
+                    .map(|o| format!("{o:.2}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            ]);
+            sec.claims.push(Claim::check(
+                format!("{} has order {} on the {pname}", spec.name, spec.order),
+                (fit.order - spec.order).abs() <= 0.3,
+                format!("fitted {:.2}", fit.order),
+            ));
+            rows.push(json!({"solver": spec.name, "problem": pname, "order": num(fit.order)}));
+            fig.series.push(Series::points(
+                format!("{} ({pname})", spec.name),
+                hs.clone(),
+                errs,
+            ));
+        }
+    }
+    fig.save(&ctx.figure_path("own_orders.svg"))?;
+    sec.figures.push(FigureRef { file: "own_orders.svg".into(), caption: "Position error at t = 1 s against step size, every solver, single pendulum and manipulator".into() });
+    sec.tables.push(table);
+    sec.summary = json!({ "orders": rows });
+    Ok(sec)
+}
+
+fn work_precision(ctx: &Ctx) -> Result<Section, String> {
+    let mut sec = Section::default();
+    let sys = models::manipulator().map_err(|e| e.to_string())?;
+    let t_end = 2.0;
+    let hs: Vec<f64> = if ctx.quick {
+        vec![0.01, 0.005]
+    } else {
+        vec![0.02, 0.01, 0.005, 0.0025, 0.00125, 0.000625]
+    };
+    let qref = reference_q(&sys, t_end, 5e-5)?;
+    sec.setting(
+        "problem",
+        "paper-C manipulator, error = max-norm of positions at t = 2 s",
+    );
+    sec.setting(
+        "reference",
+        "DOPRI5 on the index-1 form + projection, h = 5e-5 s",
+    );
+    let mut table = Table::new(
+        "Work-precision on the manipulator",
+        &["solver", "h [s]", "error at t = 2 s", "wall time [s]"],
+    );
+    let mut rows = Vec::new();
+    let mut fig = Figure::new(
+        "Work-precision, manipulator, t = 2 s",
+        "wall time [s]",
+        "max position error",
+    )
+    .log(true, true);
+    for spec in solvers() {
+        let (mut xs, mut ys) = (vec![], vec![]);
+        for &h in &hs {
+            // repeat short runs so timings are above timer resolution
+            let (q, mut wall) = solve_to(&sys, &spec, t_end, h)?;
+            if wall < 0.05 {
+                let reps = (0.05 / wall.max(1e-6)).ceil().min(200.0) as usize;
+                let t = Instant::now();
+                for _ in 0..reps {
+                    solve_to(&sys, &spec, t_end, h)?;
+                }
+                wall = t.elapsed().as_secs_f64() / reps as f64;
+            }
+            let err = max_diff(&q, &qref);
+            table.row(vec![
+                spec.name.into(),
+                format!("{h}"),
+                fmt_e(err),
+                format!("{wall:.3e}"),
+            ]);
+            rows.push(json!({"solver": spec.name, "h": num(h), "error": num(err), "runtime_s": num(wall)}));
+            xs.push(wall);
+            ys.push(err);
+        }
+        fig.series.push(Series::points(spec.name, xs, ys));
+    }
+    fig.save(&ctx.figure_path("own_work_precision.svg"))?;
+    sec.figures.push(FigureRef {
+        file: "own_work_precision.svg".into(),
+        caption: "Error at t = 2 s against wall time, every solver, manipulator".into(),
+    });
+    sec.tables.push(table);
+    sec.summary = json!({ "work_precision": rows });
+    Ok(sec)
+}
+
+fn long_time(ctx: &Ctx) -> Result<Section, String> {
+    let mut sec = Section::default();
+    let sys = models::manipulator().map_err(|e| e.to_string())?;
+    let steps: usize = if ctx.quick { 10_000 } else { 100_000 };
+    let h = 0.01;
+    sec.setting("problem", "manipulator");
+    sec.setting("h", h);
+    sec.setting("steps", steps);
+    let mut table = Table::new(
+        "Long-time behaviour",
+        &[
+            "solver",
+            "e(H) first tenth",
+            "e(H) last tenth",
+            "e(H) overall",
+            "e(Phi)",
+            "e(Phidot)",
+        ],
+    );
+    let mut fig = Figure::new(
+        format!("Energy error over {steps} steps (h = {h} s), manipulator"),
+        "time t [s]",
+        "|H - H0| / |H0|",
+    )
+    .log(false, true);
+    let mut rows = Vec::new();
+    for spec in solvers() {
+        let mut s = State::consistent(&sys, 0.0).map_err(|e| e.to_string())?;
+        let mut integ = (spec.make)(&sys).map_err(|e| e.to_string())?;
+        let mut obs = MeasureObserver::new(&sys, false).with_series();
+        run(
+            &mut integ,
+            &sys,
+            &mut s,
+            RunConfig {
+                t_end: steps as f64 * h,
+                h,
+            },
+            &mut obs,
+        )
+        .map_err(|e| format!("{}: {e}", spec.name))?;
+        let m = obs.measures();
+        let series = obs.series.take().unwrap_or_default();
+        let tenth = series.len() / 10;
+        let first = series[..tenth.max(1)]
+            .iter()
+            .fold(0.0f64, |a, r| a.max(r[1]));
+        let last = series[series.len() - tenth.max(1)..]
+            .iter()
+            .fold(0.0f64, |a, r| a.max(r[1]));
+        table.row(vec![
+            spec.name.into(),
+            fmt_e(first),
+            fmt_e(last),
+            fmt_e(m.e_h),
+            fmt_e(m.e_phi),
+            fmt_e(m.e_phidot),
+        ]);
+        rows.push(json!({"solver": spec.name, "e_H_first_tenth": num(first), "e_H_last_tenth": num(last), "e_H": num(m.e_h), "e_phi": num(m.e_phi), "e_phidot": num(m.e_phidot)}));
+        // thin the series for the figure
+        let stride = (series.len() / 2000).max(1);
+        let (xs, ys): (Vec<f64>, Vec<f64>) =
+            series.iter().step_by(stride).map(|r| (r[0], r[1])).unzip();
+        fig.series.push(Series::line(spec.name, xs, ys));
+    }
+    fig.save(&ctx.figure_path("own_long_time_energy.svg"))?;
+    sec.figures.push(FigureRef {
+        file: "own_long_time_energy.svg".into(),
+        caption: "Relative energy error against time over the long run".into(),
+    });
+    sec.tables.push(table);
+    sec.summary = json!({ "own": { "long_time": rows } });
+    Ok(sec)
+}
+
+/// The project's own experiments.
+pub fn experiments() -> Vec<Experiment> {
+    vec![
+        Experiment {
+            id: "own-orders",
+            part: Part::Own,
+            title: "Convergence orders of every solver",
+            run: orders,
+        },
+        Experiment {
+            id: "own-work-precision",
+            part: Part::Own,
+            title: "Work-precision on the manipulator",
+            run: work_precision,
+        },
+        Experiment {
+            id: "own-long-time",
+            part: Part::Own,
+            title: "Long-time energy behaviour",
+            run: long_time,
+        },
+    ]
+}
