@@ -117,6 +117,7 @@ impl Force {
         }
     }
     /// Applied force (global axes) at a body point.
+    #[allow(clippy::self_named_constructors)] // `Force::force` next to `Force::torque`
     pub fn force(
         name: impl Into<String>,
         body: impl Into<BodyRef>,
@@ -179,6 +180,11 @@ impl Force {
                 ..
             } => {
                 let d = sub2(point(qb, *pb), point(qa, *pa));
+                if *rest_length == 0.0 {
+                    // k/2 |d|^2: the same energy, but smooth (no square root) where the
+                    // attachment points coincide
+                    return dot(d, d) * (0.5 * stiffness);
+                }
                 let e = dot(d, d).sqrt() - *rest_length;
                 e * e * (0.5 * stiffness)
             }
@@ -232,6 +238,11 @@ impl Force {
                 let ja: [DirJet; 3] = std::array::from_fn(|i| DirJet::var(i, qa[i], va[i]));
                 let jb: [DirJet; 3] = std::array::from_fn(|i| DirJet::var(i + 3, qb[i], vb[i]));
                 let d = sub2(point(&jb, *pb), point(&ja, *pa));
+                if dot(d, d).v == 0.0 {
+                    // coincident points: the line of action is undefined and the bounded
+                    // force has no limit; take zero instead of 0/0
+                    return;
+                }
                 let l = dot(d, d).sqrt();
                 // l.d1 = ldot; the force is -c ldot grad(l)
                 let s = -damping * l.d1;

@@ -9,7 +9,9 @@ use nalgebra::{DMatrix, DVector};
 /// Settings of [`System::project`].
 #[derive(Clone, Copy, Debug)]
 pub struct ProjectionOptions {
-    /// Target max-norm of `Phi` (and of the velocity constraint).
+    /// Target max-norm of `Phi`. It is floored at the round-off level of the coordinates,
+    /// `8 eps max(1, |q_guess|_inf)`, which no iteration can beat (so a model placed far from
+    /// the origin still projects).
     pub tol: f64,
     /// Newton iteration limit.
     pub max_iter: usize,
@@ -163,17 +165,18 @@ impl System {
                 |(a, ia), (i, &b)| if b.abs() > a { (b.abs(), i) } else { (a, ia) },
             )
         };
+        let tol = opts.tol.max(8.0 * f64::EPSILON * max_abs(q_guess).max(1.0));
         loop {
             self.phi(q.as_slice(), t, &mut phi);
             let (res, iw) = worst(&phi);
-            if !res.is_finite() || (iterations >= opts.max_iter && res > opts.tol) {
+            if !res.is_finite() || (iterations >= opts.max_iter && res > tol) {
                 return Err(ModelError::Projection {
                     residual: res,
                     iterations,
                     equation: self.equation_name(iw),
                 });
             }
-            if res <= opts.tol {
+            if res <= tol {
                 break;
             }
             self.phi_q(q.as_slice(), &mut jac);

@@ -244,7 +244,8 @@ impl HessJet {
         for i in 0..NV {
             out.g[i] = df * self.g[i];
             for j in 0..NV {
-                out.h[i][j] = ddf * self.g[i] * self.g[j] + df * self.h[i][j];
+                // `g_i * g_j` first so the Hessian stays exactly symmetric in floating point
+                out.h[i][j] = ddf * (self.g[i] * self.g[j]) + df * self.h[i][j];
             }
         }
         out

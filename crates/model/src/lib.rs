@@ -38,6 +38,8 @@
 //! # Ok::<(), mbd_model::ModelError>(())
 //! ```
 #![warn(missing_docs)]
+// Index loops over the fixed-size local jets (6 variables, 6x6 Hessians) read like the maths.
+#![allow(clippy::needless_range_loop)]
 
 mod body;
 mod error;

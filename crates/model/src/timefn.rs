@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// A scalar function of time with its first two derivatives, serialisable for model files.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum TimeFunction {
     /// `c`.
     Constant {

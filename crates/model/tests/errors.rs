@@ -1,0 +1,642 @@
+//! Every bad input is rejected with its specific error.
+
+mod common;
+
+use mbd_model::models::{self, four_bar, pendulum};
+use mbd_model::{
+    Body, BodyHandle, BodyRef, Force, Joint, ModelError, ModelFile, ProjectionOptions, System,
+    SystemBuilder, TimeFunction,
+};
+
+fn one_body() -> (SystemBuilder, BodyHandle) {
+    let mut b = SystemBuilder::new();
+    let h = b.add_body(Body::new("link").position(0.5, 0.0, 0.0));
+    (b, h)
+}
+
+fn err(b: SystemBuilder) -> ModelError {
+    b.build().expect_err("the model must be rejected")
+}
+
+fn invalid(e: &ModelError, el: &str, param: &str) {
+    match e {
+        ModelError::InvalidParameter {
+            element, parameter, ..
+        } => {
+            assert_eq!(element, el, "{e}");
+            assert_eq!(*parameter, param, "{e}");
+        }
+        _ => panic!("expected InvalidParameter({el}, {param}), got {e:?}"),
+    }
+}
+
+const PENDULUM_TOML: &str = r#"
+gravity = [0.0, -9.81]
+
+[[bodies]]
+name = "link1"
+mass = 1.0
+inertia = 0.08333333333333333
+position = [0.0, -0.5, -1.5707963267948966]
+
+[[joints]]
+type = "revolute"
+name = "pin1"
+body_a = "ground"
+point_a = [0.0, 0.0]
+body_b = "link1"
+point_b = [-0.5, 0.0]
+"#;
+
+#[test]
+fn valid_reference_file_builds() {
+    System::from_toml(PENDULUM_TOML).unwrap();
+}
+
+#[test]
+fn unknown_body_handle() {
+    let (mut b, _) = one_body();
+    b.add_joint(Joint::revolute(
+        "pin",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        BodyHandle(3),
+        [0.0, 0.0],
+    ));
+    match err(b) {
+        ModelError::UnknownBody { element, body } => {
+            assert_eq!(element, "pin");
+            assert!(body.contains("#3"), "{body}");
+        }
+        e => panic!("{e:?}"),
+    }
+    // in a force too
+    let (mut b, _) = one_body();
+    b.add_force(Force::torque(
+        "tq",
+        BodyHandle(1),
+        TimeFunction::constant(1.0),
+    ));
+    assert!(matches!(err(b), ModelError::UnknownBody { element, .. } if element == "tq"));
+}
+
+#[test]
+fn unknown_body_name_in_file() {
+    let text = PENDULUM_TOML.replace("body_b = \"link1\"", "body_b = \"lnk1\"");
+    match System::from_toml(&text).unwrap_err() {
+        ModelError::UnknownBody { element, body } => {
+            assert!(element.contains("pin1"), "{element}");
+            assert_eq!(body, "lnk1");
+        }
+        e => panic!("{e:?}"),
+    }
+    // and in a force, from JSON
+    let mut mf = ModelFile::from_toml(PENDULUM_TOML).unwrap();
+    mf.forces.push(mbd_model::ForceSpec::Torque {
+        name: "motor".into(),
+        body: "link2".into(),
+        torque: TimeFunction::constant(1.0),
+    });
+    match System::from_json(&mf.to_json().unwrap()).unwrap_err() {
+        ModelError::UnknownBody { element, body } => {
+            assert!(element.contains("motor"), "{element}");
+            assert_eq!(body, "link2");
+        }
+        e => panic!("{e:?}"),
+    }
+}
+
+#[test]
+fn duplicate_body_name() {
+    let (mut b, _) = one_body();
+    b.add_body(Body::new("link"));
+    assert_eq!(
+        err(b),
+        ModelError::DuplicateName {
+            kind: "body",
+            name: "link".into()
+        }
+    );
+}
+
+#[test]
+fn duplicate_joint_name() {
+    let (mut b, h) = one_body();
+    let c = b.add_body(Body::new("other").position(2.0, 0.0, 0.0));
+    b.add_joint(Joint::revolute(
+        "pin",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        h,
+        [-0.5, 0.0],
+    ));
+    b.add_joint(Joint::revolute("pin", h, [0.5, 0.0], c, [-1.0, 0.0]));
+    assert_eq!(
+        err(b),
+        ModelError::DuplicateName {
+            kind: "joint",
+            name: "pin".into()
+        }
+    );
+}
+
+#[test]
+fn duplicate_force_name() {
+    let (mut b, h) = one_body();
+    b.add_force(Force::torque("f", h, TimeFunction::constant(1.0)));
+    b.add_force(Force::force(
+        "f",
+        h,
+        [0.0, 0.0],
+        TimeFunction::constant(1.0),
+        TimeFunction::constant(0.0),
+    ));
+    assert_eq!(
+        err(b),
+        ModelError::DuplicateName {
+            kind: "force",
+            name: "f".into()
+        }
+    );
+}
+
+#[test]
+fn body_named_ground() {
+    for name in ["ground", "Ground"] {
+        let mut b = SystemBuilder::new();
+        b.add_body(Body::new(name));
+        match err(b) {
+            ModelError::DuplicateName { kind, name: n } => {
+                assert_eq!(n, name);
+                assert!(kind.contains("ground"), "{kind}");
+            }
+            e => panic!("{e:?}"),
+        }
+    }
+}
+
+#[test]
+fn zero_mass() {
+    let mut b = SystemBuilder::new();
+    b.add_body(Body::new("a").mass(0.0));
+    invalid(&err(b), "a", "mass");
+}
+
+#[test]
+fn negative_mass() {
+    let mut b = SystemBuilder::new();
+    b.add_body(Body::new("a").mass(-1.0));
+    invalid(&err(b), "a", "mass");
+}
+
+#[test]
+fn nan_inertia() {
+    let mut b = SystemBuilder::new();
+    b.add_body(Body::new("a").inertia(f64::NAN));
+    let e = err(b);
+    invalid(&e, "a", "inertia");
+    assert!(matches!(e, ModelError::InvalidParameter { value, .. } if value.is_nan()));
+}
+
+#[test]
+fn infinite_position() {
+    let mut b = SystemBuilder::new();
+    b.add_body(Body::new("a").position(0.0, f64::INFINITY, 0.0));
+    invalid(&err(b), "a", "position");
+    let mut b = SystemBuilder::new();
+    b.add_body(Body::new("a").velocity(0.0, 0.0, f64::NEG_INFINITY));
+    invalid(&err(b), "a", "velocity");
+}
+
+#[test]
+fn non_finite_gravity() {
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, f64::NAN]);
+    b.add_body(Body::new("a"));
+    invalid(&err(b), "gravity", "gravity");
+}
+
+#[test]
+fn distance_length_zero_negative_nan() {
+    for len in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let (mut b, h) = one_body();
+        b.add_joint(Joint::distance(
+            "rod",
+            BodyRef::Ground,
+            [0.0, 0.0],
+            h,
+            [0.0, 0.0],
+            len,
+        ));
+        invalid(&err(b), "rod", "length");
+    }
+}
+
+#[test]
+fn prismatic_zero_axis() {
+    let (mut b, h) = one_body();
+    b.add_joint(Joint::prismatic(
+        "slide",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        h,
+        [0.0, 0.0],
+        [0.0, 0.0],
+        0.0,
+    ));
+    invalid(&err(b), "slide", "axis length");
+}
+
+#[test]
+fn non_finite_joint_and_force_parameters() {
+    let (mut b, h) = one_body();
+    b.add_joint(Joint::revolute(
+        "pin",
+        BodyRef::Ground,
+        [f64::NAN, 0.0],
+        h,
+        [0.0, 0.0],
+    ));
+    invalid(&err(b), "pin", "point_a");
+    let (mut b, h) = one_body();
+    b.add_joint(Joint::angle_driver(
+        "drv",
+        BodyRef::Ground,
+        h,
+        TimeFunction::Polynomial {
+            coeffs: vec![0.0, f64::INFINITY],
+        },
+    ));
+    invalid(&err(b), "drv", "f");
+    let (mut b, h) = one_body();
+    b.add_force(Force::force(
+        "push",
+        h,
+        [0.0, 0.0],
+        TimeFunction::constant(1.0),
+        TimeFunction::constant(f64::NAN),
+    ));
+    invalid(&err(b), "push", "fy");
+}
+
+#[test]
+fn joint_to_the_same_body() {
+    let (mut b, h) = one_body();
+    b.add_joint(Joint::revolute("pin", h, [0.0, 0.0], h, [0.5, 0.0]));
+    assert_eq!(
+        err(b),
+        ModelError::SameBody {
+            joint: "pin".into(),
+            body: "link".into()
+        }
+    );
+}
+
+#[test]
+fn ground_to_ground_joint() {
+    let (mut b, _) = one_body();
+    b.add_joint(Joint::weld(
+        "fix",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        BodyRef::Ground,
+        [1.0, 0.0],
+        0.0,
+    ));
+    assert_eq!(
+        err(b),
+        ModelError::SameBody {
+            joint: "fix".into(),
+            body: "ground".into()
+        }
+    );
+    // an absolute constraint on ground, a spring from ground to ground, a load on ground
+    let (mut b, _) = one_body();
+    b.add_joint(Joint::absolute(
+        "abs",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        mbd_model::Coordinate::X,
+        0.0,
+    ));
+    assert!(matches!(err(b), ModelError::SameBody { joint, .. } if joint == "abs"));
+    let (mut b, _) = one_body();
+    b.add_force(Force::spring_damper(
+        "s",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        BodyRef::Ground,
+        [1.0, 0.0],
+        1.0,
+        0.0,
+        1.0,
+    ));
+    assert!(matches!(err(b), ModelError::SameBody { joint, .. } if joint == "s"));
+    let (mut b, _) = one_body();
+    b.add_force(Force::torque(
+        "tq",
+        BodyRef::Ground,
+        TimeFunction::constant(1.0),
+    ));
+    assert!(matches!(err(b), ModelError::SameBody { joint, .. } if joint == "tq"));
+}
+
+#[test]
+fn redundant_four_bar() {
+    // A fifth pin between the crank tip and the coupler duplicates pin "A".
+    let mut mf = four_bar().unwrap().to_model_file();
+    mf.joints.push(mbd_model::JointSpec::Revolute {
+        name: "A_again".into(),
+        body_a: "crank".into(),
+        point_a: [0.2, 0.0],
+        body_b: "coupler".into(),
+        point_b: [-0.6, 0.0],
+    });
+    match mf.build().unwrap_err() {
+        ModelError::Redundant { equation, joints } => {
+            assert!(equation.starts_with("A_again."), "{equation}");
+            assert!(joints.contains(&"A_again".to_string()), "{joints:?}");
+            assert!(joints.contains(&"A".to_string()), "{joints:?}");
+        }
+        e => panic!("{e:?}"),
+    }
+}
+
+#[test]
+fn redundant_double_pin() {
+    let mut mf = pendulum(1.0, 1.0, 0.2, 9.81).unwrap().to_model_file();
+    let extra = match &mf.joints[0] {
+        mbd_model::JointSpec::Revolute {
+            body_a,
+            point_a,
+            body_b,
+            point_b,
+            ..
+        } => mbd_model::JointSpec::Revolute {
+            name: "pin_again".into(),
+            body_a: body_a.clone(),
+            point_a: *point_a,
+            body_b: body_b.clone(),
+            point_b: *point_b,
+        },
+        _ => unreachable!(),
+    };
+    mf.joints.push(extra);
+    assert_eq!(
+        mf.build().unwrap_err(),
+        ModelError::Redundant {
+            equation: "pin_again.x".into(),
+            joints: vec!["pin1".into(), "pin_again".into()],
+        }
+    );
+}
+
+#[test]
+fn unreachable_initial_state() {
+    // One point 1 m from (0, 0) and 1 m from (5, 0): no such point exists.
+    let mut b = SystemBuilder::new();
+    let h = b.add_body(Body::new("p").position(2.5, 1.0, 0.0));
+    b.add_joint(Joint::distance(
+        "left",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        h,
+        [0.0, 0.0],
+        1.0,
+    ));
+    b.add_joint(Joint::distance(
+        "right",
+        BodyRef::Ground,
+        [5.0, 0.0],
+        h,
+        [0.0, 0.0],
+        1.0,
+    ));
+    let sys = b.build().unwrap();
+    match sys.consistent_state(0.0).unwrap_err() {
+        ModelError::Projection {
+            residual, equation, ..
+        } => {
+            assert!(residual > 1.0, "{residual}");
+            assert!(equation.starts_with("left") || equation.starts_with("right"));
+        }
+        e => panic!("{e:?}"),
+    }
+}
+
+#[test]
+fn negative_stiffness_and_damping() {
+    let (mut b, h) = one_body();
+    b.add_force(Force::spring_damper(
+        "s",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        h,
+        [0.0, 0.0],
+        -1.0,
+        0.0,
+        1.0,
+    ));
+    invalid(&err(b), "s", "stiffness");
+    let (mut b, h) = one_body();
+    b.add_force(Force::spring_damper(
+        "s",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        h,
+        [0.0, 0.0],
+        1.0,
+        -0.1,
+        1.0,
+    ));
+    invalid(&err(b), "s", "damping");
+    let (mut b, h) = one_body();
+    b.add_force(Force::spring_damper(
+        "s",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        h,
+        [0.0, 0.0],
+        1.0,
+        0.0,
+        -1.0,
+    ));
+    invalid(&err(b), "s", "rest_length");
+    let (mut b, h) = one_body();
+    b.add_force(Force::rotary_spring_damper(
+        "r",
+        BodyRef::Ground,
+        h,
+        -2.0,
+        0.0,
+        0.0,
+    ));
+    invalid(&err(b), "r", "stiffness");
+    let (mut b, h) = one_body();
+    b.add_force(Force::rotary_spring_damper(
+        "r",
+        BodyRef::Ground,
+        h,
+        2.0,
+        f64::NAN,
+        0.0,
+    ));
+    invalid(&err(b), "r", "damping");
+}
+
+#[test]
+fn empty_model() {
+    assert_eq!(SystemBuilder::new().build().unwrap_err(), ModelError::Empty);
+    assert_eq!(models::n_link_chain(0).unwrap_err(), ModelError::Empty);
+    assert_eq!(
+        System::from_json(r#"{"bodies": []}"#).unwrap_err(),
+        ModelError::Empty
+    );
+}
+
+#[test]
+fn malformed_json() {
+    let e = System::from_json(r#"{"bodies": [{"name": "a", "mass": 1.0,}]}"#).unwrap_err();
+    assert!(
+        matches!(e, ModelError::Parse { format: "json", .. }),
+        "{e:?}"
+    );
+    // wrong type
+    let e = System::from_json(r#"{"bodies": [{"name": "a", "mass": "heavy", "inertia": 1}]}"#)
+        .unwrap_err();
+    assert!(
+        matches!(e, ModelError::Parse { format: "json", .. }),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn malformed_toml() {
+    let e = System::from_toml("[[bodies]\nname = \"a\"").unwrap_err();
+    assert!(
+        matches!(e, ModelError::Parse { format: "toml", .. }),
+        "{e:?}"
+    );
+    // missing required field
+    let e = System::from_toml(&PENDULUM_TOML.replace("mass = 1.0\n", "")).unwrap_err();
+    match e {
+        ModelError::Parse { format, message } => {
+            assert_eq!(format, "toml");
+            assert!(message.contains("mass"), "{message}");
+        }
+        e => panic!("{e:?}"),
+    }
+}
+
+fn unknown_field(text: &str, field: &str) {
+    for e in [
+        System::from_toml(text).unwrap_err(),
+        System::from_json(
+            &serde_json::to_string(&toml::from_str::<toml::Value>(text).unwrap()).unwrap(),
+        )
+        .unwrap_err(),
+    ] {
+        match e {
+            ModelError::Parse { message, .. } => {
+                assert!(message.contains("unknown field"), "{message}");
+                assert!(message.contains(field), "{message}");
+            }
+            e => panic!("unknown field '{field}' accepted: {e:?}"),
+        }
+    }
+}
+
+#[test]
+fn unknown_fields_are_rejected() {
+    // top level
+    unknown_field(&format!("gravty = [0.0, 1.0]\n{PENDULUM_TOML}"), "gravty");
+    // in a joint
+    unknown_field(
+        &PENDULUM_TOML.replace(
+            "point_b = [-0.5, 0.0]",
+            "point_b = [-0.5, 0.0]\nlength = 2.0",
+        ),
+        "length",
+    );
+    // in a body: a misspelt optional field must not silently default
+    unknown_field(
+        &PENDULUM_TOML.replace("position =", "velocty = [0.0, 0.0, 1.0]\nposition ="),
+        "velocty",
+    );
+    // in a time function
+    let drv = format!(
+        "{PENDULUM_TOML}\n[[forces]]\ntype = \"torque\"\nname = \"m\"\nbody = \"link1\"\n\
+         torque = {{ kind = \"harmonic\", amplitude = 1.0, omega = 2.0, phse = 0.5 }}\n"
+    );
+    unknown_field(&drv, "phse");
+    // in a force
+    let f = format!(
+        "{PENDULUM_TOML}\n[[forces]]\ntype = \"torque\"\nname = \"m\"\nbody = \"link1\"\n\
+         torque = {{ kind = \"constant\", value = 1.0 }}\npoint = [1.0, 0.0]\n"
+    );
+    unknown_field(&f, "point");
+}
+
+#[test]
+fn wrong_length_vectors() {
+    let sys = models::manipulator().unwrap();
+    let opts = ProjectionOptions::default();
+    assert_eq!(
+        sys.project(&[0.0; 5], &[0.0; 6], 0.0, opts).unwrap_err(),
+        ModelError::Dimension {
+            what: "q_guess",
+            expected: 6,
+            got: 5
+        }
+    );
+    assert_eq!(
+        sys.project(&[0.0; 6], &[0.0; 7], 0.0, opts).unwrap_err(),
+        ModelError::Dimension {
+            what: "v_guess",
+            expected: 6,
+            got: 7
+        }
+    );
+    assert!(matches!(
+        sys.check_rank(&[0.0; 2], 0.0).unwrap_err(),
+        ModelError::Dimension {
+            what: "q",
+            expected: 6,
+            got: 2
+        }
+    ));
+}
+
+#[test]
+fn non_finite_guess() {
+    let sys = models::manipulator().unwrap();
+    let (q, v) = sys.initial_guess();
+    let mut qb = q.as_slice().to_vec();
+    qb[4] = f64::NAN;
+    let e = sys
+        .project(&qb, v.as_slice(), 0.0, ProjectionOptions::default())
+        .unwrap_err();
+    invalid(&e, "initial state", "q_guess");
+    let mut vb = v.as_slice().to_vec();
+    vb[0] = f64::INFINITY;
+    let e = sys
+        .project(q.as_slice(), &vb, 0.0, ProjectionOptions::default())
+        .unwrap_err();
+    invalid(&e, "initial state", "v_guess");
+}
+
+#[test]
+fn io_errors() {
+    let e = System::from_path("/nonexistent/model.toml").unwrap_err();
+    assert!(matches!(e, ModelError::Parse { format: "io", .. }), "{e:?}");
+    let dir = std::env::temp_dir().join(format!("mbd-model-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("model.yaml");
+    std::fs::write(&p, PENDULUM_TOML).unwrap();
+    let e = System::from_path(&p).unwrap_err();
+    assert!(matches!(e, ModelError::Parse { format: "io", .. }), "{e:?}");
+    let p = dir.join("model.toml");
+    std::fs::write(&p, PENDULUM_TOML).unwrap();
+    assert_eq!(System::from_path(&p).unwrap().n_coords(), 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
