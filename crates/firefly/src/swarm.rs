@@ -70,6 +70,7 @@ struct Mover {
 impl Mover {
     /// Moves `xi` toward `xj`: `xi += beta(r) (xj - xi) + alpha (u - 1/2) width`,
     /// then confines every coordinate to the box. Draws exactly `d` uniforms.
+    #[inline]
     fn attract(&self, xi: &mut [f64], xj: &[f64], alpha: f64, rng: &mut ChaCha8Rng) {
         let mut r2 = 0.0;
         for ((a, b), s) in xi.iter().zip(xj).zip(&self.dist_scale) {
@@ -77,29 +78,38 @@ impl Mover {
             r2 += t * t;
         }
         let beta = (self.beta0 - self.beta_min) * (-self.gamma * r2).exp() + self.beta_min;
-        for (k, (a, b)) in xi.iter_mut().zip(xj).enumerate() {
+        let geometry = self.lo.iter().zip(&self.hi).zip(&self.width);
+        for ((a, b), ((&l, &h), w)) in xi.iter_mut().zip(xj).zip(geometry) {
             let u: f64 = rng.random();
-            let v = *a + beta * (b - *a) + alpha * (u - 0.5) * self.width[k];
-            *a = self.confine(v, k);
+            let v = *a + beta * (b - *a) + alpha * (u - 0.5) * w;
+            *a = self.confine(v, l, h);
         }
     }
 
     /// Pure random step `xi += alpha (u - 1/2) width`, confined. Draws `d` uniforms.
     fn walk(&self, xi: &mut [f64], alpha: f64, rng: &mut ChaCha8Rng) {
-        for (k, a) in xi.iter_mut().enumerate() {
+        let geometry = self.lo.iter().zip(&self.hi).zip(&self.width);
+        for (a, ((&l, &h), w)) in xi.iter_mut().zip(geometry) {
             let u: f64 = rng.random();
-            let v = *a + alpha * (u - 0.5) * self.width[k];
-            *a = self.confine(v, k);
+            let v = *a + alpha * (u - 0.5) * w;
+            *a = self.confine(v, l, h);
         }
     }
 
-    /// Brings coordinate `k` back into `[lo_k, hi_k]`.
-    #[inline]
-    fn confine(&self, v: f64, k: usize) -> f64 {
-        let (l, h) = (self.lo[k], self.hi[k]);
+    /// Brings `v` back into `[l, h]` (fast path: already inside).
+    #[inline(always)]
+    fn confine(&self, v: f64, l: f64, h: f64) -> f64 {
         if v >= l && v <= h {
-            return v;
+            v
+        } else {
+            self.outside(v, l, h)
         }
+    }
+
+    /// Slow path of [`Mover::confine`] for a value outside `[l, h]` (or NaN).
+    #[cold]
+    #[inline(never)]
+    fn outside(&self, v: f64, l: f64, h: f64) -> f64 {
         let clamp = |v: f64| if v > h { h } else { l }; // NaN goes to `l`
         match self.boundary {
             BoundaryHandling::Clamp => clamp(v),
@@ -587,25 +597,25 @@ mod tests {
     #[test]
     fn clamp_projects_onto_bounds() {
         let m = mover(-1.0, 2.0, BoundaryHandling::Clamp);
-        assert_eq!(m.confine(0.5, 0), 0.5);
-        assert_eq!(m.confine(-3.0, 0), -1.0);
-        assert_eq!(m.confine(7.0, 0), 2.0);
-        assert_eq!(m.confine(f64::NAN, 0), -1.0);
-        assert_eq!(m.confine(f64::INFINITY, 0), 2.0);
+        assert_eq!(m.confine(0.5, m.lo[0], m.hi[0]), 0.5);
+        assert_eq!(m.confine(-3.0, m.lo[0], m.hi[0]), -1.0);
+        assert_eq!(m.confine(7.0, m.lo[0], m.hi[0]), 2.0);
+        assert_eq!(m.confine(f64::NAN, m.lo[0], m.hi[0]), -1.0);
+        assert_eq!(m.confine(f64::INFINITY, m.lo[0], m.hi[0]), 2.0);
     }
 
     #[test]
     fn reflect_mirrors_and_folds() {
         let m = mover(0.0, 1.0, BoundaryHandling::Reflect);
-        assert_eq!(m.confine(0.25, 0), 0.25);
-        assert!((m.confine(1.25, 0) - 0.75).abs() < 1e-15);
-        assert!((m.confine(-0.25, 0) - 0.25).abs() < 1e-15);
+        assert_eq!(m.confine(0.25, m.lo[0], m.hi[0]), 0.25);
+        assert!((m.confine(1.25, m.lo[0], m.hi[0]) - 0.75).abs() < 1e-15);
+        assert!((m.confine(-0.25, m.lo[0], m.hi[0]) - 0.25).abs() < 1e-15);
         // Overshoot by more than a width folds again: 2.25 -> 0.25.
-        assert!((m.confine(2.25, 0) - 0.25).abs() < 1e-15);
-        assert!((m.confine(-1.75, 0) - 0.25).abs() < 1e-15);
-        assert_eq!(m.confine(f64::NEG_INFINITY, 0), 0.0);
+        assert!((m.confine(2.25, m.lo[0], m.hi[0]) - 0.25).abs() < 1e-15);
+        assert!((m.confine(-1.75, m.lo[0], m.hi[0]) - 0.25).abs() < 1e-15);
+        assert_eq!(m.confine(f64::NEG_INFINITY, m.lo[0], m.hi[0]), 0.0);
         let fixed = mover(3.0, 3.0, BoundaryHandling::Reflect);
-        assert_eq!(fixed.confine(5.0, 0), 3.0);
+        assert_eq!(fixed.confine(5.0, fixed.lo[0], fixed.hi[0]), 3.0);
     }
 
     #[test]
@@ -654,7 +664,7 @@ mod tests {
             let hi = lo + w;
             let b = if reflect { BoundaryHandling::Reflect } else { BoundaryHandling::Clamp };
             let m = mover(lo, hi, b);
-            let c = m.confine(v, 0);
+            let c = m.confine(v, m.lo[0], m.hi[0]);
             prop_assert!(lo <= c && c <= hi, "{} -> {} not in [{}, {}]", v, c, lo, hi);
         }
 
