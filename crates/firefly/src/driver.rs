@@ -157,10 +157,11 @@ impl<'a> Firefly<'a> {
         }
     }
 
-    /// Minimises `objective`, evaluating each generation's batch in parallel
-    /// on the current rayon thread pool (use `ThreadPool::install` to choose
-    /// one). Only [`Variant::Snapshot`](crate::Variant::Snapshot) evaluates in
-    /// parallel; the classic variants run serially. The result is
+    /// Minimises `objective`, moving and evaluating the fireflies of each
+    /// generation in parallel on the current rayon thread pool (use
+    /// `ThreadPool::install` to choose one). Only
+    /// [`Variant::Snapshot`](crate::Variant::Snapshot) runs in parallel; the
+    /// classic variants run serially. The result is
     /// bit-identical to [`Firefly::minimize`] with the same settings, whatever
     /// the number of threads.
     ///

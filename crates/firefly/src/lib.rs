@@ -4,7 +4,7 @@
 //! algorithm (*Nature-Inspired Metaheuristic Algorithms*, 2008; *Firefly
 //! algorithm, stochastic test functions and design optimisation*, 2010). It
 //! minimises any `FnMut(&[f64]) -> f64` (or an [`Objective`] implementor) over
-//! a box `[lo, hi]^d`, serially or with rayon-parallel evaluations
+//! a box `[lo, hi]^d`, serially or with rayon-parallel moves and evaluations
 //! ([`SyncObjective`]), and is bit-for-bit reproducible from a `u64` seed.
 //!
 //! ```
@@ -55,7 +55,7 @@
 //! Three loop forms are offered ([`Variant`]):
 //! * [`Variant::Snapshot`] (default): sort by brightness, freeze a snapshot,
 //!   move every firefly toward the brighter fireflies *of the snapshot*, then
-//!   evaluate all new positions as one batch — in parallel with
+//!   evaluate all new positions — moves and evaluations in parallel with
 //!   [`Firefly::minimize_parallel`];
 //! * [`Variant::Classic`]: Yang's in-place double loop, evaluating after every
 //!   move;
@@ -64,11 +64,16 @@
 //!
 //! ## Determinism
 //!
-//! The random stream is a [`rand_chacha::ChaCha8Rng`] seeded with
-//! `seed_from_u64(settings.seed)`. All random numbers are drawn serially on the
-//! calling thread, in a fixed order (initial positions, then move by move);
-//! only objective evaluations run on rayon workers, each writing its own slot,
-//! and their results are folded in serially in index order. The same seed
+//! Random numbers come from [`rand_chacha::ChaCha8Rng`] keyed with
+//! `seed_from_u64(settings.seed)`. Initial positions and the classic variants
+//! use the generator's stream 0, drawn serially in a fixed order. In the
+//! snapshot variant, the firefly of sorted rank `k` in generation `g` draws
+//! from its own ChaCha stream `g n + k`, so its move depends only on the
+//! frozen snapshot and that stream; moving and evaluating each firefly is an
+//! independent task, run on rayon workers by
+//! [`Firefly::minimize_parallel`], each writing only its own slots, and the
+//! bookkeeping (counters, best-so-far) is done afterwards serially in index
+//! order. The same seed
 //! therefore gives bit-identical results serially or in parallel, on any
 //! thread count.
 //!

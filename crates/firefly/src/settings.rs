@@ -24,10 +24,11 @@ pub enum Variant {
     ClassicSweep,
     /// The sorted snapshot variant (default). The population is sorted by
     /// brightness, copied into a snapshot, every firefly is moved toward every
-    /// strictly brighter firefly *of the snapshot*, and then all new positions
-    /// are evaluated as one batch. The batch may be evaluated in parallel
+    /// strictly brighter firefly *of the snapshot* (each firefly drawing from
+    /// its own random stream), and then all new positions are evaluated. Moves
+    /// and evaluations may run in parallel
     /// ([`Firefly::minimize_parallel`](crate::Firefly::minimize_parallel)); the
-    /// result is bit-identical to the serial evaluation. One generation costs at
+    /// result is bit-identical to the serial run. One generation costs at
     /// most `n` evaluations.
     #[default]
     Snapshot,

@@ -17,8 +17,13 @@ use crate::{
 trait Evaluator {
     /// Evaluates one point.
     fn one(&mut self, x: &[f64]) -> f64;
-    /// Evaluates the rows (length `d`) of `xs` into `out`, one value per row.
-    fn batch(&mut self, xs: &[f64], d: usize, out: &mut [f64]);
+
+    /// For every row `i` (length `d`) of `rows`: runs `prepare(i, row)` (which
+    /// may modify the row, e.g. move the firefly), then evaluates the row into
+    /// `out[i]`. Rows are independent, so they may be processed in parallel.
+    fn batch<P>(&mut self, rows: &mut [f64], d: usize, out: &mut [f64], prepare: P)
+    where
+        P: Fn(usize, &mut [f64]) + Sync;
 }
 
 struct SerialEval<'o, O: ?Sized>(&'o mut O);
@@ -28,9 +33,13 @@ impl<O: Objective + ?Sized> Evaluator for SerialEval<'_, O> {
         self.0.eval(x)
     }
 
-    fn batch(&mut self, xs: &[f64], d: usize, out: &mut [f64]) {
-        for (x, o) in xs.chunks_exact(d).zip(out.iter_mut()) {
-            *o = self.0.eval(x);
+    fn batch<P>(&mut self, rows: &mut [f64], d: usize, out: &mut [f64], prepare: P)
+    where
+        P: Fn(usize, &mut [f64]) + Sync,
+    {
+        for (i, (row, o)) in rows.chunks_exact_mut(d).zip(out.iter_mut()).enumerate() {
+            prepare(i, row);
+            *o = self.0.eval(row);
         }
     }
 }
@@ -42,13 +51,21 @@ impl<O: SyncObjective + ?Sized> Evaluator for ParallelEval<'_, O> {
         self.0.eval(x)
     }
 
-    fn batch(&mut self, xs: &[f64], d: usize, out: &mut [f64]) {
+    fn batch<P>(&mut self, rows: &mut [f64], d: usize, out: &mut [f64], prepare: P)
+    where
+        P: Fn(usize, &mut [f64]) + Sync,
+    {
         let obj = self.0;
-        // Each value lands in its own slot, so the outcome cannot depend on
-        // scheduling or on the number of threads.
-        xs.par_chunks_exact(d)
+        // Each row is prepared from its own inputs and its value lands in its
+        // own slot, so the outcome cannot depend on scheduling or on the
+        // number of threads.
+        rows.par_chunks_exact_mut(d)
             .zip(out.par_iter_mut())
-            .for_each(|(x, o)| *o = obj.eval(x));
+            .enumerate()
+            .for_each(|(i, (row, o))| {
+                prepare(i, row);
+                *o = obj.eval(row);
+            });
     }
 }
 
@@ -145,10 +162,10 @@ fn two_rows(buf: &mut [f64], i: usize, j: usize, d: usize) -> (&mut [f64], &[f64
 /// Life cycle: [`Swarm::new`] places the population (supplied positions first,
 /// the rest uniform in the box), [`Swarm::initialize`] evaluates it
 /// (generation 0), and each [`Swarm::step`] runs one generation of the
-/// configured [`Variant`]. The `*_parallel` methods evaluate batches with
-/// rayon; for [`Variant::Snapshot`] they give bit-identical results to the
-/// serial methods on any number of threads, and for the classic variants
-/// (inherently sequential) they simply evaluate serially.
+/// configured [`Variant`]. The `*_parallel` methods use rayon: for
+/// [`Variant::Snapshot`] the moves and evaluations of a generation run in
+/// parallel with bit-identical results to the serial methods on any number of
+/// threads; the classic variants (inherently sequential) simply run serially.
 ///
 /// All buffers are allocated once in [`Swarm::new`]; a generation allocates
 /// nothing (rayon's task bookkeeping aside).
@@ -165,7 +182,11 @@ pub struct Swarm {
     alpha_decay: f64,
     variant: Variant,
     walk: bool,
+    /// Main stream (stream 0): initial positions and the classic variants.
     rng: ChaCha8Rng,
+    /// Unused copy of the freshly seeded generator; the snapshot variant
+    /// derives one stream per (generation, firefly) from it.
+    stream_root: ChaCha8Rng,
     pos: Vec<f64>,
     fit: Vec<f64>,
     snap_pos: Vec<f64>,
@@ -219,7 +240,8 @@ impl Swarm {
                 .map(|&w| if w > 0.0 { 1.0 / w } else { 0.0 })
                 .collect(),
         };
-        let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
+        let stream_root = ChaCha8Rng::seed_from_u64(settings.seed);
+        let mut rng = stream_root.clone();
         let mut pos = vec![0.0; n * d];
         for (i, row) in pos.chunks_exact_mut(d).enumerate() {
             if let Some(x) = initial.get(i) {
@@ -252,6 +274,7 @@ impl Swarm {
             variant: settings.variant,
             walk: settings.best_random_walk,
             rng,
+            stream_root,
             pos,
             fit: vec![f64::INFINITY; n],
             snap_pos: vec![0.0; n * d],
@@ -297,9 +320,9 @@ impl Swarm {
         self.step_with(&mut SerialEval(objective), eval_limit);
     }
 
-    /// As [`Swarm::step`], evaluating the snapshot variant's batch in parallel
-    /// with rayon (bit-identical to [`Swarm::step`]); the classic variants are
-    /// evaluated serially.
+    /// As [`Swarm::step`], moving and evaluating the snapshot variant's
+    /// fireflies in parallel with rayon (bit-identical to [`Swarm::step`]); the
+    /// classic variants run serially.
     pub fn step_parallel<O: SyncObjective + ?Sized>(
         &mut self,
         objective: &O,
@@ -394,7 +417,7 @@ impl Swarm {
         self.initialized = true;
         let m = capped(self.n, eval_limit);
         let d = self.d;
-        e.batch(&self.pos[..m * d], d, &mut self.raw[..m]);
+        e.batch(&mut self.pos[..m * d], d, &mut self.raw[..m], |_, _| ());
         for i in 0..m {
             self.absorb(i, self.raw[i]);
         }
@@ -435,8 +458,8 @@ impl Swarm {
         }
     }
 
-    /// Sorted snapshot generation: moves from a frozen copy, then one batch
-    /// evaluation.
+    /// Sorted snapshot generation: every firefly moves from a frozen copy with
+    /// its own random stream and is evaluated; independent per firefly.
     fn step_snapshot<E: Evaluator>(&mut self, e: &mut E, eval_limit: Option<u64>) {
         let (n, d) = (self.n, self.d);
         for (k, o) in self.order.iter_mut().enumerate() {
@@ -462,24 +485,37 @@ impl Swarm {
             self.snap_fit.iter().take_while(|&&f| f == f0).count()
         };
         let m = t + capped(n - t, eval_limit);
+
+        // Firefly `k` (sorted rank) draws its random numbers from its own
+        // ChaCha stream `g * n + k` (g = this generation, 1-based), so its move
+        // depends only on the snapshot and that stream: the moves, and the
+        // evaluations, can run in any order or in parallel with identical
+        // results. Stream 0 (the main stream) is never used here.
         let alpha = self.alpha;
-        for k in t..m {
-            let xi = &mut self.pos[k * d..(k + 1) * d];
-            let fk = self.snap_fit[k];
+        let stream_base = (self.generation + 1).wrapping_mul(n as u64);
+        let mover = &self.mover;
+        let snap_pos = &self.snap_pos;
+        let snap_fit = &self.snap_fit;
+        let root = &self.stream_root;
+        let prepare = |offset: usize, xi: &mut [f64]| {
+            let k = t + offset;
+            let mut rng = root.clone();
+            rng.set_stream(stream_base.wrapping_add(k as u64));
+            let fk = snap_fit[k];
             let mut moved = false;
-            for (xj, &fj) in self.snap_pos.chunks_exact(d).zip(&self.snap_fit[..k]) {
+            for (xj, &fj) in snap_pos.chunks_exact(d).zip(&snap_fit[..k]) {
                 if fj < fk {
-                    self.mover.attract(xi, xj, alpha, &mut self.rng);
+                    mover.attract(xi, xj, alpha, &mut rng);
                     moved = true;
                 } else {
                     break; // sorted: no brighter firefly follows
                 }
             }
             if !moved {
-                self.mover.walk(xi, alpha, &mut self.rng);
+                mover.walk(xi, alpha, &mut rng);
             }
-        }
-        e.batch(&self.pos[t * d..m * d], d, &mut self.raw[t..m]);
+        };
+        e.batch(&mut self.pos[t * d..m * d], d, &mut self.raw[t..m], prepare);
         for k in t..m {
             self.absorb(k, self.raw[k]);
         }

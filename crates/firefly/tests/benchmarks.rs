@@ -95,7 +95,7 @@ fn rastrigin() {
 #[test]
 fn ackley() {
     check("ackley", 2, 1e-4, 1e-3);
-    check("ackley", 10, 1e-2, 2.5);
+    check("ackley", 10, 1e-2, 3.5);
 }
 
 #[test]
