@@ -37,10 +37,13 @@ pub struct MeasureObserver {
     m: RunMeasures,
     sum_rel: f64,
     phi: Vec<f64>,
-    acc: Option<(AccelerationSolver, Vec<f64>, Vec<f64>, Vec<f64>)>,
+    acc: Option<AccelWorkspace>,
     /// Optional per-sample record `(t, |H - H0|/|H0|, ||Phi||, ||Phidot||)` for figures.
     pub series: Option<Vec<[f64; 4]>>,
 }
+
+/// Index-1 solver with buffers for `a`, `lambda` and the residual.
+type AccelWorkspace = (AccelerationSolver, Vec<f64>, Vec<f64>, Vec<f64>);
 
 fn max_abs(x: &[f64]) -> f64 {
     x.iter().fold(

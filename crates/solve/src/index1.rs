@@ -12,22 +12,13 @@ use crate::tableau::{ButcherTableau, ExplicitRk};
 use mbd_model::System;
 
 /// Settings of [`Index1Rk`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Index1Options {
     /// Baumgarte parameters `(alpha, beta)`: the acceleration constraint becomes
     /// `Phi_q a = gamma - 2 alpha Phidot - beta^2 Phi`. `None` (default) = off.
     pub baumgarte: Option<(f64, f64)>,
     /// Project `(q, v)` onto the constraints after every step (default off).
     pub projection: Option<ProjectionSettings>,
-}
-
-impl Default for Index1Options {
-    fn default() -> Self {
-        Index1Options {
-            baumgarte: None,
-            projection: None,
-        }
-    }
 }
 
 /// Explicit RK on the index-1 equations, allocation-free per step.

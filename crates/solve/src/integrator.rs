@@ -221,7 +221,7 @@ pub fn step_count(t0: f64, t_end: f64, h: f64) -> Result<usize, SolveError> {
     } else {
         r.ceil()
     };
-    if n < 1.0 || n > 1e12 {
+    if !(1.0..=1e12).contains(&n) {
         return Err(SolveError::InvalidStep { h });
     }
     Ok(n as usize)

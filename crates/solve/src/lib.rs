@@ -46,6 +46,8 @@
 //! # Ok::<(), SolveError>(())
 //! ```
 #![warn(missing_docs)]
+// Index loops mirror the formulas; negated comparisons deliberately treat NaN as failure.
+#![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 mod accel;
 mod error;
