@@ -1,0 +1,32 @@
+//! The error type of the crate's functions beyond the [`mbd_solve::Integrator`] interface.
+
+use mbd_solve::SolveError;
+use thiserror::Error;
+
+/// Errors of the calibration and of the error measures (integration errors are wrapped).
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SymplecticError {
+    /// An error of the integrator or the model.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// The reference trajectory does not match the run (length or sample times).
+    #[error("reference trajectory '{method}' does not match the run: {detail}")]
+    Reference {
+        /// The reference's method string.
+        method: String,
+        /// What does not match.
+        detail: String,
+    },
+    /// The secant iteration for `gamma_opt` failed.
+    #[error("gamma calibration failed after {iterations} secant iterations at gamma = {gamma}: {reason} (dW history: {history:?})")]
+    Calibration {
+        /// Secant iterations done.
+        iterations: usize,
+        /// The last gamma tried.
+        gamma: f64,
+        /// Why it stopped.
+        reason: String,
+        /// `(gamma, dW)` pairs evaluated so far.
+        history: Vec<(f64, f64)>,
+    },
+}

@@ -1,0 +1,150 @@
+//! Settings of the (s,s) scheme.
+
+use mbd_solve::{NewtonOptions, SolveError};
+
+/// Where the `s + 1` control points of a step lie (and so where the constraints are enforced).
+///
+/// For `s <= 2` both choices are the same points (`0, 1` and `0, 1/2, 1`) and give bit-identical
+/// results. They differ from `s = 3` on: see the crate docs and `docs/symplectic.md`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Nodes {
+    /// Gauss-Lobatto points (default): the constraint-curvature forces are then integrated by the
+    /// `(s+1)`-point Lobatto rule, of order `2s`, and the scheme has order `2s` for every `s`.
+    #[default]
+    Lobatto,
+    /// Equally spaced points `nu / s` (the literal reading of paper A). The constraint forces are
+    /// then lumped by a closed Newton-Cotes rule, which limits the order to 2, 4, 4, 6 for
+    /// `s = 1, 2, 3, 4`.
+    Equispaced,
+}
+
+/// Settings of [`crate::Galerkin`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SymplecticOptions {
+    /// Degree of the interpolation and number of Gauss points (`s >= 1`); order `2s`.
+    pub s: usize,
+    /// The preadjustment parameter `gamma` (0: the plain scheme; 1: `gamma_T`).
+    pub gamma: f64,
+    /// Placement of the control points.
+    pub nodes: Nodes,
+    /// Newton settings for the stage equations. `tol` bounds the max-norm of the scaled residual
+    /// (displacement units, relative to `1 + ||q||_inf`); the iteration also stops when an update
+    /// is below `step_tol (1 + ||q||_inf)`; `max_iter` limits the iterations; `max_halvings`
+    /// allows backtracking on the residual norm; `jacobian_every` > 1 keeps the Jacobian for that
+    /// many iterations (simplified Newton).
+    pub newton: NewtonOptions,
+    /// Relative step of the central differences used for the third derivatives of `V` and `Phi`
+    /// in `grad W_s` (`s >= 2` with `gamma != 0`), Richardson-extrapolated (error `O(eps^4)`).
+    pub fd_step: f64,
+}
+
+impl Default for SymplecticOptions {
+    fn default() -> Self {
+        SymplecticOptions {
+            s: 2,
+            gamma: 0.0,
+            nodes: Nodes::Lobatto,
+            newton: NewtonOptions {
+                tol: 1e-14,
+                step_tol: 1e-15,
+                max_iter: 25,
+                max_halvings: 0,
+                jacobian_every: 1,
+            },
+            fd_step: 2e-3,
+        }
+    }
+}
+
+impl SymplecticOptions {
+    /// The plain `(s,s)` scheme with default settings.
+    pub fn new(s: usize) -> Self {
+        SymplecticOptions {
+            s,
+            ..Default::default()
+        }
+    }
+    /// Sets `gamma`.
+    pub fn with_gamma(mut self, gamma: f64) -> Self {
+        self.gamma = gamma;
+        self
+    }
+    /// Sets the control-point placement.
+    pub fn with_nodes(mut self, nodes: Nodes) -> Self {
+        self.nodes = nodes;
+        self
+    }
+    /// Sets the Newton settings.
+    pub fn with_newton(mut self, newton: NewtonOptions) -> Self {
+        self.newton = newton;
+        self
+    }
+
+    /// Checks every setting; the error names the parameter at fault.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        if self.s == 0 || self.s > 16 {
+            return Err(SolveError::InvalidParameter {
+                parameter: "s",
+                value: self.s as f64,
+                reason: "the degree s must be between 1 and 16",
+            });
+        }
+        if !self.gamma.is_finite() {
+            return Err(SolveError::InvalidParameter {
+                parameter: "gamma",
+                value: self.gamma,
+                reason: "must be finite",
+            });
+        }
+        if !(self.fd_step.is_finite() && self.fd_step > 0.0 && self.fd_step < 1.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "fd_step",
+                value: self.fd_step,
+                reason: "must be in (0, 1)",
+            });
+        }
+        self.newton.validate()
+    }
+}
+
+/// `kappa_s`: the constant of the preadjustment term `-gamma kappa_s h^(2s) W_s` for which
+/// `gamma = 1` cancels the leading phase error of the (s,s) scheme with Lobatto control points
+/// (for `s <= 2` also the equispaced scheme):
+/// `kappa_s = -(s!)^2 / (s ((2s)!)^2 (2s+1))`, i.e. `-1/12, -1/1440, -1/302400, -1/101606400`
+/// for `s = 1..4`. Derived in `docs/symplectic.md`; returns NaN for `s = 0`.
+pub fn kappa(s: usize) -> f64 {
+    if s == 0 {
+        return f64::NAN;
+    }
+    let mut fs = 1.0f64;
+    for k in 1..=s {
+        fs *= k as f64;
+    }
+    let mut f2s = 1.0f64;
+    for k in 1..=2 * s {
+        f2s *= k as f64;
+    }
+    -(fs * fs) / (s as f64 * f2s * f2s * (2 * s + 1) as f64)
+}
+
+/// The scheme's leading relative frequency error on a linear(ised) system whose stiffness comes
+/// from constraint curvature (gravity-loaded pendulums): `omega_h / omega - 1 ~ c_s (omega h)^(2s)`
+/// with `c_s = -kappa_s / 2` (1/24, 1/2880, 1/604800, 1/203212800): the numerical motion runs
+/// fast. For stiffness from the potential Hessian (springs) the constant is instead
+/// `-(s!)^2 / (((2s)!)^2 (2s+1))` (the Gauss rule's), and runs slow.
+pub fn phase_constant(s: usize) -> f64 {
+    -0.5 * kappa(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn kappa_values() {
+        assert!((kappa(1) + 1.0 / 12.0).abs() < 1e-17);
+        assert!((kappa(2) + 1.0 / 1440.0).abs() < 1e-18);
+        assert!((kappa(3) + 1.0 / 302400.0).abs() < 1e-20);
+        assert!((kappa(4) + 1.0 / 101606400.0).abs() < 1e-22);
+        assert!(kappa(0).is_nan());
+    }
+}
