@@ -8,6 +8,8 @@
 //!   direction `v` (so `v^T H v` — the quadratic velocity term of the acceleration right-hand side
 //!   `gamma` — without forming the Hessian),
 //! * [`HessJet`] gives the value, the gradient and the full 6x6 Hessian,
+//! * [`Dual`] gives the value and the first derivative along one direction only (the cheapest
+//!   way to the velocity constraint `Phi_q v`),
 //!
 //! so the Jacobian, `gamma` and the Hessians are exact (to round-off) and consistent with the
 //! equation by construction. Finite-difference tests check them all.
@@ -356,6 +358,123 @@ impl Scalar for HessJet {
     }
 }
 
+/// Value and first derivative along one direction (a dual number): the velocity constraint
+/// `Phi_q v` at the cost of about two `f64` evaluations, without the gradient.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dual {
+    /// Value.
+    pub v: f64,
+    /// Derivative along the seeded direction.
+    pub d: f64,
+}
+
+impl Dual {
+    /// A variable with value `x` and direction component `dir`.
+    #[inline(always)]
+    pub fn var(x: f64, dir: f64) -> Self {
+        Dual { v: x, d: dir }
+    }
+}
+
+impl Add for Dual {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Dual {
+            v: self.v + o.v,
+            d: self.d + o.d,
+        }
+    }
+}
+impl Sub for Dual {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Dual {
+            v: self.v - o.v,
+            d: self.d - o.d,
+        }
+    }
+}
+impl Mul for Dual {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        Dual {
+            v: self.v * o.v,
+            d: self.d * o.v + self.v * o.d,
+        }
+    }
+}
+impl Neg for Dual {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Dual {
+            v: -self.v,
+            d: -self.d,
+        }
+    }
+}
+impl Add<f64> for Dual {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, c: f64) -> Self {
+        self.v += c;
+        self
+    }
+}
+impl Sub<f64> for Dual {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(mut self, c: f64) -> Self {
+        self.v -= c;
+        self
+    }
+}
+impl Mul<f64> for Dual {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, c: f64) -> Self {
+        Dual {
+            v: self.v * c,
+            d: self.d * c,
+        }
+    }
+}
+impl Scalar for Dual {
+    #[inline(always)]
+    fn cst(v: f64) -> Self {
+        Dual { v, d: 0.0 }
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (
+            Dual {
+                v: s,
+                d: c * self.d,
+            },
+            Dual {
+                v: c,
+                d: -s * self.d,
+            },
+        )
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let r = self.v.sqrt();
+        Dual {
+            v: r,
+            d: 0.5 / r * self.d,
+        }
+    }
+    #[inline(always)]
+    fn val(self) -> f64 {
+        self.v
+    }
+}
+
 /// A point fixed in a body frame, in global coordinates: `r + A(theta) s`.
 #[inline(always)]
 pub fn point<T: Scalar>(q: &[T; 3], s: [f64; 2]) -> [T; 2] {
@@ -426,5 +545,8 @@ mod tests {
         assert!((vhv - d.d2).abs() < 1e-12);
         let gd: f64 = (0..6).map(|i| d.g[i] * dir[i]).sum();
         assert!((gd - d.d1).abs() < 1e-14);
+        let du = f(std::array::from_fn(|i| Dual::var(x0[i], dir[i])));
+        assert!((du.v - d.v).abs() < 1e-15);
+        assert!((du.d - d.d1).abs() < 1e-14);
     }
 }

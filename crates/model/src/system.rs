@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyHandle, BodyRef};
 use crate::error::ModelError;
 use crate::force::{Force, ForceKind};
-use crate::jet::{DirJet, HessJet, Scalar, NV};
+use crate::jet::{DirJet, Dual, HessJet, Scalar, NV};
 use crate::joint::{Joint, JointKind};
 use nalgebra::{DMatrix, DVector, Vector2};
 
@@ -647,6 +647,36 @@ impl System {
         }
     }
 
+    /// `Phi(q, t)` and the velocity constraint `Phi_q v + Phi_t` in one pass with dual numbers
+    /// (no gradients formed): the cheapest evaluation of both constraint levels, e.g. for the
+    /// residual of a Newton iteration on the first-order manifold.
+    pub fn phi_and_phi_dot(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+    ) {
+        let loc = |i: Option<usize>| -> [Dual; 3] {
+            match i {
+                Some(i) => std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k])),
+                None => [Dual::cst(0.0); 3],
+            }
+        };
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let mut e = [Dual::cst(0.0); 3];
+            j.eval(&loc(at.a), &loc(at.b), &mut e);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                let tp = j.time_part(k, t);
+                phi[o + k] = e[k].v - tp[0];
+                phi_dot[o + k] = e[k].d - tp[1];
+            }
+        }
+    }
+
     /// `Phi_q` as (row, column, value) triplets of its structural non-zeros, for sparse
     /// factorisations. `out` is cleared first; its capacity is reused.
     pub fn phi_q_triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
@@ -951,6 +981,15 @@ mod phi_q_dot_jacobian_tests {
             let mut jref = DMatrix::zeros(m, n);
             sys.phi_q(&q, &mut jref);
             assert!((&jq - &jref).amax() < 1e-15);
+            let (mut p1, mut p2, mut d1, mut d2) =
+                (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+            sys.phi(&q, 0.7, &mut p1);
+            sys.phi_dot(&q, &v, 0.7, &mut d1);
+            sys.phi_and_phi_dot(&q, &v, 0.7, &mut p2, &mut d2);
+            for r in 0..m {
+                assert!((p1[r] - p2[r]).abs() < 1e-15);
+                assert!((d1[r] - d2[r]).abs() < 1e-13);
+            }
             let eps = 1e-6;
             let mut jp = DMatrix::zeros(m, n);
             let mut jm = DMatrix::zeros(m, n);
