@@ -295,7 +295,6 @@ impl Galerkin {
                 }
             }
         }
-        drop(jm);
         // constraint curvature at the interior control points
         for nu in 1..s {
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];

@@ -40,6 +40,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
+// index loops mirror the formulas (several arrays indexed together)
+#![allow(clippy::needless_range_loop)]
 
 mod calibrate;
 mod error;

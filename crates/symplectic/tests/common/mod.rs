@@ -1,0 +1,44 @@
+#![allow(dead_code)]
+use mbd_model::System;
+use mbd_solve::{Integrator, State};
+use mbd_symplectic::{Galerkin, SymplecticOptions};
+
+/// Least-squares slope of log(err) against log(h).
+pub fn slope(h: &[f64], e: &[f64]) -> f64 {
+    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
+    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
+    let n = x.len() as f64;
+    let mx = x.iter().sum::<f64>() / n;
+    let my = y.iter().sum::<f64>() / n;
+    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
+    sxy / sxx
+}
+
+/// Options with Newton converged to round-off (for measurements near the floor).
+pub fn tight(s: usize) -> SymplecticOptions {
+    let mut o = SymplecticOptions::new(s);
+    o.newton.tol = 1e-17;
+    o
+}
+
+/// Runs `n` steps of `h`; returns the final state and max |H - H0| over the run.
+pub fn run(sys: &System, s0: &State, opts: SymplecticOptions, h: f64, n: usize) -> (State, f64) {
+    let mut g = Galerkin::new(sys, opts).unwrap();
+    let mut st = s0.clone();
+    let h0 = sys.energy(st.q.as_slice(), st.v.as_slice());
+    let mut eh: f64 = 0.0;
+    for k in 1..=n {
+        g.step(sys, &mut st, h).unwrap();
+        st.t = s0.t + k as f64 * h;
+        eh = eh.max((sys.energy(st.q.as_slice(), st.v.as_slice()) - h0).abs());
+    }
+    (st, eh)
+}
+
+pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
