@@ -4,7 +4,7 @@
 //! and time-dependent loads are non-conservative and enter only the generalized force.
 
 use crate::body::BodyRef;
-use crate::jet::{dot, point, sub2, Scalar};
+use crate::jet::{dot, point, sub2, Frame, Scalar};
 use crate::timefn::TimeFunction;
 
 /// The kinds of force element.
@@ -170,7 +170,7 @@ impl Force {
 
     /// Potential energy of the conservative part, generic over the scalar type.
     #[inline]
-    pub(crate) fn potential<T: Scalar>(&self, qa: &[T; 3], qb: &[T; 3]) -> T {
+    pub(crate) fn potential<T: Scalar>(&self, qa: &Frame<T>, qb: &Frame<T>) -> T {
         match &self.kind {
             ForceKind::SpringDamper {
                 pa,
@@ -235,8 +235,8 @@ impl Force {
                 if *damping == 0.0 {
                     return;
                 }
-                let ja: [DirJet; 3] = std::array::from_fn(|i| DirJet::var(i, qa[i], va[i]));
-                let jb: [DirJet; 3] = std::array::from_fn(|i| DirJet::var(i + 3, qb[i], vb[i]));
+                let ja = Frame::new(std::array::from_fn(|i| DirJet::var(i, qa[i], va[i])));
+                let jb = Frame::new(std::array::from_fn(|i| DirJet::var(i + 3, qb[i], vb[i])));
                 let d = sub2(point(&jb, *pb), point(&ja, *pa));
                 if dot(d, d).v == 0.0 {
                     // coincident points: the line of action is undefined and the bounded

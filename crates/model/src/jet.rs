@@ -475,18 +475,57 @@ impl Scalar for Dual {
     }
 }
 
+/// A body's coordinates `(x, y, theta)` with `cos theta` and `sin theta` evaluated once, so the
+/// points and directions of one element share them (and ground costs no trigonometry).
+#[derive(Clone, Copy, Debug)]
+pub struct Frame<T> {
+    /// `(x, y, theta)`.
+    pub q: [T; 3],
+    /// `cos theta`.
+    pub c: T,
+    /// `sin theta`.
+    pub s: T,
+}
+
+impl<T: Scalar> Frame<T> {
+    /// A moving frame.
+    #[inline(always)]
+    pub fn new(q: [T; 3]) -> Self {
+        let (s, c) = q[2].sin_cos();
+        Frame { q, c, s }
+    }
+    /// The ground frame (identity, constant).
+    #[inline(always)]
+    pub fn fixed() -> Self {
+        Frame {
+            q: [T::cst(0.0); 3],
+            c: T::cst(1.0),
+            s: T::cst(0.0),
+        }
+    }
+}
+
+impl<T> std::ops::Index<usize> for Frame<T> {
+    type Output = T;
+    #[inline(always)]
+    fn index(&self, i: usize) -> &T {
+        &self.q[i]
+    }
+}
+
 /// A point fixed in a body frame, in global coordinates: `r + A(theta) s`.
 #[inline(always)]
-pub fn point<T: Scalar>(q: &[T; 3], s: [f64; 2]) -> [T; 2] {
-    let (sn, cs) = q[2].sin_cos();
-    [q[0] + cs * s[0] - sn * s[1], q[1] + sn * s[0] + cs * s[1]]
+pub fn point<T: Scalar>(f: &Frame<T>, s: [f64; 2]) -> [T; 2] {
+    [
+        f.q[0] + f.c * s[0] - f.s * s[1],
+        f.q[1] + f.s * s[0] + f.c * s[1],
+    ]
 }
 
 /// A direction fixed in a body frame, in global coordinates: `A(theta) u`.
 #[inline(always)]
-pub fn direction<T: Scalar>(q: &[T; 3], u: [f64; 2]) -> [T; 2] {
-    let (sn, cs) = q[2].sin_cos();
-    [cs * u[0] - sn * u[1], sn * u[0] + cs * u[1]]
+pub fn direction<T: Scalar>(f: &Frame<T>, u: [f64; 2]) -> [T; 2] {
+    [f.c * u[0] - f.s * u[1], f.s * u[0] + f.c * u[1]]
 }
 
 /// Dot product of two planar vectors.
@@ -506,8 +545,8 @@ mod tests {
     use super::*;
 
     fn f<T: Scalar>(x: [T; 6]) -> T {
-        let p = point(&[x[0], x[1], x[2]], [0.3, -0.2]);
-        let q = point(&[x[3], x[4], x[5]], [-0.1, 0.4]);
+        let p = point(&Frame::new([x[0], x[1], x[2]]), [0.3, -0.2]);
+        let q = point(&Frame::new([x[3], x[4], x[5]]), [-0.1, 0.4]);
         let d = sub2(q, p);
         dot(d, d).sqrt() * x[2] + x[0] * x[4]
     }

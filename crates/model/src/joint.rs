@@ -5,7 +5,7 @@
 //! `Phi_t = -f'(t)` and `Phi_tt = -f''(t)`.
 
 use crate::body::BodyRef;
-use crate::jet::{direction, dot, point, sub2, Scalar};
+use crate::jet::{direction, dot, point, sub2, Frame, Scalar};
 use crate::timefn::TimeFunction;
 use serde::{Deserialize, Serialize};
 
@@ -292,7 +292,7 @@ impl Joint {
 
     /// The time-free part `g(q_a, q_b)` of the equations, written once for every scalar type.
     #[inline]
-    pub(crate) fn eval<T: Scalar>(&self, qa: &[T; 3], qb: &[T; 3], out: &mut [T; 3]) {
+    pub(crate) fn eval<T: Scalar>(&self, qa: &Frame<T>, qb: &Frame<T>, out: &mut [T; 3]) {
         match &self.kind {
             JointKind::Revolute { pa, pb, .. } => {
                 let d = sub2(point(qa, *pa), point(qb, *pb));

@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyHandle, BodyRef};
 use crate::error::ModelError;
 use crate::force::{Force, ForceKind};
-use crate::jet::{DirJet, Dual, HessJet, Scalar, NV};
+use crate::jet::{DirJet, Dual, Frame, HessJet, Scalar, NV};
 use crate::joint::{Joint, JointKind};
 use nalgebra::{DMatrix, DVector, Vector2};
 
@@ -490,19 +490,28 @@ impl System {
         }
     }
     #[inline(always)]
-    fn loc_dir(q: &[f64], v: Option<&[f64]>, i: Option<usize>, slot: usize) -> [DirJet; 3] {
+    fn frm_f64(q: &[f64], i: Option<usize>) -> Frame<f64> {
         match i {
-            Some(i) => std::array::from_fn(|k| {
-                DirJet::var(slot + k, q[3 * i + k], v.map_or(0.0, |v| v[3 * i + k]))
-            }),
-            None => [DirJet::cst(0.0); 3],
+            Some(i) => Frame::new([q[3 * i], q[3 * i + 1], q[3 * i + 2]]),
+            None => Frame::fixed(),
         }
     }
     #[inline(always)]
-    fn loc_hess(q: &[f64], i: Option<usize>, slot: usize) -> [HessJet; 3] {
+    fn loc_dir(q: &[f64], v: Option<&[f64]>, i: Option<usize>, slot: usize) -> Frame<DirJet> {
         match i {
-            Some(i) => std::array::from_fn(|k| HessJet::var(slot + k, q[3 * i + k])),
-            None => [HessJet::cst(0.0); 3],
+            Some(i) => Frame::new(std::array::from_fn(|k| {
+                DirJet::var(slot + k, q[3 * i + k], v.map_or(0.0, |v| v[3 * i + k]))
+            })),
+            None => Frame::fixed(),
+        }
+    }
+    #[inline(always)]
+    fn loc_hess(q: &[f64], i: Option<usize>, slot: usize) -> Frame<HessJet> {
+        match i {
+            Some(i) => Frame::new(std::array::from_fn(|k| {
+                HessJet::var(slot + k, q[3 * i + k])
+            })),
+            None => Frame::fixed(),
         }
     }
     // ---------------------------------------------------------------- constraints
@@ -511,8 +520,8 @@ impl System {
     pub fn phi(&self, q: &[f64], t: f64, out: &mut [f64]) {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let qa = Self::loc_f64(q, at.a);
-            let qb = Self::loc_f64(q, at.b);
+            let qa = Self::frm_f64(q, at.a);
+            let qb = Self::frm_f64(q, at.b);
             let mut e = [0.0; 3];
             j.eval(&qa, &qb, &mut e);
             let o = self.row_offset[ji];
@@ -559,7 +568,7 @@ impl System {
 
     /// The constraint Jacobian `Phi_q` (m x n, dense) into `out` (overwritten).
     pub fn phi_q(&self, q: &[f64], out: &mut DMatrix<f64>) {
-        out.fill(0.0);
+        out.as_mut_slice().fill(0.0);
         for ji in 0..self.joints.len() {
             let e = self.joint_dir(ji, q, None);
             let o = self.row_offset[ji];
@@ -579,7 +588,7 @@ impl System {
         phi_q: &mut DMatrix<f64>,
         gamma: &mut [f64],
     ) {
-        phi_q.fill(0.0);
+        phi_q.as_mut_slice().fill(0.0);
         for (ji, j) in self.joints.iter().enumerate() {
             let e = self.joint_dir(ji, q, Some(v));
             let o = self.row_offset[ji];
@@ -602,7 +611,7 @@ impl System {
         phi_q: &mut DMatrix<f64>,
         out: &mut DMatrix<f64>,
     ) {
-        phi_q.fill(0.0);
+        phi_q.as_mut_slice().fill(0.0);
         out.fill(0.0);
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
@@ -658,10 +667,12 @@ impl System {
         phi: &mut [f64],
         phi_dot: &mut [f64],
     ) {
-        let loc = |i: Option<usize>| -> [Dual; 3] {
+        let loc = |i: Option<usize>| -> Frame<Dual> {
             match i {
-                Some(i) => std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k])),
-                None => [Dual::cst(0.0); 3],
+                Some(i) => Frame::new(std::array::from_fn(|k| {
+                    Dual::var(q[3 * i + k], v[3 * i + k])
+                })),
+                None => Frame::fixed(),
             }
         };
         for (ji, j) in self.joints.iter().enumerate() {
@@ -762,7 +773,7 @@ impl System {
         }
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
-            v += f.potential(&Self::loc_f64(q, at.a), &Self::loc_f64(q, at.b));
+            v += f.potential(&Self::frm_f64(q, at.a), &Self::frm_f64(q, at.b));
         }
         v
     }

@@ -97,22 +97,27 @@ impl AccelerationSolver {
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
         let (n, m) = (self.n, self.m);
-        let minv = sys.inv_mass_diag();
+        let minv = sys.inv_mass_diag().as_slice();
         // a_free = M^-1 Q
-        for i in 0..n {
-            self.w[i] = minv[i] * self.forces[i];
+        for ((w, &mi), &f) in self.w.iter_mut().zip(minv).zip(&self.forces) {
+            *w = mi * f;
         }
-        let j = &self.phi_q;
-        {
-            let mut s = self.chol.matrix_mut();
-            for c in 0..m {
-                for r in c..m {
-                    let mut acc = 0.0;
-                    for k in 0..n {
-                        acc += j[(r, k)] * minv[k] * j[(c, k)];
-                    }
-                    s[(r, c)] = acc;
-                }
+        // Phi_q is column-major m x n: column k holds d Phi / d q_k.
+        let jac = self.phi_q.as_slice();
+        // S = sum_k minv_k col_k col_k^T (lower triangle), rhs = Phi_q a_free - gamma
+        self.chol.clear();
+        for (lr, g) in lambda.iter_mut().zip(&self.gamma) {
+            *lr = -g;
+        }
+        for k in 0..n {
+            let col = &jac[k * m..(k + 1) * m];
+            if col.iter().all(|&x| x == 0.0) {
+                continue;
+            }
+            self.chol.add_rank_one(minv[k], col);
+            let wk = self.w[k];
+            for (lr, &c) in lambda.iter_mut().zip(col) {
+                *lr += c * wk;
             }
         }
         self.chol.factor_in_place().map_err(|e| {
@@ -126,21 +131,11 @@ impl AccelerationSolver {
                 detail: sys.equation_name(i),
             }
         })?;
-        // rhs = Phi_q M^-1 Q - gamma
-        for r in 0..m {
-            let mut acc = 0.0;
-            for k in 0..n {
-                acc += j[(r, k)] * self.w[k];
-            }
-            lambda[r] = acc - self.gamma[r];
-        }
         self.chol.solve_in_place(lambda);
         for k in 0..n {
-            let mut acc = 0.0;
-            for r in 0..m {
-                acc += j[(r, k)] * lambda[r];
-            }
-            a[k] = self.w[k] - minv[k] * acc;
+            let col = &jac[k * m..(k + 1) * m];
+            let dot: f64 = col.iter().zip(lambda.iter()).map(|(c, l)| c * l).sum();
+            a[k] = self.w[k] - minv[k] * dot;
         }
         Ok(())
     }
