@@ -9,6 +9,7 @@
 //! | [`model`] | bodies, joints, forces, `System` (Phi, Phi_q, gamma, Hessians, energy), model files |
 //! | [`solve`] | the `Integrator` trait, run loop, observers, Newton, index-1 solve, tableaus |
 //! | [`rk4`] | RK4 baseline (optional Baumgarte / projection) |
+//! | [`symplectic`] | paper A: (s,s) constrained Galerkin variational integrator, preadjusted gamma |
 //! | [`analysis`] | energy/constraint errors, trajectory errors, convergence orders, CSV/JSON |
 //!
 //! ```
@@ -32,3 +33,4 @@ pub use mbd_analysis as analysis;
 pub use mbd_model as model;
 pub use mbd_rk4 as rk4;
 pub use mbd_solve as solve;
+pub use mbd_symplectic as symplectic;

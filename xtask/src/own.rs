@@ -9,6 +9,7 @@ use mbd_rk4::{Rk4, Rk4Options};
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Integrator, NoObserver, RunConfig, SolveError, State,
 };
+use mbd_symplectic::{Galerkin, SymplecticOptions};
 use serde_json::json;
 use std::time::Instant;
 
@@ -34,6 +35,16 @@ pub fn solvers() -> Vec<SolverSpec> {
             name: "RK4 (index-1, projection)",
             order: 4.0,
             make: |s| Ok(Box::new(Rk4::new(s, Rk4Options::projected())?)),
+        },
+        SolverSpec {
+            name: "symplectic (1,1)",
+            order: 2.0,
+            make: |s| Ok(Box::new(Galerkin::new(s, SymplecticOptions::new(1))?)),
+        },
+        SolverSpec {
+            name: "symplectic (2,2)",
+            order: 4.0,
+            make: |s| Ok(Box::new(Galerkin::new(s, SymplecticOptions::new(2))?)),
         },
     ]
 }
