@@ -1,10 +1,11 @@
 //! The (s,s) constrained Galerkin variational integrator, optionally preadjusted.
 
+use crate::lu::SmallLu;
 use crate::options::{kappa, Nodes, SymplecticOptions};
 use crate::preadjust::Preadjustment;
 use crate::tables::Tables;
 use mbd_model::System;
-use mbd_solve::linalg::{DenseCholesky, DenseLu, FactorError};
+use mbd_solve::linalg::DenseCholesky;
 use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
 use nalgebra::DMatrix;
 
@@ -30,7 +31,7 @@ pub struct Galerkin {
     dx: Vec<f64>,
     r: Vec<f64>,
     xt: Vec<f64>,
-    lu: DenseLu,
+    lu: SmallLu,
     qk: Vec<f64>,
     hvk: Vec<f64>,
     qn: Vec<f64>,
@@ -58,6 +59,11 @@ pub struct Galerkin {
     hist_q: Vec<f64>,
     hist_x: Vec<f64>,
     gk: f64,
+    has_forces: bool,
+    jac_valid: bool,
+    jac_h: f64,
+    jac_gk: f64,
+    jacobians: usize,
 }
 
 fn norm_inf(x: &[f64]) -> f64 {
@@ -98,7 +104,7 @@ impl Galerkin {
             dx: vec![0.0; dim],
             r: vec![0.0; dim],
             xt: vec![0.0; dim],
-            lu: DenseLu::new(dim),
+            lu: SmallLu::new(dim),
             qk: vec![0.0; n],
             hvk: vec![0.0; n],
             qn: vec![0.0; (s + 1) * n],
@@ -126,6 +132,11 @@ impl Galerkin {
             hist_q: vec![0.0; n],
             hist_x: vec![0.0; dim],
             gk: 0.0,
+            has_forces: !sys.forces().is_empty(),
+            jac_valid: false,
+            jac_h: f64::NAN,
+            jac_gk: f64::NAN,
+            jacobians: 0,
         })
     }
 
@@ -152,6 +163,11 @@ impl Galerkin {
     /// The effective preadjustment factor `gamma kappa_s h^(2s)` of the last step.
     pub fn preadjustment_factor(&self) -> f64 {
         self.gk
+    }
+
+    /// Number of Jacobian evaluations (and LU factorisations) since the integrator was built.
+    pub fn jacobian_count(&self) -> usize {
+        self.jacobians
     }
 
     /// Residual of the stage equations at `self.x` into `self.r`.
@@ -241,7 +257,11 @@ impl Galerkin {
         sys.phi_q(&self.qn[s * n..(s + 1) * n], &mut self.phiq[s]);
         for j in 0..s {
             let qj = &self.qj[j * n..(j + 1) * n];
-            sys.potential_hessian(qj, &mut self.hq[j]);
+            if self.has_forces {
+                sys.potential_hessian(qj, &mut self.hq[j]);
+            } else {
+                self.hq[j].fill(0.0);
+            }
             if let Some(pre) = &mut self.pre {
                 pre.approximate_hessian(sys, qj, &mut self.wh)
                     .map_err(|e| with_time(e, t))?;
@@ -257,18 +277,15 @@ impl Galerkin {
         }
         let h2 = h * h;
         let tab = &self.tab;
-        let mut jm = self.lu.matrix_mut();
-        for c in 0..self.dim {
-            for r in 0..self.dim {
-                jm[(r, c)] = 0.0;
-            }
-        }
+        let dim = self.dim;
+        let jm = &mut self.lu.a;
+        jm.iter_mut().for_each(|x| *x = 0.0);
         for nu in 0..s {
             for mu in 1..=s {
                 let (ro, co) = (nu * n, (mu - 1) * n);
                 let kk = tab.k[nu * s1 + mu];
                 for i in 0..n {
-                    jm[(ro + i, co + i)] += kk;
+                    jm[(ro + i) * dim + co + i] += kk;
                 }
                 for j in 0..s {
                     if !self.hess_nz[j] {
@@ -282,7 +299,7 @@ impl Galerkin {
                             if self.nonconservative {
                                 v += cv * self.hv[j][(i, l)];
                             }
-                            jm[(ro + i, co + l)] -= h2 * self.minv[i] * v;
+                            jm[(ro + i) * dim + co + l] -= h2 * self.minv[i] * v;
                         }
                     }
                 }
@@ -291,7 +308,7 @@ impl Galerkin {
             let co = s * n + nu * m;
             for r in 0..m {
                 for i in 0..n {
-                    jm[(nu * n + i, co + r)] = -h2 * self.minv[i] * self.phiq[nu][(r, i)];
+                    jm[(nu * n + i) * dim + co + r] = -h2 * self.minv[i] * self.phiq[nu][(r, i)];
                 }
             }
         }
@@ -299,37 +316,34 @@ impl Galerkin {
         for nu in 1..s {
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
             sys.constraint_hessian(&self.qn[nu * n..(nu + 1) * n], lam, &mut self.hc);
-            let mut jm = self.lu.matrix_mut();
+            let jm = &mut self.lu.a;
             let o = (nu - 1) * n;
             for l in 0..n {
                 for i in 0..n {
-                    jm[(nu * n + i, o + l)] -= h2 * self.minv[i] * self.hc[(i, l)];
+                    jm[(nu * n + i) * dim + o + l] -= h2 * self.minv[i] * self.hc[(i, l)];
                 }
             }
         }
         {
-            let mut jm = self.lu.matrix_mut();
+            let jm = &mut self.lu.a;
             for nu in 1..=s {
                 let ro = s * n + (nu - 1) * m;
                 let co = (nu - 1) * n;
                 for r in 0..m {
                     for l in 0..n {
-                        jm[(ro + r, co + l)] = self.phiq[nu][(r, l)];
+                        jm[(ro + r) * dim + co + l] = self.phiq[nu][(r, l)];
                     }
                 }
             }
         }
-        self.lu.factor_in_place().map_err(|e| {
-            let i = match e {
-                FactorError::Singular(i) | FactorError::NotPositiveDefinite(i) => i,
-            };
-            SolveError::Singular {
-                t,
-                what: "Jacobian of the symplectic stage equations",
-                detail: format!(
-                    "pivot {i} (h = {h}; redundant constraints or a singular configuration)"
-                ),
-            }
+        self.jacobians += 1;
+        self.jac_valid = false;
+        self.lu.factor().map_err(|i| SolveError::Singular {
+            t,
+            what: "Jacobian of the symplectic stage equations",
+            detail: format!(
+                "pivot {i} (h = {h}; redundant constraints or a singular configuration)"
+            ),
         })
     }
 
@@ -435,20 +449,38 @@ impl Galerkin {
         if !res.is_finite() {
             return Err(fail(res, 0, self.tab.s));
         }
+        // simplified Newton: one Jacobian per step (or the last step's, if reuse is on), kept
+        // while it contracts by 4x per iteration, recomputed every `jacobian_every` iterations
+        let mut need_jacobian = !(self.opts.reuse_jacobian
+            && self.jac_valid
+            && (self.jac_h - h).abs() <= 1e-12 * h
+            && self.jac_gk == self.gk);
+        let mut chord = !need_jacobian;
+        let mut since_jacobian = 0usize;
+        let mut prev_step = f64::INFINITY;
         while res > tol {
             if it >= o.max_iter {
                 return Err(fail(res, it, self.tab.s));
             }
-            if it % o.jacobian_every == 0 {
+            if need_jacobian || since_jacobian >= o.jacobian_every {
                 self.jacobian(sys, t, h)?;
+                self.jac_valid = true;
+                self.jac_h = h;
+                self.jac_gk = self.gk;
+                since_jacobian = 0;
+                need_jacobian = false;
+                chord = false;
+                prev_step = f64::INFINITY;
             }
+            since_jacobian += 1;
             for i in 0..self.dim {
                 self.dx[i] = -self.r[i];
             }
-            self.lu.solve_in_place(&mut self.dx);
+            self.lu.solve(&mut self.dx);
             self.xt.copy_from_slice(&self.x);
             let mut lambda = 1.0;
             let mut halvings = 0;
+            let res_before = res;
             loop {
                 for i in 0..self.dim {
                     self.x[i] = self.xt[i] + lambda * self.dx[i];
@@ -464,10 +496,24 @@ impl Galerkin {
                 halvings += 1;
             }
             it += 1;
+            let step = lambda * norm_inf(&self.dx[..sn]);
+            let poor = step > 0.25 * prev_step && step > 1e3 * f64::EPSILON * qscale;
+            if poor || !res.is_finite() || (chord && res > res_before) {
+                // the Jacobian does not contract well: recompute it here
+                need_jacobian = true;
+                if !res.is_finite() || res > res_before {
+                    self.x.copy_from_slice(&self.xt);
+                    self.residual(sys, t, h)?;
+                    evals += 1;
+                    res = norm_inf(&self.r);
+                }
+                prev_step = f64::INFINITY;
+                continue;
+            }
+            prev_step = step;
             if !res.is_finite() {
                 return Err(fail(res, it, self.tab.s));
             }
-            let step = lambda * norm_inf(&self.dx[..sn]);
             if step <= o.step_tol * qscale {
                 // stagnated at round-off: accept if the residual is sane
                 if res <= 1e-8 * qscale {
@@ -515,6 +561,7 @@ impl Integrator for Galerkin {
 
     fn reset(&mut self) {
         self.hist_valid = false;
+        self.jac_valid = false;
     }
 
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
@@ -648,7 +695,7 @@ mod tests {
                 .zip(&g.r)
                 .map(|(a, b)| (a - b) / (2.0 * d))
                 .collect();
-            g.lu.solve_in_place(&mut col);
+            g.lu.solve(&mut col);
             for (i, c) in col.iter().enumerate() {
                 let e = if i == k { 1.0 } else { 0.0 };
                 worst = worst.max((c - e).abs());

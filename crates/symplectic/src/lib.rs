@@ -46,6 +46,7 @@
 mod calibrate;
 mod error;
 mod galerkin;
+mod lu;
 mod options;
 mod preadjust;
 mod tables;

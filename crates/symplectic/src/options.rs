@@ -30,12 +30,18 @@ pub struct SymplecticOptions {
     /// Newton settings for the stage equations. `tol` bounds the max-norm of the scaled residual
     /// (displacement units, relative to `1 + ||q||_inf`); the iteration also stops when an update
     /// is below `step_tol (1 + ||q||_inf)`; `max_iter` limits the iterations; `max_halvings`
-    /// allows backtracking on the residual norm; `jacobian_every` > 1 keeps the Jacobian for that
-    /// many iterations (simplified Newton).
+    /// allows backtracking on the residual norm; the Jacobian is evaluated at the predictor and
+    /// kept (simplified Newton) for up to `jacobian_every` iterations while each iteration
+    /// shrinks the update at least 4x (`jacobian_every = 1`: full Newton; default 6).
     pub newton: NewtonOptions,
     /// Relative step of the central differences used for the third derivatives of `V` and `Phi`
     /// in `grad W_s` (`s >= 2` with `gamma != 0`), Richardson-extrapolated (error `O(eps^4)`).
     pub fd_step: f64,
+    /// Start a step with the factored Jacobian of the previous step (same `h`) instead of a new
+    /// one; it is recomputed as soon as the simplified Newton iteration contracts by less than
+    /// 4x per iteration. Default off (one Jacobian per step, at the predictor). The converged solution does not depend on it (to the
+    /// Newton tolerance).
+    pub reuse_jacobian: bool,
 }
 
 impl Default for SymplecticOptions {
@@ -49,9 +55,10 @@ impl Default for SymplecticOptions {
                 step_tol: 1e-15,
                 max_iter: 25,
                 max_halvings: 0,
-                jacobian_every: 1,
+                jacobian_every: 6,
             },
             fd_step: 2e-3,
+            reuse_jacobian: false,
         }
     }
 }

@@ -1,0 +1,36 @@
+//! Steps the (2,2) scheme on the manipulator in a loop (for profiling) and prints the time per
+//! step and the Newton work.
+use mbd_model::models;
+use mbd_solve::{Integrator, State};
+use mbd_symplectic::{Galerkin, SymplecticOptions};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let s: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(2);
+    let sys = models::manipulator()?;
+    let s0 = State::consistent(&sys, 0.0)?;
+    let mut g = Galerkin::new(&sys, SymplecticOptions::new(s))?;
+    let mut st = s0.clone();
+    let (mut it, mut ev) = (0usize, 0usize);
+    let n = 200_000;
+    let t0 = std::time::Instant::now();
+    for _ in 0..n {
+        if st.t > 10.0 {
+            st = s0.clone();
+        }
+        let r = g.step(&sys, &mut st, 0.01)?;
+        it += r.newton_iterations;
+        ev += r.rhs_evals;
+    }
+    let dt = t0.elapsed().as_secs_f64() / n as f64;
+    println!(
+        "({s},{s}): {:.3} us/step, {:.2} iterations, {:.2} residuals, {:.3} Jacobians per step",
+        dt * 1e6,
+        it as f64 / n as f64,
+        ev as f64 / n as f64,
+        g.jacobian_count() as f64 / n as f64
+    );
+    Ok(())
+}
