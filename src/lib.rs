@@ -34,3 +34,7 @@ pub use mbd_model as model;
 pub use mbd_rk4 as rk4;
 pub use mbd_solve as solve;
 pub use mbd_symplectic as symplectic;
+
+/// The README's usage example, compiled and run as a doctest.
+#[doc = include_str!("../README.md")]
+mod readme {}
