@@ -1,0 +1,41 @@
+//! `Integrator::step` allocates nothing (counting global allocator), for s = 1, 2 and with the
+//! preadjustment on.
+use mbd_model::models;
+use mbd_solve::{Integrator, State};
+use mbd_symplectic::{Galerkin, SymplecticOptions};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+struct Counting;
+thread_local! {
+    // per thread: the test harness allocates on its own threads meanwhile
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { System.dealloc(p, l) }
+    }
+}
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn steps_allocate_nothing() {
+    let sys = models::manipulator().unwrap();
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    for (s, gamma) in [(1, 0.0), (2, 0.0), (3, 0.0), (2, 1.0)] {
+        let mut g = Galerkin::new(&sys, SymplecticOptions::new(s).with_gamma(gamma)).unwrap();
+        let mut st = s0.clone();
+        g.step(&sys, &mut st, 0.01).unwrap();
+        let before = ALLOCS.with(|c| c.get());
+        for _ in 0..100 {
+            g.step(&sys, &mut st, 0.01).unwrap();
+        }
+        let n = ALLOCS.with(|c| c.get()) - before;
+        assert_eq!(n, 0, "s={s} gamma={gamma}: {n} allocations in 100 steps");
+    }
+}
