@@ -1,0 +1,707 @@
+//! The local chart of the constraint manifold at an accepted point (paper B's "local
+//! parameterisation"), allocation-free after [`TangentChart::new`].
+
+use mbd_model::System;
+use mbd_solve::SolveError;
+use nalgebra::DMatrix;
+
+/// Settings of the chord Newton iteration that maps chart coordinates to the manifold.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSettings {
+    /// Converged when `||f(x(xi), t)||_inf <= tol` (position and velocity constraints).
+    pub tol: f64,
+    /// Iteration limit; reaching it is a [`ChartFailure`].
+    pub max_iter: usize,
+    /// Divergence test: an iteration whose residual exceeds `divergence` times the previous one
+    /// ends the iteration with a [`ChartFailure`] (the point has left the chart's domain).
+    pub divergence: f64,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        NewtonSettings {
+            tol: 1e-13,
+            max_iter: 30,
+            divergence: 2.0,
+        }
+    }
+}
+
+impl NewtonSettings {
+    /// Checks the settings: `tol` positive and finite, `max_iter >= 1`, `divergence >= 1`.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        if !(self.tol.is_finite() && self.tol > 0.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "newton.tol",
+                value: self.tol,
+                reason: "must be positive and finite",
+            });
+        }
+        if self.max_iter == 0 {
+            return Err(SolveError::InvalidParameter {
+                parameter: "newton.max_iter",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
+        }
+        if !(self.divergence.is_finite() && self.divergence >= 1.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "newton.divergence",
+                value: self.divergence,
+                reason: "must be finite and at least 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The chord Newton iteration of a chart map did not converge: the point `xi` lies outside the
+/// chart's domain (step too large, or a singular configuration near).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChartFailure {
+    /// Time at which the map was evaluated.
+    pub t: f64,
+    /// `||f||_inf` when the iteration stopped (may be NaN or infinite).
+    pub residual: f64,
+    /// Iterations done.
+    pub iterations: usize,
+}
+
+impl ChartFailure {
+    /// The failure as a [`SolveError::Newton`] with context `"tangent chart"`.
+    pub fn into_error(self) -> SolveError {
+        SolveError::Newton {
+            t: self.t,
+            residual: self.residual,
+            iterations: self.iterations,
+            context: "tangent chart (chord Newton on f(x(xi)) = 0)".into(),
+        }
+    }
+}
+
+/// What a successful chart map did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MapStats {
+    /// Chord Newton iterations.
+    pub iterations: usize,
+    /// Final `||f||_inf`.
+    pub residual: f64,
+}
+
+/// A chart of the manifold `f(x, t) = (Phi(q, t), Phi_q v + Phi_t) = 0` at a centre
+/// `x_c = (q_c, v_c)`:
+///
+/// ```text
+/// x(xi, zeta) = x_c + U xi + Q1 zeta,   Df(x_c)^T = Q1 R  (thin QR),   [Q1 U] orthogonal,
+/// ```
+///
+/// with `U` (`2n x 2(n-m)`) an orthonormal basis of `ker Df(x_c)` and `zeta` (= `R eta` of the
+/// paper's `Df(x_c)^T eta`) from a chord Newton iteration on `f(x(xi, zeta), t) = 0`:
+/// `x <- x - Q1 J^-1 f`. With `J = R^T = Df(x_c) Q1` this is the paper's
+/// `eta <- eta - (Df Df^T)^-1 f` (since `Df Df^T = R^T R`), written without forming
+/// `Df Df^T`; [`TangentChart::select_iteration_matrix`] offers a better `J` for points away from
+/// the centre. The correction matrices (`Q1 R^-T`, `2n x 2m`) are formed once per chart, so an
+/// iteration costs one residual evaluation and one or two `2n x 2m` products.
+///
+/// The QR factorisation is a Householder QR on preallocated buffers that skips the zero lower
+/// half of the first `m` columns of `Df^T`; the full orthogonal factor `Q = [Q1 U]` is
+/// accumulated explicitly (`docs/tangent.md` explains why this is not faer's blocked QR: for the
+/// small dense `Df^T` of a planar mechanism it is several times faster). Everything lives in
+/// buffers allocated by [`TangentChart::new`].
+#[derive(Clone, Debug)]
+pub struct TangentChart {
+    n: usize,
+    m: usize,
+    /// `Phi_q(q_c)`.
+    phi_q: DMatrix<f64>,
+    /// `(Phi_q v_c)_q` at `q_c`.
+    dphi: DMatrix<f64>,
+    /// `Df(x_c)^T` (`2n x 2m`, column-major), overwritten by the QR factors: `R` in the upper
+    /// triangle, the Householder vectors (unit leading entry implied) below.
+    a: Vec<f64>,
+    /// Householder coefficients.
+    tau: Vec<f64>,
+    /// `Q = [Q1 U]` (`2n x 2n`, column-major).
+    q: Vec<f64>,
+    /// The centre `(q_c, v_c)`.
+    xc: Vec<f64>,
+    /// Time of the centre.
+    tc: f64,
+    /// Residual buffer `f` (`2m`).
+    f: Vec<f64>,
+    /// `Phi_q` and `(Phi_q v)_q` at the secondary point `x_e`.
+    pq_e: DMatrix<f64>,
+    dphi_e: DMatrix<f64>,
+    /// `E = (Df(x_e) - Df(x_c)) Q1` (`2m x 2m`, column-major), valid if `has_e`.
+    e: Vec<f64>,
+    has_e: bool,
+    /// `R^-1` (`2m x 2m`, column-major, upper triangular).
+    rinv: Vec<f64>,
+    /// `P0 = Q1 R^-T` (`2n x 2m`, column-major).
+    p0: Vec<f64>,
+    /// `K = E R^-T` (`2m x 2m`, column-major): `J_s = (I + s K) R^T`.
+    k: Vec<f64>,
+    /// Work vectors of the iteration (`2m`).
+    u: Vec<f64>,
+    w: Vec<f64>,
+    /// The interpolation parameter of the active iteration matrix (0: the centre's).
+    s: f64,
+    /// Relative threshold on the diagonal of `R` below which `Df(x_c)` counts as rank deficient.
+    pub singular_tol: f64,
+    centred: bool,
+}
+
+impl TangentChart {
+    /// A chart workspace for `sys` (allocates once).
+    pub fn new(sys: &System) -> Self {
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let (nn, mm) = (2 * n, 2 * m);
+        let mut q = vec![0.0; nn * nn];
+        for i in 0..nn {
+            q[i * nn + i] = 1.0;
+        }
+        TangentChart {
+            n,
+            m,
+            phi_q: DMatrix::zeros(m, n),
+            dphi: DMatrix::zeros(m, n),
+            a: vec![0.0; nn * mm],
+            tau: vec![0.0; mm],
+            q,
+            xc: vec![0.0; nn],
+            tc: 0.0,
+            f: vec![0.0; mm],
+            pq_e: DMatrix::zeros(m, n),
+            dphi_e: DMatrix::zeros(m, n),
+            e: vec![0.0; mm * mm],
+            has_e: false,
+            rinv: vec![0.0; mm * mm],
+            p0: vec![0.0; nn * mm],
+            k: vec![0.0; mm * mm],
+            u: vec![0.0; mm],
+            w: vec![0.0; mm],
+            s: 0.0,
+            singular_tol: 1e-8,
+            centred: false,
+        }
+    }
+
+    /// Dimension of the chart, `2 (n - m)`: twice the degrees of freedom.
+    pub fn dim(&self) -> usize {
+        2 * (self.n - self.m)
+    }
+
+    /// Dimension of the ambient space, `2n`.
+    pub fn ambient_dim(&self) -> usize {
+        2 * self.n
+    }
+
+    /// Number of constraint equations of `f`, `2m`.
+    pub fn codim(&self) -> usize {
+        2 * self.m
+    }
+
+    /// The centre `x_c = (q_c, v_c)` (length `2n`).
+    pub fn centre_point(&self) -> &[f64] {
+        &self.xc
+    }
+
+    /// Time at which the chart was centred.
+    pub fn centre_time(&self) -> f64 {
+        self.tc
+    }
+
+    #[inline]
+    fn col(&self, k: usize) -> &[f64] {
+        let nn = 2 * self.n;
+        &self.q[k * nn..(k + 1) * nn]
+    }
+
+    /// Column `k` of the tangent basis `U` (`k < dim()`), a unit vector of length `2n`.
+    pub fn tangent(&self, k: usize) -> &[f64] {
+        self.col(2 * self.m + k)
+    }
+
+    /// Column `k` of the normal basis `Q1` (`k < 2m`): an orthonormal basis of the range of
+    /// `Df(x_c)^T`.
+    pub fn normal(&self, k: usize) -> &[f64] {
+        self.col(k)
+    }
+
+    /// Entry `(i, j)` of the triangular factor `R` (`2m x 2m`) of `Df(x_c)^T = Q1 R`.
+    pub fn r(&self, i: usize, j: usize) -> f64 {
+        if i > j {
+            0.0
+        } else {
+            self.a[j * 2 * self.n + i]
+        }
+    }
+
+    /// `Df(x_c) = [[Phi_q, 0], [(Phi_q v)_q, Phi_q]]` as a dense `2m x 2n` matrix (allocates; for
+    /// tests and diagnostics).
+    pub fn jacobian(&self) -> DMatrix<f64> {
+        let (n, m) = (self.n, self.m);
+        let mut d = DMatrix::zeros(2 * m, 2 * n);
+        for r in 0..m {
+            for c in 0..n {
+                d[(r, c)] = self.phi_q[(r, c)];
+                d[(m + r, c)] = self.dphi[(r, c)];
+                d[(m + r, n + c)] = self.phi_q[(r, c)];
+            }
+        }
+        d
+    }
+
+    /// Centres the chart at `(q, v)` at time `t`: evaluates `Df`, factors `Df^T = Q1 R` and forms
+    /// `Q = [Q1 U]`. A rank-deficient `Df` (redundant constraints or a singular configuration) is
+    /// [`SolveError::Singular`] naming the first dependent equation. Resets the iteration
+    /// matrix to the centre's.
+    pub fn centre(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) -> Result<(), SolveError> {
+        let (n, m) = (self.n, self.m);
+        let (nn, mm) = (2 * n, 2 * m);
+        self.centred = false;
+        self.has_e = false;
+        self.s = 0.0;
+        if q.len() != n || v.len() != n {
+            return Err(SolveError::Dimension {
+                what: "chart centre (q, v)",
+                expected: n,
+                got: if q.len() != n { q.len() } else { v.len() },
+            });
+        }
+        self.xc[..n].copy_from_slice(q);
+        self.xc[n..].copy_from_slice(v);
+        self.tc = t;
+        if m == 0 {
+            self.centred = true;
+            return Ok(());
+        }
+        sys.phi_q_dot_jacobian(q, v, &mut self.phi_q, &mut self.dphi);
+        // Df^T = [[Phi_q^T, dphi^T], [0, Phi_q^T]], column-major 2n x 2m
+        for k in 0..m {
+            let (ca, cb) = self.a.split_at_mut((m + k) * nn);
+            let ca = &mut ca[k * nn..(k + 1) * nn];
+            let cb = &mut cb[..nn];
+            for c in 0..n {
+                let p = self.phi_q[(k, c)];
+                ca[c] = p;
+                ca[n + c] = 0.0;
+                cb[c] = self.dphi[(k, c)];
+                cb[n + c] = p;
+            }
+        }
+        if self.a.iter().any(|x| !x.is_finite()) {
+            return Err(SolveError::NonFinite {
+                t,
+                what: "constraint Jacobian at the chart centre",
+            });
+        }
+        householder_qr(&mut self.a, &mut self.tau, nn, mm, m, n);
+        let dmax = (0..mm).fold(0.0f64, |d, i| d.max(self.a[i * nn + i].abs()));
+        for i in 0..mm {
+            let rii = self.a[i * nn + i].abs();
+            if rii.is_nan() || rii <= self.singular_tol * dmax {
+                let detail = if i < m {
+                    format!("position constraint {}", sys.equation_name(i))
+                } else {
+                    format!("velocity constraint {}", sys.equation_name(i - m))
+                };
+                return Err(SolveError::Singular {
+                    t,
+                    what: "constraint Jacobian Df of the tangent chart",
+                    detail,
+                });
+            }
+        }
+        form_q(&self.a, &self.tau, nn, mm, m, n, &mut self.q);
+        // R^-1 by back substitution, column by column (diagonal first: 1 / R_ii)
+        self.rinv.fill(0.0);
+        for i in 0..mm {
+            self.rinv[i * mm + i] = 1.0 / self.a[i * nn + i];
+        }
+        for j in 0..mm {
+            for i in (0..j).rev() {
+                let mut acc = 0.0;
+                for k in i + 1..=j {
+                    acc -= self.a[k * nn + i] * self.rinv[j * mm + k];
+                }
+                self.rinv[j * mm + i] = acc * self.rinv[i * mm + i];
+            }
+        }
+        // P0 = Q1 R^-T: column k = sum_{j >= k} (R^-1)_{kj} Q1_j
+        self.p0.fill(0.0);
+        for k in 0..mm {
+            for j in k..mm {
+                let c = self.rinv[j * mm + k];
+                let (p0, q) = (
+                    &mut self.p0[k * nn..(k + 1) * nn],
+                    &self.q[j * nn..(j + 1) * nn],
+                );
+                axpy(c, q, p0);
+            }
+        }
+        self.centred = true;
+        Ok(())
+    }
+
+    /// Whether [`TangentChart::centre`] succeeded since the last attempt.
+    pub fn is_centred(&self) -> bool {
+        self.centred
+    }
+
+    /// Evaluates `Df` at a second point `x_e` (typically the Euler prediction `x_c + h F(x_c)` of
+    /// the step's end point) and stores `E = (Df(x_e) - Df(x_c)) Q1`, so that
+    /// [`TangentChart::select_iteration_matrix`] can interpolate the Newton matrix along the
+    /// step. A non-finite `Df(x_e)` leaves the chart with the centre matrix `R^T` only.
+    pub fn set_secondary_point(&mut self, sys: &System, x_e: &[f64]) {
+        let (n, m) = (self.n, self.m);
+        let (nn, mm) = (2 * n, 2 * m);
+        self.has_e = false;
+        self.s = 0.0;
+        if m == 0 || x_e.len() != nn || !self.centred {
+            return;
+        }
+        sys.phi_q_dot_jacobian(&x_e[..n], &x_e[n..], &mut self.pq_e, &mut self.dphi_e);
+        // Delta Df = [[dP, 0], [dX, dP]] with dP = Phi_q(e) - Phi_q(c), dX likewise
+        self.pq_e -= &self.phi_q;
+        self.dphi_e -= &self.dphi;
+        for k in 0..mm {
+            let col = &self.q[k * nn..(k + 1) * nn];
+            let (cq, cv) = col.split_at(n);
+            let ek = &mut self.e[k * mm..(k + 1) * mm];
+            for r in 0..m {
+                let mut p = 0.0;
+                let mut x = 0.0;
+                let mut pv = 0.0;
+                for c in 0..n {
+                    let dp = self.pq_e[(r, c)];
+                    p += dp * cq[c];
+                    x += self.dphi_e[(r, c)] * cq[c];
+                    pv += dp * cv[c];
+                }
+                ek[r] = p;
+                ek[m + r] = x + pv;
+            }
+        }
+        if !self.e.iter().all(|x| x.is_finite()) {
+            return;
+        }
+        // K = E R^-T: column k = sum_{j >= k} (R^-1)_{kj} E_j
+        self.k.fill(0.0);
+        for k in 0..mm {
+            for j in k..mm {
+                let c = self.rinv[j * mm + k];
+                let (kk, e) = (
+                    &mut self.k[k * mm..(k + 1) * mm],
+                    &self.e[j * mm..(j + 1) * mm],
+                );
+                axpy(c, e, kk);
+            }
+        }
+        self.has_e = true;
+    }
+
+    /// Chooses the matrix `J` of the chord iteration for the next maps: `R^T = Df(x_c) Q1` if
+    /// `s` is 0 or no secondary point is set, else `J_s = R^T + s E`, the linear interpolation of
+    /// `Df Q1` between the centre (`s = 0`) and the secondary point (`s = 1`); for a stage at
+    /// `t_c + c h` pass `s = c`. With `K = E R^-T`, `J_s = (I + s K) R^T`, and the iteration
+    /// applies `J_s^-1 = R^-T (I + s K)^-1` through the expansion
+    /// `(I + s K)^-1 ~ I - s K + s^2 K^2` (`|s K| = O(h)`, so the neglected `O(h^3)` is below the
+    /// `O(h^2)` interpolation error): `x <- x - P0 (f - s K f + s^2 K K f)` with `P0 = Q1 R^-T`
+    /// formed once per chart and `K` once per step. Whatever the matrix, the iteration converges
+    /// to the same point of the chart: the matrix only sets its speed.
+    pub fn select_iteration_matrix(&mut self, s: f64) {
+        self.s = if self.has_e && s.is_finite() { s } else { 0.0 };
+    }
+
+    /// `f(x, t) = (Phi(q, t), Phi_q v + Phi_t)` into `out` (length `2m`); returns its max-norm
+    /// (NaN if any entry is not finite).
+    pub fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        let (p, pd) = out[..2 * m].split_at_mut(m);
+        sys.phi_and_phi_dot(q, v, t, p, pd);
+        let mut r = 0.0f64;
+        for &e in out[..2 * m].iter() {
+            if !e.is_finite() {
+                return f64::NAN;
+            }
+            r = r.max(e.abs());
+        }
+        r
+    }
+
+    /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
+    pub fn point(&self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
+        let mm = 2 * self.m;
+        x.copy_from_slice(&self.xc);
+        for (k, &z) in zeta.iter().enumerate() {
+            if z != 0.0 {
+                axpy(z, self.col(k), x);
+            }
+        }
+        for (k, &s) in xi.iter().enumerate() {
+            if s != 0.0 {
+                axpy(s, self.col(mm + k), x);
+            }
+        }
+    }
+
+    /// Maps chart coordinates `xi` (length [`TangentChart::dim`]) to the point `x` (length
+    /// `2n`) of the manifold at time `t`: `x = x_c + U xi + Q1 zeta` with `zeta` from chord
+    /// Newton started at the value passed in (the caller's predictor; 0 is valid) and left at
+    /// the converged value. Fails with a [`ChartFailure`] if the iteration diverges, produces
+    /// non-finite values or reaches the iteration limit.
+    pub fn map(
+        &mut self,
+        sys: &System,
+        xi: &[f64],
+        t: f64,
+        zeta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+    ) -> Result<MapStats, ChartFailure> {
+        self.point(xi, zeta, x);
+        self.solve_normal(sys, t, zeta, x, newton)
+    }
+
+    /// Chord Newton along the normal directions from the point `x`: on success `x` is on the
+    /// manifold at time `t` (with the same tangent coordinates `U^T (x - x_c)`) and `zeta` is
+    /// set to its normal coordinates `Q1^T (x - x_c)`.
+    pub fn solve_normal(
+        &mut self,
+        sys: &System,
+        t: f64,
+        zeta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+    ) -> Result<MapStats, ChartFailure> {
+        if self.m == 0 {
+            return Ok(MapStats::default());
+        }
+        let mut f = std::mem::take(&mut self.f);
+        let res = self.residual(sys, x, t, &mut f);
+        let out = self.chord(sys, t, x, newton, &mut f, res);
+        self.f = f;
+        if out.is_ok() {
+            let nn = 2 * self.n;
+            for (k, z) in zeta.iter_mut().enumerate() {
+                let col = &self.q[k * nn..(k + 1) * nn];
+                *z = col
+                    .iter()
+                    .zip(x.iter().zip(&self.xc))
+                    .map(|(c, (x, xc))| c * (x - xc))
+                    .sum();
+            }
+        }
+        out
+    }
+
+    fn chord(
+        &mut self,
+        sys: &System,
+        t: f64,
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        f: &mut [f64],
+        res0: f64,
+    ) -> Result<MapStats, ChartFailure> {
+        let nn = 2 * self.n;
+        let s = self.s;
+        let mut res = res0;
+        let mut it = 0;
+        loop {
+            if !res.is_finite() {
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+            if res <= newton.tol {
+                return Ok(MapStats {
+                    iterations: it,
+                    residual: res,
+                });
+            }
+            if it >= newton.max_iter {
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+            // x <- x - Q1 J^-1 f = x - P0 (I + s K)^-1 f
+            if s != 0.0 {
+                let mm = f.len();
+                // u = K f, w = f - s u + s^2 K u
+                self.u.fill(0.0);
+                for (j, &fj) in f.iter().enumerate() {
+                    axpy(fj, &self.k[j * mm..(j + 1) * mm], &mut self.u);
+                }
+                for (wi, (fi, ui)) in self.w.iter_mut().zip(f.iter().zip(&self.u)) {
+                    *wi = fi - s * ui;
+                }
+                let s2 = s * s;
+                for (j, &uj) in self.u.iter().enumerate() {
+                    axpy(s2 * uj, &self.k[j * mm..(j + 1) * mm], &mut self.w);
+                }
+                f.copy_from_slice(&self.w);
+            }
+            for (k, &fk) in f.iter().enumerate() {
+                axpy(-fk, &self.p0[k * nn..(k + 1) * nn], x);
+            }
+            it += 1;
+            let prev = res;
+            res = self.residual(sys, x, t, f);
+            if res > newton.divergence * prev && res > newton.tol {
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+        }
+    }
+
+    /// `out = [Q1 U]^T y`: the normal components (first `2m`) and the tangent components (last
+    /// `2(n - m)`) of a vector `y` of length `2n`.
+    pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = dot(self.col(k), y);
+        }
+    }
+}
+
+/// Householder QR of the `rows x cols` column-major matrix `a` (`rows >= cols`) in place
+/// (LAPACK `dgeqr2` conventions): `R` in the upper triangle, the essential parts of the
+/// Householder vectors `v_k` (with `v_k[k] = 1`) below the diagonal, `H_k = I - tau_k v_k v_k^T`,
+/// `a = H_0 H_1 ... H_{cols-1} [R; 0]`. The first `short` columns must vanish below row `half`
+/// (true of `Df^T`: its first `m` columns are `(Phi_q^T, 0)`); their reflectors then act on rows
+/// `k..half` only and the others never refill those zeros.
+fn householder_qr(
+    a: &mut [f64],
+    tau: &mut [f64],
+    rows: usize,
+    cols: usize,
+    short: usize,
+    half: usize,
+) {
+    for k in 0..cols {
+        let end = if k < short { half } else { rows };
+        let (head, tail) = a.split_at_mut((k + 1) * rows);
+        let col = &mut head[k * rows..];
+        let x0 = col[k];
+        let sigma: f64 = col[k + 1..end].iter().map(|x| x * x).sum();
+        if sigma == 0.0 {
+            tau[k] = 0.0;
+            continue;
+        }
+        let norm = (x0 * x0 + sigma).sqrt();
+        let beta = if x0 >= 0.0 { -norm } else { norm };
+        tau[k] = (beta - x0) / beta;
+        let scale = 1.0 / (x0 - beta);
+        for x in col[k + 1..end].iter_mut() {
+            *x *= scale;
+        }
+        col[k] = beta;
+        let v = &col[k + 1..end];
+        let tk = tau[k];
+        for j in 0..cols - k - 1 {
+            let cj = &mut tail[j * rows..(j + 1) * rows];
+            let w = cj[k] + dot(v, &cj[k + 1..end]);
+            let s = tk * w;
+            cj[k] -= s;
+            axpy(-s, v, &mut cj[k + 1..end]);
+        }
+    }
+}
+
+/// `q = H_0 H_1 ... H_{cols-1}` (`rows x rows`, column-major) by backward accumulation, for the
+/// factors of [`householder_qr`] with the same `short` and `half`.
+fn form_q(
+    a: &[f64],
+    tau: &[f64],
+    rows: usize,
+    cols: usize,
+    short: usize,
+    half: usize,
+    q: &mut [f64],
+) {
+    q.fill(0.0);
+    for i in 0..rows {
+        q[i * rows + i] = 1.0;
+    }
+    for k in (0..cols).rev() {
+        let tk = tau[k];
+        if tk == 0.0 {
+            continue;
+        }
+        let end = if k < short { half } else { rows };
+        let v = &a[k * rows + k + 1..k * rows + end];
+        // columns < k of H_k ... H_{cols-1} are still unit vectors with zero rows >= k
+        for j in k..rows {
+            let cj = &mut q[j * rows..(j + 1) * rows];
+            let w = cj[k] + dot(v, &cj[k + 1..end]);
+            if w != 0.0 {
+                let s = tk * w;
+                cj[k] -= s;
+                axpy(-s, v, &mut cj[k + 1..end]);
+            }
+        }
+    }
+}
+
+#[inline]
+fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
+    }
+}
+
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn householder_qr_reconstructs_and_q_is_orthogonal() {
+        // 8 x 4 with the first 2 columns zero below row 4 (the structure of Df^T)
+        let (rows, cols, short, half) = (8, 4, 2, 4);
+        let mut a0: Vec<f64> = (0..rows * cols)
+            .map(|i| ((i * 37 % 11) as f64 - 5.0) * 0.3 + if i % 9 == 0 { 2.0 } else { 0.0 })
+            .collect();
+        for k in 0..short {
+            for r in half..rows {
+                a0[k * rows + r] = 0.0;
+            }
+        }
+        for (short, half) in [(0, rows), (short, half)] {
+            let mut a = a0.clone();
+            let mut tau = vec![0.0; cols];
+            householder_qr(&mut a, &mut tau, rows, cols, short, half);
+            let mut q = vec![0.0; rows * rows];
+            form_q(&a, &tau, rows, cols, short, half, &mut q);
+            for i in 0..rows {
+                for j in 0..rows {
+                    let d = dot(&q[i * rows..(i + 1) * rows], &q[j * rows..(j + 1) * rows]);
+                    let e = if i == j { 1.0 } else { 0.0 };
+                    assert!((d - e).abs() < 1e-14, "({i},{j}) {d}");
+                }
+            }
+            for j in 0..cols {
+                for i in 0..rows {
+                    let mut s = 0.0;
+                    for k in 0..=j {
+                        s += q[k * rows + i] * a[j * rows + k];
+                    }
+                    assert!((s - a0[j * rows + i]).abs() < 1e-13, "({i},{j})");
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,847 @@
+//! The tangent-space Runge-Kutta integrator: fixed steps ([`Integrator`]) and adaptive steps
+//! ([`TangentRk::integrate_adaptive`]).
+
+use crate::chart::{ChartFailure, NewtonSettings, TangentChart};
+use crate::error::TangentError;
+use mbd_model::System;
+use mbd_solve::{
+    AccelerationSolver, ButcherTableau, ExplicitRk, Flow, Integrator, Observer, SolveError, State,
+    StepController, StepStats,
+};
+
+/// The matrix of the chord Newton iteration of the chart maps (the limit, the point of the
+/// chart, is the same for both; only the speed differs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IterationMatrix {
+    /// `Df(x_c) Q1 = R^T`, factored once per chart: the paper's chord iteration. Contraction
+    /// factor `O(h)` per iteration.
+    Centre,
+    /// `Df Q1` interpolated linearly between the centre and the Euler prediction of the end
+    /// point, `x_c + h F(x_c)` (one more evaluation of `Df` per step and one small LU per
+    /// distinct stage node `c_i`). Contraction factor `O(h^2)`: about half the iterations of
+    /// [`IterationMatrix::Centre`] at the same tolerance (the default).
+    #[default]
+    Interpolated,
+}
+
+/// Settings of [`TangentRk`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TangentOptions {
+    /// The chord Newton iteration of the chart map (tolerance 1e-13 on `||(Phi, Phidot)||_inf`
+    /// by default).
+    pub newton: NewtonSettings,
+    /// The chord iteration's matrix (default [`IterationMatrix::Interpolated`]).
+    pub iteration_matrix: IterationMatrix,
+    /// Automatic step halving on chart failure in fixed-step mode: a step whose chart map fails
+    /// is redone as two half steps (each re-centring the chart), recursively up to this depth
+    /// (so at most `2^max_halvings` sub-steps). Every halving is counted in
+    /// [`TangentStats::halvings`]. 0 turns it off: a chart failure is then an error at once.
+    /// Default 4. At most 30.
+    pub max_halvings: u32,
+    /// Relative threshold on the diagonal of `R` (QR of `Df^T`) below which the configuration
+    /// counts as singular (an error). Default 1e-8.
+    pub singular_tol: f64,
+    /// Largest `||(Phi, Phidot)||_inf` accepted for the state handed to a step (it is projected
+    /// onto the manifold by the first chart map). Larger is an error: project the state first
+    /// (`System::project`). Default 1e-8.
+    pub consistency_tol: f64,
+}
+
+impl Default for TangentOptions {
+    fn default() -> Self {
+        TangentOptions {
+            newton: NewtonSettings::default(),
+            iteration_matrix: IterationMatrix::default(),
+            max_halvings: 4,
+            singular_tol: 1e-8,
+            consistency_tol: 1e-8,
+        }
+    }
+}
+
+impl TangentOptions {
+    /// Checks every setting.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        self.newton.validate()?;
+        if self.max_halvings > 30 {
+            return Err(SolveError::InvalidParameter {
+                parameter: "max_halvings",
+                value: self.max_halvings as f64,
+                reason: "must be at most 30",
+            });
+        }
+        if !(self.singular_tol.is_finite() && self.singular_tol > 0.0 && self.singular_tol < 1.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "singular_tol",
+                value: self.singular_tol,
+                reason: "must lie in (0, 1)",
+            });
+        }
+        if !(self.consistency_tol.is_finite() && self.consistency_tol >= self.newton.tol) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "consistency_tol",
+                value: self.consistency_tol,
+                reason: "must be finite and at least newton.tol",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Work counters of a [`TangentRk`], cumulative since construction or the last
+/// [`Integrator::reset`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TangentStats {
+    /// Accepted steps (sub-steps of halved steps count one each).
+    pub steps: usize,
+    /// Chart centrings (QR factorisations of `Df^T`).
+    pub charts: usize,
+    /// Fixed-step mode: steps redone as two halves after a chart failure.
+    pub halvings: usize,
+    /// Chart failures met (recovered by halving or rejection, or returned as errors).
+    pub chart_failures: usize,
+    /// Chord Newton iterations, all maps.
+    pub newton_iterations: usize,
+    /// Most chord Newton iterations of one map.
+    pub max_map_iterations: usize,
+    /// Acceleration solves (right-hand-side evaluations).
+    pub rhs_evals: usize,
+    /// Largest `||(Phi, Phidot)||_inf` of an accepted step's end point.
+    pub max_residual: f64,
+}
+
+/// Settings of [`TangentRk::integrate_adaptive`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveSettings {
+    /// Tolerances, safety factor, shrink/growth limits and the smallest step. The scaled error
+    /// is `rms(e_i / (atol + rtol max(|x_c,i|, |x_new,i|)))` with `e = U err_xi` the embedded
+    /// estimate mapped to `x = (q, v)`.
+    pub controller: StepController,
+    /// First step size; `None` picks `0.01 ||x||/||F||` in the scaled norm.
+    pub h0: Option<f64>,
+    /// Largest step size.
+    pub h_max: f64,
+    /// Limit on accepted plus rejected steps.
+    pub max_steps: usize,
+}
+
+impl Default for AdaptiveSettings {
+    fn default() -> Self {
+        AdaptiveSettings {
+            controller: StepController::default(),
+            h0: None,
+            h_max: f64::INFINITY,
+            max_steps: 10_000_000,
+        }
+    }
+}
+
+impl AdaptiveSettings {
+    /// Default settings with `atol = rtol = tol`.
+    pub fn with_tolerance(tol: f64) -> Self {
+        let mut s = Self::default();
+        s.controller.atol = tol;
+        s.controller.rtol = tol;
+        s
+    }
+
+    /// Checks every setting.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        let c = &self.controller;
+        let bad = |parameter, value, reason| {
+            Err(SolveError::InvalidParameter {
+                parameter,
+                value,
+                reason,
+            })
+        };
+        if !(c.atol.is_finite() && c.atol >= 0.0) {
+            return bad("controller.atol", c.atol, "must be non-negative and finite");
+        }
+        if !(c.rtol.is_finite() && c.rtol >= 0.0) {
+            return bad("controller.rtol", c.rtol, "must be non-negative and finite");
+        }
+        if !(c.atol > 0.0 || c.rtol > 0.0) {
+            return bad(
+                "controller.atol",
+                c.atol,
+                "atol and rtol cannot both be zero",
+            );
+        }
+        if !(c.safety > 0.0 && c.safety <= 1.0) {
+            return bad("controller.safety", c.safety, "must lie in (0, 1]");
+        }
+        if !(c.fac_min > 0.0 && c.fac_min < 1.0) {
+            return bad("controller.fac_min", c.fac_min, "must lie in (0, 1)");
+        }
+        if !(c.fac_max > 1.0 && c.fac_max.is_finite()) {
+            return bad(
+                "controller.fac_max",
+                c.fac_max,
+                "must be finite and above 1",
+            );
+        }
+        if !(c.h_min.is_finite() && c.h_min > 0.0) {
+            return bad("controller.h_min", c.h_min, "must be positive and finite");
+        }
+        if let Some(h0) = self.h0 {
+            if !(h0.is_finite() && h0 > 0.0) {
+                return bad("h0", h0, "must be positive and finite");
+            }
+        }
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return bad("h_max", self.h_max, "must be positive");
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", 0.0, "must be at least 1");
+        }
+        Ok(())
+    }
+}
+
+/// Summary of [`TangentRk::integrate_adaptive`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AdaptiveStats {
+    /// Accepted steps.
+    pub accepted: usize,
+    /// Steps rejected by the error test.
+    pub rejected: usize,
+    /// Steps rejected because the chart map failed (retried with half the step).
+    pub chart_rejections: usize,
+    /// Acceleration solves.
+    pub rhs_evals: usize,
+    /// Chord Newton iterations.
+    pub newton_iterations: usize,
+    /// Smallest accepted step.
+    pub h_min: f64,
+    /// Largest accepted step.
+    pub h_max: f64,
+    /// Largest `||(Phi, Phidot)||_inf` at an accepted point.
+    pub max_residual: f64,
+    /// Whether the observer stopped the run early.
+    pub stopped_early: bool,
+}
+
+/// Why an attempted step failed.
+enum Attempt {
+    /// The chart map failed (recoverable with a smaller step).
+    Chart(ChartFailure),
+    /// Anything else (singular configuration, bad model): returned as is.
+    Hard(SolveError),
+}
+
+/// Paper B's method: explicit Runge-Kutta on the state equation `xi' = U^T F(x(xi), t)` of a
+/// local chart of the constraint manifold, re-centred after every accepted step.
+///
+/// One step from `(t, x_c)`: centre the chart at `x_c` (QR of `Df(x_c)^T`), integrate `xi` from 0
+/// over `[t, t + h]` with the tableau, evaluating every stage at a point of the manifold found by
+/// chord Newton, and map the result back. Position and velocity constraints hold at every step
+/// to the Newton tolerance. Allocation-free per step after [`TangentRk::new`].
+#[derive(Debug)]
+pub struct TangentRk {
+    chart: TangentChart,
+    rk: ExplicitRk,
+    acc: AccelerationSolver,
+    options: TangentOptions,
+    stats: TangentStats,
+    n: usize,
+    m: usize,
+    stages: usize,
+    a_coef: Vec<f64>,
+    b_coef: Vec<f64>,
+    c_coef: Vec<f64>,
+    /// Whether the last stage is the end point (`c_s = 1`, `a_sj = b_j`).
+    fsal: bool,
+    /// Current accepted point `(q, v)`.
+    cur: Vec<f64>,
+    /// Its time.
+    cur_t: f64,
+    /// Whether `cur` is on the manifold at `cur_t` to the Newton tolerance.
+    cur_ok: bool,
+    /// End point of the last attempt.
+    xnew: Vec<f64>,
+    /// Stage point.
+    x: Vec<f64>,
+    /// Chart coordinates.
+    xi: Vec<f64>,
+    /// Normal coordinates (chord Newton unknowns).
+    zeta: Vec<f64>,
+    /// Normal part of the plain RK stage value.
+    zplain: Vec<f64>,
+    /// Normal components `Q1^T F` of each stage's derivative (`stages x 2m`).
+    g: Vec<f64>,
+    /// `F = (v, a)`.
+    fx: Vec<f64>,
+    /// `Q^T F`.
+    proj: Vec<f64>,
+    /// Residual buffer.
+    res: Vec<f64>,
+    acc_a: Vec<f64>,
+    lambda: Vec<f64>,
+    /// Error estimate mapped to `x`, and the error scale.
+    ex: Vec<f64>,
+    scale: Vec<f64>,
+}
+
+/// Per-attempt work counts.
+#[derive(Clone, Copy, Debug, Default)]
+struct AttemptWork {
+    iterations: usize,
+    max_map_iterations: usize,
+    rhs_evals: usize,
+    residual: f64,
+}
+
+impl TangentRk {
+    /// A solver for `sys` with `tableau` (any explicit tableau; validated) and `options`.
+    pub fn new(
+        sys: &System,
+        tableau: ButcherTableau,
+        options: TangentOptions,
+    ) -> Result<Self, SolveError> {
+        options.validate()?;
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let mut chart = TangentChart::new(sys);
+        chart.singular_tol = options.singular_tol;
+        let dim = chart.dim();
+        let s = tableau.stages;
+        let a_coef = tableau.a.clone();
+        let b_coef = tableau.b.clone();
+        let c_coef = tableau.c.clone();
+        let fsal = s > 0
+            && tableau.c[s - 1] == 1.0
+            && (0..s).all(|j| tableau.a[(s - 1) * s + j] == tableau.b[j]);
+        let rk = ExplicitRk::new(tableau, dim)?;
+        Ok(TangentRk {
+            chart,
+            rk,
+            acc: AccelerationSolver::new(sys),
+            options,
+            stats: TangentStats::default(),
+            n,
+            m,
+            stages: s,
+            a_coef,
+            b_coef,
+            c_coef,
+            fsal,
+            cur: vec![0.0; 2 * n],
+            cur_t: f64::NAN,
+            cur_ok: false,
+            xnew: vec![0.0; 2 * n],
+            x: vec![0.0; 2 * n],
+            xi: vec![0.0; dim],
+            zeta: vec![0.0; 2 * m],
+            zplain: vec![0.0; 2 * m],
+            g: vec![0.0; s * 2 * m],
+            fx: vec![0.0; 2 * n],
+            proj: vec![0.0; 2 * n],
+            res: vec![0.0; 2 * m],
+            acc_a: vec![0.0; n],
+            lambda: vec![0.0; m],
+            ex: vec![0.0; 2 * n],
+            scale: vec![0.0; 2 * n],
+        })
+    }
+
+    /// Tangent-space RK4 with default options (the paper's method).
+    pub fn rk4(sys: &System) -> Result<Self, SolveError> {
+        Self::new(sys, ButcherTableau::rk4(), TangentOptions::default())
+    }
+
+    /// Tangent-space DOPRI5 (order 5, embedded order-4 estimate for
+    /// [`TangentRk::integrate_adaptive`]) with default options.
+    pub fn dopri5(sys: &System) -> Result<Self, SolveError> {
+        Self::new(sys, ButcherTableau::dopri5(), TangentOptions::default())
+    }
+
+    /// The tableau.
+    pub fn tableau(&self) -> &ButcherTableau {
+        &self.rk.tableau
+    }
+
+    /// The options.
+    pub fn options(&self) -> &TangentOptions {
+        &self.options
+    }
+
+    /// Work counters since construction or the last reset.
+    pub fn stats(&self) -> &TangentStats {
+        &self.stats
+    }
+
+    /// The chart of the last step (centred at that step's start point).
+    pub fn chart(&self) -> &TangentChart {
+        &self.chart
+    }
+
+    /// Dimension of the state equation, `2 (n - m)`.
+    pub fn state_dim(&self) -> usize {
+        self.chart.dim()
+    }
+
+    fn check_sizes(&self, sys: &System, state: &State) -> Result<(), SolveError> {
+        if sys.n_coords() != self.n || sys.n_constraints() != self.m {
+            return Err(SolveError::Dimension {
+                what: "system (not the one the solver was built for: coordinates)",
+                expected: self.n,
+                got: sys.n_coords(),
+            });
+        }
+        state.check(sys)?;
+        if !state.is_finite() {
+            return Err(SolveError::NonFinite {
+                t: state.t,
+                what: "state handed to the tangent-space step",
+            });
+        }
+        Ok(())
+    }
+
+    /// Loads `state` into `cur` and checks it lies on the manifold to `consistency_tol`.
+    fn load(&mut self, sys: &System, state: &State) -> Result<(), SolveError> {
+        let n = self.n;
+        if self.cur_ok
+            && state.t == self.cur_t
+            && state.q.as_slice() == &self.cur[..n]
+            && state.v.as_slice() == &self.cur[n..]
+        {
+            // the state is the end point of our last step: on the manifold to newton.tol
+            return Ok(());
+        }
+        self.cur[..n].copy_from_slice(state.q.as_slice());
+        self.cur[n..].copy_from_slice(state.v.as_slice());
+        self.cur_t = state.t;
+        self.cur_ok = self.m == 0;
+        if self.m == 0 {
+            return Ok(());
+        }
+        let r = self.chart.residual(sys, &self.cur, state.t, &mut self.res);
+        self.cur_ok = r <= self.options.newton.tol;
+        if r.is_nan() || r > self.options.consistency_tol {
+            return Err(SolveError::InvalidParameter {
+                parameter: "state: ||(Phi, Phidot)||_inf",
+                value: r,
+                reason: "the state is not on the constraint manifold (above consistency_tol); \
+                         project it first (System::project)",
+            });
+        }
+        Ok(())
+    }
+
+    fn store(&self, state: &mut State) {
+        let n = self.n;
+        state.q.as_mut_slice().copy_from_slice(&self.cur[..n]);
+        state.v.as_mut_slice().copy_from_slice(&self.cur[n..]);
+    }
+
+    fn centre(&mut self, sys: &System, t: f64) -> Result<(), SolveError> {
+        let n = self.n;
+        let (q, v) = self.cur.split_at(n);
+        self.chart.centre(sys, q, v, t)?;
+        self.stats.charts += 1;
+        Ok(())
+    }
+
+    /// One attempted step of size `h` from the chart centre (at time `t`) into `xnew`; the
+    /// embedded error estimate in chart coordinates (if the tableau has one) is left in
+    /// `rk.err`.
+    ///
+    /// Newton starting points (they change only where the chord iteration starts, never its
+    /// limit): stage `i` starts from the plain RK stage value `x_c + h sum_j a_ij F_j` (its
+    /// tangent part is exactly `U Y_i`); the end point from the plain RK result
+    /// `x_c + h sum_j b_j F_j`, whose normal part is the RK quadrature of `zeta' = Q1^T F` and so
+    /// accurate to the method's order. For a FSAL tableau (last stage at `c = 1` with
+    /// `a_sj = b_j`, as DOPRI5) the last stage point is the end point. The iteration matrix of
+    /// stage `i` is `Df Q1` interpolated to `c_i` (see [`IterationMatrix`]).
+    fn attempt(&mut self, sys: &System, t: f64, h: f64) -> Result<AttemptWork, Attempt> {
+        let n = self.n;
+        let mm = 2 * self.m;
+        let s = self.stages;
+        let newton = self.options.newton;
+        let interpolate = self.options.iteration_matrix == IterationMatrix::Interpolated;
+        // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
+        let centre_ok = self.cur_ok && self.cur_t == t;
+        let quadratic = !sys.is_rheonomic();
+        let mut ylast_sq = 0.0f64;
+        let mut work = AttemptWork::default();
+        let mut failure: Option<ChartFailure> = None;
+        let mut stage = 0usize;
+        self.xi.fill(0.0);
+        {
+            let chart = &mut self.chart;
+            let acc = &mut self.acc;
+            let zlast = &mut self.zeta;
+            let (zplain, x, g, fx, proj) = (
+                &mut self.zplain,
+                &mut self.x,
+                &mut self.g,
+                &mut self.fx,
+                &mut self.proj,
+            );
+            let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
+            let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
+            let work = &mut work;
+            let failure = &mut failure;
+            let mut rhs = |ti: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
+                let i = stage;
+                // plain RK stage value's normal part
+                zplain.fill(0.0);
+                for j in 0..i {
+                    let a = a_coef[i * s + j];
+                    if a != 0.0 {
+                        axpy(h * a, &g[j * mm..(j + 1) * mm], zplain);
+                    }
+                }
+                if i == 1 && interpolate {
+                    // Euler prediction of the end point, x_c + h F(x_c): where the iteration
+                    // matrix is interpolated to
+                    x.copy_from_slice(chart.centre_point());
+                    axpy(h, fx, x);
+                    chart.set_secondary_point(sys, x);
+                }
+                chart.select_iteration_matrix(c_coef[i]);
+                let ysq: f64 = y.iter().map(|v| v * v).sum();
+                if quadratic && ylast_sq > 0.0 {
+                    // scleronomic: the normal offset of the manifold above Y grows like |Y|^2
+                    let r = ysq / ylast_sq;
+                    for (z, zl) in zplain.iter_mut().zip(zlast.iter()) {
+                        *z = r * zl;
+                    }
+                }
+                let mapped = if i == 0 && centre_ok && ti == t {
+                    x.copy_from_slice(chart.centre_point());
+                    Ok(crate::chart::MapStats::default())
+                } else {
+                    chart.map(sys, y, ti, zplain, x, &newton)
+                };
+                if ysq > 0.0 && mapped.is_ok() {
+                    zlast.copy_from_slice(zplain);
+                    ylast_sq = ysq;
+                }
+                match mapped {
+                    Ok(ms) => {
+                        work.iterations += ms.iterations;
+                        work.max_map_iterations = work.max_map_iterations.max(ms.iterations);
+                        work.residual = ms.residual;
+                    }
+                    Err(e) => {
+                        *failure = Some(e);
+                        // a cheap sentinel (no allocation); the caller reads `failure`
+                        return Err(SolveError::NonFinite {
+                            t: ti,
+                            what: "tangent chart",
+                        });
+                    }
+                }
+                let (q, v) = x.split_at(n);
+                acc.solve(sys, q, v, ti, acc_a, lambda)?;
+                work.rhs_evals += 1;
+                fx[..n].copy_from_slice(v);
+                fx[n..].copy_from_slice(acc_a);
+                chart.coordinates(fx, proj);
+                g[i * mm..(i + 1) * mm].copy_from_slice(&proj[..mm]);
+                dy.copy_from_slice(&proj[mm..]);
+                stage += 1;
+                Ok(())
+            };
+            if let Err(e) = self.rk.step(&mut rhs, t, &mut self.xi, h) {
+                return Err(match failure.take() {
+                    Some(f) => Attempt::Chart(f),
+                    None => Attempt::Hard(e),
+                });
+            }
+        }
+        let t1 = t + h;
+        if self.fsal {
+            // the last stage was evaluated at xi = h sum b_j k_j, t + h: it is the end point
+            self.xnew.copy_from_slice(&self.x);
+        } else {
+            self.chart.select_iteration_matrix(1.0);
+            self.zeta.fill(0.0);
+            for j in 0..s {
+                let b = self.b_coef[j];
+                if b != 0.0 {
+                    axpy(h * b, &self.g[j * mm..(j + 1) * mm], &mut self.zeta);
+                }
+            }
+            match self
+                .chart
+                .map(sys, &self.xi, t1, &mut self.zeta, &mut self.xnew, &newton)
+            {
+                Ok(ms) => {
+                    work.iterations += ms.iterations;
+                    work.max_map_iterations = work.max_map_iterations.max(ms.iterations);
+                    work.residual = ms.residual;
+                }
+                Err(e) => return Err(Attempt::Chart(e)),
+            }
+        }
+        if self.xnew.iter().any(|x| !x.is_finite()) {
+            return Err(Attempt::Hard(SolveError::NonFinite {
+                t: t1,
+                what: "state after tangent-space step",
+            }));
+        }
+        Ok(work)
+    }
+
+    fn account(&mut self, w: &AttemptWork) {
+        self.stats.newton_iterations += w.iterations;
+        self.stats.max_map_iterations = self.stats.max_map_iterations.max(w.max_map_iterations);
+        self.stats.rhs_evals += w.rhs_evals;
+    }
+
+    /// Advances `cur` from `t` by `h`, halving on chart failure up to `max_halvings` levels.
+    fn advance(
+        &mut self,
+        sys: &System,
+        t: f64,
+        h: f64,
+        depth: u32,
+        out: &mut StepStats,
+    ) -> Result<(), SolveError> {
+        self.centre(sys, t)?;
+        match self.attempt(sys, t, h) {
+            Ok(w) => {
+                self.account(&w);
+                std::mem::swap(&mut self.cur, &mut self.xnew);
+                self.cur_t = t + h;
+                self.cur_ok = true;
+                self.stats.steps += 1;
+                self.stats.max_residual = self.stats.max_residual.max(w.residual);
+                out.newton_iterations += w.iterations;
+                out.rhs_evals += w.rhs_evals;
+                out.residual = out.residual.max(w.residual);
+                Ok(())
+            }
+            Err(Attempt::Chart(f)) => {
+                self.stats.chart_failures += 1;
+                if depth < self.options.max_halvings {
+                    self.stats.halvings += 1;
+                    let h2 = 0.5 * h;
+                    self.advance(sys, t, h2, depth + 1, out)?;
+                    self.advance(sys, t + h2, h2, depth + 1, out)
+                } else {
+                    Err(f.into_error())
+                }
+            }
+            Err(Attempt::Hard(e)) => Err(e),
+        }
+    }
+
+    /// Integrates from `state.t` to `t_end` with adaptive steps controlled by the tableau's
+    /// embedded error estimate (e.g. DOPRI5 5(4), Bogacki-Shampine 3(2)), calling `observer`
+    /// with the initial state (step 0) and after every accepted step. A chart failure rejects
+    /// the step and retries with half of it; a step size below `controller.h_min` is
+    /// [`TangentError::StepSizeTooSmall`].
+    pub fn integrate_adaptive<O: Observer + ?Sized>(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        t_end: f64,
+        settings: &AdaptiveSettings,
+        observer: &mut O,
+    ) -> Result<AdaptiveStats, TangentError> {
+        settings.validate()?;
+        self.check_sizes(sys, state)?;
+        let t0 = state.t;
+        if !(t_end.is_finite() && t_end > t0) {
+            return Err(SolveError::InvalidInterval {
+                t0,
+                t_end,
+                reason: "end time must be finite and after the start time",
+            }
+            .into());
+        }
+        let q_order = match (&self.rk.tableau.b_hat, self.rk.tableau.embedded_order) {
+            (Some(_), q) if q > 0 => q,
+            _ => {
+                return Err(SolveError::Unsupported(format!(
+                "adaptive stepping needs a tableau with an embedded error estimate; '{}' has none \
+                     (use DOPRI5 or Bogacki-Shampine)",
+                self.rk.tableau.name
+            ))
+                .into())
+            }
+        };
+        self.load(sys, state)?;
+        let ctrl = settings.controller;
+        let mut st = AdaptiveStats {
+            h_min: f64::INFINITY,
+            ..Default::default()
+        };
+        if observer.observe(sys, state, 0)? == Flow::Stop {
+            st.stopped_early = true;
+            st.h_min = 0.0;
+            return Ok(st);
+        }
+        let mut h = match settings.h0 {
+            Some(h0) => h0,
+            None => self.initial_step(sys, t0, &ctrl)?,
+        };
+        h = h.min(settings.h_max);
+        let mut t = t0;
+        let mut last_rejected = false;
+        let mut centred_at = f64::NAN;
+        let mut attempts = 0usize;
+        while t < t_end {
+            attempts += 1;
+            if attempts > settings.max_steps {
+                return Err(TangentError::TooManySteps {
+                    t,
+                    max_steps: settings.max_steps,
+                });
+            }
+            let remaining = t_end - t;
+            let last = h >= remaining * (1.0 - 1e-12);
+            let hs = if last { remaining } else { h };
+            if hs < ctrl.h_min && !last {
+                return Err(TangentError::StepSizeTooSmall {
+                    t,
+                    h: hs,
+                    h_min: ctrl.h_min,
+                });
+            }
+            if centred_at != t {
+                self.centre(sys, t)?;
+                centred_at = t;
+            }
+            match self.attempt(sys, t, hs) {
+                Ok(w) => {
+                    self.account(&w);
+                    st.rhs_evals += w.rhs_evals;
+                    st.newton_iterations += w.iterations;
+                    // error estimate mapped to x: e = U err_xi
+                    self.ex.fill(0.0);
+                    for (k, &e) in self.rk.err.iter().enumerate() {
+                        let col = self.chart.tangent(k);
+                        for (exi, c) in self.ex.iter_mut().zip(col) {
+                            *exi += e * c;
+                        }
+                    }
+                    for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
+                        *s = a.abs().max(b.abs());
+                    }
+                    let en = ctrl.error_norm(&self.ex, &self.scale);
+                    if !en.is_finite() {
+                        return Err(SolveError::NonFinite {
+                            t,
+                            what: "embedded error estimate",
+                        }
+                        .into());
+                    }
+                    if en <= 1.0 {
+                        std::mem::swap(&mut self.cur, &mut self.xnew);
+                        t = if last { t_end } else { t + hs };
+                        self.cur_t = t;
+                        self.cur_ok = true;
+                        st.accepted += 1;
+                        st.h_min = st.h_min.min(hs);
+                        st.h_max = st.h_max.max(hs);
+                        st.max_residual = st.max_residual.max(w.residual);
+                        self.stats.steps += 1;
+                        self.stats.max_residual = self.stats.max_residual.max(w.residual);
+                        state.t = t;
+                        self.store(state);
+                        let mut fac = ctrl.factor(en, q_order);
+                        if last_rejected {
+                            fac = fac.min(1.0);
+                        }
+                        last_rejected = false;
+                        h = (hs * fac).min(settings.h_max);
+                        if observer.observe(sys, state, st.accepted)? == Flow::Stop {
+                            st.stopped_early = true;
+                            break;
+                        }
+                    } else {
+                        st.rejected += 1;
+                        last_rejected = true;
+                        h = hs * ctrl.factor(en, q_order).min(1.0);
+                    }
+                }
+                Err(Attempt::Chart(f)) => {
+                    self.stats.chart_failures += 1;
+                    st.chart_rejections += 1;
+                    last_rejected = true;
+                    h = 0.5 * hs;
+                    if h < ctrl.h_min {
+                        return Err(TangentError::Chart {
+                            source: f.into_error(),
+                            h: hs,
+                        });
+                    }
+                }
+                Err(Attempt::Hard(e)) => return Err(e.into()),
+            }
+        }
+        if st.accepted == 0 {
+            st.h_min = 0.0;
+        }
+        Ok(st)
+    }
+
+    /// `h0 = 0.01 ||x|| / ||F(x)||` in the controller's scaled RMS norm (Hairer, Norsett and
+    /// Wanner's first guess), at least `h_min`.
+    fn initial_step(
+        &mut self,
+        sys: &System,
+        t: f64,
+        ctrl: &StepController,
+    ) -> Result<f64, SolveError> {
+        let n = self.n;
+        let (q, v) = self.cur.split_at(n);
+        self.acc
+            .solve(sys, q, v, t, &mut self.acc_a, &mut self.lambda)?;
+        self.stats.rhs_evals += 1;
+        self.fx[..n].copy_from_slice(v);
+        self.fx[n..].copy_from_slice(&self.acc_a);
+        for (s, x) in self.scale.iter_mut().zip(&self.cur) {
+            *s = x.abs();
+        }
+        let d0 = ctrl.error_norm(&self.cur, &self.scale);
+        let d1 = ctrl.error_norm(&self.fx, &self.scale);
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        };
+        Ok(h0.max(ctrl.h_min))
+    }
+}
+
+#[inline]
+fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
+    }
+}
+
+impl Integrator for TangentRk {
+    fn name(&self) -> String {
+        format!("tangent-space {}", self.rk.tableau.name)
+    }
+
+    fn order(&self) -> Option<u32> {
+        Some(self.rk.tableau.order)
+    }
+
+    fn reset(&mut self) {
+        self.stats = TangentStats::default();
+        self.cur_ok = false;
+    }
+
+    fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        self.check_sizes(sys, state)?;
+        if !(h.is_finite() && h > 0.0) {
+            return Err(SolveError::InvalidStep { h });
+        }
+        self.load(sys, state)?;
+        let mut out = StepStats::default();
+        let t = state.t;
+        self.advance(sys, t, h, 0, &mut out)?;
+        self.store(state);
+        state.t = t + h;
+        Ok(out)
+    }
+}
