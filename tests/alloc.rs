@@ -36,7 +36,13 @@ fn count_step_allocations<I: Integrator>(mut integ: I, sys: &mbd::model::System)
     ALLOCS.load(Ordering::SeqCst) - before
 }
 
+// One test function: the allocation counter is global, so concurrent tests would pollute it.
 #[test]
+fn steps_allocate_nothing() {
+    rk4_steps_allocate_nothing();
+    sparse_rk4_steps_allocate_nothing();
+}
+
 fn rk4_steps_allocate_nothing() {
     let sys = models::manipulator().unwrap();
     assert_eq!(
@@ -52,6 +58,19 @@ fn rk4_steps_allocate_nothing() {
             Rk4::new(&sys, Rk4Options::baumgarte(5.0, 5.0)).unwrap(),
             &sys
         ),
+        0
+    );
+}
+
+fn sparse_rk4_steps_allocate_nothing() {
+    use mbd::solve::LinearSolver;
+    let sys = models::n_link_chain(60).unwrap();
+    let opts = Rk4Options {
+        linear: LinearSolver::Sparse,
+        ..Rk4Options::plain()
+    };
+    assert_eq!(
+        count_step_allocations(Rk4::new(&sys, opts).unwrap(), &sys),
         0
     );
 }

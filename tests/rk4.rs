@@ -162,3 +162,38 @@ fn run_lands_on_t_end_when_h_does_not_divide() {
     assert_eq!(st.steps, 4);
     assert_eq!(s.t, 1.0);
 }
+
+#[test]
+fn sparse_and_dense_index1_solves_agree_on_a_chain() {
+    use mbd::solve::LinearSolver;
+    let sys = models::n_link_chain(30).unwrap();
+    let mut finals = vec![];
+    for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
+        let mut s = State::consistent(&sys, 0.0).unwrap();
+        let mut rk = Rk4::new(
+            &sys,
+            Rk4Options {
+                linear,
+                ..Rk4Options::projected()
+            },
+        )
+        .unwrap();
+        run(
+            &mut rk,
+            &sys,
+            &mut s,
+            RunConfig {
+                t_end: 0.2,
+                h: 0.002,
+            },
+            &mut NoObserver,
+        )
+        .unwrap();
+        finals.push(s.q.as_slice().to_vec());
+    }
+    let d = finals[0]
+        .iter()
+        .zip(&finals[1])
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(d < 1e-10, "dense vs sparse differ by {d}");
+}

@@ -61,6 +61,10 @@ impl System {
         }
         let mut jac = DMatrix::zeros(m, n);
         self.phi_q(q, &mut jac);
+        // Fast path: a well-conditioned Cholesky factor of Phi_q M^-1 Phi_q^T proves full rank.
+        if self.schur_well_conditioned(&jac) {
+            return Ok(());
+        }
         // Gram-Schmidt on the rows (twice for stability), tracking each basis vector as a
         // combination of the original rows so a dependency can be traced to its joints.
         let scale = (0..m)
@@ -220,19 +224,46 @@ impl System {
     }
 
     /// Solves `(Phi_q M^-1 Phi_q^T) y = rhs` (Cholesky); an error if not positive definite.
-    fn schur_solve(&self, jac: &DMatrix<f64>, rhs: &[f64]) -> Result<DVector<f64>, ()> {
+    /// `S = Phi_q M^-1 Phi_q^T` (dense), accumulated column by column over the few non-zeros of
+    /// each column of `Phi_q`, so building it costs `O(n k^2)` for `k` non-zeros per column.
+    fn schur_matrix(&self, jac: &DMatrix<f64>) -> Mat<f64> {
         let m = self.m;
         let mut s = Mat::<f64>::zeros(m, m);
-        for i in 0..m {
-            for j in 0..m {
-                let mut acc = 0.0;
-                for k in 0..self.n {
-                    acc += jac[(i, k)] * self.inv_mass[k] * jac[(j, k)];
+        let mut nz: Vec<(usize, f64)> = Vec::with_capacity(8);
+        for k in 0..self.n {
+            nz.clear();
+            let col = jac.column(k);
+            for (r, &x) in col.iter().enumerate() {
+                if x != 0.0 {
+                    nz.push((r, x));
                 }
-                s[(i, j)] = acc;
+            }
+            let w = self.inv_mass[k];
+            for &(i, xi) in &nz {
+                for &(j, xj) in &nz {
+                    s[(i, j)] += w * xi * xj;
+                }
             }
         }
-        let llt = s.llt(Side::Lower).map_err(|_| ())?;
+        s
+    }
+
+    /// Whether `S` has a Cholesky factor with pivots above `1e-7` of the largest (`S` condition
+    /// below ~1e14): the fast full-rank test of [`System::check_rank`].
+    fn schur_well_conditioned(&self, jac: &DMatrix<f64>) -> bool {
+        let Ok(llt) = self.schur_matrix(jac).llt(Side::Lower) else {
+            return false;
+        };
+        let l = llt.L();
+        let d: Vec<f64> = (0..self.m).map(|i| l[(i, i)].abs()).collect();
+        let dmax = d.iter().cloned().fold(0.0, f64::max);
+        d.iter().all(|&x| x > 1e-7 * dmax)
+    }
+
+    /// Solves `(Phi_q M^-1 Phi_q^T) y = rhs` (Cholesky); an error if not positive definite.
+    fn schur_solve(&self, jac: &DMatrix<f64>, rhs: &[f64]) -> Result<DVector<f64>, ()> {
+        let m = self.m;
+        let llt = self.schur_matrix(jac).llt(Side::Lower).map_err(|_| ())?;
         let mut b = Mat::<f64>::zeros(m, 1);
         for i in 0..m {
             b[(i, 0)] = rhs[i];

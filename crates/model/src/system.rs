@@ -634,6 +634,33 @@ impl System {
         }
     }
 
+    /// The bodies a joint attaches, as coordinate-block indices (`None` = ground).
+    pub fn joint_bodies(&self, j: JointHandle) -> (Option<usize>, Option<usize>) {
+        let at = self.joint_attach[j.0];
+        (at.a, at.b)
+    }
+
+    /// `Phi_q` in element-local form and `gamma`, for sparse assembly: row `r` of `Phi_q` is
+    /// `grads[r][0..3]` in the columns of the joint's first body and `grads[r][3..6]` in those of
+    /// its second ([`System::joint_bodies`]; entries for ground are zero).
+    pub fn phi_q_local_gamma(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        grads: &mut [[f64; 6]],
+        gamma: &mut [f64],
+    ) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, Some(v));
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                grads[o + k] = e[k].g;
+                gamma[o + k] = -e[k].d2 + j.time_part(k, t)[2];
+            }
+        }
+    }
+
     /// `gamma(q, v, t)` alone.
     pub fn gamma(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         for (ji, j) in self.joints.iter().enumerate() {

@@ -27,8 +27,8 @@
 
 use mbd_model::System;
 use mbd_solve::{
-    ButcherTableau, Index1Options, Index1Rk, Integrator, ProjectionSettings, SolveError, State,
-    StepStats,
+    ButcherTableau, Index1Options, Index1Rk, Integrator, LinearSolver, ProjectionSettings,
+    SolveError, State, StepStats,
 };
 
 /// Options of [`Rk4`]: both stabilisations off by default.
@@ -38,6 +38,8 @@ pub struct Rk4Options {
     pub baumgarte: Option<(f64, f64)>,
     /// Post-step projection.
     pub projection: Option<ProjectionSettings>,
+    /// Dense or sparse index-1 solve (default: sparse for large systems).
+    pub linear: LinearSolver,
 }
 
 impl Rk4Options {
@@ -49,14 +51,14 @@ impl Rk4Options {
     pub fn baumgarte(alpha: f64, beta: f64) -> Self {
         Rk4Options {
             baumgarte: Some((alpha, beta)),
-            projection: None,
+            ..Default::default()
         }
     }
     /// RK4 with post-step projection (default tolerance 1e-14).
     pub fn projected() -> Self {
         Rk4Options {
-            baumgarte: None,
             projection: Some(ProjectionSettings::default()),
+            ..Default::default()
         }
     }
 }
@@ -76,6 +78,7 @@ impl Rk4 {
             Index1Options {
                 baumgarte: options.baumgarte,
                 projection: options.projection,
+                linear: options.linear,
             },
         )?;
         Ok(Rk4 { inner })

@@ -7,6 +7,7 @@ use crate::accel::AccelerationSolver;
 use crate::error::SolveError;
 use crate::integrator::{Integrator, StepStats};
 use crate::projection::{ProjectionSettings, Projector};
+use crate::sparse::SparseAccelerationSolver;
 use crate::state::State;
 use crate::tableau::{ButcherTableau, ExplicitRk};
 use mbd_model::System;
@@ -19,13 +20,82 @@ pub struct Index1Options {
     pub baumgarte: Option<(f64, f64)>,
     /// Project `(q, v)` onto the constraints after every step (default off).
     pub projection: Option<ProjectionSettings>,
+    /// Dense or sparse index-1 solve (default: sparse above [`SPARSE_THRESHOLD`] constraints).
+    pub linear: LinearSolver,
+}
+
+/// Constraint count above which [`LinearSolver::Auto`] picks the sparse index-1 solve.
+pub const SPARSE_THRESHOLD: usize = 48;
+
+/// Which factorisation the index-1 solve uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LinearSolver {
+    /// Dense below [`SPARSE_THRESHOLD`] constraints, sparse above.
+    #[default]
+    Auto,
+    /// Dense Schur complement with Cholesky ([`AccelerationSolver`]).
+    Dense,
+    /// Sparse Schur complement with sparse Cholesky ([`SparseAccelerationSolver`]).
+    Sparse,
+}
+
+#[derive(Debug)]
+enum Accel {
+    Dense(AccelerationSolver),
+    Sparse(Box<SparseAccelerationSolver>),
+}
+
+impl Accel {
+    #[allow(clippy::too_many_arguments)]
+    fn stage(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        baum: Option<(f64, f64)>,
+        phi: &mut [f64],
+        phid: &mut [f64],
+        a: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<(), SolveError> {
+        let stab = |sys: &System, gamma: &mut [f64], phi: &mut [f64], phid: &mut [f64]| {
+            if let Some((al, be)) = baum {
+                sys.phi_and_phi_dot(q, v, t, phi, phid);
+                for k in 0..gamma.len() {
+                    gamma[k] -= 2.0 * al * phid[k] + be * be * phi[k];
+                }
+            }
+        };
+        match self {
+            Accel::Dense(acc) => {
+                sys.forces_into(q, v, t, &mut acc.forces);
+                if acc.gamma.is_empty() {
+                    let minv = sys.inv_mass_diag();
+                    for i in 0..a.len() {
+                        a[i] = minv[i] * acc.forces[i];
+                    }
+                    return Ok(());
+                }
+                sys.phi_q_gamma(q, v, t, &mut acc.phi_q, &mut acc.gamma);
+                stab(sys, &mut acc.gamma, phi, phid);
+                acc.finish(sys, t, a, lambda)
+            }
+            Accel::Sparse(sp) => {
+                sys.forces_into(q, v, t, &mut sp.forces);
+                sys.phi_q_local_gamma(q, v, t, &mut sp.grads, &mut sp.gamma);
+                stab(sys, &mut sp.gamma, phi, phid);
+                sp.finish(sys, t, a, lambda)
+            }
+        }
+    }
 }
 
 /// Explicit RK on the index-1 equations, allocation-free per step.
 #[derive(Debug)]
 pub struct Index1Rk {
     rk: ExplicitRk,
-    acc: AccelerationSolver,
+    acc: Accel,
     projector: Option<Projector>,
     options: Index1Options,
     y: Vec<f64>,
@@ -64,7 +134,12 @@ impl Index1Rk {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         Ok(Index1Rk {
             rk: ExplicitRk::new(tableau, 2 * n)?,
-            acc: AccelerationSolver::new(sys),
+            acc: match (options.linear, m > SPARSE_THRESHOLD) {
+                (LinearSolver::Dense, _) | (LinearSolver::Auto, false) => {
+                    Accel::Dense(AccelerationSolver::new(sys))
+                }
+                _ => Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?)),
+            },
             projector: options.projection.map(|p| Projector::new(sys, p)),
             options,
             y: vec![0.0; 2 * n],
@@ -122,23 +197,7 @@ impl Integrator for Index1Rk {
         let mut evals = 0;
         let mut f = |t: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
             let (q, v) = y.split_at(n);
-            sys.forces_into(q, v, t, &mut acc.forces);
-            sys.phi_q_gamma(q, v, t, &mut acc.phi_q, &mut acc.gamma);
-            if let Some((al, be)) = baum {
-                sys.phi(q, t, phi);
-                sys.phi_dot(q, v, t, phid);
-                for k in 0..phi.len() {
-                    acc.gamma[k] -= 2.0 * al * phid[k] + be * be * phi[k];
-                }
-            }
-            if !acc.gamma.is_empty() {
-                acc.finish(sys, t, a, lambda)?;
-            } else {
-                let minv = sys.inv_mass_diag();
-                for i in 0..n {
-                    a[i] = minv[i] * acc.forces[i];
-                }
-            }
+            acc.stage(sys, q, v, t, baum, phi, phid, a, lambda)?;
             dy[..n].copy_from_slice(v);
             dy[n..].copy_from_slice(a);
             evals += 1;
@@ -203,6 +262,7 @@ pub fn reference_trajectory(
         Index1Options {
             baumgarte: None,
             projection: Some(ProjectionSettings::default()),
+            ..Default::default()
         },
     )?;
     let mut s = state0.clone();
