@@ -1,0 +1,186 @@
+//! Adaptive stepping with the embedded estimate (DOPRI5 5(4), Bogacki-Shampine 3(2)) in chart
+//! coordinates: the error against a reference follows the requested tolerance, constraints stay
+//! at the Newton tolerance at every accepted step, and chart failures are rejections.
+
+mod common;
+
+use common::{state_error, ResidualWatch};
+use mbd_model::models;
+use mbd_solve::{reference_trajectory, ButcherTableau, NoObserver, SolveError, State};
+use mbd_tangent::{AdaptiveSettings, TangentError, TangentOptions, TangentRk};
+
+#[test]
+fn dopri5_error_follows_tolerance_on_manipulator() {
+    let sys = models::manipulator().expect("model");
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let r = reference_trajectory(&sys, &s0, 1.0, 1, 8000, ButcherTableau::dopri5()).expect("ref");
+    let mut errs = vec![];
+    let mut steps = vec![];
+    for tol in [1e-5, 1e-7, 1e-9, 1e-11] {
+        let mut s = s0.clone();
+        let mut dp = TangentRk::dopri5(&sys).expect("solver");
+        let mut watch = ResidualWatch::default();
+        let st = dp
+            .integrate_adaptive(
+                &sys,
+                &mut s,
+                1.0,
+                &AdaptiveSettings::with_tolerance(tol),
+                &mut watch,
+            )
+            .expect("adaptive run");
+        assert_eq!(s.t, 1.0);
+        assert_eq!(watch.samples, st.accepted + 1);
+        assert!(watch.max_phi <= 1e-12 && watch.max_phidot <= 1e-12);
+        assert!(st.max_residual <= 1e-12);
+        let e = state_error(&s, &r.q[1], &r.v[1]);
+        println!(
+            "tol {tol:e}: error {e:e}, accepted {}, rejected {}, chart rejections {}, h in [{:e}, {:e}]",
+            st.accepted, st.rejected, st.chart_rejections, st.h_min, st.h_max
+        );
+        errs.push(e);
+        steps.push(st.accepted);
+    }
+    for w in errs.windows(2) {
+        // 100x tighter tolerance: at least 10x smaller error
+        assert!(w[1] < 0.1 * w[0], "{errs:?}");
+    }
+    for (e, tol) in errs.iter().zip([1e-5, 1e-7, 1e-9, 1e-11]) {
+        assert!(*e < 1e3 * tol, "error {e} for tolerance {tol}");
+    }
+    assert!(steps.windows(2).all(|w| w[1] > w[0]), "{steps:?}");
+}
+
+#[test]
+fn bogacki_shampine_adaptive_and_tableau_without_estimate_is_an_error() {
+    let sys = models::slider_crank().expect("model");
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let r = reference_trajectory(&sys, &s0, 0.5, 1, 4000, ButcherTableau::dopri5()).expect("ref");
+    let mut s = s0.clone();
+    let mut bs = TangentRk::new(
+        &sys,
+        ButcherTableau::bogacki_shampine(),
+        TangentOptions::default(),
+    )
+    .expect("solver");
+    let st = bs
+        .integrate_adaptive(
+            &sys,
+            &mut s,
+            0.5,
+            &AdaptiveSettings::with_tolerance(1e-8),
+            &mut NoObserver,
+        )
+        .expect("run");
+    let e = state_error(&s, &r.q[1], &r.v[1]);
+    assert!(e < 1e-5, "error {e}");
+    assert!(st.accepted > 10);
+
+    let mut rk4 = TangentRk::rk4(&sys).expect("solver");
+    let mut s = s0.clone();
+    let err = rk4
+        .integrate_adaptive(
+            &sys,
+            &mut s,
+            0.5,
+            &AdaptiveSettings::default(),
+            &mut NoObserver,
+        )
+        .unwrap_err();
+    assert!(
+        matches!(err, TangentError::Solve(SolveError::Unsupported(_))),
+        "{err}"
+    );
+    assert_eq!(s, s0, "the state is untouched on error");
+}
+
+#[test]
+fn too_large_first_step_is_rejected_not_fatal() {
+    let sys = models::manipulator().expect("model");
+    let mut s = State::consistent(&sys, 0.0).expect("state");
+    let mut dp = TangentRk::dopri5(&sys).expect("solver");
+    let mut set = AdaptiveSettings::with_tolerance(1e-8);
+    set.h0 = Some(2.0);
+    let st = dp
+        .integrate_adaptive(&sys, &mut s, 2.0, &set, &mut NoObserver)
+        .expect("run");
+    assert!(st.rejected + st.chart_rejections > 0);
+    assert_eq!(s.t, 2.0);
+}
+
+#[test]
+fn bad_adaptive_settings_are_errors() {
+    let sys = models::pendulum(1.0, 1.0, 0.5, 9.81).expect("model");
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let mut dp = TangentRk::dopri5(&sys).expect("solver");
+    let mut bad = vec![];
+    let mut a = AdaptiveSettings::default();
+    a.controller.atol = -1.0;
+    bad.push(a);
+    let mut a = AdaptiveSettings::default();
+    a.controller.rtol = f64::NAN;
+    bad.push(a);
+    let mut a = AdaptiveSettings::default();
+    a.controller.atol = 0.0;
+    a.controller.rtol = 0.0;
+    bad.push(a);
+    let mut a = AdaptiveSettings::default();
+    a.controller.h_min = 0.0;
+    bad.push(a);
+    let mut a = AdaptiveSettings::default();
+    a.controller.fac_max = 0.5;
+    bad.push(a);
+    let mut a = AdaptiveSettings::default();
+    a.h0 = Some(-1.0);
+    bad.push(a);
+    let mut a = AdaptiveSettings::default();
+    a.h_max = 0.0;
+    bad.push(a);
+    let mut a = AdaptiveSettings::default();
+    a.max_steps = 0;
+    bad.push(a);
+    for a in &bad {
+        let mut s = s0.clone();
+        let e = dp.integrate_adaptive(&sys, &mut s, 1.0, a, &mut NoObserver);
+        assert!(
+            matches!(
+                e,
+                Err(TangentError::Solve(SolveError::InvalidParameter { .. }))
+            ),
+            "{a:?}: {e:?}"
+        );
+    }
+    // end time before the start, or not finite
+    for t_end in [-1.0, 0.0, f64::NAN, f64::INFINITY] {
+        let mut s = s0.clone();
+        let e = dp.integrate_adaptive(
+            &sys,
+            &mut s,
+            t_end,
+            &AdaptiveSettings::default(),
+            &mut NoObserver,
+        );
+        assert!(
+            matches!(
+                e,
+                Err(TangentError::Solve(SolveError::InvalidInterval { .. }))
+            ),
+            "{e:?}"
+        );
+    }
+    // step-count limit and h_min
+    let mut a = AdaptiveSettings::with_tolerance(1e-12);
+    a.max_steps = 5;
+    let mut s = s0.clone();
+    let e = dp.integrate_adaptive(&sys, &mut s, 1.0, &a, &mut NoObserver);
+    assert!(matches!(e, Err(TangentError::TooManySteps { .. })), "{e:?}");
+    let mut a = AdaptiveSettings::with_tolerance(1e-14);
+    a.controller.h_min = 1e-2;
+    a.h0 = Some(0.5);
+    let mut s = s0.clone();
+    let e = dp.integrate_adaptive(&sys, &mut s, 1.0, &a, &mut NoObserver);
+    assert!(
+        matches!(e, Err(TangentError::StepSizeTooSmall { .. })),
+        "{e:?}"
+    );
+}

@@ -1,0 +1,55 @@
+//! A step allocates nothing (fixed and adaptive, RK4 and DOPRI5), counted by a global allocator.
+
+use mbd_model::models;
+use mbd_solve::{Integrator, NoObserver, State};
+use mbd_tangent::{AdaptiveSettings, TangentRk};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { System.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(p, l, n) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn steps_allocate_nothing() {
+    for sys in [
+        models::manipulator().expect("model"),
+        models::slider_crank().expect("model"),
+    ] {
+        let mut s = State::consistent(&sys, 0.0).expect("state");
+        let mut rk4 = TangentRk::rk4(&sys).expect("solver");
+        let mut dp = TangentRk::dopri5(&sys).expect("solver");
+        let settings = AdaptiveSettings::with_tolerance(1e-9);
+        rk4.step(&sys, &mut s, 1e-3).expect("warm-up");
+        let before = ALLOCS.load(Ordering::SeqCst);
+        for _ in 0..200 {
+            rk4.step(&sys, &mut s, 1e-3).expect("step");
+            dp.step(&sys, &mut s, 1e-3).expect("step");
+        }
+        // steps that need halving (h = 0.1 on the manipulator) allocate nothing either
+        for _ in 0..10 {
+            rk4.step(&sys, &mut s, 0.1).expect("halved step");
+        }
+        let t1 = s.t + 0.5;
+        dp.integrate_adaptive(&sys, &mut s, t1, &settings, &mut NoObserver)
+            .expect("adaptive");
+        let after = ALLOCS.load(Ordering::SeqCst);
+        assert_eq!(after - before, 0, "allocations during steps");
+    }
+}
