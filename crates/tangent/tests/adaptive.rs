@@ -113,32 +113,33 @@ fn bad_adaptive_settings_are_errors() {
     let sys = models::pendulum(1.0, 1.0, 0.5, 9.81).expect("model");
     let s0 = State::consistent(&sys, 0.0).expect("state");
     let mut dp = TangentRk::dopri5(&sys).expect("solver");
-    let mut bad = vec![];
-    let mut a = AdaptiveSettings::default();
-    a.controller.atol = -1.0;
-    bad.push(a);
-    let mut a = AdaptiveSettings::default();
-    a.controller.rtol = f64::NAN;
-    bad.push(a);
-    let mut a = AdaptiveSettings::default();
-    a.controller.atol = 0.0;
-    a.controller.rtol = 0.0;
-    bad.push(a);
-    let mut a = AdaptiveSettings::default();
-    a.controller.h_min = 0.0;
-    bad.push(a);
-    let mut a = AdaptiveSettings::default();
-    a.controller.fac_max = 0.5;
-    bad.push(a);
-    let mut a = AdaptiveSettings::default();
-    a.h0 = Some(-1.0);
-    bad.push(a);
-    let mut a = AdaptiveSettings::default();
-    a.h_max = 0.0;
-    bad.push(a);
-    let mut a = AdaptiveSettings::default();
-    a.max_steps = 0;
-    bad.push(a);
+    let ctrl = |f: &dyn Fn(&mut mbd_solve::StepController)| {
+        let mut a = AdaptiveSettings::default();
+        f(&mut a.controller);
+        a
+    };
+    let bad = [
+        ctrl(&|c| c.atol = -1.0),
+        ctrl(&|c| c.rtol = f64::NAN),
+        ctrl(&|c| {
+            c.atol = 0.0;
+            c.rtol = 0.0
+        }),
+        ctrl(&|c| c.h_min = 0.0),
+        ctrl(&|c| c.fac_max = 0.5),
+        AdaptiveSettings {
+            h0: Some(-1.0),
+            ..Default::default()
+        },
+        AdaptiveSettings {
+            h_max: 0.0,
+            ..Default::default()
+        },
+        AdaptiveSettings {
+            max_steps: 0,
+            ..Default::default()
+        },
+    ];
     for a in &bad {
         let mut s = s0.clone();
         let e = dp.integrate_adaptive(&sys, &mut s, 1.0, a, &mut NoObserver);
