@@ -1,0 +1,908 @@
+//! The FA-DAE integrator: predictor, box, firefly run, optional Gauss-Newton polish,
+//! completion of the accepted state.
+
+use crate::accel::RefinedAcceleration;
+use crate::error::FaDaeError;
+use crate::objective::{StepProblem, Workspace};
+use crate::options::{FaDaeOptions, MissPolicy, PartitionChoice, Predictor};
+use crate::partition::Partition;
+use crate::small::SmallLu;
+use mbd_firefly::{Bounds, Firefly, Objective, StopReason, SyncObjective};
+use mbd_model::System;
+use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
+use std::sync::Mutex;
+
+/// What one step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepInfo {
+    /// Start time of the step.
+    pub t: f64,
+    /// Step size.
+    pub h: f64,
+    /// Objective at the predictor (the centre of the first box).
+    pub objective_predictor: f64,
+    /// Best objective found by the firefly algorithm.
+    pub objective_firefly: f64,
+    /// Objective of the accepted state (after the polish, if on).
+    pub objective_final: f64,
+    /// The step's target: `max(tolerance * objective_predictor, floor)`.
+    pub target: f64,
+    /// Whether the firefly reached the target (`objective_firefly <= target`).
+    pub reached_target: bool,
+    /// Why the (last) firefly run stopped.
+    pub stop_reason: StopReason,
+    /// Firefly generations, over all runs of the step.
+    pub generations: u64,
+    /// Objective evaluations of the firefly runs.
+    pub evaluations: u64,
+    /// Box widenings (the best point was at a face of the box).
+    pub expansions: u32,
+    /// Firefly runs (stages) of the step.
+    pub stages: u32,
+    /// Gauss-Newton iterations of the polish (0 when off).
+    pub polish_iterations: usize,
+    /// Objective evaluations of the polish.
+    pub polish_evaluations: usize,
+    /// Whether the partition was re-chosen at this step.
+    pub repartitioned: bool,
+}
+
+impl Default for StepInfo {
+    fn default() -> Self {
+        StepInfo {
+            t: 0.0,
+            h: 0.0,
+            objective_predictor: 0.0,
+            objective_firefly: 0.0,
+            objective_final: 0.0,
+            target: 0.0,
+            reached_target: true,
+            stop_reason: StopReason::TargetReached,
+            generations: 0,
+            evaluations: 0,
+            expansions: 0,
+            stages: 0,
+            polish_iterations: 0,
+            polish_evaluations: 0,
+            repartitioned: false,
+        }
+    }
+}
+
+/// Totals over the steps since the last [`Integrator::reset`] (the run loop resets before the
+/// first step, so these are per run).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FaDaeStats {
+    /// Steps taken.
+    pub steps: u64,
+    /// Firefly generations.
+    pub generations: u64,
+    /// Objective evaluations (firefly, polish and the predictor's).
+    pub evaluations: u64,
+    /// Box re-runs.
+    pub expansions: u64,
+    /// Steps whose firefly stopped above the target (accepted under [`MissPolicy::Accept`]).
+    pub target_misses: u64,
+    /// Partition changes.
+    pub repartitions: u64,
+    /// Gauss-Newton iterations of the polish.
+    pub polish_iterations: u64,
+    /// Smallest ratio `objective(predictor) / max(objective(firefly result), floor)` of a
+    /// counted step.
+    pub min_ratio: f64,
+    /// Steps whose predictor was already within a factor 100 of the objective's round-off
+    /// floor (no 100-fold reduction is measurable there); left out of the ratio statistics.
+    pub roundoff_steps: u64,
+    /// Sum of `ln(ratio)` over the counted steps.
+    pub log_ratio_sum: f64,
+    /// Number of counted steps.
+    pub ratio_count: u64,
+    /// Largest objective of an accepted state.
+    pub max_objective: f64,
+}
+
+impl FaDaeStats {
+    fn new() -> Self {
+        FaDaeStats {
+            min_ratio: f64::INFINITY,
+            ..Default::default()
+        }
+    }
+
+    /// Geometric mean of `objective(predictor) / objective(firefly result)` over the steps (the
+    /// arithmetic mean is dominated by single huge ratios; both are "much larger than 100" when
+    /// the optimiser does the work).
+    pub fn mean_ratio(&self) -> f64 {
+        if self.ratio_count == 0 {
+            f64::NAN
+        } else {
+            (self.log_ratio_sum / self.ratio_count as f64).exp()
+        }
+    }
+
+    /// Mean generations per step.
+    pub fn mean_generations(&self) -> f64 {
+        self.generations as f64 / (self.steps.max(1)) as f64
+    }
+}
+
+/// Serial objective adaptor.
+struct SerialObjective<'a> {
+    prob: &'a StepProblem,
+    sys: &'a System,
+    ws: &'a mut Workspace,
+}
+
+impl Objective for SerialObjective<'_> {
+    fn eval(&mut self, x: &[f64]) -> f64 {
+        self.prob.objective(self.sys, self.ws, x)
+    }
+    fn dim(&self) -> Option<usize> {
+        Some(self.prob.dim())
+    }
+}
+
+/// Parallel objective adaptor: a pool of workspaces, any free one is used (the value does not
+/// depend on which: every evaluation starts from the same data).
+struct ParallelObjective<'a> {
+    prob: &'a StepProblem,
+    sys: &'a System,
+    pool: &'a [Mutex<Workspace>],
+}
+
+impl SyncObjective for ParallelObjective<'_> {
+    fn eval(&self, x: &[f64]) -> f64 {
+        let k = self.pool.len();
+        let start = rayon::current_thread_index().unwrap_or(0);
+        loop {
+            for i in 0..k {
+                if let Ok(mut ws) = self.pool[(start + i) % k].try_lock() {
+                    return self.prob.objective(self.sys, &mut ws, x);
+                }
+            }
+            std::thread::yield_now();
+        }
+    }
+    fn dim(&self) -> Option<usize> {
+        Some(self.prob.dim())
+    }
+}
+
+/// SplitMix64 finaliser: a well-mixed 64-bit hash of `x`.
+fn splitmix64(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^ (x >> 31)
+}
+
+/// The seed of attempt `attempt` of step `step` for the run seed `seed`.
+pub fn step_seed(seed: u64, step: u64, attempt: u32) -> u64 {
+    splitmix64(seed ^ splitmix64(step ^ splitmix64(u64::from(attempt) ^ 0xFA_DAE)))
+}
+
+/// The FA-DAE solver of paper C: an [`Integrator`] whose every step is a firefly minimisation
+/// of the two-point Gauss residual of the equations of motion. See the crate documentation and
+/// `docs/firefly-gauss.md`.
+#[derive(Debug)]
+pub struct FireflyGauss {
+    opts: FaDaeOptions,
+    n: usize,
+    m: usize,
+    partition: Partition,
+    prob: StepProblem,
+    ws: Workspace,
+    pool: Vec<Mutex<Workspace>>,
+    acc: AccelerationSolver,
+    lambda: Vec<f64>,
+    end_acc: RefinedAcceleration,
+    // RK4 predictor
+    ka: [Vec<f64>; 4],
+    kv: [Vec<f64>; 4],
+    qs: Vec<f64>,
+    vs: Vec<f64>,
+    rq: Vec<f64>,
+    rv: Vec<f64>,
+    qhat: Vec<f64>,
+    vhat: Vec<f64>,
+    // decision space
+    xhat: Vec<f64>,
+    xtay: Vec<f64>,
+    centre: Vec<f64>,
+    half: Vec<f64>,
+    best: Vec<f64>,
+    corr: Vec<f64>,
+    corr_prev: Vec<f64>,
+    floor: Vec<f64>,
+    /// Corrections available (0, 1, 2 = two or more).
+    n_corr: u8,
+    // polish
+    gn_lu: SmallLu,
+    gn_r: Vec<f64>,
+    gn_rt: Vec<f64>,
+    gn_dx: Vec<f64>,
+    gn_xt: Vec<f64>,
+    step_index: u64,
+    last: StepInfo,
+    stats: FaDaeStats,
+}
+
+impl FireflyGauss {
+    /// A solver for `sys`. The partition is chosen (or checked) at the system's initial guess.
+    ///
+    /// # Errors
+    /// Invalid options ([`FaDaeError::InvalidOption`], [`FaDaeError::Firefly`]), invalid
+    /// independent coordinates ([`FaDaeError::InvalidPartition`]), a system without degrees of
+    /// freedom or with redundant constraints ([`FaDaeError::Unsupported`]).
+    pub fn new(sys: &System, options: FaDaeOptions) -> Result<Self, FaDaeError> {
+        options.validate()?;
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let (q0, _) = sys.initial_guess();
+        let partition = match &options.partition {
+            PartitionChoice::Auto => Partition::auto(sys, q0.as_slice())?,
+            PartitionChoice::Given(ind) => Partition::given(sys, q0.as_slice(), ind)?,
+        };
+        let dof = partition.dof();
+        let mut prob = StepProblem::new(sys, &partition);
+        prob.newton_max_iter = options.newton_max_iter;
+        let threads = rayon::current_num_threads().max(1) + 1;
+        let pool = if options.parallel {
+            (0..threads)
+                .map(|_| Mutex::new(Workspace::new(sys)))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let z = || vec![0.0; n];
+        let d = || vec![0.0; 2 * dof];
+        Ok(FireflyGauss {
+            n,
+            m,
+            partition,
+            prob,
+            ws: Workspace::new(sys),
+            pool,
+            acc: AccelerationSolver::new(sys),
+            lambda: vec![0.0; m],
+            end_acc: RefinedAcceleration::new(sys),
+            ka: [z(), z(), z(), z()],
+            kv: [z(), z(), z(), z()],
+            qs: z(),
+            vs: z(),
+            rq: z(),
+            rv: z(),
+            qhat: z(),
+            vhat: z(),
+            xhat: d(),
+            xtay: d(),
+            centre: d(),
+            half: d(),
+            best: d(),
+            corr: d(),
+            corr_prev: d(),
+            floor: d(),
+            n_corr: 0,
+            gn_lu: SmallLu::new(2 * dof),
+            gn_r: d(),
+            gn_rt: d(),
+            gn_dx: d(),
+            gn_xt: d(),
+            step_index: 0,
+            last: StepInfo::default(),
+            stats: FaDaeStats::new(),
+            opts: options,
+        })
+    }
+
+    /// The options in use.
+    pub fn options(&self) -> &FaDaeOptions {
+        &self.opts
+    }
+
+    /// The current coordinate partition.
+    pub fn partition(&self) -> &Partition {
+        &self.partition
+    }
+
+    /// Accelerations at the end of the last step (index-1 solve with one refinement step), with
+    /// `||Phi_q a - gamma||_inf` as [`RefinedAcceleration::residual`].
+    pub fn end_acceleration(&self) -> &RefinedAcceleration {
+        &self.end_acc
+    }
+
+    /// The accepted decision vector `(z, zdot)` of the last step.
+    pub fn last_solution(&self) -> &[f64] {
+        &self.best
+    }
+
+    /// The objective of the last step's problem at the decision vector `x` (length
+    /// `2 dof`; NaN if `x` cannot be completed or has the wrong length). For diagnostics and
+    /// benchmarks: one call is one objective evaluation as the optimiser sees it.
+    pub fn objective_at(&mut self, sys: &System, x: &[f64]) -> f64 {
+        if x.len() != self.prob.dim() || sys.n_coords() != self.n {
+            return f64::NAN;
+        }
+        self.prob.objective(sys, &mut self.ws, x)
+    }
+
+    /// What the last step did.
+    pub fn last_step(&self) -> &StepInfo {
+        &self.last
+    }
+
+    /// Totals since the last reset.
+    pub fn stats(&self) -> &FaDaeStats {
+        &self.stats
+    }
+
+    /// One step of size `h` from `state` (advancing `state.t` by `h`), with the crate's own
+    /// error type. [`Integrator::step`] calls this.
+    ///
+    /// # Errors
+    /// Wrong-size state or system, `h <= 0` or not finite, a singular dependent block, a
+    /// failed completion of the accepted state, no feasible candidate, or a missed target under
+    /// [`MissPolicy::Error`]. On error `state` is unchanged.
+    pub fn try_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+    ) -> Result<StepStats, FaDaeError> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(SolveError::InvalidStep { h }.into());
+        }
+        if sys.n_coords() != self.n || sys.n_constraints() != self.m {
+            return Err(SolveError::Dimension {
+                what: "system (not the one the FA-DAE solver was built for)",
+                expected: self.n,
+                got: sys.n_coords(),
+            }
+            .into());
+        }
+        state.check(sys)?;
+        if !state.is_finite() {
+            return Err(SolveError::NonFinite {
+                t: state.t,
+                what: "state at the step's start",
+            }
+            .into());
+        }
+        let t0 = state.t;
+        let mut info = StepInfo {
+            t: t0,
+            h,
+            ..StepInfo::default()
+        };
+        info.repartitioned = self.check_partition(sys, state)?;
+        self.predict(sys, state, h)?;
+        let dof = self.partition.dof();
+        let nd = 2 * dof;
+
+        // the step problem (chord Jacobian at the predictor, metric at q0)
+        self.prob.q_start.copy_from_slice(&self.qhat);
+        // Phi's round-off scales with the translational coordinates (every third coordinate is
+        // an angle, which enters only through sin and cos)
+        let xy_max = state
+            .q
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % 3 != 2)
+            .fold(1.0f64, |a, (_, x)| a.max(x.abs()));
+        self.prob.newton_tol = self.opts.newton_tol * xy_max;
+        self.prob
+            .prepare(
+                sys,
+                &mut self.ws,
+                t0,
+                h,
+                state.q.as_slice(),
+                state.v.as_slice(),
+            )
+            .map_err(|what| SolveError::Singular {
+                t: t0,
+                what: "FA-DAE step matrix",
+                detail: what.to_string(),
+            })?;
+        self.predictor_and_box(dof, h);
+        let f_pred = {
+            let centre = std::mem::take(&mut self.centre);
+            let f = self.prob.objective(sys, &mut self.ws, &centre);
+            self.centre = centre;
+            f
+        };
+        // round-off floor of the objective: each of the 2 dof residual components carries
+        // a few ulps of the independent coordinates
+        let floor = {
+            let zmax = self.xhat[..dof].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            let s = f64::EPSILON * (1.0 + zmax);
+            128.0 * dof as f64 * s * s
+        };
+        let target = if f_pred.is_finite() {
+            (self.opts.tolerance * f_pred).max(floor)
+        } else {
+            floor
+        };
+        info.objective_predictor = f_pred;
+        info.target = target;
+
+        // firefly stages: each run is seeded with the best point so far and searches a box
+        // centred on it; the box shrinks when the run ends inside it and widens when the best
+        // point sits at a face.
+        let b = self.opts.bounds.clone();
+        let mut f_best = if self.opts.seed_predictor {
+            f_pred
+        } else {
+            f64::INFINITY
+        };
+        self.best.copy_from_slice(&self.centre);
+        let mut f_centre = f_pred;
+        let mut stage = 0u32;
+        loop {
+            let remaining = self.opts.max_generations.saturating_sub(info.generations);
+            let seed_centre = self.opts.seed_predictor || stage > 0;
+            let result = self.run_firefly(sys, target, stage, remaining, seed_centre)?;
+            info.generations += result.generations;
+            info.evaluations += result.evaluations;
+            info.stop_reason = result.stop_reason;
+            info.stages = stage + 1;
+            if result.best_f < f_best || (!f_best.is_finite() && result.best_f.is_finite()) {
+                f_best = result.best_f;
+                self.best.copy_from_slice(&result.best_x);
+            }
+            if f_best <= target || info.generations >= self.opts.max_generations {
+                break;
+            }
+            if !f_best.is_finite() {
+                // nothing feasible in the box: widen it
+                if info.expansions >= b.max_expansions {
+                    return Err(FaDaeError::NoFeasibleCandidate { t: t0 });
+                }
+                for w in self.half.iter_mut() {
+                    *w *= b.expansion;
+                }
+                info.expansions += 1;
+                stage += 1;
+                continue;
+            }
+            let at_face = (0..nd).any(|k| {
+                let w = self.half[k];
+                w > 0.0
+                    && (self.best[k] - self.centre[k]).abs() >= w * (1.0 - 2.0 * b.edge_fraction)
+            });
+            let mut changed = false;
+            if at_face && info.expansions < b.max_expansions {
+                for w in self.half.iter_mut() {
+                    *w *= b.expansion;
+                }
+                info.expansions += 1;
+                changed = true;
+            } else {
+                // shrink around the best point, by the distance reduction the stage achieved
+                let reduction = if f_centre.is_finite() && f_centre > 0.0 {
+                    (f_best / f_centre).sqrt()
+                } else {
+                    b.max_shrink
+                };
+                let factor = (b.safety * reduction).clamp(b.min_shrink, b.max_shrink);
+                for k in 0..nd {
+                    let w = (self.half[k] * factor).max(self.floor[k]);
+                    changed |= w < self.half[k];
+                    self.half[k] = w;
+                }
+            }
+            if !changed && f_best >= f_centre {
+                // at the floor and no progress: nothing more to gain
+                break;
+            }
+            self.centre.copy_from_slice(&self.best);
+            f_centre = f_best;
+            stage += 1;
+        }
+        info.objective_firefly = f_best;
+        info.reached_target = info.objective_firefly <= target;
+        if !info.reached_target && self.opts.on_miss == MissPolicy::Error {
+            return Err(FaDaeError::TargetMissed {
+                t: t0,
+                best: info.objective_firefly,
+                target,
+                generations: info.generations,
+                reason: format!("{:?}", info.stop_reason),
+            });
+        }
+        info.objective_final = info.objective_firefly;
+        if self.opts.polish {
+            let (it, evals, f) = self.polish(sys, info.objective_firefly);
+            info.polish_iterations = it;
+            info.polish_evaluations = evals;
+            info.objective_final = f;
+        }
+
+        // accepted state
+        let best = std::mem::take(&mut self.best);
+        let done = self.prob.complete(sys, &mut self.ws, &best);
+        self.best = best;
+        if done.is_none() {
+            return Err(SolveError::Newton {
+                t: t0,
+                residual: f64::NAN,
+                iterations: self.opts.newton_max_iter,
+                context: "FA-DAE completion of the accepted state".into(),
+            }
+            .into());
+        }
+        // accelerations of the accepted state (index-1 solve, refined): the third constraint
+        // level at the grid point
+        self.end_acc.solve(sys, &self.ws.q1, &self.ws.v1, t0 + h)?;
+        state.q.as_mut_slice().copy_from_slice(&self.ws.q1);
+        state.v.as_mut_slice().copy_from_slice(&self.ws.v1);
+        state.t = t0 + h;
+        std::mem::swap(&mut self.corr, &mut self.corr_prev);
+        for k in 0..nd {
+            self.corr[k] = self.best[k] - self.xhat[k];
+        }
+        self.n_corr = (self.n_corr + 1).min(2);
+        self.step_index += 1;
+
+        // bookkeeping
+        let s = &mut self.stats;
+        s.steps += 1;
+        s.generations += info.generations;
+        let evals = info.evaluations + info.polish_evaluations as u64 + 1;
+        s.evaluations += evals;
+        s.expansions += u64::from(info.expansions);
+        s.target_misses += u64::from(!info.reached_target);
+        s.repartitions += u64::from(info.repartitioned);
+        s.polish_iterations += info.polish_iterations as u64;
+        s.max_objective = s.max_objective.max(info.objective_final);
+        if f_pred.is_finite() && f_pred > 100.0 * floor {
+            let ratio = f_pred / info.objective_firefly.max(floor);
+            s.min_ratio = s.min_ratio.min(ratio);
+            s.log_ratio_sum += ratio.ln();
+            s.ratio_count += 1;
+        } else {
+            s.roundoff_steps += 1;
+        }
+        self.last = info;
+        Ok(StepStats {
+            newton_iterations: info.polish_iterations,
+            residual: info.objective_final.sqrt(),
+            rhs_evals: 5,
+            objective_evals: evals as usize,
+        })
+    }
+
+    /// Auto partitioning: re-choose when the dependent block at the step's start is
+    /// ill-conditioned. Given partitioning: error when it is singular.
+    fn check_partition(&mut self, sys: &System, state: &State) -> Result<bool, FaDaeError> {
+        let m = self.m;
+        let q = state.q.as_slice();
+        sys.phi_q(q, &mut self.ws.jac);
+        self.partition
+            .fill_dependent_block(&self.ws.jac, self.ws.lu.matrix_mut());
+        let ratio = match self.ws.lu.factor() {
+            Ok((pmin, pmax)) => pmin / pmax,
+            Err(_) => 0.0,
+        };
+        let _ = m;
+        match self.opts.partition {
+            PartitionChoice::Given(_) => {
+                if !(ratio > 1e-12) {
+                    return Err(SolveError::Singular {
+                        t: state.t,
+                        what: "dependent block of Phi_q (user-given partition)",
+                        detail: format!("independent coordinates {:?}", self.partition.independent),
+                    }
+                    .into());
+                }
+                Ok(false)
+            }
+            PartitionChoice::Auto => {
+                if ratio >= self.opts.repartition_threshold {
+                    return Ok(false);
+                }
+                let p = Partition::auto(sys, q)?;
+                let changed = p != self.partition;
+                if changed {
+                    self.partition = p;
+                    self.prob.set_partition(&self.partition);
+                    self.n_corr = 0;
+                }
+                Ok(changed)
+            }
+        }
+    }
+
+    /// RK4 on the index-1 form from the state (the predictor) and a second-order Taylor step
+    /// (for the first box).
+    fn predict(&mut self, sys: &System, state: &State, h: f64) -> Result<(), FaDaeError> {
+        let t0 = state.t;
+        let (mut qo, mut vo) = (
+            std::mem::take(&mut self.qhat),
+            std::mem::take(&mut self.vhat),
+        );
+        let r = self.rk4(
+            sys,
+            state.q.as_slice(),
+            state.v.as_slice(),
+            t0,
+            h,
+            &mut qo,
+            &mut vo,
+        );
+        self.qhat = qo;
+        self.vhat = vo;
+        r?;
+        let dof = self.partition.dof();
+        for (k, &i) in self.partition.independent.iter().enumerate() {
+            self.xhat[k] = self.qhat[i];
+            self.xhat[dof + k] = self.vhat[i];
+        }
+        if self.n_corr == 0 {
+            // no correction history yet: estimate the predictor's error by Richardson
+            // extrapolation, two RK4 half steps against the full step
+            let (mut qm, mut vm) = (std::mem::take(&mut self.qs), std::mem::take(&mut self.vs));
+            let (mut q2, mut v2) = (vec![0.0; self.n], vec![0.0; self.n]);
+            let mut r = self.rk4(
+                sys,
+                state.q.as_slice(),
+                state.v.as_slice(),
+                t0,
+                0.5 * h,
+                &mut qm,
+                &mut vm,
+            );
+            if r.is_ok() {
+                r = self.rk4(sys, &qm, &vm, t0 + 0.5 * h, 0.5 * h, &mut q2, &mut v2);
+            }
+            self.qs = qm;
+            self.vs = vm;
+            r?;
+            for (k, &i) in self.partition.independent.iter().enumerate() {
+                self.xtay[k] = self.xhat[k] + (q2[i] - self.xhat[k]) * (16.0 / 15.0);
+                self.xtay[dof + k] =
+                    self.xhat[dof + k] + (v2[i] - self.xhat[dof + k]) * (16.0 / 15.0);
+            }
+        }
+        if self.qhat.iter().chain(&self.vhat).any(|x| !x.is_finite()) {
+            return Err(SolveError::NonFinite {
+                t: t0,
+                what: "FA-DAE predictor",
+            }
+            .into());
+        }
+        Ok(())
+    }
+
+    /// One classic RK4 step on the index-1 form from `(q0, v0, t0)` into `(qo, vo)`.
+    #[allow(clippy::too_many_arguments)]
+    fn rk4(
+        &mut self,
+        sys: &System,
+        q0: &[f64],
+        v0: &[f64],
+        t0: f64,
+        h: f64,
+        qo: &mut [f64],
+        vo: &mut [f64],
+    ) -> Result<(), FaDaeError> {
+        let n = self.n;
+        let c = [0.0, 0.5, 0.5, 1.0];
+        let (mut qs, mut vs) = (std::mem::take(&mut self.rq), std::mem::take(&mut self.rv));
+        let mut res = Ok(());
+        for s in 0..4 {
+            if s == 0 {
+                qs.copy_from_slice(q0);
+                vs.copy_from_slice(v0);
+            } else {
+                let (kv, ka) = (&self.kv[s - 1], &self.ka[s - 1]);
+                for i in 0..n {
+                    qs[i] = q0[i] + c[s] * h * kv[i];
+                    vs[i] = v0[i] + c[s] * h * ka[i];
+                }
+            }
+            self.kv[s].copy_from_slice(&vs);
+            let ka = &mut self.ka[s];
+            res = self
+                .acc
+                .solve(sys, &qs, &vs, t0 + c[s] * h, ka, &mut self.lambda);
+            if res.is_err() {
+                break;
+            }
+        }
+        self.rq = qs;
+        self.rv = vs;
+        res?;
+        for i in 0..n {
+            qo[i] = q0[i]
+                + h / 6.0
+                    * (self.kv[0][i] + 2.0 * self.kv[1][i] + 2.0 * self.kv[2][i] + self.kv[3][i]);
+            vo[i] = v0[i]
+                + h / 6.0
+                    * (self.ka[0][i] + 2.0 * self.ka[1][i] + 2.0 * self.ka[2][i] + self.ka[3][i]);
+        }
+        Ok(())
+    }
+
+    /// The predictor (into `centre`) and the box half-widths and floors.
+    fn predictor_and_box(&mut self, dof: usize, h: f64) {
+        let nd = 2 * dof;
+        let b = &self.opts.bounds;
+        let corrected = self.opts.predictor == Predictor::CorrectedRk4;
+        let group_max = |v: &[f64]| v.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+        let diff_max = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        };
+        // estimated error of the predictor, per group (positions, velocities)
+        let (ez, ev) = match (self.n_corr, corrected) {
+            (0, _) => (
+                diff_max(&self.xhat[..dof], &self.xtay[..dof]),
+                diff_max(&self.xhat[dof..], &self.xtay[dof..]),
+            ),
+            (1, _) | (_, false) => (group_max(&self.corr[..dof]), group_max(&self.corr[dof..])),
+            _ => (
+                diff_max(&self.corr[..dof], &self.corr_prev[..dof]),
+                diff_max(&self.corr[dof..], &self.corr_prev[dof..]),
+            ),
+        };
+        for k in 0..nd {
+            self.centre[k] = self.xhat[k]
+                + if corrected && self.n_corr > 0 {
+                    self.corr[k]
+                } else {
+                    0.0
+                };
+        }
+        // balanced box: a full half-width in z or in zdot moves the interpolant's second
+        // derivative at the Gauss nodes by comparable amounts (6 dz / h^2 vs 4 dzdot / h)
+        let fz = b.min_relative * (1.0 + group_max(&self.centre[..dof]));
+        let fv = b.min_relative * (1.0 + group_max(&self.centre[dof..]));
+        let wz = (b.safety * ez.max(h * ev)).max(fz);
+        let wv = (wz / h).max(fv);
+        for k in 0..dof {
+            self.half[k] = wz;
+            self.half[dof + k] = wv;
+            self.floor[k] = fz;
+            self.floor[dof + k] = fv;
+        }
+        for k in 0..nd {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            self.centre[k] += sign * self.opts.predictor_offset * self.half[k];
+        }
+    }
+
+    fn run_firefly(
+        &mut self,
+        sys: &System,
+        target: f64,
+        attempt: u32,
+        max_generations: u64,
+        seed_centre: bool,
+    ) -> Result<mbd_firefly::FireflyResult, FaDaeError> {
+        let bounds = Bounds::centered(&self.centre, &self.half)?;
+        let settings =
+            self.opts
+                .firefly
+                .clone()
+                .seed(step_seed(self.opts.seed, self.step_index, attempt));
+        let mut ff = Firefly::new(bounds)
+            .settings(settings)
+            .termination(self.opts.stage_termination(target, max_generations));
+        if seed_centre {
+            ff = ff.initial_position(self.centre.clone());
+        }
+        let result = if self.opts.parallel {
+            let obj = ParallelObjective {
+                prob: &self.prob,
+                sys,
+                pool: &self.pool,
+            };
+            ff.minimize_parallel(&obj)?
+        } else {
+            let mut obj = SerialObjective {
+                prob: &self.prob,
+                sys,
+                ws: &mut self.ws,
+            };
+            ff.minimize(&mut obj)?
+        };
+        Ok(result)
+    }
+
+    /// Gauss-Newton on the residual vector from `self.best` (forward-difference Jacobian).
+    /// Keeps the best point; returns (iterations, evaluations, objective).
+    fn polish(&mut self, sys: &System, f_start: f64) -> (usize, usize, f64) {
+        let nd = self.best.len();
+        let dof = nd / 2;
+        let mut evals = 0;
+        let prob = &self.prob;
+        let ws = &mut self.ws;
+        if !prob.residual_vector(sys, ws, &self.best, &mut self.gn_r) {
+            return (0, 1, f_start);
+        }
+        evals += 1;
+        let mut f = self.gn_r.iter().map(|r| r * r).sum::<f64>();
+        let mut iters = 0;
+        for _ in 0..self.opts.polish_max_iter {
+            if f == 0.0 {
+                break;
+            }
+            // Jacobian by forward differences, column by column
+            let mut ok = true;
+            for j in 0..nd {
+                let eta = if j < dof {
+                    1e-7 * (1.0 + self.best[j].abs())
+                } else {
+                    1e-6 * (1.0 + self.best[j].abs())
+                };
+                self.gn_xt.copy_from_slice(&self.best);
+                self.gn_xt[j] += eta;
+                let eta = self.gn_xt[j] - self.best[j];
+                evals += 1;
+                if !prob.residual_vector(sys, ws, &self.gn_xt, &mut self.gn_rt) {
+                    ok = false;
+                    break;
+                }
+                let a = self.gn_lu.matrix_mut();
+                for i in 0..nd {
+                    a[i * nd + j] = (self.gn_rt[i] - self.gn_r[i]) / eta;
+                }
+            }
+            if !ok || self.gn_lu.factor().is_err() {
+                break;
+            }
+            for i in 0..nd {
+                self.gn_dx[i] = -self.gn_r[i];
+            }
+            self.gn_lu.solve(&mut self.gn_dx);
+            for i in 0..nd {
+                self.gn_xt[i] = self.best[i] + self.gn_dx[i];
+            }
+            evals += 1;
+            if !prob.residual_vector(sys, ws, &self.gn_xt, &mut self.gn_rt) {
+                break;
+            }
+            let ft = self.gn_rt.iter().map(|r| r * r).sum::<f64>();
+            if !(ft < f) {
+                break;
+            }
+            iters += 1;
+            f = ft;
+            self.best.copy_from_slice(&self.gn_xt);
+            std::mem::swap(&mut self.gn_r, &mut self.gn_rt);
+            let small = (0..nd)
+                .all(|i| self.gn_dx[i].abs() <= 4.0 * f64::EPSILON * (1.0 + self.best[i].abs()));
+            if small {
+                break;
+            }
+        }
+        (iters, evals, f)
+    }
+}
+
+impl Integrator for FireflyGauss {
+    fn name(&self) -> String {
+        let mut s = String::from("FA-DAE (firefly");
+        if self.opts.polish {
+            s += " + Gauss-Newton polish";
+        }
+        s += ")";
+        s
+    }
+
+    fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        self.try_step(sys, state, h).map_err(SolveError::from)
+    }
+
+    fn reset(&mut self) {
+        self.step_index = 0;
+        self.n_corr = 0;
+        self.stats = FaDaeStats::new();
+        self.last = StepInfo::default();
+    }
+
+    fn order(&self) -> Option<u32> {
+        Some(4)
+    }
+}
