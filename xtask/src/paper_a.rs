@@ -394,6 +394,7 @@ fn table3(ctx: &Ctx) -> Result<Section, String> {
     sec.setting("reference", &r.method);
     sec.notes.push("gamma_opt is calibrated at h = 0.01 over N_t = 10 (Table 2) and then used at h = 0.04 over N_t = 100, as we read the paper (the correction scales with kappa_s h^(2s), so gamma is step-independent to leading order). The rows 'gamma_opt (direct)' calibrate at the evaluation setting itself (h = 0.04, N_t = 100), the best one parameter can do there.".into());
     sec.notes.push(NT_NOTE.to_string());
+    sec.notes.push("Why the gain is smaller at s = 2 (docs/symplectic.md): at small amplitude both normal modes of the double pendulum share the phase constant c_s = -kappa_s/2 and gamma = 1 cancels it (tested); at 30 degrees the phase error has an amplitude-dependent part that the linear-mode shape of W_s cannot represent. On the single pendulum (s = 2, h = 0.1, 20 s) gamma_opt grows from 1.01 at 2 degrees to 3.0 at 30 degrees and 91 at 45 degrees; with two modes of different amplitude, one gamma zeroes the signed mean dW but cannot cancel both drifts.".into());
     let mut t = Table::new(
         "Table 3: gamma = 0 against gamma_opt (E[dH] signed, as the paper prints it)",
         &[
@@ -441,19 +442,32 @@ fn table3(ctx: &Ctx) -> Result<Section, String> {
             m0.mean_abs_dx / mo.mean_abs_dx,
             m0.mean_abs_dy / mo.mean_abs_dy,
         );
+        let (dx, dy) = (
+            m0.mean_abs_dx / md.mean_abs_dx,
+            m0.mean_abs_dy / md.mean_abs_dy,
+        );
         sec.claims.push(Claim::check(
-            format!("gamma_opt lowers E|dx| and E|dy| at least 10x against gamma = 0 (s = {s})"),
+            format!("gamma_opt (calibrated at h = 0.01, N_t = 10, used at h = 0.04, N_t = 100) lowers E|dx| and E|dy| at least 10x against gamma = 0 (s = {s})"),
             fx >= 10.0 && fy >= 10.0,
             format!(
-                "gamma_opt = {:.4} (h = 0.01, 10 s): E|dx| {} -> {} ({fx:.2}x), E|dy| {} -> {} ({fy:.2}x); directly calibrated gamma_opt = {:.4}: {:.2}x / {:.2}x",
+                "gamma_opt = {:.4}: E|dx| {} -> {} ({fx:.2}x), E|dy| {} -> {} ({fy:.2}x)",
                 cal.gamma_opt,
                 fmt_e(m0.mean_abs_dx),
                 fmt_e(mo.mean_abs_dx),
                 fmt_e(m0.mean_abs_dy),
                 fmt_e(mo.mean_abs_dy),
+            ),
+        ));
+        sec.claims.push(Claim::check(
+            format!("gamma_opt calibrated at the evaluation setting (h = 0.04, N_t = 100) lowers E|dx| and E|dy| at least 10x against gamma = 0 (s = {s})"),
+            dx >= 10.0 && dy >= 10.0,
+            format!(
+                "gamma_opt = {:.4}: E|dx| {} -> {} ({dx:.2}x), E|dy| {} -> {} ({dy:.2}x)",
                 direct.gamma_opt,
-                m0.mean_abs_dx / md.mean_abs_dx,
-                m0.mean_abs_dy / md.mean_abs_dy
+                fmt_e(m0.mean_abs_dx),
+                fmt_e(md.mean_abs_dx),
+                fmt_e(m0.mean_abs_dy),
+                fmt_e(md.mean_abs_dy),
             ),
         ));
     }

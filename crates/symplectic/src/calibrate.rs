@@ -143,6 +143,9 @@ pub struct CalibrationSettings {
     pub tol: f64,
     /// Secant iterations allowed (after the two starting evaluations).
     pub max_iter: usize,
+    /// Also converged when `|dW| <= dw_tol`: the round-off floor of the signed means (default
+    /// 1e-14, for coordinates of order 1 m); below it the secant would only chase noise.
+    pub dw_tol: f64,
 }
 
 impl Default for CalibrationSettings {
@@ -151,6 +154,7 @@ impl Default for CalibrationSettings {
             start: (0.0, 1.0),
             tol: 1e-9,
             max_iter: 30,
+            dw_tol: 1e-14,
         }
     }
 }
@@ -215,7 +219,7 @@ pub fn calibrate_gamma(
         }
     };
     for it in 1..=settings.max_iter {
-        if d1 == 0.0 {
+        if d1.abs() <= settings.dw_tol {
             return Ok(Calibration {
                 gamma_opt: g1,
                 history,
@@ -242,7 +246,7 @@ pub fn calibrate_gamma(
         g1 = g2;
         d1 = e2.dw();
         best = e2;
-        if (g1 - g0).abs() <= settings.tol * (1.0 + g1.abs()) {
+        if (g1 - g0).abs() <= settings.tol * (1.0 + g1.abs()) || d1.abs() <= settings.dw_tol {
             return Ok(Calibration {
                 gamma_opt: g1,
                 history,
