@@ -883,7 +883,7 @@ fn fig7(ctx: &Ctx) -> Result<Section, String> {
     ));
     sec.figures.push(FigureRef {
         file: "paper_a_fig7.svg".into(),
-        caption: "x-component of body 2's centre of mass: reference, gamma = 0 and gamma_opt (last 10 s; the CSV has the whole run only for this window)".into(),
+        caption: "x-component of body 2's centre of mass: reference, gamma = 0 and gamma_opt over the last 10 s of the run".into(),
     });
     sec.summary = json!({"paper_a": {"fig7": {"max_abs_dx2_gamma0": num(err(&curves[0])), "max_abs_dx2_gamma_opt": num(err(&curves[1])), "gamma_opt": num(cal.gamma_opt)}}});
     Ok(sec)
