@@ -21,7 +21,7 @@ impl Default for NewtonSettings {
     fn default() -> Self {
         NewtonSettings {
             tol: 1e-13,
-            max_iter: 30,
+            max_iter: 50,
             divergence: 2.0,
         }
     }

@@ -1,0 +1,49 @@
+//! The chord iteration's matrix changes the work, not the result: the centre matrix (the
+//! paper's chord, default) and the interpolated one land on the same chart points.
+
+mod common;
+
+use common::state_error;
+use mbd_model::models;
+use mbd_solve::{run, ButcherTableau, NoObserver, RunConfig, State};
+use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
+
+#[test]
+fn centre_and_interpolated_matrices_agree() {
+    for sys in [
+        models::manipulator().expect("model"),
+        models::four_bar().expect("model"),
+    ] {
+        let s0 = State::consistent(&sys, 0.0).expect("state");
+        let mut ends = vec![];
+        let mut iters = vec![];
+        for m in [IterationMatrix::Centre, IterationMatrix::Interpolated] {
+            let opts = TangentOptions {
+                iteration_matrix: m,
+                ..Default::default()
+            };
+            let mut rk = TangentRk::new(&sys, ButcherTableau::rk4(), opts).expect("solver");
+            let mut s = s0.clone();
+            run(
+                &mut rk,
+                &sys,
+                &mut s,
+                RunConfig {
+                    t_end: 1.0,
+                    h: 0.01,
+                },
+                &mut NoObserver,
+            )
+            .expect("run");
+            iters.push(rk.stats().newton_iterations);
+            ends.push(s);
+        }
+        let d = state_error(&ends[0], ends[1].q.as_slice(), ends[1].v.as_slice());
+        println!(
+            "iterations centre {} interpolated {}, difference {d:e}",
+            iters[0], iters[1]
+        );
+        assert!(d < 1e-10, "{d}");
+        assert!((iters[1] as f64) < 0.75 * iters[0] as f64, "{iters:?}");
+    }
+}
