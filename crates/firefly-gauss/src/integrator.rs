@@ -586,7 +586,7 @@ impl FireflyGauss {
         let _ = m;
         match self.opts.partition {
             PartitionChoice::Given(_) => {
-                if !(ratio > 1e-12) {
+                if ratio.is_nan() || ratio <= 1e-12 {
                     return Err(SolveError::Singular {
                         t: state.t,
                         what: "dependent block of Phi_q (user-given partition)",
@@ -689,22 +689,22 @@ impl FireflyGauss {
         let c = [0.0, 0.5, 0.5, 1.0];
         let (mut qs, mut vs) = (std::mem::take(&mut self.rq), std::mem::take(&mut self.rv));
         let mut res = Ok(());
-        for s in 0..4 {
+        for (s, &cs) in c.iter().enumerate() {
             if s == 0 {
                 qs.copy_from_slice(q0);
                 vs.copy_from_slice(v0);
             } else {
                 let (kv, ka) = (&self.kv[s - 1], &self.ka[s - 1]);
                 for i in 0..n {
-                    qs[i] = q0[i] + c[s] * h * kv[i];
-                    vs[i] = v0[i] + c[s] * h * ka[i];
+                    qs[i] = q0[i] + cs * h * kv[i];
+                    vs[i] = v0[i] + cs * h * ka[i];
                 }
             }
             self.kv[s].copy_from_slice(&vs);
             let ka = &mut self.ka[s];
             res = self
                 .acc
-                .solve(sys, &qs, &vs, t0 + c[s] * h, ka, &mut self.lambda);
+                .solve(sys, &qs, &vs, t0 + cs * h, ka, &mut self.lambda);
             if res.is_err() {
                 break;
             }
@@ -864,7 +864,7 @@ impl FireflyGauss {
                 break;
             }
             let ft = self.gn_rt.iter().map(|r| r * r).sum::<f64>();
-            if !(ft < f) {
+            if ft.is_nan() || ft >= f {
                 break;
             }
             iters += 1;

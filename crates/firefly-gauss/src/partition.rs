@@ -50,7 +50,7 @@ impl Partition {
                     }
                 }
             }
-            if !(best > 1e-10 * scale.max(f64::MIN_POSITIVE)) {
+            if best.is_nan() || best <= 1e-10 * scale.max(f64::MIN_POSITIVE) {
                 return Err(FaDaeError::Unsupported(format!(
                     "Phi_q is rank deficient (rank {k} < {m} constraints): redundant constraints \
                      or a singular configuration; equation {}",

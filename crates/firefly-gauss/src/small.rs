@@ -41,8 +41,7 @@ impl SmallLu {
                     p = r;
                 }
             }
-            // `!(x > 0)` also catches NaN
-            if !(best > 0.0) || !best.is_finite() {
+            if best.is_nan() || best <= 0.0 || !best.is_finite() {
                 return Err(k);
             }
             self.piv[k] = p;
