@@ -14,7 +14,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut g = Galerkin::new(&sys, SymplecticOptions::new(s))?;
     let mut st = s0.clone();
     let (mut it, mut ev) = (0usize, 0usize);
-    let n = 200_000;
+    let n: usize = std::env::args()
+        .nth(2)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(200_000);
     let t0 = std::time::Instant::now();
     for _ in 0..n {
         if st.t > 10.0 {

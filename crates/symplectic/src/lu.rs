@@ -7,17 +7,17 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
     let mut acc = [0.0f64; 4];
-    let chunks = n / 4;
-    for c in 0..chunks {
-        let (x, y) = (&a[4 * c..4 * c + 4], &b[4 * c..4 * c + 4]);
+    let (ac, bc) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ar, br) = (ac.remainder(), bc.remainder());
+    for (x, y) in ac.zip(bc) {
         acc[0] += x[0] * y[0];
         acc[1] += x[1] * y[1];
         acc[2] += x[2] * y[2];
         acc[3] += x[3] * y[3];
     }
     let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for k in 4 * chunks..n {
-        s += a[k] * b[k];
+    for (x, y) in ar.iter().zip(br) {
+        s += x * y;
     }
     s
 }
@@ -60,9 +60,8 @@ impl SmallLu {
                 return Err(k);
             }
             if p != k {
-                for j in 0..n {
-                    a.swap(k * n + j, p * n + j);
-                }
+                let (lo, hi) = a.split_at_mut(p * n);
+                lo[k * n..(k + 1) * n].swap_with_slice(&mut hi[..n]);
             }
             let inv = 1.0 / a[k * n + k];
             let (top, bottom) = a.split_at_mut((k + 1) * n);
