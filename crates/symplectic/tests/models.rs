@@ -240,3 +240,24 @@ fn predictor_history_survives_the_run_loop() {
     assert!(stats.newton_iterations as f64 / (stats.steps as f64) < 3.5);
     assert_eq!(g.order(), Some(4));
 }
+
+#[test]
+fn ten_link_chain_and_jacobian_reuse() {
+    let sys = models::n_link_chain(10).unwrap();
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    let mut plain = SymplecticOptions::new(2);
+    let mut reuse = plain;
+    reuse.reuse_jacobian = true;
+    plain.newton.tol = 1e-15;
+    reuse.newton.tol = 1e-15;
+    let (a, _) = common::run(&sys, &s0, plain, 0.005, 200);
+    let (b, _) = common::run(&sys, &s0, reuse, 0.005, 200);
+    let d = common::max_abs_diff(a.q.as_slice(), b.q.as_slice());
+    assert!(d < 1e-10, "reuse_jacobian changes the solution by {d}");
+    let mut r = vec![0.0; sys.n_constraints()];
+    sys.phi(b.q.as_slice(), b.t, &mut r);
+    assert!(r.iter().all(|x| x.abs() < 1e-12));
+    let h0 = sys.energy(s0.q.as_slice(), s0.v.as_slice());
+    let h1 = sys.energy(b.q.as_slice(), b.v.as_slice());
+    assert!((h1 - h0).abs() < 1e-6 * h0.abs().max(1.0), "{h0} {h1}");
+}
