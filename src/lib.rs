@@ -10,6 +10,9 @@
 //! | [`solve`] | the `Integrator` trait, run loop, observers, Newton, index-1 solve, tableaus |
 //! | [`rk4`] | RK4 baseline (optional Baumgarte / projection) |
 //! | [`symplectic`] | paper A: (s,s) constrained Galerkin variational integrator, preadjusted gamma |
+//! | [`tangent`] | paper B: tangent-space parameterisation with any explicit RK tableau |
+//! | [`firefly`] | the firefly metaheuristic, generic over any objective |
+//! | [`firefly_gauss`] | paper C: the firefly-Gauss DAE solver |
 //! | [`analysis`] | energy/constraint errors, trajectory errors, convergence orders, CSV/JSON |
 //!
 //! ```
@@ -30,10 +33,13 @@
 #![warn(missing_docs)]
 
 pub use mbd_analysis as analysis;
+pub use mbd_firefly as firefly;
+pub use mbd_firefly_gauss as firefly_gauss;
 pub use mbd_model as model;
 pub use mbd_rk4 as rk4;
 pub use mbd_solve as solve;
 pub use mbd_symplectic as symplectic;
+pub use mbd_tangent as tangent;
 
 /// The README's usage example, compiled and run as a doctest.
 #[doc = include_str!("../README.md")]

@@ -4,12 +4,14 @@
 use crate::plot::{Figure, Series};
 use crate::report::{fmt_e, num, Claim, Ctx, Experiment, FigureRef, Part, Section, Table};
 use mbd_analysis::{fit_order, MeasureObserver};
+use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd_model::{models, System};
 use mbd_rk4::{Rk4, Rk4Options};
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Integrator, NoObserver, RunConfig, SolveError, State,
 };
 use mbd_symplectic::{Galerkin, SymplecticOptions};
+use mbd_tangent::TangentRk;
 use serde_json::json;
 use std::time::Instant;
 
@@ -21,6 +23,8 @@ pub struct SolverSpec {
     pub order: f64,
     /// Builds the integrator for a system.
     pub make: fn(&System) -> Result<Box<dyn Integrator>, SolveError>,
+    /// Include in the 10^5-step long-time study (too slow for the optimisation-based solver).
+    pub long_time: bool,
 }
 
 /// Every solver of the project, as compared in the own experiments.
@@ -29,22 +33,52 @@ pub fn solvers() -> Vec<SolverSpec> {
         SolverSpec {
             name: "RK4 (index-1, plain)",
             order: 4.0,
+            long_time: true,
             make: |s| Ok(Box::new(Rk4::new(s, Rk4Options::plain())?)),
         },
         SolverSpec {
             name: "RK4 (index-1, projection)",
             order: 4.0,
+            long_time: true,
             make: |s| Ok(Box::new(Rk4::new(s, Rk4Options::projected())?)),
         },
         SolverSpec {
             name: "symplectic (1,1)",
             order: 2.0,
+            long_time: true,
             make: |s| Ok(Box::new(Galerkin::new(s, SymplecticOptions::new(1))?)),
         },
         SolverSpec {
             name: "symplectic (2,2)",
             order: 4.0,
+            long_time: true,
             make: |s| Ok(Box::new(Galerkin::new(s, SymplecticOptions::new(2))?)),
+        },
+        SolverSpec {
+            name: "tangent-space RK4",
+            order: 4.0,
+            long_time: true,
+            make: |s| Ok(Box::new(TangentRk::rk4(s)?)),
+        },
+        SolverSpec {
+            name: "tangent-space DOPRI5 (fixed step)",
+            order: 5.0,
+            long_time: false,
+            make: |s| Ok(Box::new(TangentRk::dopri5(s)?)),
+        },
+        SolverSpec {
+            name: "FA-DAE + Gauss-Newton polish",
+            order: 4.0,
+            long_time: false,
+            make: |s| {
+                let opts = FaDaeOptions {
+                    polish: true,
+                    ..FaDaeOptions::default()
+                };
+                let fa = FireflyGauss::new(s, opts)
+                    .map_err(|e| SolveError::Unsupported(e.to_string()))?;
+                Ok(Box::new(fa))
+            },
         },
     ]
 }
@@ -254,7 +288,7 @@ fn long_time(ctx: &Ctx) -> Result<Section, String> {
     )
     .log(false, true);
     let mut rows = Vec::new();
-    for spec in solvers() {
+    for spec in solvers().into_iter().filter(|s| s.long_time) {
         let mut s = State::consistent(&sys, 0.0).map_err(|e| e.to_string())?;
         let mut integ = (spec.make)(&sys).map_err(|e| e.to_string())?;
         let mut obs = MeasureObserver::new(&sys, false).with_series();
