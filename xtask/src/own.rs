@@ -142,7 +142,7 @@ fn orders(ctx: &Ctx) -> Result<Section, String> {
     };
     sec.setting(
         "error",
-        "max-norm of positions at t = 1 s against DOPRI5 + projection at h = 1e-4",
+        "max-norm of positions at t = 1 s against DOPRI5 + projection at h = 5e-5; errors below 1e-11 are dropped as the floor",
     );
     sec.setting("step sizes", format!("{hs:?}"));
     let mut table = Table::new(
@@ -157,14 +157,15 @@ fn orders(ctx: &Ctx) -> Result<Section, String> {
     )
     .log(true, true);
     for (pname, sys) in problems() {
-        let qref = reference_q(&sys, t_end, 1e-4)?;
+        let qref = reference_q(&sys, t_end, 5e-5)?;
         for spec in solvers() {
             let mut errs = Vec::new();
             for &h in &hs {
                 let (q, _) = solve_to(&sys, &spec, t_end, h)?;
                 errs.push(max_diff(&q, &qref));
             }
-            let fit = fit_order(&hs, &errs, 1e-12)
+            // points within 1e-11 of zero are at the reference's / round-off floor
+            let fit = fit_order(&hs, &errs, 1e-11)
                 .map_err(|e| format!("{} on {pname}: {e}", spec.name))?;
             table.row(vec![
                 spec.name.into(),
@@ -177,10 +178,12 @@ fn orders(ctx: &Ctx) -> Result<Section, String> {
                     .collect::<Vec<_>>()
                     .join(", "),
             ]);
+            // the asymptotic order: the local order of the finest pair above the floor
+            let finest = fit.local.last().copied().unwrap_or(fit.order);
             sec.claims.push(Claim::check(
-                format!("{} has order {} on the {pname}", spec.name, spec.order),
-                (fit.order - spec.order).abs() <= 0.3,
-                format!("fitted {:.2}", fit.order),
+                format!("{} has order {} on the {pname} (local order of the finest resolved pair within 0.3)", spec.name, spec.order),
+                (finest - spec.order).abs() <= 0.3,
+                format!("finest local order {finest:.2}, least-squares slope {:.2}", fit.order),
             ));
             rows.push(json!({"solver": spec.name, "problem": pname, "order": num(fit.order)}));
             fig.series.push(Series::points(
