@@ -45,20 +45,20 @@ fn bench(c: &mut Criterion) {
             h,
         );
     }
-    let chord = TangentRk::new(
+    let interp = TangentRk::new(
         &sys,
         ButcherTableau::rk4(),
         TangentOptions {
-            iteration_matrix: IterationMatrix::Centre,
+            iteration_matrix: IterationMatrix::Interpolated,
             ..Default::default()
         },
     )
     .expect("tangent");
     bench_one(
         c,
-        "tangent_rk4_centre_chord_step_manipulator_h0.01",
+        "tangent_rk4_interpolated_step_manipulator_h0.01",
         &sys,
-        chord,
+        interp,
         0.01,
     );
     let dp = TangentRk::dopri5(&sys).expect("tangent");
