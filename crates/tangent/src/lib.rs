@@ -19,8 +19,8 @@
 //!   [`ButcherTableau`] (RK4 by default; DOPRI5 with adaptive steps), mapped back, and the chart
 //!   re-centred at the new point ([`TangentRk`]).
 //!
-//! Position and velocity constraints then hold to the Newton tolerance (1e-13 by default) at
-//! every step; rheonomic drivers work (`f` and `F` are evaluated at the stage times); chart
+//! Position and velocity constraints then hold to the Newton tolerance (1e-13 by default, raised
+//! to the round-off floor of evaluating them for fast or far-out states) at every step; rheonomic drivers work (`f` and `F` are evaluated at the stage times); chart
 //! failure (Newton diverging near a singular configuration or for a too-large step) is either
 //! recovered by documented step halving (counted in [`TangentStats::halvings`]) or an error with
 //! time and residual — never a silent wrong state. See `docs/tangent.md` for the derivation.
@@ -39,7 +39,7 @@
 //! let mut phid = vec![0.0; sys.n_constraints()];
 //! sys.phi(state.q.as_slice(), state.t, &mut phi);
 //! sys.phi_dot(state.q.as_slice(), state.v.as_slice(), state.t, &mut phid);
-//! assert!(phi.iter().chain(&phid).all(|r| r.abs() <= 1e-13));
+//! assert!(phi.iter().chain(&phid).all(|r| r.abs() <= 1e-12));
 //!
 //! // adaptive DOPRI5 5(4) to t = 2 s at tolerance 1e-9
 //! let mut dp = TangentRk::dopri5(&sys)?;
@@ -51,7 +51,7 @@
 //!     &mut NoObserver,
 //! )?;
 //! assert!(stats.accepted > 0 && (state.t - 2.0).abs() < 1e-15);
-//! assert!(stats.max_residual <= 1e-13);
+//! assert!(stats.max_residual <= 1e-12);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
@@ -60,7 +60,7 @@ mod chart;
 mod error;
 mod integrator;
 
-pub use chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
+pub use chart::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR};
 pub use error::TangentError;
 pub use integrator::{
     AdaptiveSettings, AdaptiveStats, IterationMatrix, TangentOptions, TangentRk, TangentStats,
