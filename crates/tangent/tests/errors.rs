@@ -1,6 +1,8 @@
 //! Bad input is an error (never a panic), and a chart that cannot be followed is an error with
 //! time and residual, or a counted step halving — never a silent wrong state.
 
+mod common;
+
 use mbd_model::{models, Body, BodyRef, Joint, SystemBuilder};
 use mbd_solve::{ButcherTableau, Integrator, SolveError, State};
 use mbd_tangent::{NewtonSettings, TangentOptions, TangentRk};
@@ -188,58 +190,7 @@ fn singular_configuration_is_an_error() {
     // slider-crank with crank and rod of equal length, started folded at the crank pivot
     // (crank up, rod down onto the slider at the origin): Phi_q loses rank there
     let l = 0.3;
-    let mut b = SystemBuilder::new();
-    b.set_gravity([0.0, -9.81]);
-    let th = 1.0f64;
-    let a = [l * th.cos(), l * th.sin()];
-    let xs = 2.0 * a[0];
-    let crank = b.add_body(
-        Body::new("crank")
-            .rod(1.0, l)
-            .position(0.5 * a[0], 0.5 * a[1], th),
-    );
-    let rod = b.add_body(
-        Body::new("rod")
-            .rod(1.0, l)
-            .position(0.5 * (a[0] + xs), 0.5 * a[1], -th),
-    );
-    let slider = b.add_body(
-        Body::new("slider")
-            .mass(0.5)
-            .inertia(0.01)
-            .position(xs, 0.0, 0.0),
-    );
-    b.add_joint(Joint::revolute(
-        "o",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        crank,
-        [-0.5 * l, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "a",
-        crank,
-        [0.5 * l, 0.0],
-        rod,
-        [-0.5 * l, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "b",
-        rod,
-        [0.5 * l, 0.0],
-        slider,
-        [0.0, 0.0],
-    ));
-    b.add_joint(Joint::prismatic(
-        "s",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        slider,
-        [0.0, 0.0],
-        [1.0, 0.0],
-        0.0,
-    ));
-    let sys = b.build().expect("regular at the initial angle");
+    let sys = common::slider_crank(l, l, 1.0, None);
     let mut rk = TangentRk::rk4(&sys).expect("solver");
     // the folded configuration: crank at 90 degrees, rod at -90 degrees, slider at the pivot
     let half = std::f64::consts::FRAC_PI_2;

@@ -111,64 +111,7 @@ fn fully_driven_slider_crank_follows_exact_kinematics() {
     // crank r = 0.15, rod l = 0.5, slider on the x-axis; crank angle = 0.7 + 6 t: no dof left
     let (r, l) = (0.15, 0.5);
     let th = 0.7f64;
-    let a = [r * th.cos(), r * th.sin()];
-    let xs = a[0] + (l * l - a[1] * a[1]).sqrt();
-    let phi = (-a[1]).atan2(xs - a[0]);
-    let mut b = SystemBuilder::new();
-    b.set_gravity([0.0, -9.81]);
-    let crank = b.add_body(
-        Body::new("crank")
-            .rod(1.0, r)
-            .position(0.5 * a[0], 0.5 * a[1], th),
-    );
-    let rod = b.add_body(
-        Body::new("rod")
-            .rod(1.0, l)
-            .position(0.5 * (a[0] + xs), 0.5 * a[1], phi),
-    );
-    let slider = b.add_body(
-        Body::new("slider")
-            .mass(0.5)
-            .inertia(0.01)
-            .position(xs, 0.0, 0.0),
-    );
-    b.add_joint(Joint::revolute(
-        "o",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        crank,
-        [-0.5 * r, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "a",
-        crank,
-        [0.5 * r, 0.0],
-        rod,
-        [-0.5 * l, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "b",
-        rod,
-        [0.5 * l, 0.0],
-        slider,
-        [0.0, 0.0],
-    ));
-    b.add_joint(Joint::prismatic(
-        "s",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        slider,
-        [0.0, 0.0],
-        [1.0, 0.0],
-        0.0,
-    ));
-    b.add_joint(Joint::angle_driver(
-        "d",
-        BodyRef::Ground,
-        crank,
-        TimeFunction::linear(th, 6.0),
-    ));
-    let sys = b.build().expect("model");
+    let sys = common::slider_crank(r, l, th, Some(6.0));
     assert_eq!(sys.dof(), 0);
     let mut state = State::consistent(&sys, 0.0).expect("state");
     let mut rk = TangentRk::rk4(&sys).expect("solver");
