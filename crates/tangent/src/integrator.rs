@@ -102,11 +102,11 @@ pub struct TangentStats {
     pub halvings: usize,
     /// Chart failures met (recovered by halving or rejection, or returned as errors).
     pub chart_failures: usize,
-    /// Chord Newton iterations, all maps.
+    /// Chord Newton iterations of the accepted steps (all their maps).
     pub newton_iterations: usize,
-    /// Most chord Newton iterations of one map.
+    /// Most chord Newton iterations of one map of an accepted step.
     pub max_map_iterations: usize,
-    /// Acceleration solves (right-hand-side evaluations).
+    /// Acceleration solves (right-hand-side evaluations) of the accepted steps.
     pub rhs_evals: usize,
     /// Largest `||(Phi, Phidot)||_inf` of an accepted step's end point.
     pub max_residual: f64,
