@@ -9,6 +9,7 @@ use mbd::solve::{
     reference_trajectory, run, ButcherTableau, Integrator, NoObserver, RunConfig, State,
 };
 use mbd::symplectic::{Galerkin, SymplecticOptions};
+use mbd::tangent::TangentRk;
 
 type Make = fn(&System) -> Box<dyn Integrator>;
 
@@ -26,6 +27,7 @@ fn solvers() -> Vec<(&'static str, u32, Make)> {
         ("symplectic (2,2)", 4, |s| {
             Box::new(Galerkin::new(s, SymplecticOptions::new(2)).unwrap())
         }),
+        ("tangent RK4", 4, |s| Box::new(TangentRk::rk4(s).unwrap())),
     ]
 }
 
