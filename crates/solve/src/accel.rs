@@ -54,8 +54,34 @@ impl AccelerationSolver {
         a: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
+        self.check_sizes(q, v, a, lambda)?;
         sys.forces_into(q, v, t, &mut self.forces);
         self.solve_with_forces(sys, q, v, t, a, lambda)
+    }
+
+    fn check_sizes(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        lambda: &[f64],
+    ) -> Result<(), SolveError> {
+        let (n, m) = (self.n, self.m);
+        for (what, got, expected) in [
+            ("q", q.len(), n),
+            ("v", v.len(), n),
+            ("a", a.len(), n),
+            ("lambda", lambda.len(), m),
+        ] {
+            if got != expected {
+                return Err(SolveError::Dimension {
+                    what,
+                    expected,
+                    got,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// As [`AccelerationSolver::solve`], with the applied forces already in
@@ -69,14 +95,8 @@ impl AccelerationSolver {
         a: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
+        self.check_sizes(q, v, a, lambda)?;
         let (n, m) = (self.n, self.m);
-        if q.len() != n || v.len() != n || a.len() != n || lambda.len() != m {
-            return Err(SolveError::Dimension {
-                what: "acceleration solve arguments",
-                expected: n,
-                got: q.len(),
-            });
-        }
         if m == 0 {
             let minv = sys.inv_mass_diag();
             for i in 0..n {
@@ -138,5 +158,41 @@ impl AccelerationSolver {
             a[k] = self.w[k] - minv[k] * dot;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn wrong_sizes_are_errors_not_panics() {
+        let sys = mbd_model::models::pendulum(1.0, 1.0, 0.2, 9.81).unwrap();
+        let mut acc = AccelerationSolver::new(&sys);
+        let (mut a, mut l) = (vec![0.0; 3], vec![0.0; 2]);
+        let err = acc.solve(&sys, &[0.0; 2], &[0.0; 3], 0.0, &mut a, &mut l);
+        assert!(matches!(
+            err,
+            Err(SolveError::Dimension {
+                what: "q",
+                expected: 3,
+                got: 2
+            })
+        ));
+        let mut l1 = vec![0.0; 1];
+        let err = acc.solve(&sys, &[0.0, -0.5, -1.5], &[0.0; 3], 0.0, &mut a, &mut l1);
+        assert!(matches!(
+            err,
+            Err(SolveError::Dimension { what: "lambda", .. })
+        ));
+        assert!(acc
+            .solve(
+                &sys,
+                &[0.0, -0.5, -std::f64::consts::FRAC_PI_2],
+                &[0.0; 3],
+                0.0,
+                &mut a,
+                &mut l
+            )
+            .is_ok());
     }
 }
