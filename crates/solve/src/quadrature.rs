@@ -31,8 +31,9 @@ pub fn gauss_legendre(s: usize) -> (Vec<f64>, Vec<f64>) {
     (nodes, weights)
 }
 
-/// `(P_n(x), P_n'(x))` by the three-term recurrence.
-fn legendre(n: usize, x: f64) -> (f64, f64) {
+/// The Legendre polynomial and its derivative, `(P_n(x), P_n'(x))`, by the three-term
+/// recurrence (the derivative formula needs `|x| != 1`).
+pub fn legendre(n: usize, x: f64) -> (f64, f64) {
     if n == 0 {
         return (1.0, 0.0);
     }

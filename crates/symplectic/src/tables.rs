@@ -3,7 +3,7 @@
 //! extrapolation matrix.
 
 use crate::options::Nodes;
-use mbd_solve::quadrature::{gauss_legendre, LagrangeBasis};
+use mbd_solve::quadrature::{gauss_legendre, legendre, LagrangeBasis};
 
 /// Abscissae `0 = tau_0 < ... < tau_s = 1` of the `s + 1` Gauss-Lobatto points on `[0, 1]`
 /// (the ends and the roots of `P_s'(2 tau - 1)`). For `s <= 2` they are the equally spaced
@@ -35,19 +35,6 @@ pub fn lobatto_nodes(s: usize) -> Vec<f64> {
         pts[i] = sym;
     }
     pts
-}
-
-/// `(P_n(x), P_n'(x))` by the three-term recurrence.
-fn legendre(n: usize, x: f64) -> (f64, f64) {
-    let (mut p0, mut p1) = (1.0, x);
-    for k in 2..=n {
-        let kf = k as f64;
-        let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
-        p0 = p1;
-        p1 = p2;
-    }
-    let d = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-    (p1, d)
 }
 
 /// All coefficients of the scheme, stored row-major.
