@@ -1,5 +1,7 @@
 //! Steps the (2,2) scheme on the manipulator in a loop (for profiling) and prints the time per
 //! step and the Newton work.
+//!
+//! `cargo run --release -p mbd-symplectic --example profile_step [s] [steps] [predictor_order]`
 use mbd_model::models;
 use mbd_solve::{Integrator, State};
 use mbd_symplectic::{Galerkin, SymplecticOptions};
@@ -11,7 +13,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or(2);
     let sys = models::manipulator()?;
     let s0 = State::consistent(&sys, 0.0)?;
-    let mut g = Galerkin::new(&sys, SymplecticOptions::new(s))?;
+    let mut opts = SymplecticOptions::new(s);
+    if let Some(p) = std::env::args().nth(3).and_then(|a| a.parse().ok()) {
+        opts.predictor_order = p;
+    }
+    let mut g = Galerkin::new(&sys, opts)?;
     let mut st = s0.clone();
     let (mut it, mut ev) = (0usize, 0usize);
     let n: usize = std::env::args()

@@ -1,7 +1,7 @@
 //! The (s,s) constrained Galerkin variational integrator, optionally preadjusted.
 
 use crate::lu::SmallLu;
-use crate::options::{kappa, Nodes, SymplecticOptions};
+use crate::options::{kappa, Nodes, SymplecticOptions, MAX_PREDICTOR_ORDER};
 use crate::preadjust::Preadjustment;
 use crate::tables::Tables;
 use mbd_model::System;
@@ -58,12 +58,31 @@ pub struct Galerkin {
     hist_h: f64,
     hist_q: Vec<f64>,
     hist_x: Vec<f64>,
+    /// The last `hist_len` converged unknown vectors of consecutive steps with the same `h`,
+    /// newest first (`(MAX_PREDICTOR_ORDER + 1) * dim`).
+    hist_multi: Vec<f64>,
+    hist_len: usize,
     gk: f64,
     has_forces: bool,
     jac_valid: bool,
     jac_h: f64,
     jac_gk: f64,
     jacobians: usize,
+}
+
+/// The LU of the stage Jacobian with the elimination order that keeps it sparse: for each
+/// coordinate `i`, the momentum rows `(nu, i)`, `nu = 0..s-1`, paired with the displacement
+/// unknowns `Z_(nu+1), i` (their `s x s` block is the stiffness matrix `K` when the Hessians
+/// are sparse); then the constraint rows with the multipliers (their Schur complement).
+fn stage_lu(n: usize, m: usize, s: usize) -> SmallLu {
+    let mut order: Vec<usize> = Vec::with_capacity(s * (n + m));
+    for i in 0..n {
+        for nu in 0..s {
+            order.push(nu * n + i);
+        }
+    }
+    order.extend(s * n..s * (n + m));
+    SmallLu::with_ordering(order.clone(), order)
 }
 
 fn norm_inf(x: &[f64]) -> f64 {
@@ -104,7 +123,7 @@ impl Galerkin {
             dx: vec![0.0; dim],
             r: vec![0.0; dim],
             xt: vec![0.0; dim],
-            lu: SmallLu::new(dim),
+            lu: stage_lu(n, m, s),
             qk: vec![0.0; n],
             hvk: vec![0.0; n],
             qn: vec![0.0; (s + 1) * n],
@@ -131,6 +150,8 @@ impl Galerkin {
             hist_h: f64::NAN,
             hist_q: vec![0.0; n],
             hist_x: vec![0.0; dim],
+            hist_multi: vec![0.0; (MAX_PREDICTOR_ORDER + 1) * dim],
+            hist_len: 0,
             gk: 0.0,
             has_forces: !sys.forces().is_empty(),
             jac_valid: false,
@@ -277,15 +298,14 @@ impl Galerkin {
         }
         let h2 = h * h;
         let tab = &self.tab;
-        let dim = self.dim;
-        let jm = &mut self.lu.a;
-        jm.iter_mut().for_each(|x| *x = 0.0);
+        let jm = &mut self.lu;
+        jm.clear();
         for nu in 0..s {
             for mu in 1..=s {
                 let (ro, co) = (nu * n, (mu - 1) * n);
                 let kk = tab.k[nu * s1 + mu];
                 for i in 0..n {
-                    jm[(ro + i) * dim + co + i] += kk;
+                    *jm.entry(ro + i, co + i) += kk;
                 }
                 for j in 0..s {
                     if !self.hess_nz[j] {
@@ -299,7 +319,7 @@ impl Galerkin {
                             if self.nonconservative {
                                 v += cv * self.hv[j][(i, l)];
                             }
-                            jm[(ro + i) * dim + co + l] -= h2 * self.minv[i] * v;
+                            *jm.entry(ro + i, co + l) -= h2 * self.minv[i] * v;
                         }
                     }
                 }
@@ -308,7 +328,7 @@ impl Galerkin {
             let co = s * n + nu * m;
             for r in 0..m {
                 for i in 0..n {
-                    jm[(nu * n + i) * dim + co + r] = -h2 * self.minv[i] * self.phiq[nu][(r, i)];
+                    *jm.entry(nu * n + i, co + r) = -h2 * self.minv[i] * self.phiq[nu][(r, i)];
                 }
             }
         }
@@ -316,22 +336,22 @@ impl Galerkin {
         for nu in 1..s {
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
             sys.constraint_hessian(&self.qn[nu * n..(nu + 1) * n], lam, &mut self.hc);
-            let jm = &mut self.lu.a;
+            let jm = &mut self.lu;
             let o = (nu - 1) * n;
             for l in 0..n {
                 for i in 0..n {
-                    jm[(nu * n + i) * dim + o + l] -= h2 * self.minv[i] * self.hc[(i, l)];
+                    *jm.entry(nu * n + i, o + l) -= h2 * self.minv[i] * self.hc[(i, l)];
                 }
             }
         }
         {
-            let jm = &mut self.lu.a;
+            let jm = &mut self.lu;
             for nu in 1..=s {
                 let ro = s * n + (nu - 1) * m;
                 let co = (nu - 1) * n;
                 for r in 0..m {
                     for l in 0..n {
-                        jm[(ro + r) * dim + co + l] = self.phiq[nu][(r, l)];
+                        *jm.entry(ro + r, co + l) = self.phiq[nu][(r, l)];
                     }
                 }
             }
@@ -388,7 +408,22 @@ impl Galerkin {
             && (self.hist_t - state.t).abs() <= 1e-9 * h
             && (self.hist_h - h).abs() <= 1e-9 * h
             && self.hist_q.as_slice() == state.q.as_slice();
-        if usable {
+        let p = self.opts.predictor_order;
+        if usable && p > 0 && self.hist_len > p {
+            // multistep: the degree-p polynomial through the last p + 1 solutions at t_k + h,
+            // x_{k+1} = sum_i (-1)^i C(p+1, i+1) x_{k-i}
+            let dim = self.dim;
+            self.x.fill(0.0);
+            let mut c = (p + 1) as f64;
+            for i in 0..=p {
+                let xi = &self.hist_multi[i * dim..(i + 1) * dim];
+                for (a, b) in self.x.iter_mut().zip(xi) {
+                    *a += c * b;
+                }
+                // next coefficient: -C(p+1, i+2) = -C(p+1, i+1) (p - i) / (i + 2)
+                c = -c * (p - i) as f64 / (i + 2) as f64;
+            }
+        } else if usable {
             // extrapolate the previous step's polynomial: Q_nu ~ sum_mu l_mu(1 + tau_nu) Q'_mu,
             // written in displacements from q_k = Q'_s
             for nu in 1..=s {
@@ -561,6 +596,7 @@ impl Integrator for Galerkin {
 
     fn reset(&mut self) {
         self.hist_valid = false;
+        self.hist_len = 0;
         self.jac_valid = false;
     }
 
@@ -641,6 +677,19 @@ impl Integrator for Galerkin {
         }
         state.t = t1;
         // history for the predictor
+        let contiguous = self.hist_valid
+            && (self.hist_t - t).abs() <= 1e-9 * h
+            && (self.hist_h - h).abs() <= 1e-9 * h
+            && self.hist_q.as_slice() == self.qk.as_slice();
+        let dim = self.dim;
+        let keep = if contiguous {
+            self.hist_len.min(MAX_PREDICTOR_ORDER)
+        } else {
+            0
+        };
+        self.hist_multi.copy_within(0..keep * dim, dim);
+        self.hist_multi[..dim].copy_from_slice(&self.x);
+        self.hist_len = keep + 1;
         self.hist_x.copy_from_slice(&self.x);
         self.hist_q.copy_from_slice(state.q.as_slice());
         self.hist_t = state.t;

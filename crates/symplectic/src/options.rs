@@ -42,6 +42,14 @@ pub struct SymplecticOptions {
     /// 4x per iteration. Default off (one Jacobian per step, at the predictor). The converged solution does not depend on it (to the
     /// Newton tolerance).
     pub reuse_jacobian: bool,
+    /// Order `p` of the multistep predictor: once `p + 1` consecutive steps of the same `h` have
+    /// been taken, the unknowns of the next step (control-point displacements and multipliers)
+    /// are extrapolated by the degree-`p` polynomial through the last `p + 1` solutions
+    /// (error `O(h^(p+1))` in the multipliers); before that, the previous step's interpolant is
+    /// extrapolated (or, on the first step, a Taylor predictor from the index-1 accelerations).
+    /// 0 turns the multistep predictor off. Default 3; at most 6. Only the number of Newton
+    /// iterations depends on it, not the solution (to the Newton tolerance).
+    pub predictor_order: usize,
 }
 
 impl Default for SymplecticOptions {
@@ -59,6 +67,7 @@ impl Default for SymplecticOptions {
             },
             fd_step: 2e-3,
             reuse_jacobian: false,
+            predictor_order: 3,
         }
     }
 }
@@ -110,9 +119,19 @@ impl SymplecticOptions {
                 reason: "must be in (0, 1)",
             });
         }
+        if self.predictor_order > MAX_PREDICTOR_ORDER {
+            return Err(SolveError::InvalidParameter {
+                parameter: "predictor_order",
+                value: self.predictor_order as f64,
+                reason: "must be at most 6",
+            });
+        }
         self.newton.validate()
     }
 }
+
+/// Largest [`SymplecticOptions::predictor_order`].
+pub const MAX_PREDICTOR_ORDER: usize = 6;
 
 /// `kappa_s`: the constant of the preadjustment term `-gamma kappa_s h^(2s) W_s` for which
 /// `gamma = 1` cancels the leading phase error of the (s,s) scheme with Lobatto control points

@@ -15,11 +15,15 @@ fn invalid_options_are_rejected() {
             fd_step: 0.0,
             ..SymplecticOptions::new(2)
         },
+        SymplecticOptions {
+            predictor_order: 7,
+            ..SymplecticOptions::new(2)
+        },
     ];
     for o in bad {
         match Galerkin::new(&sys, o) {
             Err(SolveError::InvalidParameter { parameter, .. }) => {
-                assert!(["s", "gamma", "fd_step"].contains(&parameter))
+                assert!(["s", "gamma", "fd_step", "predictor_order"].contains(&parameter))
             }
             other => panic!("expected InvalidParameter, got {other:?}"),
         }
