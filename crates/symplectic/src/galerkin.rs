@@ -62,6 +62,8 @@ pub struct Galerkin {
     /// newest first (`(MAX_PREDICTOR_ORDER + 1) * dim`).
     hist_multi: Vec<f64>,
     hist_len: usize,
+    /// `phiq[s]` holds `Phi_q` at the end of the last step.
+    end_phiq_valid: bool,
     gk: f64,
     has_forces: bool,
     jac_valid: bool,
@@ -152,6 +154,7 @@ impl Galerkin {
             hist_x: vec![0.0; dim],
             hist_multi: vec![0.0; (MAX_PREDICTOR_ORDER + 1) * dim],
             hist_len: 0,
+            end_phiq_valid: false,
             gk: 0.0,
             has_forces: !sys.forces().is_empty(),
             jac_valid: false,
@@ -193,7 +196,28 @@ impl Galerkin {
 
     /// Residual of the stage equations at `self.x` into `self.r`.
     fn residual(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
+        self.kinematics(sys, t, h)?;
+        self.momentum_rows(sys, h);
+        self.constraint_rows(sys, t, h);
+        Ok(())
+    }
+
+    /// The constraint rows of the residual, `Phi(Q_nu, t + tau_nu h)` (after `kinematics`).
+    fn constraint_rows(&mut self, sys: &System, t: f64, h: f64) {
         let (n, m, s) = (self.n, self.m, self.tab.s);
+        for nu in 1..=s {
+            let o = s * n + (nu - 1) * m;
+            sys.phi(
+                &self.qn[nu * n..(nu + 1) * n],
+                t + self.tab.tau[nu] * h,
+                &mut self.r[o..o + m],
+            );
+        }
+    }
+
+    /// Control points, Gauss-point positions, displacements and forces at `self.x`.
+    fn kinematics(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
+        let (n, s) = (self.n, self.tab.s);
         let s1 = s + 1;
         let tab = &self.tab;
         self.qn[..n].copy_from_slice(&self.qk);
@@ -235,6 +259,14 @@ impl Galerkin {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The momentum rows of the residual (after `kinematics`).
+    fn momentum_rows(&mut self, sys: &System, h: f64) {
+        let (n, m, s) = (self.n, self.m, self.tab.s);
+        let s1 = s + 1;
+        let tab = &self.tab;
         let h2 = h * h;
         for nu in 0..s {
             if nu >= 1 {
@@ -260,15 +292,6 @@ impl Galerkin {
                 self.r[nu * n + i] = res;
             }
         }
-        for nu in 1..=s {
-            let o = s * n + (nu - 1) * m;
-            sys.phi(
-                &self.qn[nu * n..(nu + 1) * n],
-                t + tab.tau[nu] * h,
-                &mut self.r[o..o + m],
-            );
-        }
-        Ok(())
     }
 
     /// Jacobian of the stage equations at `self.x` (after `residual` at the same point), factored.
@@ -305,7 +328,7 @@ impl Galerkin {
                 let (ro, co) = (nu * n, (mu - 1) * n);
                 let kk = tab.k[nu * s1 + mu];
                 for i in 0..n {
-                    *jm.entry(ro + i, co + i) += kk;
+                    jm.add(ro + i, co + i, kk);
                 }
                 for j in 0..s {
                     if !self.hess_nz[j] {
@@ -319,7 +342,7 @@ impl Galerkin {
                             if self.nonconservative {
                                 v += cv * self.hv[j][(i, l)];
                             }
-                            *jm.entry(ro + i, co + l) -= h2 * self.minv[i] * v;
+                            jm.add(ro + i, co + l, -(h2 * self.minv[i] * v));
                         }
                     }
                 }
@@ -328,7 +351,11 @@ impl Galerkin {
             let co = s * n + nu * m;
             for r in 0..m {
                 for i in 0..n {
-                    *jm.entry(nu * n + i, co + r) = -h2 * self.minv[i] * self.phiq[nu][(r, i)];
+                    jm.set(
+                        nu * n + i,
+                        co + r,
+                        -h2 * self.minv[i] * self.phiq[nu][(r, i)],
+                    );
                 }
             }
         }
@@ -340,7 +367,7 @@ impl Galerkin {
             let o = (nu - 1) * n;
             for l in 0..n {
                 for i in 0..n {
-                    *jm.entry(nu * n + i, o + l) -= h2 * self.minv[i] * self.hc[(i, l)];
+                    jm.add(nu * n + i, o + l, -(h2 * self.minv[i] * self.hc[(i, l)]));
                 }
             }
         }
@@ -351,7 +378,7 @@ impl Galerkin {
                 let co = (nu - 1) * n;
                 for r in 0..m {
                     for l in 0..n {
-                        *jm.entry(ro + r, co + l) = self.phiq[nu][(r, l)];
+                        jm.set(ro + r, co + l, self.phiq[nu][(r, l)]);
                     }
                 }
             }
@@ -468,8 +495,16 @@ impl Galerkin {
 
     fn newton(&mut self, sys: &System, t: f64, h: f64) -> Result<StepStats, SolveError> {
         let o = self.opts.newton;
+        // Tolerance: relative to the positions, not the angles (which grow without bound on
+        // rotating bodies), plus the round-off floor of the constraints, which is set by the
+        // angles: cos and sin of theta carry an error of about eps |theta|.
+        let pscale = 1.0
+            + self
+                .qk
+                .chunks(3)
+                .fold(0.0f64, |a, c| a.max(c[0].abs()).max(c[1].abs()));
         let qscale = 1.0 + norm_inf(&self.qk);
-        let tol = o.tol * qscale;
+        let tol = o.tol * pscale + 4.0 * f64::EPSILON * qscale;
         let sn = self.tab.s * self.n;
         self.residual(sys, t, h)?;
         let mut res = norm_inf(&self.r);
@@ -512,6 +547,35 @@ impl Galerkin {
                 self.dx[i] = -self.r[i];
             }
             self.lu.solve(&mut self.dx);
+            // simplified-Newton stopping rule (Hairer & Wanner, IV.8): with the contraction
+            // theta estimated from two updates with the same Jacobian, the error left after
+            // this update is about theta / (1 - theta) |dZ|; when that is below the tolerance
+            // the update is applied and only the constraints are checked at the result (the
+            // momentum rows, with Phi_q at the interior control points, are not re-evaluated)
+            let dz = norm_inf(&self.dx[..sn]);
+            if prev_step.is_finite() && dz.is_finite() {
+                let theta = dz / prev_step;
+                let left = theta / (1.0 - theta) * dz;
+                if theta < 0.5 && left <= 0.1 * tol {
+                    for (x, d) in self.x.iter_mut().zip(&self.dx) {
+                        *x += d;
+                    }
+                    self.kinematics(sys, t, h)?;
+                    self.constraint_rows(sys, t, h);
+                    evals += 1;
+                    it += 1;
+                    let cres = norm_inf(&self.r[sn..]);
+                    if cres <= tol {
+                        res = cres.max(left);
+                        break;
+                    }
+                    // the constraints are not met yet: complete the residual and go on
+                    self.momentum_rows(sys, h);
+                    res = norm_inf(&self.r);
+                    prev_step = dz;
+                    continue;
+                }
+            }
             self.xt.copy_from_slice(&self.x);
             let mut lambda = 1.0;
             let mut halvings = 0;
@@ -597,6 +661,7 @@ impl Integrator for Galerkin {
     fn reset(&mut self) {
         self.hist_valid = false;
         self.hist_len = 0;
+        self.end_phiq_valid = false;
         self.jac_valid = false;
     }
 
@@ -624,7 +689,14 @@ impl Integrator for Galerkin {
         for i in 0..n {
             self.hvk[i] = h * state.v[i];
         }
-        sys.phi_q(&self.qk, &mut self.phiq[0]);
+        if self.end_phiq_valid && self.hist_q == self.qk {
+            // Phi_q at the end of the previous step, which is where this one starts
+            let (first, rest) = self.phiq.split_at_mut(1);
+            first[0].copy_from(&rest[s - 1]);
+        } else {
+            sys.phi_q(&self.qk, &mut self.phiq[0]);
+        }
+        self.end_phiq_valid = false;
         self.gk = self.opts.gamma * self.kappa * h.powi(2 * s as i32);
         self.predict(sys, state, h)?;
         let stats = self.newton(sys, t, h)?;
@@ -643,6 +715,7 @@ impl Integrator for Galerkin {
         let t1 = t + h;
         if m > 0 {
             sys.phi_q(qn1, &mut self.phiq[s]);
+            self.end_phiq_valid = true;
             let g = &self.phiq[s];
             {
                 let mut sm = self.proj.matrix_mut();

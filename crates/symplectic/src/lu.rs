@@ -1,31 +1,60 @@
-//! A small LU with threshold partial pivoting on preallocated row-major buffers, for the
-//! 10-100 unknowns of the stage equations, which exploits their sparsity.
+//! A small sparse LU on preallocated row-major buffers, for the 10-100 unknowns of the stage
+//! equations.
 //!
 //! The Jacobian of the stage equations is mostly zeros (for the (2,2) scheme on a double
 //! pendulum, 90 of 400 entries are nonzero: identity blocks, the sparse `Phi_q` and the
-//! constraint curvature). Three things keep the work proportional to the nonzeros:
+//! constraint curvature), and its nonzero pattern is fixed by the model's structure. So:
 //! - a fixed symmetric ordering chosen by the caller ([`SmallLu::with_ordering`]): the
 //!   Galerkin scheme puts the `s` displacement unknowns of each coordinate together (their
 //!   block of the Jacobian is `s x s` when the Hessians are sparse) and the multipliers last, so
 //!   the elimination of the displacements fills in little and leaves a small Schur complement
 //!   on the multipliers;
-//! - threshold pivoting: the diagonal pivot is kept unless another entry of its column is more
-//!   than `1 / PIVOT_THRESHOLD` times larger (then the largest is taken, as in partial
-//!   pivoting); this keeps the ordering while bounding the growth of the factors (the usual
-//!   compromise of sparse LU codes);
-//! - the elimination updates a row only in the columns where the pivot row is nonzero, and
-//!   [`SmallLu::factor`] records the nonzero pattern of `L` and `U` so that [`SmallLu::solve`]
-//!   touches only those entries.
+//! - the pattern of the entries that have ever been nonzero is tracked as the matrix is written
+//!   ([`SmallLu::add`], [`SmallLu::set`]); when it grows (in the first steps, and whenever an
+//!   entry becomes nonzero for the first time), a symbolic factorisation with the diagonal
+//!   pivots of the ordering is recomputed; each numeric factorisation runs over its index lists
+//!   only (no searching or scanning of zeros). A diagonal
+//!   pivot is accepted if it is at least `PIVOT_THRESHOLD` times the largest entry of its
+//!   column (threshold pivoting, the usual compromise of sparse LU codes between sparsity and
+//!   the growth of the factors); if one is not, that factorisation is redone by
+//! - the general path: threshold partial pivoting (the diagonal pivot unless another entry of
+//!   its column is more than `1 / PIVOT_THRESHOLD` times larger), which updates a row only in
+//!   the columns where the pivot row is nonzero and records the nonzero pattern of `L` and `U`
+//!   as it goes.
+//!
+//! [`SmallLu::solve`] touches only the recorded nonzeros of `L` and `U`.
 
 /// A diagonal pivot is kept if it is at least this fraction of the largest entry of its column.
 const PIVOT_THRESHOLD: f64 = 0.1;
+
+/// Nonzero lists of `L` (by columns) and `U` (by rows) of one factorisation.
+#[derive(Clone, Debug, Default)]
+struct Pattern {
+    /// Rows of the multipliers of column `k`: `l_idx[l_start[k]..l_start[k + 1]]`.
+    l_idx: Vec<usize>,
+    l_start: Vec<usize>,
+    /// Columns right of the diagonal in the `k`-th pivot row: `u_idx[u_start[k]..u_start[k + 1]]`.
+    u_idx: Vec<usize>,
+    u_start: Vec<usize>,
+}
+
+impl Pattern {
+    fn new(n: usize) -> Self {
+        Pattern {
+            l_idx: vec![0; n * n],
+            l_start: vec![0; n + 1],
+            u_idx: vec![0; n * n],
+            u_start: vec![0; n + 1],
+        }
+    }
+}
 
 /// LU of an `n x n` matrix with a fixed row and column ordering.
 ///
 /// The caller writes the matrix in its own numbering through [`SmallLu::entry`] (after
 /// [`SmallLu::clear`]); it is stored in the ordered numbering, row-major. Row interchanges are
 /// kept in a permutation vector (rows never move in memory), so the nonzero lists recorded
-/// during the elimination (`L` by columns, `U` by rows) stay valid for [`SmallLu::solve`].
+/// during the elimination stay valid for [`SmallLu::solve`].
 #[derive(Clone, Debug)]
 pub(crate) struct SmallLu {
     n: usize,
@@ -39,15 +68,28 @@ pub(crate) struct SmallLu {
     /// The ordered matrix (row-major), factored in place: multipliers below and `U` on and
     /// above the diagonal, each in the (physical) row it was computed in.
     f: Vec<f64>,
+    /// Copy of the matrix for the general path when the static pivots fail.
+    backup: Vec<f64>,
     /// `rp[k]`: the physical row of the `k`-th pivot.
     rp: Vec<usize>,
-    /// Physical rows with a nonzero multiplier in column `k` (`l_start` delimits columns).
-    l_idx: Vec<usize>,
-    l_start: Vec<usize>,
-    /// Nonzero columns right of the diagonal of the `k`-th pivot row, and their values.
-    u_idx: Vec<usize>,
-    u_val: Vec<f64>,
-    u_start: Vec<usize>,
+    /// Nonzeros of the last factorisation of the general path.
+    dynamic: Pattern,
+    /// Entries (ordered numbering) that have been nonzero in some matrix so far.
+    mask: Vec<bool>,
+    /// `mask` with the fill-in of the elimination (scratch of the symbolic factorisation).
+    fill: Vec<bool>,
+    /// Whether `mask` grew since the last symbolic factorisation.
+    dirty: bool,
+    /// The symbolic factorisation of `mask` with static diagonal pivots.
+    symbolic: Pattern,
+    /// Whether the last factorisation used `symbolic`.
+    static_used: bool,
+    /// Number of factorisations that fell back to the general path.
+    fallbacks: usize,
+    /// Number of symbolic factorisations.
+    analyses: usize,
+    /// Values of the pivot row (scratch).
+    pv: Vec<f64>,
     /// Scratch vectors of the solve.
     y: Vec<f64>,
     x: Vec<f64>,
@@ -80,15 +122,65 @@ impl SmallLu {
             rpos,
             cpos,
             f: vec![0.0; n * n],
+            backup: vec![0.0; n * n],
             rp: (0..n).collect(),
-            l_idx: vec![0; n * n],
-            l_start: vec![0; n + 1],
-            u_idx: vec![0; n * n],
-            u_val: vec![0.0; n * n],
-            u_start: vec![0; n + 1],
+            dynamic: Pattern::new(n),
+            mask: (0..n * n).map(|k| k % (n + 1) == 0).collect(),
+            fill: vec![false; n * n],
+            dirty: true,
+            symbolic: Pattern::new(n),
+            static_used: false,
+            fallbacks: 0,
+            analyses: 0,
+            pv: vec![0.0; n],
             y: vec![0.0; n],
             x: vec![0.0; n],
         }
+    }
+
+    /// Symbolic factorisation of `mask` with the diagonal pivots of the ordering.
+    fn analyse(&mut self) {
+        let n = self.n;
+        let mask = &mut self.fill;
+        mask.copy_from_slice(&self.mask);
+        let p = &mut self.symbolic;
+        let (mut nl, mut nu) = (0, 0);
+        for k in 0..n {
+            p.u_start[k] = nu;
+            for j in k + 1..n {
+                if mask[k * n + j] {
+                    p.u_idx[nu] = j;
+                    nu += 1;
+                }
+            }
+            p.l_start[k] = nl;
+            for i in k + 1..n {
+                if mask[i * n + k] {
+                    p.l_idx[nl] = i;
+                    nl += 1;
+                    for &j in &p.u_idx[p.u_start[k]..nu] {
+                        mask[i * n + j] = true;
+                    }
+                }
+            }
+        }
+        p.l_start[n] = nl;
+        p.u_start[n] = nu;
+        self.dirty = false;
+        self.analyses += 1;
+    }
+
+    /// Number of factorisations in which a static pivot failed the threshold test, so the
+    /// general path was taken.
+    #[cfg(test)]
+    pub fn fallbacks(&self) -> usize {
+        self.fallbacks
+    }
+
+    /// Number of symbolic factorisations (one per growth of the pattern).
+    #[cfg(test)]
+    pub fn analyses(&self) -> usize {
+        self.analyses
     }
 
     /// Sets the matrix to zero (before it is written by [`SmallLu::entry`]).
@@ -96,67 +188,135 @@ impl SmallLu {
         self.f.fill(0.0);
     }
 
-    /// The entry `(r, c)` of the matrix, in the caller's numbering.
+    /// Adds `v` to the entry `(r, c)` (the caller's numbering).
     #[inline]
-    pub fn entry(&mut self, r: usize, c: usize) -> &mut f64 {
-        &mut self.f[self.rpos[r] * self.n + self.cpos[c]]
+    pub fn add(&mut self, r: usize, c: usize, v: f64) {
+        let k = self.rpos[r] * self.n + self.cpos[c];
+        self.f[k] += v;
+        self.track(k, v);
+    }
+
+    /// Sets the entry `(r, c)` (the caller's numbering) to `v`.
+    #[inline]
+    pub fn set(&mut self, r: usize, c: usize, v: f64) {
+        let k = self.rpos[r] * self.n + self.cpos[c];
+        self.f[k] = v;
+        self.track(k, v);
+    }
+
+    #[inline]
+    fn track(&mut self, k: usize, v: f64) {
+        if v != 0.0 && !self.mask[k] {
+            self.mask[k] = true;
+            self.dirty = true;
+        }
     }
 
     /// Factors the matrix in place; `Err(i)` if pivot `i` (in the ordered numbering) is
     /// negligible.
     pub fn factor(&mut self) -> Result<(), usize> {
         let n = self.n;
-        let a = &mut self.f;
         let mut mx = [0.0f64; 4];
-        let chunks = a.chunks_exact(4);
-        let rest = chunks.remainder();
-        for c in chunks {
-            for (m, x) in mx.iter_mut().zip(c) {
-                *m = m.max(x.abs());
+        for (b, f) in self.backup.chunks_exact_mut(4).zip(self.f.chunks_exact(4)) {
+            for k in 0..4 {
+                b[k] = f[k];
+                mx[k] = mx[k].max(f[k].abs());
             }
         }
-        for x in rest {
-            mx[0] = mx[0].max(x.abs());
+        let r = n * n - n * n % 4;
+        for (b, &f) in self.backup[r..].iter_mut().zip(&self.f[r..]) {
+            *b = f;
+            mx[0] = mx[0].max(f.abs());
         }
         let scale = mx[0].max(mx[1]).max(mx[2].max(mx[3]));
         let tol = 1e-14 * scale.max(f64::MIN_POSITIVE) * n as f64;
+        if self.dirty {
+            self.analyse();
+        }
+        if self.factor_static(tol) {
+            self.static_used = true;
+            return Ok(());
+        }
+        self.fallbacks += 1;
+        self.f.copy_from_slice(&self.backup);
+        self.static_used = false;
+        self.factor_dynamic(tol)
+    }
+
+    /// Elimination with the static diagonal pivots over the symbolic pattern; `false` (with
+    /// the matrix partly eliminated) if a pivot fails the threshold.
+    fn factor_static(&mut self, tol: f64) -> bool {
+        let p = &self.symbolic;
+        let n = self.n;
+        let a = &mut self.f;
+        for k in 0..n {
+            let piv = a[k * n + k];
+            let lrows = &p.l_idx[p.l_start[k]..p.l_start[k + 1]];
+            let colmax = lrows.iter().fold(0.0f64, |m, &i| m.max(a[i * n + k].abs()));
+            // (also false for NaN)
+            if !(piv.abs() > tol && piv.abs() >= PIVOT_THRESHOLD * colmax) {
+                return false;
+            }
+            let ucols = &p.u_idx[p.u_start[k]..p.u_start[k + 1]];
+            for (v, &j) in self.pv.iter_mut().zip(ucols) {
+                *v = a[k * n + j];
+            }
+            let pv = &self.pv[..ucols.len()];
+            let inv = 1.0 / piv;
+            for &i in lrows {
+                let row = &mut a[i * n..(i + 1) * n];
+                let f = row[k] * inv;
+                row[k] = f;
+                if f != 0.0 {
+                    for (&j, &v) in ucols.iter().zip(pv) {
+                        row[j] -= f * v;
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Threshold partial pivoting, recording the nonzeros of `L` and `U`.
+    fn factor_dynamic(&mut self, tol: f64) -> Result<(), usize> {
+        let n = self.n;
+        let a = &mut self.f;
+        let p = &mut self.dynamic;
         for (k, r) in self.rp.iter_mut().enumerate() {
             *r = k;
         }
         let (mut nl, mut nu) = (0, 0);
         for k in 0..n {
             let diag = a[self.rp[k] * n + k].abs();
-            let mut p = k;
+            let mut piv = k;
             let mut best = diag;
             for i in k + 1..n {
                 let v = a[self.rp[i] * n + k].abs();
                 if v > best {
                     best = v;
-                    p = i;
+                    piv = i;
                 }
             }
             if best.is_nan() || best <= tol {
                 return Err(k);
             }
             if diag < PIVOT_THRESHOLD * best {
-                self.rp.swap(k, p);
+                self.rp.swap(k, piv);
             }
             let pk = self.rp[k];
             // the nonzeros of the pivot row right of the diagonal: the row of U
-            self.u_start[k] = nu;
+            p.u_start[k] = nu;
             for (j, &v) in a[pk * n..(pk + 1) * n].iter().enumerate().skip(k + 1) {
                 if v != 0.0 {
-                    self.u_idx[nu] = j;
-                    self.u_val[nu] = v;
+                    p.u_idx[nu] = j;
+                    self.pv[nu - p.u_start[k]] = v;
                     nu += 1;
                 }
             }
-            let (uc, uv) = (
-                &self.u_idx[self.u_start[k]..nu],
-                &self.u_val[self.u_start[k]..nu],
-            );
+            let uc = &p.u_idx[p.u_start[k]..nu];
+            let uv = &self.pv[..uc.len()];
             let inv = 1.0 / a[pk * n + k];
-            self.l_start[k] = nl;
+            p.l_start[k] = nl;
             for &ph in &self.rp[k + 1..] {
                 let row = &mut a[ph * n..(ph + 1) * n];
                 let f = row[k];
@@ -166,13 +326,13 @@ impl SmallLu {
                     for (&j, &v) in uc.iter().zip(uv) {
                         row[j] -= f * v;
                     }
-                    self.l_idx[nl] = ph;
+                    p.l_idx[nl] = ph;
                     nl += 1;
                 }
             }
         }
-        self.l_start[n] = nl;
-        self.u_start[n] = nu;
+        p.l_start[n] = nl;
+        p.u_start[n] = nu;
         Ok(())
     }
 
@@ -182,27 +342,33 @@ impl SmallLu {
         let n = self.n;
         let a = &self.f;
         let (y, x) = (&mut self.y, &mut self.x);
+        let (p, rp): (&Pattern, Option<&[usize]>) = if self.static_used {
+            (&self.symbolic, None)
+        } else {
+            (&self.dynamic, Some(&self.rp))
+        };
+        let row_of = |k: usize| rp.map_or(k, |rp| rp[k]);
         for (yi, &r) in y.iter_mut().zip(&self.rows) {
             *yi = b[r];
         }
-        // forward: L z = P y, column by column (z_k ends in y[rp[k]])
+        // forward: L z = P y, column by column (z_k ends in y[row_of(k)])
         for k in 0..n {
-            let yk = y[self.rp[k]];
+            let yk = y[row_of(k)];
             if yk != 0.0 {
-                for &ph in &self.l_idx[self.l_start[k]..self.l_start[k + 1]] {
+                for &ph in &p.l_idx[p.l_start[k]..p.l_start[k + 1]] {
                     y[ph] -= a[ph * n + k] * yk;
                 }
             }
         }
         // backward: U x = z, row by row
         for k in (0..n).rev() {
-            let (lo, hi) = (self.u_start[k], self.u_start[k + 1]);
+            let pk = row_of(k);
+            let row = &a[pk * n..(pk + 1) * n];
             let mut s = 0.0;
-            for (&j, &v) in self.u_idx[lo..hi].iter().zip(&self.u_val[lo..hi]) {
-                s += v * x[j];
+            for &j in &p.u_idx[p.u_start[k]..p.u_start[k + 1]] {
+                s += row[j] * x[j];
             }
-            let pk = self.rp[k];
-            x[k] = (y[pk] - s) / a[pk * n + k];
+            x[k] = (y[pk] - s) / row[k];
         }
         for (&xj, &c) in x.iter().zip(&self.cols) {
             b[c] = xj;
@@ -219,7 +385,7 @@ mod tests {
         lu.clear();
         for i in 0..n {
             for j in 0..n {
-                *lu.entry(i, j) = a[i * n + j];
+                lu.set(i, j, a[i * n + j]);
             }
         }
     }
@@ -282,5 +448,67 @@ mod tests {
                 );
             }
         }
+    }
+
+    fn check(lu: &mut SmallLu, a: &[f64]) {
+        let n = lu.n;
+        let x: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
+        let mut b: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum())
+            .collect();
+        lu.solve(&mut b);
+        for i in 0..n {
+            assert!(
+                (b[i] - x[i]).abs() < 1e-12,
+                "x[{i}] off by {:e}",
+                b[i] - x[i]
+            );
+        }
+    }
+
+    /// The pattern grows when a new entry becomes nonzero (a new symbolic factorisation), the
+    /// static pivots are used while they pass the threshold, and a failing diagonal pivot falls
+    /// back to partial pivoting with the same solution.
+    #[test]
+    fn pattern_growth_and_pivot_fallback() {
+        let n = 4;
+        let mut lu = SmallLu::new(n);
+        let mut a = vec![
+            4.0, 1.0, 0.0, 0.0, //
+            1.0, 4.0, 0.0, 0.0, //
+            0.0, 0.0, 4.0, 1.0, //
+            0.0, 0.0, 1.0, 4.0,
+        ];
+        fill(&mut lu, &a);
+        lu.factor().unwrap();
+        check(&mut lu, &a);
+        assert_eq!((lu.analyses(), lu.fallbacks()), (1, 0));
+        // same pattern: no new analysis
+        a[0] = 5.0;
+        fill(&mut lu, &a);
+        lu.factor().unwrap();
+        check(&mut lu, &a);
+        assert_eq!((lu.analyses(), lu.fallbacks()), (1, 0));
+        // a coupling appears: re-analysed, with fill-in
+        a[3] = 2.0;
+        a[3 * n] = -1.0;
+        fill(&mut lu, &a);
+        lu.factor().unwrap();
+        check(&mut lu, &a);
+        assert_eq!((lu.analyses(), lu.fallbacks()), (2, 0));
+        // a zero diagonal: the static pivot fails, partial pivoting takes over
+        a[0] = 0.0;
+        fill(&mut lu, &a);
+        lu.factor().unwrap();
+        check(&mut lu, &a);
+        assert_eq!(lu.fallbacks(), 1);
+        // singular: an error naming the pivot
+        let z = vec![0.0; n * n];
+        fill(&mut lu, &z);
+        assert_eq!(lu.factor(), Err(0));
+        let mut nan = a.clone();
+        nan[5] = f64::NAN;
+        fill(&mut lu, &nan);
+        assert!(lu.factor().is_err());
     }
 }
