@@ -93,7 +93,8 @@ impl ChartFailure {
 pub struct MapStats {
     /// Chord Newton iterations.
     pub iterations: usize,
-    /// Final `||f||_inf`.
+    /// Final `||f||_inf`; for a map that stopped on the predicted residual
+    /// ([`TangentChart::map_predicted`]), that prediction.
     pub residual: f64,
 }
 

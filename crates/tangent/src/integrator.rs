@@ -521,6 +521,7 @@ impl TangentRk {
             );
             let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
             let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
+            let fsal = self.fsal;
             let (eta_now, eta_hist, eta_pred, eta_tmp) = (
                 &mut self.eta_now,
                 &self.eta_hist,
@@ -571,6 +572,9 @@ impl TangentRk {
                 let mapped = if i == 0 && centre_ok && ti == t {
                     x.copy_from_slice(chart.centre_point());
                     Ok(crate::chart::MapStats::default())
+                } else if fsal && i + 1 == s {
+                    // FSAL: this stage point is the step's end point, whose residual is verified
+                    chart.map(sys, y, ti, zplain, x, &newton)
                 } else {
                     chart.map_predicted(sys, y, ti, zplain, x, &newton)
                 };
