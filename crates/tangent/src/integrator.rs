@@ -283,7 +283,22 @@ pub struct TangentRk {
     /// Error estimate mapped to `x`, and the error scale.
     ex: Vec<f64>,
     scale: Vec<f64>,
+    /// The paper's normal coefficients `eta` of every map of the attempt in progress (stage `i`
+    /// at `i * 2m`, the end point at `s * 2m`; stage 0 is the centre, `eta = 0`).
+    eta_now: Vec<f64>,
+    /// `eta_now` of the last `hist_len` (at most [`HISTORY`]) accepted steps, most recent
+    /// first, all of size `hist_h`, consecutive, the latest ending at `hist_t`.
+    eta_hist: Vec<f64>,
+    hist_len: usize,
+    hist_h: f64,
+    hist_t: f64,
+    /// Extrapolated `eta` of the map in progress, and of an earlier stage.
+    eta_pred: Vec<f64>,
+    eta_tmp: Vec<f64>,
 }
+
+/// Steps of `eta` history kept for the Newton starting points.
+const HISTORY: usize = 3;
 
 /// Per-attempt work counts.
 #[derive(Clone, Copy, Debug, Default)]
@@ -343,6 +358,13 @@ impl TangentRk {
             lambda: vec![0.0; m],
             ex: vec![0.0; 2 * n],
             scale: vec![0.0; 2 * n],
+            eta_now: vec![0.0; (s + 1) * 2 * m],
+            eta_hist: vec![0.0; HISTORY * (s + 1) * 2 * m],
+            hist_len: 0,
+            hist_h: f64::NAN,
+            hist_t: f64::NAN,
+            eta_pred: vec![0.0; 2 * m],
+            eta_tmp: vec![0.0; 2 * m],
         })
     }
 
@@ -411,6 +433,7 @@ impl TangentRk {
             // the state is the end point of our last step: on the manifold to newton.tol
             return Ok(());
         }
+        self.hist_len = 0;
         self.cur[..n].copy_from_slice(state.q.as_slice());
         self.cur[n..].copy_from_slice(state.v.as_slice());
         self.cur_t = state.t;
@@ -450,11 +473,18 @@ impl TangentRk {
     /// `rk.err`.
     ///
     /// Newton starting points (they change only where the chord iteration starts, never its
-    /// limit): for scleronomic constraints, stage `i` starts from the normal coordinates the
-    /// latest earlier stage `j` with `Y_j != 0` converged to, scaled by `|Y_i|^2 / |Y_j|^2` (the
-    /// manifold's normal offset above the tangent plane grows quadratically); otherwise (first
-    /// such stage, rheonomic constraints) from the plain RK stage value
-    /// `x_c + h sum_j a_ij F_j` (tangent part exactly `U Y_i`). The end point starts from the
+    /// limit). After accepted fixed steps of the same size, each stage map starts from the
+    /// paper's normal coefficients `eta` (`Df(x_c)^T eta`, independent of the basis `Q1`) of
+    /// the same stage in the last up to three steps, extrapolated by a polynomial in the step
+    /// index (`eta` is a smooth function of the step's start point along the trajectory), and
+    /// corrected by the extrapolation error the latest earlier stage `j` of this step showed,
+    /// scaled by `|Y_i|^2 / |Y_j|^2`. Without such history: for scleronomic constraints,
+    /// stage `i` starts from the normal coordinates the latest earlier stage `j` with
+    /// `Y_j != 0` converged to, scaled by `|Y_i|^2 / |Y_j|^2` (the manifold's normal offset
+    /// above the tangent plane grows quadratically); otherwise (first such stage, rheonomic
+    /// constraints) from the plain RK stage value `x_c + h sum_j a_ij F_j` (tangent part
+    /// exactly `U Y_i`). Stage maps may stop on the predicted residual
+    /// ([`TangentChart::map_predicted`]); the end point's residual is verified. The end point starts from the
     /// plain RK result `x_c + h sum_j b_j F_j`, whose normal part is the RK quadrature of
     /// `zeta' = Q1^T F` and so accurate to the method's order. For a FSAL tableau (last stage
     /// at `c = 1` with `a_sj = b_j`, as DOPRI5) the last stage point is the end point. With
@@ -468,7 +498,12 @@ impl TangentRk {
         // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
         let centre_ok = self.cur_ok && self.cur_t == t;
         let quadratic = !sys.is_rheonomic();
+        if !(self.hist_h == h && self.hist_t == t) {
+            self.hist_len = 0;
+        }
+        let npts = self.hist_len;
         let mut ylast_sq = 0.0f64;
+        let mut jlast = 0usize;
         let mut work = AttemptWork::default();
         let mut failure: Option<ChartFailure> = None;
         let mut stage = 0usize;
@@ -486,6 +521,13 @@ impl TangentRk {
             );
             let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
             let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
+            let fsal = self.fsal;
+            let (eta_now, eta_hist, eta_pred, eta_tmp) = (
+                &mut self.eta_now,
+                &self.eta_hist,
+                &mut self.eta_pred,
+                &mut self.eta_tmp,
+            );
             let work = &mut work;
             let failure = &mut failure;
             let mut rhs = |ti: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
@@ -507,7 +549,20 @@ impl TangentRk {
                 }
                 chart.select_iteration_matrix(c_coef[i]);
                 let ysq: f64 = y.iter().map(|v| v * v).sum();
-                if quadratic && ylast_sq > 0.0 {
+                if npts > 0 {
+                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, eta_pred);
+                    if jlast > 0 {
+                        // correct by the extrapolation error of the latest mapped stage j,
+                        // scaled like the normal offset (|Y_i|^2 / |Y_j|^2)
+                        let r = ysq / ylast_sq;
+                        extrapolate(eta_hist, npts, (s + 1) * mm, jlast * mm, eta_tmp);
+                        let now = &eta_now[jlast * mm..(jlast + 1) * mm];
+                        for ((p, e), x) in eta_pred.iter_mut().zip(now).zip(eta_tmp.iter()) {
+                            *p += r * (e - x);
+                        }
+                    }
+                    chart.zeta_from_eta(eta_pred, zplain);
+                } else if quadratic && ylast_sq > 0.0 {
                     // scleronomic: the normal offset of the manifold above Y grows like |Y|^2
                     let r = ysq / ylast_sq;
                     for (z, zl) in zplain.iter_mut().zip(zlast.iter()) {
@@ -517,12 +572,19 @@ impl TangentRk {
                 let mapped = if i == 0 && centre_ok && ti == t {
                     x.copy_from_slice(chart.centre_point());
                     Ok(crate::chart::MapStats::default())
-                } else {
+                } else if fsal && i + 1 == s {
+                    // FSAL: this stage point is the step's end point, whose residual is verified
                     chart.map(sys, y, ti, zplain, x, &newton)
+                } else {
+                    chart.map_predicted(sys, y, ti, zplain, x, &newton)
                 };
                 if ysq > 0.0 && mapped.is_ok() {
                     zlast.copy_from_slice(zplain);
                     ylast_sq = ysq;
+                    jlast = i;
+                }
+                if mapped.is_ok() {
+                    chart.eta_from_zeta(zplain, &mut eta_now[i * mm..(i + 1) * mm]);
                 }
                 match mapped {
                     Ok(ms) => {
@@ -581,6 +643,8 @@ impl TangentRk {
                 }
                 Err(e) => return Err(Attempt::Chart(e)),
             }
+            self.chart
+                .eta_from_zeta(&self.zeta, &mut self.eta_now[s * mm..(s + 1) * mm]);
         }
         if self.xnew.iter().any(|x| !x.is_finite()) {
             return Err(Attempt::Hard(SolveError::NonFinite {
@@ -589,6 +653,16 @@ impl TangentRk {
             }));
         }
         Ok(work)
+    }
+
+    /// Records the accepted attempt's `eta` (a step of size `h` ending at `t_end`).
+    fn commit_history(&mut self, h: f64, t_end: f64) {
+        let len = self.eta_now.len();
+        self.eta_hist.copy_within(0..(HISTORY - 1) * len, len);
+        self.eta_hist[..len].copy_from_slice(&self.eta_now);
+        self.hist_len = (self.hist_len + 1).min(HISTORY);
+        self.hist_h = h;
+        self.hist_t = t_end;
     }
 
     fn account(&mut self, w: &AttemptWork) {
@@ -610,6 +684,7 @@ impl TangentRk {
         match self.attempt(sys, t, h) {
             Ok(w) => {
                 self.account(&w);
+                self.commit_history(h, t + h);
                 std::mem::swap(&mut self.cur, &mut self.xnew);
                 self.cur_t = t + h;
                 self.cur_ok = true;
@@ -739,6 +814,7 @@ impl TangentRk {
                     if en <= 1.0 {
                         std::mem::swap(&mut self.cur, &mut self.xnew);
                         t = if last { t_end } else { t + hs };
+                        self.commit_history(hs, t);
                         self.cur_t = t;
                         self.cur_ok = true;
                         st.accepted += 1;
@@ -815,6 +891,20 @@ impl TangentRk {
     }
 }
 
+/// Polynomial extrapolation to the next step of the `eta` of one map (offset `off` within a
+/// step's record of length `len`) from the last `npts` (1 to 3) steps, most recent first.
+fn extrapolate(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64]) {
+    let w: &[f64] = match npts {
+        1 => &[1.0],
+        2 => &[2.0, -1.0],
+        _ => &[3.0, -3.0, 1.0],
+    };
+    out.fill(0.0);
+    for (k, &wk) in w.iter().enumerate() {
+        axpy(wk, &hist[k * len + off..k * len + off + out.len()], out);
+    }
+}
+
 #[inline]
 fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
     for (yi, xi) in y.iter_mut().zip(x) {
@@ -834,6 +924,7 @@ impl Integrator for TangentRk {
     fn reset(&mut self) {
         self.stats = TangentStats::default();
         self.cur_ok = false;
+        self.hist_len = 0;
     }
 
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {

@@ -1,0 +1,77 @@
+//! Runs a fixed number of steps of tangent-space RK4 or plain RK4 (`Index1Rk`, RK4 tableau) on
+//! the manipulator, from `t = 0`, inside one non-inlined function `run_steps`, for instruction
+//! counts that do not depend on machine load:
+//!
+//! ```text
+//! valgrind --tool=callgrind --toggle-collect='*run_steps*' \
+//!     target/release/examples/step_count tangent 0.01 1000
+//! ```
+//!
+//! Arguments: `tangent` | `plain`, the step `h` (default 0.01), the number of steps (default
+//! `10 / h`, the first 10 s of motion, as the benchmark cycles through), and `interpolated` for
+//! [`IterationMatrix::Interpolated`] (tangent only). Prints the chord
+//! iterations per step of the tangent solver.
+use mbd_model::{models, System};
+use mbd_solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, SolveError, State};
+use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
+
+#[inline(never)]
+fn run_steps<I: Integrator>(
+    integ: &mut I,
+    sys: &System,
+    s: &mut State,
+    h: f64,
+    steps: usize,
+) -> Result<(), SolveError> {
+    for _ in 0..steps {
+        integ.step(sys, s, h)?;
+    }
+    Ok(())
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let which = args.next().unwrap_or_else(|| "tangent".into());
+    let h: f64 = match args.next() {
+        Some(a) => a.parse()?,
+        None => 0.01,
+    };
+    let steps: usize = match args.next() {
+        Some(a) => a.parse()?,
+        None => (10.0 / h).round() as usize,
+    };
+    let sys = models::manipulator()?;
+    let mut s = State::consistent(&sys, 0.0)?;
+    match which.as_str() {
+        "plain" => {
+            let mut p = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
+            run_steps(&mut p, &sys, &mut s, h, steps)?;
+            println!("plain RK4: {steps} steps of {h}, t = {}", s.t);
+        }
+        _ => {
+            let opts = TangentOptions {
+                iteration_matrix: if args.next().as_deref() == Some("interpolated") {
+                    IterationMatrix::Interpolated
+                } else {
+                    IterationMatrix::Centre
+                },
+                ..Default::default()
+            };
+            let mut t = TangentRk::new(&sys, ButcherTableau::rk4(), opts)?;
+            run_steps(&mut t, &sys, &mut s, h, steps)?;
+            let st = t.stats();
+            println!(
+                "tangent RK4: {steps} steps of {h}, t = {}, {:.2} chord iterations/step, \
+                 max map {}, max residual {:.2e}, halvings {}; final max |q| {:.0}, max |v| {:.0}",
+                s.t,
+                st.newton_iterations as f64 / st.steps as f64,
+                st.max_map_iterations,
+                st.max_residual,
+                st.halvings,
+                s.q.amax(),
+                s.v.amax()
+            );
+        }
+    }
+    Ok(())
+}
