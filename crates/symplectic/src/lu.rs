@@ -68,7 +68,10 @@ pub(crate) struct SmallLu {
     /// The ordered matrix (row-major), factored in place: multipliers below and `U` on and
     /// above the diagonal, each in the (physical) row it was computed in.
     f: Vec<f64>,
-    /// Copy of the matrix for the general path when the static pivots fail.
+    /// Positions (ordered numbering) of the `n_nz` entries of `mask`.
+    nz: Vec<usize>,
+    n_nz: usize,
+    /// Copy of the matrix at `nz`, for the general path when the static pivots fail.
     backup: Vec<f64>,
     /// `rp[k]`: the physical row of the `k`-th pivot.
     rp: Vec<usize>,
@@ -122,6 +125,8 @@ impl SmallLu {
             rpos,
             cpos,
             f: vec![0.0; n * n],
+            nz: vec![0; n * n],
+            n_nz: 0,
             backup: vec![0.0; n * n],
             rp: (0..n).collect(),
             dynamic: Pattern::new(n),
@@ -141,6 +146,13 @@ impl SmallLu {
     /// Symbolic factorisation of `mask` with the diagonal pivots of the ordering.
     fn analyse(&mut self) {
         let n = self.n;
+        self.n_nz = 0;
+        for (k, &m) in self.mask.iter().enumerate() {
+            if m {
+                self.nz[self.n_nz] = k;
+                self.n_nz += 1;
+            }
+        }
         let mask = &mut self.fill;
         mask.copy_from_slice(&self.mask);
         let p = &mut self.symbolic;
@@ -216,29 +228,29 @@ impl SmallLu {
     /// negligible.
     pub fn factor(&mut self) -> Result<(), usize> {
         let n = self.n;
-        let mut mx = [0.0f64; 4];
-        for (b, f) in self.backup.chunks_exact_mut(4).zip(self.f.chunks_exact(4)) {
-            for k in 0..4 {
-                b[k] = f[k];
-                mx[k] = mx[k].max(f[k].abs());
-            }
-        }
-        let r = n * n - n * n % 4;
-        for (b, &f) in self.backup[r..].iter_mut().zip(&self.f[r..]) {
-            *b = f;
-            mx[0] = mx[0].max(f.abs());
-        }
-        let scale = mx[0].max(mx[1]).max(mx[2].max(mx[3]));
-        let tol = 1e-14 * scale.max(f64::MIN_POSITIVE) * n as f64;
         if self.dirty {
             self.analyse();
         }
+        // the entries outside the pattern are zero: the scale and the copy for the fallback
+        // need only the pattern's
+        let mut scale = 0.0f64;
+        for (b, &k) in self.backup.iter_mut().zip(&self.nz[..self.n_nz]) {
+            let v = self.f[k];
+            *b = v;
+            if v.abs() > scale {
+                scale = v.abs();
+            }
+        }
+        let tol = 1e-14 * scale.max(f64::MIN_POSITIVE) * n as f64;
         if self.factor_static(tol) {
             self.static_used = true;
             return Ok(());
         }
         self.fallbacks += 1;
-        self.f.copy_from_slice(&self.backup);
+        self.f.fill(0.0);
+        for (&b, &k) in self.backup.iter().zip(&self.nz[..self.n_nz]) {
+            self.f[k] = b;
+        }
         self.static_used = false;
         self.factor_dynamic(tol)
     }
