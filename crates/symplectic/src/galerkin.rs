@@ -221,22 +221,27 @@ impl Galerkin {
         let s1 = s + 1;
         let tab = &self.tab;
         self.qn[..n].copy_from_slice(&self.qk);
-        for nu in 1..=s {
-            for i in 0..n {
-                self.qn[nu * n + i] = self.qk[i] + self.x[(nu - 1) * n + i];
+        for (qn, z) in self.qn[n..].chunks_exact_mut(n).zip(self.x.chunks_exact(n)) {
+            for ((q, &qk), &z) in qn.iter_mut().zip(&self.qk).zip(z) {
+                *q = qk + z;
             }
         }
         for j in 0..s {
-            for i in 0..n {
-                let mut q = 0.0;
-                let mut hv = 0.0;
-                for nu in 1..=s {
-                    let z = self.x[(nu - 1) * n + i];
-                    q += tab.a[j * s1 + nu] * z;
-                    hv += tab.d[j * s1 + nu] * z;
+            // Q(c_j) - q_k and h Q'(c_j): combinations of the displacements Z_nu
+            let qj = &mut self.qj[j * n..(j + 1) * n];
+            let hvj = &mut self.hvj[j * n..(j + 1) * n];
+            qj.fill(0.0);
+            hvj.fill(0.0);
+            for nu in 1..=s {
+                let (a, d) = (tab.a[j * s1 + nu], tab.d[j * s1 + nu]);
+                let z = &self.x[(nu - 1) * n..nu * n];
+                for ((q, hv), &z) in qj.iter_mut().zip(hvj.iter_mut()).zip(z) {
+                    *q += a * z;
+                    *hv += d * z;
                 }
-                self.qj[j * n + i] = self.qk[i] + q;
-                self.hvj[j * n + i] = hv;
+            }
+            for (q, &qk) in qj.iter_mut().zip(&self.qk) {
+                *q += qk;
             }
             let qj = &self.qj[j * n..(j + 1) * n];
             let gj = &mut self.gj[j * n..(j + 1) * n];
@@ -265,26 +270,28 @@ impl Galerkin {
     /// The momentum rows of the residual (after `kinematics`).
     fn momentum_rows(&mut self, sys: &System, h: f64) {
         let (n, m, s) = (self.n, self.m, self.tab.s);
-        let s1 = s + 1;
         let tab = &self.tab;
         let h2 = h * h;
         for nu in 0..s {
             if nu >= 1 {
                 sys.phi_q(&self.qn[nu * n..(nu + 1) * n], &mut self.phiq[nu]);
             }
-            let g = &self.phiq[nu];
+            let g = self.phiq[nu].as_slice();
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
+            let (bd, ba) = (&tab.bd[nu * s..(nu + 1) * s], &tab.ba[nu * s..(nu + 1) * s]);
             for i in 0..n {
                 let mut ak = 0.0;
                 let mut ag = 0.0;
                 for j in 0..s {
-                    ak += tab.b[j] * tab.d[j * s1 + nu] * self.hvj[j * n + i];
-                    ag += tab.b[j] * tab.a[j * s1 + nu] * self.gj[j * n + i];
+                    ak += bd[j] * self.hvj[j * n + i];
+                    ag += ba[j] * self.gj[j * n + i];
                 }
-                let mut al = 0.0;
-                for r in 0..m {
-                    al += g[(r, i)] * lam[r];
-                }
+                // (Phi_q^T lam)_i: column i of the column-major m x n Phi_q
+                let al: f64 = g[i * m..(i + 1) * m]
+                    .iter()
+                    .zip(lam)
+                    .map(|(a, b)| a * b)
+                    .sum();
                 let mut res = ak - h2 * self.minv[i] * (ag + al);
                 if nu == 0 {
                     res += self.hvk[i];
@@ -299,7 +306,12 @@ impl Galerkin {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let s1 = s + 1;
         sys.phi_q(&self.qn[s * n..(s + 1) * n], &mut self.phiq[s]);
+        let any_hessian = self.has_forces || self.pre.is_some() || self.nonconservative;
         for j in 0..s {
+            if !any_hessian {
+                self.hess_nz[j] = false;
+                continue;
+            }
             let qj = &self.qj[j * n..(j + 1) * n];
             if self.has_forces {
                 sys.potential_hessian(qj, &mut self.hq[j]);
@@ -351,11 +363,10 @@ impl Galerkin {
             let co = s * n + nu * m;
             for r in 0..m {
                 for i in 0..n {
-                    jm.set(
-                        nu * n + i,
-                        co + r,
-                        -h2 * self.minv[i] * self.phiq[nu][(r, i)],
-                    );
+                    let g = self.phiq[nu][(r, i)];
+                    if g != 0.0 {
+                        jm.set(nu * n + i, co + r, -h2 * self.minv[i] * g);
+                    }
                 }
             }
         }
@@ -367,7 +378,10 @@ impl Galerkin {
             let o = (nu - 1) * n;
             for l in 0..n {
                 for i in 0..n {
-                    jm.add(nu * n + i, o + l, -(h2 * self.minv[i] * self.hc[(i, l)]));
+                    let c = self.hc[(i, l)];
+                    if c != 0.0 {
+                        jm.add(nu * n + i, o + l, -(h2 * self.minv[i] * c));
+                    }
                 }
             }
         }
@@ -378,7 +392,10 @@ impl Galerkin {
                 let co = (nu - 1) * n;
                 for r in 0..m {
                     for l in 0..n {
-                        jm.set(ro + r, co + l, self.phiq[nu][(r, l)]);
+                        let g = self.phiq[nu][(r, l)];
+                        if g != 0.0 {
+                            jm.set(ro + r, co + l, g);
+                        }
                     }
                 }
             }

@@ -55,6 +55,10 @@ pub(crate) struct Tables {
     pub k: Vec<f64>,
     /// `w[nu] = sum_j b_j a_{j nu}` (= integral of l_nu).
     pub w: Vec<f64>,
+    /// `bd[nu * s + j] = b_j l_nu'(c_j)` and `ba[nu * s + j] = b_j l_nu(c_j)` (weights of the
+    /// momentum rows), `nu = 0..=s`.
+    pub bd: Vec<f64>,
+    pub ba: Vec<f64>,
     /// `e[(nu-1) * (s+1) + mu] = l_mu(1 + tau_nu)`, nu = 1..s (extrapolation to the next step).
     pub e: Vec<f64>,
 }
@@ -84,6 +88,14 @@ impl Tables {
             }
             w[nu] = (0..s).map(|j| b[j] * a[j * s1 + nu]).sum();
         }
+        let mut bd = vec![0.0; s1 * s];
+        let mut ba = vec![0.0; s1 * s];
+        for nu in 0..s1 {
+            for j in 0..s {
+                bd[nu * s + j] = b[j] * d[j * s1 + nu];
+                ba[nu * s + j] = b[j] * a[j * s1 + nu];
+            }
+        }
         let mut e = vec![0.0; s * s1];
         for nu in 1..=s {
             basis.values(1.0 + tau[nu], &mut e[(nu - 1) * s1..nu * s1]);
@@ -97,6 +109,8 @@ impl Tables {
             d,
             k,
             w,
+            bd,
+            ba,
             e,
         }
     }
