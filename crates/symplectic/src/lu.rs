@@ -91,8 +91,11 @@ pub(crate) struct SmallLu {
     fallbacks: usize,
     /// Number of symbolic factorisations.
     analyses: usize,
-    /// Values of the pivot row (scratch).
-    pv: Vec<f64>,
+    /// Values of the active pattern's nonzeros: multipliers of `L` (aligned with `l_idx`),
+    /// entries of `U` right of the diagonal (aligned with `u_idx`), inverse pivots.
+    l_val: Vec<f64>,
+    u_val: Vec<f64>,
+    dinv: Vec<f64>,
     /// Scratch vectors of the solve.
     y: Vec<f64>,
     x: Vec<f64>,
@@ -137,7 +140,9 @@ impl SmallLu {
             static_used: false,
             fallbacks: 0,
             analyses: 0,
-            pv: vec![0.0; n],
+            l_val: vec![0.0; n * n],
+            u_val: vec![0.0; n * n],
+            dinv: vec![0.0; n],
             y: vec![0.0; n],
             x: vec![0.0; n],
         }
@@ -242,6 +247,9 @@ impl SmallLu {
             }
         }
         let tol = 1e-14 * scale.max(f64::MIN_POSITIVE) * n as f64;
+        for (k, r) in self.rp.iter_mut().enumerate() {
+            *r = k;
+        }
         if self.factor_static(tol) {
             self.static_used = true;
             return Ok(());
@@ -258,29 +266,32 @@ impl SmallLu {
     /// Elimination with the static diagonal pivots over the symbolic pattern; `false` (with
     /// the matrix partly eliminated) if a pivot fails the threshold.
     fn factor_static(&mut self, tol: f64) -> bool {
-        let p = &self.symbolic;
         let n = self.n;
-        let a = &mut self.f;
+        let (a, p) = (&mut self.f, &self.symbolic);
+        let (l_val, u_val, dinv) = (&mut self.l_val, &mut self.u_val, &mut self.dinv);
         for k in 0..n {
             let piv = a[k * n + k];
-            let lrows = &p.l_idx[p.l_start[k]..p.l_start[k + 1]];
+            let (ls, le) = (p.l_start[k], p.l_start[k + 1]);
+            let lrows = &p.l_idx[ls..le];
             let colmax = lrows.iter().fold(0.0f64, |m, &i| m.max(a[i * n + k].abs()));
             // (also false for NaN)
             if !(piv.abs() > tol && piv.abs() >= PIVOT_THRESHOLD * colmax) {
                 return false;
             }
-            let ucols = &p.u_idx[p.u_start[k]..p.u_start[k + 1]];
-            for (v, &j) in self.pv.iter_mut().zip(ucols) {
+            let (us, ue) = (p.u_start[k], p.u_start[k + 1]);
+            let ucols = &p.u_idx[us..ue];
+            for (v, &j) in u_val[us..ue].iter_mut().zip(ucols) {
                 *v = a[k * n + j];
             }
-            let pv = &self.pv[..ucols.len()];
+            let uv = &u_val[us..ue];
             let inv = 1.0 / piv;
-            for &i in lrows {
+            dinv[k] = inv;
+            for (lv, &i) in l_val[ls..le].iter_mut().zip(lrows) {
                 let row = &mut a[i * n..(i + 1) * n];
                 let f = row[k] * inv;
-                row[k] = f;
+                *lv = f;
                 if f != 0.0 {
-                    for (&j, &v) in ucols.iter().zip(pv) {
+                    for (&j, &v) in ucols.iter().zip(uv) {
                         row[j] -= f * v;
                     }
                 }
@@ -321,24 +332,25 @@ impl SmallLu {
             for (j, &v) in a[pk * n..(pk + 1) * n].iter().enumerate().skip(k + 1) {
                 if v != 0.0 {
                     p.u_idx[nu] = j;
-                    self.pv[nu - p.u_start[k]] = v;
+                    self.u_val[nu] = v;
                     nu += 1;
                 }
             }
             let uc = &p.u_idx[p.u_start[k]..nu];
-            let uv = &self.pv[..uc.len()];
+            let uv = &self.u_val[p.u_start[k]..nu];
             let inv = 1.0 / a[pk * n + k];
+            self.dinv[k] = inv;
             p.l_start[k] = nl;
             for &ph in &self.rp[k + 1..] {
                 let row = &mut a[ph * n..(ph + 1) * n];
                 let f = row[k];
                 if f != 0.0 {
                     let f = f * inv;
-                    row[k] = f;
                     for (&j, &v) in uc.iter().zip(uv) {
                         row[j] -= f * v;
                     }
                     p.l_idx[nl] = ph;
+                    self.l_val[nl] = f;
                     nl += 1;
                 }
             }
@@ -352,35 +364,33 @@ impl SmallLu {
     /// numbering).
     pub fn solve(&mut self, b: &mut [f64]) {
         let n = self.n;
-        let a = &self.f;
-        let (y, x) = (&mut self.y, &mut self.x);
-        let (p, rp): (&Pattern, Option<&[usize]>) = if self.static_used {
-            (&self.symbolic, None)
+        let (y, x, rp) = (&mut self.y, &mut self.x, &self.rp);
+        let p = if self.static_used {
+            &self.symbolic
         } else {
-            (&self.dynamic, Some(&self.rp))
+            &self.dynamic
         };
-        let row_of = |k: usize| rp.map_or(k, |rp| rp[k]);
         for (yi, &r) in y.iter_mut().zip(&self.rows) {
             *yi = b[r];
         }
-        // forward: L z = P y, column by column (z_k ends in y[row_of(k)])
+        // forward: L z = P y, column by column (z_k ends in y[rp[k]])
         for k in 0..n {
-            let yk = y[row_of(k)];
+            let yk = y[rp[k]];
             if yk != 0.0 {
-                for &ph in &p.l_idx[p.l_start[k]..p.l_start[k + 1]] {
-                    y[ph] -= a[ph * n + k] * yk;
+                let (ls, le) = (p.l_start[k], p.l_start[k + 1]);
+                for (&ph, &l) in p.l_idx[ls..le].iter().zip(&self.l_val[ls..le]) {
+                    y[ph] -= l * yk;
                 }
             }
         }
         // backward: U x = z, row by row
         for k in (0..n).rev() {
-            let pk = row_of(k);
-            let row = &a[pk * n..(pk + 1) * n];
+            let (us, ue) = (p.u_start[k], p.u_start[k + 1]);
             let mut s = 0.0;
-            for &j in &p.u_idx[p.u_start[k]..p.u_start[k + 1]] {
-                s += row[j] * x[j];
+            for (&j, &u) in p.u_idx[us..ue].iter().zip(&self.u_val[us..ue]) {
+                s += u * x[j];
             }
-            x[k] = (y[pk] - s) / row[k];
+            x[k] = (y[rp[k]] - s) * self.dinv[k];
         }
         for (&xj, &c) in x.iter().zip(&self.cols) {
             b[c] = xj;
