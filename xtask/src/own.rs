@@ -1,5 +1,5 @@
 //! The project's own experiments: convergence orders of every solver, work-precision on the
-//! manipulator, long-time energy behaviour.
+//! manipulator, long-time energy behaviour, cost of one step against the RK4 peer.
 
 use crate::plot::{Figure, Series};
 use crate::report::{fmt_e, num, Claim, Ctx, Experiment, FigureRef, Part, Section, Table};
@@ -8,7 +8,8 @@ use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd_model::{models, System};
 use mbd_rk4::{Rk4, Rk4Options};
 use mbd_solve::{
-    reference_trajectory, run, ButcherTableau, Integrator, NoObserver, RunConfig, SolveError, State,
+    reference_trajectory, run, ButcherTableau, Index1Options, Index1Rk, Integrator, NoObserver,
+    RunConfig, SolveError, State,
 };
 use mbd_symplectic::{Galerkin, SymplecticOptions};
 use mbd_tangent::TangentRk;
@@ -420,9 +421,133 @@ fn scaling(ctx: &Ctx) -> Result<Section, String> {
     Ok(sec)
 }
 
+/// Best time per step over `blocks` blocks of `steps` steps of the manipulator at `h`,
+/// restarting from `s0` whenever `t` passes 10 s, for `integ` and for `peer`, the blocks of the
+/// two interleaved (so both see the same machine load).
+fn interleaved_step_cost(
+    sys: &System,
+    s0: &State,
+    integ: &mut dyn Integrator,
+    peer: &mut dyn Integrator,
+    blocks: usize,
+    steps: usize,
+    peer_steps: usize,
+) -> Result<(f64, f64), String> {
+    let block = |it: &mut dyn Integrator, st: &mut State, n: usize| -> Result<f64, String> {
+        let t = Instant::now();
+        for _ in 0..n {
+            if st.t > 10.0 {
+                *st = s0.clone();
+                it.reset();
+            }
+            it.step(sys, st, 0.01).map_err(|e| e.to_string())?;
+        }
+        Ok(t.elapsed().as_secs_f64() / n as f64)
+    };
+    let (mut best, mut best_peer) = (f64::INFINITY, f64::INFINITY);
+    let (mut a, mut b) = (s0.clone(), s0.clone());
+    for _ in 0..blocks {
+        best = best.min(block(&mut *integ, &mut a, steps)?);
+        best_peer = best_peer.min(block(&mut *peer, &mut b, peer_steps)?);
+    }
+    Ok((best, best_peer))
+}
+
+fn step_cost(ctx: &Ctx) -> Result<Section, String> {
+    let mut sec = Section::default();
+    let sys = models::manipulator().map_err(|e| e.to_string())?;
+    let s0 = State::consistent(&sys, 0.0).map_err(|e| e.to_string())?;
+    let (blocks, steps) = if ctx.quick { (5, 2_000) } else { (30, 10_000) };
+    sec.setting("problem", "manipulator, h = 0.01 s");
+    sec.setting(
+        "peer",
+        "RK4 on the index-1 form (mbd_solve::Index1Rk, RK4 tableau), the plain RK4 step",
+    );
+    sec.setting(
+        "method",
+        format!("best of {blocks} blocks of {steps} steps (FA-DAE: 1/100 of that), each solver's blocks interleaved with the peer's"),
+    );
+    sec.notes.push("Wall-clock times of one step on this machine; the ratio to the peer, measured in the same interleaved loop, is the portable number. Other experiments run at the same time on the `--jobs` threads, so for clean numbers run `cargo xtask reproduce own --only own-step-cost --jobs 1` (criterion benches: `cargo bench -p mbd-rk4`, `-p mbd-symplectic`, `-p mbd-tangent`).".into());
+    let mut table = Table::new(
+        "Cost of one step on the manipulator",
+        &[
+            "solver",
+            "time per step [us]",
+            "RK4 peer [us]",
+            "ratio to the peer",
+            "target",
+        ],
+    );
+    // (name, target in us, target ratio)
+    let targets: [(&str, Option<f64>, Option<f64>); 5] = [
+        ("RK4 (index-1, plain)", Some(1.0), None),
+        ("symplectic (1,1)", Some(2.0), None),
+        ("symplectic (2,2)", Some(5.0), None),
+        ("tangent-space RK4", None, Some(4.0)),
+        ("FA-DAE + Gauss-Newton polish", None, None),
+    ];
+    let mut peer = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())
+        .map_err(|e| e.to_string())?;
+    let mut rows = Vec::new();
+    for spec in solvers() {
+        let Some(&(_, abs, ratio)) = targets.iter().find(|t| t.0 == spec.name) else {
+            continue;
+        };
+        let mut integ = (spec.make)(&sys).map_err(|e| e.to_string())?;
+        let n = if spec.long_time { steps } else { steps / 100 };
+        let (per, per_peer) =
+            interleaved_step_cost(&sys, &s0, integ.as_mut(), &mut peer, blocks, n, steps)?;
+        let r = per / per_peer;
+        let target = match (abs, ratio) {
+            (Some(us), _) => format!("<= {us} us"),
+            (None, Some(x)) => format!("<= {x}x the peer"),
+            _ => "-".into(),
+        };
+        table.row(vec![
+            spec.name.into(),
+            format!("{:.3}", per * 1e6),
+            format!("{:.3}", per_peer * 1e6),
+            format!("{r:.2}"),
+            target,
+        ]);
+        if let Some(us) = abs {
+            sec.claims.push(Claim::check(
+                format!("one {} step on the manipulator within {us} us", spec.name),
+                per * 1e6 <= us,
+                format!(
+                    "{:.3} us ({r:.2}x the RK4 peer's {:.3} us)",
+                    per * 1e6,
+                    per_peer * 1e6
+                ),
+            ));
+        }
+        if let Some(x) = ratio {
+            sec.claims.push(Claim::check(
+                format!("one {} step within {x}x a plain RK4 step", spec.name),
+                r <= x,
+                format!(
+                    "{r:.2}x ({:.3} us against {:.3} us)",
+                    per * 1e6,
+                    per_peer * 1e6
+                ),
+            ));
+        }
+        rows.push(json!({"solver": spec.name, "runtime_s": num(per), "peer_runtime_s": num(per_peer), "ratio": num(r)}));
+    }
+    sec.tables.push(table);
+    sec.timings = json!({ "step_cost": rows });
+    Ok(sec)
+}
+
 /// The project's own experiments.
 pub fn experiments() -> Vec<Experiment> {
     vec![
+        Experiment {
+            id: "own-step-cost",
+            part: Part::Own,
+            title: "Cost of one step against the RK4 peer",
+            run: step_cost,
+        },
         Experiment {
             id: "own-scaling",
             part: Part::Own,
