@@ -126,11 +126,20 @@ pub struct TangentChart {
     phi_q: DMatrix<f64>,
     /// `(Phi_q v_c)_q` at `q_c`.
     dphi: DMatrix<f64>,
-    /// `Df(x_c)^T` (`2n x 2m`, column-major), overwritten by the QR factors: `R` in the upper
-    /// triangle, the Householder vectors (unit leading entry implied) below.
+    /// `R` (`2m x 2m`, upper triangular) of `Df(x_c)^T = Q1 R`, column-major with column
+    /// stride `2n` (entries below the diagonal unused).
     a: Vec<f64>,
-    /// Householder coefficients.
+    /// Householder coefficients of the two small QR factorisations.
     tau: Vec<f64>,
+    /// `Phi_q^T` (`n x m`) overwritten by its QR factors (`Ra` and reflectors).
+    aq: Vec<f64>,
+    /// `B = [D; Ra]` (`n x m`) overwritten by its QR factors (`Rb` and reflectors).
+    bq: Vec<f64>,
+    /// The orthogonal factors `Qa` of `Phi_q^T` and `Qb` of `B` (`n x n`, column-major).
+    qa: Vec<f64>,
+    qb: Vec<f64>,
+    /// A row of `(Phi_q v)_q` (`n`), work vector.
+    xt: Vec<f64>,
     /// `Q = [Q1 U]` (`2n x 2n`, column-major).
     q: Vec<f64>,
     /// The centre `(q_c, v_c)`.
@@ -193,7 +202,12 @@ impl TangentChart {
             phi_q: DMatrix::zeros(m, n),
             dphi: DMatrix::zeros(m, n),
             a: vec![0.0; nn * mm],
-            tau: vec![0.0; mm],
+            tau: vec![0.0; m],
+            aq: vec![0.0; n * m],
+            bq: vec![0.0; n * m],
+            qa: vec![0.0; n * n],
+            qb: vec![0.0; n * n],
+            xt: vec![0.0; n],
             q,
             xc: vec![0.0; nn],
             tc: 0.0,
@@ -314,26 +328,64 @@ impl TangentChart {
             return Ok(());
         }
         sys.phi_q_dot_jacobian(q, v, &mut self.phi_q, &mut self.dphi);
-        // Df^T = [[Phi_q^T, dphi^T], [0, Phi_q^T]], column-major 2n x 2m
-        for k in 0..m {
-            let (ca, cb) = self.a.split_at_mut((m + k) * nn);
-            let ca = &mut ca[k * nn..(k + 1) * nn];
-            let cb = &mut cb[..nn];
-            for c in 0..n {
-                let p = self.phi_q[(k, c)];
-                ca[c] = p;
-                ca[n + c] = 0.0;
-                cb[c] = self.dphi[(k, c)];
-                cb[n + c] = p;
-            }
-        }
-        if self.a.iter().any(|x| !x.is_finite()) {
+        if self
+            .phi_q
+            .as_slice()
+            .iter()
+            .chain(self.dphi.as_slice())
+            .any(|x| !x.is_finite())
+        {
             return Err(SolveError::NonFinite {
                 t,
                 what: "constraint Jacobian at the chart centre",
             });
         }
-        householder_qr(&mut self.a, &mut self.tau, nn, mm, m, n);
+        if m > n {
+            // more constraint equations than coordinates: necessarily dependent
+            return Err(SolveError::Singular {
+                t,
+                what: "constraint Jacobian Df of the tangent chart",
+                detail: format!("position constraint {}", sys.equation_name(n)),
+            });
+        }
+        let nm = n - m;
+        // 1. Phi_q^T = Qa [Ra; 0] (n x m), Qa = [Qa1 Na] explicit (n x n)
+        let pq = self.phi_q.as_slice(); // column-major m x n: (r, c) at c m + r
+        for k in 0..m {
+            for c in 0..n {
+                self.aq[k * n + c] = pq[c * m + k];
+            }
+        }
+        householder_qr(&mut self.aq, &mut self.tau, n, m, 0, n);
+        form_q(&self.aq, &self.tau, n, m, 0, n, &mut self.qa);
+        // 2. Qa^T X^T with X = (Phi_q v)_q: its first m rows are the block C of R, the other
+        //    n - m rows (D = Na^T X^T) stacked on Ra form B = [D; Ra] (n x m)
+        let xs = self.dphi.as_slice();
+        for j in 0..m {
+            for c in 0..n {
+                self.xt[c] = xs[c * m + j];
+            }
+            for i in 0..n {
+                let g = dot(&self.qa[i * n..(i + 1) * n], &self.xt);
+                if i < m {
+                    self.a[(m + j) * nn + i] = g;
+                } else {
+                    self.bq[j * n + i - m] = g;
+                }
+            }
+            for i in 0..m {
+                self.bq[j * n + nm + i] = if i <= j { self.aq[j * n + i] } else { 0.0 };
+                // R's leading block: Ra
+                self.a[j * nn + i] = if i <= j { self.aq[j * n + i] } else { 0.0 };
+            }
+        }
+        // 3. B = Qb [Rb; 0], Qb explicit (n x n)
+        householder_qr(&mut self.bq, &mut self.tau, n, m, 0, n);
+        for j in 0..m {
+            for i in 0..=j {
+                self.a[(m + j) * nn + m + i] = self.bq[j * n + i];
+            }
+        }
         let dmax = (0..mm).fold(0.0f64, |d, i| d.max(self.a[i * nn + i].abs()));
         for i in 0..mm {
             let rii = self.a[i * nn + i].abs();
@@ -350,7 +402,28 @@ impl TangentChart {
                 });
             }
         }
-        form_q(&self.a, &self.tau, nn, mm, m, n, &mut self.q);
+        form_q(&self.bq, &self.tau, n, m, 0, n, &mut self.qb);
+        // 4. Q = [[Qa1, W Qb, 0], [0, ., Na]] with W y = (Na y[..n-m], Qa1 y[n-m..]): columns
+        //    0..m = (Qa1, 0), m..m+n = W Qb (the last n - m of them tangent), m+n..2n = (0, Na)
+        for k in 0..m {
+            let col = &mut self.q[k * nn..(k + 1) * nn];
+            col[..n].copy_from_slice(&self.qa[k * n..(k + 1) * n]);
+            col[n..].fill(0.0);
+        }
+        for j in 0..n {
+            let y = &self.qb[j * n..(j + 1) * n];
+            let col = &mut self.q[(m + j) * nn..(m + j + 1) * nn];
+            let (cq, cv) = col.split_at_mut(n);
+            cq.fill(0.0);
+            cv.fill(0.0);
+            gemv_cols(&self.qa[m * n..], &y[..nm], cq);
+            gemv_cols(&self.qa[..m * n], &y[nm..], cv);
+        }
+        for l in 0..nm {
+            let col = &mut self.q[(m + n + l) * nn..(m + n + l + 1) * nn];
+            col[..n].fill(0.0);
+            col[n..].copy_from_slice(&self.qa[(m + l) * n..(m + l + 1) * n]);
+        }
         // R^-1 by back substitution, column by column (diagonal first: 1 / R_ii)
         self.rinv.fill(0.0);
         for i in 0..mm {
@@ -368,10 +441,11 @@ impl TangentChart {
         // P0 = Q1 R^-T: column k = sum_{j >= k} (R^-1)_{kj} Q1_j
         self.p0.fill(0.0);
         for k in 0..mm {
-            let col = &mut self.p0[k * nn..(k + 1) * nn];
             for j in k..mm {
-                axpy(self.rinv[j * mm + k], &self.q[j * nn..(j + 1) * nn], col);
+                self.u[j] = self.rinv[j * mm + k];
             }
+            let col = &mut self.p0[k * nn..(k + 1) * nn];
+            gemv_cols(&self.q[k * nn..mm * nn], &self.u[k..mm], col);
         }
         self.centred = true;
         Ok(())
@@ -1012,6 +1086,55 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The block-structured chart: `[Q1 U]` orthonormal, `Q1 R = Df^T`, `Df U = 0`.
+    #[test]
+    fn block_chart_factors_df() {
+        for sys in [
+            mbd_model::models::manipulator().expect("model"),
+            mbd_model::models::four_bar().expect("model"),
+            mbd_model::models::slider_crank().expect("model"),
+        ] {
+            let st = mbd_solve::State::consistent(&sys, 0.0).expect("state");
+            let mut v = st.v.clone();
+            for (i, x) in v.iter_mut().enumerate() {
+                *x += 0.1 * (i as f64 + 1.0); // off the manifold in v: Df is all that matters
+            }
+            let mut chart = TangentChart::new(&sys);
+            chart
+                .centre(&sys, st.q.as_slice(), v.as_slice(), 0.0)
+                .expect("centre");
+            let (dim, mm, nn) = (chart.dim(), chart.codim(), chart.ambient_dim());
+            let col = |k: usize| {
+                if k < mm {
+                    chart.normal(k)
+                } else {
+                    chart.tangent(k - mm)
+                }
+            };
+            for i in 0..nn {
+                for j in 0..nn {
+                    let d = dot(col(i), col(j));
+                    let e = if i == j { 1.0 } else { 0.0 };
+                    assert!((d - e).abs() < 1e-14, "({i},{j}) {d}");
+                }
+            }
+            let df = chart.jacobian();
+            let scale = df.amax();
+            for j in 0..mm {
+                for i in 0..nn {
+                    let qr: f64 = (0..=j).map(|k| chart.normal(k)[i] * chart.r(k, j)).sum();
+                    assert!((qr - df[(j, i)]).abs() < 1e-13 * scale, "Q1 R ({i},{j})");
+                }
+            }
+            for k in 0..dim {
+                for r in 0..mm {
+                    let d: f64 = (0..nn).map(|c| df[(r, c)] * chart.tangent(k)[c]).sum();
+                    assert!(d.abs() < 1e-13 * scale, "Df U ({r},{k}) {d}");
+                }
+            }
+        }
+    }
 
     /// The Broyden iteration reaches the same chart points as the plain chord (to 1e-13) with
     /// fewer iterations, also when its updated matrix is carried to a second map.
