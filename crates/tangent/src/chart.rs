@@ -568,18 +568,10 @@ impl TangentChart {
 
     /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
     pub fn point(&self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
-        let mm = 2 * self.m;
+        let (nn, mm) = (2 * self.n, 2 * self.m);
         x.copy_from_slice(&self.xc);
-        for (k, &z) in zeta.iter().enumerate() {
-            if z != 0.0 {
-                axpy(z, self.col(k), x);
-            }
-        }
-        for (k, &s) in xi.iter().enumerate() {
-            if s != 0.0 {
-                axpy(s, self.col(mm + k), x);
-            }
-        }
+        gemv_cols(&self.q[..mm * nn], &zeta[..mm], x);
+        gemv_cols(&self.q[mm * nn..], xi, x);
     }
 
     /// Maps chart coordinates `xi` (length [`TangentChart::dim`]) to the point `x` (length
@@ -670,9 +662,8 @@ impl TangentChart {
             for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
                 *d = xv - xc;
             }
-            for (k, z) in zeta.iter_mut().enumerate().take(2 * self.m) {
-                *z = dot(&self.q[k * nn..(k + 1) * nn], &self.dx);
-            }
+            let mm = 2 * self.m;
+            gemv_t_cols(&self.q[..mm * nn], &self.dx, &mut zeta[..mm]);
         }
         out
     }
@@ -916,9 +907,7 @@ impl TangentChart {
     /// `out = [Q1 U]^T y`: the normal components (first `2m`) and the tangent components (last
     /// `2(n - m)`) of a vector `y` of length `2n`.
     pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
-        for (k, o) in out.iter_mut().enumerate() {
-            *o = dot(self.col(k), y);
-        }
+        gemv_t_cols(&self.q, y, out);
     }
 }
 
@@ -1023,6 +1012,40 @@ fn gemv_cols(cols: &[f64], a: &[f64], y: &mut [f64]) {
     }
     for (col, &ak) in blocks.remainder().chunks_exact(r).zip(coef.remainder()) {
         axpy(ak, col, y);
+    }
+}
+
+/// `out_k = c_k . y` for the columns `c_k` (of the length of `y`, `out.len()` of them) of the
+/// column-major matrix `cols`, four columns per pass over `y`.
+#[inline]
+fn gemv_t_cols(cols: &[f64], y: &[f64], out: &mut [f64]) {
+    let r = y.len();
+    if r == 0 {
+        out.fill(0.0);
+        return;
+    }
+    let cols = &cols[..out.len() * r];
+    let mut blocks = cols.chunks_exact(4 * r);
+    let mut outs = out.chunks_exact_mut(4);
+    for (b, o) in (&mut blocks).zip(&mut outs) {
+        let (c0, rest) = b.split_at(r);
+        let (c1, rest) = rest.split_at(r);
+        let (c2, c3) = rest.split_at(r);
+        let mut d = [0.0f64; 4];
+        for ((((yi, x0), x1), x2), x3) in y.iter().zip(c0).zip(c1).zip(c2).zip(c3) {
+            d[0] += yi * x0;
+            d[1] += yi * x1;
+            d[2] += yi * x2;
+            d[3] += yi * x3;
+        }
+        o.copy_from_slice(&d);
+    }
+    for (col, o) in blocks
+        .remainder()
+        .chunks_exact(r)
+        .zip(outs.into_remainder())
+    {
+        *o = dot(col, y);
     }
 }
 
