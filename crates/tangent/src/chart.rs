@@ -138,8 +138,9 @@ pub struct TangentChart {
     /// The orthogonal factors `Qa` of `Phi_q^T` and `Qb` of `B` (`n x n`, column-major).
     qa: Vec<f64>,
     qb: Vec<f64>,
-    /// A row of `(Phi_q v)_q` (`n`), work vector.
+    /// A row of `(Phi_q v)_q`, and `Qa^T` times it (`n`), work vectors.
     xt: Vec<f64>,
+    g: Vec<f64>,
     /// `Q = [Q1 U]` (`2n x 2n`, column-major).
     q: Vec<f64>,
     /// The centre `(q_c, v_c)`.
@@ -208,6 +209,7 @@ impl TangentChart {
             qa: vec![0.0; n * n],
             qb: vec![0.0; n * n],
             xt: vec![0.0; n],
+            g: vec![0.0; n],
             q,
             xc: vec![0.0; nn],
             tc: 0.0,
@@ -365,14 +367,9 @@ impl TangentChart {
             for c in 0..n {
                 self.xt[c] = xs[c * m + j];
             }
-            for i in 0..n {
-                let g = dot(&self.qa[i * n..(i + 1) * n], &self.xt);
-                if i < m {
-                    self.a[(m + j) * nn + i] = g;
-                } else {
-                    self.bq[j * n + i - m] = g;
-                }
-            }
+            gemv_t_cols(&self.qa, &self.xt, &mut self.g);
+            self.a[(m + j) * nn..(m + j) * nn + m].copy_from_slice(&self.g[..m]);
+            self.bq[j * n..j * n + nm].copy_from_slice(&self.g[m..]);
             for i in 0..m {
                 self.bq[j * n + nm + i] = if i <= j { self.aq[j * n + i] } else { 0.0 };
                 // R's leading block: Ra
