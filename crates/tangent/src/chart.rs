@@ -113,11 +113,14 @@ pub struct MapStats {
 /// the centre. The correction matrices (`Q1 R^-T`, `2n x 2m`) are formed once per chart, so an
 /// iteration costs one residual evaluation and one or two `2n x 2m` products.
 ///
-/// The QR factorisation is a Householder QR on preallocated buffers that skips the zero lower
-/// half of the first `m` columns of `Df^T`; the full orthogonal factor `Q = [Q1 U]` is
-/// accumulated explicitly (`docs/tangent.md` explains why this is not faer's blocked QR: for the
-/// small dense `Df^T` of a planar mechanism it is several times faster). Everything lives in
-/// buffers allocated by [`TangentChart::new`].
+/// The QR factorisation uses the block structure `Df = [[Phi_q, 0], [X, Phi_q]]`
+/// (`X = (Phi_q v)_q`): `Phi_q^T = Qa [Ra; 0]` (`Qa = [Qa1 Na]`), then
+/// `B = [Na^T X^T; Ra] = Qb [Rb; 0]`, both `n x m` Householder QRs on preallocated buffers; with
+/// `C = Qa1^T X^T` and the isometry `W y = (Na y[..n-m], Qa1 y[n-m..])`,
+/// `R = [[Ra, C], [0, Rb]]`, `Q1 = [(Qa1, 0), W Qb1]` and `U = [W Qb2, (0, Na)]`, a thin QR of
+/// `Df^T` with an orthonormal complement, without factoring the `2n x 2m` matrix
+/// (`docs/tangent.md` section 2; faer's blocked QR is several times slower at these sizes).
+/// Everything lives in buffers allocated by [`TangentChart::new`].
 #[derive(Clone, Debug)]
 pub struct TangentChart {
     n: usize,
@@ -305,7 +308,8 @@ impl TangentChart {
     }
 
     /// Centres the chart at `(q, v)` at time `t`: evaluates `Df`, factors `Df^T = Q1 R` and forms
-    /// `Q = [Q1 U]`. A rank-deficient `Df` (redundant constraints or a singular configuration) is
+    /// `Q = [Q1 U]` from the QRs of `Phi_q^T` and of the `n x m` block `[Na^T X^T; Ra]` (see the
+    /// type's documentation). A rank-deficient `Df` (redundant constraints or a singular configuration) is
     /// [`SolveError::Singular`] naming the first dependent equation. Resets the iteration
     /// matrix to the centre's.
     pub fn centre(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) -> Result<(), SolveError> {
