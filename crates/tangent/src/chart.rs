@@ -473,23 +473,16 @@ impl TangentChart {
         // Delta Df = [[dP, 0], [dX, dP]] with dP = Phi_q(e) - Phi_q(c), dX likewise
         self.pq_e -= &self.phi_q;
         self.dphi_e -= &self.dphi;
+        // column k of E: (dP cq, dX cq + dP cv) for Q1_k = (cq, cv); dP, dX column-major m x n
+        let (dp, dx) = (self.pq_e.as_slice(), self.dphi_e.as_slice());
+        self.e.fill(0.0);
         for k in 0..mm {
             let col = &self.q[k * nn..(k + 1) * nn];
             let (cq, cv) = col.split_at(n);
-            let ek = &mut self.e[k * mm..(k + 1) * mm];
-            for r in 0..m {
-                let mut p = 0.0;
-                let mut x = 0.0;
-                let mut pv = 0.0;
-                for c in 0..n {
-                    let dp = self.pq_e[(r, c)];
-                    p += dp * cq[c];
-                    x += self.dphi_e[(r, c)] * cq[c];
-                    pv += dp * cv[c];
-                }
-                ek[r] = p;
-                ek[m + r] = x + pv;
-            }
+            let (ep, ev) = self.e[k * mm..(k + 1) * mm].split_at_mut(m);
+            gemv_cols(dp, cq, ep);
+            gemv_cols(dx, cq, ev);
+            gemv_cols(dp, cv, ev);
         }
         if !self.e.iter().all(|x| x.is_finite()) {
             return;
@@ -498,13 +491,13 @@ impl TangentChart {
         self.k.fill(0.0);
         for k in 0..mm {
             for j in k..mm {
-                let c = self.rinv[j * mm + k];
-                let (kk, e) = (
-                    &mut self.k[k * mm..(k + 1) * mm],
-                    &self.e[j * mm..(j + 1) * mm],
-                );
-                axpy(c, e, kk);
+                self.u[j] = self.rinv[j * mm + k];
             }
+            gemv_cols(
+                &self.e[k * mm..],
+                &self.u[k..mm],
+                &mut self.k[k * mm..(k + 1) * mm],
+            );
         }
         self.has_e = true;
     }
@@ -713,20 +706,15 @@ impl TangentChart {
             }
             // x <- x - Q1 J^-1 f = x - P0 (I + s K)^-1 f
             if s != 0.0 {
-                let mm = f.len();
-                // u = K f, w = f - s u + s^2 K u
+                // u = K f, f <- f - s u + s^2 K u
                 self.u.fill(0.0);
-                for (j, &fj) in f.iter().enumerate() {
-                    axpy(fj, &self.k[j * mm..(j + 1) * mm], &mut self.u);
-                }
-                for (wi, (fi, ui)) in self.w.iter_mut().zip(f.iter().zip(&self.u)) {
-                    *wi = fi - s * ui;
-                }
+                gemv_cols(&self.k, f, &mut self.u);
                 let s2 = s * s;
-                for (j, &uj) in self.u.iter().enumerate() {
-                    axpy(s2 * uj, &self.k[j * mm..(j + 1) * mm], &mut self.w);
+                for ((fi, ui), wi) in f.iter_mut().zip(&self.u).zip(self.w.iter_mut()) {
+                    *fi -= s * ui;
+                    *wi = s2 * ui;
                 }
-                f.copy_from_slice(&self.w);
+                gemv_cols(&self.k, &self.w, f);
             }
             // f is overwritten by the next residual: negate it in place
             for fk in f.iter_mut() {
