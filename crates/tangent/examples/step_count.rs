@@ -8,9 +8,10 @@
 //! ```
 //!
 //! Arguments: `tangent` | `plain`, the step `h` (default 0.01), the number of steps (default
-//! `10 / h`, the first 10 s of motion, as the benchmark cycles through), and `interpolated` for
-//! [`IterationMatrix::Interpolated`] (tangent only). Prints the chord
-//! iterations per step of the tangent solver.
+//! `10 / h`, the first 10 s of motion, as the benchmark cycles through), and the iteration
+//! matrix `centre`, `interpolated` or `broyden` ([`IterationMatrix`], tangent only; default:
+//! the solver's default). Prints the chord iterations and Broyden updates per step of the
+//! tangent solver.
 use mbd_model::{models, System};
 use mbd_solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, SolveError, State};
 use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
@@ -50,21 +51,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         _ => {
             let opts = TangentOptions {
-                iteration_matrix: if args.next().as_deref() == Some("interpolated") {
-                    IterationMatrix::Interpolated
-                } else {
-                    IterationMatrix::Centre
+                iteration_matrix: match args.next().as_deref() {
+                    Some("interpolated") => IterationMatrix::Interpolated,
+                    Some("broyden") => IterationMatrix::Broyden,
+                    Some("centre") => IterationMatrix::Centre,
+                    _ => IterationMatrix::default(),
                 },
                 ..Default::default()
             };
             let mut t = TangentRk::new(&sys, ButcherTableau::rk4(), opts)?;
             run_steps(&mut t, &sys, &mut s, h, steps)?;
             let st = t.stats();
+            let (upd, resets) = t.chart().broyden_counts();
             println!(
                 "tangent RK4: {steps} steps of {h}, t = {}, {:.2} chord iterations/step, \
+                 {:.2} Broyden updates/step, {resets} resets, \
                  max map {}, max residual {:.2e}, halvings {}; final max |q| {:.0}, max |v| {:.0}",
                 s.t,
                 st.newton_iterations as f64 / st.steps as f64,
+                upd as f64 / st.steps as f64,
                 st.max_map_iterations,
                 st.max_residual,
                 st.halvings,

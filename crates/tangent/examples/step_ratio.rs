@@ -2,7 +2,7 @@
 //! on the manipulator: the two run in interleaved blocks of 20000 steps and the best block of
 //! 30 counts, which keeps the ratio steady on a shared machine.
 //!
-//! `cargo run --release -p mbd-tangent --example step_ratio [h] [interpolated]`
+//! `cargo run --release -p mbd-tangent --example step_ratio [h] [centre|interpolated|broyden]`
 use mbd_model::models;
 use mbd_solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, State};
 use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
@@ -14,10 +14,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(a) => a.parse()?,
         None => 0.01,
     };
-    let iteration_matrix = if args.next().as_deref() == Some("interpolated") {
-        IterationMatrix::Interpolated
-    } else {
-        IterationMatrix::Centre
+    let iteration_matrix = match args.next().as_deref() {
+        Some("interpolated") => IterationMatrix::Interpolated,
+        Some("broyden") => IterationMatrix::Broyden,
+        Some("centre") => IterationMatrix::Centre,
+        _ => IterationMatrix::default(),
     };
     let sys = models::manipulator()?;
     let s0 = State::consistent(&sys, 0.0)?;

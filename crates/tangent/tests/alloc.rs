@@ -2,7 +2,7 @@
 
 use mbd_model::models;
 use mbd_solve::{Integrator, NoObserver, State};
-use mbd_tangent::{AdaptiveSettings, TangentRk};
+use mbd_tangent::{AdaptiveSettings, ButcherTableau, IterationMatrix, TangentOptions, TangentRk};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -35,16 +35,23 @@ fn steps_allocate_nothing() {
         let mut s = State::consistent(&sys, 0.0).expect("state");
         let mut rk4 = TangentRk::rk4(&sys).expect("solver");
         let mut dp = TangentRk::dopri5(&sys).expect("solver");
+        let broyden = TangentOptions {
+            iteration_matrix: IterationMatrix::Broyden,
+            ..Default::default()
+        };
+        let mut br = TangentRk::new(&sys, ButcherTableau::rk4(), broyden).expect("solver");
         let settings = AdaptiveSettings::with_tolerance(1e-9);
         rk4.step(&sys, &mut s, 1e-3).expect("warm-up");
         let before = ALLOCS.load(Ordering::SeqCst);
         for _ in 0..200 {
             rk4.step(&sys, &mut s, 1e-3).expect("step");
             dp.step(&sys, &mut s, 1e-3).expect("step");
+            br.step(&sys, &mut s, 1e-3).expect("step");
         }
         // steps that need halving (h = 0.1 on the manipulator) allocate nothing either
         for _ in 0..10 {
             rk4.step(&sys, &mut s, 0.1).expect("halved step");
+            br.step(&sys, &mut s, 0.1).expect("halved step");
         }
         let t1 = s.t + 0.5;
         dp.integrate_adaptive(&sys, &mut s, t1, &settings, &mut NoObserver)

@@ -1,5 +1,6 @@
 //! The chord iteration's matrix changes the work, not the result: the centre matrix (the
-//! paper's chord, default) and the interpolated one land on the same chart points.
+//! paper's chord, default), the interpolated one and the Broyden-updated one land on the same
+//! chart points.
 
 mod common;
 
@@ -9,7 +10,7 @@ use mbd_solve::{run, ButcherTableau, NoObserver, RunConfig, State};
 use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
 
 #[test]
-fn centre_and_interpolated_matrices_agree() {
+fn centre_interpolated_and_broyden_matrices_agree() {
     for sys in [
         models::manipulator().expect("model"),
         models::four_bar().expect("model"),
@@ -17,7 +18,11 @@ fn centre_and_interpolated_matrices_agree() {
         let s0 = State::consistent(&sys, 0.0).expect("state");
         let mut ends = vec![];
         let mut iters = vec![];
-        for m in [IterationMatrix::Centre, IterationMatrix::Interpolated] {
+        for m in [
+            IterationMatrix::Centre,
+            IterationMatrix::Interpolated,
+            IterationMatrix::Broyden,
+        ] {
             let opts = TangentOptions {
                 iteration_matrix: m,
                 ..Default::default()
@@ -39,11 +44,14 @@ fn centre_and_interpolated_matrices_agree() {
             ends.push(s);
         }
         let d = state_error(&ends[0], ends[1].q.as_slice(), ends[1].v.as_slice());
+        let db = state_error(&ends[0], ends[2].q.as_slice(), ends[2].v.as_slice());
         println!(
-            "iterations centre {} interpolated {}, difference {d:e}",
-            iters[0], iters[1]
+            "iterations centre {} interpolated {} Broyden {}, difference {d:e} / {db:e}",
+            iters[0], iters[1], iters[2]
         );
         assert!(d < 1e-10, "{d}");
+        assert!(db < 1e-10, "{db}");
         assert!((iters[1] as f64) < 0.75 * iters[0] as f64, "{iters:?}");
+        assert!(iters[2] < iters[0], "{iters:?}");
     }
 }
