@@ -96,6 +96,8 @@ pub struct MapStats {
     /// Final `||f||_inf`; for a map that stopped on the predicted residual
     /// ([`TangentChart::map_predicted`]), that prediction.
     pub residual: f64,
+    /// `||f||_inf` at the starting point, before the first iteration.
+    pub initial_residual: f64,
 }
 
 /// A chart of the manifold `f(x, t) = (Phi(q, t), Phi_q v + Phi_t) = 0` at a centre
@@ -695,6 +697,7 @@ impl TangentChart {
                 return Ok(MapStats {
                     iterations: it,
                     residual: res,
+                    initial_residual: res0,
                 });
             }
             if it >= newton.max_iter {
@@ -729,6 +732,7 @@ impl TangentChart {
                 return Ok(MapStats {
                     iterations: it,
                     residual: theta * res,
+                    initial_residual: res0,
                 });
             }
             prev = res;
@@ -738,6 +742,7 @@ impl TangentChart {
                 return Ok(MapStats {
                     iterations: it,
                     residual: res,
+                    initial_residual: res0,
                 });
             }
             if res > newton.divergence * prev && res > tol {
@@ -784,6 +789,7 @@ impl TangentChart {
                 return Ok(MapStats {
                     iterations: it,
                     residual: res,
+                    initial_residual: res0,
                 });
             }
             if it >= newton.max_iter {
@@ -809,6 +815,7 @@ impl TangentChart {
                 return Ok(MapStats {
                     iterations: it,
                     residual: theta * res,
+                    initial_residual: res0,
                 });
             }
             prev = res;
@@ -818,6 +825,7 @@ impl TangentChart {
                 return Ok(MapStats {
                     iterations: it,
                     residual: res,
+                    initial_residual: res0,
                 });
             }
             if self.pb_active && (res.is_nan() || res >= prev) {

@@ -54,6 +54,16 @@ pub struct TangentOptions {
     /// onto the manifold by the first chart map). Larger is an error: project the state first
     /// (`System::project`). Default 1e-8.
     pub consistency_tol: f64,
+    /// Inexact stage maps: after an accepted step of the same size, the chart maps of the
+    /// interior Runge-Kutta stages stop at `max(newton.tol, stage_tol_ratio * E)`, where `E` is
+    /// the constraint residual `||f||_inf` of the previous step's plain RK end point
+    /// `x_c + h sum_j b_j F_j` (the end map's starting point: the method's local error in the
+    /// normal directions, `O(h^(p+1))`). A stage point off the manifold by `delta` changes the
+    /// step by about `h L delta`, so the ratio keeps that a small fraction of the local error
+    /// the method makes anyway; the step's end point is always mapped to `newton.tol`. 0 maps
+    /// every stage to `newton.tol`. Not used for FSAL tableaus (their last stage is the end
+    /// point). Default 1e-2; must lie in [0, 1).
+    pub stage_tol_ratio: f64,
 }
 
 impl Default for TangentOptions {
@@ -64,6 +74,7 @@ impl Default for TangentOptions {
             max_halvings: 4,
             singular_tol: 1e-8,
             consistency_tol: 1e-8,
+            stage_tol_ratio: 1e-2,
         }
     }
 }
@@ -91,6 +102,13 @@ impl TangentOptions {
                 parameter: "consistency_tol",
                 value: self.consistency_tol,
                 reason: "must be finite and at least newton.tol",
+            });
+        }
+        if !(self.stage_tol_ratio >= 0.0 && self.stage_tol_ratio < 1.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "stage_tol_ratio",
+                value: self.stage_tol_ratio,
+                reason: "must lie in [0, 1)",
             });
         }
         Ok(())
@@ -302,6 +320,9 @@ pub struct TangentRk {
     /// Extrapolated `eta` of the map in progress, and of an earlier stage.
     eta_pred: Vec<f64>,
     eta_tmp: Vec<f64>,
+    /// Tolerance of the interior stage maps of a step that follows the last accepted one
+    /// (`TangentOptions::stage_tol_ratio`).
+    stage_tol: f64,
 }
 
 /// Steps of `eta` history kept for the Newton starting points.
@@ -314,6 +335,8 @@ struct AttemptWork {
     max_map_iterations: usize,
     rhs_evals: usize,
     residual: f64,
+    /// `||f||_inf` at the plain RK end point (NaN for FSAL tableaus).
+    end_initial_residual: f64,
 }
 
 impl TangentRk {
@@ -373,6 +396,7 @@ impl TangentRk {
             hist_t: f64::NAN,
             eta_pred: vec![0.0; 2 * m],
             eta_tmp: vec![0.0; 2 * m],
+            stage_tol: options.newton.tol,
         })
     }
 
@@ -502,6 +526,15 @@ impl TangentRk {
         let mm = 2 * self.m;
         let s = self.stages;
         let newton = self.options.newton;
+        // interior stage maps: inexact after an accepted step of the same size
+        let stage_newton = if self.hist_h == h && self.hist_t == t {
+            NewtonSettings {
+                tol: self.stage_tol.max(newton.tol),
+                ..newton
+            }
+        } else {
+            newton
+        };
         let interpolate = self.options.iteration_matrix == IterationMatrix::Interpolated;
         // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
         let centre_ok = self.cur_ok && self.cur_t == t;
@@ -512,7 +545,10 @@ impl TangentRk {
         let npts = self.hist_len;
         let mut ylast_sq = 0.0f64;
         let mut jlast = 0usize;
-        let mut work = AttemptWork::default();
+        let mut work = AttemptWork {
+            end_initial_residual: f64::NAN,
+            ..AttemptWork::default()
+        };
         let mut failure: Option<ChartFailure> = None;
         let mut stage = 0usize;
         self.xi.fill(0.0);
@@ -584,7 +620,7 @@ impl TangentRk {
                     // FSAL: this stage point is the step's end point, whose residual is verified
                     chart.map(sys, y, ti, zplain, x, &newton)
                 } else {
-                    chart.map_predicted(sys, y, ti, zplain, x, &newton)
+                    chart.map_predicted(sys, y, ti, zplain, x, &stage_newton)
                 };
                 if ysq > 0.0 && mapped.is_ok() {
                     zlast.copy_from_slice(zplain);
@@ -648,6 +684,7 @@ impl TangentRk {
                     work.iterations += ms.iterations;
                     work.max_map_iterations = work.max_map_iterations.max(ms.iterations);
                     work.residual = ms.residual;
+                    work.end_initial_residual = ms.initial_residual;
                 }
                 Err(e) => return Err(Attempt::Chart(e)),
             }
@@ -664,7 +701,13 @@ impl TangentRk {
     }
 
     /// Records the accepted attempt's `eta` (a step of size `h` ending at `t_end`).
-    fn commit_history(&mut self, h: f64, t_end: f64) {
+    fn commit_history(&mut self, h: f64, t_end: f64, end_initial_residual: f64) {
+        let (ratio, tol) = (self.options.stage_tol_ratio, self.options.newton.tol);
+        self.stage_tol = if ratio > 0.0 && end_initial_residual.is_finite() {
+            (ratio * end_initial_residual).max(tol)
+        } else {
+            tol
+        };
         let len = self.eta_now.len();
         self.eta_hist.copy_within(0..(HISTORY - 1) * len, len);
         self.eta_hist[..len].copy_from_slice(&self.eta_now);
@@ -692,7 +735,7 @@ impl TangentRk {
         match self.attempt(sys, t, h) {
             Ok(w) => {
                 self.account(&w);
-                self.commit_history(h, t + h);
+                self.commit_history(h, t + h, w.end_initial_residual);
                 std::mem::swap(&mut self.cur, &mut self.xnew);
                 self.cur_t = t + h;
                 self.cur_ok = true;
@@ -822,7 +865,7 @@ impl TangentRk {
                     if en <= 1.0 {
                         std::mem::swap(&mut self.cur, &mut self.xnew);
                         t = if last { t_end } else { t + hs };
-                        self.commit_history(hs, t);
+                        self.commit_history(hs, t, w.end_initial_residual);
                         self.cur_t = t;
                         self.cur_ok = true;
                         st.accepted += 1;

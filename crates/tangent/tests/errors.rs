@@ -120,6 +120,18 @@ fn bad_tableaus_and_options_are_errors() {
             consistency_tol: 1e-20,
             ..Default::default()
         },
+        TangentOptions {
+            stage_tol_ratio: -0.1,
+            ..Default::default()
+        },
+        TangentOptions {
+            stage_tol_ratio: 1.0,
+            ..Default::default()
+        },
+        TangentOptions {
+            stage_tol_ratio: f64::NAN,
+            ..Default::default()
+        },
     ];
     for o in bad {
         let e = TangentRk::new(&sys, ButcherTableau::rk4(), o);
