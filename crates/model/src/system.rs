@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyHandle, BodyRef};
 use crate::error::ModelError;
 use crate::force::{Force, ForceKind};
-use crate::jet::{DirJet, Dual, Frame, HessJet, Scalar, NV};
+use crate::jet::{DirJet, Dual, Frame, HessJet, Scalar, TanJet, NV};
 use crate::joint::{Joint, JointKind};
 use nalgebra::{DMatrix, DVector, Vector2};
 
@@ -506,6 +506,15 @@ impl System {
         }
     }
     #[inline(always)]
+    fn loc_tan(q: &[f64], v: &[f64], i: Option<usize>, slot: usize) -> Frame<TanJet> {
+        match i {
+            Some(i) => Frame::new(std::array::from_fn(|k| {
+                TanJet::var(slot + k, q[3 * i + k], v[3 * i + k])
+            })),
+            None => Frame::fixed(),
+        }
+    }
+    #[inline(always)]
     fn loc_hess(q: &[f64], i: Option<usize>, slot: usize) -> Frame<HessJet> {
         match i {
             Some(i) => Frame::new(std::array::from_fn(|k| {
@@ -615,21 +624,14 @@ impl System {
         out.fill(0.0);
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let qa = Self::loc_hess(q, at.a, 0);
-            let qb = Self::loc_hess(q, at.b, 3);
-            let va = Self::loc_f64(v, at.a);
-            let vb = Self::loc_f64(v, at.b);
-            let vl = [va[0], va[1], va[2], vb[0], vb[1], vb[2]];
-            let mut e = [HessJet::cst(0.0); 3];
+            let qa = Self::loc_tan(q, v, at.a, 0);
+            let qb = Self::loc_tan(q, v, at.b, 3);
+            let mut e = [TanJet::cst(0.0); 3];
             j.eval(&qa, &qb, &mut e);
             let o = self.row_offset[ji];
             for k in 0..j.n_equations() {
                 self.scatter_row(ji, o + k, &e[k].g, phi_q);
-                let mut row = [0.0; NV];
-                for (r, x) in row.iter_mut().enumerate() {
-                    *x = (0..NV).map(|c| e[k].h[r][c] * vl[c]).sum();
-                }
-                self.scatter_row(ji, o + k, &row, out);
+                self.scatter_row(ji, o + k, &e[k].dg, out);
             }
         }
     }

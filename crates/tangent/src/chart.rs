@@ -285,6 +285,16 @@ impl TangentChart {
         self.col(k)
     }
 
+    /// `Phi_q` at the centre (`m x n`), from the last [`TangentChart::centre`].
+    pub fn centre_phi_q(&self) -> &DMatrix<f64> {
+        &self.phi_q
+    }
+
+    /// `(Phi_q v)_q` at the centre (`m x n`), from the last [`TangentChart::centre`].
+    pub fn centre_phi_q_dot_jacobian(&self) -> &DMatrix<f64> {
+        &self.dphi
+    }
+
     /// Entry `(i, j)` of the triangular factor `R` (`2m x 2m`) of `Df(x_c)^T = Q1 R`.
     pub fn r(&self, i: usize, j: usize) -> f64 {
         if i > j {

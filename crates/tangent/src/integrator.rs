@@ -539,6 +539,7 @@ impl TangentRk {
         // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
         let centre_ok = self.cur_ok && self.cur_t == t;
         let quadratic = !sys.is_rheonomic();
+        let scleronomic = quadratic && self.m > 0;
         if !(self.hist_h == h && self.hist_t == t) {
             self.hist_len = 0;
         }
@@ -646,7 +647,23 @@ impl TangentRk {
                     }
                 }
                 let (q, v) = x.split_at(n);
-                acc.solve(sys, q, v, ti, acc_a, lambda)?;
+                if i == 0 && centre_ok && ti == t && scleronomic {
+                    // at the centre: Phi_q and (Phi_q v)_q are the chart's, so
+                    // gamma = -(Phi_q v)_q v needs no model evaluation
+                    sys.forces_into(q, v, ti, &mut acc.forces);
+                    acc.phi_q.copy_from(chart.centre_phi_q());
+                    let dphi = chart.centre_phi_q_dot_jacobian().as_slice();
+                    let m = acc.gamma.len();
+                    acc.gamma.fill(0.0);
+                    for (col, &vk) in dphi.chunks_exact(m.max(1)).zip(v) {
+                        for (gr, &d) in acc.gamma.iter_mut().zip(col) {
+                            *gr -= d * vk;
+                        }
+                    }
+                    acc.finish(sys, ti, acc_a, lambda)?;
+                } else {
+                    acc.solve(sys, q, v, ti, acc_a, lambda)?;
+                }
                 work.rhs_evals += 1;
                 fx[..n].copy_from_slice(v);
                 fx[n..].copy_from_slice(acc_a);
