@@ -58,7 +58,7 @@ pub use file::{ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};
 pub use init::{ConsistentState, ProjectionOptions};
 pub use joint::{Coordinate, Joint, JointKind};
-pub use system::{ForceHandle, JointHandle, System, SystemBuilder};
+pub use system::{AngleCache, ForceHandle, JointHandle, System, SystemBuilder};
 pub use timefn::TimeFunction;
 
 pub use nalgebra;

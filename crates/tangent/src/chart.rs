@@ -1,7 +1,7 @@
 //! The local chart of the constraint manifold at an accepted point (paper B's "local
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
-use mbd_model::System;
+use mbd_model::{AngleCache, System};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -188,6 +188,8 @@ pub struct TangentChart {
     broyden_resets: usize,
     /// The interpolation parameter of the active iteration matrix (0: the centre's).
     s: f64,
+    /// `sin`/`cos` of the body angles of the last residual evaluation of a map.
+    angles: AngleCache,
     /// Relative threshold on the diagonal of `R` below which `Df(x_c)` counts as rank deficient.
     pub singular_tol: f64,
     centred: bool,
@@ -223,6 +225,7 @@ impl TangentChart {
             dphi_e: DMatrix::zeros(m, n),
             e: vec![0.0; mm * mm],
             has_e: false,
+            angles: AngleCache::new(sys),
             rinv: vec![0.0; mm * mm],
             p0: vec![0.0; nn * mm],
             dx: vec![0.0; nn],
@@ -572,6 +575,24 @@ impl TangentChart {
         r
     }
 
+    /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous
+    /// evaluation ([`AngleCache`]: a few ulps from the exact values; the chord's iterates move
+    /// by small angles).
+    fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        let (p, pd) = out[..2 * m].split_at_mut(m);
+        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
+        let mut r = 0.0f64;
+        for &e in out[..2 * m].iter() {
+            if !e.is_finite() {
+                return f64::NAN;
+            }
+            r = r.max(e.abs());
+        }
+        r
+    }
+
     /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
     pub fn point(&self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
         let (nn, mm) = (2 * self.n, 2 * self.m);
@@ -653,7 +674,9 @@ impl TangentChart {
         }
         let nn = 2 * self.n;
         let mut f = std::mem::take(&mut self.f);
-        let res = self.residual(sys, x, t, &mut f);
+        // the first residual of a map is evaluated exactly, the iterates' with rotated sin/cos
+        self.angles.invalidate();
+        let res = self.residual_cached(sys, x, t, &mut f);
         let out = if self.broyden && self.s == 0.0 {
             self.chord_broyden(sys, t, x, newton, &mut f, res, predicted)
         } else {
@@ -746,7 +769,7 @@ impl TangentChart {
                 });
             }
             prev = res;
-            res = self.residual(sys, x, t, f);
+            res = self.residual_cached(sys, x, t, f);
             // stall at the round-off floor (no progress, not slow convergence)
             if res > tol && res <= stall_cap && res >= 0.9 * prev {
                 return Ok(MapStats {
@@ -830,7 +853,7 @@ impl TangentChart {
             }
             prev = res;
             self.fprev.copy_from_slice(f);
-            res = self.residual(sys, x, t, f);
+            res = self.residual_cached(sys, x, t, f);
             if res > tol && res <= stall_cap && res >= 0.9 * prev {
                 return Ok(MapStats {
                     iterations: it,
