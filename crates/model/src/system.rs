@@ -815,30 +815,38 @@ impl System {
         phi_dot: &mut [f64],
         cache: &mut AngleCache,
     ) {
-        const STACK: usize = 16;
         let nb = self.bodies.len();
-        if nb > STACK || cache.entries.len() != nb {
+        if cache.entries.len() != nb {
             self.phi_and_phi_dot(q, v, t, phi, phi_dot);
             return;
         }
-        let fixed = Frame::fixed();
-        let mut frames = [fixed; STACK];
-        for (i, f) in frames.iter_mut().enumerate().take(nb) {
-            let (s, c) = cache.sin_cos(i, q[3 * i + 2]);
-            let w = v[3 * i + 2];
-            *f = Frame {
-                q: std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k])),
-                c: Dual { v: c, d: -s * w },
-                s: Dual { v: s, d: c * w },
-            };
+        for i in 0..nb {
+            cache.sin_cos(i, q[3 * i + 2]);
         }
         cache.valid = true;
+        let entries = &cache.entries;
+        let frame = |i: Option<usize>| -> Frame<Dual> {
+            match i {
+                Some(i) => {
+                    let e = entries[i];
+                    let w = v[3 * i + 2];
+                    Frame {
+                        q: std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k])),
+                        c: Dual {
+                            v: e.c,
+                            d: -e.s * w,
+                        },
+                        s: Dual { v: e.s, d: e.c * w },
+                    }
+                }
+                None => Frame::fixed(),
+            }
+        };
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let fa = at.a.map_or(&fixed, |i| &frames[i]);
-            let fb = at.b.map_or(&fixed, |i| &frames[i]);
+            let (fa, fb) = (frame(at.a), frame(at.b));
             let mut e = [Dual::cst(0.0); 3];
-            j.eval(fa, fb, &mut e);
+            j.eval(&fa, &fb, &mut e);
             let o = self.row_offset[ji];
             for k in 0..j.n_equations() {
                 let tp = j.time_part(k, t);
