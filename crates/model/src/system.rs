@@ -752,6 +752,28 @@ impl System {
         }
     }
 
+    /// Joint `ji`'s rows of `Phi` and `Phidot` from its bodies' frames.
+    #[inline(always)]
+    fn eval_phi_phi_dot(
+        &self,
+        ji: usize,
+        fa: &Frame<Dual>,
+        fb: &Frame<Dual>,
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+    ) {
+        let j = &self.joints[ji];
+        let mut e = [Dual::cst(0.0); 3];
+        j.eval(fa, fb, &mut e);
+        let o = self.row_offset[ji];
+        for k in 0..j.n_equations() {
+            let tp = j.time_part(k, t);
+            phi[o + k] = e[k].v - tp[0];
+            phi_dot[o + k] = e[k].d - tp[1];
+        }
+    }
+
     /// `Phi(q, t)` and the velocity constraint `Phi_q v + Phi_t` in one pass with dual numbers
     /// (no gradients formed): the cheapest evaluation of both constraint levels, e.g. for the
     /// residual of a Newton iteration on the first-order manifold.
@@ -769,15 +791,8 @@ impl System {
             }))
         };
         let fixed = Frame::fixed();
-        let mut eval = |ji: usize, j: &Joint, fa: &Frame<Dual>, fb: &Frame<Dual>| {
-            let mut e = [Dual::cst(0.0); 3];
-            j.eval(fa, fb, &mut e);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                let tp = j.time_part(k, t);
-                phi[o + k] = e[k].v - tp[0];
-                phi_dot[o + k] = e[k].d - tp[1];
-            }
+        let mut eval = |ji: usize, fa: &Frame<Dual>, fb: &Frame<Dual>| {
+            self.eval_phi_phi_dot(ji, fa, fb, t, phi, phi_dot);
         };
         // each body's sin/cos once (not once per joint) for models of up to 16 bodies
         const STACK: usize = 16;
@@ -787,18 +802,18 @@ impl System {
             for (i, f) in frames.iter_mut().enumerate().take(nb) {
                 *f = loc(i);
             }
-            for (ji, j) in self.joints.iter().enumerate() {
+            for ji in 0..self.joints.len() {
                 let at = self.joint_attach[ji];
                 let fa = at.a.map_or(&fixed, |i| &frames[i]);
                 let fb = at.b.map_or(&fixed, |i| &frames[i]);
-                eval(ji, j, fa, fb);
+                eval(ji, fa, fb);
             }
         } else {
-            for (ji, j) in self.joints.iter().enumerate() {
+            for ji in 0..self.joints.len() {
                 let at = self.joint_attach[ji];
                 let fa = at.a.map_or(fixed, loc);
                 let fb = at.b.map_or(fixed, loc);
-                eval(ji, j, &fa, &fb);
+                eval(ji, &fa, &fb);
             }
         }
     }
@@ -842,17 +857,9 @@ impl System {
                 None => Frame::fixed(),
             }
         };
-        for (ji, j) in self.joints.iter().enumerate() {
+        for ji in 0..self.joints.len() {
             let at = self.joint_attach[ji];
-            let (fa, fb) = (frame(at.a), frame(at.b));
-            let mut e = [Dual::cst(0.0); 3];
-            j.eval(&fa, &fb, &mut e);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                let tp = j.time_part(k, t);
-                phi[o + k] = e[k].v - tp[0];
-                phi_dot[o + k] = e[k].d - tp[1];
-            }
+            self.eval_phi_phi_dot(ji, &frame(at.a), &frame(at.b), t, phi, phi_dot);
         }
     }
 

@@ -719,26 +719,8 @@ impl TangentChart {
         let mut prev = f64::INFINITY;
         let mut it = 0;
         loop {
-            if !res.is_finite() {
-                return Err(ChartFailure {
-                    t,
-                    residual: res,
-                    iterations: it,
-                });
-            }
-            if res <= tol {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: res,
-                    initial_residual: res0,
-                });
-            }
-            if it >= newton.max_iter {
-                return Err(ChartFailure {
-                    t,
-                    residual: res,
-                    iterations: it,
-                });
+            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+                return verdict;
             }
             // x <- x - Q1 J^-1 f = x - P0 (I + s K)^-1 f
             if s != 0.0 {
@@ -811,26 +793,8 @@ impl TangentChart {
         // whether `wx` holds `Q1 H f` for the current `f` and `H`
         let mut have_w = false;
         loop {
-            if !res.is_finite() {
-                return Err(ChartFailure {
-                    t,
-                    residual: res,
-                    iterations: it,
-                });
-            }
-            if res <= tol {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: res,
-                    initial_residual: res0,
-                });
-            }
-            if it >= newton.max_iter {
-                return Err(ChartFailure {
-                    t,
-                    residual: res,
-                    iterations: it,
-                });
+            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+                return verdict;
             }
             if !have_w {
                 let p = if self.pb_active { &self.pb } else { &self.p0 };
@@ -938,6 +902,36 @@ impl TangentChart {
     /// `2(n - m)`) of a vector `y` of length `2n`.
     pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
         gemv_t_cols(&self.q, y, out);
+    }
+}
+
+/// The verdict at the head of a chord iteration: failed (residual not finite, or `max_iter`
+/// iterations used), converged (`res <= tol`), or `None` to go on.
+fn loop_head(
+    t: f64,
+    res: f64,
+    res0: f64,
+    it: usize,
+    tol: f64,
+    max_iter: usize,
+) -> Option<Result<MapStats, ChartFailure>> {
+    let failure = || ChartFailure {
+        t,
+        residual: res,
+        iterations: it,
+    };
+    if !res.is_finite() {
+        Some(Err(failure()))
+    } else if res <= tol {
+        Some(Ok(MapStats {
+            iterations: it,
+            residual: res,
+            initial_residual: res0,
+        }))
+    } else if it >= max_iter {
+        Some(Err(failure()))
+    } else {
+        None
     }
 }
 
