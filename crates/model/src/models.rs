@@ -8,6 +8,7 @@ use crate::body::{Body, BodyRef};
 use crate::error::ModelError;
 use crate::joint::Joint;
 use crate::system::{System, SystemBuilder};
+use crate::timefn::TimeFunction;
 use std::f64::consts::FRAC_PI_2;
 
 /// Parameters of an open chain of uniform rods pinned end to end, the first pinned to ground at
@@ -109,14 +110,75 @@ pub fn n_link_chain(n: usize) -> Result<System, ModelError> {
     })
 }
 
+/// Geometry and initial motion of a slider-crank ([`slider_crank_with`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SliderCrankParams {
+    /// Crank length `r` (m; a 1 kg rod pinned to ground at the origin).
+    pub crank: f64,
+    /// Connecting-rod length `l` (m; a 1 kg rod). `r <= l` keeps every crank angle reachable;
+    /// `r = l` has singular configurations.
+    pub rod: f64,
+    /// Initial crank angle (rad).
+    pub angle: f64,
+    /// Initial crank speed (rad/s): the velocity guess, or the driver's speed if `driven`.
+    pub speed: f64,
+    /// Drive the crank at constant `speed` (an angle driver from `angle`: rheonomic, zero
+    /// degrees of freedom).
+    pub driven: bool,
+}
+
+impl Default for SliderCrankParams {
+    /// The project's slider-crank: crank 0.15 m, rod 0.5 m, 45 degrees, 6 rad/s, free.
+    fn default() -> Self {
+        SliderCrankParams {
+            crank: 0.15,
+            rod: 0.5,
+            angle: 45f64.to_radians(),
+            speed: 6.0,
+            driven: false,
+        }
+    }
+}
+
 /// A slider-crank (closed loop): crank 0.15 m (1 kg) pinned to ground at the origin, connecting
 /// rod 0.5 m (1 kg), slider block 0.5 kg on a horizontal prismatic joint through the origin,
 /// gravity -y. Initial crank angle 45 degrees, crank spinning at 6 rad/s (a guess: use
 /// [`System::consistent_state`]).
 pub fn slider_crank() -> Result<System, ModelError> {
-    let (r, l) = (0.15, 0.5);
-    let th = 45f64.to_radians();
+    slider_crank_with(&SliderCrankParams::default())
+}
+
+/// A slider-crank of the given geometry (see [`slider_crank`] for the layout); an error names
+/// the parameter if a length is not positive and finite, the angle or speed is not finite, or
+/// the rod cannot reach the slider's line at the initial angle (`|r sin(angle)| > l`).
+pub fn slider_crank_with(p: &SliderCrankParams) -> Result<System, ModelError> {
+    let bad = |parameter: &'static str, value: f64, reason: &'static str| {
+        Err(ModelError::InvalidParameter {
+            element: "slider-crank".into(),
+            parameter,
+            value,
+            reason,
+        })
+    };
+    let (r, l, th, w) = (p.crank, p.rod, p.angle, p.speed);
+    for (name, v) in [("crank", r), ("rod", l)] {
+        if !(v.is_finite() && v > 0.0) {
+            return bad(name, v, "must be positive and finite");
+        }
+    }
+    for (name, v) in [("angle", th), ("speed", w)] {
+        if !v.is_finite() {
+            return bad(name, v, "must be finite");
+        }
+    }
     let a = [r * th.cos(), r * th.sin()];
+    if a[1].abs() > l {
+        return bad(
+            "rod",
+            l,
+            "shorter than the crank pin's height at the initial angle",
+        );
+    }
     // slider x from the rod length: (xs - ax)^2 + ay^2 = l^2
     let xs = a[0] + (l * l - a[1] * a[1]).sqrt();
     let phi = (-a[1]).atan2(xs - a[0]);
@@ -126,7 +188,7 @@ pub fn slider_crank() -> Result<System, ModelError> {
         Body::new("crank")
             .rod(1.0, r)
             .position(0.5 * a[0], 0.5 * a[1], th)
-            .velocity(-0.5 * r * th.sin() * 6.0, 0.5 * r * th.cos() * 6.0, 6.0),
+            .velocity(-0.5 * r * th.sin() * w, 0.5 * r * th.cos() * w, w),
     );
     let rod = b.add_body(
         Body::new("rod")
@@ -169,6 +231,14 @@ pub fn slider_crank() -> Result<System, ModelError> {
         [1.0, 0.0],
         0.0,
     ));
+    if p.driven {
+        b.add_joint(Joint::angle_driver(
+            "crank_drive",
+            BodyRef::Ground,
+            crank,
+            TimeFunction::linear(th, w),
+        ));
+    }
     b.build()
 }
 

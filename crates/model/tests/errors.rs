@@ -640,3 +640,63 @@ fn io_errors() {
     assert_eq!(System::from_path(&p).unwrap().n_coords(), 3);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn slider_crank_parameters_are_checked() {
+    use mbd_model::models::{slider_crank_with, SliderCrankParams};
+    let base = SliderCrankParams::default();
+    let cases = [
+        (
+            SliderCrankParams {
+                crank: -0.1,
+                ..base
+            },
+            "crank",
+        ),
+        (
+            SliderCrankParams {
+                rod: f64::NAN,
+                ..base
+            },
+            "rod",
+        ),
+        // the rod cannot reach the slider's line: |r sin(angle)| > l
+        (
+            SliderCrankParams {
+                crank: 1.0,
+                rod: 0.5,
+                angle: 1.2,
+                ..base
+            },
+            "rod",
+        ),
+        (
+            SliderCrankParams {
+                angle: f64::INFINITY,
+                ..base
+            },
+            "angle",
+        ),
+        (
+            SliderCrankParams {
+                speed: f64::NAN,
+                ..base
+            },
+            "speed",
+        ),
+    ];
+    for (p, name) in cases {
+        match slider_crank_with(&p) {
+            Err(ModelError::InvalidParameter { parameter, .. }) => assert_eq!(parameter, name),
+            other => panic!("{p:?}: expected InvalidParameter({name}), got {other:?}"),
+        }
+    }
+    let driven = slider_crank_with(&SliderCrankParams {
+        driven: true,
+        ..base
+    })
+    .unwrap();
+    assert!(driven.is_rheonomic());
+    assert_eq!(driven.dof(), 0);
+    assert_eq!(slider_crank_with(&base).unwrap().dof(), 1);
+}

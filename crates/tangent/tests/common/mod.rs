@@ -58,65 +58,12 @@ pub fn fitted_order(h: &[f64], err: &[f64]) -> f64 {
 /// and crank angle `th` (slider on the x-axis through the crank pivot), optionally with the
 /// crank driven at `omega` rad/s (`theta = th + omega t`, no degree of freedom left).
 pub fn slider_crank(r: f64, l: f64, th: f64, driven: Option<f64>) -> System {
-    use mbd_model::{Body, BodyRef, Joint, SystemBuilder, TimeFunction};
-    let a = [r * th.cos(), r * th.sin()];
-    let xs = a[0] + (l * l - a[1] * a[1]).sqrt();
-    let phi = (-a[1]).atan2(xs - a[0]);
-    let mut b = SystemBuilder::new();
-    b.set_gravity([0.0, -9.81]);
-    let crank = b.add_body(
-        Body::new("crank")
-            .rod(1.0, r)
-            .position(0.5 * a[0], 0.5 * a[1], th),
-    );
-    let rod = b.add_body(
-        Body::new("rod")
-            .rod(1.0, l)
-            .position(0.5 * (a[0] + xs), 0.5 * a[1], phi),
-    );
-    let slider = b.add_body(
-        Body::new("slider")
-            .mass(0.5)
-            .inertia(0.01)
-            .position(xs, 0.0, 0.0),
-    );
-    b.add_joint(Joint::revolute(
-        "o",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        crank,
-        [-0.5 * r, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "a",
-        crank,
-        [0.5 * r, 0.0],
-        rod,
-        [-0.5 * l, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "b",
-        rod,
-        [0.5 * l, 0.0],
-        slider,
-        [0.0, 0.0],
-    ));
-    b.add_joint(Joint::prismatic(
-        "s",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        slider,
-        [0.0, 0.0],
-        [1.0, 0.0],
-        0.0,
-    ));
-    if let Some(omega) = driven {
-        b.add_joint(Joint::angle_driver(
-            "d",
-            BodyRef::Ground,
-            crank,
-            TimeFunction::linear(th, omega),
-        ));
-    }
-    b.build().expect("slider-crank")
+    mbd_model::models::slider_crank_with(&mbd_model::models::SliderCrankParams {
+        crank: r,
+        rod: l,
+        angle: th,
+        speed: driven.unwrap_or(0.0),
+        driven: driven.is_some(),
+    })
+    .expect("slider-crank")
 }
