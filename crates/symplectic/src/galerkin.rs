@@ -57,9 +57,8 @@ pub struct Galerkin {
     hist_t: f64,
     hist_h: f64,
     hist_q: Vec<f64>,
-    hist_x: Vec<f64>,
     /// The last `hist_len` converged unknown vectors of consecutive steps with the same `h`,
-    /// newest first (`(MAX_PREDICTOR_ORDER + 1) * dim`).
+    /// newest first (`(MAX_PREDICTOR_ORDER + 1) * dim`); the first is the last step's solution.
     hist_multi: Vec<f64>,
     hist_len: usize,
     /// `phiq[s]` holds `Phi_q` at the end of the last step.
@@ -151,7 +150,6 @@ impl Galerkin {
             hist_t: f64::NAN,
             hist_h: f64::NAN,
             hist_q: vec![0.0; n],
-            hist_x: vec![0.0; dim],
             hist_multi: vec![0.0; (MAX_PREDICTOR_ORDER + 1) * dim],
             hist_len: 0,
             end_phiq_valid: false,
@@ -472,20 +470,20 @@ impl Galerkin {
             // written in displacements from q_k = Q'_s
             for nu in 1..=s {
                 for i in 0..n {
-                    let zs = self.hist_x[(s - 1) * n + i];
+                    let zs = self.hist_multi[(s - 1) * n + i];
                     let mut acc = 0.0;
                     for mu in 0..=s {
                         let zm = if mu == 0 {
                             0.0
                         } else {
-                            self.hist_x[(mu - 1) * n + i]
+                            self.hist_multi[(mu - 1) * n + i]
                         };
                         acc += self.tab.e[(nu - 1) * s1 + mu] * (zm - zs);
                     }
                     self.x[(nu - 1) * n + i] = acc;
                 }
             }
-            self.x[s * n..].copy_from_slice(&self.hist_x[s * n..]);
+            self.x[s * n..].copy_from_slice(&self.hist_multi[s * n..self.dim]);
         } else {
             self.acc.solve(
                 sys,
@@ -780,7 +778,6 @@ impl Integrator for Galerkin {
         self.hist_multi.copy_within(0..keep * dim, dim);
         self.hist_multi[..dim].copy_from_slice(&self.x);
         self.hist_len = keep + 1;
-        self.hist_x.copy_from_slice(&self.x);
         self.hist_q.copy_from_slice(state.q.as_slice());
         self.hist_t = state.t;
         self.hist_h = h;
