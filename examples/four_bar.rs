@@ -30,10 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &mut rk4,
         &sys,
         &mut state,
-        RunConfig {
-            t_end: 5.0,
-            h: 1e-3,
-        },
+        RunConfig::new(5.0, 1e-3),
         &mut obs,
     )?;
     println!("rocker angle range over 5 s: [{:.4}, {:.4}] rad", lo, hi);

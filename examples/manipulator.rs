@@ -26,10 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &mut rk4,
             &sys,
             &mut state,
-            RunConfig {
-                t_end: 20.0,
-                h: 0.01,
-            },
+            RunConfig::new(20.0, 0.01),
             &mut obs,
         )?;
         let m = obs.measures();

@@ -27,10 +27,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &mut rk4,
             &sys,
             &mut state,
-            RunConfig {
-                t_end: 10.0,
-                h: 2e-3,
-            },
+            RunConfig::new(10.0, 2e-3),
             &mut obs,
         )?;
         let m = obs.measures();

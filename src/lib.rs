@@ -25,7 +25,7 @@
 //! let mut state = State::consistent(&sys, 0.0)?;
 //! let mut rk4 = Rk4::new(&sys, Rk4Options::plain())?;
 //! let mut obs = MeasureObserver::new(&sys, false);
-//! run(&mut rk4, &sys, &mut state, RunConfig { t_end: 2.0, h: 0.01 }, &mut obs)?;
+//! run(&mut rk4, &sys, &mut state, RunConfig::new(2.0, 0.01), &mut obs)?;
 //! let m = obs.measures();
 //! assert!(m.e_phi > 1e-12); // plain RK4 drifts off the constraints
 //! # Ok::<(), Box<dyn std::error::Error>>(())

@@ -33,14 +33,7 @@ fn solvers() -> Vec<(&'static str, u32, Make)> {
 
 fn final_q(sys: &System, integ: &mut dyn Integrator, h: f64) -> Vec<f64> {
     let mut s = State::consistent(sys, 0.0).unwrap();
-    run(
-        integ,
-        sys,
-        &mut s,
-        RunConfig { t_end: 2.0, h },
-        &mut NoObserver,
-    )
-    .unwrap();
+    run(integ, sys, &mut s, RunConfig::new(2.0, h), &mut NoObserver).unwrap();
     s.q.as_slice().to_vec()
 }
 

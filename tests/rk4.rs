@@ -12,7 +12,7 @@ fn final_q(sys: &System, h: f64, t_end: f64, opts: Rk4Options) -> Vec<f64> {
         &mut rk,
         sys,
         &mut s,
-        RunConfig { t_end, h },
+        RunConfig::new(t_end, h),
         &mut NoObserver,
     )
     .unwrap();
@@ -57,17 +57,7 @@ fn manipulator_measures(opts: Rk4Options) -> mbd::analysis::RunMeasures {
     let mut s = State::consistent(&sys, 0.0).unwrap();
     let mut rk = Rk4::new(&sys, opts).unwrap();
     let mut obs = MeasureObserver::new(&sys, true);
-    run(
-        &mut rk,
-        &sys,
-        &mut s,
-        RunConfig {
-            t_end: 20.0,
-            h: 0.01,
-        },
-        &mut obs,
-    )
-    .unwrap();
+    run(&mut rk, &sys, &mut s, RunConfig::new(20.0, 0.01), &mut obs).unwrap();
     obs.measures()
 }
 
@@ -114,7 +104,7 @@ fn bad_run_inputs_are_errors() {
             &mut rk,
             &sys,
             &mut s,
-            RunConfig { t_end, h },
+            RunConfig::new(t_end, h),
             &mut NoObserver,
         );
         match r {
@@ -155,7 +145,7 @@ fn run_lands_on_t_end_when_h_does_not_divide() {
         &mut rk,
         &sys,
         &mut s,
-        RunConfig { t_end: 1.0, h: 0.3 },
+        RunConfig::new(1.0, 0.3),
         &mut NoObserver,
     )
     .unwrap();
@@ -182,10 +172,7 @@ fn sparse_and_dense_index1_solves_agree_on_a_chain() {
             &mut rk,
             &sys,
             &mut s,
-            RunConfig {
-                t_end: 0.2,
-                h: 0.002,
-            },
+            RunConfig::new(0.2, 0.002),
             &mut NoObserver,
         )
         .unwrap();

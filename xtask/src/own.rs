@@ -126,7 +126,7 @@ fn solve_to(
         &mut integ,
         sys,
         &mut s,
-        RunConfig { t_end, h },
+        RunConfig::new(t_end, h),
         &mut NoObserver,
     )
     .map_err(|e| format!("{}: {e}", spec.name))?;
@@ -300,10 +300,7 @@ fn long_time(ctx: &Ctx) -> Result<Section, String> {
             &mut integ,
             &sys,
             &mut s,
-            RunConfig {
-                t_end: steps as f64 * h,
-                h,
-            },
+            RunConfig::new(steps as f64 * h, h),
             &mut obs,
         )
         .map_err(|e| format!("{}: {e}", spec.name))?;

@@ -92,7 +92,7 @@ fn measure(
         obs = obs.with_series();
     }
     let t0 = Instant::now();
-    run(&mut integ, sys, &mut s, RunConfig { t_end, h }, &mut obs)
+    run(&mut integ, sys, &mut s, RunConfig::new(t_end, h), &mut obs)
         .map_err(|e| format!("{}: {e}", solver.name()))?;
     let runtime = t0.elapsed().as_secs_f64();
     Ok(RunOut {
@@ -367,7 +367,7 @@ fn order(ctx: &Ctx) -> Result<Section, String> {
                 &mut integ,
                 &sys,
                 &mut s,
-                RunConfig { t_end: 1.0, h },
+                RunConfig::new(1.0, h),
                 &mut NoObserver,
             )
             .map_err(|e| e.to_string())?;

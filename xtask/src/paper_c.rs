@@ -8,6 +8,7 @@ use crate::report::{
 };
 use mbd_analysis::{fit_order, MeasureObserver, RunMeasures};
 use mbd_firefly_gauss::{FaDaeOptions, FaDaeStats, FireflyGauss, RefinedAcceleration};
+use mbd_model::numeric::max_abs;
 use mbd_model::{models, BodyHandle, System};
 use mbd_rk4::{Rk4, Rk4Options};
 use mbd_solve::{
@@ -115,10 +116,6 @@ impl PcObserver {
     }
 }
 
-fn max_abs(x: &[f64]) -> f64 {
-    x.iter().fold(0.0f64, |a, b| a.max(b.abs()))
-}
-
 impl Observer for PcObserver {
     fn observe(&mut self, sys: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
         self.meas.add(sys, s)?;
@@ -170,7 +167,7 @@ fn simulate(
     let mut obs = PcObserver::new(sys, stride);
     let cpu0 = thread_cpu_seconds();
     let t = Instant::now();
-    run(integ, sys, &mut s, RunConfig { t_end, h }, &mut obs)
+    run(integ, sys, &mut s, RunConfig::new(t_end, h), &mut obs)
         .map_err(|e| format!("{} at h = {h}: {e}", integ.name()))?;
     let wall = t.elapsed().as_secs_f64();
     let runtime = match (cpu0, thread_cpu_seconds()) {
@@ -702,7 +699,7 @@ fn orders(ctx: &Ctx) -> Result<Section, String> {
                 &mut fa,
                 &sys,
                 &mut s,
-                RunConfig { t_end, h },
+                RunConfig::new(t_end, h),
                 &mut mbd_solve::NoObserver,
             )
             .map_err(|e| e.to_string())?;

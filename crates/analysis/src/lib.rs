@@ -23,7 +23,7 @@
 //!     let mut s = State::consistent(&sys, 0.0)?;
 //!     let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
 //!     let mut obs = MeasureObserver::new(&sys, true);
-//!     run(&mut rk, &sys, &mut s, RunConfig { t_end: 2.0, h }, &mut obs)?;
+//!     run(&mut rk, &sys, &mut s, RunConfig::new(2.0, h), &mut obs)?;
 //!     errs.push(obs.measures().e_h);
 //! }
 //! let fit = fit_order(&hs, &errs, 1e-14)?;

@@ -1,6 +1,7 @@
 //! Energy and constraint measures (paper C, methods.md section 5), accumulated online.
 
 use crate::error::AnalysisError;
+use mbd_model::numeric::max_abs;
 use mbd_model::System;
 use mbd_solve::{AccelerationSolver, Flow, Observer, SolveError, State};
 use serde::Serialize;
@@ -44,13 +45,6 @@ pub struct MeasureObserver {
 
 /// Index-1 solver with buffers for `a`, `lambda` and the residual.
 type AccelWorkspace = (AccelerationSolver, Vec<f64>, Vec<f64>, Vec<f64>);
-
-fn max_abs(x: &[f64]) -> f64 {
-    x.iter().fold(
-        0.0f64,
-        |a, &b| if b.is_nan() { f64::NAN } else { a.max(b.abs()) },
-    )
-}
 
 impl MeasureObserver {
     /// Accumulates energy and position/velocity constraint errors; with `accelerations`, also the

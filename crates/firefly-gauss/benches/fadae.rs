@@ -18,7 +18,7 @@ fn bench(c: &mut Criterion) {
             &mut fa,
             &sys,
             &mut s,
-            RunConfig { t_end: 0.5, h },
+            RunConfig::new(0.5, h),
             &mut NoObserver,
         )
         .expect("run");
@@ -42,7 +42,7 @@ fn bench(c: &mut Criterion) {
                 &mut fb,
                 &sys,
                 &mut s0,
-                RunConfig { t_end: 0.5, h },
+                RunConfig::new(0.5, h),
                 &mut NoObserver,
             )
             .expect("run");

@@ -44,7 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut ff = FireflyGauss::new(&sys, o)?;
     let mut obs = MeasureObserver::new(&sys, true);
     let t = Instant::now();
-    run(&mut ff, &sys, &mut s, RunConfig { t_end, h }, &mut obs)?;
+    run(&mut ff, &sys, &mut s, RunConfig::new(t_end, h), &mut obs)?;
     let wall = t.elapsed().as_secs_f64();
     let m = obs.measures();
     let st = ff.stats();

@@ -43,7 +43,7 @@
 //! let h0 = sys.energy(state.q.as_slice(), state.v.as_slice());
 //! let mut fa = FireflyGauss::new(&sys, FaDaeOptions::default().seed(7))?;
 //! assert_eq!(fa.partition().independent, vec![2, 5]); // the two link angles
-//! run(&mut fa, &sys, &mut state, RunConfig { t_end: 0.2, h: 0.01 }, &mut NoObserver)?;
+//! run(&mut fa, &sys, &mut state, RunConfig::new(0.2, 0.01), &mut NoObserver)?;
 //!
 //! // all constraint levels hold at round-off at every grid point
 //! let mut phi = vec![0.0; sys.n_constraints()];

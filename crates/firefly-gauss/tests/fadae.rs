@@ -25,7 +25,7 @@ fn run_to(sys: &System, opts: FaDaeOptions, t_end: f64, h: f64) -> (State, Firef
         &mut fa,
         sys,
         &mut s,
-        RunConfig { t_end, h },
+        RunConfig::new(t_end, h),
         &mut NoObserver,
     )
     .expect("run");
@@ -68,17 +68,7 @@ fn closed_loops_keep_constraints_too() {
         let mut s = start(&sys);
         let mut fa = FireflyGauss::new(&sys, FaDaeOptions::polished()).unwrap();
         let mut obs = MeasureObserver::new(&sys, false);
-        run(
-            &mut fa,
-            &sys,
-            &mut s,
-            RunConfig {
-                t_end: 0.2,
-                h: 0.005,
-            },
-            &mut obs,
-        )
-        .unwrap();
+        run(&mut fa, &sys, &mut s, RunConfig::new(0.2, 0.005), &mut obs).unwrap();
         let m = obs.measures();
         assert!(m.e_phi <= 1e-13 && m.e_phidot <= 1e-12, "{m:?}");
         assert!(m.e_h < 1e-4, "{m:?}");
@@ -94,7 +84,7 @@ fn energy_error_is_small_and_falls_with_h() {
             let mut s = start(&sys);
             let mut fa = FireflyGauss::new(&sys, FaDaeOptions::default().polish(polish)).unwrap();
             let mut obs = MeasureObserver::new(&sys, false);
-            run(&mut fa, &sys, &mut s, RunConfig { t_end: 1.0, h }, &mut obs).unwrap();
+            run(&mut fa, &sys, &mut s, RunConfig::new(1.0, h), &mut obs).unwrap();
             e.push(obs.measures().e_h);
         }
     }
@@ -310,17 +300,7 @@ fn missed_target_is_flagged_or_an_error_never_silent() {
     let mut s = start(&sys);
     let mut fa = FireflyGauss::new(&sys, starved.clone()).unwrap();
     let mut obs = MeasureObserver::new(&sys, false);
-    run(
-        &mut fa,
-        &sys,
-        &mut s,
-        RunConfig {
-            t_end: 0.1,
-            h: 0.01,
-        },
-        &mut obs,
-    )
-    .unwrap();
+    run(&mut fa, &sys, &mut s, RunConfig::new(0.1, 0.01), &mut obs).unwrap();
     assert_eq!(fa.stats().target_misses, 10, "{:?}", fa.stats());
     assert!(!fa.last_step().reached_target);
     let m = obs.measures();
@@ -346,15 +326,6 @@ fn missed_target_is_flagged_or_an_error_never_silent() {
     }
     assert_eq!(s, before);
     let mut rec = Recorder::new();
-    let err = run(
-        &mut fa,
-        &sys,
-        &mut s,
-        RunConfig {
-            t_end: 0.1,
-            h: 0.01,
-        },
-        &mut rec,
-    );
+    let err = run(&mut fa, &sys, &mut s, RunConfig::new(0.1, 0.01), &mut rec);
     assert!(matches!(err, Err(SolveError::Newton { .. })), "{err:?}");
 }

@@ -45,9 +45,7 @@ pub struct ConsistentState {
     pub velocity_residual: f64,
 }
 
-fn max_abs(x: &[f64]) -> f64 {
-    x.iter().fold(0.0, |a, &b| a.max(b.abs()))
-}
+use crate::numeric::max_abs;
 
 impl System {
     /// Checks that `Phi_q(q)` has full row rank. On failure returns

@@ -49,6 +49,7 @@ mod init;
 pub mod jet;
 mod joint;
 pub mod models;
+pub mod numeric;
 mod system;
 mod timefn;
 

@@ -18,7 +18,7 @@
 //! let mut state = State::consistent(&sys, 0.0)?;
 //! let h0 = sys.energy(state.q.as_slice(), state.v.as_slice());
 //! let mut rk4 = Rk4::new(&sys, Rk4Options::default())?;
-//! run(&mut rk4, &sys, &mut state, RunConfig { t_end: 1.0, h: 0.001 }, &mut NoObserver)?;
+//! run(&mut rk4, &sys, &mut state, RunConfig::new(1.0, 0.001), &mut NoObserver)?;
 //! let h1 = sys.energy(state.q.as_slice(), state.v.as_slice());
 //! assert!(((h1 - h0) / h0).abs() < 1e-6);
 //! # Ok::<(), mbd_solve::SolveError>(())

@@ -168,6 +168,13 @@ pub struct RunConfig {
     pub h: f64,
 }
 
+impl RunConfig {
+    /// A run to `t_end` with steps of `h` (validated by [`run`]).
+    pub fn new(t_end: f64, h: f64) -> Self {
+        RunConfig { t_end, h }
+    }
+}
+
 /// Summary of a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RunStats {

@@ -39,7 +39,7 @@
 //!     lambda: vec![0.0; sys.n_constraints()],
 //! };
 //! let mut rec = Recorder::new();
-//! let stats = run(&mut integ, &sys, &mut state, RunConfig { t_end: 1.0, h: 0.01 }, &mut rec)?;
+//! let stats = run(&mut integ, &sys, &mut state, RunConfig::new(1.0, 0.01), &mut rec)?;
 //! assert_eq!(stats.steps, 100);
 //! assert_eq!(rec.len(), 101);
 //! assert!((state.t - 1.0).abs() < 1e-15);

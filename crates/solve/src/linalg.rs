@@ -8,6 +8,8 @@ use faer::perm::PermRef;
 use faer::{Mat, MatMut, MatRef, Par};
 use nalgebra::DMatrix;
 
+pub use mbd_model::numeric::{max_abs, max_abs_diff};
+
 /// faer's scratch memory (wrapped for `Debug`).
 struct Scratch(MemBuffer);
 

@@ -1,7 +1,7 @@
 //! Damped Newton's method with an analytic Jacobian on preallocated buffers.
 
 use crate::error::SolveError;
-use crate::linalg::DenseLu;
+use crate::linalg::{max_abs as norm_inf, DenseLu};
 use nalgebra::DMatrix;
 
 /// A square nonlinear system `r(x) = 0`.
@@ -98,13 +98,6 @@ pub struct Newton {
     dx: Vec<f64>,
     xt: Vec<f64>,
     rt: Vec<f64>,
-}
-
-fn norm_inf(x: &[f64]) -> f64 {
-    x.iter().fold(
-        0.0f64,
-        |a, &b| if b.is_nan() { f64::NAN } else { a.max(b.abs()) },
-    )
 }
 
 impl Newton {

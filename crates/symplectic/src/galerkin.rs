@@ -5,7 +5,7 @@ use crate::options::{kappa, Nodes, SymplecticOptions, MAX_PREDICTOR_ORDER};
 use crate::preadjust::Preadjustment;
 use crate::tables::Tables;
 use mbd_model::System;
-use mbd_solve::linalg::DenseCholesky;
+use mbd_solve::linalg::{max_abs as norm_inf, DenseCholesky};
 use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
 use nalgebra::DMatrix;
 
@@ -84,13 +84,6 @@ fn stage_lu(n: usize, m: usize, s: usize) -> SmallLu {
     }
     order.extend(s * n..s * (n + m));
     SmallLu::with_ordering(order.clone(), order)
-}
-
-fn norm_inf(x: &[f64]) -> f64 {
-    x.iter().fold(
-        0.0f64,
-        |a, &b| if b.is_nan() { f64::NAN } else { a.max(b.abs()) },
-    )
 }
 
 impl Galerkin {

@@ -31,7 +31,7 @@
 //! let mut state = State::consistent(&sys, 0.0)?;
 //! let h0 = sys.energy(state.q.as_slice(), state.v.as_slice());
 //! let mut scheme = Galerkin::new(&sys, SymplecticOptions::new(2).with_gamma(1.0))?;
-//! run(&mut scheme, &sys, &mut state, RunConfig { t_end: 1.0, h: 0.01 }, &mut NoObserver)?;
+//! run(&mut scheme, &sys, &mut state, RunConfig::new(1.0, 0.01), &mut NoObserver)?;
 //! let mut phi = vec![0.0; sys.n_constraints()];
 //! sys.phi(state.q.as_slice(), state.t, &mut phi);
 //! assert!(phi.iter().all(|r| r.abs() < 1e-12));

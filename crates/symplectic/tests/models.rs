@@ -226,10 +226,7 @@ fn predictor_history_survives_the_run_loop() {
         &mut g,
         &sys,
         &mut st,
-        RunConfig {
-            t_end: 1.0,
-            h: 0.01,
-        },
+        RunConfig::new(1.0, 0.01),
         &mut NoObserver,
     )
     .unwrap();
@@ -259,10 +256,7 @@ fn multistep_predictor_saves_iterations_not_accuracy() {
                 &mut g,
                 &sys,
                 &mut st,
-                RunConfig {
-                    t_end: 2.0,
-                    h: 0.01,
-                },
+                RunConfig::new(2.0, 0.01),
                 &mut NoObserver,
             )
             .unwrap();

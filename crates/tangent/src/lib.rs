@@ -33,7 +33,7 @@
 //! let sys = models::slider_crank()?;
 //! let mut state = State::consistent(&sys, 0.0)?;
 //! let mut rk4 = TangentRk::rk4(&sys)?;
-//! run(&mut rk4, &sys, &mut state, RunConfig { t_end: 1.0, h: 1e-3 }, &mut NoObserver)?;
+//! run(&mut rk4, &sys, &mut state, RunConfig::new(1.0, 1e-3), &mut NoObserver)?;
 //! // constraints at the Newton tolerance after 1000 steps
 //! let mut phi = vec![0.0; sys.n_constraints()];
 //! let mut phid = vec![0.0; sys.n_constraints()];

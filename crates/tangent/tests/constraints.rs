@@ -13,10 +13,7 @@ fn long_run(sys: &System, h: f64, steps: usize) -> (ResidualWatch, f64) {
     let h0 = sys.energy(state.q.as_slice(), state.v.as_slice());
     let mut rk = TangentRk::rk4(sys).expect("solver");
     let mut watch = ResidualWatch::default();
-    let cfg = RunConfig {
-        t_end: h * steps as f64,
-        h,
-    };
+    let cfg = RunConfig::new(h * steps as f64, h);
     let stats = run(&mut rk, sys, &mut state, cfg, &mut watch).expect("run");
     assert_eq!(stats.steps, steps);
     assert_eq!(watch.samples, steps + 1);

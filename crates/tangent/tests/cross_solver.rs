@@ -26,7 +26,7 @@ fn tangent_rk4_agrees_with_projected_rk4_at_2s() {
             &mut tg,
             &sys,
             &mut a,
-            RunConfig { t_end: 2.0, h },
+            RunConfig::new(2.0, h),
             &mut NoObserver,
         )
         .expect("run");
@@ -40,7 +40,7 @@ fn tangent_rk4_agrees_with_projected_rk4_at_2s() {
             &mut pr,
             &sys,
             &mut b,
-            RunConfig { t_end: 2.0, h },
+            RunConfig::new(2.0, h),
             &mut NoObserver,
         )
         .expect("run");

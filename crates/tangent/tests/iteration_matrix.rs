@@ -36,10 +36,7 @@ fn centre_interpolated_and_broyden_matrices_agree() {
                 &mut rk,
                 &sys,
                 &mut s,
-                RunConfig {
-                    t_end: 1.0,
-                    h: 0.01,
-                },
+                RunConfig::new(1.0, 0.01),
                 &mut NoObserver,
             )
             .expect("run");

@@ -26,7 +26,7 @@ fn errors(sys: &System, tableau: &ButcherTableau, ns: &[usize]) -> (Vec<f64>, Ve
             &mut rk,
             sys,
             &mut s,
-            RunConfig { t_end: 1.0, h },
+            RunConfig::new(1.0, h),
             &mut NoObserver,
         )
         .expect("run");

@@ -61,10 +61,7 @@ fn driven_angle_and_its_rate_hold_at_every_step() {
         &mut rk,
         &sys,
         &mut state,
-        RunConfig {
-            t_end: 4.0,
-            h: 1e-3,
-        },
+        RunConfig::new(4.0, 1e-3),
         &mut obs,
     )
     .expect("run");
@@ -94,7 +91,7 @@ fn driven_system_converges_with_order_4() {
             &mut rk,
             &sys,
             &mut s,
-            RunConfig { t_end: 1.0, h },
+            RunConfig::new(1.0, h),
             &mut NoObserver,
         )
         .expect("run");
@@ -129,10 +126,7 @@ fn fully_driven_slider_crank_follows_exact_kinematics() {
         &mut rk,
         &sys,
         &mut state,
-        RunConfig {
-            t_end: 2.0,
-            h: 0.01,
-        },
+        RunConfig::new(2.0, 0.01),
         &mut obs,
     )
     .expect("run");

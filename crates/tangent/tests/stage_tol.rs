@@ -41,7 +41,7 @@ fn inexact_stage_maps_save_iterations_not_accuracy() {
                 &mut rk,
                 &sys,
                 &mut s,
-                RunConfig { t_end, h },
+                RunConfig::new(t_end, h),
                 &mut NoObserver,
             )
             .expect("run");
