@@ -13,6 +13,29 @@ pub enum ModelError {
         /// The name (or handle) that could not be resolved.
         body: String,
     },
+    /// A body's rotational inertia is negligible against its mass times the square of a lever
+    /// arm: the constraint matrix would be singular in double precision.
+    #[error(
+        "body '{body}': inertia {inertia:e} is negligible against mass x lever arm^2 = \
+         {mass:e} x {lever:e}^2 (joint '{joint}'), a ratio of {ratio:.1e} (limit 1e12): the \
+         mass matrix's scale would make the constraint matrix singular in double precision; \
+         give the body its real moment of inertia (a slender rod of mass m and length l has \
+         m l^2 / 12)"
+    )]
+    NegligibleInertia {
+        /// The body.
+        body: String,
+        /// Its inertia.
+        inertia: f64,
+        /// Its mass.
+        mass: f64,
+        /// The joint whose point is far from the centre of mass.
+        joint: String,
+        /// The distance of that point from the centre of mass.
+        lever: f64,
+        /// `mass * lever^2 / inertia`.
+        ratio: f64,
+    },
     /// Two bodies, joints or forces share a name.
     #[error("duplicate {kind} name '{name}'")]
     DuplicateName {

@@ -50,6 +50,7 @@ pub mod jet;
 mod joint;
 pub mod models;
 pub mod numeric;
+mod scale;
 mod system;
 mod timefn;
 
@@ -59,6 +60,7 @@ pub use file::{ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};
 pub use init::{ConsistentState, ProjectionOptions};
 pub use joint::{Coordinate, Joint, JointKind};
+pub use scale::MAX_INERTIA_RATIO;
 pub use system::{AngleCache, ForceHandle, JointHandle, System, SystemBuilder};
 pub use timefn::TimeFunction;
 

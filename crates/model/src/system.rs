@@ -410,6 +410,7 @@ impl System {
             inv_mass,
             eq_joint,
         };
+        sys.check_inertia_scale()?;
         let (q0, _) = sys.initial_guess();
         sys.check_rank(q0.as_slice(), 0.0)?;
         Ok(sys)

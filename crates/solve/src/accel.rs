@@ -43,6 +43,18 @@ impl AccelerationSolver {
         }
     }
 
+    /// The condition estimate of the last factored `S = Phi_q M^-1 Phi_q^T` after diagonal
+    /// equilibration (see [`crate::linalg::DenseCholesky::condition_estimate`]): about 1 for
+    /// well-separated constraints, growing like the inverse square distance to a singular
+    /// configuration. 1 for an unconstrained system, 0 before the first solve.
+    pub fn condition_estimate(&self) -> f64 {
+        if self.m == 0 {
+            1.0
+        } else {
+            self.chol.condition_estimate()
+        }
+    }
+
     /// Solves for the accelerations `a` (length n) and multipliers `lambda` (length m) at
     /// `(q, v, t)`.
     pub fn solve(

@@ -66,6 +66,27 @@ pub enum SolveError {
         /// Given length.
         got: usize,
     },
+    /// The constraints drifted beyond the run's drift guard.
+    #[error(
+        "constraint drift at t = {t}: {level} residual of {equation} (joint '{joint}') is \
+         {residual:e}, beyond the drift guard's {tolerance:e}; the solver has left the \
+         constraint manifold: take a smaller step, use a solver that keeps the constraints \
+         (projection, symplectic, tangent), or relax RunConfig::drift_guard"
+    )]
+    ConstraintDrift {
+        /// Time at the end of the step.
+        t: f64,
+        /// `"position"` (`Phi`) or `"velocity"` (`Phi_q v + Phi_t`).
+        level: &'static str,
+        /// The equation with the largest residual relative to its tolerance, e.g. `"pin2.x"`.
+        equation: String,
+        /// Its joint.
+        joint: String,
+        /// Its residual.
+        residual: f64,
+        /// Its tolerance.
+        tolerance: f64,
+    },
     /// The state became NaN or infinite.
     #[error("non-finite {what} at t = {t}")]
     NonFinite {

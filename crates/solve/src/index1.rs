@@ -46,6 +46,14 @@ enum Accel {
 }
 
 impl Accel {
+    /// Condition estimate of the last index-1 matrix (0 where not estimated: sparse path).
+    fn condition(&self) -> f64 {
+        match self {
+            Accel::Dense(acc) => acc.condition_estimate(),
+            Accel::Sparse(_) => 0.0,
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn stage(
         &mut self,
@@ -195,9 +203,11 @@ impl Integrator for Index1Rk {
         let (a, lambda, phi, phid) = (&mut self.a, &mut self.lambda, &mut self.phi, &mut self.phid);
         let baum = self.options.baumgarte;
         let mut evals = 0;
+        let mut condition = 0.0f64;
         let mut f = |t: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
             let (q, v) = y.split_at(n);
             acc.stage(sys, q, v, t, baum, phi, phid, a, lambda)?;
+            condition = condition.max(acc.condition());
             dy[..n].copy_from_slice(v);
             dy[n..].copy_from_slice(a);
             evals += 1;
@@ -209,6 +219,7 @@ impl Integrator for Index1Rk {
         state.t += h;
         let mut stats = StepStats {
             rhs_evals: evals,
+            condition,
             ..Default::default()
         };
         if let Some(p) = &mut self.projector {

@@ -15,6 +15,10 @@ pub struct StepStats {
     pub rhs_evals: usize,
     /// Objective evaluations (optimisation-based solvers).
     pub objective_evals: usize,
+    /// Largest condition estimate of the index-1 matrix `Phi_q M^-1 Phi_q^T` met in the step
+    /// (after diagonal equilibration; see [`crate::AccelerationSolver::condition_estimate`]);
+    /// 0 when the solver does not estimate it.
+    pub condition: f64,
 }
 
 /// A one-step method for the constrained equations of motion.
@@ -159,19 +163,108 @@ impl Observer for Recorder {
     }
 }
 
-/// Time span and step size of a fixed-step run.
+/// The constraint-drift guard of [`run`]: after every step the constraint residuals are
+/// checked, and a run whose constraints have drifted stops with
+/// [`SolveError::ConstraintDrift`] naming the time, the equation and its joint.
+///
+/// Position residuals are compared equation by equation with `position_tol` times the
+/// equation's scale ([`System::equation_scale`]: the mechanism's length scale for equations in
+/// lengths, 1 rad for angle equations). The default, `1e-3`, stops a run whose joints have come
+/// apart by 0.1% of the mechanism's size: far beyond any solver's tolerance, so it never fires on
+/// a healthy run, but it stops a solver that has left the constraint manifold (plain RK4 past a
+/// singular configuration) long before its numbers become meaningless. Velocity residuals
+/// `Phi_q v + Phi_t` are checked only if `velocity_tol` is set (absolute, in the equation's unit
+/// per second). Turn the guard off ([`RunConfig::without_drift_guard`]) to measure drift itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriftGuard {
+    /// Largest accepted `|Phi_i|`, relative to the equation's scale (default `1e-3`).
+    pub position_tol: f64,
+    /// Largest accepted `|Phi_q v + Phi_t|_i` (absolute); `None` (default) = not checked.
+    pub velocity_tol: Option<f64>,
+}
+
+impl Default for DriftGuard {
+    fn default() -> Self {
+        DriftGuard {
+            position_tol: DriftGuard::DEFAULT_POSITION_TOL,
+            velocity_tol: None,
+        }
+    }
+}
+
+impl DriftGuard {
+    /// The default relative position tolerance.
+    pub const DEFAULT_POSITION_TOL: f64 = 1e-3;
+
+    fn validate(&self) -> Result<(), SolveError> {
+        if !(self.position_tol.is_finite() && self.position_tol > 0.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "drift_guard.position_tol",
+                value: self.position_tol,
+                reason: "must be positive and finite",
+            });
+        }
+        if let Some(v) = self.velocity_tol {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(SolveError::InvalidParameter {
+                    parameter: "drift_guard.velocity_tol",
+                    value: v,
+                    reason: "must be positive and finite",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Time span, step size and safety settings of a fixed-step run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RunConfig {
     /// End time (the start is the state's time).
     pub t_end: f64,
     /// Step size.
     pub h: f64,
+    /// The constraint-drift guard (default [`DriftGuard::default`]; `None` = off).
+    pub drift_guard: Option<DriftGuard>,
+    /// Steps whose index-1 condition estimate ([`StepStats::condition`]) exceeds this are
+    /// counted in [`RunStats::near_singular_steps`] (default [`RunConfig::DEFAULT_CONDITION_LIMIT`]).
+    pub condition_limit: f64,
 }
 
 impl RunConfig {
-    /// A run to `t_end` with steps of `h` (validated by [`run`]).
+    /// The default of [`RunConfig::condition_limit`]: `1e8`, half of double precision's digits.
+    /// Passing a singular configuration of a four-bar at `h = 1e-4` lands within about `1e-4`
+    /// of it, where the estimate is about `1e8`.
+    pub const DEFAULT_CONDITION_LIMIT: f64 = 1e8;
+
+    /// A run to `t_end` with steps of `h` (validated by [`run`]), with the default drift guard
+    /// and condition limit.
     pub fn new(t_end: f64, h: f64) -> Self {
-        RunConfig { t_end, h }
+        RunConfig {
+            t_end,
+            h,
+            drift_guard: Some(DriftGuard::default()),
+            condition_limit: Self::DEFAULT_CONDITION_LIMIT,
+        }
+    }
+
+    /// The same run with the given drift guard.
+    pub fn with_drift_guard(mut self, guard: DriftGuard) -> Self {
+        self.drift_guard = Some(guard);
+        self
+    }
+
+    /// The same run without the drift guard (to measure drift itself, as the papers' RK4 tables
+    /// do).
+    pub fn without_drift_guard(mut self) -> Self {
+        self.drift_guard = None;
+        self
+    }
+
+    /// The same run with another condition limit.
+    pub fn with_condition_limit(mut self, limit: f64) -> Self {
+        self.condition_limit = limit;
+        self
     }
 }
 
@@ -190,6 +283,28 @@ pub struct RunStats {
     pub max_residual: f64,
     /// Whether an observer stopped the run early.
     pub stopped_early: bool,
+    /// Steps whose index-1 condition estimate exceeded [`RunConfig::condition_limit`]: the run
+    /// passed close to a singular configuration, where accelerations and multipliers lose
+    /// digits (see [`RunStats::warning`]).
+    pub near_singular_steps: usize,
+    /// Time at the end of the first such step.
+    pub first_near_singular: Option<f64>,
+    /// Largest condition estimate met (0 if the solver does not estimate it).
+    pub max_condition: f64,
+}
+
+impl RunStats {
+    /// A warning to show the user when the run passed near a singular configuration, `None`
+    /// otherwise.
+    pub fn warning(&self) -> Option<String> {
+        let t = self.first_near_singular?;
+        Some(format!(
+            "{} step(s) passed near a singular configuration (index-1 condition estimate up to \
+             {:.1e}, first at t = {t}): accelerations and multipliers there may have lost digits; \
+             check the mechanism's geometry or take a smaller step",
+            self.near_singular_steps, self.max_condition
+        ))
+    }
 }
 
 /// The number of steps and the size of each for a run from `t0` to `t_end` with nominal step
@@ -234,10 +349,84 @@ pub fn step_count(t0: f64, t_end: f64, h: f64) -> Result<usize, SolveError> {
     Ok(n as usize)
 }
 
+/// The guard's workspace: one residual buffer, allocated once per run.
+struct GuardState {
+    guard: DriftGuard,
+    scale: Vec<f64>,
+    buf: Vec<f64>,
+}
+
+impl GuardState {
+    fn new(sys: &System, guard: DriftGuard) -> Self {
+        let m = sys.n_constraints();
+        GuardState {
+            guard,
+            scale: (0..m).map(|r| sys.equation_scale(r)).collect(),
+            buf: vec![0.0; m],
+        }
+    }
+
+    fn check(&mut self, sys: &System, state: &State) -> Result<(), SolveError> {
+        let (q, v, t) = (state.q.as_slice(), state.v.as_slice(), state.t);
+        sys.phi(q, t, &mut self.buf);
+        self.worst("position", self.guard.position_tol, true, sys, t)?;
+        if let Some(tol) = self.guard.velocity_tol {
+            sys.phi_dot(q, v, t, &mut self.buf);
+            self.worst("velocity", tol, false, sys, t)?;
+        }
+        Ok(())
+    }
+
+    /// Errors with the equation whose residual is largest relative to its limit, if that one
+    /// is over its limit (or NaN).
+    fn worst(
+        &self,
+        level: &'static str,
+        tol: f64,
+        relative: bool,
+        sys: &System,
+        t: f64,
+    ) -> Result<(), SolveError> {
+        let limit = |r: usize| if relative { tol * self.scale[r] } else { tol };
+        let mut worst = (0usize, 0.0f64);
+        for (r, &x) in self.buf.iter().enumerate() {
+            let ratio = x.abs() / limit(r);
+            if ratio.is_nan() {
+                worst = (r, f64::NAN);
+                break;
+            }
+            if ratio > worst.1 {
+                worst = (r, ratio);
+            }
+        }
+        let (row, ratio) = worst;
+        if ratio <= 1.0 {
+            return Ok(());
+        }
+        let joint = sys
+            .equation_joint(row)
+            .map(|j| sys.joints()[j.0].name.clone())
+            .unwrap_or_default();
+        Err(SolveError::ConstraintDrift {
+            t,
+            level,
+            equation: sys.equation_name(row),
+            joint,
+            residual: self.buf[row].abs(),
+            tolerance: limit(row),
+        })
+    }
+}
+
 /// Integrates from `state.t` to `cfg.t_end` with steps of `cfg.h`, calling `observer` with the
-/// initial state (step 0) and after every step. Times are set to `t0 + k h` after each step, so
-/// they do not accumulate round-off; the last step is shortened if `h` does not divide the
-/// interval. A non-finite state after a step is an error.
+/// initial state (step 0) and after every step.
+///
+/// Every step but the last is given exactly the nominal `cfg.h` (solvers that keep a history
+/// see one step size); the last step is shortened if `h` does not divide the interval. Times
+/// are set to `t0 + k h` after each step, so they do not accumulate round-off. A non-finite
+/// state after a step is an error; so is constraint drift beyond `cfg.drift_guard`
+/// ([`SolveError::ConstraintDrift`]). Steps that pass near a singular configuration are
+/// counted in [`RunStats::near_singular_steps`].
 pub fn run<I, O>(
     integrator: &mut I,
     sys: &System,
@@ -250,6 +439,20 @@ where
     O: Observer + ?Sized,
 {
     state.check(sys)?;
+    if !(cfg.condition_limit > 0.0) {
+        return Err(SolveError::InvalidParameter {
+            parameter: "condition_limit",
+            value: cfg.condition_limit,
+            reason: "must be positive (infinity turns the count off)",
+        });
+    }
+    let mut guard = match cfg.drift_guard {
+        Some(g) => {
+            g.validate()?;
+            Some(GuardState::new(sys, g))
+        }
+        None => None,
+    };
     let t0 = state.t;
     let n = step_count(t0, cfg.t_end, cfg.h)?;
     integrator.reset();
@@ -259,12 +462,11 @@ where
         return Ok(stats);
     }
     for k in 1..=n {
-        let t_next = if k == n {
-            cfg.t_end
+        let (t_next, h) = if k == n {
+            (cfg.t_end, cfg.t_end - state.t)
         } else {
-            t0 + k as f64 * cfg.h
+            (t0 + k as f64 * cfg.h, cfg.h)
         };
-        let h = t_next - state.t;
         let s = integrator.step(sys, state, h)?;
         state.t = t_next;
         if !state.is_finite() {
@@ -273,11 +475,19 @@ where
                 what: "state after step",
             });
         }
+        if let Some(g) = guard.as_mut() {
+            g.check(sys, state)?;
+        }
         stats.steps = k;
         stats.newton_iterations += s.newton_iterations;
         stats.rhs_evals += s.rhs_evals;
         stats.objective_evals += s.objective_evals;
         stats.max_residual = stats.max_residual.max(s.residual);
+        stats.max_condition = stats.max_condition.max(s.condition);
+        if s.condition > cfg.condition_limit {
+            stats.near_singular_steps += 1;
+            stats.first_near_singular.get_or_insert(state.t);
+        }
         if observer.observe(sys, state, k)? == Flow::Stop {
             stats.stopped_early = true;
             break;

@@ -68,8 +68,8 @@ pub use index1::{
     SPARSE_THRESHOLD,
 };
 pub use integrator::{
-    run, step_count, Every, Flow, Integrator, NoObserver, Observer, Recorder, RunConfig, RunStats,
-    StepStats,
+    run, step_count, DriftGuard, Every, Flow, Integrator, NoObserver, Observer, Recorder,
+    RunConfig, RunStats, StepStats,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use projection::{ProjectionSettings, ProjectionStats, Projector};

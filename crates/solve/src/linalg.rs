@@ -139,9 +139,22 @@ pub struct DenseCholesky {
     m: usize,
     /// Column-major `m x m` storage: the matrix, then its factor.
     a: Vec<f64>,
+    /// The matrix's diagonal before the last factorisation.
+    diag: Vec<f64>,
+    /// `max_j A_jj / L_jj^2` of the last factorisation.
+    condition: f64,
     mem: Scratch,
     factored: bool,
 }
+
+/// Smallest accepted pivot of [`DenseCholesky`], relative to the matrix's own diagonal entry:
+/// `L_jj^2 >= CHOLESKY_PIVOT_TOL * A_jj`. The ratio `L_jj^2 / A_jj` is the part of row `j`
+/// that the earlier rows do not explain (for `S = Phi_q M^-1 Phi_q^T`: the squared sine of the
+/// angle, in the `M^-1` metric, between constraint gradient `j` and the span of the earlier
+/// ones). It does not change when rows and columns are scaled (`D A D`), so badly scaled but
+/// well-posed mechanisms (millimetre parts beside tonne masses) pass, while dependent
+/// constraints or a singular configuration (the ratio at round-off level) fail.
+pub const CHOLESKY_PIVOT_TOL: f64 = 1e-14;
 
 impl DenseCholesky {
     /// Workspace for `m x m` matrices.
@@ -153,9 +166,19 @@ impl DenseCholesky {
         DenseCholesky {
             m,
             a: vec![0.0; m * m],
+            diag: vec![0.0; m],
+            condition: 0.0,
             mem: Scratch(MemBuffer::new(req)),
             factored: false,
         }
+    }
+
+    /// A cheap condition estimate of the last factored matrix after symmetric diagonal
+    /// equilibration: `max_j A_jj / L_jj^2` (>= 1; a lower bound of the condition number of
+    /// `D^-1/2 A D^-1/2`, `D = diag(A)`, that grows like the inverse square distance to a
+    /// singular configuration). 0 before the first factorisation, infinite after a failed one.
+    pub fn condition_estimate(&self) -> f64 {
+        self.condition
     }
 
     /// Dimension.
@@ -194,16 +217,25 @@ impl DenseCholesky {
     }
 
     /// Factors the matrix written through [`DenseCholesky::matrix_mut`] or
-    /// [`DenseCholesky::add_rank_one`]. A matrix whose smallest pivot of `L` is below `1e-7`
-    /// times the largest (condition of `S` beyond ~1e14) counts as not positive definite: for the
+    /// [`DenseCholesky::add_rank_one`]. A pivot below [`CHOLESKY_PIVOT_TOL`] times its own
+    /// diagonal entry (a scale-invariant test) counts as not positive definite: for the
     /// constraint matrix `Phi_q M^-1 Phi_q^T` that means redundant constraints or a singular
-    /// configuration.
+    /// configuration. Also sets [`DenseCholesky::condition_estimate`].
     pub fn factor_in_place(&mut self) -> Result<(), FactorError> {
         self.factored = false;
         let m = self.m;
         if m == 0 {
             self.factored = true;
+            self.condition = 1.0;
             return Ok(());
+        }
+        self.condition = f64::INFINITY;
+        for j in 0..m {
+            let d = self.a[j + j * m];
+            if !(d > 0.0 && d.is_finite()) {
+                return Err(FactorError::NotPositiveDefinite(j));
+            }
+            self.diag[j] = d;
         }
         if m <= SMALL_CHOLESKY {
             let a = &mut self.a;
@@ -242,20 +274,16 @@ impl DenseCholesky {
                 return Err(FactorError::NotPositiveDefinite(index));
             }
         }
-        let mut dmax = 0.0f64;
-        let mut dmin = f64::INFINITY;
-        let mut imin = 0;
+        let mut worst = 0.0f64;
         for i in 0..m {
-            let d = self.a[i + i * m].abs();
-            dmax = dmax.max(d);
-            if d < dmin {
-                dmin = d;
-                imin = i;
+            let l = self.a[i + i * m];
+            let ratio = self.diag[i] / (l * l);
+            if !(ratio * CHOLESKY_PIVOT_TOL <= 1.0) {
+                return Err(FactorError::NotPositiveDefinite(i));
             }
+            worst = worst.max(ratio);
         }
-        if !(dmin > 1e-7 * dmax) {
-            return Err(FactorError::NotPositiveDefinite(imin));
-        }
+        self.condition = worst;
         self.factored = true;
         Ok(())
     }
@@ -334,6 +362,45 @@ mod tests {
             a[(1, 1)] = 1.0;
         }
         assert!(c.factor_in_place().is_err());
+    }
+
+    fn factor_2x2(c: &mut DenseCholesky, a: [[f64; 2]; 2]) -> Result<(), FactorError> {
+        {
+            let mut m = c.matrix_mut();
+            for i in 0..2 {
+                for j in 0..2 {
+                    m[(i, j)] = a[i][j];
+                }
+            }
+        }
+        c.factor_in_place()
+    }
+
+    #[test]
+    fn cholesky_pivot_test_and_condition_are_scale_invariant() {
+        // [[1, 0.5], [0.5, 1]] scaled by D = diag(1e-8, 1e8): the old test (pivots relative to
+        // the largest pivot) called this singular; the matrix is perfectly conditioned after
+        // equilibration.
+        let mut c = DenseCholesky::new(2);
+        factor_2x2(&mut c, [[1.0, 0.5], [0.5, 1.0]]).unwrap();
+        let k0 = c.condition_estimate();
+        assert!((k0 - 4.0 / 3.0).abs() < 1e-12, "{k0}");
+        let (d0, d1) = (1e-8, 1e8);
+        factor_2x2(&mut c, [[d0 * d0, 0.5 * d0 * d1], [0.5 * d0 * d1, d1 * d1]]).unwrap();
+        assert!((c.condition_estimate() - k0).abs() < 1e-10);
+        // nearly dependent rows: the estimate grows like 1 / (1 - c^2)
+        let eps = 1e-5;
+        factor_2x2(&mut c, [[1.0, 1.0 - eps], [1.0 - eps, 1.0]]).unwrap();
+        let k = c.condition_estimate();
+        assert!(k > 0.4 / eps && k < 0.6 / eps, "{k}");
+        // dependent to round-off: an error at any scale, and the estimate says so
+        for scale in [1e-12, 1.0, 1e12] {
+            let r = factor_2x2(&mut c, [[scale, scale], [scale, scale * (1.0 + 1e-16)]]);
+            assert_eq!(r, Err(FactorError::NotPositiveDefinite(1)), "scale {scale}");
+            assert!(c.condition_estimate().is_infinite());
+        }
+        // NaN on the diagonal
+        assert!(factor_2x2(&mut c, [[f64::NAN, 0.0], [0.0, 1.0]]).is_err());
     }
 
     #[test]

@@ -634,6 +634,7 @@ impl Galerkin {
             residual: res,
             rhs_evals: evals,
             objective_evals: 0,
+            ..Default::default()
         })
     }
 }

@@ -1,0 +1,102 @@
+//! Scales of a mechanism: its characteristic length, the natural unit of each constraint
+//! equation, and the build-time check that no body's inertia is negligible against its mass.
+
+use crate::error::ModelError;
+use crate::joint::JointKind;
+use crate::system::System;
+
+/// `m r^2 / J` above which a body's rotational inertia counts as negligible (see
+/// [`ModelError::NegligibleInertia`]). The Schur complement `Phi_q M^-1 Phi_q^T` of a body pinned
+/// at lever arm `r` has condition about `1 + m r^2 / J`; beyond `1e12` an index-1 solve keeps at
+/// most four significant digits, and near `1e14` every solver reports a singular matrix.
+pub const MAX_INERTIA_RATIO: f64 = 1e12;
+
+fn norm(p: [f64; 2]) -> f64 {
+    p[0].hypot(p[1])
+}
+
+impl System {
+    /// Body points of joint `j` as `(body index, lever arm from the centre of mass)` pairs.
+    fn joint_lever_arms(&self, ji: usize) -> [(Option<usize>, f64); 2] {
+        let at = self.joint_attach[ji];
+        match &self.joints[ji].kind {
+            JointKind::Revolute { pa, pb, .. }
+            | JointKind::Prismatic { pa, pb, .. }
+            | JointKind::Weld { pa, pb, .. }
+            | JointKind::Distance { pa, pb, .. } => [(at.a, norm(*pa)), (at.b, norm(*pb))],
+            JointKind::Absolute {
+                point, coordinate, ..
+            } => match coordinate {
+                crate::Coordinate::Angle => [(None, 0.0), (None, 0.0)],
+                _ => [(at.a, norm(*point)), (None, 0.0)],
+            },
+            JointKind::AngleDriver { .. } => [(None, 0.0), (None, 0.0)],
+        }
+    }
+
+    /// The mechanism's characteristic length: the largest lever arm of a joint point on a body
+    /// (distance from the body's centre of mass), distance-joint length or radius of gyration
+    /// `sqrt(J / m)`; 1 if all of them are zero. Used to scale constraint tolerances (e.g. the
+    /// run loop's drift guard) so that they mean the same for a watch mechanism and a crane.
+    pub fn length_scale(&self) -> f64 {
+        let mut l = 0.0f64;
+        for ji in 0..self.joints.len() {
+            for (body, r) in self.joint_lever_arms(ji) {
+                if body.is_some() {
+                    l = l.max(r);
+                }
+            }
+            if let JointKind::Distance { length, .. } = self.joints[ji].kind {
+                l = l.max(length);
+            }
+        }
+        for b in &self.bodies {
+            l = l.max((b.inertia / b.mass).sqrt());
+        }
+        if l > 0.0 && l.is_finite() {
+            l
+        } else {
+            1.0
+        }
+    }
+
+    /// The natural unit of constraint equation `row`: 1 (radian) for angle equations (the angle
+    /// rows of prismatic and weld joints, fixed angles, angle drivers), the
+    /// [`System::length_scale`] for equations in lengths. `|Phi_row| / equation_scale(row)` is
+    /// a relative violation.
+    pub fn equation_scale(&self, row: usize) -> f64 {
+        let Some(&ji) = self.eq_joint.get(row) else {
+            return 1.0;
+        };
+        let j = &self.joints[ji];
+        let label = j.equation_labels()[row - self.row_offset[ji]];
+        if label == "angle" {
+            1.0
+        } else {
+            self.length_scale()
+        }
+    }
+
+    /// Rejects a body whose inertia is negligible against its mass times the square of the
+    /// lever arm of a joint point on it (`m r^2 / J >` [`MAX_INERTIA_RATIO`]).
+    pub(crate) fn check_inertia_scale(&self) -> Result<(), ModelError> {
+        for ji in 0..self.joints.len() {
+            for (body, r) in self.joint_lever_arms(ji) {
+                let Some(bi) = body else { continue };
+                let b = &self.bodies[bi];
+                let ratio = b.mass * r * r / b.inertia;
+                if ratio > MAX_INERTIA_RATIO {
+                    return Err(ModelError::NegligibleInertia {
+                        body: b.name.clone(),
+                        inertia: b.inertia,
+                        mass: b.mass,
+                        joint: self.joints[ji].name.clone(),
+                        lever: r,
+                        ratio,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}

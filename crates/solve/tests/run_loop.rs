@@ -1,0 +1,275 @@
+//! The run loop: the step sizes it passes, its drift guard and its near-singular count.
+
+use mbd_model::{models, Body, BodyRef, Joint, System, SystemBuilder};
+use mbd_solve::{
+    run, AccelerationSolver, DriftGuard, Integrator, NoObserver, RunConfig, SolveError, State,
+    StepStats,
+};
+
+/// Records the step sizes it is given and moves nothing but time.
+struct Recording(Vec<f64>);
+impl Integrator for Recording {
+    fn name(&self) -> String {
+        "recording".into()
+    }
+    fn step(&mut self, _: &System, s: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        self.0.push(h);
+        s.t += h;
+        Ok(StepStats::default())
+    }
+}
+
+#[test]
+fn every_step_but_the_last_gets_the_nominal_h_bit_for_bit() {
+    let sys = models::pendulum(1.0, 1.0, 0.3, 9.81).unwrap();
+    for (t_end, h, steps, last) in [
+        (20.0, 0.01, 2000, 0.01),
+        (1.0, 1e-3, 1000, 1e-3),
+        (1.005, 0.01, 101, 0.005),
+    ] {
+        let mut s = State::consistent(&sys, 0.0).unwrap();
+        let mut rec = Recording(Vec::new());
+        let stats = run(
+            &mut rec,
+            &sys,
+            &mut s,
+            RunConfig::new(t_end, h),
+            &mut NoObserver,
+        )
+        .unwrap();
+        assert_eq!(stats.steps, steps);
+        let (init, tail) = rec.0.split_at(steps - 1);
+        assert!(init.iter().all(|&x| x == h), "a step differs from h = {h}");
+        assert!((tail[0] - last).abs() < 1e-12, "{} vs {last}", tail[0]);
+        assert_eq!(s.t, t_end);
+    }
+}
+
+/// Moves body 0 sideways at constant speed, ignoring the constraints: drift grows linearly.
+struct Drifter(f64);
+impl Integrator for Drifter {
+    fn name(&self) -> String {
+        "drifter".into()
+    }
+    fn step(&mut self, _: &System, s: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        s.q[0] += self.0 * h;
+        s.t += h;
+        Ok(StepStats::default())
+    }
+}
+
+fn two_link() -> System {
+    let mut b = SystemBuilder::new();
+    let l1 = b.add_body(Body::new("link1").rod(1.0, 1.0).position(0.5, 0.0, 0.0));
+    let l2 = b.add_body(Body::new("link2").rod(1.0, 1.0).position(1.5, 0.0, 0.0));
+    b.add_joint(Joint::revolute(
+        "pin1",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        l1,
+        [-0.5, 0.0],
+    ));
+    b.add_joint(Joint::revolute("pin2", l1, [0.5, 0.0], l2, [-0.5, 0.0]));
+    b.build().unwrap()
+}
+
+#[test]
+fn drift_guard_stops_at_the_predicted_step_naming_the_joint() {
+    let sys = two_link();
+    // length scale 0.5 (lever arms), default tolerance 1e-3 -> 5e-4 m; speed 1e-3 m/s with
+    // h = 0.01 adds 1e-5 m per step: the guard fires after step 51 (5.1e-4 m), at t = 0.51.
+    assert_eq!(sys.length_scale(), 0.5);
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let err = run(
+        &mut Drifter(1e-3),
+        &sys,
+        &mut s,
+        RunConfig::new(10.0, 0.01),
+        &mut NoObserver,
+    )
+    .expect_err("the drift guard must stop the run");
+    match &err {
+        SolveError::ConstraintDrift {
+            t,
+            level,
+            equation,
+            joint,
+            residual,
+            tolerance,
+        } => {
+            assert!((t - 0.51).abs() < 1e-12, "{t}");
+            assert_eq!(*level, "position");
+            assert_eq!(equation, "pin1.x"); // body 0's x moves: pin1.x and pin2.x both see it
+            assert_eq!(joint, "pin1");
+            assert!((tolerance - 5e-4).abs() < 1e-18);
+            assert!(*residual > 5e-4 && *residual < 5.2e-4, "{residual}");
+        }
+        other => panic!("expected ConstraintDrift, got {other:?}"),
+    }
+    assert!(err.to_string().contains("pin1"));
+
+    // off: the run goes to its end
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let cfg = RunConfig::new(1.0, 0.01).without_drift_guard();
+    let stats = run(&mut Drifter(1e-3), &sys, &mut s, cfg, &mut NoObserver).unwrap();
+    assert_eq!(stats.steps, 100);
+
+    // a looser guard fires later, a velocity guard at once (the state's Phi_q v = 1e-3)
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let g = DriftGuard {
+        position_tol: 1e-2,
+        velocity_tol: None,
+    };
+    let cfg = RunConfig::new(10.0, 0.01).with_drift_guard(g);
+    match run(&mut Drifter(1e-3), &sys, &mut s, cfg, &mut NoObserver) {
+        Err(SolveError::ConstraintDrift { t, .. }) => assert!((t - 5.01).abs() < 1e-9, "{t}"),
+        other => panic!("{other:?}"),
+    }
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    s.v[0] = 1e-3;
+    let g = DriftGuard {
+        position_tol: 1.0,
+        velocity_tol: Some(1e-4),
+    };
+    let cfg = RunConfig::new(10.0, 0.01).with_drift_guard(g);
+    match run(&mut Drifter(0.0), &sys, &mut s, cfg, &mut NoObserver) {
+        Err(SolveError::ConstraintDrift { t, level, .. }) => {
+            assert_eq!(level, "velocity");
+            assert!((t - 0.01).abs() < 1e-15);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn bad_guard_settings_are_errors() {
+    let sys = two_link();
+    for (g, name) in [
+        (
+            DriftGuard {
+                position_tol: 0.0,
+                velocity_tol: None,
+            },
+            "drift_guard.position_tol",
+        ),
+        (
+            DriftGuard {
+                position_tol: 1e-3,
+                velocity_tol: Some(f64::NAN),
+            },
+            "drift_guard.velocity_tol",
+        ),
+    ] {
+        let mut s = State::consistent(&sys, 0.0).unwrap();
+        let cfg = RunConfig::new(1.0, 0.01).with_drift_guard(g);
+        match run(&mut Drifter(0.0), &sys, &mut s, cfg, &mut NoObserver) {
+            Err(SolveError::InvalidParameter { parameter, .. }) => assert_eq!(parameter, name),
+            other => panic!("{other:?}"),
+        }
+    }
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let cfg = RunConfig::new(1.0, 0.01).with_condition_limit(-1.0);
+    assert!(matches!(
+        run(&mut Drifter(0.0), &sys, &mut s, cfg, &mut NoObserver),
+        Err(SolveError::InvalidParameter {
+            parameter: "condition_limit",
+            ..
+        })
+    ));
+}
+
+/// Reports a scripted condition estimate per step.
+struct Scripted(Vec<f64>, usize);
+impl Integrator for Scripted {
+    fn name(&self) -> String {
+        "scripted".into()
+    }
+    fn step(&mut self, _: &System, s: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        let c = self.0[self.1 % self.0.len()];
+        self.1 += 1;
+        s.t += h;
+        Ok(StepStats {
+            condition: c,
+            ..Default::default()
+        })
+    }
+}
+
+#[test]
+fn near_singular_steps_are_counted_with_the_first_time() {
+    let sys = two_link();
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let script = vec![1.0, 1.0, 3e8, 5.0, 2e9, 1.0, 1.0, 1.0, 1.0, 1.0];
+    let stats = run(
+        &mut Scripted(script, 0),
+        &sys,
+        &mut s,
+        RunConfig::new(0.1, 0.01),
+        &mut NoObserver,
+    )
+    .unwrap();
+    assert_eq!(stats.near_singular_steps, 2);
+    assert!((stats.first_near_singular.unwrap() - 0.03).abs() < 1e-15);
+    assert_eq!(stats.max_condition, 2e9);
+    let w = stats.warning().expect("a warning");
+    assert!(w.contains("2 step(s)") && w.contains("t = 0.03"), "{w}");
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let stats = run(
+        &mut Scripted(vec![1.0], 0),
+        &sys,
+        &mut s,
+        RunConfig::new(0.1, 0.01),
+        &mut NoObserver,
+    )
+    .unwrap();
+    assert_eq!(stats.near_singular_steps, 0);
+    assert!(stats.warning().is_none());
+}
+
+/// A body held by two distance joints from ground points (-1, 0) and (1, 0), at height `y`:
+/// as `y -> 0` the rods become collinear and the configuration singular.
+fn two_rods(y: f64) -> System {
+    let mut b = SystemBuilder::new();
+    let p = b.add_body(Body::new("p").mass(1.0).inertia(0.1).position(0.0, y, 0.0));
+    let l = (1.0 + y * y).sqrt();
+    b.add_joint(Joint::distance(
+        "left",
+        BodyRef::Ground,
+        [-1.0, 0.0],
+        p,
+        [0.0, 0.0],
+        l,
+    ));
+    b.add_joint(Joint::distance(
+        "right",
+        BodyRef::Ground,
+        [1.0, 0.0],
+        p,
+        [0.0, 0.0],
+        l,
+    ));
+    b.build().unwrap()
+}
+
+#[test]
+fn condition_estimate_grows_like_the_inverse_square_distance_to_a_singular_configuration() {
+    let mut prev = 0.0;
+    for y in [1.0, 1e-2, 1e-4, 1e-6] {
+        let sys = two_rods(y);
+        let s = State::consistent(&sys, 0.0).unwrap();
+        let mut acc = AccelerationSolver::new(&sys);
+        let (mut a, mut l) = (vec![0.0; 3], vec![0.0; 2]);
+        acc.solve(&sys, s.q.as_slice(), s.v.as_slice(), 0.0, &mut a, &mut l)
+            .unwrap();
+        let k = acc.condition_estimate();
+        // gradients at angle 2 atan(y): sin^2 ~ 4 y^2 for small y
+        let expect = 1.0 + 1.0 / (4.0 * y * y);
+        assert!(
+            k > 0.5 * expect.min(2.0) && k < 2.0 * expect,
+            "y = {y}: {k} vs {expect}"
+        );
+        assert!(k > prev);
+        prev = k;
+    }
+    assert!(prev > RunConfig::DEFAULT_CONDITION_LIMIT);
+}
