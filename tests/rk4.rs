@@ -57,8 +57,45 @@ fn manipulator_measures(opts: Rk4Options) -> mbd::analysis::RunMeasures {
     let mut s = State::consistent(&sys, 0.0).unwrap();
     let mut rk = Rk4::new(&sys, opts).unwrap();
     let mut obs = MeasureObserver::new(&sys, true);
-    run(&mut rk, &sys, &mut s, RunConfig::new(20.0, 0.01), &mut obs).unwrap();
+    // the paper's drift measurement: the drift guard is off
+    let cfg = RunConfig::new(20.0, 0.01).without_drift_guard();
+    run(&mut rk, &sys, &mut s, cfg, &mut obs).unwrap();
     obs.measures()
+}
+
+#[test]
+fn the_default_drift_guard_stops_plain_rk4_on_the_paper_setting_and_not_projected_rk4() {
+    let sys = models::manipulator().unwrap();
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let mut rk = Rk4::new(&sys, Rk4Options::plain()).unwrap();
+    let err = run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(20.0, 0.01),
+        &mut mbd::solve::NoObserver,
+    )
+    .expect_err("plain RK4 drifts past 1% of the links' half length within 20 s");
+    match err {
+        mbd::solve::SolveError::ConstraintDrift { t, joint, .. } => {
+            assert!(t > 1.0 && t < 20.0, "t = {t}");
+            assert!(joint.starts_with("pin"), "{joint}");
+        }
+        other => panic!("expected ConstraintDrift, got {other:?}"),
+    }
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let mut rk = Rk4::new(&sys, Rk4Options::projected()).unwrap();
+    let stats = run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(20.0, 0.01),
+        &mut mbd::solve::NoObserver,
+    )
+    .unwrap();
+    assert_eq!(stats.steps, 2000);
+    assert_eq!(stats.near_singular_steps, 0);
+    assert!(stats.max_condition >= 1.0 && stats.max_condition < 100.0);
 }
 
 #[test]

@@ -67,26 +67,6 @@ pub fn experiments() -> Vec<Experiment> {
     ]
 }
 
-const T1: [(usize, bool, [f64; 3]); 8] = [
-    (1, false, [2.38, 2.47, 3.25e-3]),
-    (1, true, [1.64, 1.70, 2.44e-3]),
-    (2, false, [4.13e-3, 4.24e-3, 3.23e-6]),
-    (2, true, [2.21e-3, 2.26e-3, 1.45e-6]),
-    (3, false, [4.89e-6, 4.86e-6, 6.15e-9]),
-    (3, true, [1.73e-6, 1.78e-6, 2.80e-9]),
-    (4, false, [2.08e-8, 2.09e-8, 3.47e-12]),
-    (4, true, [2.34e-9, 2.40e-9, 6.22e-13]),
-];
-const T2: [(usize, [f64; 3]); 2] = [
-    (1, [-0.00516079, -0.003574097, 2.981500943]),
-    (2, [-6.168893e-7, -3.251878e-7, 1.938563795]),
-];
-/// (s, gamma = 0 row, gamma_opt row): E|dx|, E|dy|, E[dH] (signed in the paper's Table 3).
-const T3: [(usize, [f64; 3], [f64; 3]); 2] = [
-    (1, [2.38, 2.47, 3.25e-3], [4.49e-2, 4.63e-2, 9.62e-4]),
-    (2, [4.13e-3, 4.24e-3, 3.23e-6], [3.19e-4, 3.25e-4, -5.42e-7]),
-];
-
 const NT_NOTE: &str = "Reading of N_t: the scan gives `h = 0.04, N_t = 100` (Table 1), `h = 0.01, N_t = 1000` (Fig. 4) and `h = 0.01, N_t = 10` (Figs. 5-6, Table 2) without units. We read N_t as **seconds of simulated time** (100 s = 2500 steps of 0.04 s), not as periods or steps. The paper's system is not legible either: ours is the project's choice (two uniform 1 kg, 1 m rods released at rest at 30 degrees; regular motion, normal-mode periods 2.2 s and 0.82 s at small amplitude). Its E|dx| cannot exceed about 1 m, so the paper's (1,1) errors of 2.4 show that its system or span differs: compare trends and claims, not digits.";
 
 struct Problem {
@@ -217,7 +197,7 @@ fn table1(ctx: &Ctx) -> Result<Section, String> {
     );
     let mut rows = Vec::new();
     let mut summary = Vec::new();
-    for (s, gt, paper) in T1 {
+    for &(s, gt, paper) in &crate::paper_values::get()?.paper_a.table1.rows {
         let gamma = if gt { 1.0 } else { 0.0 };
         let m = measures(&p, h, n, &r, s, gamma)?;
         let ours = [m.mean_abs_dx, m.mean_abs_dy, m.mean_abs_dh];
@@ -256,14 +236,20 @@ fn table1(ctx: &Ctx) -> Result<Section, String> {
             ));
         }
     }
-    sec.claims.push(Claim::check(
-        "gamma_T lowers every error (E|dx|, E|dy|, E|dH|) of every row of Table 1",
-        held,
-        format!(
-            "reduction factors gamma=0 / gamma_T (dx/dy/dH): {}",
-            ev.join("; ")
+    sec.claims.push(
+        Claim::check(
+            "gamma_T lowers every error (E|dx|, E|dy|, E|dH|) of every row of Table 1",
+            held,
+            format!(
+                "reduction factors gamma=0 / gamma_T (dx/dy/dH): {}",
+                ev.join("; ")
+            ),
+        )
+        .expected_miss(
+            "the preadjustment corrects the phase, not the energy: at s = 1 gamma_T raises E|dH| by 4/3 \
+             (derived in docs/symplectic.md section 7), and at s = 3, 4 E|dH| is at its round-off floor",
         ),
-    ));
+    );
     // the literal reading: equispaced control points for s = 3, 4
     let mut te = Table::new(
         "Table 1 with equally spaced control points (the literal reading) for s = 3, 4: the constraint forces are then lumped by Newton-Cotes weights and the order drops to 4 and 6",
@@ -333,7 +319,7 @@ fn table2(ctx: &Ctx) -> Result<Section, String> {
         ],
     );
     let mut summary = Vec::new();
-    for (s, paper) in T2 {
+    for &(s, paper) in &crate::paper_values::get()?.paper_a.table2.rows {
         let c = calibrate(&p, h, n, &r, s)?;
         let (dw1, dw2) = (c.history[0].1, c.history[1].1);
         t.row(vec![
@@ -411,7 +397,7 @@ fn table3(ctx: &Ctx) -> Result<Section, String> {
         ],
     );
     let mut summary = Vec::new();
-    for (s, p0, popt) in T3 {
+    for &(s, p0, popt) in &crate::paper_values::get()?.paper_a.table3.rows {
         let cal = calibrate(&p, hc, nc, &rc, s)?;
         let direct = calibrate(&p, h, n, &r, s)?;
         let m0 = measures(&p, h, n, &r, s, 0.0)?;
@@ -457,8 +443,12 @@ fn table3(ctx: &Ctx) -> Result<Section, String> {
                 fmt_e(m0.mean_abs_dy),
                 fmt_e(mo.mean_abs_dy),
             ),
+        ).expected_miss(
+            "gamma_opt depends on h and the span (the needed gamma grows with amplitude and differs per mode, \
+             docs/symplectic.md section 7), so calibrating on a short fine run and applying it to a long coarse \
+             one loses most of the gain",
         ));
-        sec.claims.push(Claim::check(
+        let direct_claim = Claim::check(
             format!("gamma_opt calibrated at the evaluation setting (h = 0.04, N_t = 100) lowers E|dx| and E|dy| at least 10x against gamma = 0 (s = {s})"),
             dx >= 10.0 && dy >= 10.0,
             format!(
@@ -469,7 +459,22 @@ fn table3(ctx: &Ctx) -> Result<Section, String> {
                 fmt_e(m0.mean_abs_dy),
                 fmt_e(md.mean_abs_dy),
             ),
-        ));
+        );
+        // s = 2: one gamma cannot cancel the amplitude-dependent phase error of both modes
+        // (docs/symplectic.md section 7); s = 1 holds at the paper's span (60x) but not over
+        // the quick run's shortened span
+        let direct_claim = if s >= 2 {
+            direct_claim.expected_miss(
+                "at s = 2 the needed gamma differs per mode and grows with amplitude; one gamma zeroes the \
+                 signed mean but leaves both modes' drifts partly uncorrected (docs/symplectic.md section 7)",
+            )
+        } else if ctx.quick {
+            direct_claim
+                .expected_miss("quick mode shortens the span; the claim is about the paper's 100 s")
+        } else {
+            direct_claim
+        };
+        sec.claims.push(direct_claim);
     }
     sec.tables.push(t);
     sec.summary = json!({"paper_a": {"table3": summary}});

@@ -22,7 +22,8 @@ const H: f64 = 0.01;
 const PAPER_TIME: f64 = 20.0;
 const QUICK_TIME: f64 = 2.0;
 /// Baumgarte parameters of the table's stabilised RK4 (alpha = beta: critical damping of the
-/// constraint error; the best of the sweep below on both problems at h = 0.01).
+/// constraint error). Whether it is the best of the sweep on each problem is computed and
+/// reported as a claim by the `paper-b-baumgarte` experiment.
 const BAUMGARTE: (f64, f64) = (20.0, 20.0);
 /// The sweep of Baumgarte parameters (alpha = beta).
 const SWEEP: [f64; 5] = [1.0, 5.0, 20.0, 80.0, 200.0];
@@ -92,8 +93,9 @@ fn measure(
         obs = obs.with_series();
     }
     let t0 = Instant::now();
-    run(&mut integ, sys, &mut s, RunConfig::new(t_end, h), &mut obs)
-        .map_err(|e| format!("{}: {e}", solver.name()))?;
+    // the constraint drift of plain RK4 is what this table measures: no drift guard
+    let cfg = RunConfig::new(t_end, h).without_drift_guard();
+    run(&mut integ, sys, &mut s, cfg, &mut obs).map_err(|e| format!("{}: {e}", solver.name()))?;
     let runtime = t0.elapsed().as_secs_f64();
     Ok(RunOut {
         m: obs.measures(),
@@ -269,6 +271,9 @@ fn baumgarte(ctx: &Ctx) -> Result<Section, String> {
     let mut rows = vec![];
     let mut spread = f64::INFINITY;
     let mut beats_tangent = false;
+    let mut best_is_table = true;
+    let mut best_text = Vec::new();
+    let mut vs_tangent = Vec::new();
     for (pname, sys) in problems()? {
         let tangent = measure(&sys, Solver::Tangent, t_end, H, false)?;
         let mut eps = vec![];
@@ -303,6 +308,22 @@ fn baumgarte(ctx: &Ctx) -> Result<Section, String> {
         }
         let finite: Vec<f64> = eps.iter().copied().filter(|e| e.is_finite()).collect();
         let best = finite.iter().copied().fold(f64::INFINITY, f64::min);
+        let best_ab = SWEEP
+            .iter()
+            .zip(&eps)
+            .find(|(_, &e)| e == best)
+            .map(|(&ab, _)| ab)
+            .ok_or_else(|| format!("Baumgarte sweep on the {pname}: every run failed"))?;
+        best_is_table &= best_ab == BAUMGARTE.0 && BAUMGARTE.0 == BAUMGARTE.1;
+        best_text.push(format!(
+            "{pname}: best alpha = beta = {best_ab} (e(Phi) {})",
+            fmt_e(best)
+        ));
+        vs_tangent.push(format!(
+            "{pname}: best Baumgarte e(Phi) {} against tangent-space {}",
+            fmt_e(best),
+            fmt_e(tangent.m.e_phi)
+        ));
         let worst = finite.iter().copied().fold(0.0f64, f64::max);
         spread = spread.min(worst / best);
         beats_tangent |= best <= tangent.m.e_phi;
@@ -324,7 +345,15 @@ fn baumgarte(ctx: &Ctx) -> Result<Section, String> {
     sec.claims.push(Claim::check(
         "No Baumgarte setting of the sweep reaches the tangent-space solver's constraint level",
         !beats_tangent,
-        "see the table".to_string(),
+        vs_tangent.join("; "),
+    ));
+    sec.claims.push(Claim::check(
+        format!(
+            "The Baumgarte setting of the paper-B table, ({}, {}), is the best of the sweep (smallest e(Phi)) on each problem",
+            BAUMGARTE.0, BAUMGARTE.1
+        ),
+        best_is_table,
+        best_text.join("; "),
     ));
     sec.summary = json!({ "paper_b": { "baumgarte_sweep": rows } });
     Ok(sec)

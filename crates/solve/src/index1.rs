@@ -39,6 +39,8 @@ pub enum LinearSolver {
     Sparse,
 }
 
+// the dense solver is used inline on the hot path of small systems; the sparse one is boxed
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 enum Accel {
     Dense(AccelerationSolver),
