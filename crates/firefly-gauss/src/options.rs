@@ -7,8 +7,10 @@ use mbd_firefly::{FireflySettings, Termination};
 #[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub enum PartitionChoice {
     /// Gaussian elimination with complete pivoting of `Phi_q` at the system's initial state
-    /// (default); re-chosen during the run when the dependent block becomes ill-conditioned
-    /// (pivot ratio below [`FaDaeOptions::repartition_threshold`]).
+    /// (default); re-chosen at a step's start when the dependent block has become much worse
+    /// than the best available one (`|det Phi_d| / |det Phi_best|` below
+    /// [`FaDaeOptions::repartition_threshold`]).
+
     #[default]
     Auto,
     /// These coordinate indices are independent (exactly `n - m` distinct indices whose
@@ -144,8 +146,15 @@ pub struct FaDaeOptions {
     pub newton_max_iter: usize,
     /// Behaviour when the optimiser misses the target.
     pub on_miss: MissPolicy,
-    /// Auto partitioning: re-choose the partition when the ratio of smallest to largest pivot of
-    /// the dependent block at a step's start falls below this (default 1e-3).
+    /// Auto partitioning: at each step's start, the quality of the dependent block in use is
+    /// `|det Phi_d| / |det Phi_best|`, where `Phi_best` is the block that Gaussian elimination
+    /// with complete pivoting of `Phi_q` picks (the product of its pivots); the partition is
+    /// re-chosen (to the complete-pivoting choice) when the quality falls below this threshold.
+    /// Relative to the best choice, so it also works for a single constraint (a 1x1 block is
+    /// always perfectly conditioned on its own, but not relative to the row: a distance joint
+    /// at the bottom of the swing). Must be in `[0, 0.5]`: a fresh choice has quality 1, so
+    /// it is replaced only after its conditioning worsened at least twofold relative to the
+    /// best (no thrashing). 0 switches repartitioning off.
     pub repartition_threshold: f64,
     /// Diagnostic: shift the predictor (and the box centred on it) by this fraction of the box
     /// half-width, with alternating signs per coordinate (default 0). Used to show that the
@@ -177,7 +186,7 @@ impl Default for FaDaeOptions {
             newton_tol: 1e-14,
             newton_max_iter: 10,
             on_miss: MissPolicy::Accept,
-            repartition_threshold: 1e-3,
+            repartition_threshold: 0.1,
             predictor_offset: 0.0,
         }
     }
@@ -286,14 +295,11 @@ impl FaDaeOptions {
         if self.newton_max_iter == 0 {
             return bad("newton_max_iter", 0.0, ">= 1");
         }
-        if !(self.repartition_threshold.is_finite()
-            && self.repartition_threshold >= 0.0
-            && self.repartition_threshold < 1.0)
-        {
+        if !(self.repartition_threshold >= 0.0 && self.repartition_threshold <= 0.5) {
             return bad(
                 "repartition_threshold",
                 self.repartition_threshold,
-                "in [0, 1)",
+                "in [0, 0.5]",
             );
         }
         if !(self.predictor_offset.is_finite() && self.predictor_offset.abs() <= 1.0) {

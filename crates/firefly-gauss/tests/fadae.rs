@@ -184,6 +184,13 @@ fn optimiser_does_the_work_ratio_above_100() {
     assert!(st.mean_ratio() > 100.0, "{st:?}");
     assert_eq!(st.target_misses, 0, "{st:?}");
     assert!(st.ratio_count >= 90, "{st:?}");
+    // the x, y columns (entries 1) stay the best dependent block: never re-chosen
+    assert_eq!(st.repartitions, 0, "{st:?}");
+    assert!(
+        fa.last_step().partition_quality > 0.99,
+        "{:?}",
+        fa.last_step()
+    );
     // and the predictor alone is not the answer: with the plain RK4 predictor and no
     // correction the firefly still reduces the objective a hundredfold
     let o = FaDaeOptions {
@@ -254,6 +261,24 @@ fn bad_inputs_are_errors() {
     let mut o = FaDaeOptions::default();
     o.bounds.safety = f64::INFINITY;
     assert!(matches!(mk(o), Err(FaDaeError::InvalidOption { .. })));
+    // above 0.5 a fresh partition could be replaced without having worsened twofold
+    for bad in [f64::NAN, -0.1, 0.6, 1.0] {
+        let o = FaDaeOptions {
+            repartition_threshold: bad,
+            ..FaDaeOptions::default()
+        };
+        assert!(
+            matches!(mk(o), Err(FaDaeError::InvalidOption { name, .. }) if name == "repartition_threshold"),
+            "{bad}"
+        );
+    }
+    for good in [0.0, 0.5] {
+        let o = FaDaeOptions {
+            repartition_threshold: good,
+            ..FaDaeOptions::default()
+        };
+        assert!(mk(o).is_ok(), "{good}");
+    }
     for ind in [vec![2], vec![2, 6], vec![2, 2], vec![0, 1]] {
         // wrong count, out of range, duplicate, singular dependent block (x1, y1 free)
         let o = FaDaeOptions::default().partition(PartitionChoice::Given(ind.clone()));
