@@ -8,6 +8,7 @@ use crate::options::{FaDaeOptions, MissPolicy, PartitionChoice, Predictor};
 use crate::partition::{Partition, Pivoting};
 use crate::small::SmallLu;
 use mbd_firefly::{Bounds, Firefly, Objective, StopReason, SyncObjective};
+use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::System;
 use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
 use std::sync::Mutex;
@@ -395,7 +396,7 @@ impl FireflyGauss {
             .iter()
             .enumerate()
             .filter(|(i, _)| i % 3 != 2)
-            .fold(1.0f64, |a, (_, x)| a.max(x.abs()));
+            .fold(1.0f64, |a, (_, x)| a.max(x.abs())); // finite: checked above
         self.prob.newton_tol = self.opts.newton_tol * xy_max;
         self.prob
             .prepare(
@@ -421,7 +422,7 @@ impl FireflyGauss {
         // round-off floor of the objective: each of the 2 dof residual components carries
         // a few ulps of the independent coordinates
         let floor = {
-            let zmax = self.xhat[..dof].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            let zmax = max_abs(&self.xhat[..dof]);
             let s = f64::EPSILON * (1.0 + zmax);
             128.0 * dof as f64 * s * s
         };
@@ -745,12 +746,7 @@ impl FireflyGauss {
         let nd = 2 * dof;
         let b = &self.opts.bounds;
         let corrected = self.opts.predictor == Predictor::CorrectedRk4;
-        let group_max = |v: &[f64]| v.iter().fold(0.0f64, |a, c| a.max(c.abs()));
-        let diff_max = |a: &[f64], b: &[f64]| {
-            a.iter()
-                .zip(b)
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-        };
+        let (group_max, diff_max) = (max_abs, max_abs_diff);
         // estimated error of the predictor, per group (positions, velocities)
         let (ez, ev) = match (self.n_corr, corrected) {
             (0, _) => (

@@ -4,6 +4,7 @@ use mbd_analysis::{fit_order, MeasureObserver};
 use mbd_firefly_gauss::{
     FaDaeError, FaDaeOptions, FireflyGauss, MissPolicy, PartitionChoice, Predictor,
 };
+use mbd_model::numeric::max_abs_diff;
 use mbd_model::{models, System};
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Integrator, NoObserver, Recorder, RunConfig,
@@ -110,10 +111,7 @@ fn same_seed_same_bits_and_parallel_equals_serial() {
     assert_eq!(fa.stats(), fc.stats());
     let (d, _) = run_to(&sys, o.seed(43), 0.3, 0.01);
     assert_ne!(bits(&a), bits(&d), "another seed takes another path");
-    let diff =
-        a.q.iter()
-            .zip(d.q.iter())
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let diff = max_abs_diff(a.q.as_slice(), d.q.as_slice());
     assert!(diff < 1e-9, "but lands on the same solution: {diff:e}");
 }
 
@@ -124,10 +122,8 @@ fn same_seed_same_bits_and_parallel_equals_serial() {
 fn offset_predictor_lands_on_the_same_solution() {
     let sys = manipulator();
     let d = |a: &State, b: &State| {
-        a.q.iter()
-            .zip(b.q.iter())
-            .chain(a.v.iter().zip(b.v.iter()))
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        max_abs_diff(a.q.as_slice(), b.q.as_slice())
+            .max(max_abs_diff(a.v.as_slice(), b.v.as_slice()))
     };
     for offset in [0.5, -0.7, 0.9] {
         let mut s = start(&sys);
@@ -213,11 +209,7 @@ fn polished_variant_has_order_four() {
     let mut errs = Vec::new();
     for &h in &hs {
         let (s, _) = run_to(&sys, FaDaeOptions::polished(), t_end, h);
-        errs.push(
-            s.q.iter()
-                .zip(&qref)
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs())),
-        );
+        errs.push(max_abs_diff(s.q.as_slice(), &qref));
     }
     let fit = fit_order(&hs, &errs, 1e-13).unwrap();
     assert!((fit.order - 4.0).abs() < 0.6, "{errs:?} {fit:?}");

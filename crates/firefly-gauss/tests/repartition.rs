@@ -8,6 +8,7 @@
 //! throughout) is the yardstick of accuracy.
 
 use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
+use mbd_model::numeric::max_abs;
 use mbd_model::{models, Body, BodyRef, Joint, System, SystemBuilder};
 use mbd_solve::{Integrator, State};
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -108,10 +109,11 @@ fn swing(sys: &System, opts: FaDaeOptions, period: f64, t_end: f64, h: f64) -> S
             crossings.push(t0 + 0.5 * (lo + hi) * h);
         }
     }
-    let period_error = crossings
+    let errors: Vec<f64> = crossings
         .windows(2)
-        .map(|w| (2.0 * (w[1] - w[0]) - period).abs() / period)
-        .fold(0.0f64, f64::max);
+        .map(|w| (2.0 * (w[1] - w[0]) - period) / period)
+        .collect();
+    let period_error = max_abs(&errors);
     Swing {
         period_error,
         passages: crossings.len(),
