@@ -5,9 +5,10 @@ use crate::accel::RefinedAcceleration;
 use crate::error::FaDaeError;
 use crate::objective::{StepProblem, Workspace};
 use crate::options::{FaDaeOptions, MissPolicy, PartitionChoice, Predictor};
-use crate::partition::Partition;
+use crate::partition::{Partition, Pivoting};
 use crate::small::SmallLu;
 use mbd_firefly::{Bounds, Firefly, Objective, StopReason, SyncObjective};
+use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::System;
 use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
 use std::sync::Mutex;
@@ -45,6 +46,11 @@ pub struct StepInfo {
     pub polish_evaluations: usize,
     /// Whether the partition was re-chosen at this step.
     pub repartitioned: bool,
+    /// Auto partitioning: `|det Phi_d| / |det Phi_best|` at the step's start, before any
+    /// re-choice, where `Phi_d` is the dependent block of `Phi_q` in use and `Phi_best` the
+    /// block that complete pivoting of `Phi_q` picks (capped at 1; 1 when `Phi_q` is rank
+    /// deficient). NaN for a user-given partition.
+    pub partition_quality: f64,
 }
 
 impl Default for StepInfo {
@@ -65,6 +71,7 @@ impl Default for StepInfo {
             polish_iterations: 0,
             polish_evaluations: 0,
             repartitioned: false,
+            partition_quality: f64::NAN,
         }
     }
 }
@@ -190,6 +197,7 @@ pub struct FireflyGauss {
     n: usize,
     m: usize,
     partition: Partition,
+    pivoting: Pivoting,
     prob: StepProblem,
     ws: Workspace,
     pool: Vec<Mutex<Workspace>>,
@@ -259,6 +267,7 @@ impl FireflyGauss {
             n,
             m,
             partition,
+            pivoting: Pivoting::new(m, n),
             prob,
             ws: Workspace::new(sys),
             pool,
@@ -373,7 +382,7 @@ impl FireflyGauss {
             h,
             ..StepInfo::default()
         };
-        info.repartitioned = self.check_partition(sys, state)?;
+        (info.repartitioned, info.partition_quality) = self.check_partition(sys, state)?;
         self.predict(sys, state, h)?;
         let dof = self.partition.dof();
         let nd = 2 * dof;
@@ -387,7 +396,7 @@ impl FireflyGauss {
             .iter()
             .enumerate()
             .filter(|(i, _)| i % 3 != 2)
-            .fold(1.0f64, |a, (_, x)| a.max(x.abs()));
+            .fold(1.0f64, |a, (_, x)| a.max(x.abs())); // finite: checked above
         self.prob.newton_tol = self.opts.newton_tol * xy_max;
         self.prob
             .prepare(
@@ -413,7 +422,7 @@ impl FireflyGauss {
         // round-off floor of the objective: each of the 2 dof residual components carries
         // a few ulps of the independent coordinates
         let floor = {
-            let zmax = self.xhat[..dof].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            let zmax = max_abs(&self.xhat[..dof]);
             let s = f64::EPSILON * (1.0 + zmax);
             128.0 * dof as f64 * s * s
         };
@@ -572,49 +581,58 @@ impl FireflyGauss {
         })
     }
 
-    /// Auto partitioning: re-choose when the dependent block at the step's start is
-    /// ill-conditioned. Given partitioning: error when it is singular.
-    fn check_partition(&mut self, sys: &System, state: &State) -> Result<bool, FaDaeError> {
-        let m = self.m;
+    /// Auto partitioning: re-choose when the dependent block at the step's start has become
+    /// much worse than the best available one (see [`FaDaeOptions::repartition_threshold`]).
+    /// Given partitioning: error when it is singular. Returns whether the partition changed and
+    /// the quality of the dependent block before any change (`|det Phi_d| / |det Phi_best|`;
+    /// NaN for a given partition).
+    fn check_partition(&mut self, sys: &System, state: &State) -> Result<(bool, f64), FaDaeError> {
         let q = state.q.as_slice();
         sys.phi_q(q, &mut self.ws.jac);
         self.partition
             .fill_dependent_block(&self.ws.jac, self.ws.lu.matrix_mut());
-        let ratio = match self.ws.lu.factor() {
-            Ok((pmin, pmax)) => pmin / pmax,
-            Err(_) => 0.0,
-        };
-        let _ = m;
-        match self.opts.partition {
-            PartitionChoice::Given(_) => {
-                if ratio.is_nan() || ratio <= 1e-12 {
-                    return Err(SolveError::Singular {
-                        t: state.t,
-                        what: "dependent block of Phi_q (user-given partition)",
-                        detail: format!("independent coordinates {:?}", self.partition.independent),
-                    }
-                    .into());
+        let factored = self.ws.lu.factor();
+        if let PartitionChoice::Given(_) = self.opts.partition {
+            let ratio = match factored {
+                Ok((pmin, pmax)) => pmin / pmax,
+                Err(_) => 0.0,
+            };
+            if ratio.is_nan() || ratio <= 1e-12 {
+                return Err(SolveError::Singular {
+                    t: state.t,
+                    what: "dependent block of Phi_q (user-given partition)",
+                    detail: format!("independent coordinates {:?}", self.partition.independent),
                 }
-                Ok(false)
+                .into());
             }
-            PartitionChoice::Auto => {
-                if ratio >= self.opts.repartition_threshold {
-                    return Ok(false);
-                }
-                let p = Partition::auto(sys, q)?;
-                let changed = p != self.partition;
-                if changed {
-                    self.partition = p;
-                    self.prob.set_partition(&self.partition);
-                    self.n_corr = 0;
-                }
-                Ok(changed)
-            }
+            return Ok((false, f64::NAN));
         }
+        let current = match factored {
+            Ok(_) => self.ws.lu.log_abs_det(),
+            Err(_) => f64::NEG_INFINITY,
+        };
+        // Phi_q rank deficient (a singular configuration): no block is better, keep this one
+        // (the step fails in `prepare` if it is exactly singular)
+        let Ok(best) = self.pivoting.eliminate(&self.ws.jac) else {
+            return Ok((false, 1.0));
+        };
+        let quality = (current - best).exp().min(1.0);
+        if quality >= self.opts.repartition_threshold {
+            return Ok((false, quality));
+        }
+        let p = self.pivoting.partition();
+        let changed = p != self.partition;
+        if changed {
+            self.partition = p;
+            self.prob.set_partition(&self.partition);
+            self.n_corr = 0;
+        }
+        Ok((changed, quality))
     }
 
-    /// RK4 on the index-1 form from the state (the predictor) and a second-order Taylor step
-    /// (for the first box).
+    /// RK4 on the index-1 form from the state (the predictor) and, without a correction
+    /// history (first step, after a repartition), two RK4 half steps: the Richardson estimate
+    /// of the predictor's error that sizes the first box.
     fn predict(&mut self, sys: &System, state: &State, h: f64) -> Result<(), FaDaeError> {
         let t0 = state.t;
         let (mut qo, mut vo) = (
@@ -729,12 +747,7 @@ impl FireflyGauss {
         let nd = 2 * dof;
         let b = &self.opts.bounds;
         let corrected = self.opts.predictor == Predictor::CorrectedRk4;
-        let group_max = |v: &[f64]| v.iter().fold(0.0f64, |a, c| a.max(c.abs()));
-        let diff_max = |a: &[f64], b: &[f64]| {
-            a.iter()
-                .zip(b)
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-        };
+        let (group_max, diff_max) = (max_abs, max_abs_diff);
         // estimated error of the predictor, per group (positions, velocities)
         let (ez, ev) = match (self.n_corr, corrected) {
             (0, _) => (

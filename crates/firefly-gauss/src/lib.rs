@@ -13,7 +13,9 @@
 //! 1. **Decision variables**: the independent coordinates `z` and velocities `zdot` at
 //!    `t_{k+1}` (`2 dof` numbers; for the two-link manipulator the two link angles and their
 //!    rates, as in the paper). The split is found by Gaussian elimination with complete
-//!    pivoting of `Phi_q` ([`Partition::auto`]) or given by the user
+//!    pivoting of `Phi_q` ([`Partition::auto`]) and re-chosen during the run when the
+//!    dependent block becomes much worse than the best available one
+//!    ([`FaDaeOptions::repartition_threshold`]), or given by the user
 //!    ([`PartitionChoice::Given`]).
 //! 2. **Completion**: the dependent coordinates follow from `Phi(q, t_{k+1}) = 0` (chord Newton
 //!    from the predictor, to `1e-14`), the dependent velocities from
@@ -29,9 +31,11 @@
 //!    collocation method of order 4.
 //! 4. **Optimiser**: [`mbd_firefly`] minimises the objective in a box around a predictor (RK4
 //!    plus the previous step's correction), in stages that shrink the box around the best
-//!    firefly, until the objective is `tolerance` times the predictor's (default `1e-2`: every
-//!    step improves the predictor a hundredfold). Optionally
-//!    ([`FaDaeOptions::polish`]) Gauss-Newton polishes the result on the same residual.
+//!    firefly, until the objective is `tolerance` times the predictor's. The project's default
+//!    is `tolerance = 1e-2` (every step improves the predictor a hundredfold);
+//!    [`FaDaeOptions::paper`] uses the paper's `epsilon = 1e-7` instead (about five times the
+//!    generations). Optionally ([`FaDaeOptions::polish`]) Gauss-Newton polishes the result on
+//!    the same residual.
 //!
 //! ```
 //! use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};

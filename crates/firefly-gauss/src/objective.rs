@@ -9,6 +9,7 @@
 
 use crate::partition::Partition;
 use crate::small::SmallLu;
+use mbd_model::numeric::max_abs;
 use mbd_model::System;
 use nalgebra::DMatrix;
 
@@ -179,7 +180,7 @@ impl StepProblem {
         let mut iters = 0;
         loop {
             sys.phi(&ws.q1, self.t1, &mut ws.phi);
-            let res = ws.phi.iter().fold(0.0f64, |a, r| a.max(r.abs()));
+            let res = max_abs(&ws.phi);
             if !res.is_finite() {
                 return None;
             }

@@ -2,6 +2,7 @@
 //! which are dependent (completed by Newton on `Phi = 0`).
 
 use crate::error::FaDaeError;
+use mbd_model::numeric::max_abs;
 use mbd_model::System;
 use nalgebra::DMatrix;
 
@@ -33,52 +34,15 @@ impl Partition {
         }
         let mut j = DMatrix::zeros(m, n);
         sys.phi_q(q, &mut j);
-        let scale = j.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let mut rows: Vec<usize> = (0..m).collect();
-        let mut cols: Vec<usize> = (0..n).collect();
-        for k in 0..m {
-            // complete pivoting over the remaining block
-            let (mut pr, mut pc, mut best) = (k, k, -1.0f64);
-            for (ri, &r) in rows.iter().enumerate().skip(k) {
-                for (ci, &c) in cols.iter().enumerate().skip(k) {
-                    let v = j[(r, c)].abs();
-                    // strict `>` keeps the lowest index on ties: deterministic
-                    if v > best {
-                        best = v;
-                        pr = ri;
-                        pc = ci;
-                    }
-                }
-            }
-            if best.is_nan() || best <= 1e-10 * scale.max(f64::MIN_POSITIVE) {
-                return Err(FaDaeError::Unsupported(format!(
-                    "Phi_q is rank deficient (rank {k} < {m} constraints): redundant constraints \
-                     or a singular configuration; equation {}",
-                    sys.equation_name(rows[k])
-                )));
-            }
-            rows.swap(k, pr);
-            cols.swap(k, pc);
-            let (r0, c0) = (rows[k], cols[k]);
-            let p = j[(r0, c0)];
-            for &r in rows.iter().skip(k + 1) {
-                let l = j[(r, c0)] / p;
-                if l != 0.0 {
-                    for &c in cols.iter().skip(k) {
-                        let v = j[(r0, c)];
-                        j[(r, c)] -= l * v;
-                    }
-                }
-            }
+        let mut piv = Pivoting::new(m, n);
+        match piv.eliminate(&j) {
+            Ok(_) => Ok(piv.partition()),
+            Err(k) => Err(FaDaeError::Unsupported(format!(
+                "Phi_q is rank deficient (rank {k} < {m} constraints): redundant constraints \
+                 or a singular configuration; equation {}",
+                sys.equation_name(piv.rows[k])
+            ))),
         }
-        let mut dependent = cols[..m].to_vec();
-        let mut independent = cols[m..].to_vec();
-        dependent.sort_unstable();
-        independent.sort_unstable();
-        Ok(Partition {
-            independent,
-            dependent,
-        })
     }
 
     /// A partition with the given independent coordinates; checks the indices and that the
@@ -148,6 +112,90 @@ impl Partition {
             for (c, &col) in self.dependent.iter().enumerate() {
                 out[r * m + c] = j[(r, col)];
             }
+        }
+    }
+}
+
+/// Gaussian elimination with complete pivoting of an `m x n` Jacobian `Phi_q`, with its own
+/// buffers (allocation-free after construction): the choice of [`Partition::auto`], and the
+/// yardstick of the repartitioning test (the best available dependent block).
+#[derive(Clone, Debug)]
+pub(crate) struct Pivoting {
+    j: DMatrix<f64>,
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+}
+
+impl Pivoting {
+    pub(crate) fn new(m: usize, n: usize) -> Self {
+        Pivoting {
+            j: DMatrix::zeros(m, n),
+            rows: (0..m).collect(),
+            cols: (0..n).collect(),
+        }
+    }
+
+    /// Eliminates a copy of `jac`: the `m` pivot columns (largest remaining entry first, lowest
+    /// index on ties) are the chosen dependent coordinates. Returns `ln |det|` of the chosen
+    /// block (the sum of the logarithms of the pivot magnitudes), or `Err(k)` if the `k`-th
+    /// pivot is at most `1e-10` of the largest entry (or NaN): `Phi_q` is rank deficient.
+    pub(crate) fn eliminate(&mut self, jac: &DMatrix<f64>) -> Result<f64, usize> {
+        let (m, n) = (self.rows.len(), self.cols.len());
+        let j = &mut self.j;
+        j.copy_from(jac);
+        for (i, r) in self.rows.iter_mut().enumerate() {
+            *r = i;
+        }
+        for (i, c) in self.cols.iter_mut().enumerate() {
+            *c = i;
+        }
+        let scale = max_abs(j.as_slice());
+        let mut log_det = 0.0;
+        for k in 0..m {
+            // complete pivoting over the remaining block
+            let (mut pr, mut pc, mut best) = (k, k, -1.0f64);
+            for ri in k..m {
+                for ci in k..n {
+                    let v = j[(self.rows[ri], self.cols[ci])].abs();
+                    // strict `>` keeps the lowest index on ties: deterministic
+                    if v > best {
+                        best = v;
+                        pr = ri;
+                        pc = ci;
+                    }
+                }
+            }
+            if best.is_nan() || best <= 1e-10 * scale.max(f64::MIN_POSITIVE) {
+                return Err(k);
+            }
+            self.rows.swap(k, pr);
+            self.cols.swap(k, pc);
+            log_det += best.ln();
+            let (r0, c0) = (self.rows[k], self.cols[k]);
+            let p = j[(r0, c0)];
+            for &r in &self.rows[k + 1..] {
+                let l = j[(r, c0)] / p;
+                if l != 0.0 {
+                    for &c in &self.cols[k..] {
+                        let v = j[(r0, c)];
+                        j[(r, c)] -= l * v;
+                    }
+                }
+            }
+        }
+        Ok(log_det)
+    }
+
+    /// The partition chosen by the last successful [`Pivoting::eliminate`].
+    pub(crate) fn partition(&self) -> Partition {
+        let m = self.rows.len();
+        let mut dependent = self.cols[..m].to_vec();
+        let mut independent = self.cols[m..].to_vec();
+        dependent.sort_unstable();
+        independent.sort_unstable();
+        Partition {
+            independent,
+            dependent,
         }
     }
 }

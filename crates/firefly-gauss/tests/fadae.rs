@@ -4,6 +4,7 @@ use mbd_analysis::{fit_order, MeasureObserver};
 use mbd_firefly_gauss::{
     FaDaeError, FaDaeOptions, FireflyGauss, MissPolicy, PartitionChoice, Predictor,
 };
+use mbd_model::numeric::max_abs_diff;
 use mbd_model::{models, System};
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Integrator, NoObserver, Recorder, RunConfig,
@@ -110,10 +111,7 @@ fn same_seed_same_bits_and_parallel_equals_serial() {
     assert_eq!(fa.stats(), fc.stats());
     let (d, _) = run_to(&sys, o.seed(43), 0.3, 0.01);
     assert_ne!(bits(&a), bits(&d), "another seed takes another path");
-    let diff =
-        a.q.iter()
-            .zip(d.q.iter())
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let diff = max_abs_diff(a.q.as_slice(), d.q.as_slice());
     assert!(diff < 1e-9, "but lands on the same solution: {diff:e}");
 }
 
@@ -124,10 +122,8 @@ fn same_seed_same_bits_and_parallel_equals_serial() {
 fn offset_predictor_lands_on_the_same_solution() {
     let sys = manipulator();
     let d = |a: &State, b: &State| {
-        a.q.iter()
-            .zip(b.q.iter())
-            .chain(a.v.iter().zip(b.v.iter()))
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        max_abs_diff(a.q.as_slice(), b.q.as_slice())
+            .max(max_abs_diff(a.v.as_slice(), b.v.as_slice()))
     };
     for offset in [0.5, -0.7, 0.9] {
         let mut s = start(&sys);
@@ -184,6 +180,13 @@ fn optimiser_does_the_work_ratio_above_100() {
     assert!(st.mean_ratio() > 100.0, "{st:?}");
     assert_eq!(st.target_misses, 0, "{st:?}");
     assert!(st.ratio_count >= 90, "{st:?}");
+    // the x, y columns (entries 1) stay the best dependent block: never re-chosen
+    assert_eq!(st.repartitions, 0, "{st:?}");
+    assert!(
+        fa.last_step().partition_quality > 0.99,
+        "{:?}",
+        fa.last_step()
+    );
     // and the predictor alone is not the answer: with the plain RK4 predictor and no
     // correction the firefly still reduces the objective a hundredfold
     let o = FaDaeOptions {
@@ -206,11 +209,7 @@ fn polished_variant_has_order_four() {
     let mut errs = Vec::new();
     for &h in &hs {
         let (s, _) = run_to(&sys, FaDaeOptions::polished(), t_end, h);
-        errs.push(
-            s.q.iter()
-                .zip(&qref)
-                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs())),
-        );
+        errs.push(max_abs_diff(s.q.as_slice(), &qref));
     }
     let fit = fit_order(&hs, &errs, 1e-13).unwrap();
     assert!((fit.order - 4.0).abs() < 0.6, "{errs:?} {fit:?}");
@@ -254,6 +253,24 @@ fn bad_inputs_are_errors() {
     let mut o = FaDaeOptions::default();
     o.bounds.safety = f64::INFINITY;
     assert!(matches!(mk(o), Err(FaDaeError::InvalidOption { .. })));
+    // above 0.5 a fresh partition could be replaced without having worsened twofold
+    for bad in [f64::NAN, -0.1, 0.6, 1.0] {
+        let o = FaDaeOptions {
+            repartition_threshold: bad,
+            ..FaDaeOptions::default()
+        };
+        assert!(
+            matches!(mk(o), Err(FaDaeError::InvalidOption { name, .. }) if name == "repartition_threshold"),
+            "{bad}"
+        );
+    }
+    for good in [0.0, 0.5] {
+        let o = FaDaeOptions {
+            repartition_threshold: good,
+            ..FaDaeOptions::default()
+        };
+        assert!(mk(o).is_ok(), "{good}");
+    }
     for ind in [vec![2], vec![2, 6], vec![2, 2], vec![0, 1]] {
         // wrong count, out of range, duplicate, singular dependent block (x1, y1 free)
         let o = FaDaeOptions::default().partition(PartitionChoice::Given(ind.clone()));
