@@ -35,54 +35,27 @@ struct PaperRow {
     runtime: f64,
 }
 
-fn paper_table1() -> Vec<PaperRow> {
-    let c = |e_h, mre_h, runtime| PaperRow {
-        h: 0.0,
-        e_h,
-        mre_h,
-        e_phi: PaperValue::Value(1.1102e-16),
-        e_phidot: PaperValue::Value(8.8817e-16),
-        e_phiddot: PaperValue::Value(2.8421e-14),
-        runtime,
-    };
-    vec![
-        PaperRow {
-            h: 0.002,
-            ..c(
-                PaperValue::Illegible("2.8782e-?"),
-                PaperValue::Illegible("3.2808e-?"),
-                2.9e4,
-            )
-        },
-        PaperRow {
-            h: 0.005,
-            ..c(
-                PaperValue::Value(1.8150e-4),
-                PaperValue::Illegible("3.7283e-?"),
-                1.2e4,
-            )
-        },
-        PaperRow {
-            h: 0.01,
-            ..c(
-                PaperValue::Value(7.4496e-3),
-                PaperValue::Value(1.3995e-3),
-                8.8e3,
-            )
-        },
-    ]
+fn paper_row(r: &'static crate::paper_values::PaperCRow) -> PaperRow {
+    PaperRow {
+        h: r.h,
+        e_h: r.e_h.value(),
+        mre_h: r.mre_h.value(),
+        e_phi: r.e_phi.value(),
+        e_phidot: r.e_phidot.value(),
+        e_phiddot: r.e_phiddot.value(),
+        runtime: r.runtime,
+    }
 }
 
-fn paper_rk4() -> PaperRow {
-    PaperRow {
-        h: 0.01,
-        e_h: PaperValue::Value(9.0827e-2),
-        mre_h: PaperValue::Value(2.8464e-2),
-        e_phi: PaperValue::Illegible("4.0164e-?"),
-        e_phidot: PaperValue::Illegible("4.2045e-?"),
-        e_phiddot: PaperValue::Illegible("7.8160e-?"),
-        runtime: 0.5167,
-    }
+/// Paper C's Table 1 rows (from `xtask/data/paper_values.json`).
+fn paper_table1() -> Result<Vec<PaperRow>, String> {
+    let v = crate::paper_values::get()?;
+    Ok(v.paper_c.table1.rows.iter().map(paper_row).collect())
+}
+
+/// Paper C's RK4 row of Table 2.
+fn paper_rk4() -> Result<PaperRow, String> {
+    Ok(paper_row(&crate::paper_values::get()?.paper_c.rk4))
 }
 
 /// Paper C's measures plus the acceleration residual from the refined index-1 solve and,
@@ -176,7 +149,9 @@ fn simulate(
     let mut obs = PcObserver::new(sys, stride);
     let cpu0 = thread_cpu_seconds();
     let t = Instant::now();
-    run(integ, sys, &mut s, RunConfig::new(t_end, h), &mut obs)
+    // paper C's RK4 row measures the drift of unstabilised RK4: no drift guard
+    let cfg = RunConfig::new(t_end, h).without_drift_guard();
+    run(integ, sys, &mut s, cfg, &mut obs)
         .map_err(|e| format!("{} at h = {h}: {e}", integ.name()))?;
     let wall = t.elapsed().as_secs_f64();
     let runtime = match (cpu0, thread_cpu_seconds()) {
@@ -283,7 +258,7 @@ fn table1_rows(ctx: &Ctx, polish: bool, series_for: Option<f64>) -> Result<Vec<R
     let sys = models::manipulator().map_err(|e| e.to_string())?;
     let t_end = if ctx.quick { QUICK_TIME } else { PAPER_TIME };
     let mut rows = Vec::new();
-    for p in paper_table1() {
+    for p in paper_table1()? {
         let steps = (t_end / p.h).round() as usize;
         let stride = if series_for == Some(p.h) {
             (steps / 4000).max(1)
@@ -302,7 +277,7 @@ fn table1_section(ctx: &Ctx, polish: bool) -> Result<Section, String> {
     settings(&mut sec, ctx, t_end);
     let fig_h = 0.002;
     let rows = table1_rows(ctx, polish, (!polish).then_some(fig_h))?;
-    let paper = paper_table1();
+    let paper = paper_table1()?;
     let runtime_header = format!("runtime [s] ({}, one core)", runtime_clock());
     let mut table = Table::new(
         format!(
@@ -570,11 +545,11 @@ fn table2(ctx: &Ctx) -> Result<Section, String> {
     let (ft, stt) = fadae(&sys, paper_opts, t_end, h, 0)?;
     let mut rk = Rk4::new(&sys, Rk4Options::plain()).map_err(|e| e.to_string())?;
     let rk4 = simulate(&sys, &mut rk, t_end, h, 0)?;
-    let pfa = paper_table1()
+    let pfa = paper_table1()?
         .into_iter()
         .find(|p| p.h == h)
         .ok_or("paper row")?;
-    let prk = paper_rk4();
+    let prk = paper_rk4()?;
     let mut table = Table::new(
         format!("Table 2: methods at the same step h = {h} s, {t_end} s"),
         &[
@@ -640,15 +615,24 @@ fn table2(ctx: &Ctx) -> Result<Section, String> {
             fmt_e(rk4.m.e_phidot)
         ),
     ));
-    sec.claims.push(Claim::check(
+    let energy_claim = Claim::check(
         "FA-DAE's energy error is below RK4's at the same step (Table 2)",
         fa.m.e_h < rk4.m.e_h,
         format!(
-            "e(H): FA-DAE {}, RK4 {} (paper: 7.4496e-3 vs 9.0827e-2)",
+            "e(H): FA-DAE {}, RK4 {} (paper: {} vs {})",
             fmt_e(fa.m.e_h),
-            fmt_e(rk4.m.e_h)
+            fmt_e(rk4.m.e_h),
+            pfa.e_h.cell(),
+            prk.e_h.cell()
         ),
-    ));
+    );
+    sec.claims.push(if ctx.quick {
+        energy_claim.expected_miss(
+            "quick mode runs 2 s instead of the paper's 20 s: RK4's energy error, which grows with time, is still small",
+        )
+    } else {
+        energy_claim
+    });
     sec.notes.push(format!(
         "With the paper's settings (epsilon = {paper_tol:e} as the relative target) the firefly needs {:.1} generations per step instead of the project default's {:.1} (objective ratio {:.3e}); its e(H) approaches the polished variant's, at {:.0}x the paper's speed instead of {:.0}x.",
         stt.mean_generations(),

@@ -8,7 +8,6 @@ use std::sync::OnceLock;
 const DATA: &str = include_str!("../data/paper_values.json");
 
 /// A cell of a paper's table: a number, or the legible part of an illegible one.
-#[allow(dead_code)] // paper C's tables are read by paper_c.rs (being moved onto this file)
 #[derive(Clone, Debug, Deserialize)]
 #[serde(untagged)]
 pub enum Cell {
@@ -20,7 +19,6 @@ pub enum Cell {
 
 impl Cell {
     /// As a report value.
-    #[allow(dead_code)] // see `Cell`
     pub fn value(&'static self) -> PaperValue {
         match self {
             Cell::Num(x) => PaperValue::Value(*x),
@@ -59,7 +57,6 @@ pub struct PaperA {
 }
 
 /// A row of paper C's tables.
-#[allow(dead_code)] // see `Cell`
 #[derive(Clone, Debug, Deserialize)]
 pub struct PaperCRow {
     /// Step size.
@@ -79,7 +76,6 @@ pub struct PaperCRow {
 }
 
 /// Paper C's tables.
-#[allow(dead_code)] // see `Cell`
 #[derive(Clone, Debug, Deserialize)]
 pub struct PaperC {
     /// Table 1 (FA-DAE rows).
@@ -89,7 +85,6 @@ pub struct PaperC {
 }
 
 /// Everything in the data file.
-#[allow(dead_code)] // see `Cell`
 #[derive(Clone, Debug, Deserialize)]
 pub struct PaperValues {
     /// References.
