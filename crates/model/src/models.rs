@@ -311,3 +311,118 @@ pub fn four_bar() -> Result<System, ModelError> {
     ));
     b.build()
 }
+
+/// A parallelogram four-bar (closed loop): ground pivots `A0 = (0, 0)` and `B0 = (ground, 0)`,
+/// crank and rocker of length `crank`, coupler of length `ground` (1 kg uniform rods), gravity
+/// -y, on the parallelogram branch (rocker parallel to the crank, coupler horizontal).
+///
+/// * `crank` — crank and rocker length (m), positive and finite;
+/// * `ground` — ground link and coupler length (m), positive and finite;
+/// * `angle` — initial crank angle (rad), finite and not a flat configuration
+///   (`|sin(angle)| >= 1e-6`);
+/// * `speed` — initial crank speed (rad/s), finite; the state is consistent as built;
+/// * `driven` — drive the crank at constant `speed` (an angle driver `crank_drive` from
+///   `angle`: rheonomic, no degree of freedom left).
+///
+/// Joints `A0` (ground-crank), `A` (crank-coupler), `B` (coupler-rocker) and `B0`
+/// (rocker-ground); the rocker's body x-axis points from `B0` to `B`. At crank angles `0` and
+/// `pi` all links are collinear (the *flat* configurations): `Phi_q` loses rank there (the
+/// closing loop's equations become dependent) and the parallelogram branch crosses the crossed
+/// (anti-parallelogram) branch. Free, released at `speed`, the crank turns through them if its
+/// kinetic energy `(2/3 crank^2 + 1/2 crank^2) speed^2 / 2` exceeds the potential rise
+/// `2 g crank (1 - sin(angle))` to the top.
+pub fn parallelogram_four_bar(
+    crank: f64,
+    ground: f64,
+    angle: f64,
+    speed: f64,
+    driven: bool,
+) -> Result<System, ModelError> {
+    let bad = |parameter: &'static str, value: f64, reason: &'static str| {
+        Err(ModelError::InvalidParameter {
+            element: "parallelogram four-bar".into(),
+            parameter,
+            value,
+            reason,
+        })
+    };
+    let (l, d, th, w) = (crank, ground, angle, speed);
+    for (name, v) in [("crank", l), ("ground", d)] {
+        if !(v.is_finite() && v > 0.0) {
+            return bad(name, v, "must be positive and finite");
+        }
+    }
+    for (name, v) in [("angle", th), ("speed", w)] {
+        if !v.is_finite() {
+            return bad(name, v, "must be finite");
+        }
+    }
+    let (s, c) = th.sin_cos();
+    if s.abs() < 1e-6 {
+        return bad(
+            "angle",
+            th,
+            "is a flat configuration (all links collinear, Phi_q rank deficient)",
+        );
+    }
+    let a = [l * c, l * s];
+    // crank and rocker: centre of mass velocity (-l/2 sin, l/2 cos) w; coupler translates with A
+    let vh = [-0.5 * l * s * w, 0.5 * l * c * w];
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, -9.81]);
+    let crank_b = b.add_body(
+        Body::new("crank")
+            .rod(1.0, l)
+            .position(0.5 * a[0], 0.5 * a[1], th)
+            .velocity(vh[0], vh[1], w),
+    );
+    let coupler = b.add_body(
+        Body::new("coupler")
+            .rod(1.0, d)
+            .position(a[0] + 0.5 * d, a[1], 0.0)
+            .velocity(2.0 * vh[0], 2.0 * vh[1], 0.0),
+    );
+    let rocker = b.add_body(
+        Body::new("rocker")
+            .rod(1.0, l)
+            .position(d + 0.5 * a[0], 0.5 * a[1], th)
+            .velocity(vh[0], vh[1], w),
+    );
+    b.add_joint(Joint::revolute(
+        "A0",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        crank_b,
+        [-0.5 * l, 0.0],
+    ));
+    b.add_joint(Joint::revolute(
+        "A",
+        crank_b,
+        [0.5 * l, 0.0],
+        coupler,
+        [-0.5 * d, 0.0],
+    ));
+    b.add_joint(Joint::revolute(
+        "B",
+        coupler,
+        [0.5 * d, 0.0],
+        rocker,
+        [0.5 * l, 0.0],
+    ));
+    b.add_joint(Joint::revolute(
+        "B0",
+        BodyRef::Ground,
+        [d, 0.0],
+        rocker,
+        [-0.5 * l, 0.0],
+    ));
+    if driven {
+        b.add_joint(Joint::angle_driver(
+            "crank_drive",
+            BodyRef::Ground,
+            crank_b,
+            TimeFunction::linear(th, w),
+        ));
+    }
+    b.build()
+}
