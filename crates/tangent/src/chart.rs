@@ -225,6 +225,12 @@ pub struct TangentChart {
     exact_maps: usize,
     /// `min |R_ii| / max |R_ii|` at the last centre.
     rcond: f64,
+    /// Work space of the rank report: `Phi_q^T` (`n x m`) and its pivoted QR, the column
+    /// permutation, the column norms and a Householder vector.
+    rr: Vec<f64>,
+    perm: Vec<usize>,
+    norms: Vec<f64>,
+    hv: Vec<f64>,
     /// Relative threshold on the diagonal of `R` below which `Df(x_c)` counts as rank deficient.
     pub singular_tol: f64,
     centred: bool,
@@ -283,6 +289,10 @@ impl TangentChart {
             piv: vec![0; mm],
             exact_maps: 0,
             rcond: 1.0,
+            rr: vec![0.0; n * m],
+            perm: vec![0; m],
+            norms: vec![0.0; m],
+            hv: vec![0.0; n],
             singular_tol: 1e-8,
             centred: false,
         }
@@ -555,17 +565,20 @@ impl TangentChart {
     fn rank_report(&mut self, sys: &System, t: f64, rel_tol: f64) -> Option<SolveError> {
         let (n, m) = (self.n, self.m);
         // Phi_q^T (n x m), column j = row j of Phi_q
+        // (allocation-free unless rank deficient: the report's strings)
         let pq = self.pq_x.as_slice();
-        let mut a = vec![0.0; n * m];
+        let a = &mut self.rr;
         for j in 0..m {
             for c in 0..n {
                 a[j * n + c] = pq[c * m + j];
             }
         }
-        let mut perm: Vec<usize> = (0..m).collect();
-        let mut norms: Vec<f64> = (0..m)
-            .map(|j| dot(&a[j * n..(j + 1) * n], &a[j * n..(j + 1) * n]))
-            .collect();
+        let perm = &mut self.perm;
+        for (j, p) in perm.iter_mut().enumerate() {
+            *p = j;
+        }
+        let norms = &mut self.norms;
+        let v = &mut self.hv;
         let mut r00 = 0.0f64;
         let mut rank = m;
         for k in 0..m {
@@ -592,14 +605,15 @@ impl TangentChart {
             // Householder reflector on rows k..n of column k, applied to the columns after it
             let x0 = a[k * n + k];
             let beta = if x0 >= 0.0 { -col_norm } else { col_norm };
-            let mut v: Vec<f64> = a[k * n + k..(k + 1) * n].to_vec();
+            let v = &mut v[..n - k];
+            v.copy_from_slice(&a[k * n + k..(k + 1) * n]);
             v[0] -= beta;
-            let vv = dot(&v, &v);
+            let vv = dot(v, v);
             if vv > 0.0 {
                 for j in k + 1..m {
                     let cj = &mut a[j * n + k..(j + 1) * n];
-                    let s = 2.0 * dot(&v, cj) / vv;
-                    axpy(-s, &v, cj);
+                    let s = 2.0 * dot(v, cj) / vv;
+                    axpy(-s, v, cj);
                 }
             }
             a[k * n + k] = beta;

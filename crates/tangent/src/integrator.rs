@@ -296,6 +296,11 @@ enum Attempt {
     /// The index-1 solve at a stage point after the first was singular: the stage point landed
     /// (numerically) on a singular configuration the step passes; another step size moves it.
     Stage(SolveError),
+    /// A stage at the step's end time, or the end point, is (numerically) a singular
+    /// configuration ([`SolveError::Singular`] with rank and joints): halving keeps the end
+    /// time, and with it the configuration, so fixed steps stop at once; an adaptive step
+    /// changes its end time and retries.
+    SingularEnd(SolveError),
     /// Anything else (singular configuration, bad model): returned as is.
     Hard(SolveError),
 }
@@ -379,7 +384,7 @@ const HISTORY: usize = 3;
 /// (`min |R_ii|` is about the distance to the singularity); the paper's `eta = R^-1 zeta` then
 /// varies too fast for polynomial extrapolation, and a stage point off the manifold changes the
 /// index-1 acceleration by about `1 / min |R_ii|` times its residual.
-const RCOND_DRIFT: f64 = 1.5;
+const RCOND_DRIFT: f64 = 2.0;
 
 /// Per-attempt work counts.
 #[derive(Clone, Copy, Debug, Default)]
@@ -614,7 +619,7 @@ impl TangentRk {
             end_initial_residual: f64::NAN,
             ..AttemptWork::default()
         };
-        let mut failure: Option<ChartFailure> = None;
+        let mut failure: Option<(ChartFailure, usize)> = None;
         let mut singular_stage: Option<usize> = None;
         let mut stage = 0usize;
         self.xi.fill(0.0);
@@ -705,7 +710,7 @@ impl TangentRk {
                         work.residual = ms.residual;
                     }
                     Err(e) => {
-                        *failure = Some(e);
+                        *failure = Some((e, i));
                         // a cheap sentinel (no allocation); the caller reads `failure`
                         return Err(SolveError::NonFinite {
                             t: ti,
@@ -748,7 +753,19 @@ impl TangentRk {
             };
             if let Err(e) = self.rk.step(&mut rhs, t, &mut self.xi, h) {
                 return Err(match (failure.take(), *singular_stage) {
-                    (Some(f), _) => Attempt::Chart(f),
+                    // a map at the step's end time that failed at a singular configuration
+                    (Some((f, i)), _) if self.c_coef[i] == 1.0 => {
+                        match self.chart.singular_error_at(
+                            sys,
+                            &self.x[..n],
+                            t + h,
+                            SINGULAR_REPORT_TOL,
+                        ) {
+                            Some(e) => Attempt::SingularEnd(e),
+                            None => Attempt::Chart(f),
+                        }
+                    }
+                    (Some((f, _)), _) => Attempt::Chart(f),
                     // the step's start point itself: a singular configuration, reported with
                     // the numerical rank and the joints of the dependency
                     (None, Some(0)) => Attempt::Hard(
@@ -756,9 +773,8 @@ impl TangentRk {
                             .singular_error(sys, t, SINGULAR_REPORT_TOL)
                             .unwrap_or(e),
                     ),
-                    // a stage at the step's end time: halving keeps that time (and, for a
-                    // driven mechanism, that configuration), so it is an error at once
-                    (None, Some(i)) if self.c_coef[i] == 1.0 => Attempt::Hard(
+                    // a stage at the step's end time
+                    (None, Some(i)) if self.c_coef[i] == 1.0 => Attempt::SingularEnd(
                         self.chart
                             .singular_error_at(sys, &self.x[..n], t + h, SINGULAR_REPORT_TOL)
                             .unwrap_or(e),
@@ -792,7 +808,19 @@ impl TangentRk {
                     work.residual = ms.residual;
                     work.end_initial_residual = ms.initial_residual;
                 }
-                Err(e) => return Err(Attempt::Chart(e)),
+                Err(f) => {
+                    return Err(
+                        match self.chart.singular_error_at(
+                            sys,
+                            &self.xnew[..n],
+                            t1,
+                            SINGULAR_REPORT_TOL,
+                        ) {
+                            Some(e) => Attempt::SingularEnd(e),
+                            None => Attempt::Chart(f),
+                        },
+                    )
+                }
             }
             self.chart
                 .eta_from_zeta(&self.zeta, &mut self.eta_now[s * mm..(s + 1) * mm]);
@@ -865,11 +893,11 @@ impl TangentRk {
                 } else {
                     Err(match fail {
                         Attempt::Chart(f) => f.into_error(),
-                        Attempt::Stage(e) | Attempt::Hard(e) => e,
+                        Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
                     })
                 }
             }
-            Err(Attempt::Hard(e)) => Err(e),
+            Err(Attempt::Hard(e) | Attempt::SingularEnd(e)) => Err(e),
         }
     }
 
@@ -1057,7 +1085,7 @@ impl TangentRk {
                         h = hs * grow.clamp(ctrl.fac_min, 1.0);
                     }
                 }
-                Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_))) => {
+                Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_))) => {
                     self.stats.chart_failures += 1;
                     st.chart_rejections += 1;
                     chart_failures_here += 1;
@@ -1067,7 +1095,7 @@ impl TangentRk {
                         return Err(TangentError::Chart {
                             source: match fail {
                                 Attempt::Chart(f) => f.into_error(),
-                                Attempt::Stage(e) | Attempt::Hard(e) => e,
+                                Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
                             },
                             h: hs,
                             failures: chart_failures_here,
