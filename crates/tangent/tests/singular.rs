@@ -279,3 +279,30 @@ fn singular_start_is_a_typed_error_at_once_in_both_modes() {
     assert_eq!(dp.stats().chart_failures, 0);
     assert_eq!(s, s0);
 }
+
+#[test]
+fn parallelogram_four_bar_parameters_are_checked() {
+    let bad = [
+        (0.0, 1.0, 1.0, 6.0, "crank"),
+        (0.4, f64::NAN, 1.0, 6.0, "ground"),
+        (0.4, 1.0, std::f64::consts::PI, 6.0, "angle"),
+        (0.4, 1.0, 0.0, 6.0, "angle"),
+        (0.4, 1.0, f64::INFINITY, 6.0, "angle"),
+        (0.4, 1.0, 1.0, f64::NAN, "speed"),
+    ];
+    for (l, d, th, w, name) in bad {
+        match models::parallelogram_four_bar(l, d, th, w, false) {
+            Err(mbd_model::ModelError::InvalidParameter { parameter, .. }) => {
+                assert_eq!(parameter, name)
+            }
+            other => panic!("{name}: expected an invalid parameter, got {other:?}"),
+        }
+    }
+    // as built, the state is consistent (on the parallelogram branch)
+    let sys = free_four_bar();
+    let (q, v) = sys.initial_guess();
+    let s = State::new(&sys, 0.0, q, v).expect("state");
+    let mut buf = [vec![], vec![]];
+    let (p, d) = common::residuals(&sys, &s, &mut buf);
+    assert!(p < 1e-15 && d < 1e-15, "{p} {d}");
+}
