@@ -7,13 +7,17 @@
 //!     target/release/examples/step_count tangent 0.01 1000
 //! ```
 //!
-//! Arguments: `tangent` | `plain`, the step `h` (default 0.01), the number of steps (default
+//! Arguments: `tangent` | `plain` (or `tangent-run` | `plain-run`: the same steps through
+//! `mbd_solve::run`, which passes each step `h = t_next - t`), the step `h` (default 0.01), the number of steps (default
 //! `10 / h`, the first 10 s of motion, as the benchmark cycles through), and the iteration
 //! matrix `centre`, `interpolated` or `broyden` ([`IterationMatrix`], tangent only; default:
 //! the solver's default). Prints the chord iterations and Broyden updates per step of the
 //! tangent solver.
 use mbd_model::{models, System};
-use mbd_solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, SolveError, State};
+use mbd_solve::{
+    run, ButcherTableau, Index1Options, Index1Rk, Integrator, NoObserver, RunConfig, SolveError,
+    State,
+};
 use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
 
 #[inline(never)]
@@ -23,7 +27,14 @@ fn run_steps<I: Integrator>(
     s: &mut State,
     h: f64,
     steps: usize,
+    through_run: bool,
 ) -> Result<(), SolveError> {
+    if through_run {
+        // mbd_solve::run: times t0 + k h, each step passed h = t_next - t
+        let cfg = RunConfig::new(s.t + steps as f64 * h, h);
+        run(integ, sys, s, cfg, &mut NoObserver)?;
+        return Ok(());
+    }
     for _ in 0..steps {
         integ.step(sys, s, h)?;
     }
@@ -33,6 +44,9 @@ fn run_steps<I: Integrator>(
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let which = args.next().unwrap_or_else(|| "tangent".into());
+    // `plain-run` / `tangent-run`: the same steps through `mbd_solve::run`
+    let through_run = which.ends_with("-run");
+    let which = which.trim_end_matches("-run").to_string();
     let h: f64 = match args.next() {
         Some(a) => a.parse()?,
         None => 0.01,
@@ -46,7 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     match which.as_str() {
         "plain" => {
             let mut p = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
-            run_steps(&mut p, &sys, &mut s, h, steps)?;
+            run_steps(&mut p, &sys, &mut s, h, steps, through_run)?;
             println!("plain RK4: {steps} steps of {h}, t = {}", s.t);
         }
         _ => {
@@ -60,7 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..Default::default()
             };
             let mut t = TangentRk::new(&sys, ButcherTableau::rk4(), opts)?;
-            run_steps(&mut t, &sys, &mut s, h, steps)?;
+            run_steps(&mut t, &sys, &mut s, h, steps, through_run)?;
             let st = t.stats();
             let (upd, resets) = t.chart().broyden_counts();
             println!(

@@ -1,6 +1,7 @@
 //! The local chart of the constraint manifold at an accepted point (paper B's "local
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
+use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::{AngleCache, System};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
@@ -24,6 +25,16 @@ pub struct NewtonSettings {
     /// Divergence test: an iteration whose residual exceeds `divergence` times the previous one
     /// ends the iteration with a [`ChartFailure`] (the point has left the chart's domain).
     pub divergence: f64,
+    /// Near-singular charts: a chord iteration that fails is retried by Newton's method with
+    /// the exact matrix `Df(x) Q1` at every iterate (one `Df` and a `2m x 2m` LU per
+    /// iteration) when `Df` at the starting point differs from `Df(x_c)` by at most
+    /// `fallback_change` relative (`max |Df(x) - Df(x_c)| <= fallback_change max |Df(x_c)|`).
+    /// Then the step is small for the geometry and the chord failed because `Df(x_c)` is
+    /// nearly rank deficient (its smallest singular value is of the size of the change), as
+    /// near a singular configuration: shorter steps would not help there. A larger change
+    /// means the step is too large for the chart, which stays a [`ChartFailure`] (halving or
+    /// rejection). Default 0.1; 0 turns the fallback off.
+    pub fallback_change: f64,
 }
 
 impl Default for NewtonSettings {
@@ -32,12 +43,14 @@ impl Default for NewtonSettings {
             tol: 1e-13,
             max_iter: 50,
             divergence: 2.0,
+            fallback_change: 0.1,
         }
     }
 }
 
 impl NewtonSettings {
-    /// Checks the settings: `tol` positive and finite, `max_iter >= 1`, `divergence >= 1`.
+    /// Checks the settings: `tol` positive and finite, `max_iter >= 1`, `divergence >= 1`,
+    /// `fallback_change` finite and non-negative.
     pub fn validate(&self) -> Result<(), SolveError> {
         if !(self.tol.is_finite() && self.tol > 0.0) {
             return Err(SolveError::InvalidParameter {
@@ -58,6 +71,13 @@ impl NewtonSettings {
                 parameter: "newton.divergence",
                 value: self.divergence,
                 reason: "must be finite and at least 1",
+            });
+        }
+        if !(self.fallback_change.is_finite() && self.fallback_change >= 0.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "newton.fallback_change",
+                value: self.fallback_change,
+                reason: "must be finite and non-negative",
             });
         }
         Ok(())
@@ -98,6 +118,9 @@ pub struct MapStats {
     pub residual: f64,
     /// `||f||_inf` at the starting point, before the first iteration.
     pub initial_residual: f64,
+    /// Whether the chord iteration failed and Newton's method with the exact matrix took over
+    /// ([`NewtonSettings::fallback_change`]); `iterations` then counts both.
+    pub exact: bool,
 }
 
 /// A chart of the manifold `f(x, t) = (Phi(q, t), Phi_q v + Phi_t) = 0` at a centre
@@ -190,6 +213,24 @@ pub struct TangentChart {
     s: f64,
     /// `sin`/`cos` of the body angles of the last residual evaluation of a map.
     angles: AngleCache,
+    /// The starting point of the map in progress (`2n`), for the exact Newton fallback.
+    x0: Vec<f64>,
+    /// `Phi_q` and `(Phi_q v)_q` at an iterate of the exact Newton fallback.
+    pq_x: DMatrix<f64>,
+    dphi_x: DMatrix<f64>,
+    /// `Df(x) Q1` (`2m x 2m`, column-major) and its LU factors, with the row pivots.
+    jn: Vec<f64>,
+    piv: Vec<usize>,
+    /// Maps completed by the exact Newton fallback since the chart was created.
+    exact_maps: usize,
+    /// `min |R_ii| / max |R_ii|` at the last centre.
+    rcond: f64,
+    /// Work space of the rank report: `Phi_q^T` (`n x m`) and its pivoted QR, the column
+    /// permutation, the column norms and a Householder vector.
+    rr: Vec<f64>,
+    perm: Vec<usize>,
+    norms: Vec<f64>,
+    hv: Vec<f64>,
     /// Relative threshold on the diagonal of `R` below which `Df(x_c)` counts as rank deficient.
     pub singular_tol: f64,
     centred: bool,
@@ -241,6 +282,17 @@ impl TangentChart {
             broyden_updates: 0,
             broyden_resets: 0,
             s: 0.0,
+            x0: vec![0.0; nn],
+            pq_x: DMatrix::zeros(m, n),
+            dphi_x: DMatrix::zeros(m, n),
+            jn: vec![0.0; mm * mm],
+            piv: vec![0; mm],
+            exact_maps: 0,
+            rcond: 1.0,
+            rr: vec![0.0; n * m],
+            perm: vec![0; m],
+            norms: vec![0.0; m],
+            hv: vec![0.0; n],
             singular_tol: 1e-8,
             centred: false,
         }
@@ -344,6 +396,7 @@ impl TangentChart {
         self.xc[..n].copy_from_slice(q);
         self.xc[n..].copy_from_slice(v);
         self.tc = t;
+        self.rcond = 1.0;
         if m == 0 {
             self.centred = true;
             return Ok(());
@@ -403,19 +456,24 @@ impl TangentChart {
             }
         }
         let dmax = (0..mm).fold(0.0f64, |d, i| d.max(self.a[i * nn + i].abs()));
+        let dmin = (0..mm).fold(f64::INFINITY, |d, i| d.min(self.a[i * nn + i].abs()));
+        self.rcond = dmin / dmax;
         for i in 0..mm {
             let rii = self.a[i * nn + i].abs();
             if rii.is_nan() || rii <= self.singular_tol * dmax {
-                let detail = if i < m {
-                    format!("position constraint {}", sys.equation_name(i))
-                } else {
-                    format!("velocity constraint {}", sys.equation_name(i - m))
-                };
-                return Err(SolveError::Singular {
-                    t,
-                    what: "constraint Jacobian Df of the tangent chart",
-                    detail,
-                });
+                let tol = self.singular_tol;
+                return Err(self.singular_error(sys, t, tol).unwrap_or_else(|| {
+                    let detail = if i < m {
+                        format!("position constraint {}", sys.equation_name(i))
+                    } else {
+                        format!("velocity constraint {}", sys.equation_name(i - m))
+                    };
+                    SolveError::Singular {
+                        t,
+                        what: "constraint Jacobian Df of the tangent chart",
+                        detail,
+                    }
+                }));
             }
         }
         form_q(&self.bq, &self.tau, n, m, 0, n, &mut self.qb);
@@ -465,6 +523,153 @@ impl TangentChart {
         }
         self.centred = true;
         Ok(())
+    }
+
+    /// A singular configuration at the last centre: the numerical rank of `Phi_q(q_c)` (`m x n`)
+    /// from a column-pivoted Householder QR of `Phi_q^T` (rank `r`: the pivots
+    /// `|R_kk| > rel_tol |R_00|`), the dependent equations (the pivots after `r`) and the
+    /// joints involved in the dependency (the rows with a weight above `1e-6` of the largest in
+    /// a left null vector `z`, `Phi_q^T z ~ 0`, of each dependent equation:
+    /// `z = P [R11^-1 R12 e_j; -e_j]`), as [`SolveError::Singular`]
+    /// (`what` = `"configuration (rank-deficient constraint Jacobian Phi_q)"`, `detail` =
+    /// `"rank r of m; dependent equations ...; joints ..."`). `None` if `Phi_q` has full
+    /// rank at that threshold or was not evaluated. Allocates (an error path).
+    pub fn singular_error(&mut self, sys: &System, t: f64, rel_tol: f64) -> Option<SolveError> {
+        let (n, m) = (self.n, self.m);
+        if m == 0 || m > n {
+            return None;
+        }
+        self.pq_x.copy_from(&self.phi_q);
+        self.rank_report(sys, t, rel_tol)
+    }
+
+    /// [`TangentChart::singular_error`] for `Phi_q` at the configuration `q` (length `n`; e.g.
+    /// a stage point whose index-1 solve was singular). `None` if `Phi_q(q)` has full rank at
+    /// `rel_tol` or `q` has the wrong length.
+    pub fn singular_error_at(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        t: f64,
+        rel_tol: f64,
+    ) -> Option<SolveError> {
+        let (n, m) = (self.n, self.m);
+        if m == 0 || m > n || q.len() != n {
+            return None;
+        }
+        sys.phi_q(q, &mut self.pq_x);
+        self.rank_report(sys, t, rel_tol)
+    }
+
+    /// The rank report of `Phi_q` held in `pq_x`.
+    fn rank_report(&mut self, sys: &System, t: f64, rel_tol: f64) -> Option<SolveError> {
+        let (n, m) = (self.n, self.m);
+        // Phi_q^T (n x m), column j = row j of Phi_q
+        // (allocation-free unless rank deficient: the report's strings)
+        let pq = self.pq_x.as_slice();
+        let a = &mut self.rr;
+        for j in 0..m {
+            for c in 0..n {
+                a[j * n + c] = pq[c * m + j];
+            }
+        }
+        let perm = &mut self.perm;
+        for (j, p) in perm.iter_mut().enumerate() {
+            *p = j;
+        }
+        let norms = &mut self.norms;
+        let v = &mut self.hv;
+        let mut r00 = 0.0f64;
+        let mut rank = m;
+        for k in 0..m {
+            // pivot: the remaining column of largest norm (recomputed: tiny matrices)
+            for (j, nj) in norms.iter_mut().enumerate().skip(k) {
+                *nj = dot(&a[j * n + k..(j + 1) * n], &a[j * n + k..(j + 1) * n]);
+            }
+            let p = (k..m).fold(k, |p, j| if norms[j] > norms[p] { j } else { p });
+            if p != k {
+                for c in 0..n {
+                    a.swap(k * n + c, p * n + c);
+                }
+                perm.swap(k, p);
+                norms.swap(k, p);
+            }
+            let col_norm = norms[k].sqrt();
+            if k == 0 {
+                r00 = col_norm;
+            }
+            if col_norm.is_nan() || col_norm <= rel_tol * r00 || k >= n {
+                rank = k;
+                break;
+            }
+            // Householder reflector on rows k..n of column k, applied to the columns after it
+            let x0 = a[k * n + k];
+            let beta = if x0 >= 0.0 { -col_norm } else { col_norm };
+            let v = &mut v[..n - k];
+            v.copy_from_slice(&a[k * n + k..(k + 1) * n]);
+            v[0] -= beta;
+            let vv = dot(v, v);
+            if vv > 0.0 {
+                for j in k + 1..m {
+                    let cj = &mut a[j * n + k..(j + 1) * n];
+                    let s = 2.0 * dot(v, cj) / vv;
+                    axpy(-s, v, cj);
+                }
+            }
+            a[k * n + k] = beta;
+            for x in a[k * n + k + 1..(k + 1) * n].iter_mut() {
+                *x = 0.0;
+            }
+        }
+        if rank == m {
+            return None;
+        }
+        let mut dependent = Vec::new();
+        let mut joints: Vec<String> = Vec::new();
+        for j in rank..m {
+            // y = R11^-1 R12 e_j by back substitution (R11 = rank x rank upper triangle)
+            let mut y: Vec<f64> = (0..rank).map(|i| a[j * n + i]).collect();
+            for i in (0..rank).rev() {
+                let mut acc = y[i];
+                for k in i + 1..rank {
+                    acc -= a[k * n + i] * y[k];
+                }
+                y[i] = acc / a[i * n + i];
+            }
+            let wmax = max_abs(&y).max(1.0);
+            dependent.push(sys.equation_name(perm[j]));
+            let mut rows: Vec<usize> = vec![perm[j]];
+            rows.extend(
+                (0..rank)
+                    .filter(|&i| y[i].abs() > 1e-6 * wmax)
+                    .map(|i| perm[i]),
+            );
+            rows.sort_unstable();
+            for r in rows {
+                if let Some(h) = sys.equation_joint(r) {
+                    let name = sys.joints()[h.0].name.clone();
+                    if !joints.contains(&name) {
+                        joints.push(name);
+                    }
+                }
+            }
+        }
+        Some(SolveError::Singular {
+            t,
+            what: "configuration (rank-deficient constraint Jacobian Phi_q)",
+            detail: format!(
+                "rank {rank} of {m}; dependent equations {}; joints {}",
+                dependent.join(", "),
+                joints.join(", ")
+            ),
+        })
+    }
+
+    /// `min_i |R_ii| / max_i |R_ii|` of the last [`TangentChart::centre`] (1 without
+    /// constraints): a cheap estimate of the reciprocal condition number of `Df(x_c)`, small near
+    /// a singular configuration (the centre is an error below `singular_tol`).
+    pub fn rcond(&self) -> f64 {
+        self.rcond
     }
 
     /// Whether [`TangentChart::centre`] succeeded since the last attempt.
@@ -676,17 +881,23 @@ impl TangentChart {
         let mut f = std::mem::take(&mut self.f);
         // the first residual of a map is evaluated exactly, the iterates' with rotated sin/cos
         self.angles.invalidate();
+        self.x0.copy_from_slice(x);
         let res = self.residual_cached(sys, x, t, &mut f);
-        let out = if self.broyden && self.s == 0.0 {
+        let res_start = res;
+        let mut out = if self.broyden && self.s == 0.0 {
             self.chord_broyden(sys, t, x, newton, &mut f, res, predicted)
         } else {
             self.chord(sys, t, x, newton, &mut f, res, predicted)
         };
-        self.f = f;
-        if out.is_err() {
+        if let Err(failure) = out {
             // whatever the failure taught the matrix is suspect
             self.pb_active = false;
+            if newton.fallback_change > 0.0 {
+                x.copy_from_slice(&self.x0);
+                out = self.exact_newton(sys, t, x, newton, &mut f, failure, res_start);
+            }
         }
+        self.f = f;
         if out.is_ok() {
             for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
                 *d = xv - xc;
@@ -695,6 +906,127 @@ impl TangentChart {
             gemv_t_cols(&self.q[..mm * nn], &self.dx, &mut zeta[..mm]);
         }
         out
+    }
+
+    /// Maps completed by Newton's method with the exact matrix after the chord iteration failed
+    /// ([`NewtonSettings::fallback_change`]), since the chart was created.
+    pub fn exact_maps(&self) -> usize {
+        self.exact_maps
+    }
+
+    /// The fallback after a failed chord iteration from `x` (its starting point): if `Df(x)`
+    /// is within `fallback_change` (relative) of `Df(x_c)`, Newton's method along the normal
+    /// directions with the exact matrix `J = Df(x_k) Q1` at every iterate,
+    /// `x <- x - Q1 J^-1 f(x)`; otherwise `failure` as it was. Same stopping rules as the chord
+    /// iteration; a numerically singular `J` is a failure.
+    #[allow(clippy::too_many_arguments)]
+    fn exact_newton(
+        &mut self,
+        sys: &System,
+        t: f64,
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        f: &mut [f64],
+        failure: ChartFailure,
+        res_start: f64,
+    ) -> Result<MapStats, ChartFailure> {
+        let (n, m) = (self.n, self.m);
+        let (nn, mm) = (2 * n, 2 * m);
+        // start from the better of the caller's starting point and its projection onto the
+        // tangent plane, x_c + U xi (a history predictor can be far off near a singular
+        // configuration, where the chord failed)
+        for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
+            *d = xv - xc;
+        }
+        gemv_t_cols(&self.q[..mm * nn], &self.dx, &mut self.w);
+        self.step.copy_from_slice(x);
+        for wk in self.w.iter_mut() {
+            *wk = -*wk;
+        }
+        gemv_cols(&self.q[..mm * nn], &self.w, &mut self.step);
+        let res_tangent = self.residual(sys, &self.step, t, f);
+        if res_tangent < res_start || res_start.is_nan() {
+            x.copy_from_slice(&self.step);
+        }
+        sys.phi_q_dot_jacobian(&x[..n], &x[n..], &mut self.pq_x, &mut self.dphi_x);
+        let scale = max_abs(self.phi_q.as_slice()).max(max_abs(self.dphi.as_slice()));
+        let change = max_abs_diff(self.pq_x.as_slice(), self.phi_q.as_slice())
+            .max(max_abs_diff(self.dphi_x.as_slice(), self.dphi.as_slice()));
+        if change.is_nan() || change > newton.fallback_change * scale {
+            return Err(failure);
+        }
+        let tol = newton.tol;
+        let xmax = max_abs(x);
+        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
+        let res0 = self.residual(sys, x, t, f);
+        let mut res = res0;
+        let mut it = failure.iterations;
+        let max_iter = failure.iterations + newton.max_iter;
+        let mut first = true;
+        let done = |it: usize, res: f64| MapStats {
+            iterations: it,
+            residual: res,
+            initial_residual: res0,
+            exact: true,
+        };
+        loop {
+            if let Some(verdict) = loop_head(t, res, res0, it, tol, max_iter) {
+                if verdict.is_ok() {
+                    self.exact_maps += 1;
+                }
+                return verdict.map(|_| done(it, res));
+            }
+            if !first {
+                sys.phi_q_dot_jacobian(&x[..n], &x[n..], &mut self.pq_x, &mut self.dphi_x);
+            }
+            first = false;
+            // J = Df(x) Q1: column k = (Phi_q cq, X cq + Phi_q cv) for Q1_k = (cq, cv)
+            let (dp, dx) = (self.pq_x.as_slice(), self.dphi_x.as_slice());
+            self.jn.fill(0.0);
+            for k in 0..mm {
+                let col = &self.q[k * nn..(k + 1) * nn];
+                let (cq, cv) = col.split_at(n);
+                let (jp, jv) = self.jn[k * mm..(k + 1) * mm].split_at_mut(m);
+                gemv_cols(dp, cq, jp);
+                gemv_cols(dx, cq, jv);
+                gemv_cols(dp, cv, jv);
+            }
+            for (u, fk) in self.u.iter_mut().zip(f.iter()) {
+                *u = -fk;
+            }
+            if !lu_solve(&mut self.jn, &mut self.piv, &mut self.u, mm) {
+                if res <= stall_cap {
+                    // J numerically singular: x is at a singular configuration, with the
+                    // residual at the round-off floor (the next centre reports it)
+                    self.exact_maps += 1;
+                    return Ok(done(it, res));
+                }
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+            gemv_cols(&self.q[..mm * nn], &self.u, x);
+            it += 1;
+            let prev = res;
+            res = self.residual(sys, x, t, f);
+            if res > tol && res <= stall_cap && res >= 0.9 * prev {
+                self.exact_maps += 1;
+                return Ok(done(it, res));
+            }
+            if res > newton.divergence * prev && res > tol {
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+            if res <= tol {
+                self.exact_maps += 1;
+                return Ok(done(it, res));
+            }
+        }
     }
 
     /// The chord iteration on `x` from its residual `f`.
@@ -748,6 +1080,7 @@ impl TangentChart {
                     iterations: it,
                     residual: theta * res,
                     initial_residual: res0,
+                    exact: false,
                 });
             }
             prev = res;
@@ -758,6 +1091,7 @@ impl TangentChart {
                     iterations: it,
                     residual: res,
                     initial_residual: res0,
+                    exact: false,
                 });
             }
             if res > newton.divergence * prev && res > tol {
@@ -813,6 +1147,7 @@ impl TangentChart {
                     iterations: it,
                     residual: theta * res,
                     initial_residual: res0,
+                    exact: false,
                 });
             }
             prev = res;
@@ -823,6 +1158,7 @@ impl TangentChart {
                     iterations: it,
                     residual: res,
                     initial_residual: res0,
+                    exact: false,
                 });
             }
             if self.pb_active && (res.is_nan() || res >= prev) {
@@ -927,6 +1263,7 @@ fn loop_head(
             iterations: it,
             residual: res,
             initial_residual: res0,
+            exact: false,
         }))
     } else if it >= max_iter {
         Some(Err(failure()))
@@ -1100,6 +1437,63 @@ fn rank_one_update(p: &mut [f64], s: &[f64], w: &[f64], c: f64) {
         let d = c * dot(s, col);
         axpy(-d, w, col);
     }
+}
+
+/// Solves `A x = b` in place for the `d x d` column-major matrix `a` by LU with partial
+/// pivoting (`a` is overwritten by the factors, `b` by the solution). Returns `false` if a
+/// pivot is not finite or below `d eps max |A|` (numerically singular).
+fn lu_solve(a: &mut [f64], piv: &mut [usize], b: &mut [f64], d: usize) -> bool {
+    let amax = max_abs(&a[..d * d]);
+    if !(amax.is_finite() && amax > 0.0) {
+        return false;
+    }
+    let small = d as f64 * f64::EPSILON * amax;
+    for k in 0..d {
+        let mut p = k;
+        for i in k + 1..d {
+            if a[k * d + i].abs() > a[k * d + p].abs() {
+                p = i;
+            }
+        }
+        piv[k] = p;
+        let akk = a[k * d + p];
+        if akk.is_nan() || akk.abs() <= small {
+            return false;
+        }
+        if p != k {
+            for j in 0..d {
+                a.swap(j * d + k, j * d + p);
+            }
+            b.swap(k, p);
+        }
+        let inv = 1.0 / akk;
+        for i in k + 1..d {
+            a[k * d + i] *= inv;
+        }
+        for j in k + 1..d {
+            let akj = a[j * d + k];
+            if akj != 0.0 {
+                for i in k + 1..d {
+                    a[j * d + i] -= a[k * d + i] * akj;
+                }
+            }
+        }
+    }
+    // forward (unit lower) then backward substitution
+    for k in 0..d {
+        let bk = b[k];
+        for i in k + 1..d {
+            b[i] -= a[k * d + i] * bk;
+        }
+    }
+    for k in (0..d).rev() {
+        b[k] /= a[k * d + k];
+        let bk = b[k];
+        for i in 0..k {
+            b[i] -= a[k * d + i] * bk;
+        }
+    }
+    b.iter().all(|x| x.is_finite())
 }
 
 #[inline]

@@ -17,13 +17,17 @@ pub enum TangentError {
         /// The smallest step allowed.
         h_min: f64,
     },
-    /// The chart map kept failing while the step was halved down to `h_min`.
-    #[error("tangent chart failed down to the smallest step (last h = {h:e}): {source}")]
+    /// The chart map (or a stage point's index-1 solve) kept failing while the step shrank:
+    /// `failures` times in a row at one point, or down to `h_min`.
+    #[error("tangent chart failed {failures} times in a row (last step h = {h:e}): {source}")]
     Chart {
-        /// The last chart failure, as [`SolveError::Newton`] (time, residual, iterations).
+        /// The last failure: [`SolveError::Newton`] (time, residual, iterations) for a chart
+        /// map, [`SolveError::Singular`] for a stage point's index-1 solve.
         source: SolveError,
         /// The last step size tried.
         h: f64,
+        /// Failures in a row at that point.
+        failures: usize,
     },
     /// More than `max_steps` step attempts.
     #[error("more than {max_steps} step attempts before reaching the end time (at t = {t})")]

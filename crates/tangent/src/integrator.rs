@@ -1,7 +1,7 @@
 //! The tangent-space Runge-Kutta integrator: fixed steps ([`Integrator`]) and adaptive steps
 //! ([`TangentRk::integrate_adaptive`]).
 
-use crate::chart::{ChartFailure, NewtonSettings, TangentChart};
+use crate::chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
 use crate::error::TangentError;
 use mbd_model::System;
 use mbd_solve::{
@@ -135,21 +135,40 @@ pub struct TangentStats {
     pub rhs_evals: usize,
     /// Largest `||(Phi, Phidot)||_inf` of an accepted step's end point.
     pub max_residual: f64,
+    /// Chart maps of the accepted steps completed by the exact Newton fallback after the chord
+    /// iteration failed ([`NewtonSettings::fallback_change`]: near-singular charts).
+    pub exact_maps: usize,
 }
 
 /// Settings of [`TangentRk::integrate_adaptive`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdaptiveSettings {
     /// Tolerances, safety factor, shrink/growth limits and the smallest step. The scaled error
-    /// is `rms(e_i / (atol + rtol max(|x_c,i|, |x_new,i|)))` with `e = U err_xi` the embedded
-    /// estimate mapped to `x = (q, v)`.
+    /// is `sqrt(sum_i (e_i / (atol + rtol max(|x_c,i|, |x_new,i|)))^2 / d)` with `e = U err_xi`
+    /// the embedded estimate mapped to `x = (q, v)` and `d = 2 (n - m)` the dimension of the
+    /// state equation.
     pub controller: StepController,
-    /// First step size; `None` picks `0.01 ||x||/||F||` in the scaled norm.
+    /// First step size; `None` picks Hairer, Norsett and Wanner's estimate from `F(x0)` and
+    /// one explicit Euler trial step (two acceleration solves).
     pub h0: Option<f64>,
     /// Largest step size.
     pub h_max: f64,
     /// Limit on accepted plus rejected steps.
     pub max_steps: usize,
+    /// `beta` of the PI step-size controller (Hairer-Wanner form, `q` the embedded order):
+    /// after an accepted step with error norm `err` (previous accepted step: `err_prev`),
+    /// `h <- h safety err^-(1/(q+1) - 0.75 beta) err_prev^beta`. `None` (default) is
+    /// Gustafsson's PI.3.4, `beta = 0.4 / (q+1)` (0.08 for DOPRI5: exponents 0.14 and 0.08);
+    /// `Some(0.0)` the classical I controller; Hairer and Wanner's DOPRI5 code uses 0.04. Must
+    /// lie in `[0, 1 / (1.75 (q+1)))`: at larger values a steady error never lets the step grow.
+    pub pi_beta: Option<f64>,
+    /// Factor applied to the step after a chart failure (the chart map did not converge) or a
+    /// singular index-1 solve at a stage point; the error controller's memory is left alone.
+    /// Default 0.25; must lie in (0, 1).
+    pub chart_shrink: f64,
+    /// Most chart failures in a row at one point before [`TangentError::Chart`]. Default 8
+    /// (the step shrinks by `chart_shrink^8`, 1.5e-5 by default).
+    pub max_chart_failures: usize,
 }
 
 impl Default for AdaptiveSettings {
@@ -159,6 +178,9 @@ impl Default for AdaptiveSettings {
             h0: None,
             h_max: f64::INFINITY,
             max_steps: 10_000_000,
+            pi_beta: None,
+            chart_shrink: 0.25,
+            max_chart_failures: 8,
         }
     }
 }
@@ -222,6 +244,18 @@ impl AdaptiveSettings {
         if self.max_steps == 0 {
             return bad("max_steps", 0.0, "must be at least 1");
         }
+        if let Some(b) = self.pi_beta {
+            // the bound for the tableau's embedded order is checked when it is known
+            if !(0.0..0.5).contains(&b) {
+                return bad("pi_beta", b, "must lie in [0, 1 / (1.75 (q+1)))");
+            }
+        }
+        if !(self.chart_shrink > 0.0 && self.chart_shrink < 1.0) {
+            return bad("chart_shrink", self.chart_shrink, "must lie in (0, 1)");
+        }
+        if self.max_chart_failures == 0 {
+            return bad("max_chart_failures", 0.0, "must be at least 1");
+        }
         Ok(())
     }
 }
@@ -233,8 +267,14 @@ pub struct AdaptiveStats {
     pub accepted: usize,
     /// Steps rejected by the error test.
     pub rejected: usize,
-    /// Steps rejected because the chart map failed (retried with half the step).
+    /// Steps rejected because the chart map failed, or the index-1 solve at a stage point was
+    /// singular (retried with [`AdaptiveSettings::chart_shrink`] times the step).
     pub chart_rejections: usize,
+    /// Chart maps completed by the exact Newton fallback ([`NewtonSettings::fallback_change`]).
+    pub exact_maps: usize,
+    /// The first step chosen by the initial-step estimate (0 if [`AdaptiveSettings::h0`] was
+    /// given).
+    pub h_initial_estimate: f64,
     /// Acceleration solves.
     pub rhs_evals: usize,
     /// Chord Newton iterations.
@@ -253,6 +293,14 @@ pub struct AdaptiveStats {
 enum Attempt {
     /// The chart map failed (recoverable with a smaller step).
     Chart(ChartFailure),
+    /// The index-1 solve at a stage point after the first was singular: the stage point landed
+    /// (numerically) on a singular configuration the step passes; another step size moves it.
+    Stage(SolveError),
+    /// A stage at the step's end time, or the end point, is (numerically) a singular
+    /// configuration ([`SolveError::Singular`] with rank and joints): halving keeps the end
+    /// time, and with it the configuration, so fixed steps stop at once; an adaptive step
+    /// changes its end time and retries.
+    SingularEnd(SolveError),
     /// Anything else (singular configuration, bad model): returned as is.
     Hard(SolveError),
 }
@@ -315,6 +363,8 @@ pub struct TangentRk {
     /// first, all of size `hist_h`, consecutive, the latest ending at `hist_t`.
     eta_hist: Vec<f64>,
     hist_len: usize,
+    /// [`TangentChart::rcond`] of the charts of the steps in `eta_hist`.
+    hist_rcond: [f64; HISTORY],
     hist_h: f64,
     hist_t: f64,
     /// Extrapolated `eta` of the map in progress, and of an earlier stage.
@@ -328,6 +378,14 @@ pub struct TangentRk {
 /// Steps of `eta` history kept for the Newton starting points.
 const HISTORY: usize = 3;
 
+/// Largest factor by which [`TangentChart::rcond`] may differ between the current chart and
+/// the charts of the history steps for the history to be used (predictors, inexact stage
+/// maps). Near a singular configuration `R` changes fast from chart to chart
+/// (`min |R_ii|` is about the distance to the singularity); the paper's `eta = R^-1 zeta` then
+/// varies too fast for polynomial extrapolation, and a stage point off the manifold changes the
+/// index-1 acceleration by about `1 / min |R_ii|` times its residual.
+const RCOND_DRIFT: f64 = 2.0;
+
 /// Per-attempt work counts.
 #[derive(Clone, Copy, Debug, Default)]
 struct AttemptWork {
@@ -337,6 +395,8 @@ struct AttemptWork {
     residual: f64,
     /// `||f||_inf` at the plain RK end point (NaN for FSAL tableaus).
     end_initial_residual: f64,
+    /// Maps completed by the exact Newton fallback.
+    exact_maps: usize,
 }
 
 impl TangentRk {
@@ -392,6 +452,7 @@ impl TangentRk {
             eta_now: vec![0.0; (s + 1) * 2 * m],
             eta_hist: vec![0.0; HISTORY * (s + 1) * 2 * m],
             hist_len: 0,
+            hist_rcond: [1.0; HISTORY],
             hist_h: f64::NAN,
             hist_t: f64::NAN,
             eta_pred: vec![0.0; 2 * m],
@@ -458,7 +519,7 @@ impl TangentRk {
     fn load(&mut self, sys: &System, state: &State) -> Result<(), SolveError> {
         let n = self.n;
         if self.cur_ok
-            && state.t == self.cur_t
+            && same_time(state.t, self.cur_t)
             && state.q.as_slice() == &self.cur[..n]
             && state.v.as_slice() == &self.cur[n..]
         {
@@ -526,8 +587,16 @@ impl TangentRk {
         let mm = 2 * self.m;
         let s = self.stages;
         let newton = self.options.newton;
-        // interior stage maps: inexact after an accepted step of the same size
-        let stage_newton = if self.hist_h == h && self.hist_t == t {
+        // interior stage maps: inexact after an accepted step of the same size (to rounding:
+        // `mbd_solve::run` passes `t_next - t`, which differs from the nominal step in the
+        // last bits)
+        let rcond = self.chart.rcond();
+        let follows = same_step(self.hist_h, h)
+            && same_time(self.hist_t, t)
+            && self.hist_rcond[..self.hist_len]
+                .iter()
+                .all(|&r| r <= RCOND_DRIFT * rcond && rcond <= RCOND_DRIFT * r);
+        let stage_newton = if follows {
             NewtonSettings {
                 tol: self.stage_tol.max(newton.tol),
                 ..newton
@@ -537,10 +606,10 @@ impl TangentRk {
         };
         let interpolate = self.options.iteration_matrix == IterationMatrix::Interpolated;
         // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
-        let centre_ok = self.cur_ok && self.cur_t == t;
+        let centre_ok = self.cur_ok && same_time(self.cur_t, t);
         let quadratic = !sys.is_rheonomic();
         let scleronomic = quadratic && self.m > 0;
-        if !(self.hist_h == h && self.hist_t == t) {
+        if !follows {
             self.hist_len = 0;
         }
         let npts = self.hist_len;
@@ -550,7 +619,8 @@ impl TangentRk {
             end_initial_residual: f64::NAN,
             ..AttemptWork::default()
         };
-        let mut failure: Option<ChartFailure> = None;
+        let mut failure: Option<(ChartFailure, usize)> = None;
+        let mut singular_stage: Option<usize> = None;
         let mut stage = 0usize;
         self.xi.fill(0.0);
         {
@@ -575,6 +645,7 @@ impl TangentRk {
             );
             let work = &mut work;
             let failure = &mut failure;
+            let singular_stage = &mut singular_stage;
             let mut rhs = |ti: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
                 let i = stage;
                 // plain RK stage value's normal part
@@ -616,7 +687,7 @@ impl TangentRk {
                 }
                 let mapped = if i == 0 && centre_ok && ti == t {
                     x.copy_from_slice(chart.centre_point());
-                    Ok(crate::chart::MapStats::default())
+                    Ok(MapStats::default())
                 } else if fsal && i + 1 == s {
                     // FSAL: this stage point is the step's end point, whose residual is verified
                     chart.map(sys, y, ti, zplain, x, &newton)
@@ -633,12 +704,13 @@ impl TangentRk {
                 }
                 match mapped {
                     Ok(ms) => {
+                        work.exact_maps += usize::from(ms.exact);
                         work.iterations += ms.iterations;
                         work.max_map_iterations = work.max_map_iterations.max(ms.iterations);
                         work.residual = ms.residual;
                     }
                     Err(e) => {
-                        *failure = Some(e);
+                        *failure = Some((e, i));
                         // a cheap sentinel (no allocation); the caller reads `failure`
                         return Err(SolveError::NonFinite {
                             t: ti,
@@ -647,7 +719,7 @@ impl TangentRk {
                     }
                 }
                 let (q, v) = x.split_at(n);
-                if i == 0 && centre_ok && ti == t && scleronomic {
+                let solved = if i == 0 && centre_ok && ti == t && scleronomic {
                     // at the centre: Phi_q and (Phi_q v)_q are the chart's, so
                     // gamma = -(Phi_q v)_q v needs no model evaluation
                     sys.forces_into(q, v, ti, &mut acc.forces);
@@ -660,9 +732,15 @@ impl TangentRk {
                             *gr -= d * vk;
                         }
                     }
-                    acc.finish(sys, ti, acc_a, lambda)?;
+                    acc.finish(sys, ti, acc_a, lambda)
                 } else {
-                    acc.solve(sys, q, v, ti, acc_a, lambda)?;
+                    acc.solve(sys, q, v, ti, acc_a, lambda)
+                };
+                if let Err(e) = solved {
+                    if matches!(e, SolveError::Singular { .. }) {
+                        *singular_stage = Some(i);
+                    }
+                    return Err(e);
                 }
                 work.rhs_evals += 1;
                 fx[..n].copy_from_slice(v);
@@ -674,9 +752,35 @@ impl TangentRk {
                 Ok(())
             };
             if let Err(e) = self.rk.step(&mut rhs, t, &mut self.xi, h) {
-                return Err(match failure.take() {
-                    Some(f) => Attempt::Chart(f),
-                    None => Attempt::Hard(e),
+                return Err(match (failure.take(), *singular_stage) {
+                    // a map at the step's end time that failed at a singular configuration
+                    (Some((f, i)), _) if self.c_coef[i] == 1.0 => {
+                        match self.chart.singular_error_at(
+                            sys,
+                            &self.x[..n],
+                            t + h,
+                            SINGULAR_REPORT_TOL,
+                        ) {
+                            Some(e) => Attempt::SingularEnd(e),
+                            None => Attempt::Chart(f),
+                        }
+                    }
+                    (Some((f, _)), _) => Attempt::Chart(f),
+                    // the step's start point itself: a singular configuration, reported with
+                    // the numerical rank and the joints of the dependency
+                    (None, Some(0)) => Attempt::Hard(
+                        self.chart
+                            .singular_error(sys, t, SINGULAR_REPORT_TOL)
+                            .unwrap_or(e),
+                    ),
+                    // a stage at the step's end time
+                    (None, Some(i)) if self.c_coef[i] == 1.0 => Attempt::SingularEnd(
+                        self.chart
+                            .singular_error_at(sys, &self.x[..n], t + h, SINGULAR_REPORT_TOL)
+                            .unwrap_or(e),
+                    ),
+                    (None, Some(_)) => Attempt::Stage(e),
+                    (None, None) => Attempt::Hard(e),
                 });
             }
         }
@@ -698,12 +802,25 @@ impl TangentRk {
                 .map(sys, &self.xi, t1, &mut self.zeta, &mut self.xnew, &newton)
             {
                 Ok(ms) => {
+                    work.exact_maps += usize::from(ms.exact);
                     work.iterations += ms.iterations;
                     work.max_map_iterations = work.max_map_iterations.max(ms.iterations);
                     work.residual = ms.residual;
                     work.end_initial_residual = ms.initial_residual;
                 }
-                Err(e) => return Err(Attempt::Chart(e)),
+                Err(f) => {
+                    return Err(
+                        match self.chart.singular_error_at(
+                            sys,
+                            &self.xnew[..n],
+                            t1,
+                            SINGULAR_REPORT_TOL,
+                        ) {
+                            Some(e) => Attempt::SingularEnd(e),
+                            None => Attempt::Chart(f),
+                        },
+                    )
+                }
             }
             self.chart
                 .eta_from_zeta(&self.zeta, &mut self.eta_now[s * mm..(s + 1) * mm]);
@@ -728,6 +845,8 @@ impl TangentRk {
         let len = self.eta_now.len();
         self.eta_hist.copy_within(0..(HISTORY - 1) * len, len);
         self.eta_hist[..len].copy_from_slice(&self.eta_now);
+        self.hist_rcond.copy_within(0..HISTORY - 1, 1);
+        self.hist_rcond[0] = self.chart.rcond();
         self.hist_len = (self.hist_len + 1).min(HISTORY);
         self.hist_h = h;
         self.hist_t = t_end;
@@ -737,6 +856,7 @@ impl TangentRk {
         self.stats.newton_iterations += w.iterations;
         self.stats.max_map_iterations = self.stats.max_map_iterations.max(w.max_map_iterations);
         self.stats.rhs_evals += w.rhs_evals;
+        self.stats.exact_maps += w.exact_maps;
     }
 
     /// Advances `cur` from `t` by `h`, halving on chart failure up to `max_halvings` levels.
@@ -763,7 +883,7 @@ impl TangentRk {
                 out.residual = out.residual.max(w.residual);
                 Ok(())
             }
-            Err(Attempt::Chart(f)) => {
+            Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_))) => {
                 self.stats.chart_failures += 1;
                 if depth < self.options.max_halvings {
                     self.stats.halvings += 1;
@@ -771,18 +891,32 @@ impl TangentRk {
                     self.advance(sys, t, h2, depth + 1, out)?;
                     self.advance(sys, t + h2, h2, depth + 1, out)
                 } else {
-                    Err(f.into_error())
+                    Err(match fail {
+                        Attempt::Chart(f) => f.into_error(),
+                        Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
+                    })
                 }
             }
-            Err(Attempt::Hard(e)) => Err(e),
+            Err(Attempt::Hard(e) | Attempt::SingularEnd(e)) => Err(e),
         }
     }
 
     /// Integrates from `state.t` to `t_end` with adaptive steps controlled by the tableau's
     /// embedded error estimate (e.g. DOPRI5 5(4), Bogacki-Shampine 3(2)), calling `observer`
-    /// with the initial state (step 0) and after every accepted step. A chart failure rejects
-    /// the step and retries with half of it; a step size below `controller.h_min` is
-    /// [`TangentError::StepSizeTooSmall`].
+    /// with the initial state (step 0) and after every accepted step.
+    ///
+    /// Step control (`docs/tangent.md` section 6): the first step from Hairer, Norsett and
+    /// Wanner's estimate (`f(x0)` and one explicit Euler trial step) unless
+    /// [`AdaptiveSettings::h0`] is given; after an accepted step a PI controller
+    /// (`h <- h safety err^-(1/(q+1) - 0.75 beta) err_prev^beta`, clamped to
+    /// `[fac_min, fac_max]`, no growth right after a rejection), after a rejected one
+    /// `h <- h max(fac_min, safety err^-(1/(q+1) - 0.75 beta))`. A chart failure (the chart map
+    /// did not converge) or a singular index-1 solve at a stage point multiplies the step by
+    /// [`AdaptiveSettings::chart_shrink`] without touching the controller's memory; more than
+    /// [`AdaptiveSettings::max_chart_failures`] of them in a row, or a step below
+    /// `controller.h_min`, is an error ([`TangentError::Chart`],
+    /// [`TangentError::StepSizeTooSmall`]). A singular configuration at an accepted point is
+    /// [`SolveError::Singular`] at once (no retry with smaller steps).
     pub fn integrate_adaptive<O: Observer + ?Sized>(
         &mut self,
         sys: &System,
@@ -814,6 +948,20 @@ impl TangentRk {
             }
         };
         self.load(sys, state)?;
+        self.adaptive_loop(sys, state, t_end, settings, observer, q_order)
+    }
+
+    /// The step loop of [`TangentRk::integrate_adaptive`] (`state` loaded, settings checked).
+    fn adaptive_loop<O: Observer + ?Sized>(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        t_end: f64,
+        settings: &AdaptiveSettings,
+        observer: &mut O,
+        q_order: u32,
+    ) -> Result<AdaptiveStats, TangentError> {
+        let t0 = state.t;
         let ctrl = settings.controller;
         let mut st = AdaptiveStats {
             h_min: f64::INFINITY,
@@ -826,11 +974,30 @@ impl TangentRk {
         }
         let mut h = match settings.h0 {
             Some(h0) => h0,
-            None => self.initial_step(sys, t0, &ctrl)?,
+            None => {
+                let h0 = self.initial_step(sys, t0, t_end - t0, settings)?;
+                st.h_initial_estimate = h0;
+                st.rhs_evals += 2;
+                h0
+            }
         };
         h = h.min(settings.h_max);
+        // the PI controller: exponents and memory (the error norm of the last accepted step)
+        let k = q_order as f64 + 1.0;
+        let beta = settings.pi_beta.unwrap_or(0.4 / k);
+        if beta >= 1.0 / (1.75 * k) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "pi_beta",
+                value: beta,
+                reason: "must lie in [0, 1 / (1.75 (q+1))) for the tableau's embedded order q",
+            }
+            .into());
+        }
+        let expo = 1.0 / k - 0.75 * beta;
+        let mut err_prev = 1e-4f64;
         let mut t = t0;
         let mut last_rejected = false;
+        let mut chart_failures_here = 0usize;
         let mut centred_at = f64::NAN;
         let mut attempts = 0usize;
         while t < t_end {
@@ -860,6 +1027,7 @@ impl TangentRk {
                     self.account(&w);
                     st.rhs_evals += w.rhs_evals;
                     st.newton_iterations += w.iterations;
+                    st.exact_maps += w.exact_maps;
                     // error estimate mapped to x: e = U err_xi
                     self.ex.fill(0.0);
                     for (k, &e) in self.rk.err.iter().enumerate() {
@@ -871,7 +1039,7 @@ impl TangentRk {
                     for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
                         *s = a.abs().max(b.abs());
                     }
-                    let en = ctrl.error_norm(&self.ex, &self.scale);
+                    let en = self.error_norm(&ctrl);
                     if !en.is_finite() {
                         return Err(SolveError::NonFinite {
                             t,
@@ -879,6 +1047,8 @@ impl TangentRk {
                         }
                         .into());
                     }
+                    chart_failures_here = 0;
+                    let grow = ctrl.safety * en.powf(-expo);
                     if en <= 1.0 {
                         std::mem::swap(&mut self.cur, &mut self.xnew);
                         t = if last { t_end } else { t + hs };
@@ -893,7 +1063,13 @@ impl TangentRk {
                         self.stats.max_residual = self.stats.max_residual.max(w.residual);
                         state.t = t;
                         self.store(state);
-                        let mut fac = ctrl.factor(en, q_order);
+                        // PI control (Gustafsson; Hairer-Wanner's DOPRI5 form)
+                        let mut fac = if en == 0.0 {
+                            ctrl.fac_max
+                        } else {
+                            (grow * err_prev.powf(beta)).clamp(ctrl.fac_min, ctrl.fac_max)
+                        };
+                        err_prev = en.max(1e-4);
                         if last_rejected {
                             fac = fac.min(1.0);
                         }
@@ -906,18 +1082,23 @@ impl TangentRk {
                     } else {
                         st.rejected += 1;
                         last_rejected = true;
-                        h = hs * ctrl.factor(en, q_order).min(1.0);
+                        h = hs * grow.clamp(ctrl.fac_min, 1.0);
                     }
                 }
-                Err(Attempt::Chart(f)) => {
+                Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_))) => {
                     self.stats.chart_failures += 1;
                     st.chart_rejections += 1;
+                    chart_failures_here += 1;
                     last_rejected = true;
-                    h = 0.5 * hs;
-                    if h < ctrl.h_min {
+                    h = settings.chart_shrink * hs;
+                    if h < ctrl.h_min || chart_failures_here > settings.max_chart_failures {
                         return Err(TangentError::Chart {
-                            source: f.into_error(),
+                            source: match fail {
+                                Attempt::Chart(f) => f.into_error(),
+                                Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
+                            },
                             h: hs,
+                            failures: chart_failures_here,
                         });
                     }
                 }
@@ -930,33 +1111,132 @@ impl TangentRk {
         Ok(st)
     }
 
-    /// `h0 = 0.01 ||x|| / ||F(x)||` in the controller's scaled RMS norm (Hairer, Norsett and
-    /// Wanner's first guess), at least `h_min`.
+    /// The scaled error norm of the estimate `ex` (mapped to `x`) with the scale in `scale`
+    /// (`max(|x_c,i|, |x_1,i|)`): `sqrt(sum_i (e_i / (atol + rtol scale_i))^2 / d)` with
+    /// `d = 2 (n - m)` the dimension of the state equation. `e = U err_xi` has the Euclidean
+    /// length of the estimate in chart coordinates, spread over the `2n` ambient components;
+    /// dividing by `2n` instead of `d` would shrink the RMS of a `d`-dimensional error by
+    /// `sqrt(d / 2n)` (1/sqrt(3) on the manipulator) and loosen every tolerance by that much.
+    fn error_norm(&self, ctrl: &StepController) -> f64 {
+        let d = self.chart.dim().max(1) as f64;
+        let sum: f64 = self
+            .ex
+            .iter()
+            .zip(&self.scale)
+            .map(|(e, y)| (e / (ctrl.atol + ctrl.rtol * y.abs())).powi(2))
+            .sum();
+        (sum / d).sqrt()
+    }
+
+    /// Hairer, Norsett and Wanner's initial step (`HINIT` of DOPRI5, "Solving ODEs I",
+    /// section II.4) in the controller's scaled RMS norm (`sk = atol + rtol |x0|`, normalised
+    /// like [`TangentRk::error_norm`]): `d0 = ||x0||`, `d1 = ||F(x0)||`,
+    /// `h_a = 0.01 d0 / d1` (1e-6 if either is below 1e-5), one explicit Euler trial step
+    /// `x1 = x0 + h_a F(x0)` (off the manifold by `O(h_a^2)`; the index-1 solve does not need
+    /// it on), `d2 = ||F(x1) - F(x0)|| / h_a`, `h_b = (0.01 / max(d1, d2))^(1/p)` with `p` the
+    /// method's order (`max(1e-6, 1e-3 h_a)` if `max(d1, d2) <= 1e-15`), and
+    /// `h0 = min(100 h_a, h_b, h_max, span)`, at least `h_min`. Two acceleration solves.
     fn initial_step(
         &mut self,
         sys: &System,
         t: f64,
-        ctrl: &StepController,
+        span: f64,
+        settings: &AdaptiveSettings,
     ) -> Result<f64, SolveError> {
+        let ctrl = &settings.controller;
         let n = self.n;
-        let (q, v) = self.cur.split_at(n);
-        self.acc
-            .solve(sys, q, v, t, &mut self.acc_a, &mut self.lambda)?;
-        self.stats.rhs_evals += 1;
-        self.fx[..n].copy_from_slice(v);
-        self.fx[n..].copy_from_slice(&self.acc_a);
-        for (s, x) in self.scale.iter_mut().zip(&self.cur) {
-            *s = x.abs();
+        let d = self.chart.dim().max(1) as f64;
+        let norm = |x: &[f64], y: &[f64]| -> f64 {
+            let sum: f64 = x
+                .iter()
+                .zip(y)
+                .map(|(e, y)| (e / (ctrl.atol + ctrl.rtol * y.abs())).powi(2))
+                .sum();
+            (sum / d).sqrt()
+        };
+        {
+            let (q, v) = self.cur.split_at(n);
+            if let Err(e) = self
+                .acc
+                .solve(sys, q, v, t, &mut self.acc_a, &mut self.lambda)
+            {
+                return Err(match e {
+                    SolveError::Singular { .. } => self
+                        .chart
+                        .singular_error_at(sys, q, t, SINGULAR_REPORT_TOL)
+                        .unwrap_or(e),
+                    e => e,
+                });
+            }
         }
-        let d0 = ctrl.error_norm(&self.cur, &self.scale);
-        let d1 = ctrl.error_norm(&self.fx, &self.scale);
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        self.stats.rhs_evals += 1;
+        self.fx[..n].copy_from_slice(&self.cur[n..]);
+        self.fx[n..].copy_from_slice(&self.acc_a);
+        let d0 = norm(&self.cur, &self.cur);
+        let d1 = norm(&self.fx, &self.cur);
+        let ha = if d0 < 1e-5 || d1 < 1e-5 {
             1e-6
         } else {
             0.01 * d0 / d1
+        }
+        .min(settings.h_max)
+        .min(span);
+        // explicit Euler trial step x1 = x0 + ha F(x0), F(x1) into proj
+        for ((x1, x0), f) in self.x.iter_mut().zip(&self.cur).zip(&self.fx) {
+            *x1 = x0 + ha * f;
+        }
+        {
+            let (q, v) = self.x.split_at(n);
+            self.acc
+                .solve(sys, q, v, t + ha, &mut self.acc_a, &mut self.lambda)?;
+        }
+        self.stats.rhs_evals += 1;
+        self.proj[..n].copy_from_slice(&self.x[n..]);
+        self.proj[n..].copy_from_slice(&self.acc_a);
+        for (df, f0) in self.ex.iter_mut().zip(self.proj.iter().zip(&self.fx)) {
+            *df = (f0.0 - f0.1) / ha;
+        }
+        let d2 = norm(&self.ex, &self.cur);
+        let d12 = d1.max(d2);
+        let p = self.rk.tableau.order.max(1) as f64;
+        let hb = if d12 <= 1e-15 {
+            (1e-3 * ha).max(1e-6)
+        } else {
+            (0.01 / d12).powf(1.0 / p)
         };
+        let h0 = (100.0 * ha).min(hb).min(settings.h_max).min(span);
+        if !h0.is_finite() {
+            return Err(SolveError::NonFinite {
+                t,
+                what: "initial step estimate",
+            });
+        }
         Ok(h0.max(ctrl.h_min))
     }
+}
+
+/// Relative tolerance to which two step sizes, or two times, count as the same
+/// ([`same_step`], [`same_time`]).
+const STEP_RTOL: f64 = 1e-12;
+
+/// Relative threshold of the rank report when the index-1 solve at a step's start point is
+/// singular (the dense Cholesky of `Phi_q M^-1 Phi_q^T` gives up at pivots below `1e-7` of the
+/// largest, i.e. `Phi_q` singular values about that far apart).
+const SINGULAR_REPORT_TOL: f64 = 1e-6;
+
+/// Whether two step sizes agree to [`STEP_RTOL`] relative. `mbd_solve::run` passes each step
+/// `t_next - t` with `t_next = t0 + k h`, which differs from the nominal `h` in the last bits on
+/// most steps; the fast paths that need "a step of the same size as the last" must not depend
+/// on those bits.
+#[inline]
+fn same_step(a: f64, b: f64) -> bool {
+    (a - b).abs() <= STEP_RTOL * a.abs().max(b.abs())
+}
+
+/// Whether two times agree to [`STEP_RTOL`] relative (the same instant up to rounding).
+#[inline]
+fn same_time(a: f64, b: f64) -> bool {
+    a == b || (a - b).abs() <= STEP_RTOL * a.abs().max(b.abs())
 }
 
 /// Polynomial extrapolation to the next step of the `eta` of one map (offset `off` within a

@@ -10,8 +10,8 @@
 //! constraint manifold, and any explicit Runge-Kutta method integrates those. At an accepted
 //! point `x_c`:
 //!
-//! * `Df(x_c) = [[Phi_q, 0], [(Phi_q v)_q, Phi_q]]`; the QR factorisation `Df^T = Q1 R` (faer,
-//!   in place) gives an orthonormal basis `U` of `ker Df(x_c)` (`2(n-m)` columns) and `Q1` of its
+//! * `Df(x_c) = [[Phi_q, 0], [(Phi_q v)_q, Phi_q]]`; the QR factorisation `Df^T = Q1 R` (from
+//!   two small Householder QRs of its blocks) gives an orthonormal basis `U` of `ker Df(x_c)` (`2(n-m)` columns) and `Q1` of its
 //!   orthogonal complement;
 //! * the chart `x(xi) = x_c + U xi + Df(x_c)^T eta(xi)`, with `eta` by chord Newton on
 //!   `f(x(xi), t) = 0` ([`TangentChart`]);
@@ -20,10 +20,14 @@
 //!   re-centred at the new point ([`TangentRk`]).
 //!
 //! Position and velocity constraints then hold to the Newton tolerance (1e-13 by default, raised
-//! to the round-off floor of evaluating them for fast or far-out states) at every step; rheonomic drivers work (`f` and `F` are evaluated at the stage times); chart
-//! failure (Newton diverging near a singular configuration or for a too-large step) is either
-//! recovered by documented step halving (counted in [`TangentStats::halvings`]) or an error with
-//! time and residual — never a silent wrong state. See `docs/tangent.md` for the derivation.
+//! to the round-off floor of evaluating them for fast or far-out states) at every step; rheonomic drivers work (`f` and `F` are evaluated at the stage times). Near a
+//! singular configuration (where `Phi_q` loses rank) the chord iteration hands over to Newton
+//! with the exact matrix ([`NewtonSettings::fallback_change`]), so the solver passes it on the
+//! branch it is on; a step that starts or ends exactly on one is a
+//! [`mbd_solve::SolveError::Singular`] naming time, numerical rank and joints, at once. A chart
+//! failure for a too-large step is recovered by documented step halving (counted in
+//! [`TangentStats::halvings`]) or is an error with time and residual — never a silent wrong
+//! state. See `docs/tangent.md` for the derivation.
 //!
 //! ```
 //! use mbd_model::models;

@@ -52,6 +52,49 @@ fn dopri5_error_follows_tolerance_on_manipulator() {
 }
 
 #[test]
+fn dopri5_error_and_rejections_stay_in_bounds_from_loose_to_tight_tolerances() {
+    // manipulator to t = 2 s against a DOPRI5 reference (32000 steps, projection): the error at
+    // the end stays within 100 tol and fewer than 20% of the attempts are rejected (error test
+    // or chart failure), at loose tolerances too; the first step follows the tolerance
+    let sys = models::manipulator().expect("model");
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let r = reference_trajectory(&sys, &s0, 2.0, 1, 32_000, ButcherTableau::dopri5()).expect("ref");
+    let mut h0 = vec![];
+    for tol in [1e-3, 1e-6, 1e-9, 1e-12] {
+        let mut s = s0.clone();
+        let mut dp = TangentRk::dopri5(&sys).expect("solver");
+        let st = dp
+            .integrate_adaptive(
+                &sys,
+                &mut s,
+                2.0,
+                &AdaptiveSettings::with_tolerance(tol),
+                &mut NoObserver,
+            )
+            .expect("adaptive run");
+        let e = state_error(&s, &r.q[1], &r.v[1]);
+        let attempts = st.accepted + st.rejected + st.chart_rejections;
+        let rate = (st.rejected + st.chart_rejections) as f64 / attempts as f64;
+        println!(
+            "tol {tol:.0e}: error {e:.2e} ({:.1} tol), {} accepted, {} rejected, {} chart \
+             rejections ({:.1}%), first step {:.2e}",
+            e / tol,
+            st.accepted,
+            st.rejected,
+            st.chart_rejections,
+            100.0 * rate,
+            st.h_initial_estimate
+        );
+        assert!(e / tol <= 100.0, "tol {tol}: error {e}");
+        assert!(rate < 0.2, "tol {tol}: {st:?}");
+        assert!(st.max_residual <= 1e-12);
+        h0.push(st.h_initial_estimate);
+    }
+    // the first step follows the tolerance (about tol^(1/5))
+    assert!(h0.windows(2).all(|w| w[1] < 0.5 * w[0]), "{h0:?}");
+}
+
+#[test]
 fn bogacki_shampine_adaptive_and_tableau_without_estimate_is_an_error() {
     let sys = models::slider_crank().expect("model");
     let s0 = State::consistent(&sys, 0.0).expect("state");
@@ -104,8 +147,19 @@ fn too_large_first_step_is_rejected_not_fatal() {
     let st = dp
         .integrate_adaptive(&sys, &mut s, 2.0, &set, &mut NoObserver)
         .expect("run");
-    assert!(st.rejected + st.chart_rejections > 0);
+    println!("{st:?}");
+    assert!(st.chart_rejections > 0);
+    // chart failures shrink the step by 4: from 2 s to a step the chart can take in a few
+    assert!(st.chart_rejections <= 4, "{st:?}");
     assert_eq!(s.t, 2.0);
+    // with one chart failure allowed in a row, the second is an error naming the count
+    let mut s = State::consistent(&sys, 0.0).expect("state");
+    set.max_chart_failures = 1;
+    set.chart_shrink = 0.9;
+    let e = dp
+        .integrate_adaptive(&sys, &mut s, 2.0, &set, &mut NoObserver)
+        .unwrap_err();
+    assert!(matches!(e, TangentError::Chart { failures: 2, .. }), "{e}");
 }
 
 #[test]
@@ -137,6 +191,31 @@ fn bad_adaptive_settings_are_errors() {
         },
         AdaptiveSettings {
             max_steps: 0,
+            ..Default::default()
+        },
+        AdaptiveSettings {
+            pi_beta: Some(-0.01),
+            ..Default::default()
+        },
+        // above 1 / (1.75 (q+1)) = 0.114 for DOPRI5's embedded order 4
+        AdaptiveSettings {
+            pi_beta: Some(0.12),
+            ..Default::default()
+        },
+        AdaptiveSettings {
+            pi_beta: Some(f64::NAN),
+            ..Default::default()
+        },
+        AdaptiveSettings {
+            chart_shrink: 1.0,
+            ..Default::default()
+        },
+        AdaptiveSettings {
+            chart_shrink: 0.0,
+            ..Default::default()
+        },
+        AdaptiveSettings {
+            max_chart_failures: 0,
             ..Default::default()
         },
     ];

@@ -1,0 +1,308 @@
+//! Singular configurations: a parallelogram four-bar driven through its flat configurations
+//! (all links collinear, `Phi_q` loses rank and the parallelogram branch crosses the crossed
+//! one). The tangent solver passes them on the branch it is on (the chord iteration, whose
+//! matrix is `Df` at a nearly singular centre, hands over to Newton with the exact matrix), or,
+//! when a step lands exactly on one, stops at once with a typed error naming time, rank and
+//! joints.
+
+mod common;
+
+use common::{state_error, ResidualWatch};
+use mbd_model::{models, System};
+use mbd_solve::{
+    reference_trajectory, run, ButcherTableau, Flow, Index1Options, Index1Rk, Integrator,
+    NoObserver, Observer, ProjectionSettings, RunConfig, SolveError, State,
+};
+use mbd_tangent::{AdaptiveSettings, NewtonSettings, TangentOptions, TangentRk};
+use nalgebra::DVector;
+
+/// Crank 0.4 m, ground and coupler 1 m, released at 1 rad with 6 rad/s: the crank turns
+/// through the flat configurations at about t = 0.34, 0.63, 1.11, 1.39 and 1.87 s.
+fn free_four_bar() -> System {
+    models::parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, false).expect("model")
+}
+
+/// Watches the parallelogram branch (coupler horizontal, rocker parallel to the crank) and
+/// the constraints at every sample; records the crank angles seen.
+#[derive(Default)]
+struct BranchWatch {
+    res: ResidualWatch,
+    /// Largest `|coupler angle|` and `|rocker angle - crank angle|`.
+    off_branch: f64,
+    min_crank: f64,
+    max_crank: f64,
+}
+
+impl Observer for BranchWatch {
+    fn observe(&mut self, sys: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
+        self.res.observe(sys, s, step)?;
+        let (crank, coupler, rocker) = (s.q[2], s.q[5], s.q[8]);
+        self.off_branch = self
+            .off_branch
+            .max(coupler.abs())
+            .max((rocker - crank).abs());
+        if step == 0 {
+            self.min_crank = crank;
+            self.max_crank = crank;
+        }
+        self.min_crank = self.min_crank.min(crank);
+        self.max_crank = self.max_crank.max(crank);
+        Ok(Flow::Continue)
+    }
+}
+
+fn projected_rk4(sys: &System, s0: &State, t_end: f64, h: f64) -> State {
+    let opts = Index1Options {
+        projection: Some(ProjectionSettings::default()),
+        ..Default::default()
+    };
+    let mut p = Index1Rk::new(sys, ButcherTableau::rk4(), opts).expect("projected RK4");
+    let mut s = s0.clone();
+    run(
+        &mut p,
+        sys,
+        &mut s,
+        RunConfig::new(t_end, h),
+        &mut NoObserver,
+    )
+    .expect("projected RK4");
+    s
+}
+
+#[test]
+fn tangent_rk4_passes_flat_configurations_on_the_parallelogram_branch() {
+    let sys = free_four_bar();
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let (t_end, h) = (2.0, 1e-3);
+    let r = reference_trajectory(&sys, &s0, t_end, 1, 16_000, ButcherTableau::dopri5())
+        .expect("reference");
+    let proj = projected_rk4(&sys, &s0, t_end, h);
+    let mut s = s0.clone();
+    let mut rk = TangentRk::rk4(&sys).expect("solver");
+    let mut watch = BranchWatch::default();
+    run(&mut rk, &sys, &mut s, RunConfig::new(t_end, h), &mut watch).expect("tangent RK4 run");
+    let st = *rk.stats();
+    let e_ref = state_error(&s, &r.q[1], &r.v[1]);
+    let e_proj = state_error(&s, proj.q.as_slice(), proj.v.as_slice());
+    let e_proj_ref = state_error(&proj, &r.q[1], &r.v[1]);
+    println!(
+        "crank {:.2} .. {:.2} rad; tangent - ref {e_ref:.2e}, tangent - projected {e_proj:.2e}, \
+         projected - ref {e_proj_ref:.2e}; off branch {:.1e}; max |Phi| {:.1e}, |Phidot| {:.1e}; \
+         {st:?}",
+        watch.min_crank, watch.max_crank, watch.off_branch, watch.res.max_phi, watch.res.max_phidot
+    );
+    // the crank turned through 0 (mod 2 pi) and pi several times
+    assert!(watch.max_crank - watch.min_crank > 3.0 * std::f64::consts::PI);
+    // the flat configurations needed the exact Newton fallback, and nothing was halved
+    assert!(st.exact_maps > 0, "{st:?}");
+    assert_eq!(st.halvings, 0, "{st:?}");
+    assert_eq!(st.chart_failures, 0, "{st:?}");
+    // on the parallelogram branch all the time, constraints at tolerance
+    assert!(watch.off_branch < 1e-10, "{}", watch.off_branch);
+    assert!(watch.res.max_phi <= 1e-12 && watch.res.max_phidot <= 1e-12);
+    // the same state as projected RK4 and the reference, to RK4's accuracy at this step
+    assert!(e_ref < 1e-7, "{e_ref}");
+    assert!(e_proj < 1e-7, "{e_proj}");
+}
+
+#[test]
+fn driven_crank_passes_flat_configurations() {
+    // no degree of freedom: the driver fixes the crank, the loop closes on the branch
+    let sys = models::parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, true).expect("model");
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let (t_end, h) = (2.0, 1e-3);
+    let proj = projected_rk4(&sys, &s0, t_end, h);
+    let mut s = s0.clone();
+    let mut rk = TangentRk::rk4(&sys).expect("solver");
+    let mut watch = BranchWatch::default();
+    run(&mut rk, &sys, &mut s, RunConfig::new(t_end, h), &mut watch).expect("tangent RK4 run");
+    let st = *rk.stats();
+    let e_proj = state_error(&s, proj.q.as_slice(), proj.v.as_slice());
+    println!(
+        "tangent - projected {e_proj:.2e}; off branch {:.1e}; {st:?}",
+        watch.off_branch
+    );
+    assert!(st.exact_maps > 0 && st.halvings == 0, "{st:?}");
+    assert!(watch.off_branch < 1e-10, "{}", watch.off_branch);
+    assert!(watch.res.max_phi <= 1e-12 && watch.res.max_phidot <= 1e-12);
+    // the driven crank angle is exact: theta = 1 + 6 t
+    assert!((s.q[2] - 13.0).abs() < 1e-12, "{}", s.q[2]);
+    assert!(e_proj < 1e-9, "{e_proj}");
+}
+
+#[test]
+fn without_the_exact_newton_fallback_a_passage_fails() {
+    // the behaviour before the fallback (and the proof that the test above exercises it): the
+    // chord iteration alone cannot cross a flat configuration, and halving helps only by luck
+    // (the half steps' centres must straddle the crossing at a distance larger than the step)
+    let sys = free_four_bar();
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let opts = TangentOptions {
+        newton: NewtonSettings {
+            fallback_change: 0.0,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut rk = TangentRk::new(&sys, ButcherTableau::rk4(), opts).expect("solver");
+    let mut s = s0.clone();
+    let e = run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(2.0, 1e-3),
+        &mut NoObserver,
+    )
+    .unwrap_err();
+    println!("{e}; {:?}", rk.stats());
+    match e {
+        // at the first or second passage (t = 0.34, 0.63), after halvings
+        SolveError::Newton { t, .. } => assert!((0.3..0.7).contains(&t), "{t}"),
+        other => panic!("expected a chart failure, got {other}"),
+    }
+    assert!(rk.stats().halvings > 0);
+}
+
+#[test]
+fn step_ending_exactly_on_a_flat_configuration_is_a_typed_error_at_once() {
+    // crank driven from pi/2 at pi/2 rad/s: flat (theta = pi) at t = 1 exactly, a step end of
+    // h = 1e-3. The index-1 acceleration is undefined there (projected RK4 stops too); the
+    // step that would evaluate it is an error naming the rank and the loop's joints, without
+    // halving (a halved step still ends at t = 1)
+    let half = std::f64::consts::FRAC_PI_2;
+    let sys = models::parallelogram_four_bar(0.4, 1.0, half, half, true).expect("model");
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let mut rk = TangentRk::rk4(&sys).expect("solver");
+    let mut s = s0.clone();
+    let e = run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(2.0, 1e-3),
+        &mut NoObserver,
+    )
+    .unwrap_err();
+    println!("{e}; {:?}", rk.stats());
+    match &e {
+        SolveError::Singular { t, what, detail } => {
+            assert_eq!(*t, 1.0);
+            assert!(what.contains("configuration"), "{what}");
+            assert!(detail.contains("rank 8 of 9"), "{detail}");
+            for j in ["A0", "A", "B", "B0"] {
+                assert!(detail.contains(j), "{detail}");
+            }
+            assert!(!detail.contains("crank_drive"), "{detail}");
+        }
+        other => panic!("expected a singular configuration, got {other}"),
+    }
+    assert_eq!(rk.stats().halvings, 0);
+    assert!(
+        (s.t - 0.999).abs() < 1e-12,
+        "the state stays at the last good step"
+    );
+    let projected = Index1Rk::new(
+        &sys,
+        ButcherTableau::rk4(),
+        Index1Options {
+            projection: Some(ProjectionSettings::default()),
+            ..Default::default()
+        },
+    )
+    .expect("projected RK4")
+    .step(&sys, &mut s.clone(), 1e-3);
+    assert!(matches!(projected, Err(SolveError::Singular { .. })));
+}
+
+#[test]
+fn adaptive_dopri5_passes_flat_configurations_without_a_cascade() {
+    let sys = free_four_bar();
+    let s0 = State::consistent(&sys, 0.0).expect("state");
+    let r = reference_trajectory(&sys, &s0, 2.0, 1, 16_000, ButcherTableau::dopri5())
+        .expect("reference");
+    let mut dp = TangentRk::dopri5(&sys).expect("solver");
+    let mut s = s0.clone();
+    let mut watch = BranchWatch::default();
+    let st = dp
+        .integrate_adaptive(
+            &sys,
+            &mut s,
+            2.0,
+            &AdaptiveSettings::with_tolerance(1e-8),
+            &mut watch,
+        )
+        .expect("adaptive run");
+    let e = state_error(&s, &r.q[1], &r.v[1]);
+    println!("error {e:.2e}; off branch {:.1e}; {st:?}", watch.off_branch);
+    assert_eq!(s.t, 2.0);
+    assert!(st.exact_maps > 0, "{st:?}");
+    // no cascade of ever smaller steps: at most one chart rejection per flat passage
+    assert!(st.chart_rejections <= 5, "{st:?}");
+    assert!(st.h_min > 1e-4, "{st:?}");
+    assert!(watch.off_branch < 1e-10 && watch.res.max_phi <= 1e-12);
+    assert!(e < 1e-5, "{e}");
+}
+
+#[test]
+fn singular_start_is_a_typed_error_at_once_in_both_modes() {
+    // slider-crank with crank and rod of equal length folded at the pivot (crank up, rod down
+    // onto the slider at the origin): Phi_q has rank 7 of 8
+    let l = 0.3;
+    let sys = common::slider_crank(l, l, 1.0, None);
+    let half = std::f64::consts::FRAC_PI_2;
+    let q = DVector::from_vec(vec![0.0, 0.5 * l, half, 0.0, 0.5 * l, -half, 0.0, 0.0, 0.0]);
+    let s0 = State::new(&sys, 0.0, q, DVector::zeros(9)).expect("state");
+    let mut rk = TangentRk::rk4(&sys).expect("solver");
+    let e = rk.step(&sys, &mut s0.clone(), 1e-3).unwrap_err();
+    println!("{e}");
+    assert!(
+        matches!(&e, SolveError::Singular { detail, .. } if detail.contains("rank 7 of 8")),
+        "{e}"
+    );
+    let mut dp = TangentRk::dopri5(&sys).expect("solver");
+    let mut s = s0.clone();
+    let e = dp
+        .integrate_adaptive(
+            &sys,
+            &mut s,
+            1.0,
+            &AdaptiveSettings::default(),
+            &mut NoObserver,
+        )
+        .unwrap_err();
+    assert!(
+        matches!(
+            &e,
+            mbd_tangent::TangentError::Solve(SolveError::Singular { .. })
+        ),
+        "{e}"
+    );
+    assert_eq!(dp.stats().chart_failures, 0);
+    assert_eq!(s, s0);
+}
+
+#[test]
+fn parallelogram_four_bar_parameters_are_checked() {
+    let bad = [
+        (0.0, 1.0, 1.0, 6.0, "crank"),
+        (0.4, f64::NAN, 1.0, 6.0, "ground"),
+        (0.4, 1.0, std::f64::consts::PI, 6.0, "angle"),
+        (0.4, 1.0, 0.0, 6.0, "angle"),
+        (0.4, 1.0, f64::INFINITY, 6.0, "angle"),
+        (0.4, 1.0, 1.0, f64::NAN, "speed"),
+    ];
+    for (l, d, th, w, name) in bad {
+        match models::parallelogram_four_bar(l, d, th, w, false) {
+            Err(mbd_model::ModelError::InvalidParameter { parameter, .. }) => {
+                assert_eq!(parameter, name)
+            }
+            other => panic!("{name}: expected an invalid parameter, got {other:?}"),
+        }
+    }
+    // as built, the state is consistent (on the parallelogram branch)
+    let sys = free_four_bar();
+    let (q, v) = sys.initial_guess();
+    let s = State::new(&sys, 0.0, q, v).expect("state");
+    let mut buf = [vec![], vec![]];
+    let (p, d) = common::residuals(&sys, &s, &mut buf);
+    assert!(p < 1e-15 && d < 1e-15, "{p} {d}");
+}
