@@ -8,10 +8,7 @@ use mbd::solve::{run, Integrator, NoObserver, RunConfig, State};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let n: usize = args
-        .next()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(100_000);
+    let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(100_000);
     let mode = args.next().unwrap_or_else(|| "direct".into());
     let sys = models::manipulator()?;
     let mut s = State::consistent(&sys, 0.0)?;

@@ -587,7 +587,10 @@ mod tests {
         let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
         assert!(md.contains("did not hold (expected miss: known, see docs)"));
         assert!(md.contains("Wu Zhi-gang"), "the papers are cited");
-        assert!(!md.contains("shared/"), "the report must not point outside the repository");
+        assert!(
+            !md.contains("shared/"),
+            "the report must not point outside the repository"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 

@@ -64,6 +64,12 @@ impl RefinedAcceleration {
         worst
     }
 
+    /// The condition estimate of the last index-1 matrix (see
+    /// [`AccelerationSolver::condition_estimate`]).
+    pub fn condition_estimate(&self) -> f64 {
+        self.acc.condition_estimate()
+    }
+
     /// Solves at `(q, v, t)`.
     ///
     /// # Errors

@@ -577,7 +577,7 @@ impl FireflyGauss {
             residual: info.objective_final.sqrt(),
             rhs_evals: 5,
             objective_evals: evals as usize,
-            ..Default::default()
+            condition: self.end_acc.condition_estimate(),
         })
     }
 

@@ -397,6 +397,8 @@ struct AttemptWork {
     end_initial_residual: f64,
     /// Maps completed by the exact Newton fallback.
     exact_maps: usize,
+    /// Largest index-1 condition estimate of the attempt's stage solves.
+    condition: f64,
 }
 
 impl TangentRk {
@@ -736,6 +738,9 @@ impl TangentRk {
                 } else {
                     acc.solve(sys, q, v, ti, acc_a, lambda)
                 };
+                if solved.is_ok() {
+                    work.condition = work.condition.max(acc.condition_estimate());
+                }
                 if let Err(e) = solved {
                     if matches!(e, SolveError::Singular { .. }) {
                         *singular_stage = Some(i);
@@ -881,6 +886,7 @@ impl TangentRk {
                 out.newton_iterations += w.iterations;
                 out.rhs_evals += w.rhs_evals;
                 out.residual = out.residual.max(w.residual);
+                out.condition = out.condition.max(w.condition);
                 Ok(())
             }
             Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_))) => {
