@@ -204,17 +204,23 @@ impl Galerkin {
         }
     }
 
-    /// Control points, Gauss-point positions, displacements and forces at `self.x`.
-    fn kinematics(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
-        let (n, s) = (self.n, self.tab.s);
-        let s1 = s + 1;
-        let tab = &self.tab;
+    /// The control points `Q_nu = q_k + Z_nu` at `self.x`.
+    fn place_control_points(&mut self) {
+        let n = self.n;
         self.qn[..n].copy_from_slice(&self.qk);
         for (qn, z) in self.qn[n..].chunks_exact_mut(n).zip(self.x.chunks_exact(n)) {
             for ((q, &qk), &z) in qn.iter_mut().zip(&self.qk).zip(z) {
                 *q = qk + z;
             }
         }
+    }
+
+    /// Control points, Gauss-point positions, displacements and forces at `self.x`.
+    fn kinematics(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
+        let (n, s) = (self.n, self.tab.s);
+        let s1 = s + 1;
+        self.place_control_points();
+        let tab = &self.tab;
         for j in 0..s {
             // Q(c_j) - q_k and h Q'(c_j): combinations of the displacements Z_nu
             let qj = &mut self.qj[j * n..(j + 1) * n];
@@ -577,10 +583,10 @@ impl Galerkin {
         let mut chord = !need_jacobian;
         let mut since_jacobian = 0usize;
         let mut prev_step = f64::INFINITY;
-        // At least one update, even when the predictor's residual is already below the
-        // tolerance: the predictor's error is smooth in time, so accepting it unchanged lets it
-        // accumulate coherently from step to step; the error left after an update from the
-        // Jacobian at the predictor is quadratic in it (docs/symplectic.md, "Newton").
+        // Converged when the residual and the last displacement update are both below the
+        // tolerance (or by the contraction estimate below), so never on the predictor alone:
+        // its error is smooth in time and, accepted unchanged, accumulates coherently from step
+        // to step (docs/symplectic.md, "Newton").
         let mut last_dz = f64::INFINITY;
         while !(res <= tol && last_dz <= tol) {
             if it >= o.max_iter {
@@ -601,6 +607,22 @@ impl Galerkin {
                 self.dx[i] = -self.r[i];
             }
             self.lu.solve(&mut self.dx);
+            if res <= tol {
+                // The residual is converged, but no update has been made yet (the predictor's
+                // residual was already below the tolerance) or the last one was not below the
+                // tolerance: the error left is then about the size of this update, smooth in
+                // time, and would accumulate from step to step. This update is applied without
+                // a new residual: what it leaves is quadratic in it (or theta times it), and the
+                // forces and Phi_q at the interior points that the end momentum uses are those
+                // of the previous iterate, whose displacements differ by this update (of the
+                // order of the tolerance): an error of that order times h in the momentum.
+                for (x, d) in self.x.iter_mut().zip(&self.dx) {
+                    *x += d;
+                }
+                self.place_control_points();
+                it += 1;
+                break;
+            }
             // simplified-Newton stopping rule (Hairer & Wanner, IV.8): with the contraction
             // theta estimated from two updates with the same Jacobian, the error left after
             // this update is about theta / (1 - theta) |dZ|; when that is below the tolerance

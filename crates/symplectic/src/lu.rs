@@ -22,15 +22,19 @@
 //!   the columns where the pivot row is nonzero and records the nonzero pattern of `L` and `U`
 //!   as it goes.
 //!
-//! Both paths factor the *equilibrated* matrix `D_r A D_c`: every row, then every column, is
-//! scaled by a power of two that brings its largest entry into `[1, 2)`. Powers of two scale
-//! without rounding, so the factors and the solution are exactly those of the unscaled matrix
-//! with the same pivots; what the scaling changes is the pivot tests, which become independent
-//! of the units of the equations and unknowns (the stage equations of a mechanism with
+//! **Singularity test.** A pivot is negligible, and the matrix singular, when it is at most
+//! `PIVOT_TOL n` in the *equilibrated* matrix `D_r A D_c`: every row, then every column,
+//! scaled by a power of two that brings its largest entry into `[1, 2)`, so the test does not
+//! depend on the units of the equations and unknowns (the stage equations of a mechanism with
 //! centimetre links and 1e-7 kg m^2 inertias at h = 1e-7 have multiplier columns 1e-14 times
-//! smaller than the others, which a test relative to `max |A|` took for singular). A pivot is
-//! negligible, and the matrix singular, when it is at most `PIVOT_TOL n` in the equilibrated
-//! matrix (whose rows and columns all have their largest entry in `[1, 2)`).
+//! smaller than the others, which a test relative to `max |A|` took for singular). The scaling
+//! is not applied to the stored matrix: powers of two scale without rounding, so the pivots of
+//! `D_r A D_c` are exactly `r_k u_kk c_k` and only the test needs the scale factors. They cost
+//! two passes over the pattern, so the static path computes them only when a pivot is below
+//! `4 PIVOT_TOL n max |A|` (above that the scaled test cannot fail); the general path computes
+//! them always and chooses its pivots by their magnitude in the row-scaled matrix (scaled
+//! partial pivoting). The static path's threshold test compares unscaled entries of one column,
+//! which is invariant under column scaling.
 //!
 //! [`SmallLu::solve`] touches only the recorded nonzeros of `L` and `U`.
 
@@ -113,8 +117,11 @@ pub(crate) struct SmallLu {
     /// The ordered matrix (row-major), factored in place: multipliers below and `U` on and
     /// above the diagonal, each in the (physical) row it was computed in.
     f: Vec<f64>,
-    /// Positions (ordered numbering) of the `n_nz` entries of `mask`.
+    /// Positions (ordered numbering) of the `n_nz` entries of `mask` (row by row: those of
+    /// row `i` are `nz[nz_start[i]..nz_start[i + 1]]`), and their columns.
     nz: Vec<usize>,
+    nz_start: Vec<usize>,
+    nz_col: Vec<usize>,
     n_nz: usize,
     /// Copy of the matrix at `nz`, for the general path when the static pivots fail.
     backup: Vec<f64>,
@@ -144,12 +151,14 @@ pub(crate) struct SmallLu {
     /// Scratch vectors of the solve.
     y: Vec<f64>,
     x: Vec<f64>,
-    /// Row and column scale factors (powers of two) of the equilibration, ordered numbering.
+    /// Row and column scale factors (powers of two) of the equilibration, ordered numbering
+    /// (used by the pivot tests only).
     rscale: Vec<f64>,
     cscale: Vec<f64>,
-    /// Largest entry of each row / column (scratch of the equilibration).
-    rmax: Vec<f64>,
+    /// Largest entry of each column of the row-scaled matrix (scratch of the equilibration).
     cmax: Vec<f64>,
+    /// Whether `rscale` and `cscale` belong to the matrix being factored.
+    scaled: bool,
 }
 
 impl SmallLu {
@@ -180,6 +189,8 @@ impl SmallLu {
             cpos,
             f: vec![0.0; n * n],
             nz: vec![0; n * n],
+            nz_start: vec![0; n + 1],
+            nz_col: vec![0; n * n],
             n_nz: 0,
             backup: vec![0.0; n * n],
             rp: (0..n).collect(),
@@ -198,8 +209,8 @@ impl SmallLu {
             x: vec![0.0; n],
             rscale: vec![1.0; n],
             cscale: vec![1.0; n],
-            rmax: vec![0.0; n],
             cmax: vec![0.0; n],
+            scaled: false,
         }
     }
 
@@ -208,11 +219,16 @@ impl SmallLu {
         let n = self.n;
         self.n_nz = 0;
         for (k, &m) in self.mask.iter().enumerate() {
+            if k % n == 0 {
+                self.nz_start[k / n] = self.n_nz;
+            }
             if m {
                 self.nz[self.n_nz] = k;
+                self.nz_col[self.n_nz] = k % n;
                 self.n_nz += 1;
             }
         }
+        self.nz_start[n] = self.n_nz;
         let mask = &mut self.fill;
         mask.copy_from_slice(&self.mask);
         let p = &mut self.symbolic;
@@ -284,59 +300,45 @@ impl SmallLu {
         }
     }
 
-    /// Factors the matrix in place (after equilibration, see the module docs). Errors name the
-    /// entry, row or unknown at fault in the caller's numbering.
+    /// Factors the matrix in place (singularity tests on the equilibrated matrix, see the
+    /// module docs). Errors name the entry, row or unknown at fault in the caller's numbering.
     pub fn factor(&mut self) -> Result<(), LuError> {
         let n = self.n;
         if self.dirty {
             self.analyse();
         }
-        // the entries outside the pattern are zero: the equilibration and the copy for the
+        // the entries outside the pattern are zero: the largest entry and the copy for the
         // fallback need only the pattern's
-        self.rmax.fill(0.0);
-        self.cmax.fill(0.0);
-        for &k in &self.nz[..self.n_nz] {
-            let v = self.f[k].abs();
-            let i = k / n;
-            if !v.is_finite() {
+        let mut gmax = 0.0f64;
+        // (a NaN or infinite entry makes the sum non-finite; so can an overflow, which the
+        // search below then does not confirm)
+        let mut sum = 0.0f64;
+        for (b, &k) in self.backup.iter_mut().zip(&self.nz[..self.n_nz]) {
+            let v = self.f[k];
+            *b = v;
+            let a = v.abs();
+            sum += a;
+            if a > gmax {
+                gmax = a;
+            }
+        }
+        if !sum.is_finite() {
+            let bad = self.nz[..self.n_nz]
+                .iter()
+                .find(|&&k| !self.f[k].is_finite());
+            if let Some(&k) = bad {
                 return Err(LuError::NonFinite {
-                    row: self.rows[i],
+                    row: self.rows[k / n],
                     col: self.cols[k % n],
                 });
             }
-            if v > self.rmax[i] {
-                self.rmax[i] = v;
-            }
         }
-        for i in 0..n {
-            if self.rmax[i] == 0.0 {
-                return Err(self.singular(i, i));
-            }
-            self.rscale[i] = pow2_inverse(self.rmax[i]);
-        }
-        for &k in &self.nz[..self.n_nz] {
-            let (i, j) = (k / n, k % n);
-            let v = self.f[k].abs() * self.rscale[i];
-            if v > self.cmax[j] {
-                self.cmax[j] = v;
-            }
-        }
-        for j in 0..n {
-            if self.cmax[j] == 0.0 {
-                return Err(self.singular(j, j));
-            }
-            self.cscale[j] = pow2_inverse(self.cmax[j]);
-        }
-        for (b, &k) in self.backup.iter_mut().zip(&self.nz[..self.n_nz]) {
-            let v = self.f[k] * (self.rscale[k / n] * self.cscale[k % n]);
-            self.f[k] = v;
-            *b = v;
-        }
+        self.scaled = false;
         let tol = PIVOT_TOL * n as f64;
         for (k, r) in self.rp.iter_mut().enumerate() {
             *r = k;
         }
-        if self.factor_static(tol) {
+        if self.factor_static(tol, gmax)? {
             self.static_used = true;
             return Ok(());
         }
@@ -346,39 +348,91 @@ impl SmallLu {
             self.f[k] = b;
         }
         self.static_used = false;
+        self.equilibrate()?;
         self.factor_dynamic(tol)
-            .map_err(|(i, k)| self.singular(i, k))
+            .map_err(|(i, k)| LuError::Singular {
+                row: self.rows[i],
+                col: self.cols[k],
+            })
     }
 
-    /// The error for pivot `k` (ordered numbering) with physical row `i`.
-    fn singular(&self, i: usize, k: usize) -> LuError {
-        LuError::Singular {
-            row: self.rows[i],
-            col: self.cols[k],
+    /// The scale factors of the equilibration (from `backup`, the matrix before elimination),
+    /// once per factorisation: row by row, the row's largest entry and its scale factor, then
+    /// the column maxima of the row-scaled matrix. An all-zero row or column is an error.
+    fn equilibrate(&mut self) -> Result<(), LuError> {
+        if self.scaled {
+            return Ok(());
         }
+        let (nz_col, backup) = (&self.nz_col, &self.backup);
+        let cmax = &mut self.cmax;
+        cmax.fill(0.0);
+        for (i, (w, r)) in self
+            .nz_start
+            .windows(2)
+            .zip(self.rscale.iter_mut())
+            .enumerate()
+        {
+            let row = &backup[w[0]..w[1]];
+            let mx = row.iter().fold(0.0f64, |m, b| m.max(b.abs()));
+            if mx == 0.0 {
+                return Err(LuError::Singular {
+                    row: self.rows[i],
+                    col: self.cols[i],
+                });
+            }
+            let sc = pow2_inverse(mx);
+            *r = sc;
+            for (&b, &j) in row.iter().zip(&nz_col[w[0]..w[1]]) {
+                let c = &mut cmax[j];
+                *c = c.max(b.abs() * sc);
+            }
+        }
+        for (j, (sc, &mx)) in self.cscale.iter_mut().zip(cmax.iter()).enumerate() {
+            if mx == 0.0 {
+                return Err(LuError::Singular {
+                    row: self.rows[j],
+                    col: self.cols[j],
+                });
+            }
+            *sc = pow2_inverse(mx);
+        }
+        self.scaled = true;
+        Ok(())
     }
 
-    /// Elimination with the static diagonal pivots over the symbolic pattern; `false` (with
-    /// the matrix partly eliminated) if a pivot fails the threshold.
-    fn factor_static(&mut self, tol: f64) -> bool {
+    /// Elimination with the static diagonal pivots over the symbolic pattern; `Ok(false)`
+    /// (with the matrix partly eliminated) if a pivot fails the threshold test (at least
+    /// `PIVOT_THRESHOLD` times the largest entry below it) or the singularity test.
+    ///
+    /// The singularity test is `|u_kk| r_k c_k > tol` in the equilibrated matrix. Since every
+    /// entry of the row-scaled matrix is below 1, `c_k >= 1/2`, and `r_k > 1 / (2 max |A|)`,
+    /// so `|u_kk| > 4 tol max |A|` passes it without the scale factors, which are computed
+    /// only when a pivot is smaller than that (on the papers' models: at h below about 1e-4).
+    fn factor_static(&mut self, tol: f64, gmax: f64) -> Result<bool, LuError> {
         let n = self.n;
-        let (a, p) = (&mut self.f, &self.symbolic);
-        let (l_val, u_val, dinv) = (&mut self.l_val, &mut self.u_val, &mut self.dinv);
+        let sure = 4.0 * tol * gmax;
         for k in 0..n {
-            let piv = a[k * n + k];
-            let (ls, le) = (p.l_start[k], p.l_start[k + 1]);
-            let lrows = &p.l_idx[ls..le];
-            let mut colmax = 0.0f64;
-            for &i in lrows {
-                let v = a[i * n + k].abs();
-                // (a NaN is kept, and fails the test below)
-                if v > colmax || v.is_nan() {
-                    colmax = v;
+            let piv = self.f[k * n + k];
+            let pa = piv.abs();
+            if pa.is_nan() {
+                return Ok(false);
+            }
+            if pa <= sure {
+                self.equilibrate()?;
+                if pa * self.rscale[k] * self.cscale[k] <= tol {
+                    return Ok(false);
                 }
             }
-            // (also false for NaN)
-            if !(piv.abs() > tol && piv.abs() >= PIVOT_THRESHOLD * colmax) {
-                return false;
+            let (a, p) = (&mut self.f, &self.symbolic);
+            let (l_val, u_val, dinv) = (&mut self.l_val, &mut self.u_val, &mut self.dinv);
+            let (ls, le) = (p.l_start[k], p.l_start[k + 1]);
+            let lrows = &p.l_idx[ls..le];
+            // (the entries were checked finite; a NaN from an overflow in the elimination,
+            // which `max` would skip here, reaches a later pivot through the multipliers and
+            // fails its test)
+            let colmax = lrows.iter().fold(0.0f64, |m, &i| m.max(a[i * n + k].abs()));
+            if pa < PIVOT_THRESHOLD * colmax {
+                return Ok(false);
             }
             let (us, ue) = (p.u_start[k], p.u_start[k + 1]);
             let ucols = &p.u_idx[us..ue];
@@ -399,7 +453,7 @@ impl SmallLu {
                 }
             }
         }
-        true
+        Ok(true)
     }
 
     /// Threshold partial pivoting, recording the nonzeros of `L` and `U`; `Err((i, k))` if
@@ -412,19 +466,21 @@ impl SmallLu {
             *r = k;
         }
         let (mut nl, mut nu) = (0, 0);
+        let (rs, cs) = (&self.rscale, &self.cscale);
         for k in 0..n {
-            let diag = a[self.rp[k] * n + k].abs();
+            // scaled partial pivoting: magnitudes in the equilibrated matrix
+            let diag = a[self.rp[k] * n + k].abs() * rs[self.rp[k]];
             let mut piv = k;
             let mut best = diag;
             for i in k + 1..n {
-                let v = a[self.rp[i] * n + k].abs();
+                let v = a[self.rp[i] * n + k].abs() * rs[self.rp[i]];
                 // (a NaN is taken, and fails the test below)
                 if v > best || v.is_nan() {
                     best = v;
                     piv = i;
                 }
             }
-            if best.is_nan() || best <= tol {
+            if best.is_nan() || best * cs[k] <= tol {
                 return Err((self.rp[piv], k));
             }
             if diag < PIVOT_THRESHOLD * best {
@@ -474,8 +530,8 @@ impl SmallLu {
         } else {
             &self.dynamic
         };
-        for ((yi, &r), &sc) in y.iter_mut().zip(&self.rows).zip(&self.rscale) {
-            *yi = b[r] * sc;
+        for (yi, &r) in y.iter_mut().zip(&self.rows) {
+            *yi = b[r];
         }
         // forward: L z = P y, column by column (z_k ends in y[rp[k]])
         for k in 0..n {
@@ -496,8 +552,8 @@ impl SmallLu {
             }
             x[k] = (y[rp[k]] - s) * self.dinv[k];
         }
-        for ((&xj, &c), &sc) in x.iter().zip(&self.cols).zip(&self.cscale) {
-            b[c] = xj * sc;
+        for (&xj, &c) in x.iter().zip(&self.cols) {
+            b[c] = xj;
         }
     }
 }
