@@ -159,6 +159,8 @@ pub(crate) struct SmallLu {
     cmax: Vec<f64>,
     /// Whether `rscale` and `cscale` belong to the matrix being factored.
     scaled: bool,
+    /// Number of factorisations that needed the scale factors.
+    equilibrations: usize,
 }
 
 impl SmallLu {
@@ -211,6 +213,7 @@ impl SmallLu {
             cscale: vec![1.0; n],
             cmax: vec![0.0; n],
             scaled: false,
+            equilibrations: 0,
         }
     }
 
@@ -263,6 +266,12 @@ impl SmallLu {
     #[cfg(test)]
     pub fn fallbacks(&self) -> usize {
         self.fallbacks
+    }
+
+    /// Number of factorisations that needed the equilibration's scale factors.
+    #[cfg(test)]
+    pub fn equilibrations(&self) -> usize {
+        self.equilibrations
     }
 
     /// Number of symbolic factorisations (one per growth of the pattern).
@@ -397,6 +406,7 @@ impl SmallLu {
             *sc = pow2_inverse(mx);
         }
         self.scaled = true;
+        self.equilibrations += 1;
         Ok(())
     }
 
