@@ -7,9 +7,10 @@
 //!
 //! * [`Galerkin`] implements [`mbd_solve::Integrator`]: Lagrange interpolation of `q` through
 //!   `s + 1` control points, `s`-point Gauss-Legendre quadrature of the action, constraints at
-//!   every control point, Newton with an analytic Jacobian on the `s (n + m)` stage equations,
-//!   the end momentum projected onto `Phi_q M^-1 p = 0`. Order `2s`, symplectic, no energy
-//!   drift; constraints at position and velocity level to the Newton tolerance.
+//!   every control point, Newton with an analytic Jacobian on the `s (n + m)` stage equations
+//!   (at least one update per step), the end momentum from the discrete momentum balance
+//!   projected onto `Phi_q M^-1 p = 0`. Order `2s`, symplectic, no energy drift; constraints at
+//!   position and velocity level to the Newton tolerance.
 //! * [`SymplecticOptions`]: `s`, `gamma`, the control-point placement [`Nodes`] and the Newton
 //!   settings. `gamma = 0` is the plain scheme bit for bit; [`kappa`] gives `kappa_s`.
 //! * [`Preadjustment`]: `W_s`, its gradient and the tangential force on any model.

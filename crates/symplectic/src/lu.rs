@@ -22,10 +22,59 @@
 //!   the columns where the pivot row is nonzero and records the nonzero pattern of `L` and `U`
 //!   as it goes.
 //!
+//! **Singularity test.** A pivot is negligible, and the matrix singular, when it is at most
+//! `PIVOT_TOL n` in the *equilibrated* matrix `D_r A D_c`: every row, then every column,
+//! scaled by a power of two that brings its largest entry into `[1, 2)`, so the test does not
+//! depend on the units of the equations and unknowns (the stage equations of a mechanism with
+//! centimetre links and 1e-7 kg m^2 inertias at h = 1e-7 have multiplier columns 1e-14 times
+//! smaller than the others, which a test relative to `max |A|` took for singular). The scaling
+//! is not applied to the stored matrix: powers of two scale without rounding, so the pivots of
+//! `D_r A D_c` are exactly `r_k u_kk c_k` and only the test needs the scale factors. They cost
+//! two passes over the pattern, so the static path computes them only when a pivot is below
+//! `4 PIVOT_TOL n max |A|` (above that the scaled test cannot fail); the general path computes
+//! them always and chooses its pivots by their magnitude in the row-scaled matrix (scaled
+//! partial pivoting). The static path's threshold test compares unscaled entries of one column,
+//! which is invariant under column scaling.
+//!
 //! [`SmallLu::solve`] touches only the recorded nonzeros of `L` and `U`.
 
 /// A diagonal pivot is kept if it is at least this fraction of the largest entry of its column.
 const PIVOT_THRESHOLD: f64 = 0.1;
+
+/// A pivot of the equilibrated matrix below `PIVOT_TOL n` is negligible (the matrix singular):
+/// a few hundred rounding errors of its O(1) entries.
+const PIVOT_TOL: f64 = 1e-14;
+
+/// Why a factorisation failed, in the caller's numbering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum LuError {
+    /// No usable pivot for unknown `col`; `row` is the equation the elimination reached with
+    /// it (its partner in the ordering, or the row that was to be swapped in). An all-zero row
+    /// or column is reported with its ordering partner.
+    Singular {
+        /// The caller's row.
+        row: usize,
+        /// The caller's column (unknown).
+        col: usize,
+    },
+    /// Entry `(row, col)` is NaN or infinite.
+    NonFinite {
+        /// The caller's row.
+        row: usize,
+        /// The caller's column.
+        col: usize,
+    },
+}
+
+/// The power of two `2^-e` with `v 2^-e` in `[1, 2)`, for finite `v > 0` (clamped to the
+/// normal range, so it is never zero or infinite).
+#[inline]
+fn pow2_inverse(v: f64) -> f64 {
+    let e = ((v.to_bits() >> 52) & 0x7ff) as i64; // biased exponent of v
+                                                  // 2^-(e - 1023) has biased exponent 2046 - e
+    let b = (2046 - e).clamp(1, 2046) as u64;
+    f64::from_bits(b << 52)
+}
 
 /// Nonzero lists of `L` (by columns) and `U` (by rows) of one factorisation.
 #[derive(Clone, Debug, Default)]
@@ -68,8 +117,11 @@ pub(crate) struct SmallLu {
     /// The ordered matrix (row-major), factored in place: multipliers below and `U` on and
     /// above the diagonal, each in the (physical) row it was computed in.
     f: Vec<f64>,
-    /// Positions (ordered numbering) of the `n_nz` entries of `mask`.
+    /// Positions (ordered numbering) of the `n_nz` entries of `mask` (row by row: those of
+    /// row `i` are `nz[nz_start[i]..nz_start[i + 1]]`), and their columns.
     nz: Vec<usize>,
+    nz_start: Vec<usize>,
+    nz_col: Vec<usize>,
     n_nz: usize,
     /// Copy of the matrix at `nz`, for the general path when the static pivots fail.
     backup: Vec<f64>,
@@ -99,6 +151,16 @@ pub(crate) struct SmallLu {
     /// Scratch vectors of the solve.
     y: Vec<f64>,
     x: Vec<f64>,
+    /// Row and column scale factors (powers of two) of the equilibration, ordered numbering
+    /// (used by the pivot tests only).
+    rscale: Vec<f64>,
+    cscale: Vec<f64>,
+    /// Largest entry of each column of the row-scaled matrix (scratch of the equilibration).
+    cmax: Vec<f64>,
+    /// Whether `rscale` and `cscale` belong to the matrix being factored.
+    scaled: bool,
+    /// Number of factorisations that needed the scale factors.
+    equilibrations: usize,
 }
 
 impl SmallLu {
@@ -129,6 +191,8 @@ impl SmallLu {
             cpos,
             f: vec![0.0; n * n],
             nz: vec![0; n * n],
+            nz_start: vec![0; n + 1],
+            nz_col: vec![0; n * n],
             n_nz: 0,
             backup: vec![0.0; n * n],
             rp: (0..n).collect(),
@@ -145,6 +209,11 @@ impl SmallLu {
             dinv: vec![0.0; n],
             y: vec![0.0; n],
             x: vec![0.0; n],
+            rscale: vec![1.0; n],
+            cscale: vec![1.0; n],
+            cmax: vec![0.0; n],
+            scaled: false,
+            equilibrations: 0,
         }
     }
 
@@ -153,11 +222,16 @@ impl SmallLu {
         let n = self.n;
         self.n_nz = 0;
         for (k, &m) in self.mask.iter().enumerate() {
+            if k % n == 0 {
+                self.nz_start[k / n] = self.n_nz;
+            }
             if m {
                 self.nz[self.n_nz] = k;
+                self.nz_col[self.n_nz] = k % n;
                 self.n_nz += 1;
             }
         }
+        self.nz_start[n] = self.n_nz;
         let mask = &mut self.fill;
         mask.copy_from_slice(&self.mask);
         let p = &mut self.symbolic;
@@ -192,6 +266,12 @@ impl SmallLu {
     #[cfg(test)]
     pub fn fallbacks(&self) -> usize {
         self.fallbacks
+    }
+
+    /// Number of factorisations that needed the equilibration's scale factors.
+    #[cfg(test)]
+    pub fn equilibrations(&self) -> usize {
+        self.equilibrations
     }
 
     /// Number of symbolic factorisations (one per growth of the pattern).
@@ -229,28 +309,45 @@ impl SmallLu {
         }
     }
 
-    /// Factors the matrix in place; `Err(i)` if pivot `i` (in the ordered numbering) is
-    /// negligible.
-    pub fn factor(&mut self) -> Result<(), usize> {
+    /// Factors the matrix in place (singularity tests on the equilibrated matrix, see the
+    /// module docs). Errors name the entry, row or unknown at fault in the caller's numbering.
+    pub fn factor(&mut self) -> Result<(), LuError> {
         let n = self.n;
         if self.dirty {
             self.analyse();
         }
-        // the entries outside the pattern are zero: the scale and the copy for the fallback
-        // need only the pattern's
-        let mut scale = 0.0f64;
+        // the entries outside the pattern are zero: the largest entry and the copy for the
+        // fallback need only the pattern's
+        let mut gmax = 0.0f64;
+        // (a NaN or infinite entry makes the sum non-finite; so can an overflow, which the
+        // search below then does not confirm)
+        let mut sum = 0.0f64;
         for (b, &k) in self.backup.iter_mut().zip(&self.nz[..self.n_nz]) {
             let v = self.f[k];
             *b = v;
-            if v.abs() > scale {
-                scale = v.abs();
+            let a = v.abs();
+            sum += a;
+            if a > gmax {
+                gmax = a;
             }
         }
-        let tol = 1e-14 * scale.max(f64::MIN_POSITIVE) * n as f64;
+        if !sum.is_finite() {
+            let bad = self.nz[..self.n_nz]
+                .iter()
+                .find(|&&k| !self.f[k].is_finite());
+            if let Some(&k) = bad {
+                return Err(LuError::NonFinite {
+                    row: self.rows[k / n],
+                    col: self.cols[k % n],
+                });
+            }
+        }
+        self.scaled = false;
+        let tol = PIVOT_TOL * n as f64;
         for (k, r) in self.rp.iter_mut().enumerate() {
             *r = k;
         }
-        if self.factor_static(tol) {
+        if self.factor_static(tol, gmax)? {
             self.static_used = true;
             return Ok(());
         }
@@ -260,23 +357,92 @@ impl SmallLu {
             self.f[k] = b;
         }
         self.static_used = false;
+        self.equilibrate()?;
         self.factor_dynamic(tol)
+            .map_err(|(i, k)| LuError::Singular {
+                row: self.rows[i],
+                col: self.cols[k],
+            })
     }
 
-    /// Elimination with the static diagonal pivots over the symbolic pattern; `false` (with
-    /// the matrix partly eliminated) if a pivot fails the threshold.
-    fn factor_static(&mut self, tol: f64) -> bool {
+    /// The scale factors of the equilibration (from `backup`, the matrix before elimination),
+    /// once per factorisation: row by row, the row's largest entry and its scale factor, then
+    /// the column maxima of the row-scaled matrix. An all-zero row or column is an error.
+    fn equilibrate(&mut self) -> Result<(), LuError> {
+        if self.scaled {
+            return Ok(());
+        }
+        let (nz_col, backup) = (&self.nz_col, &self.backup);
+        let cmax = &mut self.cmax;
+        cmax.fill(0.0);
+        for (i, (w, r)) in self
+            .nz_start
+            .windows(2)
+            .zip(self.rscale.iter_mut())
+            .enumerate()
+        {
+            let row = &backup[w[0]..w[1]];
+            let mx = row.iter().fold(0.0f64, |m, b| m.max(b.abs()));
+            if mx == 0.0 {
+                return Err(LuError::Singular {
+                    row: self.rows[i],
+                    col: self.cols[i],
+                });
+            }
+            let sc = pow2_inverse(mx);
+            *r = sc;
+            for (&b, &j) in row.iter().zip(&nz_col[w[0]..w[1]]) {
+                let c = &mut cmax[j];
+                *c = c.max(b.abs() * sc);
+            }
+        }
+        for (j, (sc, &mx)) in self.cscale.iter_mut().zip(cmax.iter()).enumerate() {
+            if mx == 0.0 {
+                return Err(LuError::Singular {
+                    row: self.rows[j],
+                    col: self.cols[j],
+                });
+            }
+            *sc = pow2_inverse(mx);
+        }
+        self.scaled = true;
+        self.equilibrations += 1;
+        Ok(())
+    }
+
+    /// Elimination with the static diagonal pivots over the symbolic pattern; `Ok(false)`
+    /// (with the matrix partly eliminated) if a pivot fails the threshold test (at least
+    /// `PIVOT_THRESHOLD` times the largest entry below it) or the singularity test.
+    ///
+    /// The singularity test is `|u_kk| r_k c_k > tol` in the equilibrated matrix. Since every
+    /// entry of the row-scaled matrix is below 1, `c_k >= 1/2`, and `r_k > 1 / (2 max |A|)`,
+    /// so `|u_kk| > 4 tol max |A|` passes it without the scale factors, which are computed
+    /// only when a pivot is smaller than that (on the papers' models: at h below about 1e-4).
+    fn factor_static(&mut self, tol: f64, gmax: f64) -> Result<bool, LuError> {
         let n = self.n;
-        let (a, p) = (&mut self.f, &self.symbolic);
-        let (l_val, u_val, dinv) = (&mut self.l_val, &mut self.u_val, &mut self.dinv);
+        let sure = 4.0 * tol * gmax;
         for k in 0..n {
-            let piv = a[k * n + k];
+            let piv = self.f[k * n + k];
+            let pa = piv.abs();
+            if pa.is_nan() {
+                return Ok(false);
+            }
+            if pa <= sure {
+                self.equilibrate()?;
+                if pa * self.rscale[k] * self.cscale[k] <= tol {
+                    return Ok(false);
+                }
+            }
+            let (a, p) = (&mut self.f, &self.symbolic);
+            let (l_val, u_val, dinv) = (&mut self.l_val, &mut self.u_val, &mut self.dinv);
             let (ls, le) = (p.l_start[k], p.l_start[k + 1]);
             let lrows = &p.l_idx[ls..le];
+            // (the entries were checked finite; a NaN from an overflow in the elimination,
+            // which `max` would skip here, reaches a later pivot through the multipliers and
+            // fails its test)
             let colmax = lrows.iter().fold(0.0f64, |m, &i| m.max(a[i * n + k].abs()));
-            // (also false for NaN)
-            if !(piv.abs() > tol && piv.abs() >= PIVOT_THRESHOLD * colmax) {
-                return false;
+            if pa < PIVOT_THRESHOLD * colmax {
+                return Ok(false);
             }
             let (us, ue) = (p.u_start[k], p.u_start[k + 1]);
             let ucols = &p.u_idx[us..ue];
@@ -297,11 +463,12 @@ impl SmallLu {
                 }
             }
         }
-        true
+        Ok(true)
     }
 
-    /// Threshold partial pivoting, recording the nonzeros of `L` and `U`.
-    fn factor_dynamic(&mut self, tol: f64) -> Result<(), usize> {
+    /// Threshold partial pivoting, recording the nonzeros of `L` and `U`; `Err((i, k))` if
+    /// column `k` has no usable pivot (`i`: the physical row at position `k`).
+    fn factor_dynamic(&mut self, tol: f64) -> Result<(), (usize, usize)> {
         let n = self.n;
         let a = &mut self.f;
         let p = &mut self.dynamic;
@@ -309,19 +476,22 @@ impl SmallLu {
             *r = k;
         }
         let (mut nl, mut nu) = (0, 0);
+        let (rs, cs) = (&self.rscale, &self.cscale);
         for k in 0..n {
-            let diag = a[self.rp[k] * n + k].abs();
+            // scaled partial pivoting: magnitudes in the equilibrated matrix
+            let diag = a[self.rp[k] * n + k].abs() * rs[self.rp[k]];
             let mut piv = k;
             let mut best = diag;
             for i in k + 1..n {
-                let v = a[self.rp[i] * n + k].abs();
-                if v > best {
+                let v = a[self.rp[i] * n + k].abs() * rs[self.rp[i]];
+                // (a NaN is taken, and fails the test below)
+                if v > best || v.is_nan() {
                     best = v;
                     piv = i;
                 }
             }
-            if best.is_nan() || best <= tol {
-                return Err(k);
+            if best.is_nan() || best * cs[k] <= tol {
+                return Err((self.rp[piv], k));
             }
             if diag < PIVOT_THRESHOLD * best {
                 self.rp.swap(k, piv);
@@ -428,7 +598,7 @@ mod tests {
         }
         let mut s = SmallLu::new(2);
         fill(&mut s, &[1.0, 2.0, 2.0, 4.0]);
-        assert!(s.factor().is_err());
+        assert_eq!(s.factor(), Err(LuError::Singular { row: 1, col: 1 }));
     }
 
     /// Sparse matrices with fill-in and pivoting: the solution satisfies `A x = b`.
@@ -527,10 +697,135 @@ mod tests {
         // singular: an error naming the pivot
         let z = vec![0.0; n * n];
         fill(&mut lu, &z);
-        assert_eq!(lu.factor(), Err(0));
-        let mut nan = a.clone();
-        nan[5] = f64::NAN;
-        fill(&mut lu, &nan);
-        assert!(lu.factor().is_err());
+        assert_eq!(lu.factor(), Err(LuError::Singular { row: 0, col: 0 }));
+        // non-finite entries are named, wherever they are
+        for (pos, bad) in [(5, f64::NAN), (3 * n, f64::INFINITY), (3, f64::NAN)] {
+            let mut m = a.clone();
+            m[pos] = bad;
+            fill(&mut lu, &m);
+            assert_eq!(
+                lu.factor(),
+                Err(LuError::NonFinite {
+                    row: pos / n,
+                    col: pos % n
+                })
+            );
+        }
+    }
+
+    /// A test matrix shaped like the stage Jacobian: a regular `n x n` block `K` (momentum
+    /// rows, displacement unknowns) coupled to `m` multipliers through `B` (columns) and `C`
+    /// (constraint rows), zero multiplier block.
+    fn saddle(n: usize, m: usize, seed: u64) -> Vec<f64> {
+        let mut state = seed;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
+        };
+        let d = n + m;
+        let mut a = vec![0.0; d * d];
+        for i in 0..n {
+            a[i * d + i] = 2.0 + rnd();
+            if i + 1 < n {
+                a[i * d + i + 1] = rnd();
+                a[(i + 1) * d + i] = rnd();
+            }
+        }
+        for r in 0..m {
+            for i in 0..n {
+                if (i + r) % 3 != 2 {
+                    let g = rnd();
+                    a[i * d + n + r] = g;
+                    a[(n + r) * d + i] = g + 0.1 * rnd();
+                }
+            }
+        }
+        a
+    }
+
+    /// `D_r A D_c` with row and column scales spanning `10^-span..10^span` (not powers of two).
+    fn scaled(a: &[f64], d: usize, span: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let dr: Vec<f64> = (0..d)
+            .map(|i| 10f64.powf(span * ((i * 7 % d) as f64 / d as f64 * 2.0 - 1.0)))
+            .collect();
+        let dc: Vec<f64> = (0..d)
+            .map(|j| 10f64.powf(span * ((j * 5 % d) as f64 / d as f64 * 2.0 - 1.0)) * 1.37)
+            .collect();
+        let mut s = a.to_vec();
+        for i in 0..d {
+            for j in 0..d {
+                s[i * d + j] *= dr[i] * dc[j];
+            }
+        }
+        (s, dr, dc)
+    }
+
+    /// Regular matrices whose rows and columns are scaled by up to 1e+-12 (the stage equations
+    /// of a badly scaled mechanism at tiny h): factored, and solved to a relative accuracy that
+    /// does not depend on the scaling. Before the equilibration, every scaled case failed as
+    /// "singular" (pivot below 1e-14 max |A|).
+    #[test]
+    fn badly_scaled_regular_matrices_are_solved() {
+        let (n, m) = (12, 4);
+        let d = n + m;
+        let order: Vec<usize> = (0..d).collect();
+        for seed in 1..=3 {
+            let a = saddle(n, m, seed);
+            for span in [0.0, 4.0, 8.0, 12.0] {
+                let (s, _, dc) = scaled(&a, d, span);
+                let mut lu = SmallLu::with_ordering(order.clone(), order.clone());
+                fill(&mut lu, &s);
+                lu.factor()
+                    .unwrap_or_else(|e| panic!("seed {seed}, span 1e{span}: {e:?}"));
+                // x = D_c^-1 y with y of unit size, so the scaled system has a well-scaled answer
+                let y: Vec<f64> = (0..d).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
+                let x: Vec<f64> = (0..d).map(|j| y[j] / dc[j]).collect();
+                let mut b: Vec<f64> = (0..d)
+                    .map(|i| (0..d).map(|j| s[i * d + j] * x[j]).sum())
+                    .collect();
+                lu.solve(&mut b);
+                let err = (0..d)
+                    .map(|j| ((b[j] - x[j]) * dc[j]).abs())
+                    .fold(0.0, f64::max);
+                assert!(err < 1e-12, "seed {seed}, span 1e{span}: error {err:e}");
+            }
+        }
+    }
+
+    /// Singular matrices stay singular at every scaling: a rank-deficient multiplier block
+    /// (two constraint rows equal: redundant constraints) and a zero column, scaled by up to
+    /// 1e+-12.
+    #[test]
+    fn singular_matrices_are_reported_at_every_scaling() {
+        let (n, m) = (12, 4);
+        let d = n + m;
+        let order: Vec<usize> = (0..d).collect();
+        let a = saddle(n, m, 7);
+        // redundant: constraint row n + 3 repeats row n + 1 (and so does its column)
+        let mut red = a.clone();
+        for i in 0..n {
+            red[(n + 3) * d + i] = red[(n + 1) * d + i];
+            red[i * d + n + 3] = red[i * d + n + 1];
+        }
+        // a multiplier that enters no equation
+        let mut zc = a.clone();
+        for i in 0..d {
+            zc[i * d + n + 2] = 0.0;
+        }
+        for span in [0.0, 4.0, 8.0, 12.0] {
+            for (what, base) in [("redundant", &red), ("zero column", &zc)] {
+                let (s, ..) = scaled(base, d, span);
+                let mut lu = SmallLu::with_ordering(order.clone(), order.clone());
+                fill(&mut lu, &s);
+                match lu.factor() {
+                    Err(LuError::Singular { row, col }) => {
+                        assert!(row >= n && col >= n, "{what}, 1e{span}: ({row}, {col})")
+                    }
+                    other => panic!("{what}, span 1e{span}: expected singular, got {other:?}"),
+                }
+            }
+        }
     }
 }

@@ -27,12 +27,17 @@ pub struct SymplecticOptions {
     pub gamma: f64,
     /// Placement of the control points.
     pub nodes: Nodes,
-    /// Newton settings for the stage equations. `tol` bounds the max-norm of the scaled residual
-    /// (displacement units, relative to `1 + ||q||_inf`); the iteration also stops when an update
-    /// is below `step_tol (1 + ||q||_inf)`; `max_iter` limits the iterations; `max_halvings`
-    /// allows backtracking on the residual norm; the Jacobian is evaluated at the predictor and
-    /// kept (simplified Newton) for up to `jacobian_every` iterations while each iteration
-    /// shrinks the update at least 4x (`jacobian_every = 1`: full Newton; default 6).
+    /// Newton settings for the stage equations. With `tol_k = tol (1 + max |x, y|) + 4 eps
+    /// (1 + ||q||_inf)` (lengths: the scaled residual is in displacement units), a step is
+    /// converged after at least one update when the max-norm of the residual and that of the
+    /// last displacement update are both below `tol_k`, or when the simplified-Newton estimate
+    /// of the error left after an update is below `tol_k / 10` (and the constraints below
+    /// `tol_k`); an update that stagnates below `step_tol (1 + ||q||_inf)` is accepted if the
+    /// residual is below `1e-8`. `max_iter` limits the iterations; `max_halvings` allows
+    /// backtracking on the residual norm; the Jacobian is evaluated at the predictor and kept
+    /// (simplified Newton) for up to `jacobian_every` iterations while each iteration shrinks
+    /// the update at least 4x (`jacobian_every = 1`: full Newton; default 6). See
+    /// `docs/symplectic.md` for why the predictor is never accepted without an update.
     pub newton: NewtonOptions,
     /// Relative step of the central differences used for the third derivatives of `V` and `Phi`
     /// in `grad W_s` (`s >= 2` with `gamma != 0`), Richardson-extrapolated (error `O(eps^4)`).
@@ -48,7 +53,8 @@ pub struct SymplecticOptions {
     /// (error `O(h^(p+1))` in the multipliers); before that, the previous step's interpolant is
     /// extrapolated (or, on the first step, a Taylor predictor from the index-1 accelerations).
     /// 0 turns the multistep predictor off. Default 3; at most 6. Only the number of Newton
-    /// iterations depends on it, not the solution (to the Newton tolerance).
+    /// iterations depends on it, not the solution (to round-off: at least one Newton update is
+    /// made from every prediction).
     pub predictor_order: usize,
 }
 
