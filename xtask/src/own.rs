@@ -213,8 +213,10 @@ fn orders(ctx: &Ctx) -> Result<Section, String> {
 }
 
 /// The largest rise of the error above its best value so far as `h` falls (`errs` ordered by
-/// decreasing `h`): `max_i err_i / min_{j <= i} err_j` (1 when the error never rises).
-fn worst_rise(errs: &[f64]) -> f64 {
+/// decreasing `h`): `max_i err_i / max(min_{j <= i} err_j, resolution)` (1 when the error never
+/// rises). Errors below `resolution`, the distance between two reference solutions, are not
+/// measured: a best value below it counts as `resolution`.
+fn worst_rise(errs: &[f64], resolution: f64) -> f64 {
     let mut best = f64::INFINITY;
     let mut rise = 1.0f64;
     for &e in errs {
@@ -222,7 +224,7 @@ fn worst_rise(errs: &[f64]) -> f64 {
             return f64::NAN;
         }
         best = best.min(e);
-        rise = rise.max(e / best);
+        rise = rise.max(e / best.max(resolution));
     }
     rise
 }
@@ -263,7 +265,7 @@ fn work_precision(ctx: &Ctx) -> Result<Section, String> {
         &["solver", "h [s]", "error at t = 2 s", "wall time [s]"],
     );
     let mut floors = Table::new(
-        "Round-off floor of every solver: the best error of the sweep, and the largest rise of the error above its best value so far as h keeps falling (the claim: at most 10x)",
+        "Round-off floor of every solver: the best error of the sweep, and the largest rise of the error above its best value so far as h keeps falling (the claim: at most 10x; a best value below the reference's resolution counts as that resolution)",
         &["solver", "best error", "at h [s]", "smallest h [s]", "error there", "largest rise"],
     );
     let mut rows = Vec::new();
@@ -326,7 +328,7 @@ fn work_precision(ctx: &Ctx) -> Result<Section, String> {
                 (0, f64::INFINITY),
                 |a, (i, e)| if e < a.1 { (i, e) } else { a },
             );
-        let rise = worst_rise(&ys);
+        let rise = worst_rise(&ys, ref_err);
         let last = ys.len() - 1;
         floors.row(vec![
             spec.name.into(),
@@ -377,7 +379,7 @@ fn work_precision(ctx: &Ctx) -> Result<Section, String> {
     });
     sec.tables.push(floors);
     sec.tables.push(table);
-    sec.summary = json!({ "work_precision": rows, "work_precision_floor": floor_rows });
+    sec.summary = json!({ "work_precision": rows, "work_precision_floor": floor_rows, "work_precision_reference_resolution": num(ref_err) });
     Ok(sec)
 }
 
@@ -702,4 +704,18 @@ pub fn experiments() -> Vec<Experiment> {
             run: long_time,
         },
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::worst_rise;
+
+    #[test]
+    fn worst_rise_measures_the_rise_above_the_best_so_far() {
+        assert_eq!(worst_rise(&[1.0, 0.1, 0.01, 0.001], 0.0), 1.0);
+        assert!((worst_rise(&[1.0, 0.1, 0.01, 0.05, 0.02], 0.0) - 5.0).abs() < 1e-12);
+        // a best value below the reference's resolution counts as the resolution
+        assert!((worst_rise(&[1.0, 1e-14, 2e-13], 1e-13) - 2.0).abs() < 1e-12);
+        assert!(worst_rise(&[1.0, f64::NAN, 0.5], 0.0).is_nan());
+    }
 }
