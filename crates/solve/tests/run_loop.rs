@@ -274,3 +274,31 @@ fn condition_estimate_grows_like_the_inverse_square_distance_to_a_singular_confi
     }
     assert!(prev > RunConfig::DEFAULT_CONDITION_LIMIT);
 }
+
+#[test]
+fn documented_defaults_match_the_code() {
+    let doc = include_str!("../../../docs/architecture.md");
+    assert_eq!(DriftGuard::default().position_tol, 1e-2);
+    assert!(
+        doc.contains("`position_tol = 1e-2`"),
+        "architecture.md: drift guard default"
+    );
+    assert_eq!(RunConfig::DEFAULT_CONDITION_LIMIT, 1e6);
+    assert!(
+        doc.contains("default `1e6`"),
+        "architecture.md: condition limit"
+    );
+    assert_eq!(mbd_solve::linalg::CHOLESKY_PIVOT_TOL, 1e-14);
+    assert!(
+        doc.contains("`L_jj^2 >= 1e-14 S_jj`"),
+        "architecture.md: pivot test"
+    );
+    assert_eq!(mbd_model::MAX_INERTIA_RATIO, 1e12);
+    assert!(
+        doc.contains("`m r^2 / J > 1e12`"),
+        "architecture.md: inertia ratio"
+    );
+    let cfg = RunConfig::new(1.0, 0.1);
+    assert_eq!(cfg.drift_guard, Some(DriftGuard::default()));
+    assert_eq!(cfg.condition_limit, RunConfig::DEFAULT_CONDITION_LIMIT);
+}
