@@ -17,7 +17,9 @@ pub struct StepStats {
     pub objective_evals: usize,
     /// Largest condition estimate of the index-1 matrix `Phi_q M^-1 Phi_q^T` met in the step
     /// (after diagonal equilibration; see [`crate::AccelerationSolver::condition_estimate`]);
-    /// 0 when the solver does not estimate it.
+    /// 0 when the solver does not estimate it. RK4 (`Index1Rk`), the tangent solver and FA-DAE
+    /// report it; the symplectic scheme, which never forms the index-1 matrix (its stage system
+    /// holds the constraints at the control points), reports 0.
     pub condition: f64,
 }
 
