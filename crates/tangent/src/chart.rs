@@ -905,7 +905,7 @@ impl TangentChart {
             // a chord iteration that converged far from where it started (relative to its
             // first correction) did not contract on the way: near a singular configuration it
             // can drift along the nearly singular direction onto another branch
-            if !self.travel_ok(x, &self.x0) {
+            if !self.travel_ok(x, &self.x0, ms.iterations) {
                 out = Err(ChartFailure {
                     t,
                     residual: ms.residual,
@@ -917,11 +917,13 @@ impl TangentChart {
             // whatever the failure taught the matrix is suspect
             self.pb_active = false;
             if newton.fallback_change > 0.0 {
+                let failure_iterations = failure.iterations;
                 x.copy_from_slice(&self.x0);
                 out = self.exact_newton(sys, t, x, newton, &mut f, failure, res_start);
                 if let Ok(ms) = out {
                     // the same bound on the travel from the exact iteration's start
-                    if !self.travel_ok(x, &self.wx) {
+                    let exact_iterations = ms.iterations - failure_iterations;
+                    if !self.travel_ok(x, &self.wx, exact_iterations) {
                         out = Err(ChartFailure {
                             t,
                             residual: ms.residual,
@@ -947,10 +949,19 @@ impl TangentChart {
     /// contracting iteration (factor `theta`) travels at most `1 / (1 - theta)` times its first
     /// correction and its limit is the solution nearest to the start; one that travelled
     /// further wandered, and near a singular configuration it may have reached another branch.
-    fn travel_ok(&self, x: &[f64], start: &[f64]) -> bool {
-        let travel = max_abs_diff(x, start);
-        let floor = 16.0 * f64::EPSILON * (1.0 + max_abs(start));
-        travel <= TRAVEL_FACTOR * self.first_step + floor
+    fn travel_ok(&self, x: &[f64], start: &[f64], iterations: usize) -> bool {
+        if iterations <= 1 {
+            // the travel is the first correction
+            return true;
+        }
+        // one pass: the travel and the size of the start (for the rounding floor); a NaN in
+        // `x` cannot reach here (its residual would not be finite)
+        let (mut travel, mut size) = (0.0f64, 0.0f64);
+        for (a, b) in x.iter().zip(start) {
+            travel = fast_max(travel, (a - b).abs());
+            size = fast_max(size, b.abs());
+        }
+        travel <= TRAVEL_FACTOR * self.first_step + 16.0 * f64::EPSILON * (1.0 + size)
     }
 
     /// Maps completed by Newton's method with the exact matrix after the chord iteration failed
@@ -1127,7 +1138,10 @@ impl TangentChart {
             gemv_cols(&self.p0, f, x);
             it += 1;
             if it == 1 {
-                self.first_step = max_abs_diff(x, &self.x0);
+                self.first_step = x
+                    .iter()
+                    .zip(&self.x0)
+                    .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()));
             }
             // predicted stop (stage points only): the residual after this correction is about
             // theta * res with theta the contraction just observed
@@ -1298,6 +1312,17 @@ impl TangentChart {
     /// `2(n - m)`) of a vector `y` of length `2n`.
     pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
         gemv_t_cols(&self.q, y, out);
+    }
+}
+
+/// `max(a, b)` for non-NaN `b` (one `maxsd`; `f64::max`'s NaN handling costs several
+/// instructions more in the short loops of the travel bound).
+#[inline(always)]
+fn fast_max(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
     }
 }
 
