@@ -11,6 +11,13 @@ use nalgebra::DMatrix;
 /// has converged as far as `f` can be evaluated.
 pub const ROUNDOFF_FACTOR: f64 = 8.0;
 
+/// Largest ratio of the distance a chart map's iteration (chord or exact Newton) moved its
+/// point to its first correction: a contracting iteration with factor `theta` moves at most
+/// `1 / (1 - theta)` times its first correction (4: `theta <= 3/4`). Beyond it the iteration did
+/// not contract, and its limit need not be the solution nearest to the predictor (near a
+/// singular configuration: another branch), so the map counts as failed.
+pub const TRAVEL_FACTOR: f64 = 4.0;
+
 /// Settings of the chord Newton iteration that maps chart coordinates to the manifold.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewtonSettings {
@@ -215,6 +222,9 @@ pub struct TangentChart {
     angles: AngleCache,
     /// The starting point of the map in progress (`2n`), for the exact Newton fallback.
     x0: Vec<f64>,
+    /// `||x_1 - x_0||_inf`: the first correction of the iteration in progress (chord or exact
+    /// Newton), the bound on its travel ([`TRAVEL_FACTOR`]).
+    first_step: f64,
     /// `Phi_q` and `(Phi_q v)_q` at an iterate of the exact Newton fallback.
     pq_x: DMatrix<f64>,
     dphi_x: DMatrix<f64>,
@@ -283,6 +293,7 @@ impl TangentChart {
             broyden_resets: 0,
             s: 0.0,
             x0: vec![0.0; nn],
+            first_step: 0.0,
             pq_x: DMatrix::zeros(m, n),
             dphi_x: DMatrix::zeros(m, n),
             jn: vec![0.0; mm * mm],
@@ -884,17 +895,42 @@ impl TangentChart {
         self.x0.copy_from_slice(x);
         let res = self.residual_cached(sys, x, t, &mut f);
         let res_start = res;
+        self.first_step = 0.0;
         let mut out = if self.broyden && self.s == 0.0 {
             self.chord_broyden(sys, t, x, newton, &mut f, res, predicted)
         } else {
             self.chord(sys, t, x, newton, &mut f, res, predicted)
         };
+        if let Ok(ms) = out {
+            // a chord iteration that converged far from where it started (relative to its
+            // first correction) did not contract on the way: near a singular configuration it
+            // can drift along the nearly singular direction onto another branch
+            if !self.travel_ok(x, &self.x0, ms.iterations) {
+                out = Err(ChartFailure {
+                    t,
+                    residual: ms.residual,
+                    iterations: ms.iterations,
+                });
+            }
+        }
         if let Err(failure) = out {
             // whatever the failure taught the matrix is suspect
             self.pb_active = false;
             if newton.fallback_change > 0.0 {
+                let failure_iterations = failure.iterations;
                 x.copy_from_slice(&self.x0);
                 out = self.exact_newton(sys, t, x, newton, &mut f, failure, res_start);
+                if let Ok(ms) = out {
+                    // the same bound on the travel from the exact iteration's start
+                    let exact_iterations = ms.iterations - failure_iterations;
+                    if !self.travel_ok(x, &self.wx, exact_iterations) {
+                        out = Err(ChartFailure {
+                            t,
+                            residual: ms.residual,
+                            iterations: ms.iterations,
+                        });
+                    }
+                }
             }
         }
         self.f = f;
@@ -908,6 +944,26 @@ impl TangentChart {
         out
     }
 
+    /// Whether an iteration that ended at `x` from `start` travelled at most [`TRAVEL_FACTOR`]
+    /// times its first correction ([`TangentChart::first_step`]), up to rounding. A
+    /// contracting iteration (factor `theta`) travels at most `1 / (1 - theta)` times its first
+    /// correction and its limit is the solution nearest to the start; one that travelled
+    /// further wandered, and near a singular configuration it may have reached another branch.
+    fn travel_ok(&self, x: &[f64], start: &[f64], iterations: usize) -> bool {
+        if iterations <= 1 {
+            // the travel is the first correction
+            return true;
+        }
+        // one pass: the travel and the size of the start (for the rounding floor); a NaN in
+        // `x` cannot reach here (its residual would not be finite)
+        let (mut travel, mut size) = (0.0f64, 0.0f64);
+        for (a, b) in x.iter().zip(start) {
+            travel = fast_max(travel, (a - b).abs());
+            size = fast_max(size, b.abs());
+        }
+        travel <= TRAVEL_FACTOR * self.first_step + 16.0 * f64::EPSILON * (1.0 + size)
+    }
+
     /// Maps completed by Newton's method with the exact matrix after the chord iteration failed
     /// ([`NewtonSettings::fallback_change`]), since the chart was created.
     pub fn exact_maps(&self) -> usize {
@@ -918,7 +974,8 @@ impl TangentChart {
     /// is within `fallback_change` (relative) of `Df(x_c)`, Newton's method along the normal
     /// directions with the exact matrix `J = Df(x_k) Q1` at every iterate,
     /// `x <- x - Q1 J^-1 f(x)`; otherwise `failure` as it was. Same stopping rules as the chord
-    /// iteration; a numerically singular `J` is a failure.
+    /// iteration; a numerically singular `J` is a failure. Starts from the map's predictor
+    /// (`x`); the caller bounds its travel ([`TRAVEL_FACTOR`], start copied to `wx`).
     #[allow(clippy::too_many_arguments)]
     fn exact_newton(
         &mut self,
@@ -932,22 +989,27 @@ impl TangentChart {
     ) -> Result<MapStats, ChartFailure> {
         let (n, m) = (self.n, self.m);
         let (nn, mm) = (2 * n, 2 * m);
-        // start from the better of the caller's starting point and its projection onto the
-        // tangent plane, x_c + U xi (a history predictor can be far off near a singular
-        // configuration, where the chord failed)
-        for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
-            *d = xv - xc;
+        // start from the caller's starting point (the predictor). Its projection onto the
+        // tangent plane, x_c + U xi, is only used when the predictor's residual is not finite:
+        // the residual is no measure of the distance to the branch near a singular
+        // configuration (it grows only quadratically along the nearly singular direction), and
+        // without degrees of freedom the projection is the centre itself, a whole step away
+        if res_start.is_nan() {
+            for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
+                *d = xv - xc;
+            }
+            gemv_t_cols(&self.q[..mm * nn], &self.dx, &mut self.w);
+            for wk in self.w.iter_mut() {
+                *wk = -*wk;
+            }
+            self.step.copy_from_slice(x);
+            gemv_cols(&self.q[..mm * nn], &self.w, &mut self.step);
+            if self.residual(sys, &self.step, t, f).is_finite() {
+                x.copy_from_slice(&self.step);
+            }
         }
-        gemv_t_cols(&self.q[..mm * nn], &self.dx, &mut self.w);
-        self.step.copy_from_slice(x);
-        for wk in self.w.iter_mut() {
-            *wk = -*wk;
-        }
-        gemv_cols(&self.q[..mm * nn], &self.w, &mut self.step);
-        let res_tangent = self.residual(sys, &self.step, t, f);
-        if res_tangent < res_start || res_start.is_nan() {
-            x.copy_from_slice(&self.step);
-        }
+        self.wx.copy_from_slice(x);
+        self.first_step = 0.0;
         sys.phi_q_dot_jacobian(&x[..n], &x[n..], &mut self.pq_x, &mut self.dphi_x);
         let scale = max_abs(self.phi_q.as_slice()).max(max_abs(self.dphi.as_slice()));
         let change = max_abs_diff(self.pq_x.as_slice(), self.phi_q.as_slice())
@@ -1009,6 +1071,9 @@ impl TangentChart {
             }
             gemv_cols(&self.q[..mm * nn], &self.u, x);
             it += 1;
+            if it == failure.iterations + 1 {
+                self.first_step = max_abs_diff(x, &self.wx);
+            }
             let prev = res;
             res = self.residual(sys, x, t, f);
             if res > tol && res <= stall_cap && res >= 0.9 * prev {
@@ -1072,6 +1137,12 @@ impl TangentChart {
             }
             gemv_cols(&self.p0, f, x);
             it += 1;
+            if it == 1 {
+                self.first_step = x
+                    .iter()
+                    .zip(&self.x0)
+                    .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()));
+            }
             // predicted stop (stage points only): the residual after this correction is about
             // theta * res with theta the contraction just observed
             let theta = res / prev;
@@ -1141,6 +1212,9 @@ impl TangentChart {
                 *xi -= wi;
             }
             it += 1;
+            if it == 1 {
+                self.first_step = max_abs(&self.wx);
+            }
             let theta = res / prev;
             if predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol {
                 return Ok(MapStats {
@@ -1238,6 +1312,17 @@ impl TangentChart {
     /// `2(n - m)`) of a vector `y` of length `2n`.
     pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
         gemv_t_cols(&self.q, y, out);
+    }
+}
+
+/// `max(a, b)` for non-NaN `b` (one `maxsd`; `f64::max`'s NaN handling costs several
+/// instructions more in the short loops of the travel bound).
+#[inline(always)]
+fn fast_max(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
     }
 }
 

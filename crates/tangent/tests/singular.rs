@@ -306,3 +306,91 @@ fn parallelogram_four_bar_parameters_are_checked() {
     let (p, d) = common::residuals(&sys, &s, &mut buf);
     assert!(p < 1e-15 && d < 1e-15, "{p} {d}");
 }
+
+/// Direct `step` calls of size `h` from `s0` to about `t = 2`: the end states of tangent RK4
+/// and projected RK4, the largest distance from the parallelogram branch and the largest
+/// constraint residuals of tangent RK4, and its counters.
+fn direct_steps(sys: &System, s0: &State, h: f64) -> (State, State, BranchWatch, f64) {
+    let n = (2.0 / h).round() as usize;
+    let mut rk = TangentRk::rk4(sys).expect("solver");
+    let mut proj = Index1Rk::new(
+        sys,
+        ButcherTableau::rk4(),
+        Index1Options {
+            projection: Some(ProjectionSettings::default()),
+            ..Default::default()
+        },
+    )
+    .expect("projected RK4");
+    let (mut s, mut p) = (s0.clone(), s0.clone());
+    let mut watch = BranchWatch::default();
+    watch.observe(sys, &s, 0).expect("observe");
+    for k in 1..=n {
+        rk.step(sys, &mut s, h)
+            .unwrap_or_else(|e| panic!("h = {h:e}, step {k}: {e}"));
+        proj.step(sys, &mut p, h).expect("projected RK4");
+        watch.observe(sys, &s, k).expect("observe");
+    }
+    let st = *rk.stats();
+    assert_eq!(st.steps, n);
+    (s, p, watch, st.exact_maps as f64)
+}
+
+#[test]
+fn direct_steps_keep_the_branch_at_step_sizes_differing_in_the_last_bits() {
+    // Branch selection at the flat configurations must not depend on rounding: before the
+    // travel bound on the chart maps, the driven crank under `run` (nominal h = 1e-3) ended on
+    // the crossed branch (a chord iteration from a near-singular centre drifted along the
+    // nearly singular direction onto it), while `h = t_next - t` (a few ulps off) stayed on
+    // the parallelogram. Steps 1e-3, 1e-3 (1 + 1e-15) and 0.9e-3, free and driven.
+    for driven in [true, false] {
+        let sys = models::parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, driven).expect("model");
+        let s0 = State::consistent(&sys, 0.0).expect("state");
+        for h in [1e-3, 1e-3 * (1.0 + 1e-15), 0.9e-3] {
+            let (s, p, watch, exact) = direct_steps(&sys, &s0, h);
+            let e_proj = state_error(&s, p.q.as_slice(), p.v.as_slice());
+            println!(
+                "driven {driven}, h = {h:.17e}: t = {:.6}, crank {:.6}, off branch {:.1e}, \
+                 tangent - projected {e_proj:.1e}, max |Phi| {:.1e}, |Phidot| {:.1e}, \
+                 exact maps {exact}",
+                s.t, s.q[2], watch.off_branch, watch.res.max_phi, watch.res.max_phidot
+            );
+            assert!(watch.max_crank - watch.min_crank > 3.0 * std::f64::consts::PI);
+            assert!(watch.off_branch < 1e-10, "h = {h:e}: {}", watch.off_branch);
+            assert!(watch.res.max_phi <= 1e-12 && watch.res.max_phidot <= 1e-12);
+            assert!(
+                e_proj < if driven { 1e-9 } else { 1e-7 },
+                "h = {h:e}: {e_proj}"
+            );
+            if driven {
+                assert!((s.q[2] - (1.0 + 6.0 * s.t)).abs() < 1e-11, "{}", s.q[2]);
+            }
+        }
+    }
+}
+
+#[test]
+fn run_keeps_the_branch_at_perturbed_nominal_steps() {
+    // the same through `mbd_solve::run` (nominal h to every step, times t0 + k h)
+    for driven in [true, false] {
+        let sys = models::parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, driven).expect("model");
+        let s0 = State::consistent(&sys, 0.0).expect("state");
+        for h in [1e-3 * (1.0 + 1e-15), 0.9e-3] {
+            let mut s = s0.clone();
+            let mut rk = TangentRk::rk4(&sys).expect("solver");
+            let mut watch = BranchWatch::default();
+            run(&mut rk, &sys, &mut s, RunConfig::new(2.0, h), &mut watch).expect("run");
+            let proj = projected_rk4(&sys, &s0, 2.0, h);
+            let e_proj = state_error(&s, proj.q.as_slice(), proj.v.as_slice());
+            println!(
+                "driven {driven}, h = {h:e}: off branch {:.1e}, tangent - projected {e_proj:.1e}",
+                watch.off_branch
+            );
+            assert!(watch.off_branch < 1e-10, "h = {h:e}: {}", watch.off_branch);
+            assert!(
+                e_proj < if driven { 1e-9 } else { 1e-7 },
+                "h = {h:e}: {e_proj}"
+            );
+        }
+    }
+}
