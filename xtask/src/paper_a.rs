@@ -481,22 +481,10 @@ fn table3(ctx: &Ctx) -> Result<Section, String> {
     Ok(sec)
 }
 
+/// Least-squares log-log slope of the errors above 1e-12 (`mbd_analysis::fit_order`); NaN when
+/// fewer than two points are above that floor.
 fn slope(h: &[f64], e: &[f64]) -> f64 {
-    let pts: Vec<(f64, f64)> = h
-        .iter()
-        .zip(e)
-        .filter(|(_, e)| **e > 1e-12)
-        .map(|(h, e)| (h.ln(), e.ln()))
-        .collect();
-    let n = pts.len() as f64;
-    if pts.len() < 2 {
-        return f64::NAN;
-    }
-    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
-    sxy / sxx
+    mbd_analysis::fit_order(h, e, 1e-12).map_or(f64::NAN, |f| f.order)
 }
 
 fn fig3(ctx: &Ctx) -> Result<Section, String> {
