@@ -4,21 +4,24 @@ use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{Integrator, State};
 use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    // per thread: the test harness may allocate on its own threads meanwhile (seen under load)
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
         unsafe { SysAlloc.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
         unsafe { SysAlloc.dealloc(p, l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
         unsafe { SysAlloc.realloc(p, l, n) }
     }
 }
@@ -29,11 +32,11 @@ static GLOBAL: Counting = Counting;
 fn count_step_allocations<I: Integrator>(mut integ: I, sys: &mbd::model::System) -> usize {
     let mut s = State::consistent(sys, 0.0).unwrap();
     integ.step(sys, &mut s, 0.01).unwrap(); // warm-up
-    let before = ALLOCS.load(Ordering::SeqCst);
+    let before = ALLOCS.with(|c| c.get());
     for _ in 0..100 {
         integ.step(sys, &mut s, 0.01).unwrap();
     }
-    ALLOCS.load(Ordering::SeqCst) - before
+    ALLOCS.with(|c| c.get()) - before
 }
 
 // One test function: the allocation counter is global, so concurrent tests would pollute it.

@@ -4,21 +4,24 @@ use mbd_model::models;
 use mbd_solve::{Integrator, NoObserver, State};
 use mbd_tangent::{AdaptiveSettings, ButcherTableau, IterationMatrix, TangentOptions, TangentRk};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    // per thread: the test harness may allocate on its own threads meanwhile (seen under load)
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
         unsafe { System.alloc(l) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
         unsafe { System.dealloc(p, l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
         unsafe { System.realloc(p, l, n) }
     }
 }
@@ -42,7 +45,7 @@ fn steps_allocate_nothing() {
         let mut br = TangentRk::new(&sys, ButcherTableau::rk4(), broyden).expect("solver");
         let settings = AdaptiveSettings::with_tolerance(1e-9);
         rk4.step(&sys, &mut s, 1e-3).expect("warm-up");
-        let before = ALLOCS.load(Ordering::SeqCst);
+        let before = ALLOCS.with(|c| c.get());
         for _ in 0..200 {
             rk4.step(&sys, &mut s, 1e-3).expect("step");
             dp.step(&sys, &mut s, 1e-3).expect("step");
@@ -56,7 +59,7 @@ fn steps_allocate_nothing() {
         let t1 = s.t + 0.5;
         dp.integrate_adaptive(&sys, &mut s, t1, &settings, &mut NoObserver)
             .expect("adaptive");
-        let after = ALLOCS.load(Ordering::SeqCst);
+        let after = ALLOCS.with(|c| c.get());
         assert_eq!(after - before, 0, "allocations during steps");
     }
 }
