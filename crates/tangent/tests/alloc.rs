@@ -31,6 +31,10 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn steps_allocate_nothing() {
+    // the counter counts
+    let probe = ALLOCS.with(|c| c.get());
+    std::hint::black_box(vec![1u8; 16]);
+    assert!(ALLOCS.with(|c| c.get()) > probe);
     for sys in [
         models::manipulator().expect("model"),
         models::slider_crank().expect("model"),
