@@ -42,6 +42,19 @@ pub struct DenseLu {
     pub pivot_tol: f64,
 }
 
+impl Clone for DenseLu {
+    /// A copy with the same matrix or factors (and fresh scratch memory).
+    fn clone(&self) -> Self {
+        let mut c = DenseLu::new(self.n);
+        c.lu.copy_from(&self.lu);
+        c.perm.copy_from_slice(&self.perm);
+        c.perm_inv.copy_from_slice(&self.perm_inv);
+        c.factored = self.factored;
+        c.pivot_tol = self.pivot_tol;
+        c
+    }
+}
+
 impl DenseLu {
     /// Workspace for `n x n` systems.
     pub fn new(n: usize) -> Self {

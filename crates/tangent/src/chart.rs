@@ -3,6 +3,7 @@
 
 use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::{AngleCache, System};
+use mbd_solve::linalg::DenseLu;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -228,9 +229,10 @@ pub struct TangentChart {
     /// `Phi_q` and `(Phi_q v)_q` at an iterate of the exact Newton fallback.
     pq_x: DMatrix<f64>,
     dphi_x: DMatrix<f64>,
-    /// `Df(x) Q1` (`2m x 2m`, column-major) and its LU factors, with the row pivots.
+    /// `Df(x) Q1` (`2m x 2m`, column-major), and the shared dense LU that factors it (pivot
+    /// threshold `2m eps max |J|`: numerically singular only at round-off level).
     jn: Vec<f64>,
-    piv: Vec<usize>,
+    jn_lu: DenseLu,
     /// Maps completed by the exact Newton fallback since the chart was created.
     exact_maps: usize,
     /// `min |R_ii| / max |R_ii|` at the last centre.
@@ -297,7 +299,11 @@ impl TangentChart {
             pq_x: DMatrix::zeros(m, n),
             dphi_x: DMatrix::zeros(m, n),
             jn: vec![0.0; mm * mm],
-            piv: vec![0; mm],
+            jn_lu: {
+                let mut lu = DenseLu::new(mm);
+                lu.pivot_tol = f64::EPSILON;
+                lu
+            },
             exact_maps: 0,
             rcond: 1.0,
             rr: vec![0.0; n * m],
@@ -1056,7 +1062,19 @@ impl TangentChart {
             for (u, fk) in self.u.iter_mut().zip(f.iter()) {
                 *u = -fk;
             }
-            if !lu_solve(&mut self.jn, &mut self.piv, &mut self.u, mm) {
+            let solved = {
+                let mut a = self.jn_lu.matrix_mut();
+                for c in 0..mm {
+                    for r in 0..mm {
+                        a[(r, c)] = self.jn[c * mm + r];
+                    }
+                }
+                self.jn_lu.factor_in_place().is_ok() && {
+                    self.jn_lu.solve_in_place(&mut self.u);
+                    self.u.iter().all(|x| x.is_finite())
+                }
+            };
+            if !solved {
                 if res <= stall_cap {
                     // J numerically singular: x is at a singular configuration, with the
                     // residual at the round-off floor (the next centre reports it)
@@ -1522,63 +1540,6 @@ fn rank_one_update(p: &mut [f64], s: &[f64], w: &[f64], c: f64) {
         let d = c * dot(s, col);
         axpy(-d, w, col);
     }
-}
-
-/// Solves `A x = b` in place for the `d x d` column-major matrix `a` by LU with partial
-/// pivoting (`a` is overwritten by the factors, `b` by the solution). Returns `false` if a
-/// pivot is not finite or below `d eps max |A|` (numerically singular).
-fn lu_solve(a: &mut [f64], piv: &mut [usize], b: &mut [f64], d: usize) -> bool {
-    let amax = max_abs(&a[..d * d]);
-    if !(amax.is_finite() && amax > 0.0) {
-        return false;
-    }
-    let small = d as f64 * f64::EPSILON * amax;
-    for k in 0..d {
-        let mut p = k;
-        for i in k + 1..d {
-            if a[k * d + i].abs() > a[k * d + p].abs() {
-                p = i;
-            }
-        }
-        piv[k] = p;
-        let akk = a[k * d + p];
-        if akk.is_nan() || akk.abs() <= small {
-            return false;
-        }
-        if p != k {
-            for j in 0..d {
-                a.swap(j * d + k, j * d + p);
-            }
-            b.swap(k, p);
-        }
-        let inv = 1.0 / akk;
-        for i in k + 1..d {
-            a[k * d + i] *= inv;
-        }
-        for j in k + 1..d {
-            let akj = a[j * d + k];
-            if akj != 0.0 {
-                for i in k + 1..d {
-                    a[j * d + i] -= a[k * d + i] * akj;
-                }
-            }
-        }
-    }
-    // forward (unit lower) then backward substitution
-    for k in 0..d {
-        let bk = b[k];
-        for i in k + 1..d {
-            b[i] -= a[k * d + i] * bk;
-        }
-    }
-    for k in (0..d).rev() {
-        b[k] /= a[k * d + k];
-        let bk = b[k];
-        for i in 0..k {
-            b[i] -= a[k * d + i] * bk;
-        }
-    }
-    b.iter().all(|x| x.is_finite())
 }
 
 #[inline]
