@@ -65,16 +65,26 @@ impl System {
     /// [`System::length_scale`] for equations in lengths. `|Phi_row| / equation_scale(row)` is
     /// a relative violation.
     pub fn equation_scale(&self, row: usize) -> f64 {
-        let Some(&ji) = self.eq_joint.get(row) else {
-            return 1.0;
-        };
-        let j = &self.joints[ji];
-        let label = j.equation_labels()[row - self.row_offset[ji]];
-        if label == "angle" {
+        if row >= self.m || self.is_angle_equation(row) {
             1.0
         } else {
             self.length_scale()
         }
+    }
+
+    /// [`System::equation_scale`] of every equation, with the length scale computed once.
+    pub fn equation_scales(&self) -> Vec<f64> {
+        let l = self.length_scale();
+        (0..self.m)
+            .map(|r| if self.is_angle_equation(r) { 1.0 } else { l })
+            .collect()
+    }
+
+    /// Whether equation `row` is an angle equation (false for rows out of range).
+    fn is_angle_equation(&self, row: usize) -> bool {
+        self.eq_joint.get(row).is_some_and(|&ji| {
+            self.joints[ji].equation_labels()[row - self.row_offset[ji]] == "angle"
+        })
     }
 
     /// Rejects a body whose inertia is negligible against its mass times the square of the

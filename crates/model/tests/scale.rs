@@ -79,5 +79,8 @@ fn length_scale_and_equation_scales() {
     ));
     let sys = b.build().unwrap();
     assert!((sys.equation_scale(0) - sys.length_scale()).abs() < 1e-15);
+    let all = sys.equation_scales();
+    assert_eq!(all.len(), sys.n_constraints());
+    assert!((0..all.len()).all(|r| all[r] == sys.equation_scale(r)));
     assert_eq!(sys.equation_scale(2), 1.0);
 }

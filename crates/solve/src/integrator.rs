@@ -368,7 +368,7 @@ impl GuardState {
         let m = sys.n_constraints();
         GuardState {
             guard,
-            scale: (0..m).map(|r| sys.equation_scale(r)).collect(),
+            scale: sys.equation_scales(),
             buf: vec![0.0; m],
         }
     }
