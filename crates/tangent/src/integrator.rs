@@ -3,6 +3,7 @@
 
 use crate::chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
 use crate::error::TangentError;
+use crate::kernels::axpy;
 use mbd_model::System;
 use mbd_solve::{
     AccelerationSolver, ButcherTableau, ExplicitRk, Flow, Integrator, Observer, SolveError, State,
@@ -1256,13 +1257,6 @@ fn extrapolate(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64
     out.fill(0.0);
     for (k, &wk) in w.iter().enumerate() {
         axpy(wk, &hist[k * len + off..k * len + off + out.len()], out);
-    }
-}
-
-#[inline]
-fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
-    for (yi, xi) in y.iter_mut().zip(x) {
-        *yi += a * xi;
     }
 }
 

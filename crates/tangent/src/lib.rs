@@ -63,6 +63,7 @@
 mod chart;
 mod error;
 mod integrator;
+mod kernels;
 
 pub use chart::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR};
 pub use error::TangentError;
