@@ -710,6 +710,19 @@ impl System {
         (at.a, at.b)
     }
 
+    /// `Phi_q` in element-local form alone (see [`System::phi_q_local_gamma`]): row `r` is
+    /// `grads[r][0..3]` in the columns of the joint's first body and `grads[r][3..6]` in those
+    /// of its second ([`System::joint_bodies`]).
+    pub fn phi_q_local(&self, q: &[f64], grads: &mut [[f64; 6]]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, None);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                grads[o + k] = e[k].g;
+            }
+        }
+    }
+
     /// `Phi_q` in element-local form and `gamma`, for sparse assembly: row `r` of `Phi_q` is
     /// `grads[r][0..3]` in the columns of the joint's first body and `grads[r][3..6]` in those of
     /// its second ([`System::joint_bodies`]; entries for ground are zero).

@@ -7,7 +7,7 @@ use crate::accel::AccelerationSolver;
 use crate::error::SolveError;
 use crate::integrator::{Integrator, StepStats};
 use crate::projection::{ProjectionSettings, Projector};
-use crate::sparse::SparseAccelerationSolver;
+use crate::sparse::{LinearSolver, SparseAccelerationSolver};
 use crate::state::State;
 use crate::tableau::{ButcherTableau, ExplicitRk};
 use mbd_model::System;
@@ -20,23 +20,9 @@ pub struct Index1Options {
     pub baumgarte: Option<(f64, f64)>,
     /// Project `(q, v)` onto the constraints after every step (default off).
     pub projection: Option<ProjectionSettings>,
-    /// Dense or sparse index-1 solve (default: sparse above [`SPARSE_THRESHOLD`] constraints).
+    /// Dense or sparse index-1 solve and projection (default: sparse above
+    /// [`crate::SPARSE_THRESHOLD`] constraints).
     pub linear: LinearSolver,
-}
-
-/// Constraint count above which [`LinearSolver::Auto`] picks the sparse index-1 solve.
-pub const SPARSE_THRESHOLD: usize = 48;
-
-/// Which factorisation the index-1 solve uses.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LinearSolver {
-    /// Dense below [`SPARSE_THRESHOLD`] constraints, sparse above.
-    #[default]
-    Auto,
-    /// Dense Schur complement with Cholesky ([`AccelerationSolver`]).
-    Dense,
-    /// Sparse Schur complement with sparse Cholesky ([`SparseAccelerationSolver`]).
-    Sparse,
 }
 
 // the dense solver is used inline on the hot path of small systems; the sparse one is boxed
@@ -48,11 +34,11 @@ enum Accel {
 }
 
 impl Accel {
-    /// Condition estimate of the last index-1 matrix (0 where not estimated: sparse path).
+    /// Condition estimate of the last index-1 matrix.
     fn condition(&self) -> f64 {
         match self {
             Accel::Dense(acc) => acc.condition_estimate(),
-            Accel::Sparse(_) => 0.0,
+            Accel::Sparse(sp) => sp.condition_estimate(),
         }
     }
 
@@ -92,8 +78,7 @@ impl Accel {
                 acc.finish(sys, t, a, lambda)
             }
             Accel::Sparse(sp) => {
-                sys.forces_into(q, v, t, &mut sp.forces);
-                sys.phi_q_local_gamma(q, v, t, &mut sp.grads, &mut sp.gamma);
+                sp.prepare(sys, q, v, t);
                 stab(sys, &mut sp.gamma, phi, phid);
                 sp.finish(sys, t, a, lambda)
             }
@@ -144,13 +129,15 @@ impl Index1Rk {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         Ok(Index1Rk {
             rk: ExplicitRk::new(tableau, 2 * n)?,
-            acc: match (options.linear, m > SPARSE_THRESHOLD) {
-                (LinearSolver::Dense, _) | (LinearSolver::Auto, false) => {
-                    Accel::Dense(AccelerationSolver::new(sys))
-                }
-                _ => Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?)),
+            acc: if options.linear.use_sparse(m) {
+                Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?))
+            } else {
+                Accel::Dense(AccelerationSolver::new(sys))
             },
-            projector: options.projection.map(|p| Projector::new(sys, p)),
+            projector: match options.projection {
+                Some(p) => Some(Projector::with_linear(sys, p, options.linear)?),
+                None => None,
+            },
             options,
             y: vec![0.0; 2 * n],
             a: vec![0.0; n],

@@ -57,23 +57,20 @@ pub mod linalg;
 mod newton;
 mod projection;
 pub mod quadrature;
-mod sparse;
+pub mod sparse;
 mod state;
 mod tableau;
 
 pub use accel::AccelerationSolver;
 pub use error::SolveError;
-pub use index1::{
-    reference_trajectory, Index1Options, Index1Rk, LinearSolver, ReferenceTrajectory,
-    SPARSE_THRESHOLD,
-};
+pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{
     run, step_count, DriftGuard, Every, Flow, Integrator, NoObserver, Observer, Recorder,
     RunConfig, RunStats, StepStats,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use projection::{ProjectionSettings, ProjectionStats, Projector};
-pub use sparse::SparseAccelerationSolver;
+pub use sparse::{LinearSolver, SparseAccelerationSolver, SPARSE_THRESHOLD};
 pub use state::State;
 pub use tableau::{ButcherTableau, ExplicitRk, StepController};
 

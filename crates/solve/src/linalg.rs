@@ -20,11 +20,13 @@ impl std::fmt::Debug for Scratch {
 }
 
 /// Why a factorisation failed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
 pub enum FactorError {
     /// A pivot of the LU factorisation is zero or negligible (index of the pivot).
+    #[error("singular matrix: pivot {0} is zero or negligible")]
     Singular(usize),
     /// The matrix is not (numerically) positive definite (index of the failing pivot).
+    #[error("matrix not positive definite: pivot {0} is negligible against its diagonal entry")]
     NotPositiveDefinite(usize),
 }
 

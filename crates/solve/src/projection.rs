@@ -1,8 +1,11 @@
 //! Allocation-free projection of a state onto the position and velocity constraints
-//! (minimum `M`-norm corrections), for post-step stabilisation.
+//! (minimum `M`-norm corrections), for post-step stabilisation and consistent initial states.
+//! Dense for small systems, on the sparse kernel ([`ConstraintSchur`]) above
+//! [`crate::SPARSE_THRESHOLD`] constraints.
 
 use crate::error::SolveError;
-use crate::linalg::DenseCholesky;
+use crate::linalg::{max_abs, DenseCholesky, FactorError};
+use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;
 use nalgebra::DMatrix;
 
@@ -24,6 +27,16 @@ impl Default for ProjectionSettings {
     }
 }
 
+/// The factorisation of `S = Phi_q M^-1 Phi_q^T` a projection uses.
+#[derive(Debug)]
+enum Kernel {
+    Dense {
+        jac: DMatrix<f64>,
+        chol: DenseCholesky,
+    },
+    Sparse(Box<ConstraintSchur>),
+}
+
 /// Projects `q` onto `Phi(q, t) = 0` by Newton with the minimum `M`-norm correction
 /// `dq = -M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T)^-1 Phi` and `v` onto `Phi_q v + Phi_t = 0` by the
 /// `M`-orthogonal projection.
@@ -31,8 +44,7 @@ impl Default for ProjectionSettings {
 pub struct Projector {
     /// Settings.
     pub settings: ProjectionSettings,
-    jac: DMatrix<f64>,
-    chol: DenseCholesky,
+    kernel: Kernel,
     r: Vec<f64>,
 }
 
@@ -46,38 +58,64 @@ pub struct ProjectionStats {
 }
 
 impl Projector {
-    /// A workspace for `sys`.
-    pub fn new(sys: &System, settings: ProjectionSettings) -> Self {
+    /// A workspace for `sys`, dense or sparse by the constraint count ([`LinearSolver::Auto`]).
+    pub fn new(sys: &System, settings: ProjectionSettings) -> Result<Self, SolveError> {
+        Self::with_linear(sys, settings, LinearSolver::Auto)
+    }
+
+    /// A workspace for `sys` with the factorisation chosen by `linear`.
+    pub fn with_linear(
+        sys: &System,
+        settings: ProjectionSettings,
+        linear: LinearSolver,
+    ) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        Projector {
+        let kernel = if linear.use_sparse(m) {
+            Kernel::Sparse(Box::new(ConstraintSchur::new(sys)?))
+        } else {
+            Kernel::Dense {
+                jac: DMatrix::zeros(m, n),
+                chol: DenseCholesky::new(m),
+            }
+        };
+        Ok(Projector {
             settings,
-            jac: DMatrix::zeros(m, n),
-            chol: DenseCholesky::new(m),
+            kernel,
             r: vec![0.0; m],
-        }
+        })
+    }
+
+    /// Whether the sparse kernel is in use.
+    pub fn is_sparse(&self) -> bool {
+        matches!(self.kernel, Kernel::Sparse(_))
     }
 
     fn factor(&mut self, sys: &System, q: &[f64], t: f64) -> Result<(), SolveError> {
-        sys.phi_q(q, &mut self.jac);
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let minv = sys.inv_mass_diag();
-        {
-            let j = &self.jac;
-            let mut s = self.chol.matrix_mut();
-            for c in 0..m {
-                for r in c..m {
-                    let mut acc = 0.0;
-                    for k in 0..n {
-                        acc += j[(r, k)] * minv[k] * j[(c, k)];
+        let minv = sys.inv_mass_diag().as_slice();
+        let res = match &mut self.kernel {
+            Kernel::Dense { jac, chol } => {
+                sys.phi_q(q, jac);
+                let (n, m) = (sys.n_coords(), sys.n_constraints());
+                let mut s = chol.matrix_mut();
+                for c in 0..m {
+                    for r in c..m {
+                        let mut acc = 0.0;
+                        for k in 0..n {
+                            acc += jac[(r, k)] * minv[k] * jac[(c, k)];
+                        }
+                        s[(r, c)] = acc;
                     }
-                    s[(r, c)] = acc;
                 }
+                chol.factor_in_place()
             }
-        }
-        self.chol.factor_in_place().map_err(|e| {
+            Kernel::Sparse(schur) => {
+                schur.update(sys, q);
+                schur.factor(minv)
+            }
+        };
+        res.map_err(|e| {
             let i = match e {
-                crate::linalg::FactorError::Singular(i)
-                | crate::linalg::FactorError::NotPositiveDefinite(i) => i,
+                FactorError::Singular(i) | FactorError::NotPositiveDefinite(i) => i,
             };
             SolveError::Singular {
                 t,
@@ -89,16 +127,35 @@ impl Projector {
 
     /// `x -= M^-1 Phi_q^T S^-1 r` with `r` in `self.r`.
     fn correct(&mut self, sys: &System, x: &mut [f64]) {
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
-        self.chol.solve_in_place(&mut self.r);
-        let minv = sys.inv_mass_diag();
-        for k in 0..n {
-            let mut acc = 0.0;
-            for r in 0..m {
-                acc += self.jac[(r, k)] * self.r[r];
+        let minv = sys.inv_mass_diag().as_slice();
+        match &mut self.kernel {
+            Kernel::Dense { jac, chol } => {
+                let (n, m) = (sys.n_coords(), sys.n_constraints());
+                chol.solve_in_place(&mut self.r);
+                for k in 0..n {
+                    let mut acc = 0.0;
+                    for r in 0..m {
+                        acc += jac[(r, k)] * self.r[r];
+                    }
+                    x[k] -= minv[k] * acc;
+                }
             }
-            x[k] -= minv[k] * acc;
+            Kernel::Sparse(schur) => {
+                schur.solve_in_place(&mut self.r);
+                schur.add_weighted_transpose(-1.0, minv, &self.r, x);
+            }
         }
+    }
+
+    fn check_len(&self, sys: &System, what: &'static str, x: &[f64]) -> Result<(), SolveError> {
+        if x.len() != sys.n_coords() || self.r.len() != sys.n_constraints() {
+            return Err(SolveError::Dimension {
+                what,
+                expected: sys.n_coords(),
+                got: x.len(),
+            });
+        }
+        Ok(())
     }
 
     /// Projects positions in place.
@@ -108,6 +165,7 @@ impl Projector {
         q: &mut [f64],
         t: f64,
     ) -> Result<ProjectionStats, SolveError> {
+        self.check_len(sys, "q", q)?;
         let m = sys.n_constraints();
         if m == 0 {
             return Ok(ProjectionStats::default());
@@ -115,7 +173,7 @@ impl Projector {
         let mut stats = ProjectionStats::default();
         for it in 0..=self.settings.max_iter {
             sys.phi(q, t, &mut self.r);
-            let res = self.r.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
+            let res = max_abs(&self.r);
             stats.residual = res;
             if !res.is_finite() {
                 return Err(SolveError::NonFinite {
@@ -153,6 +211,8 @@ impl Projector {
         v: &mut [f64],
         t: f64,
     ) -> Result<(), SolveError> {
+        self.check_len(sys, "q", q)?;
+        self.check_len(sys, "v", v)?;
         if sys.n_constraints() == 0 {
             return Ok(());
         }
