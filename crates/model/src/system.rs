@@ -704,6 +704,30 @@ impl System {
         }
     }
 
+    /// [`System::phi_q_dot_jacobian`] in element-local form (see [`System::phi_q_local`]):
+    /// `grads[r]` is row `r` of `Phi_q`, `dgrads[r]` row `r` of `(Phi_q v)_q`, each six numbers
+    /// in the columns of the joint's two bodies ([`System::joint_bodies`]).
+    pub fn phi_q_dot_local(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        grads: &mut [[f64; 6]],
+        dgrads: &mut [[f64; 6]],
+    ) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let qa = Self::loc_tan(q, v, at.a, 0);
+            let qb = Self::loc_tan(q, v, at.b, 3);
+            let mut e = [TanJet::cst(0.0); 3];
+            j.eval(&qa, &qb, &mut e);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                grads[o + k] = e[k].g;
+                dgrads[o + k] = e[k].dg;
+            }
+        }
+    }
+
     /// The bodies a joint attaches, as coordinate-block indices (`None` = ground).
     pub fn joint_bodies(&self, j: JointHandle) -> (Option<usize>, Option<usize>) {
         let at = self.joint_attach[j.0];

@@ -386,3 +386,41 @@ mod rank {
         }
     }
 }
+
+/// The element-local forms of `Phi_q` and `(Phi_q v)_q` scatter to the dense matrices.
+#[test]
+fn local_jacobians_scatter_to_the_dense_ones() {
+    let sys = mbd_model::models::n_link_chain(5).unwrap();
+    let (n, m) = (sys.n_coords(), sys.n_constraints());
+    let q: Vec<f64> = (0..n)
+        .map(|i| 0.3 * (i as f64).sin() + 0.1 * i as f64)
+        .collect();
+    let v: Vec<f64> = (0..n).map(|i| (0.7 * i as f64).cos()).collect();
+    let mut pq = nalgebra::DMatrix::zeros(m, n);
+    let mut pd = nalgebra::DMatrix::zeros(m, n);
+    sys.phi_q_dot_jacobian(&q, &v, &mut pq, &mut pd);
+    let (mut g, mut dg, mut g2) = (vec![[0.0; 6]; m], vec![[0.0; 6]; m], vec![[0.0; 6]; m]);
+    sys.phi_q_dot_local(&q, &v, &mut g, &mut dg);
+    sys.phi_q_local(&q, &mut g2);
+    let (mut sq, mut sd) = (
+        nalgebra::DMatrix::zeros(m, n),
+        nalgebra::DMatrix::zeros(m, n),
+    );
+    for j in 0..sys.joints().len() {
+        let jh = mbd_model::JointHandle(j);
+        let (a, b) = sys.joint_bodies(jh);
+        for r in sys.joint_rows(jh) {
+            assert_eq!(g[r], g2[r]);
+            for (body, off) in [(a, 0), (b, 3)] {
+                if let Some(body) = body {
+                    for l in 0..3 {
+                        sq[(r, 3 * body + l)] += g[r][off + l];
+                        sd[(r, 3 * body + l)] += dg[r][off + l];
+                    }
+                }
+            }
+        }
+    }
+    assert!((sq - pq).abs().max() < 1e-15);
+    assert!((sd - pd).abs().max() < 1e-15);
+}
