@@ -80,4 +80,13 @@ fn sparse_rk4_steps_allocate_nothing() {
         count_step_allocations(Rk4::new(&sys, opts).unwrap(), &sys),
         0
     );
+    // the sparse projection (sparse Cholesky of Phi_q M^-1 Phi_q^T) too
+    let projected = Rk4Options {
+        linear: LinearSolver::Sparse,
+        ..Rk4Options::projected()
+    };
+    assert_eq!(
+        count_step_allocations(Rk4::new(&sys, projected).unwrap(), &sys),
+        0
+    );
 }

@@ -7,6 +7,7 @@
 //! `--strict`, so does a claim that did not hold unless it is documented as an expected miss.
 
 mod own;
+mod own_scaling;
 mod paper_a;
 mod paper_b;
 mod paper_c;

@@ -456,86 +456,6 @@ fn long_time(ctx: &Ctx) -> Result<Section, String> {
     Ok(sec)
 }
 
-fn scaling(ctx: &Ctx) -> Result<Section, String> {
-    let mut sec = Section::default();
-    let ns: Vec<usize> = if ctx.quick {
-        vec![10, 100, 300]
-    } else {
-        vec![10, 100, 1000]
-    };
-    sec.setting(
-        "problem",
-        "N-link pendulum chain of 1 kg, 1 m rods released at 30 degrees",
-    );
-    sec.setting("solver", "RK4 on the index-1 form, h = 1e-3 s, index-1 solve chosen automatically (sparse above 48 constraints)");
-    let mut table = Table::new(
-        "Cost per RK4 step against chain length",
-        &[
-            "N",
-            "coordinates",
-            "constraints",
-            "index-1 solve",
-            "time per step [s]",
-        ],
-    );
-    let (mut xs, mut ys) = (vec![], vec![]);
-    let mut rows = Vec::new();
-    for &n in &ns {
-        let sys = models::n_link_chain(n).map_err(|e| e.to_string())?;
-        let mut s = State::consistent(&sys, 0.0).map_err(|e| e.to_string())?;
-        let mut rk = Rk4::new(&sys, Rk4Options::plain()).map_err(|e| e.to_string())?;
-        let steps = (200_000 / n).clamp(20, 20_000);
-        rk.step(&sys, &mut s, 1e-3).map_err(|e| e.to_string())?;
-        let t = Instant::now();
-        for _ in 0..steps {
-            rk.step(&sys, &mut s, 1e-3).map_err(|e| e.to_string())?;
-        }
-        let per = t.elapsed().as_secs_f64() / steps as f64;
-        let kind = if sys.n_constraints() > mbd_solve::SPARSE_THRESHOLD {
-            "sparse"
-        } else {
-            "dense"
-        };
-        table.row(vec![
-            n.to_string(),
-            sys.n_coords().to_string(),
-            sys.n_constraints().to_string(),
-            kind.into(),
-            format!("{per:.3e}"),
-        ]);
-        rows.push(json!({"n": n, "runtime_s": num(per)}));
-        xs.push(n as f64);
-        ys.push(per);
-    }
-    // growth exponent between the two largest chains (where the sparse path is in use)
-    let k = xs.len();
-    let exponent = (ys[k - 1] / ys[k - 2]).ln() / (xs[k - 1] / xs[k - 2]).ln();
-    sec.claims.push(Claim::timing(
-        "cost per step grows at most like N^1.2 (sparse factorisation for large N)",
-        exponent <= 1.2,
-        format!(
-            "exponent {exponent:.2} between N = {} and N = {}",
-            xs[k - 2],
-            xs[k - 1]
-        ),
-    ));
-    let fig = Figure::new(
-        "RK4 cost per step, N-link chain",
-        "chain length N",
-        "time per step [s]",
-    )
-    .log(true, true)
-    .with(Series::points("RK4 (index-1)", xs, ys));
-    fig.save(&ctx.figure_path("own_scaling.svg"))?;
-    sec.figures.push(FigureRef {
-        file: "own_scaling.svg".into(),
-        caption: "Cost per RK4 step against chain length".into(),
-    });
-    sec.tables.push(table);
-    sec.timings = json!({ "scaling": rows, "exponent": num(exponent) });
-    Ok(sec)
-}
-
 /// Best time per step over `blocks` blocks of `steps` steps of the manipulator at `h = 0.01`,
 /// for `integ` and for `peer`, the blocks of the two interleaved (so both see the same machine
 /// load). Steps go through the public run loop (`mbd_solve::run` with its default drift guard),
@@ -683,7 +603,7 @@ pub fn experiments() -> Vec<Experiment> {
             id: "own-scaling",
             part: Part::Own,
             title: "Cost per step against system size",
-            run: scaling,
+            run: crate::own_scaling::scaling,
         },
         Experiment {
             id: "own-orders",

@@ -230,6 +230,9 @@ pub struct Section {
     /// JSON merged into `summary.json`'s `timings` object (wall-clock numbers live only here and
     /// in fields named `runtime_s`).
     pub timings: Value,
+    /// JSON merged into `summary.json`'s top level that holds wall-clock numbers (the
+    /// `scaling` list); like `timings`, excluded from the determinism comparison.
+    pub wall_clock: Value,
 }
 
 impl Section {
@@ -438,6 +441,9 @@ pub fn write_report(
         );
         if let Ok(s) = &o.result {
             merge(&mut summary, s.summary.clone());
+            if !s.wall_clock.is_null() {
+                merge(&mut summary, s.wall_clock.clone());
+            }
             if !s.timings.is_null() {
                 let mut t = timings.remove(o.id).unwrap_or(Value::Null);
                 merge(&mut t, s.timings.clone());

@@ -69,7 +69,7 @@ pub use integrator::{
     RunConfig, RunStats, StepStats,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
-pub use projection::{ProjectionSettings, ProjectionStats, Projector};
+pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_ROUNDOFF_FACTOR};
 pub use sparse::{LinearSolver, SparseAccelerationSolver, SPARSE_THRESHOLD};
 pub use state::State;
 pub use tableau::{ButcherTableau, ExplicitRk, StepController};

@@ -9,10 +9,14 @@ use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;
 use nalgebra::DMatrix;
 
+/// The position projection stops at `max(tol, PROJECTION_ROUNDOFF_FACTOR eps max(1, |q|_inf))`: the
+/// round-off floor of evaluating `Phi` at coordinates of size `|q|`.
+pub const PROJECTION_ROUNDOFF_FACTOR: f64 = 8.0;
+
 /// Settings of [`Projector`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProjectionSettings {
-    /// Target `||Phi||_inf`.
+    /// Target `||Phi||_inf` (floored at the round-off level, see [`PROJECTION_ROUNDOFF_FACTOR`]).
     pub tol: f64,
     /// Iteration limit of the position projection.
     pub max_iter: usize,
@@ -171,6 +175,13 @@ impl Projector {
             return Ok(ProjectionStats::default());
         }
         let mut stats = ProjectionStats::default();
+        // The residual of `Phi` cannot fall below the round-off of evaluating it at coordinates
+        // of size |q|: a far-out or long mechanism (a 100-link chain reaches 100 m) has a floor
+        // above a fixed 1e-14, and Newton would otherwise iterate to `max_iter` there.
+        let tol = self
+            .settings
+            .tol
+            .max(PROJECTION_ROUNDOFF_FACTOR * f64::EPSILON * max_abs(q).max(1.0));
         for it in 0..=self.settings.max_iter {
             sys.phi(q, t, &mut self.r);
             let res = max_abs(&self.r);
@@ -181,7 +192,7 @@ impl Projector {
                     what: "constraint residual in projection",
                 });
             }
-            if res <= self.settings.tol {
+            if res <= tol {
                 return Ok(stats);
             }
             if it == self.settings.max_iter {
@@ -192,7 +203,7 @@ impl Projector {
             stats.iterations += 1;
         }
         // accept a residual at the round-off floor of the configuration
-        if stats.residual <= 1e3 * self.settings.tol {
+        if stats.residual <= 1e3 * tol {
             return Ok(stats);
         }
         Err(SolveError::Newton {
