@@ -20,10 +20,11 @@
 //! ```
 
 use crate::body::{Body, BodyHandle, BodyRef};
+use crate::builder::SystemBuilder;
 use crate::error::ModelError;
 use crate::force::{Force, ForceKind};
 use crate::joint::{Coordinate, Joint, JointKind};
-use crate::system::{System, SystemBuilder};
+use crate::system::System;
 use crate::timefn::TimeFunction;
 use serde::{Deserialize, Serialize};
 

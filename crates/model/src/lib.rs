@@ -42,12 +42,17 @@
 #![allow(clippy::needless_range_loop)]
 
 mod body;
+mod builder;
+mod cache;
+mod constraints;
+mod dynamics;
 mod error;
 mod file;
 mod force;
 mod init;
 pub mod jet;
 mod joint;
+mod kinematics;
 pub mod models;
 pub mod numeric;
 mod scale;
@@ -55,13 +60,15 @@ mod system;
 mod timefn;
 
 pub use body::{Body, BodyHandle, BodyRef};
+pub use builder::SystemBuilder;
+pub use cache::AngleCache;
 pub use error::ModelError;
 pub use file::{ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};
 pub use init::{ConsistentState, ProjectionOptions};
 pub use joint::{Coordinate, Joint, JointKind};
 pub use scale::MAX_INERTIA_RATIO;
-pub use system::{AngleCache, ForceHandle, JointHandle, System, SystemBuilder};
+pub use system::{ForceHandle, JointHandle, System};
 pub use timefn::TimeFunction;
 
 pub use nalgebra;

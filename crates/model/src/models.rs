@@ -5,9 +5,10 @@
 //! `-y`.
 
 use crate::body::{Body, BodyRef};
+use crate::builder::SystemBuilder;
 use crate::error::ModelError;
 use crate::joint::Joint;
-use crate::system::{System, SystemBuilder};
+use crate::system::System;
 use crate::timefn::TimeFunction;
 use std::f64::consts::FRAC_PI_2;
 

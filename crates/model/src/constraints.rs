@@ -1,0 +1,527 @@
+//! Evaluation of the constraints and their derivatives: `Phi`, `Phi_q`, `gamma`, `Phi_q v`,
+//! their element-local forms for sparse assembly, and the constraint Hessians.
+
+use crate::cache::AngleCache;
+use crate::jet::{DirJet, Dual, Frame, HessJet, Scalar, TanJet, NV};
+use crate::system::*;
+use nalgebra::DMatrix;
+
+impl System {
+    /// `Phi(q, t)` into `out` (length m).
+    pub fn phi(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let qa = Self::frm_f64(q, at.a);
+            let qb = Self::frm_f64(q, at.b);
+            let mut e = [0.0; 3];
+            j.eval(&qa, &qb, &mut e);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                out[o + k] = e[k] - j.time_part(k, t)[0];
+            }
+        }
+    }
+
+    /// `Phi_t(q, t)` into `out` (length m).
+    pub fn phi_t(&self, t: f64, out: &mut [f64]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                out[o + k] = -j.time_part(k, t)[1];
+            }
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn joint_dir(&self, ji: usize, q: &[f64], v: Option<&[f64]>) -> [DirJet; 3] {
+        let at = self.joint_attach[ji];
+        let qa = Self::loc_dir(q, v, at.a, 0);
+        let qb = Self::loc_dir(q, v, at.b, 3);
+        let mut e = [DirJet::cst(0.0); 3];
+        self.joints[ji].eval(&qa, &qb, &mut e);
+        e
+    }
+
+    #[inline(always)]
+    pub(crate) fn scatter_row(&self, ji: usize, row: usize, g: &[f64; NV], out: &mut DMatrix<f64>) {
+        let at = self.joint_attach[ji];
+        if let Some(i) = at.a {
+            for l in 0..3 {
+                out[(row, 3 * i + l)] += g[l];
+            }
+        }
+        if let Some(i) = at.b {
+            for l in 0..3 {
+                out[(row, 3 * i + l)] += g[3 + l];
+            }
+        }
+    }
+
+    /// The constraint Jacobian `Phi_q` (m x n, dense) into `out` (overwritten).
+    pub fn phi_q(&self, q: &[f64], out: &mut DMatrix<f64>) {
+        out.as_mut_slice().fill(0.0);
+        for ji in 0..self.joints.len() {
+            let e = self.joint_dir(ji, q, None);
+            let o = self.row_offset[ji];
+            for k in 0..self.joints[ji].n_equations() {
+                self.scatter_row(ji, o + k, &e[k].g, out);
+            }
+        }
+    }
+
+    /// `Phi_q` and the acceleration right-hand side
+    /// `gamma = -(Phi_q v)_q v - 2 Phi_qt v - Phi_tt` in one pass.
+    pub fn phi_q_gamma(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        phi_q: &mut DMatrix<f64>,
+        gamma: &mut [f64],
+    ) {
+        phi_q.as_mut_slice().fill(0.0);
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, Some(v));
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                self.scatter_row(ji, o + k, &e[k].g, phi_q);
+                gamma[o + k] = -e[k].d2 + j.time_part(k, t)[2];
+            }
+        }
+    }
+
+    /// `Phi_q` and the Jacobian of the velocity constraint with respect to `q`,
+    /// `(Phi_q v)_q = d/dq (Phi_q(q) v)` (m x n; row `k` is `v^T Hess(Phi_k)`), in one pass.
+    /// Together they form the Jacobian `[[Phi_q, 0], [(Phi_q v)_q, Phi_q]]` of the first-order
+    /// constraints `(Phi, Phi_q v + Phi_t)` in `(q, v)` (`Phi_qt = 0` for every joint, so
+    /// `Phi_t` adds nothing). Exact (Hessian jets), both outputs overwritten.
+    pub fn phi_q_dot_jacobian(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        phi_q: &mut DMatrix<f64>,
+        out: &mut DMatrix<f64>,
+    ) {
+        phi_q.as_mut_slice().fill(0.0);
+        out.fill(0.0);
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let qa = Self::loc_tan(q, v, at.a, 0);
+            let qb = Self::loc_tan(q, v, at.b, 3);
+            let mut e = [TanJet::cst(0.0); 3];
+            j.eval(&qa, &qb, &mut e);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                self.scatter_row(ji, o + k, &e[k].g, phi_q);
+                self.scatter_row(ji, o + k, &e[k].dg, out);
+            }
+        }
+    }
+
+    /// [`System::phi_q_dot_jacobian`] in element-local form (see [`System::phi_q_local`]):
+    /// `grads[r]` is row `r` of `Phi_q`, `dgrads[r]` row `r` of `(Phi_q v)_q`, each six numbers
+    /// in the columns of the joint's two bodies ([`System::joint_bodies`]).
+    pub fn phi_q_dot_local(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        grads: &mut [[f64; 6]],
+        dgrads: &mut [[f64; 6]],
+    ) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let qa = Self::loc_tan(q, v, at.a, 0);
+            let qb = Self::loc_tan(q, v, at.b, 3);
+            let mut e = [TanJet::cst(0.0); 3];
+            j.eval(&qa, &qb, &mut e);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                grads[o + k] = e[k].g;
+                dgrads[o + k] = e[k].dg;
+            }
+        }
+    }
+
+    /// The bodies a joint attaches, as coordinate-block indices (`None` = ground).
+    pub fn joint_bodies(&self, j: JointHandle) -> (Option<usize>, Option<usize>) {
+        let at = self.joint_attach[j.0];
+        (at.a, at.b)
+    }
+
+    /// `Phi_q` in element-local form alone (see [`System::phi_q_local_gamma`]): row `r` is
+    /// `grads[r][0..3]` in the columns of the joint's first body and `grads[r][3..6]` in those
+    /// of its second ([`System::joint_bodies`]).
+    pub fn phi_q_local(&self, q: &[f64], grads: &mut [[f64; 6]]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, None);
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                grads[o + k] = e[k].g;
+            }
+        }
+    }
+
+    /// `Phi_q` in element-local form and `gamma`, for sparse assembly: row `r` of `Phi_q` is
+    /// `grads[r][0..3]` in the columns of the joint's first body and `grads[r][3..6]` in those of
+    /// its second ([`System::joint_bodies`]; entries for ground are zero).
+    pub fn phi_q_local_gamma(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        grads: &mut [[f64; 6]],
+        gamma: &mut [f64],
+    ) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, Some(v));
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                grads[o + k] = e[k].g;
+                gamma[o + k] = -e[k].d2 + j.time_part(k, t)[2];
+            }
+        }
+    }
+
+    /// `gamma(q, v, t)` alone.
+    pub fn gamma(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, Some(v));
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                out[o + k] = -e[k].d2 + j.time_part(k, t)[2];
+            }
+        }
+    }
+
+    /// The velocity constraint `Phi_q v + Phi_t` into `out`.
+    pub fn phi_dot(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, Some(v));
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                out[o + k] = e[k].d1 - j.time_part(k, t)[1];
+            }
+        }
+    }
+
+    /// Joint `ji`'s rows of `Phi` and `Phidot` from its bodies' frames.
+    #[inline(always)]
+    pub(crate) fn eval_phi_phi_dot(
+        &self,
+        ji: usize,
+        fa: &Frame<Dual>,
+        fb: &Frame<Dual>,
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+    ) {
+        let j = &self.joints[ji];
+        let mut e = [Dual::cst(0.0); 3];
+        j.eval(fa, fb, &mut e);
+        let o = self.row_offset[ji];
+        for k in 0..j.n_equations() {
+            let tp = j.time_part(k, t);
+            phi[o + k] = e[k].v - tp[0];
+            phi_dot[o + k] = e[k].d - tp[1];
+        }
+    }
+
+    /// `Phi(q, t)` and the velocity constraint `Phi_q v + Phi_t` in one pass with dual numbers
+    /// (no gradients formed): the cheapest evaluation of both constraint levels, e.g. for the
+    /// residual of a Newton iteration on the first-order manifold.
+    pub fn phi_and_phi_dot(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+    ) {
+        let loc = |i: usize| -> Frame<Dual> {
+            Frame::new(std::array::from_fn(|k| {
+                Dual::var(q[3 * i + k], v[3 * i + k])
+            }))
+        };
+        let fixed = Frame::fixed();
+        let mut eval = |ji: usize, fa: &Frame<Dual>, fb: &Frame<Dual>| {
+            self.eval_phi_phi_dot(ji, fa, fb, t, phi, phi_dot);
+        };
+        // each body's sin/cos once (not once per joint) for models of up to 16 bodies
+        const STACK: usize = 16;
+        let nb = self.bodies.len();
+        if nb <= STACK {
+            let mut frames = [fixed; STACK];
+            for (i, f) in frames.iter_mut().enumerate().take(nb) {
+                *f = loc(i);
+            }
+            for ji in 0..self.joints.len() {
+                let at = self.joint_attach[ji];
+                let fa = at.a.map_or(&fixed, |i| &frames[i]);
+                let fb = at.b.map_or(&fixed, |i| &frames[i]);
+                eval(ji, fa, fb);
+            }
+        } else {
+            for ji in 0..self.joints.len() {
+                let at = self.joint_attach[ji];
+                let fa = at.a.map_or(fixed, loc);
+                let fb = at.b.map_or(fixed, loc);
+                eval(ji, &fa, &fb);
+            }
+        }
+    }
+
+    /// [`System::phi_and_phi_dot`] with the bodies' `sin`/`cos` from `cache` (see
+    /// [`AngleCache`]): the same values to a few units in the last place, cheaper when called
+    /// repeatedly at nearby configurations.
+    pub fn phi_and_phi_dot_cached(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+        cache: &mut AngleCache,
+    ) {
+        let nb = self.bodies.len();
+        if cache.entries.len() != nb {
+            self.phi_and_phi_dot(q, v, t, phi, phi_dot);
+            return;
+        }
+        for i in 0..nb {
+            cache.sin_cos(i, q[3 * i + 2]);
+        }
+        cache.valid = true;
+        let entries = &cache.entries;
+        let frame = |i: Option<usize>| -> Frame<Dual> {
+            match i {
+                Some(i) => {
+                    let e = entries[i];
+                    let w = v[3 * i + 2];
+                    Frame {
+                        q: std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k])),
+                        c: Dual {
+                            v: e.c,
+                            d: -e.s * w,
+                        },
+                        s: Dual { v: e.s, d: e.c * w },
+                    }
+                }
+                None => Frame::fixed(),
+            }
+        };
+        for ji in 0..self.joints.len() {
+            let at = self.joint_attach[ji];
+            self.eval_phi_phi_dot(ji, &frame(at.a), &frame(at.b), t, phi, phi_dot);
+        }
+    }
+
+    /// `Phi_q` as (row, column, value) triplets of its structural non-zeros, for sparse
+    /// factorisations. `out` is cleared first; its capacity is reused.
+    pub fn phi_q_triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+        out.clear();
+        for (ji, j) in self.joints.iter().enumerate() {
+            let e = self.joint_dir(ji, q, None);
+            let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                if let Some(i) = at.a {
+                    for l in 0..3 {
+                        out.push((o + k, 3 * i + l, e[k].g[l]));
+                    }
+                }
+                if let Some(i) = at.b {
+                    for l in 0..3 {
+                        out.push((o + k, 3 * i + l, e[k].g[3 + l]));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The lambda-weighted constraint Hessian `sum_k lambda_k d^2 Phi_k / dq^2` (n x n) into `out`
+    /// (overwritten).
+    pub fn constraint_hessian(&self, q: &[f64], lambda: &[f64], out: &mut DMatrix<f64>) {
+        out.fill(0.0);
+        self.add_constraint_hessian(q, lambda, 1.0, out);
+    }
+
+    /// Adds `scale * sum_k lambda_k d^2 Phi_k / dq^2` into `out`.
+    pub fn add_constraint_hessian(
+        &self,
+        q: &[f64],
+        lambda: &[f64],
+        scale: f64,
+        out: &mut DMatrix<f64>,
+    ) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let qa = Self::loc_hess(q, at.a, 0);
+            let qb = Self::loc_hess(q, at.b, 3);
+            let mut e = [HessJet::cst(0.0); 3];
+            j.eval(&qa, &qb, &mut e);
+            let o = self.row_offset[ji];
+            let mut h = [[0.0; NV]; NV];
+            for k in 0..j.n_equations() {
+                let l = lambda[o + k] * scale;
+                for r in 0..NV {
+                    for c in 0..NV {
+                        h[r][c] += l * e[k].h[r][c];
+                    }
+                }
+            }
+            Self::scatter_hess(at, &h, out);
+        }
+    }
+
+    pub(crate) fn scatter_hess(at: Attach, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {
+        let cols = |l: usize| -> Option<usize> {
+            if l < 3 {
+                at.a.map(|i| 3 * i + l)
+            } else {
+                at.b.map(|i| 3 * i + l - 3)
+            }
+        };
+        for r in 0..NV {
+            let Some(gr) = cols(r) else { continue };
+            for c in 0..NV {
+                let Some(gc) = cols(c) else { continue };
+                out[(gr, gc)] += h[r][c];
+            }
+        }
+    }
+
+    // ---------------------------------------------------------------- forces and energy
+}
+
+#[cfg(test)]
+mod phi_q_dot_jacobian_tests {
+    use crate::{models, Body, BodyRef, Coordinate, Joint, SystemBuilder, TimeFunction};
+    use nalgebra::DMatrix;
+
+    fn all_joint_kinds() -> crate::System {
+        let mut b = SystemBuilder::new();
+        let b1 = b.add_body(Body::new("b1").rod(1.0, 1.0).position(0.3, -0.2, 0.4));
+        let b2 = b.add_body(Body::new("b2").rod(2.0, 0.7).position(1.1, 0.5, -0.9));
+        let b3 = b.add_body(Body::new("b3").rod(0.5, 0.4).position(-0.6, 1.3, 2.1));
+        let b4 = b.add_body(Body::new("b4").rod(0.8, 0.9).position(0.2, 2.0, -0.3));
+        b.add_joint(Joint::revolute(
+            "r",
+            BodyRef::Ground,
+            [0.1, 0.2],
+            b1,
+            [-0.5, 0.1],
+        ));
+        b.add_joint(Joint::distance("d", b1, [0.5, 0.0], b2, [-0.3, 0.2], 0.8));
+        b.add_joint(Joint::prismatic(
+            "p",
+            b2,
+            [0.1, 0.0],
+            b3,
+            [0.0, 0.1],
+            [1.0, 0.5],
+            0.2,
+        ));
+        b.add_joint(Joint::weld("w", b3, [0.2, 0.0], b4, [-0.4, 0.1], 0.3));
+        b.add_joint(Joint::absolute("a", b4, [0.3, 0.0], Coordinate::Y, 1.0));
+        b.add_joint(Joint::angle_driver(
+            "drv",
+            BodyRef::Ground,
+            b2,
+            TimeFunction::linear(0.1, 2.0),
+        ));
+        b.build().unwrap()
+    }
+
+    #[test]
+    fn matches_finite_differences_of_phi_q_v() {
+        let systems = [
+            all_joint_kinds(),
+            models::slider_crank().unwrap(),
+            models::four_bar().unwrap(),
+            models::manipulator().unwrap(),
+            // more bodies than phi_and_phi_dot's stack of frames
+            models::n_link_chain(20).unwrap(),
+        ];
+        for sys in &systems {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let q: Vec<f64> = (0..n)
+                .map(|i| 0.3 + 0.17 * i as f64 - 0.05 * (i * i) as f64)
+                .collect();
+            let v: Vec<f64> = (0..n).map(|i| 1.3 - 0.41 * i as f64).collect();
+            let mut jq = DMatrix::zeros(m, n);
+            let mut d = DMatrix::zeros(m, n);
+            sys.phi_q_dot_jacobian(&q, &v, &mut jq, &mut d);
+            let mut jref = DMatrix::zeros(m, n);
+            sys.phi_q(&q, &mut jref);
+            assert!((&jq - &jref).amax() < 1e-15);
+            let (mut p1, mut p2, mut d1, mut d2) =
+                (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+            sys.phi(&q, 0.7, &mut p1);
+            sys.phi_dot(&q, &v, 0.7, &mut d1);
+            sys.phi_and_phi_dot(&q, &v, 0.7, &mut p2, &mut d2);
+            for r in 0..m {
+                assert!((p1[r] - p2[r]).abs() < 1e-15);
+                assert!((d1[r] - d2[r]).abs() < 1e-13);
+            }
+            let eps = 1e-6;
+            let mut jp = DMatrix::zeros(m, n);
+            let mut jm = DMatrix::zeros(m, n);
+            let vv = nalgebra::DVector::from_column_slice(&v);
+            for c in 0..n {
+                let mut qp = q.clone();
+                let mut qm = q.clone();
+                qp[c] += eps;
+                qm[c] -= eps;
+                sys.phi_q(&qp, &mut jp);
+                sys.phi_q(&qm, &mut jm);
+                let fd = (&jp * &vv - &jm * &vv) / (2.0 * eps);
+                for r in 0..m {
+                    assert!(
+                        (fd[r] - d[(r, c)]).abs() < 1e-8 * (1.0 + d[(r, c)].abs()),
+                        "row {r} col {c}: fd {} exact {}",
+                        fd[r],
+                        d[(r, c)]
+                    );
+                }
+            }
+        }
+    }
+
+    /// The angle cache gives phi and phi_dot to a few ulps of the exact evaluation along a
+    /// Newton-like sequence of nearby configurations (rotations, large jumps, invalidation).
+    #[test]
+    fn angle_cache_matches_exact_evaluation() {
+        for sys in [all_joint_kinds(), models::manipulator().unwrap()] {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let mut cache = crate::AngleCache::new(&sys);
+            let mut q: Vec<f64> = (0..n).map(|i| 0.3 + 0.17 * i as f64).collect();
+            // a wound-up angle
+            q[2] += 300.0;
+            let v: Vec<f64> = (0..n).map(|i| 1.3 - 0.41 * i as f64).collect();
+            let (mut p1, mut p2, mut d1, mut d2) =
+                (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+            let mut worst = 0.0f64;
+            for k in 0..40 {
+                // shrinking Newton-like increments, a jump every 13 evaluations
+                let step = if k % 13 == 12 {
+                    0.1
+                } else {
+                    1e-4 / (1 + k % 13) as f64
+                };
+                for (i, qi) in q.iter_mut().enumerate() {
+                    *qi += step * ((i + k) as f64 * 0.7).sin();
+                }
+                if k == 30 {
+                    cache.invalidate();
+                }
+                sys.phi_and_phi_dot(&q, &v, 0.3, &mut p1, &mut d1);
+                sys.phi_and_phi_dot_cached(&q, &v, 0.3, &mut p2, &mut d2, &mut cache);
+                for r in 0..m {
+                    worst = worst.max((p1[r] - p2[r]).abs()).max((d1[r] - d2[r]).abs());
+                }
+            }
+            println!("cached vs exact: {worst:e}");
+            assert!(worst < 1e-13, "cached vs exact: {worst:e}");
+        }
+    }
+}

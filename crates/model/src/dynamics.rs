@@ -1,0 +1,147 @@
+//! Energies and forces: potential, kinetic energy, applied and conservative forces and the
+//! potential's derivatives.
+
+use crate::system::*;
+use nalgebra::DMatrix;
+
+impl System {
+    /// Potential energy `V(q)`: gravity, springs and constant loads.
+    pub fn potential(&self, q: &[f64]) -> f64 {
+        let mut v = 0.0;
+        for (i, b) in self.bodies.iter().enumerate() {
+            v -= b.mass * (self.gravity[0] * q[3 * i] + self.gravity[1] * q[3 * i + 1]);
+        }
+        for (fi, f) in self.forces.iter().enumerate() {
+            let at = self.force_attach[fi];
+            v += f.potential(&Self::frm_f64(q, at.a), &Self::frm_f64(q, at.b));
+        }
+        v
+    }
+
+    /// Kinetic energy `1/2 v^T M v`.
+    pub fn kinetic(&self, v: &[f64]) -> f64 {
+        0.5 * v
+            .iter()
+            .zip(self.mass.iter())
+            .map(|(v, m)| m * v * v)
+            .sum::<f64>()
+    }
+
+    /// Total energy `H = T + V`.
+    pub fn energy(&self, q: &[f64], v: &[f64]) -> f64 {
+        self.kinetic(v) + self.potential(q)
+    }
+
+    /// `grad V(q)` into `out` (overwritten).
+    pub fn potential_gradient(&self, q: &[f64], out: &mut [f64]) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            out[3 * i] = -b.mass * self.gravity[0];
+            out[3 * i + 1] = -b.mass * self.gravity[1];
+            out[3 * i + 2] = 0.0;
+        }
+        for (fi, f) in self.forces.iter().enumerate() {
+            let at = self.force_attach[fi];
+            let e = f.potential(
+                &Self::loc_dir(q, None, at.a, 0),
+                &Self::loc_dir(q, None, at.b, 3),
+            );
+            if let Some(i) = at.a {
+                for l in 0..3 {
+                    out[3 * i + l] += e.g[l];
+                }
+            }
+            if let Some(i) = at.b {
+                for l in 0..3 {
+                    out[3 * i + l] += e.g[3 + l];
+                }
+            }
+        }
+    }
+
+    /// The Hessian of the potential `d^2 V / dq^2` (the stiffness) into `out` (overwritten).
+    pub fn potential_hessian(&self, q: &[f64], out: &mut DMatrix<f64>) {
+        out.fill(0.0);
+        self.add_potential_hessian(q, 1.0, out);
+    }
+
+    /// Adds `scale * d^2 V / dq^2` into `out`.
+    pub fn add_potential_hessian(&self, q: &[f64], scale: f64, out: &mut DMatrix<f64>) {
+        for (fi, f) in self.forces.iter().enumerate() {
+            let at = self.force_attach[fi];
+            let e = f.potential(&Self::loc_hess(q, at.a, 0), &Self::loc_hess(q, at.b, 3));
+            let mut h = e.h;
+            for row in h.iter_mut() {
+                for x in row.iter_mut() {
+                    *x *= scale;
+                }
+            }
+            Self::scatter_hess(at, &h, out);
+        }
+    }
+
+    /// Non-conservative generalized forces (dampers, time-dependent loads) into `out`
+    /// (overwritten).
+    pub fn nonconservative_forces(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for (fi, f) in self.forces.iter().enumerate() {
+            if !f.is_nonconservative() {
+                continue;
+            }
+            let at = self.force_attach[fi];
+            let mut loc = [0.0; 6];
+            f.nonconservative(
+                &Self::loc_f64(q, at.a),
+                &Self::loc_f64(q, at.b),
+                &Self::loc_f64(v, at.a),
+                &Self::loc_f64(v, at.b),
+                t,
+                &mut loc,
+            );
+            if let Some(i) = at.a {
+                for l in 0..3 {
+                    out[3 * i + l] += loc[l];
+                }
+            }
+            if let Some(i) = at.b {
+                for l in 0..3 {
+                    out[3 * i + l] += loc[3 + l];
+                }
+            }
+        }
+    }
+
+    /// All generalized applied forces `Q(q, v, t) = -grad V + Q_nc` into `out` (overwritten).
+    pub fn forces_into(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.potential_gradient(q, out);
+        for x in out.iter_mut() {
+            *x = -*x;
+        }
+        for (fi, f) in self.forces.iter().enumerate() {
+            if !f.is_nonconservative() {
+                continue;
+            }
+            let at = self.force_attach[fi];
+            let mut loc = [0.0; 6];
+            f.nonconservative(
+                &Self::loc_f64(q, at.a),
+                &Self::loc_f64(q, at.b),
+                &Self::loc_f64(v, at.a),
+                &Self::loc_f64(v, at.b),
+                t,
+                &mut loc,
+            );
+            if let Some(i) = at.a {
+                for l in 0..3 {
+                    out[3 * i + l] += loc[l];
+                }
+            }
+            if let Some(i) = at.b {
+                for l in 0..3 {
+                    out[3 * i + l] += loc[3 + l];
+                }
+            }
+        }
+    }
+
+    // ---------------------------------------------------------------- points
+}
