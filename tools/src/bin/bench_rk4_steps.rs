@@ -1,7 +1,7 @@
 //! Runs many RK4 steps on the manipulator (for profilers such as callgrind), called directly or
 //! through the public run loop (with or without its drift guard), to measure the loop's cost.
 //!
-//! `cargo run --release --example bench_rk4_steps -- 100000 [direct|run|run-noguard]`
+//! `cargo run --release -p mbd-tools --bin bench_rk4_steps -- 100000 [direct|run|run-noguard]`
 use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{run, Integrator, NoObserver, RunConfig, State};
