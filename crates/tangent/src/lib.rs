@@ -64,11 +64,14 @@ mod chart;
 mod error;
 mod integrator;
 mod kernels;
+mod sparse_chart;
 
 pub use chart::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR};
 pub use error::TangentError;
 pub use integrator::{
     AdaptiveSettings, AdaptiveStats, IterationMatrix, TangentOptions, TangentRk, TangentStats,
 };
+pub use mbd_solve::LinearSolver;
+pub use sparse_chart::SparseChart;
 
 pub use mbd_solve::{ButcherTableau, StepController};

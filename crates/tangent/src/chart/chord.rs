@@ -376,7 +376,7 @@ impl TangentChart {
 /// `max(a, b)` for non-NaN `b` (one `maxsd`; `f64::max`'s NaN handling costs several
 /// instructions more in the short loops of the travel bound).
 #[inline(always)]
-pub(super) fn fast_max(a: f64, b: f64) -> f64 {
+pub(crate) fn fast_max(a: f64, b: f64) -> f64 {
     if b > a {
         b
     } else {
@@ -386,7 +386,7 @@ pub(super) fn fast_max(a: f64, b: f64) -> f64 {
 
 /// The verdict at the head of a chord iteration: failed (residual not finite, or `max_iter`
 /// iterations used), converged (`res <= tol`), or `None` to go on.
-pub(super) fn loop_head(
+pub(crate) fn loop_head(
     t: f64,
     res: f64,
     res0: f64,

@@ -25,7 +25,7 @@ mod settings;
 #[cfg(test)]
 mod tests;
 
-use chord::loop_head;
+pub(crate) use chord::{fast_max, loop_head};
 pub use settings::{ChartFailure, MapStats, NewtonSettings};
 
 /// A chart of the manifold `f(x, t) = (Phi(q, t), Phi_q v + Phi_t) = 0` at a centre
@@ -148,7 +148,16 @@ pub struct TangentChart {
 impl TangentChart {
     /// A chart workspace for `sys` (allocates once).
     pub fn new(sys: &System) -> Self {
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        Self::with_dims(sys, sys.n_coords(), sys.n_constraints())
+    }
+
+    /// A chart of no dimension (`n = m = 0`, never centred): what
+    /// [`crate::TangentRk::chart`] returns on the sparse path, which has no dense chart.
+    pub(crate) fn empty(sys: &System) -> Self {
+        Self::with_dims(sys, 0, 0)
+    }
+
+    fn with_dims(sys: &System, n: usize, m: usize) -> Self {
         let (nn, mm) = (2 * n, 2 * m);
         let mut q = vec![0.0; nn * nn];
         for i in 0..nn {

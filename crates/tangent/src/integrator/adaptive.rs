@@ -281,13 +281,7 @@ impl TangentRk {
                     st.newton_iterations += w.iterations;
                     st.exact_maps += w.exact_maps;
                     // error estimate mapped to x: e = U err_xi
-                    self.ex.fill(0.0);
-                    for (k, &e) in self.rk.err.iter().enumerate() {
-                        let col = self.chart.tangent(k);
-                        for (exi, c) in self.ex.iter_mut().zip(col) {
-                            *exi += e * c;
-                        }
-                    }
+                    self.path.to_ambient(&self.rk.err, &mut self.ex);
                     for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
                         *s = a.abs().max(b.abs());
                     }
@@ -370,7 +364,7 @@ impl TangentRk {
     /// dividing by `2n` instead of `d` would shrink the RMS of a `d`-dimensional error by
     /// `sqrt(d / 2n)` (1/sqrt(3) on the manipulator) and loosen every tolerance by that much.
     pub(super) fn error_norm(&self, ctrl: &StepController) -> f64 {
-        let d = self.chart.dim().max(1) as f64;
+        let d = self.path.dim().max(1) as f64;
         let sum: f64 = self
             .ex
             .iter()
@@ -397,7 +391,7 @@ impl TangentRk {
     ) -> Result<f64, SolveError> {
         let ctrl = &settings.controller;
         let n = self.n;
-        let d = self.chart.dim().max(1) as f64;
+        let d = self.path.dim().max(1) as f64;
         let norm = |x: &[f64], y: &[f64]| -> f64 {
             let sum: f64 = x
                 .iter()
@@ -409,12 +403,12 @@ impl TangentRk {
         {
             let (q, v) = self.cur.split_at(n);
             if let Err(e) = self
-                .acc
-                .solve(sys, q, v, t, &mut self.acc_a, &mut self.lambda)
+                .path
+                .accel(sys, q, v, t, false, &mut self.acc_a, &mut self.lambda)
             {
                 return Err(match e {
                     SolveError::Singular { .. } => self
-                        .chart
+                        .path
                         .singular_error_at(sys, q, t, SINGULAR_REPORT_TOL)
                         .unwrap_or(e),
                     e => e,
@@ -439,8 +433,8 @@ impl TangentRk {
         }
         {
             let (q, v) = self.x.split_at(n);
-            self.acc
-                .solve(sys, q, v, t + ha, &mut self.acc_a, &mut self.lambda)?;
+            self.path
+                .accel(sys, q, v, t + ha, false, &mut self.acc_a, &mut self.lambda)?;
         }
         self.stats.rhs_evals += 1;
         self.proj[..n].copy_from_slice(&self.x[n..]);

@@ -33,7 +33,7 @@ impl TangentRk {
         // interior stage maps: inexact after an accepted step of the same size (to rounding:
         // `mbd_solve::run` passes `t_next - t`, which differs from the nominal step in the
         // last bits)
-        let rcond = self.chart.rcond();
+        let rcond = self.path.rcond();
         let follows = same_step(self.hist_h, h)
             && same_time(self.hist_t, t)
             && self.hist_rcond[..self.hist_len]
@@ -67,8 +67,7 @@ impl TangentRk {
         let mut stage = 0usize;
         self.xi.fill(0.0);
         {
-            let chart = &mut self.chart;
-            let acc = &mut self.acc;
+            let chart = &mut self.path;
             let zlast = &mut self.zeta;
             let (zplain, x, g, fx, proj) = (
                 &mut self.zplain,
@@ -133,9 +132,9 @@ impl TangentRk {
                     Ok(MapStats::default())
                 } else if fsal && i + 1 == s {
                     // FSAL: this stage point is the step's end point, whose residual is verified
-                    chart.map(sys, y, ti, zplain, x, &newton)
+                    chart.map(sys, y, ti, zplain, x, &newton, false)
                 } else {
-                    chart.map_predicted(sys, y, ti, zplain, x, &stage_newton)
+                    chart.map(sys, y, ti, zplain, x, &stage_newton, true)
                 };
                 if ysq > 0.0 && mapped.is_ok() {
                     zlast.copy_from_slice(zplain);
@@ -162,25 +161,12 @@ impl TangentRk {
                     }
                 }
                 let (q, v) = x.split_at(n);
-                let solved = if i == 0 && centre_ok && ti == t && scleronomic {
-                    // at the centre: Phi_q and (Phi_q v)_q are the chart's, so
-                    // gamma = -(Phi_q v)_q v needs no model evaluation
-                    sys.forces_into(q, v, ti, &mut acc.forces);
-                    acc.phi_q.copy_from(chart.centre_phi_q());
-                    let dphi = chart.centre_phi_q_dot_jacobian().as_slice();
-                    let m = acc.gamma.len();
-                    acc.gamma.fill(0.0);
-                    for (col, &vk) in dphi.chunks_exact(m.max(1)).zip(v) {
-                        for (gr, &d) in acc.gamma.iter_mut().zip(col) {
-                            *gr -= d * vk;
-                        }
-                    }
-                    acc.finish(sys, ti, acc_a, lambda)
-                } else {
-                    acc.solve(sys, q, v, ti, acc_a, lambda)
-                };
+                // at the centre: Phi_q and (Phi_q v)_q are the chart's, so (dense path)
+                // gamma = -(Phi_q v)_q v needs no model evaluation
+                let at_centre = i == 0 && centre_ok && ti == t && scleronomic;
+                let solved = chart.accel(sys, q, v, ti, at_centre, acc_a, lambda);
                 if solved.is_ok() {
-                    work.condition = work.condition.max(acc.condition_estimate());
+                    work.condition = work.condition.max(chart.condition_estimate());
                 }
                 if let Err(e) = solved {
                     if matches!(e, SolveError::Singular { .. }) {
@@ -191,9 +177,7 @@ impl TangentRk {
                 work.rhs_evals += 1;
                 fx[..n].copy_from_slice(v);
                 fx[n..].copy_from_slice(acc_a);
-                chart.coordinates(fx, proj);
-                g[i * mm..(i + 1) * mm].copy_from_slice(&proj[..mm]);
-                dy.copy_from_slice(&proj[mm..]);
+                chart.split(fx, proj, &mut g[i * mm..(i + 1) * mm], dy);
                 stage += 1;
                 Ok(())
             };
@@ -201,7 +185,7 @@ impl TangentRk {
                 return Err(match (failure.take(), *singular_stage) {
                     // a map at the step's end time that failed at a singular configuration
                     (Some((f, i)), _) if self.c_coef[i] == 1.0 => {
-                        match self.chart.singular_error_at(
+                        match self.path.singular_error_at(
                             sys,
                             &self.x[..n],
                             t + h,
@@ -215,13 +199,13 @@ impl TangentRk {
                     // the step's start point itself: a singular configuration, reported with
                     // the numerical rank and the joints of the dependency
                     (None, Some(0)) => Attempt::Hard(
-                        self.chart
+                        self.path
                             .singular_error(sys, t, SINGULAR_REPORT_TOL)
                             .unwrap_or(e),
                     ),
                     // a stage at the step's end time
                     (None, Some(i)) if self.c_coef[i] == 1.0 => Attempt::SingularEnd(
-                        self.chart
+                        self.path
                             .singular_error_at(sys, &self.x[..n], t + h, SINGULAR_REPORT_TOL)
                             .unwrap_or(e),
                     ),
@@ -235,7 +219,7 @@ impl TangentRk {
             // the last stage was evaluated at xi = h sum b_j k_j, t + h: it is the end point
             self.xnew.copy_from_slice(&self.x);
         } else {
-            self.chart.select_iteration_matrix(1.0);
+            self.path.select_iteration_matrix(1.0);
             self.zeta.fill(0.0);
             for j in 0..s {
                 let b = self.b_coef[j];
@@ -243,10 +227,15 @@ impl TangentRk {
                     axpy(h * b, &self.g[j * mm..(j + 1) * mm], &mut self.zeta);
                 }
             }
-            match self
-                .chart
-                .map(sys, &self.xi, t1, &mut self.zeta, &mut self.xnew, &newton)
-            {
+            match self.path.map(
+                sys,
+                &self.xi,
+                t1,
+                &mut self.zeta,
+                &mut self.xnew,
+                &newton,
+                false,
+            ) {
                 Ok(ms) => {
                     work.exact_maps += usize::from(ms.exact);
                     work.iterations += ms.iterations;
@@ -256,7 +245,7 @@ impl TangentRk {
                 }
                 Err(f) => {
                     return Err(
-                        match self.chart.singular_error_at(
+                        match self.path.singular_error_at(
                             sys,
                             &self.xnew[..n],
                             t1,
@@ -268,7 +257,7 @@ impl TangentRk {
                     )
                 }
             }
-            self.chart
+            self.path
                 .eta_from_zeta(&self.zeta, &mut self.eta_now[s * mm..(s + 1) * mm]);
         }
         if self.xnew.iter().any(|x| !x.is_finite()) {
@@ -292,7 +281,7 @@ impl TangentRk {
         self.eta_hist.copy_within(0..(HISTORY - 1) * len, len);
         self.eta_hist[..len].copy_from_slice(&self.eta_now);
         self.hist_rcond.copy_within(0..HISTORY - 1, 1);
-        self.hist_rcond[0] = self.chart.rcond();
+        self.hist_rcond[0] = self.path.rcond();
         self.hist_len = (self.hist_len + 1).min(HISTORY);
         self.hist_h = h;
         self.hist_t = t_end;

@@ -4,14 +4,18 @@
 use crate::chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
 use crate::error::TangentError;
 use crate::kernels::axpy;
+use crate::sparse_chart::SparseChart;
 use mbd_model::System;
 use mbd_solve::{
-    AccelerationSolver, ButcherTableau, ExplicitRk, Flow, Integrator, Observer, SolveError, State,
-    StepController, StepStats,
+    AccelerationSolver, ButcherTableau, ExplicitRk, Flow, Integrator, Observer, SolveError,
+    SparseAccelerationSolver, State, StepController, StepStats,
 };
 mod adaptive;
 mod attempt;
 mod options;
+mod path;
+
+use path::Path;
 
 pub use adaptive::{AdaptiveSettings, AdaptiveStats};
 pub use options::{IterationMatrix, TangentOptions, TangentStats};
@@ -41,9 +45,9 @@ enum Attempt {
 /// to the Newton tolerance. Allocation-free per step after [`TangentRk::new`].
 #[derive(Debug)]
 pub struct TangentRk {
-    chart: TangentChart,
+    /// The chart and the index-1 solver (dense or sparse).
+    path: Path,
     rk: ExplicitRk,
-    acc: AccelerationSolver,
     options: TangentOptions,
     stats: TangentStats,
     n: usize,
@@ -64,7 +68,7 @@ pub struct TangentRk {
     xnew: Vec<f64>,
     /// Stage point.
     x: Vec<f64>,
-    /// Chart coordinates.
+    /// Chart coordinates (dense: `xi`, `2 (n - m)`; sparse: `y`, `2n`).
     xi: Vec<f64>,
     /// Normal coordinates (chord Newton unknowns).
     zeta: Vec<f64>,
@@ -74,7 +78,7 @@ pub struct TangentRk {
     g: Vec<f64>,
     /// `F = (v, a)`.
     fx: Vec<f64>,
-    /// `Q^T F`.
+    /// `Q^T F` (dense path); work space.
     proj: Vec<f64>,
     /// Residual buffer.
     res: Vec<f64>,
@@ -137,10 +141,31 @@ impl TangentRk {
     ) -> Result<Self, SolveError> {
         options.validate()?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let mut chart = TangentChart::new(sys);
-        chart.singular_tol = options.singular_tol;
-        chart.set_broyden(options.iteration_matrix == IterationMatrix::Broyden);
-        let dim = chart.dim();
+        let path = if options.linear_solver.use_sparse(m) {
+            if options.iteration_matrix != IterationMatrix::Centre {
+                return Err(SolveError::Unsupported(format!(
+                    "the sparse tangent chart iterates with the centre's matrix only \
+                     (iteration matrix {:?}; choose LinearSolver::Dense for it)",
+                    options.iteration_matrix
+                )));
+            }
+            let mut chart = SparseChart::new(sys)?;
+            chart.singular_tol = options.singular_tol;
+            Path::Sparse {
+                chart,
+                acc: SparseAccelerationSolver::new(sys)?,
+                empty: TangentChart::empty(sys),
+            }
+        } else {
+            let mut chart = TangentChart::new(sys);
+            chart.singular_tol = options.singular_tol;
+            chart.set_broyden(options.iteration_matrix == IterationMatrix::Broyden);
+            Path::Dense {
+                chart,
+                acc: AccelerationSolver::new(sys),
+            }
+        };
+        let dim = path.coord_dim();
         let s = tableau.stages;
         let a_coef = tableau.a.clone();
         let b_coef = tableau.b.clone();
@@ -150,9 +175,8 @@ impl TangentRk {
             && (0..s).all(|j| tableau.a[(s - 1) * s + j] == tableau.b[j]);
         let rk = ExplicitRk::new(tableau, dim)?;
         Ok(TangentRk {
-            chart,
+            path,
             rk,
-            acc: AccelerationSolver::new(sys),
             options,
             stats: TangentStats::default(),
             n,
@@ -216,14 +240,33 @@ impl TangentRk {
         &self.stats
     }
 
-    /// The chart of the last step (centred at that step's start point).
+    /// The dense chart of the last step (centred at that step's start point). On the sparse
+    /// path ([`TangentRk::is_sparse`]) a chart of no dimension that is never centred: see
+    /// [`TangentRk::sparse_chart`].
     pub fn chart(&self) -> &TangentChart {
-        &self.chart
+        match &self.path {
+            Path::Dense { chart, .. } => chart,
+            Path::Sparse { empty, .. } => empty,
+        }
     }
 
-    /// Dimension of the state equation, `2 (n - m)`.
+    /// The sparse chart of the last step on the sparse path, `None` on the dense path.
+    pub fn sparse_chart(&self) -> Option<&SparseChart> {
+        match &self.path {
+            Path::Dense { .. } => None,
+            Path::Sparse { chart, .. } => Some(chart),
+        }
+    }
+
+    /// Whether the solver runs on the sparse chart ([`TangentOptions::linear_solver`]).
+    pub fn is_sparse(&self) -> bool {
+        matches!(self.path, Path::Sparse { .. })
+    }
+
+    /// Dimension of the state equation, `2 (n - m)` (the sparse path integrates it in `2n`
+    /// redundant coordinates).
     pub fn state_dim(&self) -> usize {
-        self.chart.dim()
+        self.path.dim()
     }
 
     fn check_sizes(&self, sys: &System, state: &State) -> Result<(), SolveError> {
@@ -263,7 +306,7 @@ impl TangentRk {
         if self.m == 0 {
             return Ok(());
         }
-        let r = self.chart.residual(sys, &self.cur, state.t, &mut self.res);
+        let r = self.path.residual(sys, &self.cur, state.t, &mut self.res);
         self.cur_ok = r <= self.options.newton.tol;
         if r.is_nan() || r > self.options.consistency_tol {
             return Err(SolveError::InvalidParameter {
@@ -285,7 +328,7 @@ impl TangentRk {
     fn centre(&mut self, sys: &System, t: f64) -> Result<(), SolveError> {
         let n = self.n;
         let (q, v) = self.cur.split_at(n);
-        self.chart.centre(sys, q, v, t)?;
+        self.path.centre(sys, q, v, t)?;
         self.stats.charts += 1;
         Ok(())
     }

@@ -1,7 +1,7 @@
 //! Options and work counters of [`TangentRk`](super::TangentRk).
 
 use crate::chart::NewtonSettings;
-use mbd_solve::SolveError;
+use mbd_solve::{LinearSolver, SolveError};
 
 /// The matrix of the chord Newton iteration of the chart maps (the limit, the point of the
 /// chart, is the same for both; only the speed differs).
@@ -58,6 +58,14 @@ pub struct TangentOptions {
     /// every stage to `newton.tol`. Not used for FSAL tableaus (their last stage is the end
     /// point). Default 1e-2; must lie in [0, 1).
     pub stage_tol_ratio: f64,
+    /// Which chart: [`LinearSolver::Dense`] the QR chart with an orthonormal tangent basis
+    /// ([`crate::TangentChart`], `O(n^3)` per step), [`LinearSolver::Sparse`] the chart in
+    /// redundant tangent coordinates on the sparse Cholesky factorisation of `Df Df^T`
+    /// ([`crate::SparseChart`], `O(n)` per step for chains; centre iteration matrix only, no
+    /// exact-Newton fallback), [`LinearSolver::Auto`] (default) dense up to
+    /// [`mbd_solve::SPARSE_THRESHOLD`] constraint equations, sparse above. Both give the same
+    /// trajectory up to rounding (`docs/tangent.md` section 9).
+    pub linear_solver: LinearSolver,
 }
 
 impl Default for TangentOptions {
@@ -69,6 +77,7 @@ impl Default for TangentOptions {
             singular_tol: 1e-8,
             consistency_tol: 1e-8,
             stage_tol_ratio: 1e-2,
+            linear_solver: LinearSolver::Auto,
         }
     }
 }
