@@ -295,7 +295,7 @@ impl SparseChart {
         match self.chol.factor() {
             Ok(()) => {
                 self.rcond = 1.0 / self.chol.condition_estimate().sqrt();
-                if !(self.rcond > tol) {
+                if self.rcond.is_nan() || self.rcond <= tol {
                     return Err(SolveError::Singular {
                         t,
                         what: "constraint Jacobian Df of the sparse tangent chart",

@@ -15,7 +15,7 @@ mod attempt;
 mod options;
 mod path;
 
-use path::Path;
+use path::{Path, SparseParts};
 
 pub use adaptive::{AdaptiveSettings, AdaptiveStats};
 pub use options::{IterationMatrix, TangentOptions, TangentStats};
@@ -43,6 +43,11 @@ enum Attempt {
 /// over `[t, t + h]` with the tableau, evaluating every stage at a point of the manifold found by
 /// chord Newton, and map the result back. Position and velocity constraints hold at every step
 /// to the Newton tolerance. Allocation-free per step after [`TangentRk::new`].
+///
+/// Above [`mbd_solve::SPARSE_THRESHOLD`] constraint equations (or as chosen by
+/// [`TangentOptions::linear_solver`]) the chart is a [`SparseChart`]: the state equation is
+/// integrated in redundant coordinates `y = U xi` in `ker Df(x_c)` (`y' = P F`), which gives
+/// the same steps up to rounding at `O(N)` cost for chains.
 #[derive(Debug)]
 pub struct TangentRk {
     /// The chart and the index-1 solver (dense or sparse).
@@ -151,11 +156,11 @@ impl TangentRk {
             }
             let mut chart = SparseChart::new(sys)?;
             chart.singular_tol = options.singular_tol;
-            Path::Sparse {
+            Path::Sparse(Box::new(SparseParts {
                 chart,
                 acc: SparseAccelerationSolver::new(sys)?,
                 empty: TangentChart::empty(sys),
-            }
+            }))
         } else {
             let mut chart = TangentChart::new(sys);
             chart.singular_tol = options.singular_tol;
@@ -246,7 +251,7 @@ impl TangentRk {
     pub fn chart(&self) -> &TangentChart {
         match &self.path {
             Path::Dense { chart, .. } => chart,
-            Path::Sparse { empty, .. } => empty,
+            Path::Sparse(p) => &p.empty,
         }
     }
 
@@ -254,13 +259,13 @@ impl TangentRk {
     pub fn sparse_chart(&self) -> Option<&SparseChart> {
         match &self.path {
             Path::Dense { .. } => None,
-            Path::Sparse { chart, .. } => Some(chart),
+            Path::Sparse(p) => Some(&p.chart),
         }
     }
 
     /// Whether the solver runs on the sparse chart ([`TangentOptions::linear_solver`]).
     pub fn is_sparse(&self) -> bool {
-        matches!(self.path, Path::Sparse { .. })
+        matches!(self.path, Path::Sparse(_))
     }
 
     /// Dimension of the state equation, `2 (n - m)` (the sparse path integrates it in `2n`

@@ -10,6 +10,9 @@ use mbd_model::System;
 use mbd_solve::{AccelerationSolver, SolveError, SparseAccelerationSolver};
 
 /// The chart and the index-1 solver of one path.
+// one `Path` per solver, built once: the size difference costs nothing, and the dense arm
+// stays unboxed so that its hot path does not gain an indirection
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 pub(super) enum Path {
     /// Dense chart `x_c + U xi + Q1 zeta`; chart coordinates `xi` (`2 (n - m)`), normal
@@ -19,13 +22,17 @@ pub(super) enum Path {
         acc: AccelerationSolver,
     },
     /// Sparse chart `x_c + y + Df^T eta`; chart coordinates `y` (`2n`, in `ker Df(x_c)`),
-    /// normal coordinates `eta` (`2m`). `empty` is a never-centred dense chart of no
-    /// dimension, returned by [`super::TangentRk::chart`].
-    Sparse {
-        chart: SparseChart,
-        acc: SparseAccelerationSolver,
-        empty: TangentChart,
-    },
+    /// normal coordinates `eta` (`2m`).
+    Sparse(Box<SparseParts>),
+}
+
+/// The sparse path's parts (boxed: the enum stays the size of the dense arm).
+#[derive(Debug)]
+pub(super) struct SparseParts {
+    pub(super) chart: SparseChart,
+    pub(super) acc: SparseAccelerationSolver,
+    /// A never-centred dense chart of no dimension, returned by [`super::TangentRk::chart`].
+    pub(super) empty: TangentChart,
 }
 
 impl Path {
@@ -33,7 +40,7 @@ impl Path {
     pub(super) fn coord_dim(&self) -> usize {
         match self {
             Path::Dense { chart, .. } => chart.dim(),
-            Path::Sparse { chart, .. } => chart.ambient_dim(),
+            Path::Sparse(p) => p.chart.ambient_dim(),
         }
     }
 
@@ -41,7 +48,7 @@ impl Path {
     pub(super) fn dim(&self) -> usize {
         match self {
             Path::Dense { chart, .. } => chart.dim(),
-            Path::Sparse { chart, .. } => chart.dim(),
+            Path::Sparse(p) => p.chart.dim(),
         }
     }
 
@@ -55,7 +62,7 @@ impl Path {
     ) -> Result<(), SolveError> {
         match self {
             Path::Dense { chart, .. } => chart.centre(sys, q, v, t),
-            Path::Sparse { chart, .. } => chart.centre(sys, q, v, t),
+            Path::Sparse(p) => p.chart.centre(sys, q, v, t),
         }
     }
 
@@ -63,7 +70,7 @@ impl Path {
     pub(super) fn rcond(&self) -> f64 {
         match self {
             Path::Dense { chart, .. } => chart.rcond(),
-            Path::Sparse { chart, .. } => chart.rcond(),
+            Path::Sparse(p) => p.chart.rcond(),
         }
     }
 
@@ -71,7 +78,7 @@ impl Path {
     pub(super) fn centre_point(&self) -> &[f64] {
         match self {
             Path::Dense { chart, .. } => chart.centre_point(),
-            Path::Sparse { chart, .. } => chart.centre_point(),
+            Path::Sparse(p) => p.chart.centre_point(),
         }
     }
 
@@ -97,7 +104,7 @@ impl Path {
     pub(super) fn zeta_from_eta(&self, eta: &[f64], zeta: &mut [f64]) {
         match self {
             Path::Dense { chart, .. } => chart.zeta_from_eta(eta, zeta),
-            Path::Sparse { .. } => zeta.copy_from_slice(eta),
+            Path::Sparse(_) => zeta.copy_from_slice(eta),
         }
     }
 
@@ -106,7 +113,7 @@ impl Path {
     pub(super) fn eta_from_zeta(&self, zeta: &[f64], eta: &mut [f64]) {
         match self {
             Path::Dense { chart, .. } => chart.eta_from_zeta(zeta, eta),
-            Path::Sparse { .. } => eta.copy_from_slice(zeta),
+            Path::Sparse(_) => eta.copy_from_slice(zeta),
         }
     }
 
@@ -127,8 +134,8 @@ impl Path {
         match (self, predicted) {
             (Path::Dense { chart, .. }, false) => chart.map(sys, y, t, zeta, x, newton),
             (Path::Dense { chart, .. }, true) => chart.map_predicted(sys, y, t, zeta, x, newton),
-            (Path::Sparse { chart, .. }, false) => chart.map(sys, y, t, zeta, x, newton),
-            (Path::Sparse { chart, .. }, true) => chart.map_predicted(sys, y, t, zeta, x, newton),
+            (Path::Sparse(p), false) => p.chart.map(sys, y, t, zeta, x, newton),
+            (Path::Sparse(p), true) => p.chart.map_predicted(sys, y, t, zeta, x, newton),
         }
     }
 
@@ -165,7 +172,7 @@ impl Path {
                     acc.solve(sys, q, v, t, a, lambda)
                 }
             }
-            Path::Sparse { acc, .. } => acc.solve(sys, q, v, t, a, lambda),
+            Path::Sparse(p) => p.acc.solve(sys, q, v, t, a, lambda),
         }
     }
 
@@ -174,7 +181,7 @@ impl Path {
     pub(super) fn condition_estimate(&self) -> f64 {
         match self {
             Path::Dense { acc, .. } => acc.condition_estimate(),
-            Path::Sparse { acc, .. } => acc.condition_estimate(),
+            Path::Sparse(p) => p.acc.condition_estimate(),
         }
     }
 
@@ -189,7 +196,7 @@ impl Path {
                 g.copy_from_slice(&proj[..mm]);
                 dy.copy_from_slice(&proj[mm..]);
             }
-            Path::Sparse { chart, .. } => chart.split(fx, g, dy),
+            Path::Sparse(p) => p.chart.split(fx, g, dy),
         }
     }
 
@@ -205,7 +212,7 @@ impl Path {
                     }
                 }
             }
-            Path::Sparse { .. } => out.copy_from_slice(e),
+            Path::Sparse(_) => out.copy_from_slice(e),
         }
     }
 
@@ -213,7 +220,7 @@ impl Path {
     pub(super) fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
         match self {
             Path::Dense { chart, .. } => chart.residual(sys, x, t, out),
-            Path::Sparse { chart, .. } => chart.residual(sys, x, t, out),
+            Path::Sparse(p) => p.chart.residual(sys, x, t, out),
         }
     }
 
@@ -226,7 +233,7 @@ impl Path {
     ) -> Option<SolveError> {
         match self {
             Path::Dense { chart, .. } => chart.singular_error(sys, t, rel_tol),
-            Path::Sparse { chart, .. } => chart.singular_error(sys, t, rel_tol),
+            Path::Sparse(p) => p.chart.singular_error(sys, t, rel_tol),
         }
     }
 
@@ -240,7 +247,7 @@ impl Path {
     ) -> Option<SolveError> {
         match self {
             Path::Dense { chart, .. } => chart.singular_error_at(sys, q, t, rel_tol),
-            Path::Sparse { chart, .. } => chart.singular_error_at(sys, q, t, rel_tol),
+            Path::Sparse(p) => p.chart.singular_error_at(sys, q, t, rel_tol),
         }
     }
 }
