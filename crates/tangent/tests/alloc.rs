@@ -2,7 +2,9 @@
 
 use mbd_model::models;
 use mbd_solve::{Integrator, NoObserver, State};
-use mbd_tangent::{AdaptiveSettings, ButcherTableau, IterationMatrix, TangentOptions, TangentRk};
+use mbd_tangent::{
+    AdaptiveSettings, ButcherTableau, IterationMatrix, LinearSolver, TangentOptions, TangentRk,
+};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -65,5 +67,44 @@ fn steps_allocate_nothing() {
             .expect("adaptive");
         let after = ALLOCS.with(|c| c.get());
         assert_eq!(after - before, 0, "allocations during steps");
+    }
+}
+
+#[test]
+fn sparse_steps_allocate_nothing() {
+    let sparse = TangentOptions {
+        linear_solver: LinearSolver::Sparse,
+        ..Default::default()
+    };
+    // a 30-link chain (sparse by default) and the manipulator forced onto the sparse chart
+    // (whose steps at h = 0.1 need halving)
+    let cases = [
+        (models::n_link_chain(30).expect("model"), 1e-3, false),
+        (models::manipulator().expect("model"), 1e-3, true),
+    ];
+    for (sys, h, halve) in cases {
+        let mut s = State::consistent(&sys, 0.0).expect("state");
+        let mut rk4 = TangentRk::new(&sys, ButcherTableau::rk4(), sparse).expect("solver");
+        let mut dp = TangentRk::new(&sys, ButcherTableau::dopri5(), sparse).expect("solver");
+        assert!(rk4.is_sparse() && dp.is_sparse());
+        let settings = AdaptiveSettings::with_tolerance(1e-9);
+        rk4.step(&sys, &mut s, h).expect("warm-up");
+        let before = ALLOCS.with(|c| c.get());
+        for _ in 0..100 {
+            rk4.step(&sys, &mut s, h).expect("step");
+            dp.step(&sys, &mut s, h).expect("step");
+        }
+        if halve {
+            let h0 = rk4.stats().halvings;
+            for _ in 0..10 {
+                rk4.step(&sys, &mut s, 0.1).expect("halved step");
+            }
+            assert!(rk4.stats().halvings > h0, "the large steps were halved");
+        }
+        let t1 = s.t + 0.1;
+        dp.integrate_adaptive(&sys, &mut s, t1, &settings, &mut NoObserver)
+            .expect("adaptive");
+        let after = ALLOCS.with(|c| c.get());
+        assert_eq!(after - before, 0, "allocations during sparse steps");
     }
 }

@@ -1,0 +1,416 @@
+//! The chord Newton iteration of the chart maps: the iteration matrix (centre, interpolated,
+//! Broyden), the plain and Broyden iterations, and the travel bound.
+
+use super::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR, TRAVEL_FACTOR};
+use crate::kernels::{dot, gemv_cols, gemv_t_cols, rank_one_update};
+use mbd_model::numeric::max_abs;
+use mbd_model::System;
+
+impl TangentChart {
+    /// Evaluates `Df` at a second point `x_e` (typically the Euler prediction `x_c + h F(x_c)` of
+    /// the step's end point) and stores `E = (Df(x_e) - Df(x_c)) Q1`, so that
+    /// [`TangentChart::select_iteration_matrix`] can interpolate the Newton matrix along the
+    /// step. A non-finite `Df(x_e)` leaves the chart with the centre matrix `R^T` only.
+    pub fn set_secondary_point(&mut self, sys: &System, x_e: &[f64]) {
+        let (n, m) = (self.n, self.m);
+        let (nn, mm) = (2 * n, 2 * m);
+        self.has_e = false;
+        self.s = 0.0;
+        if m == 0 || x_e.len() != nn || !self.centred {
+            return;
+        }
+        sys.phi_q_dot_jacobian(&x_e[..n], &x_e[n..], &mut self.pq_e, &mut self.dphi_e);
+        // Delta Df = [[dP, 0], [dX, dP]] with dP = Phi_q(e) - Phi_q(c), dX likewise
+        self.pq_e -= &self.phi_q;
+        self.dphi_e -= &self.dphi;
+        // column k of E: (dP cq, dX cq + dP cv) for Q1_k = (cq, cv); dP, dX column-major m x n
+        let (dp, dx) = (self.pq_e.as_slice(), self.dphi_e.as_slice());
+        self.e.fill(0.0);
+        for k in 0..mm {
+            let col = &self.q[k * nn..(k + 1) * nn];
+            let (cq, cv) = col.split_at(n);
+            let (ep, ev) = self.e[k * mm..(k + 1) * mm].split_at_mut(m);
+            gemv_cols(dp, cq, ep);
+            gemv_cols(dx, cq, ev);
+            gemv_cols(dp, cv, ev);
+        }
+        if !self.e.iter().all(|x| x.is_finite()) {
+            return;
+        }
+        // K = E R^-T: column k = sum_{j >= k} (R^-1)_{kj} E_j
+        self.k.fill(0.0);
+        for k in 0..mm {
+            for j in k..mm {
+                self.u[j] = self.rinv[j * mm + k];
+            }
+            gemv_cols(
+                &self.e[k * mm..],
+                &self.u[k..mm],
+                &mut self.k[k * mm..(k + 1) * mm],
+            );
+        }
+        self.has_e = true;
+    }
+
+    /// Chooses the matrix `J` of the chord iteration for the next maps: `R^T = Df(x_c) Q1` if
+    /// `s` is 0 or no secondary point is set, else `J_s = R^T + s E`, the linear interpolation of
+    /// `Df Q1` between the centre (`s = 0`) and the secondary point (`s = 1`); for a stage at
+    /// `t_c + c h` pass `s = c`. With `K = E R^-T`, `J_s = (I + s K) R^T`, and the iteration
+    /// applies `J_s^-1 = R^-T (I + s K)^-1` through the expansion
+    /// `(I + s K)^-1 ~ I - s K + s^2 K^2` (`|s K| = O(h)`, so the neglected `O(h^3)` is below the
+    /// `O(h^2)` interpolation error): `x <- x - P0 (f - s K f + s^2 K K f)` with `P0 = Q1 R^-T`
+    /// formed once per chart and `K` once per step. Whatever the matrix, the iteration converges
+    /// to the same point of the chart: the matrix only sets its speed.
+    pub fn select_iteration_matrix(&mut self, s: f64) {
+        self.s = if self.has_e && s.is_finite() { s } else { 0.0 };
+    }
+
+    /// Turns the quasi-Newton (good Broyden) chord iteration on or off (off by default). On,
+    /// the iteration keeps an approximation `H` of `(Df(x) Q1)^-1`, starts each chart from the
+    /// centre's `R^-T`, and after each correction `s = x_(k+1) - x_k` with residual change
+    /// `y = f_(k+1) - f_k` applies the Sherman-Morrison rank-one update
+    /// `H <- H + (s - H y) s^T H / (s^T H y)` (in the ambient space: on `P = Q1 H`, `O(n m)` per
+    /// iteration). The updated matrix carries over from one map to the next until the chart is
+    /// re-centred: the stage points of a step are close, so later maps start with a matrix that
+    /// has already learnt how `Df` changed along the step. An update whose denominator is small
+    /// (`|s^T H y| <= 0.1 |s|^2`) is skipped; an iteration that does not reduce the residual
+    /// with an updated matrix is undone and restarted from `R^-T`. Only the speed changes: the
+    /// limit is the same chart point. Ignored while an interpolated matrix
+    /// ([`TangentChart::select_iteration_matrix`] with `s != 0`) is selected.
+    pub fn set_broyden(&mut self, on: bool) {
+        self.broyden = on;
+        self.pb_active = false;
+    }
+
+    /// Whether the Broyden iteration is on ([`TangentChart::set_broyden`]).
+    pub fn broyden(&self) -> bool {
+        self.broyden
+    }
+
+    /// Broyden updates applied, and resets of the updated matrix to the centre's `R^-T` after
+    /// an iteration without progress, since the chart was created (diagnostics).
+    pub fn broyden_counts(&self) -> (usize, usize) {
+        (self.broyden_updates, self.broyden_resets)
+    }
+
+    /// The chord iteration from `x`; on success `zeta = Q1^T (x - x_c)`.
+    pub(super) fn run_chord(
+        &mut self,
+        sys: &System,
+        t: f64,
+        zeta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        predicted: bool,
+    ) -> Result<MapStats, ChartFailure> {
+        if self.m == 0 {
+            return Ok(MapStats::default());
+        }
+        let nn = 2 * self.n;
+        let mut f = std::mem::take(&mut self.f);
+        // the first residual of a map is evaluated exactly, the iterates' with rotated sin/cos
+        self.angles.invalidate();
+        self.x0.copy_from_slice(x);
+        let res = self.residual_cached(sys, x, t, &mut f);
+        let res_start = res;
+        self.first_step = 0.0;
+        let mut out = if self.broyden && self.s == 0.0 {
+            self.chord_broyden(sys, t, x, newton, &mut f, res, predicted)
+        } else {
+            self.chord(sys, t, x, newton, &mut f, res, predicted)
+        };
+        if let Ok(ms) = out {
+            // a chord iteration that converged far from where it started (relative to its
+            // first correction) did not contract on the way: near a singular configuration it
+            // can drift along the nearly singular direction onto another branch
+            if !self.travel_ok(x, &self.x0, ms.iterations) {
+                out = Err(ChartFailure {
+                    t,
+                    residual: ms.residual,
+                    iterations: ms.iterations,
+                });
+            }
+        }
+        if let Err(failure) = out {
+            // whatever the failure taught the matrix is suspect
+            self.pb_active = false;
+            if newton.fallback_change > 0.0 {
+                let failure_iterations = failure.iterations;
+                x.copy_from_slice(&self.x0);
+                out = self.exact_newton(sys, t, x, newton, &mut f, failure, res_start);
+                if let Ok(ms) = out {
+                    // the same bound on the travel from the exact iteration's start
+                    let exact_iterations = ms.iterations - failure_iterations;
+                    if !self.travel_ok(x, &self.wx, exact_iterations) {
+                        out = Err(ChartFailure {
+                            t,
+                            residual: ms.residual,
+                            iterations: ms.iterations,
+                        });
+                    }
+                }
+            }
+        }
+        self.f = f;
+        if out.is_ok() {
+            for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
+                *d = xv - xc;
+            }
+            let mm = 2 * self.m;
+            gemv_t_cols(&self.q[..mm * nn], &self.dx, &mut zeta[..mm]);
+        }
+        out
+    }
+
+    /// Whether an iteration that ended at `x` from `start` travelled at most [`TRAVEL_FACTOR`]
+    /// times its first correction ([`TangentChart::first_step`]), up to rounding. A
+    /// contracting iteration (factor `theta`) travels at most `1 / (1 - theta)` times its first
+    /// correction and its limit is the solution nearest to the start; one that travelled
+    /// further wandered, and near a singular configuration it may have reached another branch.
+    pub(super) fn travel_ok(&self, x: &[f64], start: &[f64], iterations: usize) -> bool {
+        if iterations <= 1 {
+            // the travel is the first correction
+            return true;
+        }
+        // one pass: the travel and the size of the start (for the rounding floor); a NaN in
+        // `x` cannot reach here (its residual would not be finite)
+        let (mut travel, mut size) = (0.0f64, 0.0f64);
+        for (a, b) in x.iter().zip(start) {
+            travel = fast_max(travel, (a - b).abs());
+            size = fast_max(size, b.abs());
+        }
+        travel <= TRAVEL_FACTOR * self.first_step + 16.0 * f64::EPSILON * (1.0 + size)
+    }
+
+    /// The chord iteration on `x` from its residual `f`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn chord(
+        &mut self,
+        sys: &System,
+        t: f64,
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        f: &mut [f64],
+        res0: f64,
+        predicted: bool,
+    ) -> Result<MapStats, ChartFailure> {
+        let s = self.s;
+        let tol = newton.tol;
+        // f cannot be evaluated more accurately than about eps |Phi_q| |v| (and eps |theta| in
+        // sin theta): a stall below this cap is the round-off floor, not slow convergence
+        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
+        let mut res = res0;
+        let mut prev = f64::INFINITY;
+        let mut it = 0;
+        loop {
+            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+                return verdict;
+            }
+            // x <- x - Q1 J^-1 f = x - P0 (I + s K)^-1 f
+            if s != 0.0 {
+                // u = K f, f <- f - s u + s^2 K u
+                self.u.fill(0.0);
+                gemv_cols(&self.k, f, &mut self.u);
+                let s2 = s * s;
+                for ((fi, ui), wi) in f.iter_mut().zip(&self.u).zip(self.w.iter_mut()) {
+                    *fi -= s * ui;
+                    *wi = s2 * ui;
+                }
+                gemv_cols(&self.k, &self.w, f);
+            }
+            // f is overwritten by the next residual: negate it in place
+            for fk in f.iter_mut() {
+                *fk = -*fk;
+            }
+            gemv_cols(&self.p0, f, x);
+            it += 1;
+            if it == 1 {
+                self.first_step = x
+                    .iter()
+                    .zip(&self.x0)
+                    .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()));
+            }
+            // predicted stop (stage points only): the residual after this correction is about
+            // theta * res with theta the contraction just observed
+            let theta = res / prev;
+            if predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol {
+                return Ok(MapStats {
+                    iterations: it,
+                    residual: theta * res,
+                    initial_residual: res0,
+                    exact: false,
+                });
+            }
+            prev = res;
+            res = self.residual_cached(sys, x, t, f);
+            // stall at the round-off floor (no progress, not slow convergence)
+            if res > tol && res <= stall_cap && res >= 0.9 * prev {
+                return Ok(MapStats {
+                    iterations: it,
+                    residual: res,
+                    initial_residual: res0,
+                    exact: false,
+                });
+            }
+            if res > newton.divergence * prev && res > tol {
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+        }
+    }
+
+    /// The chord iteration on `x` from its residual `f` with good Broyden updates of its matrix
+    /// (see [`TangentChart::set_broyden`]); stopping rules as [`TangentChart::map`] and
+    /// [`TangentChart::map_predicted`].
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn chord_broyden(
+        &mut self,
+        sys: &System,
+        t: f64,
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        f: &mut [f64],
+        res0: f64,
+        predicted: bool,
+    ) -> Result<MapStats, ChartFailure> {
+        let tol = newton.tol;
+        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
+        let mut res = res0;
+        let mut prev = f64::INFINITY;
+        let mut it = 0;
+        // whether `wx` holds `Q1 H f` for the current `f` and `H`
+        let mut have_w = false;
+        loop {
+            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+                return verdict;
+            }
+            if !have_w {
+                let p = if self.pb_active { &self.pb } else { &self.p0 };
+                self.wx.fill(0.0);
+                gemv_cols(p, f, &mut self.wx);
+            }
+            // x <- x - Q1 H f
+            for ((xi, si), wi) in x.iter_mut().zip(self.step.iter_mut()).zip(&self.wx) {
+                *si = -wi;
+                *xi -= wi;
+            }
+            it += 1;
+            if it == 1 {
+                self.first_step = max_abs(&self.wx);
+            }
+            let theta = res / prev;
+            if predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol {
+                return Ok(MapStats {
+                    iterations: it,
+                    residual: theta * res,
+                    initial_residual: res0,
+                    exact: false,
+                });
+            }
+            prev = res;
+            self.fprev.copy_from_slice(f);
+            res = self.residual_cached(sys, x, t, f);
+            if res > tol && res <= stall_cap && res >= 0.9 * prev {
+                return Ok(MapStats {
+                    iterations: it,
+                    residual: res,
+                    initial_residual: res0,
+                    exact: false,
+                });
+            }
+            if self.pb_active && (res.is_nan() || res >= prev) {
+                // the updated matrix made no progress: undo the step, restart from R^-T
+                for (xi, si) in x.iter_mut().zip(&self.step) {
+                    *xi -= si;
+                }
+                f.copy_from_slice(&self.fprev);
+                res = prev;
+                prev = f64::INFINITY;
+                self.pb_active = false;
+                self.broyden_resets += 1;
+                have_w = false;
+                continue;
+            }
+            if res > newton.divergence * prev && res > tol {
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+            if res <= tol {
+                continue;
+            }
+            // w = Q1 H f_(k+1); with s = step: H y = w + s, so the good Broyden update is
+            // H <- H - w (s^T H) / (s^T w + s^T s) and the next step is -w |s|^2 / den
+            {
+                let p = if self.pb_active { &self.pb } else { &self.p0 };
+                self.wx.fill(0.0);
+                gemv_cols(p, f, &mut self.wx);
+            }
+            have_w = true;
+            let ss = dot(&self.step, &self.step);
+            let den = dot(&self.step, &self.wx) + ss;
+            if den.is_finite() && den.abs() > 0.1 * ss && ss > 0.0 {
+                if !self.pb_active {
+                    self.pb.copy_from_slice(&self.p0);
+                    self.pb_active = true;
+                }
+                let inv = 1.0 / den;
+                rank_one_update(&mut self.pb, &self.step, &self.wx, inv);
+                let g = ss * inv;
+                for w in self.wx.iter_mut() {
+                    *w *= g;
+                }
+                self.broyden_updates += 1;
+            }
+        }
+    }
+}
+
+/// `max(a, b)` for non-NaN `b` (one `maxsd`; `f64::max`'s NaN handling costs several
+/// instructions more in the short loops of the travel bound).
+#[inline(always)]
+pub(crate) fn fast_max(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The verdict at the head of a chord iteration: failed (residual not finite, or `max_iter`
+/// iterations used), converged (`res <= tol`), or `None` to go on.
+pub(crate) fn loop_head(
+    t: f64,
+    res: f64,
+    res0: f64,
+    it: usize,
+    tol: f64,
+    max_iter: usize,
+) -> Option<Result<MapStats, ChartFailure>> {
+    let failure = || ChartFailure {
+        t,
+        residual: res,
+        iterations: it,
+    };
+    if !res.is_finite() {
+        Some(Err(failure()))
+    } else if res <= tol {
+        Some(Ok(MapStats {
+            iterations: it,
+            residual: res,
+            initial_residual: res0,
+            exact: false,
+        }))
+    } else if it >= max_iter {
+        Some(Err(failure()))
+    } else {
+        None
+    }
+}

@@ -1,0 +1,593 @@
+//! The local chart of the constraint manifold at an accepted point (paper B's "local
+//! parameterisation"), allocation-free after [`TangentChart::new`].
+
+use crate::kernels::{axpy, form_q, gemv_cols, gemv_t_cols, householder_qr};
+use mbd_model::{AngleCache, System};
+use mbd_solve::linalg::DenseLu;
+use mbd_solve::SolveError;
+use nalgebra::DMatrix;
+
+/// Multiple of `eps (1 + ||x||_inf)` taken as the round-off floor of evaluating `f(x)`: a chord
+/// iteration that stalls (no progress) below `max(10 tol, ROUNDOFF_FACTOR eps (1 + ||x||_inf))`
+/// has converged as far as `f` can be evaluated.
+pub const ROUNDOFF_FACTOR: f64 = 8.0;
+
+/// Largest ratio of the distance a chart map's iteration (chord or exact Newton) moved its
+/// point to its first correction: a contracting iteration with factor `theta` moves at most
+/// `1 / (1 - theta)` times its first correction (4: `theta <= 3/4`). Beyond it the iteration did
+/// not contract, and its limit need not be the solution nearest to the predictor (near a
+/// singular configuration: another branch), so the map counts as failed.
+pub const TRAVEL_FACTOR: f64 = 4.0;
+mod chord;
+mod exact;
+mod rank;
+mod settings;
+#[cfg(test)]
+mod tests;
+
+pub(crate) use chord::{fast_max, loop_head};
+pub use settings::{ChartFailure, MapStats, NewtonSettings};
+
+/// A chart of the manifold `f(x, t) = (Phi(q, t), Phi_q v + Phi_t) = 0` at a centre
+/// `x_c = (q_c, v_c)`:
+///
+/// ```text
+/// x(xi, zeta) = x_c + U xi + Q1 zeta,   Df(x_c)^T = Q1 R  (thin QR),   [Q1 U] orthogonal,
+/// ```
+///
+/// with `U` (`2n x 2(n-m)`) an orthonormal basis of `ker Df(x_c)` and `zeta` (= `R eta` of the
+/// paper's `Df(x_c)^T eta`) from a chord Newton iteration on `f(x(xi, zeta), t) = 0`:
+/// `x <- x - Q1 J^-1 f`. With `J = R^T = Df(x_c) Q1` this is the paper's
+/// `eta <- eta - (Df Df^T)^-1 f` (since `Df Df^T = R^T R`), written without forming
+/// `Df Df^T`; [`TangentChart::select_iteration_matrix`] offers a better `J` for points away from
+/// the centre. The correction matrices (`Q1 R^-T`, `2n x 2m`) are formed once per chart, so an
+/// iteration costs one residual evaluation and one or two `2n x 2m` products.
+///
+/// The QR factorisation uses the block structure `Df = [[Phi_q, 0], [X, Phi_q]]`
+/// (`X = (Phi_q v)_q`): `Phi_q^T = Qa [Ra; 0]` (`Qa = [Qa1 Na]`), then
+/// `B = [Na^T X^T; Ra] = Qb [Rb; 0]`, both `n x m` Householder QRs on preallocated buffers; with
+/// `C = Qa1^T X^T` and the isometry `W y = (Na y[..n-m], Qa1 y[n-m..])`,
+/// `R = [[Ra, C], [0, Rb]]`, `Q1 = [(Qa1, 0), W Qb1]` and `U = [W Qb2, (0, Na)]`, a thin QR of
+/// `Df^T` with an orthonormal complement, without factoring the `2n x 2m` matrix
+/// (`docs/tangent.md` section 2; faer's blocked QR is several times slower at these sizes).
+/// Everything lives in buffers allocated by [`TangentChart::new`].
+#[derive(Clone, Debug)]
+pub struct TangentChart {
+    n: usize,
+    m: usize,
+    /// `Phi_q(q_c)`.
+    phi_q: DMatrix<f64>,
+    /// `(Phi_q v_c)_q` at `q_c`.
+    dphi: DMatrix<f64>,
+    /// `R` (`2m x 2m`, upper triangular) of `Df(x_c)^T = Q1 R`, column-major with column
+    /// stride `2n` (entries below the diagonal unused).
+    a: Vec<f64>,
+    /// Householder coefficients of the two small QR factorisations.
+    tau: Vec<f64>,
+    /// `Phi_q^T` (`n x m`) overwritten by its QR factors (`Ra` and reflectors).
+    aq: Vec<f64>,
+    /// `B = [D; Ra]` (`n x m`) overwritten by its QR factors (`Rb` and reflectors).
+    bq: Vec<f64>,
+    /// The orthogonal factors `Qa` of `Phi_q^T` and `Qb` of `B` (`n x n`, column-major).
+    qa: Vec<f64>,
+    qb: Vec<f64>,
+    /// A row of `(Phi_q v)_q`, and `Qa^T` times it (`n`), work vectors.
+    xt: Vec<f64>,
+    g: Vec<f64>,
+    /// `Q = [Q1 U]` (`2n x 2n`, column-major).
+    q: Vec<f64>,
+    /// The centre `(q_c, v_c)`.
+    xc: Vec<f64>,
+    /// Time of the centre.
+    tc: f64,
+    /// Residual buffer `f` (`2m`).
+    f: Vec<f64>,
+    /// `Phi_q` and `(Phi_q v)_q` at the secondary point `x_e`.
+    pq_e: DMatrix<f64>,
+    dphi_e: DMatrix<f64>,
+    /// `E = (Df(x_e) - Df(x_c)) Q1` (`2m x 2m`, column-major), valid if `has_e`.
+    e: Vec<f64>,
+    has_e: bool,
+    /// `R^-1` (`2m x 2m`, column-major, upper triangular).
+    rinv: Vec<f64>,
+    /// `P0 = Q1 R^-T` (`2n x 2m`, column-major).
+    p0: Vec<f64>,
+    /// `x - x_c` (`2n`), work vector.
+    dx: Vec<f64>,
+    /// `K = E R^-T` (`2m x 2m`, column-major): `J_s = (I + s K) R^T`.
+    k: Vec<f64>,
+    /// Work vectors of the iteration (`2m`).
+    u: Vec<f64>,
+    w: Vec<f64>,
+    /// Whether the chord iteration updates its matrix by good Broyden rank-one updates
+    /// ([`TangentChart::set_broyden`]).
+    broyden: bool,
+    /// The Broyden-updated correction matrix `Q1 H` (`2n x 2m`, column-major; `H` the
+    /// approximation of `(Df(x) Q1)^-1`), valid if `pb_active`; else the matrix is `P0`.
+    pb: Vec<f64>,
+    pb_active: bool,
+    /// The last correction step `x_(k+1) - x_k` and the next one's direction `Q1 H f` (`2n`).
+    step: Vec<f64>,
+    wx: Vec<f64>,
+    /// The residual before the last correction (`2m`).
+    fprev: Vec<f64>,
+    /// Broyden updates applied and resets to `P0` since the chart was created.
+    broyden_updates: usize,
+    broyden_resets: usize,
+    /// The interpolation parameter of the active iteration matrix (0: the centre's).
+    s: f64,
+    /// `sin`/`cos` of the body angles of the last residual evaluation of a map.
+    angles: AngleCache,
+    /// The starting point of the map in progress (`2n`), for the exact Newton fallback.
+    x0: Vec<f64>,
+    /// `||x_1 - x_0||_inf`: the first correction of the iteration in progress (chord or exact
+    /// Newton), the bound on its travel ([`TRAVEL_FACTOR`]).
+    first_step: f64,
+    /// `Phi_q` and `(Phi_q v)_q` at an iterate of the exact Newton fallback.
+    pq_x: DMatrix<f64>,
+    dphi_x: DMatrix<f64>,
+    /// `Df(x) Q1` (`2m x 2m`, column-major), and the shared dense LU that factors it (pivot
+    /// threshold `2m eps max |J|`: numerically singular only at round-off level).
+    jn: Vec<f64>,
+    jn_lu: DenseLu,
+    /// Maps completed by the exact Newton fallback since the chart was created.
+    exact_maps: usize,
+    /// `min |R_ii| / max |R_ii|` at the last centre.
+    rcond: f64,
+    /// Work space of the rank report: `Phi_q^T` (`n x m`) and its pivoted QR, the column
+    /// permutation, the column norms and a Householder vector.
+    rr: Vec<f64>,
+    perm: Vec<usize>,
+    norms: Vec<f64>,
+    hv: Vec<f64>,
+    /// Relative threshold on the diagonal of `R` below which `Df(x_c)` counts as rank deficient.
+    pub singular_tol: f64,
+    centred: bool,
+}
+
+impl TangentChart {
+    /// A chart workspace for `sys` (allocates once).
+    pub fn new(sys: &System) -> Self {
+        Self::with_dims(sys, sys.n_coords(), sys.n_constraints())
+    }
+
+    /// A chart of no dimension (`n = m = 0`, never centred): what
+    /// [`crate::TangentRk::chart`] returns on the sparse path, which has no dense chart.
+    pub(crate) fn empty(sys: &System) -> Self {
+        Self::with_dims(sys, 0, 0)
+    }
+
+    fn with_dims(sys: &System, n: usize, m: usize) -> Self {
+        let (nn, mm) = (2 * n, 2 * m);
+        let mut q = vec![0.0; nn * nn];
+        for i in 0..nn {
+            q[i * nn + i] = 1.0;
+        }
+        TangentChart {
+            n,
+            m,
+            phi_q: DMatrix::zeros(m, n),
+            dphi: DMatrix::zeros(m, n),
+            a: vec![0.0; nn * mm],
+            tau: vec![0.0; m],
+            aq: vec![0.0; n * m],
+            bq: vec![0.0; n * m],
+            qa: vec![0.0; n * n],
+            qb: vec![0.0; n * n],
+            xt: vec![0.0; n],
+            g: vec![0.0; n],
+            q,
+            xc: vec![0.0; nn],
+            tc: 0.0,
+            f: vec![0.0; mm],
+            pq_e: DMatrix::zeros(m, n),
+            dphi_e: DMatrix::zeros(m, n),
+            e: vec![0.0; mm * mm],
+            has_e: false,
+            angles: AngleCache::new(sys),
+            rinv: vec![0.0; mm * mm],
+            p0: vec![0.0; nn * mm],
+            dx: vec![0.0; nn],
+            k: vec![0.0; mm * mm],
+            u: vec![0.0; mm],
+            w: vec![0.0; mm],
+            broyden: false,
+            pb: vec![0.0; nn * mm],
+            pb_active: false,
+            step: vec![0.0; nn],
+            wx: vec![0.0; nn],
+            fprev: vec![0.0; mm],
+            broyden_updates: 0,
+            broyden_resets: 0,
+            s: 0.0,
+            x0: vec![0.0; nn],
+            first_step: 0.0,
+            pq_x: DMatrix::zeros(m, n),
+            dphi_x: DMatrix::zeros(m, n),
+            jn: vec![0.0; mm * mm],
+            jn_lu: {
+                let mut lu = DenseLu::new(mm);
+                lu.pivot_tol = f64::EPSILON;
+                lu
+            },
+            exact_maps: 0,
+            rcond: 1.0,
+            rr: vec![0.0; n * m],
+            perm: vec![0; m],
+            norms: vec![0.0; m],
+            hv: vec![0.0; n],
+            singular_tol: 1e-8,
+            centred: false,
+        }
+    }
+
+    /// Dimension of the chart, `2 (n - m)`: twice the degrees of freedom.
+    pub fn dim(&self) -> usize {
+        2 * (self.n - self.m)
+    }
+
+    /// Dimension of the ambient space, `2n`.
+    pub fn ambient_dim(&self) -> usize {
+        2 * self.n
+    }
+
+    /// Number of constraint equations of `f`, `2m`.
+    pub fn codim(&self) -> usize {
+        2 * self.m
+    }
+
+    /// The centre `x_c = (q_c, v_c)` (length `2n`).
+    pub fn centre_point(&self) -> &[f64] {
+        &self.xc
+    }
+
+    /// Time at which the chart was centred.
+    pub fn centre_time(&self) -> f64 {
+        self.tc
+    }
+
+    #[inline]
+    fn col(&self, k: usize) -> &[f64] {
+        let nn = 2 * self.n;
+        &self.q[k * nn..(k + 1) * nn]
+    }
+
+    /// Column `k` of the tangent basis `U` (`k < dim()`), a unit vector of length `2n`.
+    pub fn tangent(&self, k: usize) -> &[f64] {
+        self.col(2 * self.m + k)
+    }
+
+    /// Column `k` of the normal basis `Q1` (`k < 2m`): an orthonormal basis of the range of
+    /// `Df(x_c)^T`.
+    pub fn normal(&self, k: usize) -> &[f64] {
+        self.col(k)
+    }
+
+    /// `Phi_q` at the centre (`m x n`), from the last [`TangentChart::centre`].
+    pub fn centre_phi_q(&self) -> &DMatrix<f64> {
+        &self.phi_q
+    }
+
+    /// `(Phi_q v)_q` at the centre (`m x n`), from the last [`TangentChart::centre`].
+    pub fn centre_phi_q_dot_jacobian(&self) -> &DMatrix<f64> {
+        &self.dphi
+    }
+
+    /// Entry `(i, j)` of the triangular factor `R` (`2m x 2m`) of `Df(x_c)^T = Q1 R`.
+    pub fn r(&self, i: usize, j: usize) -> f64 {
+        if i > j {
+            0.0
+        } else {
+            self.a[j * 2 * self.n + i]
+        }
+    }
+
+    /// `Df(x_c) = [[Phi_q, 0], [(Phi_q v)_q, Phi_q]]` as a dense `2m x 2n` matrix (allocates; for
+    /// tests and diagnostics).
+    pub fn jacobian(&self) -> DMatrix<f64> {
+        let (n, m) = (self.n, self.m);
+        let mut d = DMatrix::zeros(2 * m, 2 * n);
+        for r in 0..m {
+            for c in 0..n {
+                d[(r, c)] = self.phi_q[(r, c)];
+                d[(m + r, c)] = self.dphi[(r, c)];
+                d[(m + r, n + c)] = self.phi_q[(r, c)];
+            }
+        }
+        d
+    }
+
+    /// Centres the chart at `(q, v)` at time `t`: evaluates `Df`, factors `Df^T = Q1 R` and forms
+    /// `Q = [Q1 U]` from the QRs of `Phi_q^T` and of the `n x m` block `[Na^T X^T; Ra]` (see the
+    /// type's documentation). A rank-deficient `Df` (redundant constraints or a singular configuration) is
+    /// [`SolveError::Singular`] naming the first dependent equation. Resets the iteration
+    /// matrix to the centre's.
+    pub fn centre(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) -> Result<(), SolveError> {
+        let (n, m) = (self.n, self.m);
+        let (nn, mm) = (2 * n, 2 * m);
+        self.centred = false;
+        self.has_e = false;
+        self.s = 0.0;
+        self.pb_active = false;
+        if q.len() != n || v.len() != n {
+            return Err(SolveError::Dimension {
+                what: "chart centre (q, v)",
+                expected: n,
+                got: if q.len() != n { q.len() } else { v.len() },
+            });
+        }
+        self.xc[..n].copy_from_slice(q);
+        self.xc[n..].copy_from_slice(v);
+        self.tc = t;
+        self.rcond = 1.0;
+        if m == 0 {
+            self.centred = true;
+            return Ok(());
+        }
+        sys.phi_q_dot_jacobian(q, v, &mut self.phi_q, &mut self.dphi);
+        if self
+            .phi_q
+            .as_slice()
+            .iter()
+            .chain(self.dphi.as_slice())
+            .any(|x| !x.is_finite())
+        {
+            return Err(SolveError::NonFinite {
+                t,
+                what: "constraint Jacobian at the chart centre",
+            });
+        }
+        if m > n {
+            // more constraint equations than coordinates: necessarily dependent
+            return Err(SolveError::Singular {
+                t,
+                what: "constraint Jacobian Df of the tangent chart",
+                detail: format!("position constraint {}", sys.equation_name(n)),
+            });
+        }
+        let nm = n - m;
+        // 1. Phi_q^T = Qa [Ra; 0] (n x m), Qa = [Qa1 Na] explicit (n x n)
+        let pq = self.phi_q.as_slice(); // column-major m x n: (r, c) at c m + r
+        for k in 0..m {
+            for c in 0..n {
+                self.aq[k * n + c] = pq[c * m + k];
+            }
+        }
+        householder_qr(&mut self.aq, &mut self.tau, n, m, 0, n);
+        form_q(&self.aq, &self.tau, n, m, 0, n, &mut self.qa);
+        // 2. Qa^T X^T with X = (Phi_q v)_q: its first m rows are the block C of R, the other
+        //    n - m rows (D = Na^T X^T) stacked on Ra form B = [D; Ra] (n x m)
+        let xs = self.dphi.as_slice();
+        for j in 0..m {
+            for c in 0..n {
+                self.xt[c] = xs[c * m + j];
+            }
+            gemv_t_cols(&self.qa, &self.xt, &mut self.g);
+            self.a[(m + j) * nn..(m + j) * nn + m].copy_from_slice(&self.g[..m]);
+            self.bq[j * n..j * n + nm].copy_from_slice(&self.g[m..]);
+            for i in 0..m {
+                self.bq[j * n + nm + i] = if i <= j { self.aq[j * n + i] } else { 0.0 };
+                // R's leading block: Ra
+                self.a[j * nn + i] = if i <= j { self.aq[j * n + i] } else { 0.0 };
+            }
+        }
+        // 3. B = Qb [Rb; 0], Qb explicit (n x n)
+        householder_qr(&mut self.bq, &mut self.tau, n, m, 0, n);
+        for j in 0..m {
+            for i in 0..=j {
+                self.a[(m + j) * nn + m + i] = self.bq[j * n + i];
+            }
+        }
+        let dmax = (0..mm).fold(0.0f64, |d, i| d.max(self.a[i * nn + i].abs()));
+        let dmin = (0..mm).fold(f64::INFINITY, |d, i| d.min(self.a[i * nn + i].abs()));
+        self.rcond = dmin / dmax;
+        for i in 0..mm {
+            let rii = self.a[i * nn + i].abs();
+            if rii.is_nan() || rii <= self.singular_tol * dmax {
+                let tol = self.singular_tol;
+                return Err(self.singular_error(sys, t, tol).unwrap_or_else(|| {
+                    let detail = if i < m {
+                        format!("position constraint {}", sys.equation_name(i))
+                    } else {
+                        format!("velocity constraint {}", sys.equation_name(i - m))
+                    };
+                    SolveError::Singular {
+                        t,
+                        what: "constraint Jacobian Df of the tangent chart",
+                        detail,
+                    }
+                }));
+            }
+        }
+        form_q(&self.bq, &self.tau, n, m, 0, n, &mut self.qb);
+        // 4. Q = [[Qa1, W Qb, 0], [0, ., Na]] with W y = (Na y[..n-m], Qa1 y[n-m..]): columns
+        //    0..m = (Qa1, 0), m..m+n = W Qb (the last n - m of them tangent), m+n..2n = (0, Na)
+        for k in 0..m {
+            let col = &mut self.q[k * nn..(k + 1) * nn];
+            col[..n].copy_from_slice(&self.qa[k * n..(k + 1) * n]);
+            col[n..].fill(0.0);
+        }
+        for j in 0..n {
+            let y = &self.qb[j * n..(j + 1) * n];
+            let col = &mut self.q[(m + j) * nn..(m + j + 1) * nn];
+            let (cq, cv) = col.split_at_mut(n);
+            cq.fill(0.0);
+            cv.fill(0.0);
+            gemv_cols(&self.qa[m * n..], &y[..nm], cq);
+            gemv_cols(&self.qa[..m * n], &y[nm..], cv);
+        }
+        for l in 0..nm {
+            let col = &mut self.q[(m + n + l) * nn..(m + n + l + 1) * nn];
+            col[..n].fill(0.0);
+            col[n..].copy_from_slice(&self.qa[(m + l) * n..(m + l + 1) * n]);
+        }
+        // R^-1 by back substitution, column by column (diagonal first: 1 / R_ii)
+        self.rinv.fill(0.0);
+        for i in 0..mm {
+            self.rinv[i * mm + i] = 1.0 / self.a[i * nn + i];
+        }
+        for j in 0..mm {
+            for i in (0..j).rev() {
+                let mut acc = 0.0;
+                for k in i + 1..=j {
+                    acc -= self.a[k * nn + i] * self.rinv[j * mm + k];
+                }
+                self.rinv[j * mm + i] = acc * self.rinv[i * mm + i];
+            }
+        }
+        // P0 = Q1 R^-T: column k = sum_{j >= k} (R^-1)_{kj} Q1_j
+        self.p0.fill(0.0);
+        for k in 0..mm {
+            for j in k..mm {
+                self.u[j] = self.rinv[j * mm + k];
+            }
+            let col = &mut self.p0[k * nn..(k + 1) * nn];
+            gemv_cols(&self.q[k * nn..mm * nn], &self.u[k..mm], col);
+        }
+        self.centred = true;
+        Ok(())
+    }
+
+    /// `min_i |R_ii| / max_i |R_ii|` of the last [`TangentChart::centre`] (1 without
+    /// constraints): a cheap estimate of the reciprocal condition number of `Df(x_c)`, small near
+    /// a singular configuration (the centre is an error below `singular_tol`).
+    pub fn rcond(&self) -> f64 {
+        self.rcond
+    }
+
+    /// Whether [`TangentChart::centre`] succeeded since the last attempt.
+    pub fn is_centred(&self) -> bool {
+        self.centred
+    }
+
+    /// `f(x, t) = (Phi(q, t), Phi_q v + Phi_t)` into `out` (length `2m`); returns its max-norm
+    /// (NaN if any entry is not finite).
+    pub fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        let (p, pd) = out[..2 * m].split_at_mut(m);
+        sys.phi_and_phi_dot(q, v, t, p, pd);
+        let mut r = 0.0f64;
+        for &e in out[..2 * m].iter() {
+            if !e.is_finite() {
+                return f64::NAN;
+            }
+            r = r.max(e.abs());
+        }
+        r
+    }
+
+    /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous
+    /// evaluation ([`AngleCache`]: a few ulps from the exact values; the chord's iterates move
+    /// by small angles).
+    fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        let (p, pd) = out[..2 * m].split_at_mut(m);
+        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
+        let mut r = 0.0f64;
+        for &e in out[..2 * m].iter() {
+            if !e.is_finite() {
+                return f64::NAN;
+            }
+            r = r.max(e.abs());
+        }
+        r
+    }
+
+    /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
+    pub fn point(&self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
+        let (nn, mm) = (2 * self.n, 2 * self.m);
+        x.copy_from_slice(&self.xc);
+        gemv_cols(&self.q[..mm * nn], &zeta[..mm], x);
+        gemv_cols(&self.q[mm * nn..], xi, x);
+    }
+
+    /// Maps chart coordinates `xi` (length [`TangentChart::dim`]) to the point `x` (length
+    /// `2n`) of the manifold at time `t`: `x = x_c + U xi + Q1 zeta` with `zeta` from chord
+    /// Newton started at the value passed in (the caller's predictor; 0 is valid) and left at
+    /// the converged value. Fails with a [`ChartFailure`] if the iteration diverges, produces
+    /// non-finite values or reaches the iteration limit.
+    pub fn map(
+        &mut self,
+        sys: &System,
+        xi: &[f64],
+        t: f64,
+        zeta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+    ) -> Result<MapStats, ChartFailure> {
+        self.point(xi, zeta, x);
+        self.run_chord(sys, t, zeta, x, newton, false)
+    }
+
+    /// [`TangentChart::map`] for a Runge-Kutta stage point, whose constraint residual only
+    /// needs to be small, not verified: the iteration may also stop on the predicted residual.
+    /// After an iteration `k >= 1` with observed contraction `theta = ||f_k|| / ||f_(k-1)||
+    /// <= 1/2`, the chord correction computed from `f_k` is applied without evaluating `f` again
+    /// when `theta ||f_k||_inf <= tol`: the chord iteration contracts linearly with a rate that
+    /// does not grow from one iteration to the next (the quadratic part of the error only
+    /// shrinks), so the point it returns has a residual of about `theta ||f_k|| <= tol`, and
+    /// [`MapStats::residual`] reports that estimate. This saves the last residual evaluation of
+    /// a map; the step's end point is always mapped with [`TangentChart::map`], which verifies
+    /// the residual.
+    pub fn map_predicted(
+        &mut self,
+        sys: &System,
+        xi: &[f64],
+        t: f64,
+        zeta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+    ) -> Result<MapStats, ChartFailure> {
+        self.point(xi, zeta, x);
+        self.run_chord(sys, t, zeta, x, newton, true)
+    }
+
+    /// Chord Newton along the normal directions from the point `x`: on success `x` is on the
+    /// manifold at time `t` (with the same tangent coordinates `U^T (x - x_c)`) and `zeta` is
+    /// set to its normal coordinates `Q1^T (x - x_c)`.
+    pub fn solve_normal(
+        &mut self,
+        sys: &System,
+        t: f64,
+        zeta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+    ) -> Result<MapStats, ChartFailure> {
+        if self.m == 0 {
+            return Ok(MapStats::default());
+        }
+        self.run_chord(sys, t, zeta, x, newton, false)
+    }
+
+    /// The paper's normal coefficients `eta = R^-1 zeta` of a normal part `Q1 zeta =
+    /// Df(x_c)^T eta` (both of length `2m`). Unlike `zeta`, `eta` does not depend on the
+    /// choice of the orthonormal basis `Q1` (`eta = (Df Df^T)^-1 Df (x - x_c)`), so it varies
+    /// smoothly from one chart to the next along a trajectory.
+    pub fn eta_from_zeta(&self, zeta: &[f64], eta: &mut [f64]) {
+        let mm = 2 * self.m;
+        let eta = &mut eta[..mm];
+        eta.fill(0.0);
+        for (j, &zj) in zeta.iter().enumerate().take(mm) {
+            axpy(zj, &self.rinv[j * mm..j * mm + j + 1], &mut eta[..j + 1]);
+        }
+    }
+
+    /// `zeta = R eta`: the normal coordinates in the basis `Q1` of the paper's `Df(x_c)^T eta`
+    /// (the inverse of [`TangentChart::eta_from_zeta`]).
+    pub fn zeta_from_eta(&self, eta: &[f64], zeta: &mut [f64]) {
+        let (nn, mm) = (2 * self.n, 2 * self.m);
+        let zeta = &mut zeta[..mm];
+        zeta.fill(0.0);
+        for (j, &ej) in eta.iter().enumerate().take(mm) {
+            axpy(ej, &self.a[j * nn..j * nn + j + 1], &mut zeta[..j + 1]);
+        }
+    }
+
+    /// `out = [Q1 U]^T y`: the normal components (first `2m`) and the tangent components (last
+    /// `2(n - m)`) of a vector `y` of length `2n`.
+    pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
+        gemv_t_cols(&self.q, y, out);
+    }
+}

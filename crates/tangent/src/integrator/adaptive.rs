@@ -1,0 +1,462 @@
+//! Adaptive steps: [`AdaptiveSettings`], [`AdaptiveStats`] and
+//! [`TangentRk::integrate_adaptive`] (PI control of the embedded error estimate).
+
+use super::*;
+
+/// Settings of [`TangentRk::integrate_adaptive`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveSettings {
+    /// Tolerances, safety factor, shrink/growth limits and the smallest step. The scaled error
+    /// is `sqrt(sum_i (e_i / (atol + rtol max(|x_c,i|, |x_new,i|)))^2 / d)` with `e = U err_xi`
+    /// the embedded estimate mapped to `x = (q, v)` and `d = 2 (n - m)` the dimension of the
+    /// state equation.
+    pub controller: StepController,
+    /// First step size; `None` picks Hairer, Norsett and Wanner's estimate from `F(x0)` and
+    /// one explicit Euler trial step (two acceleration solves).
+    pub h0: Option<f64>,
+    /// Largest step size.
+    pub h_max: f64,
+    /// Limit on accepted plus rejected steps.
+    pub max_steps: usize,
+    /// `beta` of the PI step-size controller (Hairer-Wanner form, `q` the embedded order):
+    /// after an accepted step with error norm `err` (previous accepted step: `err_prev`),
+    /// `h <- h safety err^-(1/(q+1) - 0.75 beta) err_prev^beta`. `None` (default) is
+    /// Gustafsson's PI.3.4, `beta = 0.4 / (q+1)` (0.08 for DOPRI5: exponents 0.14 and 0.08);
+    /// `Some(0.0)` the classical I controller; Hairer and Wanner's DOPRI5 code uses 0.04. Must
+    /// lie in `[0, 1 / (1.75 (q+1)))`: at larger values a steady error never lets the step grow.
+    pub pi_beta: Option<f64>,
+    /// Factor applied to the step after a chart failure (the chart map did not converge) or a
+    /// singular index-1 solve at a stage point; the error controller's memory is left alone.
+    /// Default 0.25; must lie in (0, 1).
+    pub chart_shrink: f64,
+    /// Most chart failures in a row at one point before [`TangentError::Chart`]. Default 8
+    /// (the step shrinks by `chart_shrink^8`, 1.5e-5 by default).
+    pub max_chart_failures: usize,
+}
+
+impl Default for AdaptiveSettings {
+    fn default() -> Self {
+        AdaptiveSettings {
+            controller: StepController::default(),
+            h0: None,
+            h_max: f64::INFINITY,
+            max_steps: 10_000_000,
+            pi_beta: None,
+            chart_shrink: 0.25,
+            max_chart_failures: 8,
+        }
+    }
+}
+
+impl AdaptiveSettings {
+    /// Default settings with `atol = rtol = tol`.
+    pub fn with_tolerance(tol: f64) -> Self {
+        let mut s = Self::default();
+        s.controller.atol = tol;
+        s.controller.rtol = tol;
+        s
+    }
+
+    /// Checks every setting.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        let c = &self.controller;
+        let bad = |parameter, value, reason| {
+            Err(SolveError::InvalidParameter {
+                parameter,
+                value,
+                reason,
+            })
+        };
+        if !(c.atol.is_finite() && c.atol >= 0.0) {
+            return bad("controller.atol", c.atol, "must be non-negative and finite");
+        }
+        if !(c.rtol.is_finite() && c.rtol >= 0.0) {
+            return bad("controller.rtol", c.rtol, "must be non-negative and finite");
+        }
+        if !(c.atol > 0.0 || c.rtol > 0.0) {
+            return bad(
+                "controller.atol",
+                c.atol,
+                "atol and rtol cannot both be zero",
+            );
+        }
+        if !(c.safety > 0.0 && c.safety <= 1.0) {
+            return bad("controller.safety", c.safety, "must lie in (0, 1]");
+        }
+        if !(c.fac_min > 0.0 && c.fac_min < 1.0) {
+            return bad("controller.fac_min", c.fac_min, "must lie in (0, 1)");
+        }
+        if !(c.fac_max > 1.0 && c.fac_max.is_finite()) {
+            return bad(
+                "controller.fac_max",
+                c.fac_max,
+                "must be finite and above 1",
+            );
+        }
+        if !(c.h_min.is_finite() && c.h_min > 0.0) {
+            return bad("controller.h_min", c.h_min, "must be positive and finite");
+        }
+        if let Some(h0) = self.h0 {
+            if !(h0.is_finite() && h0 > 0.0) {
+                return bad("h0", h0, "must be positive and finite");
+            }
+        }
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return bad("h_max", self.h_max, "must be positive");
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", 0.0, "must be at least 1");
+        }
+        if let Some(b) = self.pi_beta {
+            // the bound for the tableau's embedded order is checked when it is known
+            if !(0.0..0.5).contains(&b) {
+                return bad("pi_beta", b, "must lie in [0, 1 / (1.75 (q+1)))");
+            }
+        }
+        if !(self.chart_shrink > 0.0 && self.chart_shrink < 1.0) {
+            return bad("chart_shrink", self.chart_shrink, "must lie in (0, 1)");
+        }
+        if self.max_chart_failures == 0 {
+            return bad("max_chart_failures", 0.0, "must be at least 1");
+        }
+        Ok(())
+    }
+}
+
+/// Summary of [`TangentRk::integrate_adaptive`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AdaptiveStats {
+    /// Accepted steps.
+    pub accepted: usize,
+    /// Steps rejected by the error test.
+    pub rejected: usize,
+    /// Steps rejected because the chart map failed, or the index-1 solve at a stage point was
+    /// singular (retried with [`AdaptiveSettings::chart_shrink`] times the step).
+    pub chart_rejections: usize,
+    /// Chart maps completed by the exact Newton fallback ([`NewtonSettings::fallback_change`]).
+    pub exact_maps: usize,
+    /// The first step chosen by the initial-step estimate (0 if [`AdaptiveSettings::h0`] was
+    /// given).
+    pub h_initial_estimate: f64,
+    /// Acceleration solves.
+    pub rhs_evals: usize,
+    /// Chord Newton iterations.
+    pub newton_iterations: usize,
+    /// Smallest accepted step.
+    pub h_min: f64,
+    /// Largest accepted step.
+    pub h_max: f64,
+    /// Largest `||(Phi, Phidot)||_inf` at an accepted point.
+    pub max_residual: f64,
+    /// Whether the observer stopped the run early.
+    pub stopped_early: bool,
+}
+
+impl TangentRk {
+    /// Integrates from `state.t` to `t_end` with adaptive steps controlled by the tableau's
+    /// embedded error estimate (e.g. DOPRI5 5(4), Bogacki-Shampine 3(2)), calling `observer`
+    /// with the initial state (step 0) and after every accepted step.
+    ///
+    /// Step control (`docs/tangent.md` section 6): the first step from Hairer, Norsett and
+    /// Wanner's estimate (`f(x0)` and one explicit Euler trial step) unless
+    /// [`AdaptiveSettings::h0`] is given; after an accepted step a PI controller
+    /// (`h <- h safety err^-(1/(q+1) - 0.75 beta) err_prev^beta`, clamped to
+    /// `[fac_min, fac_max]`, no growth right after a rejection), after a rejected one
+    /// `h <- h max(fac_min, safety err^-(1/(q+1) - 0.75 beta))`. A chart failure (the chart map
+    /// did not converge) or a singular index-1 solve at a stage point multiplies the step by
+    /// [`AdaptiveSettings::chart_shrink`] without touching the controller's memory; more than
+    /// [`AdaptiveSettings::max_chart_failures`] of them in a row, or a step below
+    /// `controller.h_min`, is an error ([`TangentError::Chart`],
+    /// [`TangentError::StepSizeTooSmall`]). A singular configuration at an accepted point is
+    /// [`SolveError::Singular`] at once (no retry with smaller steps).
+    pub fn integrate_adaptive<O: Observer + ?Sized>(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        t_end: f64,
+        settings: &AdaptiveSettings,
+        observer: &mut O,
+    ) -> Result<AdaptiveStats, TangentError> {
+        settings.validate()?;
+        self.check_sizes(sys, state)?;
+        let t0 = state.t;
+        if !(t_end.is_finite() && t_end > t0) {
+            return Err(SolveError::InvalidInterval {
+                t0,
+                t_end,
+                reason: "end time must be finite and after the start time",
+            }
+            .into());
+        }
+        let q_order = match (&self.rk.tableau.b_hat, self.rk.tableau.embedded_order) {
+            (Some(_), q) if q > 0 => q,
+            _ => {
+                return Err(SolveError::Unsupported(format!(
+                "adaptive stepping needs a tableau with an embedded error estimate; '{}' has none \
+                     (use DOPRI5 or Bogacki-Shampine)",
+                self.rk.tableau.name
+            ))
+                .into())
+            }
+        };
+        self.load(sys, state)?;
+        self.adaptive_loop(sys, state, t_end, settings, observer, q_order)
+    }
+
+    /// The step loop of [`TangentRk::integrate_adaptive`] (`state` loaded, settings checked).
+    pub(super) fn adaptive_loop<O: Observer + ?Sized>(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        t_end: f64,
+        settings: &AdaptiveSettings,
+        observer: &mut O,
+        q_order: u32,
+    ) -> Result<AdaptiveStats, TangentError> {
+        let t0 = state.t;
+        let ctrl = settings.controller;
+        let mut st = AdaptiveStats {
+            h_min: f64::INFINITY,
+            ..Default::default()
+        };
+        if observer.observe(sys, state, 0)? == Flow::Stop {
+            st.stopped_early = true;
+            st.h_min = 0.0;
+            return Ok(st);
+        }
+        let mut h = match settings.h0 {
+            Some(h0) => h0,
+            None => {
+                let h0 = self.initial_step(sys, t0, t_end - t0, settings)?;
+                st.h_initial_estimate = h0;
+                st.rhs_evals += 2;
+                h0
+            }
+        };
+        h = h.min(settings.h_max);
+        // the PI controller: exponents and memory (the error norm of the last accepted step)
+        let k = q_order as f64 + 1.0;
+        let beta = settings.pi_beta.unwrap_or(0.4 / k);
+        if beta >= 1.0 / (1.75 * k) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "pi_beta",
+                value: beta,
+                reason: "must lie in [0, 1 / (1.75 (q+1))) for the tableau's embedded order q",
+            }
+            .into());
+        }
+        let expo = 1.0 / k - 0.75 * beta;
+        let mut err_prev = 1e-4f64;
+        let mut t = t0;
+        let mut last_rejected = false;
+        let mut chart_failures_here = 0usize;
+        let mut centred_at = f64::NAN;
+        let mut attempts = 0usize;
+        while t < t_end {
+            attempts += 1;
+            if attempts > settings.max_steps {
+                return Err(TangentError::TooManySteps {
+                    t,
+                    max_steps: settings.max_steps,
+                });
+            }
+            let remaining = t_end - t;
+            let last = h >= remaining * (1.0 - 1e-12);
+            let hs = if last { remaining } else { h };
+            if hs < ctrl.h_min && !last {
+                return Err(TangentError::StepSizeTooSmall {
+                    t,
+                    h: hs,
+                    h_min: ctrl.h_min,
+                });
+            }
+            if centred_at != t {
+                self.centre(sys, t)?;
+                centred_at = t;
+            }
+            match self.attempt(sys, t, hs) {
+                Ok(w) => {
+                    self.account(&w);
+                    st.rhs_evals += w.rhs_evals;
+                    st.newton_iterations += w.iterations;
+                    st.exact_maps += w.exact_maps;
+                    // error estimate mapped to x: e = U err_xi
+                    self.path.to_ambient(&self.rk.err, &mut self.ex);
+                    for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
+                        *s = a.abs().max(b.abs());
+                    }
+                    let en = self.error_norm(&ctrl);
+                    if !en.is_finite() {
+                        return Err(SolveError::NonFinite {
+                            t,
+                            what: "embedded error estimate",
+                        }
+                        .into());
+                    }
+                    chart_failures_here = 0;
+                    let grow = ctrl.safety * en.powf(-expo);
+                    if en <= 1.0 {
+                        std::mem::swap(&mut self.cur, &mut self.xnew);
+                        t = if last { t_end } else { t + hs };
+                        self.commit_history(hs, t, w.end_initial_residual);
+                        self.cur_t = t;
+                        self.cur_ok = true;
+                        st.accepted += 1;
+                        st.h_min = st.h_min.min(hs);
+                        st.h_max = st.h_max.max(hs);
+                        st.max_residual = st.max_residual.max(w.residual);
+                        self.stats.steps += 1;
+                        self.stats.max_residual = self.stats.max_residual.max(w.residual);
+                        state.t = t;
+                        self.store(state);
+                        // PI control (Gustafsson; Hairer-Wanner's DOPRI5 form)
+                        let mut fac = if en == 0.0 {
+                            ctrl.fac_max
+                        } else {
+                            (grow * err_prev.powf(beta)).clamp(ctrl.fac_min, ctrl.fac_max)
+                        };
+                        err_prev = en.max(1e-4);
+                        if last_rejected {
+                            fac = fac.min(1.0);
+                        }
+                        last_rejected = false;
+                        h = (hs * fac).min(settings.h_max);
+                        if observer.observe(sys, state, st.accepted)? == Flow::Stop {
+                            st.stopped_early = true;
+                            break;
+                        }
+                    } else {
+                        st.rejected += 1;
+                        last_rejected = true;
+                        h = hs * grow.clamp(ctrl.fac_min, 1.0);
+                    }
+                }
+                Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_))) => {
+                    self.stats.chart_failures += 1;
+                    st.chart_rejections += 1;
+                    chart_failures_here += 1;
+                    last_rejected = true;
+                    h = settings.chart_shrink * hs;
+                    if h < ctrl.h_min || chart_failures_here > settings.max_chart_failures {
+                        return Err(TangentError::Chart {
+                            source: match fail {
+                                Attempt::Chart(f) => f.into_error(),
+                                Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
+                            },
+                            h: hs,
+                            failures: chart_failures_here,
+                        });
+                    }
+                }
+                Err(Attempt::Hard(e)) => return Err(e.into()),
+            }
+        }
+        if st.accepted == 0 {
+            st.h_min = 0.0;
+        }
+        Ok(st)
+    }
+
+    /// The scaled error norm of the estimate `ex` (mapped to `x`) with the scale in `scale`
+    /// (`max(|x_c,i|, |x_1,i|)`): `sqrt(sum_i (e_i / (atol + rtol scale_i))^2 / d)` with
+    /// `d = 2 (n - m)` the dimension of the state equation. `e = U err_xi` has the Euclidean
+    /// length of the estimate in chart coordinates, spread over the `2n` ambient components;
+    /// dividing by `2n` instead of `d` would shrink the RMS of a `d`-dimensional error by
+    /// `sqrt(d / 2n)` (1/sqrt(3) on the manipulator) and loosen every tolerance by that much.
+    pub(super) fn error_norm(&self, ctrl: &StepController) -> f64 {
+        let d = self.path.dim().max(1) as f64;
+        let sum: f64 = self
+            .ex
+            .iter()
+            .zip(&self.scale)
+            .map(|(e, y)| (e / (ctrl.atol + ctrl.rtol * y.abs())).powi(2))
+            .sum();
+        (sum / d).sqrt()
+    }
+
+    /// Hairer, Norsett and Wanner's initial step (`HINIT` of DOPRI5, "Solving ODEs I",
+    /// section II.4) in the controller's scaled RMS norm (`sk = atol + rtol |x0|`, normalised
+    /// like [`TangentRk::error_norm`]): `d0 = ||x0||`, `d1 = ||F(x0)||`,
+    /// `h_a = 0.01 d0 / d1` (1e-6 if either is below 1e-5), one explicit Euler trial step
+    /// `x1 = x0 + h_a F(x0)` (off the manifold by `O(h_a^2)`; the index-1 solve does not need
+    /// it on), `d2 = ||F(x1) - F(x0)|| / h_a`, `h_b = (0.01 / max(d1, d2))^(1/p)` with `p` the
+    /// method's order (`max(1e-6, 1e-3 h_a)` if `max(d1, d2) <= 1e-15`), and
+    /// `h0 = min(100 h_a, h_b, h_max, span)`, at least `h_min`. Two acceleration solves.
+    pub(super) fn initial_step(
+        &mut self,
+        sys: &System,
+        t: f64,
+        span: f64,
+        settings: &AdaptiveSettings,
+    ) -> Result<f64, SolveError> {
+        let ctrl = &settings.controller;
+        let n = self.n;
+        let d = self.path.dim().max(1) as f64;
+        let norm = |x: &[f64], y: &[f64]| -> f64 {
+            let sum: f64 = x
+                .iter()
+                .zip(y)
+                .map(|(e, y)| (e / (ctrl.atol + ctrl.rtol * y.abs())).powi(2))
+                .sum();
+            (sum / d).sqrt()
+        };
+        {
+            let (q, v) = self.cur.split_at(n);
+            if let Err(e) = self
+                .path
+                .accel(sys, q, v, t, false, &mut self.acc_a, &mut self.lambda)
+            {
+                return Err(match e {
+                    SolveError::Singular { .. } => self
+                        .path
+                        .singular_error_at(sys, q, t, SINGULAR_REPORT_TOL)
+                        .unwrap_or(e),
+                    e => e,
+                });
+            }
+        }
+        self.stats.rhs_evals += 1;
+        self.fx[..n].copy_from_slice(&self.cur[n..]);
+        self.fx[n..].copy_from_slice(&self.acc_a);
+        let d0 = norm(&self.cur, &self.cur);
+        let d1 = norm(&self.fx, &self.cur);
+        let ha = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        }
+        .min(settings.h_max)
+        .min(span);
+        // explicit Euler trial step x1 = x0 + ha F(x0), F(x1) into proj
+        for ((x1, x0), f) in self.x.iter_mut().zip(&self.cur).zip(&self.fx) {
+            *x1 = x0 + ha * f;
+        }
+        {
+            let (q, v) = self.x.split_at(n);
+            self.path
+                .accel(sys, q, v, t + ha, false, &mut self.acc_a, &mut self.lambda)?;
+        }
+        self.stats.rhs_evals += 1;
+        self.proj[..n].copy_from_slice(&self.x[n..]);
+        self.proj[n..].copy_from_slice(&self.acc_a);
+        for (df, f0) in self.ex.iter_mut().zip(self.proj.iter().zip(&self.fx)) {
+            *df = (f0.0 - f0.1) / ha;
+        }
+        let d2 = norm(&self.ex, &self.cur);
+        let d12 = d1.max(d2);
+        let p = self.rk.tableau.order.max(1) as f64;
+        let hb = if d12 <= 1e-15 {
+            (1e-3 * ha).max(1e-6)
+        } else {
+            (0.01 / d12).powf(1.0 / p)
+        };
+        let h0 = (100.0 * ha).min(hb).min(settings.h_max).min(span);
+        if !h0.is_finite() {
+            return Err(SolveError::NonFinite {
+                t,
+                what: "initial step estimate",
+            });
+        }
+        Ok(h0.max(ctrl.h_min))
+    }
+}

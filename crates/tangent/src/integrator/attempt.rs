@@ -1,0 +1,303 @@
+//! One attempted step of [`TangentRk`]: the stage maps with their Newton starting points and
+//! the end-point map, and the `eta` history the starting points are extrapolated from.
+
+use super::*;
+
+impl TangentRk {
+    /// One attempted step of size `h` from the chart centre (at time `t`) into `xnew`; the
+    /// embedded error estimate in chart coordinates (if the tableau has one) is left in
+    /// `rk.err`.
+    ///
+    /// Newton starting points (they change only where the chord iteration starts, never its
+    /// limit). After accepted fixed steps of the same size, each stage map starts from the
+    /// paper's normal coefficients `eta` (`Df(x_c)^T eta`, independent of the basis `Q1`) of
+    /// the same stage in the last up to three steps, extrapolated by a polynomial in the step
+    /// index (`eta` is a smooth function of the step's start point along the trajectory), and
+    /// corrected by the extrapolation error the latest earlier stage `j` of this step showed,
+    /// scaled by `|Y_i|^2 / |Y_j|^2`. Without such history: for scleronomic constraints,
+    /// stage `i` starts from the normal coordinates the latest earlier stage `j` with
+    /// `Y_j != 0` converged to, scaled by `|Y_i|^2 / |Y_j|^2` (the manifold's normal offset
+    /// above the tangent plane grows quadratically); otherwise (first such stage, rheonomic
+    /// constraints) from the plain RK stage value `x_c + h sum_j a_ij F_j` (tangent part
+    /// exactly `U Y_i`). Stage maps may stop on the predicted residual
+    /// ([`TangentChart::map_predicted`]); the end point's residual is verified. The end point starts from the
+    /// plain RK result `x_c + h sum_j b_j F_j`, whose normal part is the RK quadrature of
+    /// `zeta' = Q1^T F` and so accurate to the method's order. For a FSAL tableau (last stage
+    /// at `c = 1` with `a_sj = b_j`, as DOPRI5) the last stage point is the end point. With
+    /// [`IterationMatrix::Interpolated`] stage `i` iterates with `Df Q1` interpolated to `c_i`.
+    pub(super) fn attempt(&mut self, sys: &System, t: f64, h: f64) -> Result<AttemptWork, Attempt> {
+        let n = self.n;
+        let mm = 2 * self.m;
+        let s = self.stages;
+        let newton = self.options.newton;
+        // interior stage maps: inexact after an accepted step of the same size (to rounding:
+        // `mbd_solve::run` passes `t_next - t`, which differs from the nominal step in the
+        // last bits)
+        let rcond = self.path.rcond();
+        let follows = same_step(self.hist_h, h)
+            && same_time(self.hist_t, t)
+            && self.hist_rcond[..self.hist_len]
+                .iter()
+                .all(|&r| r <= RCOND_DRIFT * rcond && rcond <= RCOND_DRIFT * r);
+        let stage_newton = if follows {
+            NewtonSettings {
+                tol: self.stage_tol.max(newton.tol),
+                ..newton
+            }
+        } else {
+            newton
+        };
+        let interpolate = self.options.iteration_matrix == IterationMatrix::Interpolated;
+        // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
+        let centre_ok = self.cur_ok && same_time(self.cur_t, t);
+        let quadratic = !sys.is_rheonomic();
+        let scleronomic = quadratic && self.m > 0;
+        if !follows {
+            self.hist_len = 0;
+        }
+        let npts = self.hist_len;
+        let mut ylast_sq = 0.0f64;
+        let mut jlast = 0usize;
+        let mut work = AttemptWork {
+            end_initial_residual: f64::NAN,
+            ..AttemptWork::default()
+        };
+        let mut failure: Option<(ChartFailure, usize)> = None;
+        let mut singular_stage: Option<usize> = None;
+        let mut stage = 0usize;
+        self.xi.fill(0.0);
+        {
+            let chart = &mut self.path;
+            let zlast = &mut self.zeta;
+            let (zplain, x, g, fx, proj) = (
+                &mut self.zplain,
+                &mut self.x,
+                &mut self.g,
+                &mut self.fx,
+                &mut self.proj,
+            );
+            let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
+            let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
+            let fsal = self.fsal;
+            let (eta_now, eta_hist, eta_pred, eta_tmp) = (
+                &mut self.eta_now,
+                &self.eta_hist,
+                &mut self.eta_pred,
+                &mut self.eta_tmp,
+            );
+            let work = &mut work;
+            let failure = &mut failure;
+            let singular_stage = &mut singular_stage;
+            let mut rhs = |ti: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
+                let i = stage;
+                // plain RK stage value's normal part
+                zplain.fill(0.0);
+                for j in 0..i {
+                    let a = a_coef[i * s + j];
+                    if a != 0.0 {
+                        axpy(h * a, &g[j * mm..(j + 1) * mm], zplain);
+                    }
+                }
+                if i == 1 && interpolate {
+                    // Euler prediction of the end point, x_c + h F(x_c): where the iteration
+                    // matrix is interpolated to
+                    x.copy_from_slice(chart.centre_point());
+                    axpy(h, fx, x);
+                    chart.set_secondary_point(sys, x);
+                }
+                chart.select_iteration_matrix(c_coef[i]);
+                let ysq: f64 = y.iter().map(|v| v * v).sum();
+                if npts > 0 {
+                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, eta_pred);
+                    if jlast > 0 {
+                        // correct by the extrapolation error of the latest mapped stage j,
+                        // scaled like the normal offset (|Y_i|^2 / |Y_j|^2)
+                        let r = ysq / ylast_sq;
+                        extrapolate(eta_hist, npts, (s + 1) * mm, jlast * mm, eta_tmp);
+                        let now = &eta_now[jlast * mm..(jlast + 1) * mm];
+                        for ((p, e), x) in eta_pred.iter_mut().zip(now).zip(eta_tmp.iter()) {
+                            *p += r * (e - x);
+                        }
+                    }
+                    chart.zeta_from_eta(eta_pred, zplain);
+                } else if quadratic && ylast_sq > 0.0 {
+                    // scleronomic: the normal offset of the manifold above Y grows like |Y|^2
+                    let r = ysq / ylast_sq;
+                    for (z, zl) in zplain.iter_mut().zip(zlast.iter()) {
+                        *z = r * zl;
+                    }
+                }
+                let mapped = if i == 0 && centre_ok && ti == t {
+                    x.copy_from_slice(chart.centre_point());
+                    Ok(MapStats::default())
+                } else if fsal && i + 1 == s {
+                    // FSAL: this stage point is the step's end point, whose residual is verified
+                    chart.map(sys, y, ti, zplain, x, &newton, false)
+                } else {
+                    chart.map(sys, y, ti, zplain, x, &stage_newton, true)
+                };
+                if ysq > 0.0 && mapped.is_ok() {
+                    zlast.copy_from_slice(zplain);
+                    ylast_sq = ysq;
+                    jlast = i;
+                }
+                if mapped.is_ok() {
+                    chart.eta_from_zeta(zplain, &mut eta_now[i * mm..(i + 1) * mm]);
+                }
+                match mapped {
+                    Ok(ms) => {
+                        work.exact_maps += usize::from(ms.exact);
+                        work.iterations += ms.iterations;
+                        work.max_map_iterations = work.max_map_iterations.max(ms.iterations);
+                        work.residual = ms.residual;
+                    }
+                    Err(e) => {
+                        *failure = Some((e, i));
+                        // a cheap sentinel (no allocation); the caller reads `failure`
+                        return Err(SolveError::NonFinite {
+                            t: ti,
+                            what: "tangent chart",
+                        });
+                    }
+                }
+                let (q, v) = x.split_at(n);
+                // at the centre: Phi_q and (Phi_q v)_q are the chart's, so (dense path)
+                // gamma = -(Phi_q v)_q v needs no model evaluation
+                let at_centre = i == 0 && centre_ok && ti == t && scleronomic;
+                let solved = chart.accel(sys, q, v, ti, at_centre, acc_a, lambda);
+                if solved.is_ok() {
+                    work.condition = work.condition.max(chart.condition_estimate());
+                }
+                if let Err(e) = solved {
+                    if matches!(e, SolveError::Singular { .. }) {
+                        *singular_stage = Some(i);
+                    }
+                    return Err(e);
+                }
+                work.rhs_evals += 1;
+                fx[..n].copy_from_slice(v);
+                fx[n..].copy_from_slice(acc_a);
+                chart.split(fx, proj, &mut g[i * mm..(i + 1) * mm], dy);
+                stage += 1;
+                Ok(())
+            };
+            if let Err(e) = self.rk.step(&mut rhs, t, &mut self.xi, h) {
+                return Err(match (failure.take(), *singular_stage) {
+                    // a map at the step's end time that failed at a singular configuration
+                    (Some((f, i)), _) if self.c_coef[i] == 1.0 => {
+                        match self.path.singular_error_at(
+                            sys,
+                            &self.x[..n],
+                            t + h,
+                            SINGULAR_REPORT_TOL,
+                        ) {
+                            Some(e) => Attempt::SingularEnd(e),
+                            None => Attempt::Chart(f),
+                        }
+                    }
+                    (Some((f, _)), _) => Attempt::Chart(f),
+                    // the step's start point itself: a singular configuration, reported with
+                    // the numerical rank and the joints of the dependency
+                    (None, Some(0)) => Attempt::Hard(
+                        self.path
+                            .singular_error(sys, t, SINGULAR_REPORT_TOL)
+                            .unwrap_or(e),
+                    ),
+                    // a stage at the step's end time
+                    (None, Some(i)) if self.c_coef[i] == 1.0 => Attempt::SingularEnd(
+                        self.path
+                            .singular_error_at(sys, &self.x[..n], t + h, SINGULAR_REPORT_TOL)
+                            .unwrap_or(e),
+                    ),
+                    (None, Some(_)) => Attempt::Stage(e),
+                    (None, None) => Attempt::Hard(e),
+                });
+            }
+        }
+        let t1 = t + h;
+        if self.fsal {
+            // the last stage was evaluated at xi = h sum b_j k_j, t + h: it is the end point
+            self.xnew.copy_from_slice(&self.x);
+        } else {
+            self.path.select_iteration_matrix(1.0);
+            self.zeta.fill(0.0);
+            for j in 0..s {
+                let b = self.b_coef[j];
+                if b != 0.0 {
+                    axpy(h * b, &self.g[j * mm..(j + 1) * mm], &mut self.zeta);
+                }
+            }
+            match self.path.map(
+                sys,
+                &self.xi,
+                t1,
+                &mut self.zeta,
+                &mut self.xnew,
+                &newton,
+                false,
+            ) {
+                Ok(ms) => {
+                    work.exact_maps += usize::from(ms.exact);
+                    work.iterations += ms.iterations;
+                    work.max_map_iterations = work.max_map_iterations.max(ms.iterations);
+                    work.residual = ms.residual;
+                    work.end_initial_residual = ms.initial_residual;
+                }
+                Err(f) => {
+                    return Err(
+                        match self.path.singular_error_at(
+                            sys,
+                            &self.xnew[..n],
+                            t1,
+                            SINGULAR_REPORT_TOL,
+                        ) {
+                            Some(e) => Attempt::SingularEnd(e),
+                            None => Attempt::Chart(f),
+                        },
+                    )
+                }
+            }
+            self.path
+                .eta_from_zeta(&self.zeta, &mut self.eta_now[s * mm..(s + 1) * mm]);
+        }
+        if self.xnew.iter().any(|x| !x.is_finite()) {
+            return Err(Attempt::Hard(SolveError::NonFinite {
+                t: t1,
+                what: "state after tangent-space step",
+            }));
+        }
+        Ok(work)
+    }
+
+    /// Records the accepted attempt's `eta` (a step of size `h` ending at `t_end`).
+    pub(super) fn commit_history(&mut self, h: f64, t_end: f64, end_initial_residual: f64) {
+        let (ratio, tol) = (self.options.stage_tol_ratio, self.options.newton.tol);
+        self.stage_tol = if ratio > 0.0 && end_initial_residual.is_finite() {
+            (ratio * end_initial_residual).max(tol)
+        } else {
+            tol
+        };
+        let len = self.eta_now.len();
+        self.eta_hist.copy_within(0..(HISTORY - 1) * len, len);
+        self.eta_hist[..len].copy_from_slice(&self.eta_now);
+        self.hist_rcond.copy_within(0..HISTORY - 1, 1);
+        self.hist_rcond[0] = self.path.rcond();
+        self.hist_len = (self.hist_len + 1).min(HISTORY);
+        self.hist_h = h;
+        self.hist_t = t_end;
+    }
+}
+
+/// Polynomial extrapolation to the next step of the `eta` of one map (offset `off` within a
+/// step's record of length `len`) from the last `npts` (1 to 3) steps, most recent first.
+pub(super) fn extrapolate(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64]) {
+    let w: &[f64] = match npts {
+        1 => &[1.0],
+        2 => &[2.0, -1.0],
+        _ => &[3.0, -3.0, 1.0],
+    };
+    out.fill(0.0);
+    for (k, &wk) in w.iter().enumerate() {
+        axpy(wk, &hist[k * len + off..k * len + off + out.len()], out);
+    }
+}

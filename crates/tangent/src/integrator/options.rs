@@ -1,0 +1,144 @@
+//! Options and work counters of [`TangentRk`](super::TangentRk).
+
+use crate::chart::NewtonSettings;
+use mbd_solve::{LinearSolver, SolveError};
+
+/// The matrix of the chord Newton iteration of the chart maps (the limit, the point of the
+/// chart, is the same for both; only the speed differs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IterationMatrix {
+    /// `Df(x_c) Q1 = R^T`, factored once per chart: the paper's chord iteration (the
+    /// default). Contraction factor `O(h)` per iteration; each iteration costs one residual
+    /// evaluation and one `2n x 2m` product.
+    #[default]
+    Centre,
+    /// `Df Q1` interpolated linearly between the centre and the Euler prediction of the end
+    /// point, `x_c + h F(x_c)`: one more evaluation of `Df` per step, and each iteration applies
+    /// a `2m x 2m` correction on top. Contraction factor `O(h^2)`: about half the iterations of
+    /// [`IterationMatrix::Centre`], and a larger domain of convergence for large steps; per
+    /// step it is slower on the small mechanisms of the papers (see `docs/tangent.md`).
+    Interpolated,
+    /// Starts each chart from the centre's `R^-T` and improves the iteration's inverse matrix
+    /// by good Broyden rank-one updates after every correction, carried from one map of the
+    /// step to the next ([`TangentChart::set_broyden`]): superlinear convergence for `O(n m)`
+    /// more work per iteration, no extra `Df`. On the manipulator it saves a third of the
+    /// iterations at `h = 0.01` but costs more per step than the centre chord (the residual is
+    /// cheap there; `docs/tangent.md`), so it is not the default.
+    Broyden,
+}
+
+/// Settings of [`TangentRk`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TangentOptions {
+    /// The chord Newton iteration of the chart map (tolerance 1e-13 on `||(Phi, Phidot)||_inf`
+    /// by default).
+    pub newton: NewtonSettings,
+    /// The chord iteration's matrix (default [`IterationMatrix::Centre`]).
+    pub iteration_matrix: IterationMatrix,
+    /// Automatic step halving on chart failure in fixed-step mode: a step whose chart map fails
+    /// is redone as two half steps (each re-centring the chart), recursively up to this depth
+    /// (so at most `2^max_halvings` sub-steps). Every halving is counted in
+    /// [`TangentStats::halvings`]. 0 turns it off: a chart failure is then an error at once.
+    /// Default 4. At most 30.
+    pub max_halvings: u32,
+    /// Relative threshold on the diagonal of `R` (QR of `Df^T`) below which the configuration
+    /// counts as singular (an error). Default 1e-8.
+    pub singular_tol: f64,
+    /// Largest `||(Phi, Phidot)||_inf` accepted for the state handed to a step (it is projected
+    /// onto the manifold by the first chart map). Larger is an error: project the state first
+    /// (`System::project`). Default 1e-8.
+    pub consistency_tol: f64,
+    /// Inexact stage maps: after an accepted step of the same size, the chart maps of the
+    /// interior Runge-Kutta stages stop at `max(newton.tol, stage_tol_ratio * E)`, where `E` is
+    /// the constraint residual `||f||_inf` of the previous step's plain RK end point
+    /// `x_c + h sum_j b_j F_j` (the end map's starting point: the method's local error in the
+    /// normal directions, `O(h^(p+1))`). A stage point off the manifold by `delta` changes the
+    /// step by about `h L delta`, so the ratio keeps that a small fraction of the local error
+    /// the method makes anyway; the step's end point is always mapped to `newton.tol`. 0 maps
+    /// every stage to `newton.tol`. Not used for FSAL tableaus (their last stage is the end
+    /// point). Default 1e-2; must lie in [0, 1).
+    pub stage_tol_ratio: f64,
+    /// Which chart: [`LinearSolver::Dense`] the QR chart with an orthonormal tangent basis
+    /// ([`crate::TangentChart`], `O(n^3)` per step), [`LinearSolver::Sparse`] the chart in
+    /// redundant tangent coordinates on the sparse Cholesky factorisation of `Df Df^T`
+    /// ([`crate::SparseChart`], `O(n)` per step for chains; centre iteration matrix only, no
+    /// exact-Newton fallback), [`LinearSolver::Auto`] (default) dense up to
+    /// [`mbd_solve::SPARSE_THRESHOLD`] constraint equations, sparse above. Both give the same
+    /// trajectory up to rounding (`docs/tangent.md` section 9).
+    pub linear_solver: LinearSolver,
+}
+
+impl Default for TangentOptions {
+    fn default() -> Self {
+        TangentOptions {
+            newton: NewtonSettings::default(),
+            iteration_matrix: IterationMatrix::default(),
+            max_halvings: 4,
+            singular_tol: 1e-8,
+            consistency_tol: 1e-8,
+            stage_tol_ratio: 1e-2,
+            linear_solver: LinearSolver::Auto,
+        }
+    }
+}
+
+impl TangentOptions {
+    /// Checks every setting.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        self.newton.validate()?;
+        if self.max_halvings > 30 {
+            return Err(SolveError::InvalidParameter {
+                parameter: "max_halvings",
+                value: self.max_halvings as f64,
+                reason: "must be at most 30",
+            });
+        }
+        if !(self.singular_tol.is_finite() && self.singular_tol > 0.0 && self.singular_tol < 1.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "singular_tol",
+                value: self.singular_tol,
+                reason: "must lie in (0, 1)",
+            });
+        }
+        if !(self.consistency_tol.is_finite() && self.consistency_tol >= self.newton.tol) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "consistency_tol",
+                value: self.consistency_tol,
+                reason: "must be finite and at least newton.tol",
+            });
+        }
+        if !(self.stage_tol_ratio >= 0.0 && self.stage_tol_ratio < 1.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "stage_tol_ratio",
+                value: self.stage_tol_ratio,
+                reason: "must lie in [0, 1)",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Work counters of a [`TangentRk`], cumulative since construction or the last
+/// [`Integrator::reset`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TangentStats {
+    /// Accepted steps (sub-steps of halved steps count one each).
+    pub steps: usize,
+    /// Chart centrings (QR factorisations of `Df^T`).
+    pub charts: usize,
+    /// Fixed-step mode: steps redone as two halves after a chart failure.
+    pub halvings: usize,
+    /// Chart failures met (recovered by halving or rejection, or returned as errors).
+    pub chart_failures: usize,
+    /// Chord Newton iterations of the accepted steps (all their maps).
+    pub newton_iterations: usize,
+    /// Most chord Newton iterations of one map of an accepted step.
+    pub max_map_iterations: usize,
+    /// Acceleration solves (right-hand-side evaluations) of the accepted steps.
+    pub rhs_evals: usize,
+    /// Largest `||(Phi, Phidot)||_inf` of an accepted step's end point.
+    pub max_residual: f64,
+    /// Chart maps of the accepted steps completed by the exact Newton fallback after the chord
+    /// iteration failed ([`NewtonSettings::fallback_change`]: near-singular charts).
+    pub exact_maps: usize,
+}

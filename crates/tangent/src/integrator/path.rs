@@ -1,0 +1,253 @@
+//! The two linear-algebra paths of [`TangentRk`](super::TangentRk): the dense chart (QR of
+//! `Df^T`, orthonormal tangent basis, dense index-1 solve) for small systems and the sparse
+//! chart (redundant tangent coordinates, sparse Cholesky of `Df Df^T`, sparse index-1 solve)
+//! for large ones. One enum dispatch per chart operation; the dense arm runs exactly the code
+//! it ran before the sparse path existed.
+
+use crate::chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
+use crate::sparse_chart::SparseChart;
+use mbd_model::System;
+use mbd_solve::{AccelerationSolver, SolveError, SparseAccelerationSolver};
+
+/// The chart and the index-1 solver of one path.
+// one `Path` per solver, built once: the size difference costs nothing, and the dense arm
+// stays unboxed so that its hot path does not gain an indirection
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug)]
+pub(super) enum Path {
+    /// Dense chart `x_c + U xi + Q1 zeta`; chart coordinates `xi` (`2 (n - m)`), normal
+    /// coordinates `zeta` (`2m`).
+    Dense {
+        chart: TangentChart,
+        acc: AccelerationSolver,
+    },
+    /// Sparse chart `x_c + y + Df^T eta`; chart coordinates `y` (`2n`, in `ker Df(x_c)`),
+    /// normal coordinates `eta` (`2m`).
+    Sparse(Box<SparseParts>),
+}
+
+/// The sparse path's parts (boxed: the enum stays the size of the dense arm).
+#[derive(Debug)]
+pub(super) struct SparseParts {
+    pub(super) chart: SparseChart,
+    pub(super) acc: SparseAccelerationSolver,
+    /// A never-centred dense chart of no dimension, returned by [`super::TangentRk::chart`].
+    pub(super) empty: TangentChart,
+}
+
+impl Path {
+    /// Length of the chart coordinates the Runge-Kutta method integrates.
+    pub(super) fn coord_dim(&self) -> usize {
+        match self {
+            Path::Dense { chart, .. } => chart.dim(),
+            Path::Sparse(p) => p.chart.ambient_dim(),
+        }
+    }
+
+    /// Dimension of the manifold, `2 (n - m)`.
+    pub(super) fn dim(&self) -> usize {
+        match self {
+            Path::Dense { chart, .. } => chart.dim(),
+            Path::Sparse(p) => p.chart.dim(),
+        }
+    }
+
+    #[inline]
+    pub(super) fn centre(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+    ) -> Result<(), SolveError> {
+        match self {
+            Path::Dense { chart, .. } => chart.centre(sys, q, v, t),
+            Path::Sparse(p) => p.chart.centre(sys, q, v, t),
+        }
+    }
+
+    #[inline]
+    pub(super) fn rcond(&self) -> f64 {
+        match self {
+            Path::Dense { chart, .. } => chart.rcond(),
+            Path::Sparse(p) => p.chart.rcond(),
+        }
+    }
+
+    #[inline]
+    pub(super) fn centre_point(&self) -> &[f64] {
+        match self {
+            Path::Dense { chart, .. } => chart.centre_point(),
+            Path::Sparse(p) => p.chart.centre_point(),
+        }
+    }
+
+    /// The dense chart's interpolated iteration matrix (the sparse path has only the
+    /// centre's; [`super::TangentRk::new`] rejects the other choices there).
+    #[inline]
+    pub(super) fn set_secondary_point(&mut self, sys: &System, x_e: &[f64]) {
+        if let Path::Dense { chart, .. } = self {
+            chart.set_secondary_point(sys, x_e);
+        }
+    }
+
+    #[inline]
+    pub(super) fn select_iteration_matrix(&mut self, s: f64) {
+        if let Path::Dense { chart, .. } = self {
+            chart.select_iteration_matrix(s);
+        }
+    }
+
+    /// Normal coordinates from the paper's `eta` (the sparse chart's normal coordinates are
+    /// `eta` itself).
+    #[inline]
+    pub(super) fn zeta_from_eta(&self, eta: &[f64], zeta: &mut [f64]) {
+        match self {
+            Path::Dense { chart, .. } => chart.zeta_from_eta(eta, zeta),
+            Path::Sparse(_) => zeta.copy_from_slice(eta),
+        }
+    }
+
+    /// The paper's `eta` from normal coordinates.
+    #[inline]
+    pub(super) fn eta_from_zeta(&self, zeta: &[f64], eta: &mut [f64]) {
+        match self {
+            Path::Dense { chart, .. } => chart.eta_from_zeta(zeta, eta),
+            Path::Sparse(_) => eta.copy_from_slice(zeta),
+        }
+    }
+
+    /// The chart map, verifying the residual (`predicted = false`) or allowed to stop on the
+    /// predicted one (stage points).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub(super) fn map(
+        &mut self,
+        sys: &System,
+        y: &[f64],
+        t: f64,
+        zeta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        predicted: bool,
+    ) -> Result<MapStats, ChartFailure> {
+        match (self, predicted) {
+            (Path::Dense { chart, .. }, false) => chart.map(sys, y, t, zeta, x, newton),
+            (Path::Dense { chart, .. }, true) => chart.map_predicted(sys, y, t, zeta, x, newton),
+            (Path::Sparse(p), false) => p.chart.map(sys, y, t, zeta, x, newton),
+            (Path::Sparse(p), true) => p.chart.map_predicted(sys, y, t, zeta, x, newton),
+        }
+    }
+
+    /// The index-1 accelerations at `(q, v, t)`. `at_centre`: `(q, v)` is the chart's centre
+    /// and the constraints are scleronomic, so the dense path takes `Phi_q` and
+    /// `gamma = -(Phi_q v)_q v` from the chart instead of evaluating the model.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub(super) fn accel(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        at_centre: bool,
+        a: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<(), SolveError> {
+        match self {
+            Path::Dense { chart, acc } => {
+                if at_centre {
+                    sys.forces_into(q, v, t, &mut acc.forces);
+                    acc.phi_q.copy_from(chart.centre_phi_q());
+                    let dphi = chart.centre_phi_q_dot_jacobian().as_slice();
+                    let m = acc.gamma.len();
+                    acc.gamma.fill(0.0);
+                    for (col, &vk) in dphi.chunks_exact(m.max(1)).zip(v) {
+                        for (gr, &d) in acc.gamma.iter_mut().zip(col) {
+                            *gr -= d * vk;
+                        }
+                    }
+                    acc.finish(sys, t, a, lambda)
+                } else {
+                    acc.solve(sys, q, v, t, a, lambda)
+                }
+            }
+            Path::Sparse(p) => p.acc.solve(sys, q, v, t, a, lambda),
+        }
+    }
+
+    /// Condition estimate of the last index-1 solve.
+    #[inline]
+    pub(super) fn condition_estimate(&self) -> f64 {
+        match self {
+            Path::Dense { acc, .. } => acc.condition_estimate(),
+            Path::Sparse(p) => p.acc.condition_estimate(),
+        }
+    }
+
+    /// Splits `F` into its normal coordinates `g` (`2m`) and the state equation's right-hand
+    /// side `dy` (dense: `U^T F`; sparse: `P F`); `proj` is work space of length `2n`.
+    #[inline]
+    pub(super) fn split(&mut self, fx: &[f64], proj: &mut [f64], g: &mut [f64], dy: &mut [f64]) {
+        match self {
+            Path::Dense { chart, .. } => {
+                let mm = g.len();
+                chart.coordinates(fx, proj);
+                g.copy_from_slice(&proj[..mm]);
+                dy.copy_from_slice(&proj[mm..]);
+            }
+            Path::Sparse(p) => p.chart.split(fx, g, dy),
+        }
+    }
+
+    /// A vector in chart coordinates mapped to `x` (dense: `U e`; sparse: `e` itself).
+    pub(super) fn to_ambient(&self, e: &[f64], out: &mut [f64]) {
+        match self {
+            Path::Dense { chart, .. } => {
+                out.fill(0.0);
+                for (k, &ek) in e.iter().enumerate() {
+                    let col = chart.tangent(k);
+                    for (o, c) in out.iter_mut().zip(col) {
+                        *o += ek * c;
+                    }
+                }
+            }
+            Path::Sparse(_) => out.copy_from_slice(e),
+        }
+    }
+
+    /// `||f(x, t)||_inf` with `f` into `out`.
+    pub(super) fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        match self {
+            Path::Dense { chart, .. } => chart.residual(sys, x, t, out),
+            Path::Sparse(p) => p.chart.residual(sys, x, t, out),
+        }
+    }
+
+    /// The rank report at the chart's centre.
+    pub(super) fn singular_error(
+        &mut self,
+        sys: &System,
+        t: f64,
+        rel_tol: f64,
+    ) -> Option<SolveError> {
+        match self {
+            Path::Dense { chart, .. } => chart.singular_error(sys, t, rel_tol),
+            Path::Sparse(p) => p.chart.singular_error(sys, t, rel_tol),
+        }
+    }
+
+    /// The rank report at the configuration `q`.
+    pub(super) fn singular_error_at(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        t: f64,
+        rel_tol: f64,
+    ) -> Option<SolveError> {
+        match self {
+            Path::Dense { chart, .. } => chart.singular_error_at(sys, q, t, rel_tol),
+            Path::Sparse(p) => p.chart.singular_error_at(sys, q, t, rel_tol),
+        }
+    }
+}

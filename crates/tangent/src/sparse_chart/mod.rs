@@ -1,0 +1,570 @@
+//! The sparse chart for large mechanisms: redundant tangent coordinates `y` in `ker Df(x_c)`,
+//! the projector `P = I - Df^T G^-1 Df` and the chord iteration on `eta`, all through one sparse
+//! Cholesky factorisation of `G = Df(x_c) Df(x_c)^T` per centre (`docs/tangent.md` section 9).
+
+use crate::chart::{fast_max, TRAVEL_FACTOR};
+use crate::chart::{loop_head, ChartFailure, MapStats, NewtonSettings, ROUNDOFF_FACTOR};
+use mbd_model::{AngleCache, JointHandle, System};
+use mbd_solve::linalg::FactorError;
+use mbd_solve::sparse::SparseCholesky;
+use mbd_solve::SolveError;
+
+mod rank;
+
+/// One contribution of a body shared by rows `r1 >= r2` to the four entries of `G` that couple
+/// them: `o1`, `o2` are the body's offsets (0 or 3) in the rows' local gradients, and `pp`, `vp`, `pv`, `vv` the value slots of (position `r1`, position `r2`),
+/// (velocity `r1`, position `r2`), (position `r1`, velocity `r2`) and (velocity `r1`,
+/// velocity `r2`) (`pv` is unused when `r1 == r2`: it is `vp` by symmetry).
+#[derive(Clone, Copy, Debug)]
+struct Contribution {
+    r1: usize,
+    r2: usize,
+    o1: usize,
+    o2: usize,
+    pp: usize,
+    vp: usize,
+    pv: usize,
+    vv: usize,
+}
+
+/// One contribution of a shared body to `Phi_q Phi_q^T` (rank report): rows `r1 >= r2`, body
+/// offsets, value slot.
+#[derive(Clone, Copy, Debug)]
+struct PosContribution {
+    r1: usize,
+    r2: usize,
+    o1: usize,
+    o2: usize,
+    idx: usize,
+}
+
+/// A chart of the manifold `f(x, t) = (Phi, Phi_q v + Phi_t) = 0` at a centre `x_c` without an
+/// explicit basis of `ker Df(x_c)` (which is dense for a chain):
+///
+/// ```text
+/// x(y) = x_c + y + Df(x_c)^T eta(y),   y in ker Df(x_c) (redundant coordinates in R^2n),
+/// ```
+///
+/// with `eta` (`2m`) from the chord iteration `G d = -f(x)`, `x <- x + Df^T d`, `eta <- eta + d`
+/// and `G = Df(x_c) Df(x_c)^T` (`2m x 2m`). `Df = [[Phi_q, 0], [X, Phi_q]]` (`X = (Phi_q v)_q`)
+/// is kept in element-local form (each equation acts on at most two bodies), so `G` couples two
+/// equations only when they act on a common body: block tridiagonal for a chain. Its pattern
+/// is analysed once in [`SparseChart::new`]; [`SparseChart::centre`] refills and refactors it,
+/// and the same factorisation gives the projector `P F = F - Df^T G^-1 Df F` of the state
+/// equation `y' = P F(x(y), t)` ([`SparseChart::split`]). Every operation costs `O(n + m)` for
+/// a chain, and none allocates after [`SparseChart::new`].
+///
+/// The chord iteration is the dense chart's ([`crate::TangentChart`]: `Q1 R^-T = Df^T G^-1`),
+/// so from the same starting point it reaches the same chart point; `y = U xi` maps the dense
+/// chart's coordinates to these. Unlike the dense chart it has no exact-Newton fallback, no
+/// Broyden updates and no interpolated iteration matrix (a failed chord iteration is a
+/// [`ChartFailure`]: halving or rejection). The Cholesky factorisation of `G` squares the
+/// condition number of `Df` (the QR of the dense chart does not), so near-singular
+/// configurations are detected at `cond(Df) ~ 1e7` (the kernel's pivot test
+/// `L_jj^2 >= 1e-14 G_jj`) or earlier by [`SparseChart::singular_tol`].
+#[derive(Debug)]
+pub struct SparseChart {
+    n: usize,
+    m: usize,
+    /// The bodies of each equation (`None` = ground).
+    row_bodies: Vec<(Option<usize>, Option<usize>)>,
+    /// Element-local rows of `Phi_q` and `(Phi_q v)_q` at the centre.
+    grads: Vec<[f64; 6]>,
+    dgrads: Vec<[f64; 6]>,
+    contributions: Vec<Contribution>,
+    /// `G = Df Df^T` (`2m x 2m`; index `r` position equation `r`, `m + r` velocity equation `r`).
+    chol: SparseCholesky,
+    /// `Phi_q Phi_q^T` at a configuration (rank report), its contributions and rows of `Phi_q`.
+    pos_chol: SparseCholesky,
+    pos_contributions: Vec<PosContribution>,
+    grads_x: Vec<[f64; 6]>,
+    /// The centre `(q_c, v_c)` and its time.
+    xc: Vec<f64>,
+    tc: f64,
+    /// Residual and correction buffers (`2m`).
+    f: Vec<f64>,
+    d: Vec<f64>,
+    /// The starting point of the map in progress (`2n`), for the travel bound.
+    x0: Vec<f64>,
+    first_step: f64,
+    angles: AngleCache,
+    rcond: f64,
+    centred: bool,
+    /// Relative threshold: the centre is singular when `1 / sqrt(cond(G))` (the estimate of
+    /// the smallest relative singular value of `Df`) is below it. Default 1e-8 (then the
+    /// kernel's pivot test, at about 1e-7, decides).
+    pub singular_tol: f64,
+}
+
+impl SparseChart {
+    /// A sparse chart workspace for `sys`: analyses the patterns of `G` and of
+    /// `Phi_q Phi_q^T` (allocates once).
+    pub fn new(sys: &System) -> Result<Self, SolveError> {
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let mut row_bodies = vec![(None, None); m];
+        for j in 0..sys.joints().len() {
+            let jb = sys.joint_bodies(JointHandle(j));
+            for r in sys.joint_rows(JointHandle(j)) {
+                row_bodies[r] = jb;
+            }
+        }
+        let mut by_body: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n / 3];
+        for (r, &(a, b)) in row_bodies.iter().enumerate() {
+            if let Some(a) = a {
+                by_body[a].push((r, 0));
+            }
+            if let Some(b) = b {
+                by_body[b].push((r, 3));
+            }
+        }
+        let mut pattern = Vec::new();
+        let mut pos_pattern = Vec::new();
+        for rows in &by_body {
+            for &(r1, _) in rows {
+                for &(r2, _) in rows {
+                    if r1 >= r2 {
+                        pattern.push((r1, r2));
+                        pattern.push((m + r1, r2));
+                        pattern.push((m + r2, r1));
+                        pattern.push((m + r1, m + r2));
+                        pos_pattern.push((r1, r2));
+                    }
+                }
+            }
+        }
+        let chol = SparseCholesky::new(2 * m, &pattern)?;
+        let pos_chol = SparseCholesky::new(m, &pos_pattern)?;
+        let missing = |r: usize, c: usize| {
+            SolveError::Unsupported(format!("sparse chart: pattern lacks entry ({r}, {c})"))
+        };
+        let slot =
+            |ch: &SparseCholesky, r: usize, c: usize| ch.slot(r, c).ok_or_else(|| missing(r, c));
+        let mut contributions = Vec::new();
+        let mut pos_contributions = Vec::new();
+        for rows in &by_body {
+            for &(r1, o1) in rows {
+                for &(r2, o2) in rows {
+                    if r1 >= r2 {
+                        contributions.push(Contribution {
+                            r1,
+                            r2,
+                            o1,
+                            o2,
+                            pp: slot(&chol, r1, r2)?,
+                            vp: slot(&chol, m + r1, r2)?,
+                            pv: slot(&chol, r1, m + r2)?,
+                            vv: slot(&chol, m + r1, m + r2)?,
+                        });
+                        pos_contributions.push(PosContribution {
+                            r1,
+                            r2,
+                            o1,
+                            o2,
+                            idx: slot(&pos_chol, r1, r2)?,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(SparseChart {
+            n,
+            m,
+            row_bodies,
+            grads: vec![[0.0; 6]; m],
+            dgrads: vec![[0.0; 6]; m],
+            contributions,
+            chol,
+            pos_chol,
+            pos_contributions,
+            grads_x: vec![[0.0; 6]; m],
+            xc: vec![0.0; 2 * n],
+            tc: 0.0,
+            f: vec![0.0; 2 * m],
+            d: vec![0.0; 2 * m],
+            x0: vec![0.0; 2 * n],
+            first_step: 0.0,
+            angles: AngleCache::new(sys),
+            rcond: 1.0,
+            centred: false,
+            singular_tol: 1e-8,
+        })
+    }
+
+    /// Dimension of the manifold, `2 (n - m)` (the chart's coordinates `y` are redundant:
+    /// `2n` numbers in a `2 (n - m)`-dimensional subspace).
+    pub fn dim(&self) -> usize {
+        2 * (self.n - self.m.min(self.n))
+    }
+
+    /// Dimension of the ambient space, `2n`: the length of `y`.
+    pub fn ambient_dim(&self) -> usize {
+        2 * self.n
+    }
+
+    /// Number of constraint equations of `f`, `2m`: the length of `eta`.
+    pub fn codim(&self) -> usize {
+        2 * self.m
+    }
+
+    /// The centre `x_c = (q_c, v_c)` (length `2n`).
+    pub fn centre_point(&self) -> &[f64] {
+        &self.xc
+    }
+
+    /// Time at which the chart was centred.
+    pub fn centre_time(&self) -> f64 {
+        self.tc
+    }
+
+    /// `1 / sqrt(cond(G))` of the last centre, from the sparse Cholesky's condition estimate
+    /// (1 without constraints): the analogue of [`crate::TangentChart::rcond`].
+    pub fn rcond(&self) -> f64 {
+        self.rcond
+    }
+
+    /// Whether [`SparseChart::centre`] succeeded since the last attempt.
+    pub fn is_centred(&self) -> bool {
+        self.centred
+    }
+
+    /// Non-zeros of the lower triangle of `G`, and of its Cholesky factor (fill included).
+    pub fn nnz(&self) -> (usize, usize) {
+        (self.chol.nnz(), self.chol.factor_nnz())
+    }
+
+    /// Centres the chart at `(q, v)` at time `t`: evaluates `Df` in element-local form,
+    /// assembles `G = Df Df^T` and factors it. A failing pivot (or a condition estimate beyond
+    /// `1 / singular_tol^2`) is [`SolveError::Singular`] naming the equation.
+    pub fn centre(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) -> Result<(), SolveError> {
+        let (n, m) = (self.n, self.m);
+        self.centred = false;
+        if q.len() != n || v.len() != n {
+            return Err(SolveError::Dimension {
+                what: "chart centre (q, v)",
+                expected: n,
+                got: if q.len() != n { q.len() } else { v.len() },
+            });
+        }
+        self.xc[..n].copy_from_slice(q);
+        self.xc[n..].copy_from_slice(v);
+        self.tc = t;
+        self.rcond = 1.0;
+        if m == 0 {
+            self.centred = true;
+            return Ok(());
+        }
+        sys.phi_q_dot_local(q, v, &mut self.grads, &mut self.dgrads);
+        if self
+            .grads
+            .iter()
+            .chain(&self.dgrads)
+            .any(|g| g.iter().any(|x| !x.is_finite()))
+        {
+            return Err(SolveError::NonFinite {
+                t,
+                what: "constraint Jacobian at the chart centre",
+            });
+        }
+        if m > n {
+            return Err(SolveError::Singular {
+                t,
+                what: "constraint Jacobian Df of the tangent chart",
+                detail: format!("position constraint {}", sys.equation_name(n)),
+            });
+        }
+        self.chol.clear();
+        let vals = self.chol.values_mut();
+        for c in &self.contributions {
+            let (a1, a2) = (&self.grads[c.r1], &self.grads[c.r2]);
+            let (x1, x2) = (&self.dgrads[c.r1], &self.dgrads[c.r2]);
+            let (mut aa, mut xa, mut ax, mut xx) = (0.0, 0.0, 0.0, 0.0);
+            for l in 0..3 {
+                let (p1, p2) = (a1[c.o1 + l], a2[c.o2 + l]);
+                let (d1, d2) = (x1[c.o1 + l], x2[c.o2 + l]);
+                aa += p1 * p2;
+                xa += d1 * p2;
+                ax += p1 * d2;
+                xx += d1 * d2;
+            }
+            vals[c.pp] += aa;
+            vals[c.vp] += xa;
+            if c.r1 != c.r2 {
+                vals[c.pv] += ax;
+            }
+            vals[c.vv] += xx + aa;
+        }
+        let tol = self.singular_tol;
+        match self.chol.factor() {
+            Ok(()) => {
+                self.rcond = 1.0 / self.chol.condition_estimate().sqrt();
+                if self.rcond.is_nan() || self.rcond <= tol {
+                    return Err(SolveError::Singular {
+                        t,
+                        what: "constraint Jacobian Df of the sparse tangent chart",
+                        detail: format!(
+                            "condition estimate {:.3e} of Df Df^T beyond 1 / singular_tol^2",
+                            self.chol.condition_estimate()
+                        ),
+                    });
+                }
+            }
+            Err(FactorError::Singular(i) | FactorError::NotPositiveDefinite(i)) => {
+                self.rcond = 0.0;
+                return Err(self.singular_error(sys, t, tol).unwrap_or_else(|| {
+                    SolveError::Singular {
+                        t,
+                        what: "constraint Jacobian Df of the sparse tangent chart (Cholesky of Df Df^T)",
+                        detail: if i < m {
+                            format!("position constraint {}", sys.equation_name(i))
+                        } else {
+                            format!("velocity constraint {}", sys.equation_name(i - m))
+                        },
+                    }
+                }));
+            }
+        }
+        self.centred = true;
+        Ok(())
+    }
+
+    /// `out = Df(x_c) z` for `z` of length `2n` (`out` of length `2m`).
+    pub fn apply_df(&self, z: &[f64], out: &mut [f64]) {
+        let (n, m) = (self.n, self.m);
+        let (zq, zv) = z.split_at(n);
+        let (op, ov) = out[..2 * m].split_at_mut(m);
+        for r in 0..m {
+            let (a, x) = (&self.grads[r], &self.dgrads[r]);
+            let (mut p, mut d) = (0.0, 0.0);
+            let (ba, bb) = self.row_bodies[r];
+            if let Some(b) = ba {
+                for l in 0..3 {
+                    p += a[l] * zq[3 * b + l];
+                    d += x[l] * zq[3 * b + l] + a[l] * zv[3 * b + l];
+                }
+            }
+            if let Some(b) = bb {
+                for l in 0..3 {
+                    p += a[3 + l] * zq[3 * b + l];
+                    d += x[3 + l] * zq[3 * b + l] + a[3 + l] * zv[3 * b + l];
+                }
+            }
+            op[r] = p;
+            ov[r] = d;
+        }
+    }
+
+    /// `out += alpha Df(x_c)^T e` for `e` of length `2m` (`out` of length `2n`).
+    pub fn add_df_t(&self, alpha: f64, e: &[f64], out: &mut [f64]) {
+        let (n, m) = (self.n, self.m);
+        let (oq, ov) = out.split_at_mut(n);
+        for r in 0..m {
+            let (a, x) = (&self.grads[r], &self.dgrads[r]);
+            let (ep, ev) = (alpha * e[r], alpha * e[m + r]);
+            let (ba, bb) = self.row_bodies[r];
+            if let Some(b) = ba {
+                for l in 0..3 {
+                    oq[3 * b + l] += a[l] * ep + x[l] * ev;
+                    ov[3 * b + l] += a[l] * ev;
+                }
+            }
+            if let Some(b) = bb {
+                for l in 0..3 {
+                    oq[3 * b + l] += a[3 + l] * ep + x[3 + l] * ev;
+                    ov[3 * b + l] += a[3 + l] * ev;
+                }
+            }
+        }
+    }
+
+    /// Splits `F` (length `2n`) into its normal coefficients `g = G^-1 Df F` (length `2m`:
+    /// `F = P F + Df^T g`) and its tangent part `dy = P F = F - Df^T g` (length `2n`), the
+    /// right-hand side of the state equation `y' = P F`.
+    pub fn split(&mut self, fx: &[f64], g: &mut [f64], dy: &mut [f64]) {
+        dy.copy_from_slice(fx);
+        if self.m == 0 {
+            return;
+        }
+        self.apply_df(fx, g);
+        self.chol.solve_in_place(g);
+        self.add_df_t(-1.0, g, dy);
+    }
+
+    /// Writes `x = x_c + y + Df(x_c)^T eta` into `x` (no Newton).
+    pub fn point(&self, y: &[f64], eta: &[f64], x: &mut [f64]) {
+        for ((xv, c), yv) in x.iter_mut().zip(&self.xc).zip(y) {
+            *xv = c + yv;
+        }
+        if self.m > 0 {
+            self.add_df_t(1.0, eta, x);
+        }
+    }
+
+    /// `f(x, t) = (Phi(q, t), Phi_q v + Phi_t)` into `out` (length `2m`); returns its max-norm
+    /// (NaN if any entry is not finite).
+    pub fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        let (p, pd) = out[..2 * m].split_at_mut(m);
+        sys.phi_and_phi_dot(q, v, t, p, pd);
+        max_norm(&out[..2 * m])
+    }
+
+    /// [`SparseChart::residual`] with rotated `sin`/`cos` ([`AngleCache`]).
+    fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        let (p, pd) = out[..2 * m].split_at_mut(m);
+        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
+        max_norm(&out[..2 * m])
+    }
+
+    /// Maps `y` (length `2n`, in `ker Df(x_c)`) to the point `x` of the manifold at time `t`:
+    /// `x = x_c + y + Df^T eta` with `eta` by chord Newton started at the value passed in and
+    /// left at the converged value. Stopping rules and travel bound as
+    /// [`crate::TangentChart::map`].
+    pub fn map(
+        &mut self,
+        sys: &System,
+        y: &[f64],
+        t: f64,
+        eta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+    ) -> Result<MapStats, ChartFailure> {
+        self.point(y, eta, x);
+        self.chord(sys, t, eta, x, newton, false)
+    }
+
+    /// [`SparseChart::map`] for a Runge-Kutta stage point: may stop on the predicted residual
+    /// (as [`crate::TangentChart::map_predicted`]).
+    pub fn map_predicted(
+        &mut self,
+        sys: &System,
+        y: &[f64],
+        t: f64,
+        eta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+    ) -> Result<MapStats, ChartFailure> {
+        self.point(y, eta, x);
+        self.chord(sys, t, eta, x, newton, true)
+    }
+
+    /// The chord iteration `G d = -f(x)`, `x <- x + Df^T d`, `eta <- eta + d` from `x`.
+    fn chord(
+        &mut self,
+        sys: &System,
+        t: f64,
+        eta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        predicted: bool,
+    ) -> Result<MapStats, ChartFailure> {
+        if self.m == 0 {
+            return Ok(MapStats::default());
+        }
+        let mut f = std::mem::take(&mut self.f);
+        let mut d = std::mem::take(&mut self.d);
+        let out = self.chord_loop(sys, t, eta, x, newton, predicted, &mut f, &mut d);
+        self.f = f;
+        self.d = d;
+        let ms = out?;
+        if ms.iterations > 1 {
+            let (mut travel, mut size) = (0.0f64, 0.0f64);
+            for (a, b) in x.iter().zip(&self.x0) {
+                travel = fast_max(travel, (a - b).abs());
+                size = fast_max(size, b.abs());
+            }
+            if travel > TRAVEL_FACTOR * self.first_step + 16.0 * f64::EPSILON * (1.0 + size) {
+                return Err(ChartFailure {
+                    t,
+                    residual: ms.residual,
+                    iterations: ms.iterations,
+                });
+            }
+        }
+        Ok(ms)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn chord_loop(
+        &mut self,
+        sys: &System,
+        t: f64,
+        eta: &mut [f64],
+        x: &mut [f64],
+        newton: &NewtonSettings,
+        predicted: bool,
+        f: &mut [f64],
+        d: &mut [f64],
+    ) -> Result<MapStats, ChartFailure> {
+        self.angles.invalidate();
+        self.x0.copy_from_slice(x);
+        self.first_step = 0.0;
+        let tol = newton.tol;
+        let res0 = self.residual_cached(sys, x, t, f);
+        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
+        let mut res = res0;
+        let mut prev = f64::INFINITY;
+        let mut it = 0;
+        loop {
+            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+                return verdict;
+            }
+            for (dk, fk) in d.iter_mut().zip(f.iter()) {
+                *dk = -fk;
+            }
+            self.chol.solve_in_place(d);
+            self.add_df_t(1.0, d, x);
+            for (e, dk) in eta.iter_mut().zip(d.iter()) {
+                *e += dk;
+            }
+            it += 1;
+            if it == 1 {
+                self.first_step = x
+                    .iter()
+                    .zip(&self.x0)
+                    .fold(0.0f64, |s, (a, b)| fast_max(s, (a - b).abs()));
+            }
+            let theta = res / prev;
+            if predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol {
+                return Ok(MapStats {
+                    iterations: it,
+                    residual: theta * res,
+                    initial_residual: res0,
+                    exact: false,
+                });
+            }
+            prev = res;
+            res = self.residual_cached(sys, x, t, f);
+            if res > tol && res <= stall_cap && res >= 0.9 * prev {
+                return Ok(MapStats {
+                    iterations: it,
+                    residual: res,
+                    initial_residual: res0,
+                    exact: false,
+                });
+            }
+            if res > newton.divergence * prev && res > tol {
+                return Err(ChartFailure {
+                    t,
+                    residual: res,
+                    iterations: it,
+                });
+            }
+        }
+    }
+}
+
+/// `max |v_i|`, NaN if some entry is not finite.
+fn max_norm(v: &[f64]) -> f64 {
+    let mut r = 0.0f64;
+    for &e in v {
+        if !e.is_finite() {
+            return f64::NAN;
+        }
+        r = r.max(e.abs());
+    }
+    r
+}
