@@ -2,7 +2,7 @@
 //! `mbd-rk4` wraps) on the paper-C manipulator, at h = 0.01 (paper C's step) and h = 0.002.
 //! The target is a ratio of at most 4; `docs/tangent.md` records the measured ratio.
 //! Also: tangent DOPRI5, and tangent RK4 with the interpolated iteration matrix. Criterion times
-//! each function on its own; on a loaded machine `examples/step_ratio.rs` (interleaved blocks,
+//! each function on its own; on a loaded machine `tools/src/bin/tangent_step_ratio.rs` (interleaved blocks,
 //! best of 30) gives the steadier ratio.
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbd_model::{models, System};

@@ -2,10 +2,10 @@
 //! on the manipulator: the two run in interleaved blocks of 20000 steps and the best block of
 //! 30 counts, which keeps the ratio steady on a shared machine.
 //!
-//! `cargo run --release -p mbd-tangent --example step_ratio [h] [centre|interpolated|broyden]`
-use mbd_model::models;
-use mbd_solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, State};
-use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
+//! `cargo run --release -p mbd-tools --bin tangent_step_ratio [h] [centre|interpolated|broyden]`
+use mbd::model::models;
+use mbd::solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, State};
+use mbd::tangent::{IterationMatrix, TangentOptions, TangentRk};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -2,21 +2,21 @@
 //! configurations, with direct `step` calls at a given step size:
 //!
 //! ```text
-//! cargo run --release -p mbd-tangent --example branch_probe -- <driven|free> <h> [t_end]
+//! cargo run --release -p mbd-tools --bin tangent_branch_probe -- <driven|free> <h> [t_end]
 //! ```
 //!
 //! Prints the steps at which the exact Newton fallback was used or the state left the
 //! parallelogram branch (coupler angle, rocker - crank angle), and the end state.
-use mbd_model::models;
-use mbd_solve::{Integrator, State};
-use mbd_tangent::TangentRk;
+use mbd::model::models;
+use mbd::solve::{Integrator, State};
+use mbd::tangent::TangentRk;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let driven = args.get(1).map(|s| s == "driven").unwrap_or(true);
     let h: f64 = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(1e-3);
     let t_end: f64 = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(2.0);
-    // "run": the times of `mbd_solve::run` (t_k = k h set after each step, nominal h)
+    // "run": the times of `mbd::solve::run` (t_k = k h set after each step, nominal h)
     let run_times = std::env::var("RUN_TIMES").is_ok();
     let sys = models::parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, driven)?;
     let mut s = State::consistent(&sys, 0.0)?;

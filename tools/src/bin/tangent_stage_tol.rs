@@ -2,10 +2,10 @@
 //! and the chord work of tangent-space RK4 on the manipulator: error at `t = 2 s` against a
 //! DOPRI5 reference for several step sizes and ratios.
 //!
-//! `cargo run --release -p mbd-tangent --example stage_tol`
-use mbd_model::models;
-use mbd_solve::{reference_trajectory, ButcherTableau, Integrator, State};
-use mbd_tangent::{TangentOptions, TangentRk};
+//! `cargo run --release -p mbd-tools --bin tangent_stage_tol`
+use mbd::model::models;
+use mbd::solve::{reference_trajectory, ButcherTableau, Integrator, State};
+use mbd::tangent::{TangentOptions, TangentRk};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sys = models::manipulator()?;

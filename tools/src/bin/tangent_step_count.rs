@@ -4,21 +4,21 @@
 //!
 //! ```text
 //! valgrind --tool=callgrind --toggle-collect='*run_steps*' \
-//!     target/release/examples/step_count tangent 0.01 1000
+//!     target/release/tangent_step_count tangent 0.01 1000
 //! ```
 //!
 //! Arguments: `tangent` | `plain` (or `tangent-run` | `plain-run`: the same steps through
-//! `mbd_solve::run`, which passes each step `h = t_next - t`), the step `h` (default 0.01), the number of steps (default
+//! `mbd::solve::run`, which passes each step `h = t_next - t`), the step `h` (default 0.01), the number of steps (default
 //! `10 / h`, the first 10 s of motion, as the benchmark cycles through), and the iteration
 //! matrix `centre`, `interpolated` or `broyden` ([`IterationMatrix`], tangent only; default:
 //! the solver's default). Prints the chord iterations and Broyden updates per step of the
 //! tangent solver.
-use mbd_model::{models, System};
-use mbd_solve::{
+use mbd::model::{models, System};
+use mbd::solve::{
     run, ButcherTableau, Index1Options, Index1Rk, Integrator, NoObserver, RunConfig, SolveError,
     State,
 };
-use mbd_tangent::{IterationMatrix, TangentOptions, TangentRk};
+use mbd::tangent::{IterationMatrix, TangentOptions, TangentRk};
 
 #[inline(never)]
 fn run_steps<I: Integrator>(
@@ -30,7 +30,7 @@ fn run_steps<I: Integrator>(
     through_run: bool,
 ) -> Result<(), SolveError> {
     if through_run {
-        // mbd_solve::run: times t0 + k h, each step passed h = t_next - t
+        // mbd::solve::run: times t0 + k h, each step passed h = t_next - t
         let cfg = RunConfig::new(s.t + steps as f64 * h, h);
         run(integ, sys, s, cfg, &mut NoObserver)?;
         return Ok(());
@@ -44,7 +44,7 @@ fn run_steps<I: Integrator>(
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let which = args.next().unwrap_or_else(|| "tangent".into());
-    // `plain-run` / `tangent-run`: the same steps through `mbd_solve::run`
+    // `plain-run` / `tangent-run`: the same steps through `mbd::solve::run`
     let through_run = which.ends_with("-run");
     let which = which.trim_end_matches("-run").to_string();
     let h: f64 = match args.next() {

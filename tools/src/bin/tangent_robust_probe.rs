@@ -1,8 +1,8 @@
 //! The measurements of `docs/tangent.md` sections 6 and 7 (issue 10, robustness):
 //!
 //! ```text
-//! cargo run --release -p mbd-tangent --example robust_probe -- adaptive
-//! cargo run --release -p mbd-tangent --example robust_probe -- fourbar
+//! cargo run --release -p mbd-tools --bin tangent_robust_probe -- adaptive
+//! cargo run --release -p mbd-tools --bin tangent_robust_probe -- fourbar
 //! ```
 //!
 //! `adaptive`: tangent DOPRI5 on the manipulator to t = 2 s at tolerances 1e-3 .. 1e-12 against a
@@ -13,12 +13,12 @@
 //! `fourbar`: the parallelogram four-bar through its flat configurations (free and with the
 //! crank driven), h = 1e-3 to t = 2 s: RK4 with projection, tangent RK4 and adaptive tangent
 //! DOPRI5 (tol 1e-8).
-use mbd_model::models;
-use mbd_solve::{
+use mbd::model::models;
+use mbd::solve::{
     reference_trajectory, run, ButcherTableau, Index1Options, Index1Rk, NoObserver,
     ProjectionSettings, RunConfig, State,
 };
-use mbd_tangent::{AdaptiveSettings, TangentRk};
+use mbd::tangent::{AdaptiveSettings, TangentRk};
 
 fn env_f64(name: &str) -> Result<Option<f64>, Box<dyn std::error::Error>> {
     match std::env::var(name) {
@@ -28,7 +28,7 @@ fn env_f64(name: &str) -> Result<Option<f64>, Box<dyn std::error::Error>> {
 }
 
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    mbd_model::numeric::max_abs_diff(a, b)
+    mbd::model::numeric::max_abs_diff(a, b)
 }
 
 fn adaptive() -> Result<(), Box<dyn std::error::Error>> {

@@ -1,9 +1,9 @@
 //! Exploration: e(H), constraint errors, runtime and optimiser statistics on the manipulator.
-//! `cargo run --release -p mbd-firefly-gauss --example explore -- T h [polish] [decay] [tol]`
-use mbd_analysis::MeasureObserver;
-use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
-use mbd_model::models;
-use mbd_solve::{run, RunConfig, State};
+//! `cargo run --release -p mbd-tools --bin fadae_explore -- T h [polish] [decay] [tol]`
+use mbd::analysis::MeasureObserver;
+use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
+use mbd::model::models;
+use mbd::solve::{run, RunConfig, State};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(v) = env("PLAIN") {
         if v == "1" {
-            o.predictor = mbd_firefly_gauss::Predictor::Rk4;
+            o.predictor = mbd::firefly_gauss::Predictor::Rk4;
         }
     }
     let sys = models::manipulator()?;

@@ -1,17 +1,17 @@
 //! Per-step cost of tangent-space RK4 against plain RK4 (`Index1Rk` with the RK4 tableau, the
-//! index-1 method `mbd-rk4` wraps) on `n_link_chain(N)`, both through `mbd_solve::run` at
+//! index-1 method `mbd-rk4` wraps) on `n_link_chain(N)`, both through `mbd::solve::run` at
 //! `h = 1e-3`. Tangent RK4 runs on its default path (dense QR chart up to
 //! `SPARSE_THRESHOLD` constraint equations, sparse chart above) and, for the smaller chains,
 //! forced onto the dense chart for comparison. Each solver runs in interleaved blocks of about
 //! 0.2 s from the same initial state; the best block counts (steady on a shared machine).
 //!
-//! `cargo run --release -p mbd-tangent --example chain_scaling [N ...] [--dense-max N]`
+//! `cargo run --release -p mbd-tools --bin tangent_chain_scaling [N ...] [--dense-max N]`
 //! (default N = 10 30 100 300 1000, dense chart for N <= 100).
-use mbd_model::models;
-use mbd_solve::{
+use mbd::model::models;
+use mbd::solve::{
     run, ButcherTableau, Index1Options, Index1Rk, Integrator, NoObserver, RunConfig, State,
 };
-use mbd_tangent::{LinearSolver, TangentOptions, TangentRk};
+use mbd::tangent::{LinearSolver, TangentOptions, TangentRk};
 use std::time::Instant;
 
 const H: f64 = 1e-3;
@@ -21,7 +21,7 @@ const BLOCKS: usize = 5;
 /// Best per-step time (seconds) of `integ` over [`BLOCKS`] blocks of `steps` steps from `s0`.
 fn block_time(
     integ: &mut dyn Integrator,
-    sys: &mbd_model::System,
+    sys: &mbd::model::System,
     s0: &State,
     steps: usize,
 ) -> Result<f64, Box<dyn std::error::Error>> {
