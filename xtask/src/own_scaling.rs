@@ -13,14 +13,20 @@ use serde_json::json;
 use std::time::Instant;
 
 /// The solvers compared (names of [`solvers`]) with their target ratio to plain RK4 at
-/// N = 100 and N = 1000 (issue 11).
-const TARGETS: [(&str, f64); 5] = [
-    ("RK4 (index-1, plain)", 1.5),
-    ("RK4 (index-1, projection)", 2.0),
-    ("symplectic (1,1)", 3.0),
-    ("symplectic (2,2)", 8.0),
-    ("tangent-space RK4", 8.0),
+/// N = 100 and N = 1000 (issue 11). FA-DAE optimises `2 (n - m)` variables per step with a
+/// swarm and is not meant to scale: it is measured (as far as the time budget allows) to
+/// document its limit, with no target.
+const TARGETS: [(&str, Option<f64>); 6] = [
+    ("RK4 (index-1, plain)", None),
+    ("RK4 (index-1, projection)", Some(2.0)),
+    ("symplectic (1,1)", Some(3.0)),
+    ("symplectic (2,2)", Some(8.0)),
+    ("tangent-space RK4", Some(8.0)),
+    (FA_DAE, None),
 ];
+
+/// The solver measured without targets.
+const FA_DAE: &str = "FA-DAE + Gauss-Newton polish";
 
 /// Largest allowed cost exponent between N = 100 and N = 1000.
 const MAX_EXPONENT: f64 = 1.2;
@@ -123,9 +129,21 @@ pub fn scaling(ctx: &Ctx) -> Result<Section, String> {
                 skipped.push((name, n));
                 continue;
             }
-            let mut integ = (spec.make)(&sys).map_err(|e| format!("{name}, N = {n}: {e}"))?;
-            let (per, peer_per) = measure(&sys, &s0, integ.as_mut(), &mut peer, blocks, block_s)
-                .map_err(|e| format!("{name}, N = {n}: {e}"))?;
+            let measured = (spec.make)(&sys)
+                .map_err(|e| e.to_string())
+                .and_then(|mut integ| {
+                    measure(&sys, &s0, integ.as_mut(), &mut peer, blocks, block_s)
+                });
+            let (per, peer_per) = match measured {
+                Ok(x) => x,
+                // FA-DAE is measured to document its limit: a failure there is a finding
+                Err(e) if name == FA_DAE => {
+                    sec.notes.push(format!("{name} failed on the {n}-link chain: {e}"));
+                    skipped.push((name, n));
+                    continue;
+                }
+                Err(e) => return Err(format!("{name}, N = {n}: {e}")),
+            };
             cells.push(Cell {
                 solver: name,
                 n_bodies: n,
@@ -169,7 +187,15 @@ pub fn scaling(ctx: &Ctx) -> Result<Section, String> {
                 "ratio_to_rk4": num(c.per_step / c.peer),
             }));
         }
-        if name != TARGETS[0].0 {
+        fig = fig.with(Series::line(
+            name,
+            mine.iter().map(|c| c.n_bodies as f64).collect(),
+            mine.iter().map(|c| c.per_step).collect(),
+        ));
+        if name == FA_DAE {
+            continue;
+        }
+        if let Some(target) = target {
             for n in [100, 1000] {
                 sec.claims.push(match at(n) {
                     Some(c) => {
@@ -204,11 +230,6 @@ pub fn scaling(ctx: &Ctx) -> Result<Section, String> {
                 "not measured at both sizes".to_string(),
             ),
         });
-        fig = fig.with(Series::line(
-            name,
-            mine.iter().map(|c| c.n_bodies as f64).collect(),
-            mine.iter().map(|c| c.per_step).collect(),
-        ));
     }
     fig.save(&ctx.figure_path("own_scaling.svg"))?;
     sec.figures.push(FigureRef {
