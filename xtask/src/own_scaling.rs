@@ -138,7 +138,8 @@ pub fn scaling(ctx: &Ctx) -> Result<Section, String> {
                 Ok(x) => x,
                 // FA-DAE is measured to document its limit: a failure there is a finding
                 Err(e) if name == FA_DAE => {
-                    sec.notes.push(format!("{name} failed on the {n}-link chain: {e}"));
+                    sec.notes
+                        .push(format!("{name} failed on the {n}-link chain: {e}"));
                     skipped.push((name, n));
                     continue;
                 }

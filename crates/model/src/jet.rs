@@ -39,8 +39,6 @@ pub trait Scalar:
     fn sin_cos(self) -> (Self, Self);
     /// Square root (the caller keeps the argument positive).
     fn sqrt(self) -> Self;
-    /// The value part.
-    fn val(self) -> f64;
 }
 
 impl Scalar for f64 {
@@ -55,10 +53,6 @@ impl Scalar for f64 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         f64::sqrt(self)
-    }
-    #[inline(always)]
-    fn val(self) -> f64 {
-        self
     }
 }
 
@@ -210,10 +204,6 @@ impl Scalar for DirJet {
         let r = self.v.sqrt();
         self.chain(r, 0.5 / r, -0.25 / (r * self.v))
     }
-    #[inline(always)]
-    fn val(self) -> f64 {
-        self.v
-    }
 }
 
 /// Value, gradient, derivative along a direction `w` and the gradient of that derivative, with
@@ -362,10 +352,6 @@ impl Scalar for TanJet {
         let r = self.v.sqrt();
         self.chain(r, 0.5 / r, -0.25 / (r * self.v))
     }
-    #[inline(always)]
-    fn val(self) -> f64 {
-        self.v
-    }
 }
 
 /// Value, gradient and full Hessian with respect to the 6 local variables.
@@ -507,10 +493,6 @@ impl Scalar for HessJet {
         let r = self.v.sqrt();
         self.chain(r, 0.5 / r, -0.25 / (r * self.v))
     }
-    #[inline(always)]
-    fn val(self) -> f64 {
-        self.v
-    }
 }
 
 /// Value and first derivative along one direction (a dual number): the velocity constraint
@@ -623,10 +605,6 @@ impl Scalar for Dual {
             v: r,
             d: 0.5 / r * self.d,
         }
-    }
-    #[inline(always)]
-    fn val(self) -> f64 {
-        self.v
     }
 }
 

@@ -50,7 +50,7 @@ mod error;
 mod file;
 mod force;
 mod init;
-pub mod jet;
+mod jet;
 mod joint;
 mod kinematics;
 pub mod models;
