@@ -6,11 +6,11 @@
 use mbd::analysis::MeasureObserver;
 use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
-use mbd::solve::{run, RunConfig, State};
+use mbd::solve::{consistent_state, run, RunConfig, State};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sys = models::slider_crank()?;
-    let init = sys.consistent_state(0.0)?;
+    let init = consistent_state(&sys, 0.0)?;
     println!(
         "initial guess corrected by {:.2e} (positions), {:.2e} (velocities)",
         init.position_correction, init.velocity_correction

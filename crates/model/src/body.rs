@@ -32,7 +32,7 @@ impl BodyRef {
 }
 
 /// A planar rigid body: mass, centroidal moment of inertia, and an initial state (a guess that
-/// [`crate::System::consistent_state`] projects onto the constraints).
+/// `mbd_solve::consistent_state` projects onto the constraints).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Body {

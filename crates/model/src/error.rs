@@ -72,16 +72,6 @@ pub enum ModelError {
         /// The joints whose equations are linearly dependent.
         joints: Vec<String>,
     },
-    /// Newton projection onto the constraint manifold failed.
-    #[error("initial state cannot be projected onto the constraints: residual {residual:e} after {iterations} iterations (worst equation: {equation})")]
-    Projection {
-        /// Max-norm residual when it stopped.
-        residual: f64,
-        /// Iterations done.
-        iterations: usize,
-        /// The equation with the largest residual.
-        equation: String,
-    },
     /// A vector or matrix argument has the wrong size.
     #[error("{what}: expected length {expected}, got {got}")]
     Dimension {
@@ -102,11 +92,5 @@ pub enum ModelError {
         format: &'static str,
         /// The parser's message.
         message: String,
-    },
-    /// A configuration where the constraint Jacobian loses rank (e.g. a singular slider-crank).
-    #[error("singular configuration: constraint Jacobian is rank deficient (joints {joints:?})")]
-    Singular {
-        /// The joints involved.
-        joints: Vec<String>,
     },
 }

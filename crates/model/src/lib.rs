@@ -30,11 +30,13 @@
 //! let sys = b.build()?;
 //! assert_eq!((sys.n_coords(), sys.n_constraints(), sys.dof()), (3, 2, 1));
 //!
-//! let x0 = sys.consistent_state(0.0)?;
+//! // the stored initial state (here already consistent; `mbd_solve::consistent_state`
+//! // projects a guess onto the constraints)
+//! let (q0, v0) = sys.initial_guess();
 //! let mut phi = vec![0.0; sys.n_constraints()];
-//! sys.phi(x0.q.as_slice(), 0.0, &mut phi);
+//! sys.phi(q0.as_slice(), 0.0, &mut phi);
 //! assert!(phi.iter().all(|r| r.abs() < 1e-12));
-//! assert!((sys.energy(x0.q.as_slice(), x0.v.as_slice()) + 9.81 * 0.5).abs() < 1e-12);
+//! assert!((sys.energy(q0.as_slice(), v0.as_slice()) + 9.81 * 0.5).abs() < 1e-12);
 //! # Ok::<(), mbd_model::ModelError>(())
 //! ```
 #![warn(missing_docs)]
@@ -65,7 +67,6 @@ pub use cache::AngleCache;
 pub use error::ModelError;
 pub use file::{ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};
-pub use init::{ConsistentState, ProjectionOptions};
 pub use joint::{Coordinate, Joint, JointKind};
 pub use scale::MAX_INERTIA_RATIO;
 pub use system::{ForceHandle, JointHandle, System};

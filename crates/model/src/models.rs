@@ -144,7 +144,7 @@ impl Default for SliderCrankParams {
 /// A slider-crank (closed loop): crank 0.15 m (1 kg) pinned to ground at the origin, connecting
 /// rod 0.5 m (1 kg), slider block 0.5 kg on a horizontal prismatic joint through the origin,
 /// gravity -y. Initial crank angle 45 degrees, crank spinning at 6 rad/s (a guess: use
-/// [`System::consistent_state`]).
+/// `mbd_solve::consistent_state`).
 pub fn slider_crank() -> Result<System, ModelError> {
     slider_crank_with(&SliderCrankParams::default())
 }
@@ -245,7 +245,7 @@ pub fn slider_crank_with(p: &SliderCrankParams) -> Result<System, ModelError> {
 
 /// A crank-rocker four-bar linkage (closed loop): ground pivots at (0,0) and (1,0), crank 0.4 m,
 /// coupler 1.2 m, rocker 0.8 m (1 kg uniform rods), gravity -y, crank at 60 degrees spinning at
-/// 4 rad/s (a guess: use [`System::consistent_state`]).
+/// 4 rad/s (a guess: use `mbd_solve::consistent_state`).
 pub fn four_bar() -> Result<System, ModelError> {
     let (lc, lk, lr) = (0.4, 1.2, 0.8);
     let d = [1.0, 0.0];

@@ -4,8 +4,8 @@ mod common;
 
 use mbd_model::models::{self, four_bar, pendulum};
 use mbd_model::{
-    Body, BodyHandle, BodyRef, Force, Joint, ModelError, ModelFile, ProjectionOptions, System,
-    SystemBuilder, TimeFunction,
+    Body, BodyHandle, BodyRef, Force, Joint, ModelError, ModelFile, System, SystemBuilder,
+    TimeFunction,
 };
 
 fn one_body() -> (SystemBuilder, BodyHandle) {
@@ -413,12 +413,16 @@ fn unreachable_initial_state() {
         1.0,
     ));
     let sys = b.build().unwrap();
-    match sys.consistent_state(0.0).unwrap_err() {
-        ModelError::Projection {
-            residual, equation, ..
+    match mbd_solve::consistent_state(&sys, 0.0).unwrap_err() {
+        mbd_solve::SolveError::Newton {
+            residual, context, ..
         } => {
             assert!(residual > 1.0, "{residual}");
-            assert!(equation.starts_with("left") || equation.starts_with("right"));
+            assert!(
+                context.contains("largest residual in left")
+                    || context.contains("largest residual in right"),
+                "{context}"
+            );
         }
         e => panic!("{e:?}"),
     }
@@ -580,18 +584,18 @@ fn unknown_fields_are_rejected() {
 #[test]
 fn wrong_length_vectors() {
     let sys = models::manipulator().unwrap();
-    let opts = ProjectionOptions::default();
+    let opts = mbd_solve::ConsistentOptions::default();
     assert_eq!(
-        sys.project(&[0.0; 5], &[0.0; 6], 0.0, opts).unwrap_err(),
-        ModelError::Dimension {
+        mbd_solve::project_state(&sys, &[0.0; 5], &[0.0; 6], 0.0, opts).unwrap_err(),
+        mbd_solve::SolveError::Dimension {
             what: "q_guess",
             expected: 6,
             got: 5
         }
     );
     assert_eq!(
-        sys.project(&[0.0; 6], &[0.0; 7], 0.0, opts).unwrap_err(),
-        ModelError::Dimension {
+        mbd_solve::project_state(&sys, &[0.0; 6], &[0.0; 7], 0.0, opts).unwrap_err(),
+        mbd_solve::SolveError::Dimension {
             what: "v_guess",
             expected: 6,
             got: 7
@@ -613,16 +617,38 @@ fn non_finite_guess() {
     let (q, v) = sys.initial_guess();
     let mut qb = q.as_slice().to_vec();
     qb[4] = f64::NAN;
-    let e = sys
-        .project(&qb, v.as_slice(), 0.0, ProjectionOptions::default())
-        .unwrap_err();
-    invalid(&e, "initial state", "q_guess");
+    let e = mbd_solve::project_state(
+        &sys,
+        &qb,
+        v.as_slice(),
+        0.0,
+        mbd_solve::ConsistentOptions::default(),
+    )
+    .unwrap_err();
+    assert_eq!(
+        e,
+        mbd_solve::SolveError::NonFinite {
+            t: 0.0,
+            what: "initial state q_guess"
+        }
+    );
     let mut vb = v.as_slice().to_vec();
     vb[0] = f64::INFINITY;
-    let e = sys
-        .project(q.as_slice(), &vb, 0.0, ProjectionOptions::default())
-        .unwrap_err();
-    invalid(&e, "initial state", "v_guess");
+    let e = mbd_solve::project_state(
+        &sys,
+        q.as_slice(),
+        &vb,
+        0.0,
+        mbd_solve::ConsistentOptions::default(),
+    )
+    .unwrap_err();
+    assert_eq!(
+        e,
+        mbd_solve::SolveError::NonFinite {
+            t: 0.0,
+            what: "initial state v_guess"
+        }
+    );
 }
 
 #[test]

@@ -125,7 +125,7 @@ point_b = [-0.5, 0.0]               # point_a defaults to the origin
     let (qa, _) = file.initial_guess();
     let (qb, _) = builder.initial_guess();
     assert!((qa - qb).amax() < 1e-15);
-    let xa = file.consistent_state(0.0).unwrap();
+    let xa = mbd_solve::consistent_state(&file, 0.0).unwrap();
     let ea = file.energy(xa.q.as_slice(), xa.v.as_slice());
     assert!((ea + 9.81 * 0.5 * 0.4f64.cos()).abs() < 1e-13, "{ea}");
 }

@@ -5,9 +5,7 @@ mod common;
 use common::*;
 use mbd_model::models::{self, chain, ChainParams};
 use mbd_model::nalgebra::DMatrix;
-use mbd_model::{
-    Body, BodyHandle, BodyRef, Joint, ProjectionOptions, System, SystemBuilder, TimeFunction,
-};
+use mbd_model::{Body, BodyHandle, BodyRef, Joint, System, SystemBuilder, TimeFunction};
 
 fn named_models() -> Vec<(&'static str, System)> {
     vec![
@@ -48,7 +46,7 @@ fn model_dimensions() {
 fn manipulator_initial_energy() {
     // theta1 = pi/3, theta2 = 0, at rest: H0 = g (m1 L1/2 sin60 + m2 (L1 sin60 + 0)) = 12.7436 J
     let sys = models::manipulator().unwrap();
-    let x0 = sys.consistent_state(0.0).unwrap();
+    let x0 = mbd_solve::consistent_state(&sys, 0.0).unwrap();
     let h0 = sys.energy(x0.q.as_slice(), x0.v.as_slice());
     assert!((h0 - 12.7436).abs() < 1e-4, "H0 = {h0}");
     let exact = 9.81 * (0.5 + 1.0) * 60f64.to_radians().sin();
@@ -117,7 +115,7 @@ fn chain_rejects_mismatched_lengths() {
 /// Projects perturbed consistent states; returns the smallest and largest position corrections.
 fn perturb_and_project(sys: &System, t: f64, seed: u64) -> (f64, f64) {
     let (n, m) = (sys.n_coords(), sys.n_constraints());
-    let base = sys.consistent_state(t).unwrap();
+    let base = mbd_solve::consistent_state(sys, t).unwrap();
     let mut r = rng(seed);
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for _ in 0..20 {
@@ -131,8 +129,7 @@ fn perturb_and_project(sys: &System, t: f64, seed: u64) -> (f64, f64) {
             .iter()
             .map(|x| x + uni(&mut r, -1e-3, 1e-3))
             .collect();
-        let x = sys
-            .project(&q, &v, t, ProjectionOptions::default())
+        let x = mbd_solve::project_state(sys, &q, &v, t, mbd_solve::ConsistentOptions::default())
             .unwrap();
         let (mut phi, mut pd) = (vec![0.0; m], vec![0.0; m]);
         sys.phi(x.q.as_slice(), t, &mut phi);
@@ -178,7 +175,7 @@ fn velocity_projection_is_m_orthogonal() {
     // v = v_guess - M^-1 Phi_q^T mu: the correction is the minimum kinetic-energy-norm one,
     // so for every admissible w (Phi_q w = 0): (v - v_guess)^T M w = 0.
     let sys = models::four_bar().unwrap();
-    let x = sys.consistent_state(0.0).unwrap();
+    let x = mbd_solve::consistent_state(&sys, 0.0).unwrap();
     let (v_guess_q, v_guess) = sys.initial_guess();
     let _ = v_guess_q;
     let dv = &x.v - &v_guess;
@@ -216,7 +213,7 @@ fn rheonomic_projection_includes_phi_t() {
     assert!(sys.is_rheonomic());
     assert_eq!(sys.dof(), 1);
     let t = 0.4;
-    let x = sys.consistent_state(t).unwrap();
+    let x = mbd_solve::consistent_state(&sys, t).unwrap();
     let m = sys.n_constraints();
     let (mut phi, mut pt, mut pd) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     sys.phi(x.q.as_slice(), t, &mut phi);
@@ -263,7 +260,13 @@ fn projection_far_from_the_origin() {
     for _ in 0..10 {
         let (q0, v0) = sys.initial_guess();
         let q: Vec<f64> = q0.iter().map(|x| x + uni(&mut r, -1e-3, 1e-3)).collect();
-        let x = sys.project(&q, v0.as_slice(), 0.0, ProjectionOptions::default());
+        let x = mbd_solve::project_state(
+            &sys,
+            &q,
+            v0.as_slice(),
+            0.0,
+            mbd_solve::ConsistentOptions::default(),
+        );
         let x = x.unwrap();
         // the best attainable: a few ulps of the coordinates (ulp(2.5e6) = 4.7e-10)
         assert!(x.residual <= 8.0 * f64::EPSILON * 2.6e6, "{:e}", x.residual);

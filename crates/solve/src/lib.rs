@@ -50,6 +50,7 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 mod accel;
+mod consistent;
 mod error;
 mod index1;
 mod integrator;
@@ -62,6 +63,7 @@ mod state;
 mod tableau;
 
 pub use accel::AccelerationSolver;
+pub use consistent::{consistent_state, project_state, ConsistentOptions, ConsistentState};
 pub use error::SolveError;
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{

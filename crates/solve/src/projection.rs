@@ -206,11 +206,17 @@ impl Projector {
         if stats.residual <= 1e3 * tol {
             return Ok(stats);
         }
+        let worst = (0..self.r.len())
+            .max_by(|&a, &b| self.r[a].abs().total_cmp(&self.r[b].abs()))
+            .unwrap_or(0);
         Err(SolveError::Newton {
             t,
             residual: stats.residual,
             iterations: stats.iterations,
-            context: "position projection".into(),
+            context: format!(
+                "position projection (largest residual in {})",
+                sys.equation_name(worst)
+            ),
         })
     }
 

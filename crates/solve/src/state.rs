@@ -1,7 +1,7 @@
 //! The state every integrator advances.
 
 use crate::error::SolveError;
-use mbd_model::{ConsistentState, System};
+use mbd_model::System;
 use nalgebra::DVector;
 
 /// Time, positions and velocities of a system.
@@ -50,7 +50,7 @@ impl State {
     /// The consistent initial state of the system's stored guess at time `t0` (projected onto
     /// the position and velocity constraints).
     pub fn consistent(sys: &System, t0: f64) -> Result<State, SolveError> {
-        let c: ConsistentState = sys.consistent_state(t0)?;
+        let c = crate::consistent::consistent_state(sys, t0)?;
         Ok(State {
             t: t0,
             q: c.q,
