@@ -30,6 +30,40 @@ pub enum FactorError {
     NotPositiveDefinite(usize),
 }
 
+/// Why an LU factorisation failed, in the caller's numbering of rows (equations) and columns
+/// (unknowns).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LuError {
+    /// No usable pivot for unknown `col`; `row` is the equation the elimination paired with it
+    /// (or could not pair).
+    #[error("singular matrix: no pivot for column {col} (row {row})")]
+    Singular {
+        /// The caller's row.
+        row: usize,
+        /// The caller's column (unknown).
+        col: usize,
+    },
+    /// Entry `(row, col)` is NaN or infinite.
+    #[error("non-finite matrix entry ({row}, {col})")]
+    NonFinite {
+        /// The caller's row.
+        row: usize,
+        /// The caller's column.
+        col: usize,
+    },
+}
+
+/// The power of two `2^-e` with `v 2^-e` in `[1, 2)`, for finite `v > 0` (clamped to the
+/// normal range, so it is never zero or infinite): the exact scale factor of the
+/// equilibrations.
+#[inline]
+pub fn pow2_inverse(v: f64) -> f64 {
+    let e = ((v.to_bits() >> 52) & 0x7ff) as i64; // biased exponent of v
+                                                  // 2^-(e - 1023) has biased exponent 2046 - e
+    let b = (2046 - e).clamp(1, 2046) as u64;
+    f64::from_bits(b << 52)
+}
+
 /// LU with partial pivoting of an `n x n` matrix, reusing its storage: `factor` then `solve`
 /// allocate nothing.
 #[derive(Debug)]
