@@ -45,36 +45,7 @@ const PIVOT_THRESHOLD: f64 = 0.1;
 /// a few hundred rounding errors of its O(1) entries.
 const PIVOT_TOL: f64 = 1e-14;
 
-/// Why a factorisation failed, in the caller's numbering.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum LuError {
-    /// No usable pivot for unknown `col`; `row` is the equation the elimination reached with
-    /// it (its partner in the ordering, or the row that was to be swapped in). An all-zero row
-    /// or column is reported with its ordering partner.
-    Singular {
-        /// The caller's row.
-        row: usize,
-        /// The caller's column (unknown).
-        col: usize,
-    },
-    /// Entry `(row, col)` is NaN or infinite.
-    NonFinite {
-        /// The caller's row.
-        row: usize,
-        /// The caller's column.
-        col: usize,
-    },
-}
-
-/// The power of two `2^-e` with `v 2^-e` in `[1, 2)`, for finite `v > 0` (clamped to the
-/// normal range, so it is never zero or infinite).
-#[inline]
-fn pow2_inverse(v: f64) -> f64 {
-    let e = ((v.to_bits() >> 52) & 0x7ff) as i64; // biased exponent of v
-                                                  // 2^-(e - 1023) has biased exponent 2046 - e
-    let b = (2046 - e).clamp(1, 2046) as u64;
-    f64::from_bits(b << 52)
-}
+pub(crate) use mbd_solve::linalg::{pow2_inverse, LuError};
 
 /// Nonzero lists of `L` (by columns) and `U` (by rows) of one factorisation.
 #[derive(Clone, Debug, Default)]
