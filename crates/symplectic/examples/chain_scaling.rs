@@ -8,8 +8,8 @@
 //! (`--reuse`: `reuse_jacobian = true`; `--dense`: force the dense stage solve.)
 use mbd_model::models;
 use mbd_solve::{
-    run, ButcherTableau, Index1Options, Index1Rk, Integrator, LinearSolver, NoObserver,
-    RunConfig, State,
+    run, ButcherTableau, Index1Options, Index1Rk, Integrator, LinearSolver, NoObserver, RunConfig,
+    State,
 };
 use mbd_symplectic::{Galerkin, SymplecticOptions};
 use std::time::Instant;

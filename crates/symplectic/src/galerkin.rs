@@ -1,11 +1,10 @@
 //! The (s,s) constrained Galerkin variational integrator, optionally preadjusted.
 
-use crate::lu::SmallLu;
 use crate::options::{kappa, Nodes, SymplecticOptions, MAX_PREDICTOR_ORDER};
 use crate::preadjust::Preadjustment;
 use crate::tables::Tables;
 use mbd_model::System;
-use mbd_solve::linalg::{max_abs as norm_inf, DenseCholesky};
+use mbd_solve::linalg::{max_abs as norm_inf, DenseCholesky, DenseLu};
 use mbd_solve::{AccelerationSolver, Integrator, LinearSolver, SolveError, State, StepStats};
 use nalgebra::DMatrix;
 use sparse::{add_transpose, SparseStage};
@@ -35,7 +34,7 @@ pub struct Galerkin {
     dx: Vec<f64>,
     r: Vec<f64>,
     xt: Vec<f64>,
-    lu: SmallLu,
+    lu: DenseLu,
     qk: Vec<f64>,
     hvk: Vec<f64>,
     qn: Vec<f64>,
@@ -85,7 +84,7 @@ pub struct Galerkin {
 /// coordinate `i`, the momentum rows `(nu, i)`, `nu = 0..s-1`, paired with the displacement
 /// unknowns `Z_(nu+1), i` (their `s x s` block is the stiffness matrix `K` when the Hessians
 /// are sparse); then the constraint rows with the multipliers (their Schur complement).
-fn stage_lu(n: usize, m: usize, s: usize) -> SmallLu {
+fn stage_lu(n: usize, m: usize, s: usize) -> DenseLu {
     let mut order: Vec<usize> = Vec::with_capacity(s * (n + m));
     for i in 0..n {
         for nu in 0..s {
@@ -93,7 +92,7 @@ fn stage_lu(n: usize, m: usize, s: usize) -> SmallLu {
         }
     }
     order.extend(s * n..s * (n + m));
-    SmallLu::with_ordering(order.clone(), order)
+    DenseLu::with_ordering(order.clone(), order)
 }
 
 impl Galerkin {
@@ -145,7 +144,7 @@ impl Galerkin {
             r: vec![0.0; dim],
             xt: vec![0.0; dim],
             lu: if use_sparse {
-                SmallLu::with_ordering(Vec::new(), Vec::new())
+                DenseLu::with_ordering(Vec::new(), Vec::new())
             } else {
                 stage_lu(n, m, s)
             },
@@ -266,7 +265,7 @@ impl Galerkin {
     fn solve_stage(&mut self, b: &mut [f64]) {
         match &mut self.sparse {
             Some(sp) => sp.lu.solve_in_place(b),
-            None => self.lu.solve(b),
+            None => self.lu.solve_in_place(b),
         }
     }
 
@@ -512,7 +511,7 @@ impl Galerkin {
         }
         self.jacobians += 1;
         self.jac_valid = false;
-        let res = self.lu.factor();
+        let res = self.lu.factor_lu();
         self.stage_error(sys, t, h, res)
     }
 
