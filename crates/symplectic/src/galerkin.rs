@@ -92,14 +92,12 @@ impl Galerkin {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let dim = s * (n + m);
         let tab = Tables::new(s, options.nodes);
-        let forces = !sys.forces().is_empty();
-        let sparse_ok = options.gamma == 0.0 && !forces;
+        let sparse_ok = options.gamma == 0.0;
         let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
-                "the sparse symplectic stage solve needs gamma = 0 and a model without force \
-                 elements (the preadjustment's Hessian is dense; force Hessians are not \
-                 available element by element)"
+                "the sparse symplectic stage solve needs gamma = 0 (the preadjustment's \
+                 Hessian is dense)"
                     .into(),
             ));
         }

@@ -66,4 +66,23 @@ fn sparse_steps_allocate_nothing() {
         let n = ALLOCS.with(|c| c.get()) - before;
         assert_eq!(n, 0, "s={s} reuse={reuse}: {n} allocations in 100 steps");
     }
+    // force elements with damping: the coloured force differences allocate nothing either
+    let sys = damped_spring_chain(30);
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    for s in [1, 2] {
+        let mut g = Galerkin::new(&sys, SymplecticOptions::new(s)).unwrap();
+        assert!(g.is_sparse());
+        let mut st = s0.clone();
+        for _ in 0..3 {
+            g.step(&sys, &mut st, 1e-3).unwrap();
+        }
+        let before = ALLOCS.with(|c| c.get());
+        for _ in 0..100 {
+            g.step(&sys, &mut st, 1e-3).unwrap();
+        }
+        let n = ALLOCS.with(|c| c.get()) - before;
+        assert_eq!(n, 0, "damped chain, s={s}: {n} allocations in 100 steps");
+    }
 }
+
+include!("common/damped.rs");

@@ -5,7 +5,7 @@
 //! bodies (see `docs/symplectic.md`, "Sparse stage solve").
 
 use super::Galerkin;
-use mbd_model::{JointHandle, System};
+use mbd_model::{BodyRef, JointHandle, System};
 use mbd_solve::linalg::LuError;
 use mbd_solve::sparse::{ConstraintSchur, SparseLu};
 use mbd_solve::{SolveError, SparseAccelerationSolver};
@@ -41,6 +41,25 @@ pub(super) struct SparseStage {
     vdir: Vec<f64>,
     gscratch: Vec<[f64; 6]>,
     dgrads: Vec<[f64; 6]>,
+    /// Force-Hessian entries `(row coordinate, column coordinate)`: every body that a force
+    /// element acts on, with itself and with each body it shares an element with.
+    fent: Vec<(usize, usize)>,
+    /// `fent_slot[(nu s + mu - 1) E + e]`: the slot of entry `e` in block (momentum row `nu`,
+    /// `Z_mu`).
+    fent_slot: Vec<usize>,
+    /// `fseed[3 k + l]`: the entries whose column is coordinate `l` of a body of force colour
+    /// `k` (a distance-2 colouring of the force graph: no row sees two bodies of one colour).
+    fseed: Vec<Vec<usize>>,
+    /// Bodies of each force colour.
+    fcolor_bodies: Vec<Vec<usize>>,
+    /// Values of the entries at one Gauss point: `d(grad V - Qnc)/dq` and `-dQnc/dv`.
+    hq: Vec<f64>,
+    hv: Vec<f64>,
+    /// Workspaces of the force differences.
+    qp: Vec<f64>,
+    vp: Vec<f64>,
+    gp: Vec<f64>,
+    gm: Vec<f64>,
     /// `Phi_q^T lambda` (scratch of the residual and the end momentum).
     pub(super) al: Vec<f64>,
     /// `Phi_q v` (scratch of the projection).
@@ -120,6 +139,43 @@ impl SparseStage {
                 }
             }
         }
+        // force graph: closed neighbourhoods of the bodies with a force element
+        let mut fnbr: Vec<Vec<usize>> = vec![Vec::new(); nb];
+        for f in sys.forces() {
+            let idx = |r: BodyRef| match r {
+                BodyRef::Body(h) if h.0 < nb => Some(h.0),
+                _ => None,
+            };
+            let (a, b) = f.bodies();
+            let (a, b) = (idx(a), idx(b));
+            for x in [a, b].into_iter().flatten() {
+                fnbr[x].push(x);
+                for y in [a, b].into_iter().flatten() {
+                    fnbr[x].push(y);
+                }
+            }
+        }
+        for v in &mut fnbr {
+            v.sort_unstable();
+            v.dedup();
+        }
+        let mut fent = Vec::new();
+        for (a, nbrs) in fnbr.iter().enumerate() {
+            for &b in nbrs {
+                for r in 0..3 {
+                    for c in 0..3 {
+                        fent.push((3 * a + r, 3 * b + c));
+                    }
+                }
+            }
+        }
+        for nu in 0..s {
+            for mu in 1..=s {
+                for &(i, l) in &fent {
+                    entries.push((nu * n + i, (mu - 1) * n + l));
+                }
+            }
+        }
         let lu = SparseLu::new(dim, &entries)?;
         let slot = |r: usize, c: usize| lu.slot(r, c).unwrap_or(NONE);
         let mut k_slot = vec![NONE; s * s * n];
@@ -179,6 +235,42 @@ impl SparseStage {
             }
             color_bodies[k].push(b);
         }
+        let mut fent_slot = vec![NONE; s * s * fent.len()];
+        for nu in 0..s {
+            for mu in 1..=s {
+                let base = (nu * s + mu - 1) * fent.len();
+                for (e, &(i, l)) in fent.iter().enumerate() {
+                    fent_slot[base + e] = slot(nu * n + i, (mu - 1) * n + l);
+                }
+            }
+        }
+        // distance-2 colouring of the bodies with force elements
+        let mut fcolor = vec![usize::MAX; nb];
+        let mut fcolor_bodies: Vec<Vec<usize>> = Vec::new();
+        for b in 0..nb {
+            if fnbr[b].is_empty() {
+                continue;
+            }
+            let mut k = 0;
+            let clash = |k: usize| {
+                fnbr[b]
+                    .iter()
+                    .any(|&x| fcolor[x] == k || fnbr[x].iter().any(|&y| fcolor[y] == k))
+            };
+            while clash(k) {
+                k += 1;
+            }
+            fcolor[b] = k;
+            if fcolor_bodies.len() <= k {
+                fcolor_bodies.resize(k + 1, Vec::new());
+            }
+            fcolor_bodies[k].push(b);
+        }
+        let mut fseed = vec![Vec::new(); 3 * fcolor_bodies.len()];
+        for (e, &(_, l)) in fent.iter().enumerate() {
+            fseed[3 * fcolor[l / 3] + l % 3].push(e);
+        }
+        let ne = fent.len();
         Ok(SparseStage {
             lu,
             row_bodies,
@@ -193,6 +285,16 @@ impl SparseStage {
             vdir: vec![0.0; n],
             gscratch: vec![[0.0; 6]; m],
             dgrads: vec![[0.0; 6]; m],
+            fent,
+            fent_slot,
+            fseed,
+            fcolor_bodies,
+            hq: vec![0.0; ne],
+            hv: vec![0.0; ne],
+            qp: vec![0.0; n],
+            vp: vec![0.0; n],
+            gp: vec![0.0; n],
+            gm: vec![0.0; n],
             al: vec![0.0; n],
             pv: vec![0.0; m],
         })
@@ -249,6 +351,91 @@ impl Galerkin {
                     for (&k, &v) in sp.con_slot[(nu - 1) * m + r].iter().zip(g) {
                         if k != NONE {
                             vals[k] = v;
+                        }
+                    }
+                }
+            }
+        }
+        // force Hessians at the Gauss points (coloured central differences)
+        if !sp.fent.is_empty() {
+            let nonconservative = self.nonconservative;
+            for j in 0..s {
+                let qj = &self.qj[j * n..(j + 1) * n];
+                let tj = t + tab.c[j] * h;
+                for (v, &hv) in sp.vp.iter_mut().zip(&self.hvj[j * n..(j + 1) * n]) {
+                    *v = hv / h;
+                }
+                sp.qp.copy_from_slice(qj);
+                // the generalised force with the sign of grad V: grad V - Qnc
+                let grad = |q: &[f64], v: &[f64], out: &mut [f64], tmp: &mut [f64]| {
+                    sys.potential_gradient(q, out);
+                    if nonconservative {
+                        sys.nonconservative_forces(q, v, tj, tmp);
+                        for (o, &f) in out.iter_mut().zip(tmp.iter()) {
+                            *o -= f;
+                        }
+                    }
+                };
+                for (k, bodies) in sp.fcolor_bodies.iter().enumerate() {
+                    for l in 0..3 {
+                        let seeds = &sp.fseed[3 * k + l];
+                        for (wrt_v, active) in [(false, true), (true, nonconservative)] {
+                            if !active {
+                                continue;
+                            }
+                            let x = if wrt_v { &mut sp.vp } else { &mut sp.qp };
+                            for &b in bodies {
+                                let c = 3 * b + l;
+                                x[c] += 1e-6 * (1.0 + x[c].abs());
+                            }
+                            grad(&sp.qp, &sp.vp, &mut sp.gp, &mut sp.al);
+                            let x = if wrt_v { &mut sp.vp } else { &mut sp.qp };
+                            for &b in bodies {
+                                let c = 3 * b + l;
+                                let x0 = if wrt_v {
+                                    self.hvj[j * n + c] / h
+                                } else {
+                                    qj[c]
+                                };
+                                x[c] = x0 - 1e-6 * (1.0 + x0.abs());
+                            }
+                            grad(&sp.qp, &sp.vp, &mut sp.gm, &mut sp.al);
+                            let x = if wrt_v { &mut sp.vp } else { &mut sp.qp };
+                            for &b in bodies {
+                                let c = 3 * b + l;
+                                x[c] = if wrt_v {
+                                    self.hvj[j * n + c] / h
+                                } else {
+                                    qj[c]
+                                };
+                            }
+                            let out = if wrt_v { &mut sp.hv } else { &mut sp.hq };
+                            for &e in seeds {
+                                let (i, c) = sp.fent[e];
+                                let x0 = if wrt_v {
+                                    self.hvj[j * n + c] / h
+                                } else {
+                                    qj[c]
+                                };
+                                let d = 1e-6 * (1.0 + x0.abs());
+                                out[e] = (sp.gp[i] - sp.gm[i]) / ((x0 + d) - (x0 - d));
+                            }
+                        }
+                    }
+                }
+                let vals = sp.lu.values_mut();
+                let ne = sp.fent.len();
+                for nu in 0..s {
+                    for mu in 1..=s {
+                        let ca = tab.b[j] * tab.a[j * s1 + nu] * tab.a[j * s1 + mu];
+                        let cv = tab.b[j] * tab.a[j * s1 + nu] * tab.d[j * s1 + mu] / h;
+                        let base = (nu * s + mu - 1) * ne;
+                        for (e, &(i, _)) in sp.fent.iter().enumerate() {
+                            let mut v = ca * sp.hq[e];
+                            if nonconservative {
+                                v += cv * sp.hv[e];
+                            }
+                            vals[sp.fent_slot[base + e]] += -(h2 * minv[i] * v);
                         }
                     }
                 }

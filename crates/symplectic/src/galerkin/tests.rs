@@ -69,6 +69,8 @@ fn check_jacobian(sys: &System, s: usize, gamma: f64, solver: LinearSolver) {
     );
 }
 
+include!("../../tests/common/damped.rs");
+
 #[test]
 fn jacobian_matches_finite_differences() {
     let sys = models::manipulator().unwrap();
@@ -80,6 +82,18 @@ fn jacobian_matches_finite_differences() {
     let sc = models::slider_crank().unwrap();
     check_jacobian(&sc, 2, 0.0, LinearSolver::Dense);
     check_jacobian(&sc, 3, 0.0, LinearSolver::Sparse);
+    // force elements (a spring-damper and a driving torque: stiffness and damping Hessians
+    // by coloured central differences on the sparse path)
+    let sq = models::andrews_squeezer().unwrap();
+    assert!(!sq.forces().is_empty());
+    let dc = damped_spring_chain(4);
+    assert!(!dc.is_conservative());
+    for s in 1..=2 {
+        for sys in [&sq, &dc] {
+            check_jacobian(sys, s, 0.0, LinearSolver::Dense);
+            check_jacobian(sys, s, 0.0, LinearSolver::Sparse);
+        }
+    }
     // the sparse assembly (coloured curvature seeds) on a chain with a free end
     let chain = models::n_link_chain(5).unwrap();
     for s in 1..=3 {
