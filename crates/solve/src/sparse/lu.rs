@@ -529,6 +529,35 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
+        // numerically dependent columns 3, 7, 10 (column 10 = column 3 + column 7, dense
+        // columns so no structural zero decides): the column named is one of them, in the
+        // caller's numbering (COLAMD permutes the columns); and likewise for dependent rows
+        let n = 12;
+        let a = random(n, 11);
+        let mut dc = a.clone();
+        for i in 0..n {
+            dc[i * n + 3] += 0.7 + 0.01 * i as f64;
+            dc[i * n + 7] -= 0.4;
+            dc[i * n + 10] = dc[i * n + 3] + dc[i * n + 7];
+        }
+        match load(&dc, n).factor() {
+            Err(LuError::Singular { col, .. }) => {
+                assert!([3, 7, 10].contains(&col), "col {col}")
+            }
+            other => panic!("{other:?}"),
+        }
+        let mut dr = random(n, 4);
+        for j in 0..n {
+            dr[2 * n + j] += 0.5 + 0.01 * j as f64;
+            dr[4 * n + j] -= 0.25;
+            dr[9 * n + j] = dr[2 * n + j] + dr[4 * n + j];
+        }
+        match load(&dr, n).factor() {
+            Err(LuError::Singular { row, .. }) => {
+                assert!([2, 4, 9].contains(&row), "row {row}")
+            }
+            other => panic!("{other:?}"),
+        }
         let mut lu = load(&[1.0, f64::NAN, 0.0, 1.0], 2);
         assert_eq!(lu.factor(), Err(LuError::NonFinite { row: 0, col: 1 }));
     }
