@@ -6,10 +6,10 @@ use crate::error::FaDaeError;
 use crate::objective::{StepProblem, Workspace};
 use crate::options::{FaDaeOptions, MissPolicy, PartitionChoice, Predictor};
 use crate::partition::{Partition, Pivoting};
-use crate::small::SmallLu;
 use mbd_firefly::{Bounds, Firefly, Objective, StopReason, SyncObjective};
 use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::System;
+use mbd_solve::linalg::DenseLu;
 use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
 use std::sync::Mutex;
 
@@ -225,7 +225,7 @@ pub struct FireflyGauss {
     /// Corrections available (0, 1, 2 = two or more).
     n_corr: u8,
     // polish
-    gn_lu: SmallLu,
+    gn_lu: DenseLu,
     gn_r: Vec<f64>,
     gn_rt: Vec<f64>,
     gn_dx: Vec<f64>,
@@ -291,7 +291,7 @@ impl FireflyGauss {
             corr_prev: d(),
             floor: d(),
             n_corr: 0,
-            gn_lu: SmallLu::new(2 * dof),
+            gn_lu: crate::objective::small_lu(2 * dof),
             gn_r: d(),
             gn_rt: d(),
             gn_dx: d(),
@@ -590,8 +590,8 @@ impl FireflyGauss {
         let q = state.q.as_slice();
         sys.phi_q(q, &mut self.ws.jac);
         self.partition
-            .fill_dependent_block(&self.ws.jac, self.ws.lu.matrix_mut());
-        let factored = self.ws.lu.factor();
+            .fill_dependent_block(&self.ws.jac, self.ws.lu.rows_mut());
+        let factored = self.ws.lu.factor_lu().map(|()| self.ws.lu.pivot_range());
         if let PartitionChoice::Given(_) = self.opts.partition {
             let ratio = match factored {
                 Ok((pmin, pmax)) => pmin / pmax,
@@ -858,18 +858,18 @@ impl FireflyGauss {
                     ok = false;
                     break;
                 }
-                let a = self.gn_lu.matrix_mut();
+                let a = self.gn_lu.rows_mut();
                 for i in 0..nd {
                     a[i * nd + j] = (self.gn_rt[i] - self.gn_r[i]) / eta;
                 }
             }
-            if !ok || self.gn_lu.factor().is_err() {
+            if !ok || self.gn_lu.factor_lu().is_err() {
                 break;
             }
             for i in 0..nd {
                 self.gn_dx[i] = -self.gn_r[i];
             }
-            self.gn_lu.solve(&mut self.gn_dx);
+            self.gn_lu.solve_in_place(&mut self.gn_dx);
             for i in 0..nd {
                 self.gn_xt[i] = self.best[i] + self.gn_dx[i];
             }

@@ -89,7 +89,6 @@ mod integrator;
 mod objective;
 mod options;
 mod partition;
-mod small;
 
 pub use accel::RefinedAcceleration;
 pub use error::FaDaeError;

@@ -8,9 +8,9 @@
 //! predictor's), so the serial and the parallel optimiser see identical values.
 
 use crate::partition::Partition;
-use crate::small::SmallLu;
 use mbd_model::numeric::max_abs;
 use mbd_model::System;
+use mbd_solve::linalg::DenseLu;
 use nalgebra::DMatrix;
 
 /// Cubic Hermite weights at one Gauss point `tau` of `[0, 1]`, for the forms
@@ -65,12 +65,12 @@ pub(crate) struct StepProblem {
     /// Start of the Newton iteration for the dependent coordinates (predicted `q_{k+1}`).
     pub q_start: Vec<f64>,
     /// LU of the dependent block of `Phi_q(q_start)` (chord Newton).
-    pub chord: SmallLu,
+    pub chord: DenseLu,
     /// `Phi_t(t1)`.
     pub phi_t1: Vec<f64>,
     /// LU of `G0 = N0^T M N0` at `q0` (the tangent metric that turns the projected residual
     /// into independent-coordinate accelerations).
-    pub metric: SmallLu,
+    pub metric: DenseLu,
     pub mass: Vec<f64>,
     pub nodes: [GaussNode; 2],
     /// Newton tolerance on `||Phi||_inf` (absolute, already scaled by the coordinates).
@@ -94,9 +94,9 @@ impl StepProblem {
             q0: vec![0.0; n],
             v0: vec![0.0; n],
             q_start: vec![0.0; n],
-            chord: SmallLu::new(m),
+            chord: crate::objective::small_lu(m),
             phi_t1: vec![0.0; m],
-            metric: SmallLu::new(dof),
+            metric: crate::objective::small_lu(dof),
             mass: sys.mass_diag().iter().copied().collect(),
             nodes: gauss_nodes(),
             newton_tol: 1e-14,
@@ -134,24 +134,24 @@ impl StepProblem {
         sys.phi_t(self.t1, &mut self.phi_t1);
         // chord Jacobian at the predicted positions
         sys.phi_q(&self.q_start, &mut ws.jac);
-        fill_block(&ws.jac, &self.dep, self.m, self.chord.matrix_mut());
+        fill_block(&ws.jac, &self.dep, self.m, self.chord.rows_mut());
         self.chord
-            .factor()
+            .factor_lu()
             .map_err(|_| "dependent block of Phi_q at the predicted state")?;
         // metric G0 = M_z + X^T M_d X with X = Phi_d^-1 Phi_z at q0
         sys.phi_q(q0, &mut ws.jac);
-        fill_block(&ws.jac, &self.dep, self.m, ws.lu.matrix_mut());
+        fill_block(&ws.jac, &self.dep, self.m, ws.lu.rows_mut());
         ws.lu
-            .factor()
+            .factor_lu()
             .map_err(|_| "dependent block of Phi_q at the step's start")?;
         let (m, dof) = (self.m, self.dof);
         for (c, &zc) in self.ind.iter().enumerate() {
             for r in 0..m {
                 ws.x[c * m + r] = ws.jac[(r, zc)];
             }
-            ws.lu.solve(&mut ws.x[c * m..(c + 1) * m]);
+            ws.lu.solve_in_place(&mut ws.x[c * m..(c + 1) * m]);
         }
-        let g = self.metric.matrix_mut();
+        let g = self.metric.rows_mut();
         for a in 0..dof {
             for b in 0..dof {
                 let mut s = if a == b { self.mass[self.ind[a]] } else { 0.0 };
@@ -162,7 +162,7 @@ impl StepProblem {
             }
         }
         self.metric
-            .factor()
+            .factor_lu()
             .map_err(|_| "tangent mass metric N^T M N")?;
         Ok(())
     }
@@ -192,7 +192,7 @@ impl StepProblem {
             if iters >= self.newton_max_iter {
                 return None;
             }
-            self.chord.solve(&mut ws.phi);
+            self.chord.solve_with(&mut ws.phi, &mut ws.ly, &mut ws.lx);
             for (r, &d) in self.dep.iter().enumerate() {
                 ws.q1[d] -= ws.phi[r];
             }
@@ -200,8 +200,8 @@ impl StepProblem {
         }
         // velocities: Phi_d v_d = -Phi_t - Phi_z zdot at the converged q1
         sys.phi_q(&ws.q1, &mut ws.jac);
-        fill_block(&ws.jac, &self.dep, m, ws.lu.matrix_mut());
-        ws.lu.factor().ok()?;
+        fill_block(&ws.jac, &self.dep, m, ws.lu.rows_mut());
+        ws.lu.factor_lu().ok()?;
         for r in 0..m {
             let mut s = -self.phi_t1[r];
             for (k, &i) in self.ind.iter().enumerate() {
@@ -209,7 +209,7 @@ impl StepProblem {
             }
             ws.rhs[r] = s;
         }
-        ws.lu.solve(&mut ws.rhs);
+        ws.lu.solve_in_place(&mut ws.rhs);
         for (k, &i) in self.ind.iter().enumerate() {
             ws.v1[i] = x[dof + k];
         }
@@ -244,14 +244,14 @@ impl StepProblem {
             }
             // eliminate lambda: rho = N^T r = r_z - Phi_z^T mu,  Phi_d^T mu = r_d
             sys.phi_q(&ws.qg, &mut ws.jac);
-            fill_block(&ws.jac, &self.dep, m, ws.lu.matrix_mut());
-            if ws.lu.factor().is_err() {
+            fill_block(&ws.jac, &self.dep, m, ws.lu.rows_mut());
+            if ws.lu.factor_lu().is_err() {
                 return false;
             }
             for (k, &d) in self.dep.iter().enumerate() {
                 ws.mu[k] = ws.r[d];
             }
-            ws.lu.solve_transpose(&mut ws.mu);
+            ws.lu.solve_transpose_in_place(&mut ws.mu);
             let rho = &mut out[g * dof..(g + 1) * dof];
             for (k, &i) in self.ind.iter().enumerate() {
                 let mut s = ws.r[i];
@@ -260,7 +260,7 @@ impl StepProblem {
                 }
                 rho[k] = s;
             }
-            self.metric.solve(rho);
+            self.metric.solve_with(rho, &mut ws.ly, &mut ws.lx);
             for x in rho.iter_mut() {
                 *x *= scale;
             }
@@ -315,7 +315,7 @@ pub(crate) struct Workspace {
     pub rhs: Vec<f64>,
     pub mu: Vec<f64>,
     pub jac: DMatrix<f64>,
-    pub lu: SmallLu,
+    pub lu: DenseLu,
     pub dq: Vec<f64>,
     pub qg: Vec<f64>,
     pub vg: Vec<f64>,
@@ -323,6 +323,9 @@ pub(crate) struct Workspace {
     pub force: Vec<f64>,
     pub x: Vec<f64>,
     pub res: Vec<f64>,
+    /// Workspace of the solves with the shared LUs (`max(m, dof)` each).
+    pub ly: Vec<f64>,
+    pub lx: Vec<f64>,
 }
 
 impl Workspace {
@@ -336,7 +339,7 @@ impl Workspace {
             rhs: vec![0.0; m],
             mu: vec![0.0; m],
             jac: DMatrix::zeros(m, n),
-            lu: SmallLu::new(m),
+            lu: crate::objective::small_lu(m),
             dq: vec![0.0; n],
             qg: vec![0.0; n],
             vg: vec![0.0; n],
@@ -344,6 +347,17 @@ impl Workspace {
             force: vec![0.0; n],
             x: vec![0.0; m * dof],
             res: vec![0.0; 2 * dof],
+            ly: vec![0.0; m.max(dof)],
+            lx: vec![0.0; m.max(dof)],
         }
     }
+}
+
+/// The project's dense LU ([`DenseLu`]) as the small LUs here use it: only an exactly zero (or
+/// non-finite) pivot fails the factorisation; the callers judge the conditioning themselves
+/// from [`DenseLu::pivot_range`] or [`DenseLu::log_abs_det`].
+pub(crate) fn small_lu(n: usize) -> DenseLu {
+    let mut lu = DenseLu::new(n);
+    lu.pivot_tol = 0.0;
+    lu
 }

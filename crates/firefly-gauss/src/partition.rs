@@ -88,9 +88,9 @@ impl Partition {
         };
         let mut j = DMatrix::zeros(m, n);
         sys.phi_q(q, &mut j);
-        let mut lu = crate::small::SmallLu::new(m);
-        p.fill_dependent_block(&j, lu.matrix_mut());
-        match lu.factor() {
+        let mut lu = crate::objective::small_lu(m);
+        p.fill_dependent_block(&j, lu.rows_mut());
+        match lu.factor_lu().map(|()| lu.pivot_range()) {
             Ok((pmin, pmax)) if pmin > 1e-10 * pmax => Ok(p),
             _ => Err(bad(
                 "the dependent block of Phi_q is singular at the initial state: these \

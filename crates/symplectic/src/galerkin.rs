@@ -1,13 +1,20 @@
 //! The (s,s) constrained Galerkin variational integrator, optionally preadjusted.
 
-use crate::lu::{LuError, SmallLu};
 use crate::options::{kappa, Nodes, SymplecticOptions, MAX_PREDICTOR_ORDER};
 use crate::preadjust::Preadjustment;
 use crate::tables::Tables;
+use dense::stage_lu;
 use mbd_model::System;
-use mbd_solve::linalg::{max_abs as norm_inf, DenseCholesky};
-use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
+use mbd_solve::linalg::{DenseCholesky, DenseLu};
+use mbd_solve::{AccelerationSolver, Integrator, LinearSolver, SolveError, State, StepStats};
 use nalgebra::DMatrix;
+use sparse::{add_transpose, SparseStage};
+
+mod dense;
+mod newton;
+mod sparse;
+#[cfg(test)]
+mod tests;
 
 /// The parameter-preadjusted (s,s) constrained Galerkin variational integrator (paper A).
 ///
@@ -30,7 +37,7 @@ pub struct Galerkin {
     dx: Vec<f64>,
     r: Vec<f64>,
     xt: Vec<f64>,
-    lu: SmallLu,
+    lu: DenseLu,
     qk: Vec<f64>,
     hvk: Vec<f64>,
     qn: Vec<f64>,
@@ -40,7 +47,12 @@ pub struct Galerkin {
     hq: Vec<DMatrix<f64>>,
     hv: Vec<DMatrix<f64>>,
     hess_nz: Vec<bool>,
+    /// Dense path: `Phi_q` at the control points `0..=s` (empty on the sparse path).
     phiq: Vec<DMatrix<f64>>,
+    /// Sparse path: `Phi_q` at the control points in element-local rows (empty when dense).
+    grads: Vec<Vec<[f64; 6]>>,
+    /// The sparse stage solve, if the system takes the sparse path.
+    sparse: Option<Box<SparseStage>>,
     hc: DMatrix<f64>,
     wgrad: Vec<f64>,
     wh: DMatrix<f64>,
@@ -49,7 +61,8 @@ pub struct Galerkin {
     proj: DenseCholesky,
     vm: Vec<f64>,
     mu: Vec<f64>,
-    acc: AccelerationSolver,
+    /// The dense index-1 solve of the first step's predictor (None on the sparse path).
+    acc: Option<AccelerationSolver>,
     acc_a: Vec<f64>,
     acc_l: Vec<f64>,
     hist_valid: bool,
@@ -69,22 +82,6 @@ pub struct Galerkin {
     jac_gk: f64,
     jacobians: usize,
 }
-
-/// The LU of the stage Jacobian with the elimination order that keeps it sparse: for each
-/// coordinate `i`, the momentum rows `(nu, i)`, `nu = 0..s-1`, paired with the displacement
-/// unknowns `Z_(nu+1), i` (their `s x s` block is the stiffness matrix `K` when the Hessians
-/// are sparse); then the constraint rows with the multipliers (their Schur complement).
-fn stage_lu(n: usize, m: usize, s: usize) -> SmallLu {
-    let mut order: Vec<usize> = Vec::with_capacity(s * (n + m));
-    for i in 0..n {
-        for nu in 0..s {
-            order.push(nu * n + i);
-        }
-    }
-    order.extend(s * n..s * (n + m));
-    SmallLu::with_ordering(order.clone(), order)
-}
-
 impl Galerkin {
     /// A scheme for `sys` with the given options (validated). Models with non-conservative
     /// forces are integrated by the discrete Lagrange-d'Alembert principle (forces at the Gauss
@@ -95,6 +92,22 @@ impl Galerkin {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let dim = s * (n + m);
         let tab = Tables::new(s, options.nodes);
+        let sparse_ok = options.gamma == 0.0;
+        let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
+        if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
+            return Err(SolveError::Unsupported(
+                "the sparse symplectic stage solve needs gamma = 0 (the preadjustment's \
+                 Hessian is dense)"
+                    .into(),
+            ));
+        }
+        let sparse = if use_sparse {
+            Some(Box::new(SparseStage::new(sys, s)?))
+        } else {
+            None
+        };
+        // the dense matrices are not allocated on the sparse path
+        let (nd, md) = if use_sparse { (0, 0) } else { (n, m) };
         let pre = if options.gamma != 0.0 {
             let mut p = Preadjustment::new(sys, s)?;
             p.fd_step = options.fd_step;
@@ -115,26 +128,44 @@ impl Galerkin {
             dx: vec![0.0; dim],
             r: vec![0.0; dim],
             xt: vec![0.0; dim],
-            lu: stage_lu(n, m, s),
+            lu: if use_sparse {
+                DenseLu::with_ordering(Vec::new(), Vec::new())
+            } else {
+                stage_lu(n, m, s)
+            },
             qk: vec![0.0; n],
             hvk: vec![0.0; n],
             qn: vec![0.0; (s + 1) * n],
             qj: vec![0.0; s * n],
             hvj: vec![0.0; s * n],
             gj: vec![0.0; s * n],
-            hq: vec![DMatrix::zeros(n, n); s],
-            hv: vec![DMatrix::zeros(n, n); s],
+            hq: vec![DMatrix::zeros(nd, nd); s],
+            hv: vec![DMatrix::zeros(nd, nd); s],
             hess_nz: vec![false; s],
-            phiq: vec![DMatrix::zeros(m, n); s + 1],
-            hc: DMatrix::zeros(n, n),
+            phiq: if use_sparse {
+                Vec::new()
+            } else {
+                vec![DMatrix::zeros(m, n); s + 1]
+            },
+            grads: if use_sparse {
+                vec![vec![[0.0; 6]; m]; s + 1]
+            } else {
+                Vec::new()
+            },
+            sparse,
+            hc: DMatrix::zeros(nd, nd),
             wgrad: vec![0.0; n],
-            wh: DMatrix::zeros(n, n),
+            wh: DMatrix::zeros(nd, nd),
             pre,
             tn: std::array::from_fn(|_| vec![0.0; n]),
-            proj: DenseCholesky::new(m),
+            proj: DenseCholesky::new(md),
             vm: vec![0.0; n],
             mu: vec![0.0; m],
-            acc: AccelerationSolver::new(sys),
+            acc: if use_sparse {
+                None
+            } else {
+                Some(AccelerationSolver::new(sys))
+            },
             acc_a: vec![0.0; n],
             acc_l: vec![0.0; m],
             hist_valid: false,
@@ -181,6 +212,46 @@ impl Galerkin {
     /// Number of Jacobian evaluations (and LU factorisations) since the integrator was built.
     pub fn jacobian_count(&self) -> usize {
         self.jacobians
+    }
+
+    /// Whether the stage equations are solved by the sparse path (see
+    /// [`SymplecticOptions::linear_solver`]).
+    pub fn is_sparse(&self) -> bool {
+        self.sparse.is_some()
+    }
+
+    /// Stored entries of the sparse stage Jacobian and of its LU factors (0, 0 on the dense
+    /// path; the factors' count after the first factorisation).
+    pub fn sparse_nnz(&self) -> (usize, usize) {
+        self.sparse
+            .as_ref()
+            .map_or((0, 0), |sp| (sp.lu.nnz(), sp.lu.factor_nnz()))
+    }
+
+    /// `Phi_q` at the start of a step, `q_k` (or copied from the end of the last step).
+    fn start_phiq(&mut self, sys: &System, reuse: bool) {
+        let s = self.tab.s;
+        if self.sparse.is_some() {
+            if reuse {
+                let (first, rest) = self.grads.split_at_mut(1);
+                first[0].copy_from_slice(&rest[s - 1]);
+            } else {
+                sys.phi_q_local(&self.qk, &mut self.grads[0]);
+            }
+        } else if reuse {
+            let (first, rest) = self.phiq.split_at_mut(1);
+            first[0].copy_from(&rest[s - 1]);
+        } else {
+            sys.phi_q(&self.qk, &mut self.phiq[0]);
+        }
+    }
+
+    /// Solves the factored stage Jacobian in place.
+    fn solve_stage(&mut self, b: &mut [f64]) {
+        match &mut self.sparse {
+            Some(sp) => sp.lu.solve_in_place(b),
+            None => self.lu.solve_in_place(b),
+        }
     }
 
     /// Residual of the stage equations at `self.x` into `self.r`.
@@ -267,6 +338,31 @@ impl Galerkin {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let tab = &self.tab;
         let h2 = h * h;
+        if let Some(sp) = &mut self.sparse {
+            for nu in 0..s {
+                if nu >= 1 {
+                    sys.phi_q_local(&self.qn[nu * n..(nu + 1) * n], &mut self.grads[nu]);
+                }
+                let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
+                sp.al.fill(0.0);
+                add_transpose(&self.grads[nu], &sp.row_bodies, lam, &mut sp.al);
+                let (bd, ba) = (&tab.bd[nu * s..(nu + 1) * s], &tab.ba[nu * s..(nu + 1) * s]);
+                for i in 0..n {
+                    let mut ak = 0.0;
+                    let mut ag = 0.0;
+                    for j in 0..s {
+                        ak += bd[j] * self.hvj[j * n + i];
+                        ag += ba[j] * self.gj[j * n + i];
+                    }
+                    let mut res = ak - h2 * self.minv[i] * (ag + sp.al[i]);
+                    if nu == 0 {
+                        res += self.hvk[i];
+                    }
+                    self.r[nu * n + i] = res;
+                }
+            }
+            return;
+        }
         for nu in 0..s {
             if nu >= 1 {
                 sys.phi_q(&self.qn[nu * n..(nu + 1) * n], &mut self.phiq[nu]);
@@ -296,123 +392,13 @@ impl Galerkin {
         }
     }
 
-    /// Jacobian of the stage equations at `self.x` (after `residual` at the same point), factored.
+    /// Jacobian of the stage equations at `self.x` (after `residual` at the same point),
+    /// factored: dense or sparse assembly (`dense.rs`, `sparse.rs`).
     fn jacobian(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
-        let (n, m, s) = (self.n, self.m, self.tab.s);
-        let s1 = s + 1;
-        sys.phi_q(&self.qn[s * n..(s + 1) * n], &mut self.phiq[s]);
-        let any_hessian = self.has_forces || self.pre.is_some() || self.nonconservative;
-        for j in 0..s {
-            if !any_hessian {
-                self.hess_nz[j] = false;
-                continue;
-            }
-            let qj = &self.qj[j * n..(j + 1) * n];
-            if self.has_forces {
-                sys.potential_hessian(qj, &mut self.hq[j]);
-            } else {
-                self.hq[j].fill(0.0);
-            }
-            if let Some(pre) = &mut self.pre {
-                pre.approximate_hessian(sys, qj, &mut self.wh)
-                    .map_err(|e| with_time(e, t))?;
-                for (a, b) in self.hq[j].iter_mut().zip(self.wh.iter()) {
-                    *a += self.gk * b;
-                }
-            }
-            if self.nonconservative {
-                self.nc_jacobian(sys, j, t + self.tab.c[j] * h, h);
-            }
-            self.hess_nz[j] = self.hq[j].iter().any(|&x| x != 0.0)
-                || (self.nonconservative && self.hv[j].iter().any(|&x| x != 0.0));
-        }
-        let h2 = h * h;
-        let tab = &self.tab;
-        let jm = &mut self.lu;
-        jm.clear();
-        for nu in 0..s {
-            for mu in 1..=s {
-                let (ro, co) = (nu * n, (mu - 1) * n);
-                let kk = tab.k[nu * s1 + mu];
-                for i in 0..n {
-                    jm.add(ro + i, co + i, kk);
-                }
-                for j in 0..s {
-                    if !self.hess_nz[j] {
-                        continue;
-                    }
-                    let ca = tab.b[j] * tab.a[j * s1 + nu] * tab.a[j * s1 + mu];
-                    let cv = tab.b[j] * tab.a[j * s1 + nu] * tab.d[j * s1 + mu] / h;
-                    for l in 0..n {
-                        for i in 0..n {
-                            let mut v = ca * self.hq[j][(i, l)];
-                            if self.nonconservative {
-                                v += cv * self.hv[j][(i, l)];
-                            }
-                            jm.add(ro + i, co + l, -(h2 * self.minv[i] * v));
-                        }
-                    }
-                }
-            }
-            // multiplier columns
-            let co = s * n + nu * m;
-            for r in 0..m {
-                for i in 0..n {
-                    let g = self.phiq[nu][(r, i)];
-                    if g != 0.0 {
-                        jm.set(nu * n + i, co + r, -h2 * self.minv[i] * g);
-                    }
-                }
-            }
-        }
-        // constraint curvature at the interior control points
-        for nu in 1..s {
-            let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
-            sys.constraint_hessian(&self.qn[nu * n..(nu + 1) * n], lam, &mut self.hc);
-            let jm = &mut self.lu;
-            let o = (nu - 1) * n;
-            for l in 0..n {
-                for i in 0..n {
-                    let c = self.hc[(i, l)];
-                    if c != 0.0 {
-                        jm.add(nu * n + i, o + l, -(h2 * self.minv[i] * c));
-                    }
-                }
-            }
-        }
-        {
-            let jm = &mut self.lu;
-            for nu in 1..=s {
-                let ro = s * n + (nu - 1) * m;
-                let co = (nu - 1) * n;
-                for r in 0..m {
-                    for l in 0..n {
-                        let g = self.phiq[nu][(r, l)];
-                        if g != 0.0 {
-                            jm.set(ro + r, co + l, g);
-                        }
-                    }
-                }
-            }
-        }
-        self.jacobians += 1;
-        self.jac_valid = false;
-        match self.lu.factor() {
-            Ok(()) => Ok(()),
-            Err(LuError::Singular { row, col }) => Err(SolveError::Singular {
-                t,
-                what: "Jacobian of the symplectic stage equations",
-                detail: format!(
-                    "no pivot for the {} in the {} (h = {h}; redundant constraints or a \
-                     singular configuration)",
-                    self.unknown_name(sys, col),
-                    self.equation_name(sys, row)
-                ),
-            }),
-            Err(LuError::NonFinite { .. }) => Err(SolveError::NonFinite {
-                t,
-                what: "Jacobian of the symplectic stage equations",
-            }),
+        if self.sparse.is_some() {
+            self.jacobian_sparse(sys, t, h)
+        } else {
+            self.jacobian_dense(sys, t, h)
         }
     }
 
@@ -451,279 +437,6 @@ impl Galerkin {
             )
         }
     }
-
-    /// Central-difference Jacobians of the non-conservative forces at Gauss point `j`:
-    /// `hq[j] -= dQnc/dq`, `hv[j] = -dQnc/dv`.
-    fn nc_jacobian(&mut self, sys: &System, j: usize, tj: f64, h: f64) {
-        let n = self.n;
-        let [q, v, fp, fm] = &mut self.tn;
-        q.copy_from_slice(&self.qj[j * n..(j + 1) * n]);
-        for i in 0..n {
-            v[i] = self.hvj[j * n + i] / h;
-        }
-        for l in 0..n {
-            let dq = 1e-6 * (1.0 + q[l].abs());
-            let q0 = q[l];
-            q[l] = q0 + dq;
-            sys.nonconservative_forces(q, v, tj, fp);
-            q[l] = q0 - dq;
-            sys.nonconservative_forces(q, v, tj, fm);
-            q[l] = q0;
-            for i in 0..n {
-                self.hq[j][(i, l)] -= (fp[i] - fm[i]) / (2.0 * dq);
-            }
-            let dv = 1e-6 * (1.0 + v[l].abs());
-            let v0 = v[l];
-            v[l] = v0 + dv;
-            sys.nonconservative_forces(q, v, tj, fp);
-            v[l] = v0 - dv;
-            sys.nonconservative_forces(q, v, tj, fm);
-            v[l] = v0;
-            for i in 0..n {
-                self.hv[j][(i, l)] = -(fp[i] - fm[i]) / (2.0 * dv);
-            }
-        }
-    }
-
-    /// Initial guess of the unknowns.
-    fn predict(&mut self, sys: &System, state: &State, h: f64) -> Result<(), SolveError> {
-        let (n, m, s) = (self.n, self.m, self.tab.s);
-        let s1 = s + 1;
-        let usable = self.hist_valid
-            && (self.hist_t - state.t).abs() <= 1e-9 * h
-            && (self.hist_h - h).abs() <= 1e-9 * h
-            && self.hist_q.as_slice() == state.q.as_slice();
-        let p = self.opts.predictor_order;
-        if usable && p > 0 && self.hist_len > p {
-            // multistep: the degree-p polynomial through the last p + 1 solutions at t_k + h,
-            // x_{k+1} = sum_i (-1)^i C(p+1, i+1) x_{k-i}
-            let dim = self.dim;
-            self.x.fill(0.0);
-            let mut c = (p + 1) as f64;
-            for i in 0..=p {
-                let xi = &self.hist_multi[i * dim..(i + 1) * dim];
-                for (a, b) in self.x.iter_mut().zip(xi) {
-                    *a += c * b;
-                }
-                // next coefficient: -C(p+1, i+2) = -C(p+1, i+1) (p - i) / (i + 2)
-                c = -c * (p - i) as f64 / (i + 2) as f64;
-            }
-        } else if usable {
-            // extrapolate the previous step's polynomial: Q_nu ~ sum_mu l_mu(1 + tau_nu) Q'_mu,
-            // written in displacements from q_k = Q'_s
-            for nu in 1..=s {
-                for i in 0..n {
-                    let zs = self.hist_multi[(s - 1) * n + i];
-                    let mut acc = 0.0;
-                    for mu in 0..=s {
-                        let zm = if mu == 0 {
-                            0.0
-                        } else {
-                            self.hist_multi[(mu - 1) * n + i]
-                        };
-                        acc += self.tab.e[(nu - 1) * s1 + mu] * (zm - zs);
-                    }
-                    self.x[(nu - 1) * n + i] = acc;
-                }
-            }
-            self.x[s * n..].copy_from_slice(&self.hist_multi[s * n..self.dim]);
-        } else {
-            self.acc.solve(
-                sys,
-                state.q.as_slice(),
-                state.v.as_slice(),
-                state.t,
-                &mut self.acc_a,
-                &mut self.acc_l,
-            )?;
-            for nu in 1..=s {
-                let th = self.tab.tau[nu] * h;
-                for i in 0..n {
-                    self.x[(nu - 1) * n + i] = th * state.v[i] + 0.5 * th * th * self.acc_a[i];
-                }
-            }
-            for nu in 0..s {
-                for r in 0..m {
-                    self.x[s * n + nu * m + r] = self.tab.w[nu] * self.acc_l[r];
-                }
-            }
-        }
-        Ok(())
-    }
-
-    fn newton(&mut self, sys: &System, t: f64, h: f64) -> Result<StepStats, SolveError> {
-        let o = self.opts.newton;
-        // Tolerance: relative to the positions, not the angles (which grow without bound on
-        // rotating bodies), plus the round-off floor of the constraints, which is set by the
-        // angles: cos and sin of theta carry an error of about eps |theta|. (NaN-safe: the
-        // state was checked finite, but a NaN here would make every test below pass.)
-        let pscale = 1.0 + position_scale(&self.qk);
-        let qscale = 1.0 + norm_inf(&self.qk);
-        let tol = o.tol * pscale + 4.0 * f64::EPSILON * qscale;
-        let sn = self.tab.s * self.n;
-        self.residual(sys, t, h)?;
-        let mut res = norm_inf(&self.r);
-        let mut evals = 1;
-        let mut it = 0;
-        let fail = |res: f64, it: usize, s: usize| SolveError::Newton {
-            t,
-            residual: res,
-            iterations: it,
-            context: format!("symplectic ({s},{s}) stage equations, h = {h}"),
-        };
-        if !res.is_finite() {
-            return Err(fail(res, 0, self.tab.s));
-        }
-        // simplified Newton: one Jacobian per step (or the last step's, if reuse is on), kept
-        // while it contracts by 4x per iteration, recomputed every `jacobian_every` iterations
-        let mut need_jacobian = !(self.opts.reuse_jacobian
-            && self.jac_valid
-            && (self.jac_h - h).abs() <= 1e-12 * h
-            && self.jac_gk == self.gk);
-        let mut chord = !need_jacobian;
-        let mut since_jacobian = 0usize;
-        let mut prev_step = f64::INFINITY;
-        // Converged when the residual and the last displacement update are both below the
-        // tolerance (or by the contraction estimate below), so never on the predictor alone:
-        // its error is smooth in time and, accepted unchanged, accumulates coherently from step
-        // to step (docs/symplectic.md, "Newton").
-        let mut last_dz = f64::INFINITY;
-        while !(res <= tol && last_dz <= tol) {
-            if it >= o.max_iter {
-                return Err(fail(res, it, self.tab.s));
-            }
-            if need_jacobian || since_jacobian >= o.jacobian_every {
-                self.jacobian(sys, t, h)?;
-                self.jac_valid = true;
-                self.jac_h = h;
-                self.jac_gk = self.gk;
-                since_jacobian = 0;
-                need_jacobian = false;
-                chord = false;
-                prev_step = f64::INFINITY;
-            }
-            since_jacobian += 1;
-            for i in 0..self.dim {
-                self.dx[i] = -self.r[i];
-            }
-            self.lu.solve(&mut self.dx);
-            if res <= tol {
-                // The residual is converged, but no update has been made yet (the predictor's
-                // residual was already below the tolerance) or the last one was not below the
-                // tolerance: the error left is then about the size of this update, smooth in
-                // time, and would accumulate from step to step. This update is applied without
-                // a new residual: what it leaves is quadratic in it (or theta times it), and the
-                // forces and Phi_q at the interior points that the end momentum uses are those
-                // of the previous iterate, whose displacements differ by this update (of the
-                // order of the tolerance): an error of that order times h in the momentum.
-                for (x, d) in self.x.iter_mut().zip(&self.dx) {
-                    *x += d;
-                }
-                self.place_control_points();
-                it += 1;
-                break;
-            }
-            // simplified-Newton stopping rule (Hairer & Wanner, IV.8): with the contraction
-            // theta estimated from two updates with the same Jacobian, the error left after
-            // this update is about theta / (1 - theta) |dZ|; when that is below the tolerance
-            // the update is applied and only the constraints are checked at the result (the
-            // momentum rows, with Phi_q at the interior control points, are not re-evaluated)
-            let dz = norm_inf(&self.dx[..sn]);
-            if prev_step.is_finite() && dz.is_finite() {
-                let theta = dz / prev_step;
-                let left = theta / (1.0 - theta) * dz;
-                if theta < 0.5 && left <= 0.1 * tol {
-                    for (x, d) in self.x.iter_mut().zip(&self.dx) {
-                        *x += d;
-                    }
-                    self.kinematics(sys, t, h)?;
-                    self.constraint_rows(sys, t, h);
-                    evals += 1;
-                    it += 1;
-                    let cres = norm_inf(&self.r[sn..]);
-                    if cres <= tol {
-                        res = cres.max(left);
-                        break;
-                    }
-                    // the constraints are not met yet: complete the residual and go on
-                    self.momentum_rows(sys, h);
-                    res = norm_inf(&self.r);
-                    prev_step = dz;
-                    continue;
-                }
-            }
-            self.xt.copy_from_slice(&self.x);
-            let mut lambda = 1.0;
-            let mut halvings = 0;
-            let res_before = res;
-            loop {
-                for i in 0..self.dim {
-                    self.x[i] = self.xt[i] + lambda * self.dx[i];
-                }
-                self.residual(sys, t, h)?;
-                evals += 1;
-                let rn = norm_inf(&self.r);
-                if (rn.is_finite() && rn < res) || halvings >= o.max_halvings {
-                    res = rn;
-                    break;
-                }
-                lambda *= 0.5;
-                halvings += 1;
-            }
-            it += 1;
-            let step = lambda * norm_inf(&self.dx[..sn]);
-            let poor = step > 0.25 * prev_step && step > 1e3 * f64::EPSILON * qscale;
-            // (a residual that grew but is below the tolerance is round-off: the update from
-            // an already converged predictor is kept)
-            let worse = res > res_before && res > tol;
-            if poor || !res.is_finite() || (chord && worse) {
-                // the Jacobian does not contract well: recompute it here
-                need_jacobian = true;
-                last_dz = step;
-                if !res.is_finite() || worse {
-                    last_dz = f64::INFINITY;
-                    self.x.copy_from_slice(&self.xt);
-                    self.residual(sys, t, h)?;
-                    evals += 1;
-                    res = norm_inf(&self.r);
-                }
-                prev_step = f64::INFINITY;
-                continue;
-            }
-            prev_step = step;
-            last_dz = step;
-            if !res.is_finite() {
-                return Err(fail(res, it, self.tab.s));
-            }
-            if step <= o.step_tol * qscale {
-                // stagnated at round-off: accept if the residual is sane
-                if res <= 1e-8 * qscale {
-                    break;
-                }
-                return Err(fail(res, it, self.tab.s));
-            }
-        }
-        Ok(StepStats {
-            newton_iterations: it,
-            residual: res,
-            rhs_evals: evals,
-            objective_evals: 0,
-            ..Default::default()
-        })
-    }
-}
-
-/// `max |x_i|, |y_i|` over the bodies (every third coordinate is an angle); NaN if any is NaN.
-fn position_scale(q: &[f64]) -> f64 {
-    let mut m = 0.0f64;
-    for c in q.chunks(3) {
-        let a = norm_inf(&c[..2.min(c.len())]);
-        if a.is_nan() {
-            return f64::NAN;
-        }
-        m = m.max(a);
-    }
-    m
 }
 
 fn with_time(e: SolveError, t: f64) -> SolveError {
@@ -785,13 +498,9 @@ impl Integrator for Galerkin {
         for i in 0..n {
             self.hvk[i] = h * state.v[i];
         }
-        if self.end_phiq_valid && self.hist_q == self.qk {
-            // Phi_q at the end of the previous step, which is where this one starts
-            let (first, rest) = self.phiq.split_at_mut(1);
-            first[0].copy_from(&rest[s - 1]);
-        } else {
-            sys.phi_q(&self.qk, &mut self.phiq[0]);
-        }
+        // (reuse: Phi_q at the end of the previous step, which is where this one starts)
+        let reuse = self.end_phiq_valid && self.hist_q == self.qk;
+        self.start_phiq(sys, reuse);
         self.end_phiq_valid = false;
         self.gk = self.opts.gamma * self.kappa * h.powi(2 * s as i32);
         self.predict(sys, state, h)?;
@@ -810,7 +519,12 @@ impl Integrator for Galerkin {
                 *fi += bj * g;
             }
         }
-        if m > 0 {
+        if let Some(sp) = &self.sparse {
+            let lts = self.x[s * n..].chunks_exact(m);
+            for (grads, lt) in self.grads[..s].iter().zip(lts) {
+                add_transpose(grads, &sp.row_bodies, lt, f);
+            }
+        } else if m > 0 {
             let lts = self.x[s * n..].chunks_exact(m);
             for (phiq, lt) in self.phiq[..s].iter().zip(lts) {
                 // (Phi_q^T lt)_i: column i of the column-major m x n Phi_q
@@ -830,7 +544,27 @@ impl Integrator for Galerkin {
         }
         let qn1 = &self.qn[s * n..(s + 1) * n];
         let t1 = t + h;
-        if m > 0 {
+        if let Some(sp) = &mut self.sparse {
+            // M^-1-orthogonal projection onto Phi_q v + Phi_t = 0, O(N) (docs/symplectic.md)
+            sp.schur.update(sys, qn1);
+            self.grads[s].copy_from_slice(sp.schur.grads());
+            self.end_phiq_valid = true;
+            sp.schur
+                .factor(&self.minv)
+                .map_err(|_| SolveError::Singular {
+                    t: t1,
+                    what: "momentum projection matrix Phi_q M^-1 Phi_q^T",
+                    detail: "redundant constraints or a singular configuration".into(),
+                })?;
+            sys.phi_t(t1, &mut self.mu);
+            sp.schur.apply(&self.vm, &mut sp.pv);
+            for (mu, &pv) in self.mu.iter_mut().zip(&sp.pv) {
+                *mu += pv;
+            }
+            sp.schur.solve_in_place(&mut self.mu);
+            sp.schur
+                .add_weighted_transpose(-1.0, &self.minv, &self.mu, &mut self.vm);
+        } else if m > 0 {
             sys.phi_q(qn1, &mut self.phiq[s]);
             self.end_phiq_valid = true;
             let g = &self.phiq[s];
@@ -883,146 +617,5 @@ impl Integrator for Galerkin {
         self.hist_h = h;
         self.hist_valid = true;
         Ok(stats)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use mbd_model::models;
-
-    /// The analytic Jacobian against central differences of the residual, at a point off the
-    /// solution (random-ish unknowns), for several s and models.
-    fn check_jacobian(sys: &System, s: usize, gamma: f64) {
-        let st = State::consistent(sys, 0.0).unwrap();
-        let mut st = st;
-        for i in 0..st.v.len() {
-            st.v[i] += 0.3 * ((i as f64) * 1.7).sin();
-        }
-        let h = 0.05;
-        let mut g = Galerkin::new(sys, SymplecticOptions::new(s).with_gamma(gamma)).unwrap();
-        g.qk.copy_from_slice(st.q.as_slice());
-        for i in 0..g.n {
-            g.hvk[i] = h * st.v[i];
-        }
-        sys.phi_q(&g.qk, &mut g.phiq[0]);
-        g.gk = gamma * g.kappa * h.powi(2 * s as i32);
-        g.predict(sys, &st, h).unwrap();
-        for i in 0..g.dim {
-            g.x[i] += 1e-3 * ((i as f64) * 0.77).cos();
-        }
-        g.residual(sys, 0.0, h).unwrap();
-        // analytic, unfactored: rebuild by solving with unit vectors is awkward; instead compare
-        // J * e_k via the LU: J^{-1} (FD column) = e_k
-        g.jacobian(sys, 0.0, h).unwrap();
-        let x0 = g.x.clone();
-        let dim = g.dim;
-        let mut worst: f64 = 0.0;
-        for k in 0..dim {
-            let d = 1e-6;
-            g.x.copy_from_slice(&x0);
-            g.x[k] += d;
-            g.residual(sys, 0.0, h).unwrap();
-            let rp = g.r.clone();
-            g.x[k] -= 2.0 * d;
-            g.residual(sys, 0.0, h).unwrap();
-            let mut col: Vec<f64> = rp
-                .iter()
-                .zip(&g.r)
-                .map(|(a, b)| (a - b) / (2.0 * d))
-                .collect();
-            g.lu.solve(&mut col);
-            for (i, c) in col.iter().enumerate() {
-                let e = if i == k { 1.0 } else { 0.0 };
-                worst = worst.max((c - e).abs());
-            }
-        }
-        let tolerance = if gamma == 0.0 { 1e-6 } else { 1e-2 };
-        assert!(
-            worst < tolerance,
-            "s={s} gamma={gamma}: J^-1 J_fd - I = {worst:e}"
-        );
-    }
-
-    #[test]
-    fn jacobian_matches_finite_differences() {
-        let sys = models::manipulator().unwrap();
-        for s in 1..=4 {
-            check_jacobian(&sys, s, 0.0);
-        }
-        check_jacobian(&sys, 2, 1.0);
-        let sc = models::slider_crank().unwrap();
-        check_jacobian(&sc, 2, 0.0);
-    }
-
-    /// A stage matrix that is singular (a slider-crank with crank = rod at the dead point,
-    /// where the slider's constraint rows lose rank) is reported as singular at every h, with
-    /// the unknown and the equation named; the same mechanism off the dead point is not.
-    #[test]
-    fn singular_stage_matrix_is_reported() {
-        use mbd_model::models::{slider_crank_with, SliderCrankParams};
-        let r = 0.3;
-        let sys = slider_crank_with(&SliderCrankParams {
-            crank: r,
-            rod: r,
-            ..Default::default()
-        })
-        .unwrap();
-        let half_pi = std::f64::consts::FRAC_PI_2;
-        // crank up, rod down, slider on the crank pivot
-        let dead = [0.0, 0.5 * r, half_pi, 0.0, 0.5 * r, -half_pi, 0.0, 0.0, 0.0];
-        let st = State::consistent(&sys, 0.0).unwrap();
-        for s in 1..=3 {
-            for h in [1e-7, 1e-3, 1e-1] {
-                let mut g = Galerkin::new(&sys, SymplecticOptions::new(s)).unwrap();
-                for (q, at_dead) in [(st.q.as_slice(), false), (&dead[..], true)] {
-                    g.qk.copy_from_slice(q);
-                    g.hvk.fill(0.0);
-                    sys.phi_q(&g.qk, &mut g.phiq[0]);
-                    g.x.fill(0.0);
-                    g.residual(&sys, 0.0, h).unwrap();
-                    match (g.jacobian(&sys, 0.0, h), at_dead) {
-                        (Ok(()), false) => {}
-                        (Err(SolveError::Singular { detail, .. }), true) => {
-                            assert!(
-                                detail.contains("multiplier of") || detail.contains("constraint"),
-                                "s = {s}, h = {h}: {detail}"
-                            );
-                        }
-                        (other, _) => panic!("s = {s}, h = {h}, dead point {at_dead}: {other:?}"),
-                    }
-                }
-            }
-        }
-    }
-
-    /// On the manipulator and the slider-crank the static pivots of the coordinate-blocked
-    /// ordering pass the pivot tests at every step, from h = 0.01 down to h = 1e-6 (the general
-    /// path is a guard, not the normal path), and at the usual steps without the scale factors
-    /// of the equilibration (measured: they are first needed between h = 1e-5 and 1e-6, for
-    /// s = 2 and 3).
-    #[test]
-    fn static_pivots_are_used() {
-        for sys in [
-            models::manipulator().unwrap(),
-            models::slider_crank().unwrap(),
-        ] {
-            let s0 = State::consistent(&sys, 0.0).unwrap();
-            for s in 1..=3 {
-                for h in [1e-2, 1e-4, 1e-6] {
-                    let mut g = Galerkin::new(&sys, SymplecticOptions::new(s)).unwrap();
-                    let mut st = s0.clone();
-                    for _ in 0..200 {
-                        g.step(&sys, &mut st, h).unwrap();
-                    }
-                    assert_eq!(g.lu.fallbacks(), 0, "s = {s}, h = {h}");
-                    // the scale factors are needed only for pivots near the singular test's
-                    // threshold: at h = 1e-6 for s >= 2, not at the usual steps
-                    if h >= 1e-4 {
-                        assert_eq!(g.lu.equilibrations(), 0, "s = {s}, h = {h}");
-                    }
-                }
-            }
-        }
     }
 }

@@ -47,7 +47,6 @@
 mod calibrate;
 mod error;
 mod galerkin;
-mod lu;
 mod options;
 mod preadjust;
 mod tables;

@@ -1,6 +1,6 @@
 //! Settings of the (s,s) scheme.
 
-use mbd_solve::{NewtonOptions, SolveError};
+use mbd_solve::{LinearSolver, NewtonOptions, SolveError};
 
 /// Where the `s + 1` control points of a step lie (and so where the constraints are enforced).
 ///
@@ -56,6 +56,12 @@ pub struct SymplecticOptions {
     /// iterations depends on it, not the solution (to round-off: at least one Newton update is
     /// made from every prediction).
     pub predictor_order: usize,
+    /// Dense or sparse stage solve. [`LinearSolver::Auto`] (default) takes the sparse path
+    /// (`O(N)` per step on a chain of `N` bodies; `docs/symplectic.md`, "Sparse stage solve")
+    /// above [`mbd_solve::SPARSE_THRESHOLD`] constraint equations when it is available: with
+    /// `gamma = 0` on models without force elements (gravity is fine). Forcing
+    /// [`LinearSolver::Sparse`] where it is not available is an error of [`crate::Galerkin::new`].
+    pub linear_solver: LinearSolver,
 }
 
 impl Default for SymplecticOptions {
@@ -74,6 +80,7 @@ impl Default for SymplecticOptions {
             fd_step: 2e-3,
             reuse_jacobian: false,
             predictor_order: 3,
+            linear_solver: LinearSolver::Auto,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! `Integrator::step` allocates nothing (counting global allocator), for s = 1, 2 and with the
-//! preadjustment on.
+//! preadjustment on, on the dense and on the sparse path.
 use mbd_model::models;
-use mbd_solve::{Integrator, State};
+use mbd_solve::{Integrator, LinearSolver, State};
 use mbd_symplectic::{Galerkin, SymplecticOptions};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -39,3 +39,50 @@ fn steps_allocate_nothing() {
         assert_eq!(n, 0, "s={s} gamma={gamma}: {n} allocations in 100 steps");
     }
 }
+
+/// The sparse path (a 30-link chain, sparse stage LU, sparse projection): after the first
+/// steps (which size the LU's factor storage), no step allocates, with one Jacobian per step
+/// and with the Jacobian reused.
+#[test]
+fn sparse_steps_allocate_nothing() {
+    let sys = models::n_link_chain(30).unwrap();
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    for (s, reuse) in [(1, false), (2, false), (3, false), (2, true)] {
+        let opts = SymplecticOptions {
+            linear_solver: LinearSolver::Sparse,
+            reuse_jacobian: reuse,
+            ..SymplecticOptions::new(s)
+        };
+        let mut g = Galerkin::new(&sys, opts).unwrap();
+        assert!(g.is_sparse());
+        let mut st = s0.clone();
+        for _ in 0..3 {
+            g.step(&sys, &mut st, 1e-3).unwrap();
+        }
+        let before = ALLOCS.with(|c| c.get());
+        for _ in 0..100 {
+            g.step(&sys, &mut st, 1e-3).unwrap();
+        }
+        let n = ALLOCS.with(|c| c.get()) - before;
+        assert_eq!(n, 0, "s={s} reuse={reuse}: {n} allocations in 100 steps");
+    }
+    // force elements with damping: the coloured force differences allocate nothing either
+    let sys = damped_spring_chain(30);
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    for s in [1, 2] {
+        let mut g = Galerkin::new(&sys, SymplecticOptions::new(s)).unwrap();
+        assert!(g.is_sparse());
+        let mut st = s0.clone();
+        for _ in 0..3 {
+            g.step(&sys, &mut st, 1e-3).unwrap();
+        }
+        let before = ALLOCS.with(|c| c.get());
+        for _ in 0..100 {
+            g.step(&sys, &mut st, 1e-3).unwrap();
+        }
+        let n = ALLOCS.with(|c| c.get()) - before;
+        assert_eq!(n, 0, "damped chain, s={s}: {n} allocations in 100 steps");
+    }
+}
+
+include!("common/damped.rs");

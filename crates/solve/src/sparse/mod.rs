@@ -7,16 +7,21 @@
 //! * [`ConstraintSchur`]: the constraint Jacobian `Phi_q` in element-local form (each equation
 //!   acts on at most two bodies) and the matrix `S = Phi_q W Phi_q^T` for a diagonal weight `W`
 //!   (the index-1 solve and the projections use `W = M^-1`);
+//! * [`SparseLu`]: a general square matrix on a fixed pattern (the symplectic stage
+//!   equations), analysed once and refactored into reused storage, with a scale-invariant
+//!   pivot test by power-of-two equilibration;
 //! * [`SparseAccelerationSolver`]: the index-1 acceleration solve on top of both.
 //!
 //! For a chain of `N` bodies every one of them costs `O(N)` per call.
 
 mod accel;
 mod cholesky;
+mod lu;
 mod schur;
 
 pub use accel::SparseAccelerationSolver;
 pub use cholesky::SparseCholesky;
+pub use lu::{SparseLu, SPARSE_PIVOT_TOL};
 pub use schur::ConstraintSchur;
 
 /// Constraint count above which [`LinearSolver::Auto`] picks the sparse path (index-1 solve,

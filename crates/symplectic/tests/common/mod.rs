@@ -42,3 +42,6 @@ pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max)
 }
+
+// (shared with the crate's unit tests, which include the file)
+include!("damped.rs");

@@ -1,16 +1,19 @@
-//! A small sparse LU on preallocated row-major buffers, for the 10-100 unknowns of the stage
-//! equations.
+//! The project's dense LU: `n x n` storage (row-major, preallocated), with a static
+//! elimination order, pattern tracking and a scale-invariant pivot test. It is the dense path
+//! of the symplectic stage equations (10-100 unknowns, mostly zeros), the Newton solver's and
+//! the tangent chart's LU, and the small LUs of firefly-gauss (with `pivot_tol = 0`).
+//! A general dense matrix is handled the same way: its pattern is simply full.
 //!
 //! The Jacobian of the stage equations is mostly zeros (for the (2,2) scheme on a double
 //! pendulum, 90 of 400 entries are nonzero: identity blocks, the sparse `Phi_q` and the
 //! constraint curvature), and its nonzero pattern is fixed by the model's structure. So:
-//! - a fixed symmetric ordering chosen by the caller ([`SmallLu::with_ordering`]): the
+//! - a fixed symmetric ordering chosen by the caller ([`DenseLu::with_ordering`]): the
 //!   Galerkin scheme puts the `s` displacement unknowns of each coordinate together (their
 //!   block of the Jacobian is `s x s` when the Hessians are sparse) and the multipliers last, so
 //!   the elimination of the displacements fills in little and leaves a small Schur complement
 //!   on the multipliers;
 //! - the pattern of the entries that have ever been nonzero is tracked as the matrix is written
-//!   ([`SmallLu::add`], [`SmallLu::set`]); when it grows (in the first steps, and whenever an
+//!   ([`DenseLu::add`], [`DenseLu::set`]); when it grows (in the first steps, and whenever an
 //!   entry becomes nonzero for the first time), a symbolic factorisation with the diagonal
 //!   pivots of the ordering is recomputed; each numeric factorisation runs over its index lists
 //!   only (no searching or scanning of zeros). A diagonal
@@ -36,45 +39,18 @@
 //! partial pivoting). The static path's threshold test compares unscaled entries of one column,
 //! which is invariant under column scaling.
 //!
-//! [`SmallLu::solve`] touches only the recorded nonzeros of `L` and `U`.
+//! [`DenseLu::solve`] touches only the recorded nonzeros of `L` and `U`.
 
 /// A diagonal pivot is kept if it is at least this fraction of the largest entry of its column.
-const PIVOT_THRESHOLD: f64 = 0.1;
+pub const PIVOT_THRESHOLD: f64 = 0.1;
 
 /// A pivot of the equilibrated matrix below `PIVOT_TOL n` is negligible (the matrix singular):
-/// a few hundred rounding errors of its O(1) entries.
-const PIVOT_TOL: f64 = 1e-14;
+/// a few hundred rounding errors of its O(1) entries. The default of [`DenseLu::pivot_tol`].
+pub const PIVOT_TOL: f64 = 1e-14;
 
-/// Why a factorisation failed, in the caller's numbering.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum LuError {
-    /// No usable pivot for unknown `col`; `row` is the equation the elimination reached with
-    /// it (its partner in the ordering, or the row that was to be swapped in). An all-zero row
-    /// or column is reported with its ordering partner.
-    Singular {
-        /// The caller's row.
-        row: usize,
-        /// The caller's column (unknown).
-        col: usize,
-    },
-    /// Entry `(row, col)` is NaN or infinite.
-    NonFinite {
-        /// The caller's row.
-        row: usize,
-        /// The caller's column.
-        col: usize,
-    },
-}
-
-/// The power of two `2^-e` with `v 2^-e` in `[1, 2)`, for finite `v > 0` (clamped to the
-/// normal range, so it is never zero or infinite).
-#[inline]
-fn pow2_inverse(v: f64) -> f64 {
-    let e = ((v.to_bits() >> 52) & 0x7ff) as i64; // biased exponent of v
-                                                  // 2^-(e - 1023) has biased exponent 2046 - e
-    let b = (2046 - e).clamp(1, 2046) as u64;
-    f64::from_bits(b << 52)
-}
+use super::{pow2_inverse, FactorError, LuError};
+use faer::MatMut;
+use nalgebra::DMatrix;
 
 /// Nonzero lists of `L` (by columns) and `U` (by rows) of one factorisation.
 #[derive(Clone, Debug, Default)]
@@ -98,14 +74,18 @@ impl Pattern {
     }
 }
 
-/// LU of an `n x n` matrix with a fixed row and column ordering.
+/// LU of an `n x n` matrix with a fixed row and column ordering (see the module documentation).
 ///
-/// The caller writes the matrix in its own numbering through [`SmallLu::entry`] (after
-/// [`SmallLu::clear`]); it is stored in the ordered numbering, row-major. Row interchanges are
-/// kept in a permutation vector (rows never move in memory), so the nonzero lists recorded
-/// during the elimination stay valid for [`SmallLu::solve`].
+/// The caller writes the matrix in its own numbering through [`DenseLu::add`] /
+/// [`DenseLu::set`] (after [`DenseLu::clear`]), which track its nonzero pattern, or writes every
+/// entry through [`DenseLu::matrix_mut`] / [`DenseLu::rows_mut`] (the storage, in the ordered
+/// numbering: the natural one for [`DenseLu::new`]), or copies a matrix in
+/// ([`DenseLu::factor`]). It is stored in the ordered numbering, row-major. Row interchanges
+/// are kept in a permutation vector (rows never move in memory), so the nonzero lists recorded
+/// during the elimination stay valid for [`DenseLu::solve_in_place`]. Factorisations and
+/// solves allocate nothing.
 #[derive(Clone, Debug)]
-pub(crate) struct SmallLu {
+pub struct DenseLu {
     n: usize,
     /// `rows[i]`: the caller's row stored at row `i` of the ordered matrix.
     rows: Vec<usize>,
@@ -161,11 +141,18 @@ pub(crate) struct SmallLu {
     scaled: bool,
     /// Number of factorisations that needed the scale factors.
     equilibrations: usize,
+    /// Whether the storage was written directly since the last factorisation (the pattern is
+    /// then rescanned).
+    raw: bool,
+    /// Whether the last factorisation succeeded (and nothing was written since).
+    factored: bool,
+    /// A pivot of the equilibrated matrix at most `pivot_tol n` counts as zero (default
+    /// [`PIVOT_TOL`]; 0: only exact zeros).
+    pub pivot_tol: f64,
 }
 
-impl SmallLu {
+impl DenseLu {
     /// An LU of `n x n` matrices in the natural ordering.
-    #[cfg(test)]
     pub fn new(n: usize) -> Self {
         Self::with_ordering((0..n).collect(), (0..n).collect())
     }
@@ -183,7 +170,7 @@ impl SmallLu {
         for (j, &c) in cols.iter().enumerate() {
             cpos[c] = j;
         }
-        SmallLu {
+        DenseLu {
             n,
             rows,
             cols,
@@ -214,7 +201,74 @@ impl SmallLu {
             cmax: vec![0.0; n],
             scaled: false,
             equilibrations: 0,
+            raw: false,
+            factored: false,
+            pivot_tol: PIVOT_TOL,
         }
+    }
+
+    /// Dimension.
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// The storage (ordered numbering, the natural one for [`DenseLu::new`]) as a matrix, to be
+    /// overwritten entirely (after a factorisation it holds the factors), then factored by
+    /// [`DenseLu::factor_in_place`] or [`DenseLu::factor_lu`].
+    pub fn matrix_mut(&mut self) -> MatMut<'_, f64> {
+        self.raw = true;
+        self.factored = false;
+        MatMut::from_row_major_slice_mut(&mut self.f, self.n, self.n)
+    }
+
+    /// The storage as a row-major slice (`a[r * n + c]`, ordered numbering), to be overwritten
+    /// entirely, like [`DenseLu::matrix_mut`].
+    pub fn rows_mut(&mut self) -> &mut [f64] {
+        self.raw = true;
+        self.factored = false;
+        &mut self.f
+    }
+
+    /// Copies `a` (natural numbering of [`DenseLu::new`]) in and factors it; the error gives
+    /// the unknown (column) without a usable pivot.
+    pub fn factor(&mut self, a: &DMatrix<f64>) -> Result<(), FactorError> {
+        let n = self.n;
+        for r in 0..n {
+            for c in 0..n {
+                self.f[r * n + c] = a[(r, c)];
+            }
+        }
+        self.raw = true;
+        self.factor_in_place()
+    }
+
+    /// Factors the matrix written through [`DenseLu::matrix_mut`] (or the entry methods); the
+    /// error gives the unknown (column) without a usable pivot.
+    pub fn factor_in_place(&mut self) -> Result<(), FactorError> {
+        self.factor_lu().map_err(|e| match e {
+            LuError::Singular { col, .. } | LuError::NonFinite { col, .. } => {
+                FactorError::Singular(col)
+            }
+        })
+    }
+
+    /// Smallest and largest pivot magnitude of the last successful factorisation (unscaled).
+    pub fn pivot_range(&self) -> (f64, f64) {
+        self.dinv[..self.n]
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
+                let p = 1.0 / d.abs();
+                (lo.min(p), hi.max(p))
+            })
+    }
+
+    /// `ln |det A|` of the last successful factorisation: the sum of the logarithms of the
+    /// pivot magnitudes (no overflow or underflow for any size).
+    pub fn log_abs_det(&self) -> f64 {
+        -self.dinv[..self.n]
+            .iter()
+            .map(|d| d.abs().ln())
+            .sum::<f64>()
     }
 
     /// Symbolic factorisation of `mask` with the diagonal pivots of the ordering.
@@ -263,25 +317,23 @@ impl SmallLu {
 
     /// Number of factorisations in which a static pivot failed the threshold test, so the
     /// general path was taken.
-    #[cfg(test)]
     pub fn fallbacks(&self) -> usize {
         self.fallbacks
     }
 
     /// Number of factorisations that needed the equilibration's scale factors.
-    #[cfg(test)]
     pub fn equilibrations(&self) -> usize {
         self.equilibrations
     }
 
     /// Number of symbolic factorisations (one per growth of the pattern).
-    #[cfg(test)]
     pub fn analyses(&self) -> usize {
         self.analyses
     }
 
-    /// Sets the matrix to zero (before it is written by [`SmallLu::entry`]).
+    /// Sets the matrix to zero (before it is written by [`DenseLu::add`] / [`DenseLu::set`]).
     pub fn clear(&mut self) {
+        self.factored = false;
         self.f.fill(0.0);
     }
 
@@ -311,8 +363,19 @@ impl SmallLu {
 
     /// Factors the matrix in place (singularity tests on the equilibrated matrix, see the
     /// module docs). Errors name the entry, row or unknown at fault in the caller's numbering.
-    pub fn factor(&mut self) -> Result<(), LuError> {
+    pub fn factor_lu(&mut self) -> Result<(), LuError> {
         let n = self.n;
+        self.factored = false;
+        if self.raw {
+            // written directly: every nonzero joins the pattern
+            for (k, &v) in self.f.iter().enumerate() {
+                if v != 0.0 && !self.mask[k] {
+                    self.mask[k] = true;
+                    self.dirty = true;
+                }
+            }
+            self.raw = false;
+        }
         if self.dirty {
             self.analyse();
         }
@@ -343,12 +406,13 @@ impl SmallLu {
             }
         }
         self.scaled = false;
-        let tol = PIVOT_TOL * n as f64;
+        let tol = self.pivot_tol * n as f64;
         for (k, r) in self.rp.iter_mut().enumerate() {
             *r = k;
         }
         if self.factor_static(tol, gmax)? {
             self.static_used = true;
+            self.factored = true;
             return Ok(());
         }
         self.fallbacks += 1;
@@ -362,7 +426,9 @@ impl SmallLu {
             .map_err(|(i, k)| LuError::Singular {
                 row: self.rows[i],
                 col: self.cols[k],
-            })
+            })?;
+        self.factored = true;
+        Ok(())
     }
 
     /// The scale factors of the equilibration (from `backup`, the matrix before elimination),
@@ -530,11 +596,22 @@ impl SmallLu {
         Ok(())
     }
 
-    /// Solves `A x = b` in place after [`SmallLu::factor`] (`b` and `x` in the caller's
-    /// numbering).
-    pub fn solve(&mut self, b: &mut [f64]) {
+    /// Solves `A x = b` in place after a successful factorisation (`b` and `x` in the
+    /// caller's numbering; without one, `b` is left unchanged).
+    pub fn solve_in_place(&mut self, b: &mut [f64]) {
+        let (mut y, mut x) = (std::mem::take(&mut self.y), std::mem::take(&mut self.x));
+        self.solve_with(b, &mut y, &mut x);
+        (self.y, self.x) = (y, x);
+    }
+
+    /// [`DenseLu::solve_in_place`] through a shared reference, with the caller's workspace
+    /// (`y` and `x` of length at least `n`).
+    pub fn solve_with(&self, b: &mut [f64], y: &mut [f64], x: &mut [f64]) {
         let n = self.n;
-        let (y, x, rp) = (&mut self.y, &mut self.x, &self.rp);
+        if !self.factored || b.len() != n || y.len() < n || x.len() < n {
+            return;
+        }
+        let rp = &self.rp;
         let p = if self.static_used {
             &self.symbolic
         } else {
@@ -566,266 +643,49 @@ impl SmallLu {
             b[c] = xj;
         }
     }
+
+    /// Solves `A^T x = b` in place after a successful factorisation (`b` and `x` in the
+    /// caller's numbering; without one, `b` is left unchanged).
+    pub fn solve_transpose_in_place(&mut self, b: &mut [f64]) {
+        let n = self.n;
+        if !self.factored || b.len() != n {
+            return;
+        }
+        let (y, x, rp) = (&mut self.y, &mut self.x, &self.rp);
+        let p = if self.static_used {
+            &self.symbolic
+        } else {
+            &self.dynamic
+        };
+        // the ordered matrix is B = P^T L U (P: pivot k is physical row rp[k]), so
+        // B^T = U^T L^T P: U^T w = d, then L^T v = w, then y = P^T v
+        for (xj, &c) in x.iter_mut().zip(&self.cols) {
+            *xj = b[c];
+        }
+        for k in 0..n {
+            let wk = x[k] * self.dinv[k];
+            x[k] = wk;
+            if wk != 0.0 {
+                let (us, ue) = (p.u_start[k], p.u_start[k + 1]);
+                for (&j, &u) in p.u_idx[us..ue].iter().zip(&self.u_val[us..ue]) {
+                    x[j] -= u * wk;
+                }
+            }
+        }
+        // L^T v = w backwards, v kept by physical row (L's rows are physical)
+        for k in (0..n).rev() {
+            let (ls, le) = (p.l_start[k], p.l_start[k + 1]);
+            let mut v = x[k];
+            for (&ph, &l) in p.l_idx[ls..le].iter().zip(&self.l_val[ls..le]) {
+                v -= l * y[ph];
+            }
+            y[rp[k]] = v;
+        }
+        for (&yi, &r) in y.iter().zip(&self.rows) {
+            b[r] = yi;
+        }
+    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn fill(lu: &mut SmallLu, a: &[f64]) {
-        let n = lu.n;
-        lu.clear();
-        for i in 0..n {
-            for j in 0..n {
-                lu.set(i, j, a[i * n + j]);
-            }
-        }
-    }
-
-    #[test]
-    fn solves_with_pivoting() {
-        let mut lu = SmallLu::new(3);
-        let a = [0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 3.0, 0.0, 1.0];
-        fill(&mut lu, &a);
-        lu.factor().unwrap();
-        let x = [1.0, -2.0, 0.5];
-        let mut b: Vec<f64> = (0..3)
-            .map(|i| (0..3).map(|j| a[i * 3 + j] * x[j]).sum())
-            .collect();
-        lu.solve(&mut b);
-        for i in 0..3 {
-            assert!((b[i] - x[i]).abs() < 1e-14);
-        }
-        let mut s = SmallLu::new(2);
-        fill(&mut s, &[1.0, 2.0, 2.0, 4.0]);
-        assert_eq!(s.factor(), Err(LuError::Singular { row: 1, col: 1 }));
-    }
-
-    /// Sparse matrices with fill-in and pivoting: the solution satisfies `A x = b`.
-    #[test]
-    fn solves_sparse_systems_with_fill_in() {
-        for (n, seed) in [(7usize, 1u64), (20, 2), (31, 3)] {
-            let mut state = seed;
-            let mut rnd = || {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 11) as f64) / ((1u64 << 53) as f64)
-            };
-            // a scrambled ordering: reversed rows, rotated columns
-            let mut lu = SmallLu::with_ordering(
-                (0..n).rev().collect(),
-                (0..n).map(|j| (j + 3) % n).collect(),
-            );
-            let mut a = vec![0.0; n * n];
-            for i in 0..n {
-                for j in 0..n {
-                    // a sparse pattern plus a permuted diagonal (the system stays regular)
-                    a[i * n + j] = if rnd() < 0.2 { rnd() - 0.5 } else { 0.0 };
-                }
-                a[i * n + (i * 3 + 1) % n] += 2.0;
-            }
-            fill(&mut lu, &a);
-            lu.factor().unwrap();
-            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
-            let mut b: Vec<f64> = (0..n)
-                .map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum())
-                .collect();
-            lu.solve(&mut b);
-            for i in 0..n {
-                assert!(
-                    (b[i] - x[i]).abs() < 1e-12,
-                    "n = {n}: x[{i}] off by {:e}",
-                    b[i] - x[i]
-                );
-            }
-        }
-    }
-
-    fn check(lu: &mut SmallLu, a: &[f64]) {
-        let n = lu.n;
-        let x: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
-        let mut b: Vec<f64> = (0..n)
-            .map(|i| (0..n).map(|j| a[i * n + j] * x[j]).sum())
-            .collect();
-        lu.solve(&mut b);
-        for i in 0..n {
-            assert!(
-                (b[i] - x[i]).abs() < 1e-12,
-                "x[{i}] off by {:e}",
-                b[i] - x[i]
-            );
-        }
-    }
-
-    /// The pattern grows when a new entry becomes nonzero (a new symbolic factorisation), the
-    /// static pivots are used while they pass the threshold, and a failing diagonal pivot falls
-    /// back to partial pivoting with the same solution.
-    #[test]
-    fn pattern_growth_and_pivot_fallback() {
-        let n = 4;
-        let mut lu = SmallLu::new(n);
-        let mut a = vec![
-            4.0, 1.0, 0.0, 0.0, //
-            1.0, 4.0, 0.0, 0.0, //
-            0.0, 0.0, 4.0, 1.0, //
-            0.0, 0.0, 1.0, 4.0,
-        ];
-        fill(&mut lu, &a);
-        lu.factor().unwrap();
-        check(&mut lu, &a);
-        assert_eq!((lu.analyses(), lu.fallbacks()), (1, 0));
-        // same pattern: no new analysis
-        a[0] = 5.0;
-        fill(&mut lu, &a);
-        lu.factor().unwrap();
-        check(&mut lu, &a);
-        assert_eq!((lu.analyses(), lu.fallbacks()), (1, 0));
-        // a coupling appears: re-analysed, with fill-in
-        a[3] = 2.0;
-        a[3 * n] = -1.0;
-        fill(&mut lu, &a);
-        lu.factor().unwrap();
-        check(&mut lu, &a);
-        assert_eq!((lu.analyses(), lu.fallbacks()), (2, 0));
-        // a zero diagonal: the static pivot fails, partial pivoting takes over
-        a[0] = 0.0;
-        fill(&mut lu, &a);
-        lu.factor().unwrap();
-        check(&mut lu, &a);
-        assert_eq!(lu.fallbacks(), 1);
-        // singular: an error naming the pivot
-        let z = vec![0.0; n * n];
-        fill(&mut lu, &z);
-        assert_eq!(lu.factor(), Err(LuError::Singular { row: 0, col: 0 }));
-        // non-finite entries are named, wherever they are
-        for (pos, bad) in [(5, f64::NAN), (3 * n, f64::INFINITY), (3, f64::NAN)] {
-            let mut m = a.clone();
-            m[pos] = bad;
-            fill(&mut lu, &m);
-            assert_eq!(
-                lu.factor(),
-                Err(LuError::NonFinite {
-                    row: pos / n,
-                    col: pos % n
-                })
-            );
-        }
-    }
-
-    /// A test matrix shaped like the stage Jacobian: a regular `n x n` block `K` (momentum
-    /// rows, displacement unknowns) coupled to `m` multipliers through `B` (columns) and `C`
-    /// (constraint rows), zero multiplier block.
-    fn saddle(n: usize, m: usize, seed: u64) -> Vec<f64> {
-        let mut state = seed;
-        let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
-        };
-        let d = n + m;
-        let mut a = vec![0.0; d * d];
-        for i in 0..n {
-            a[i * d + i] = 2.0 + rnd();
-            if i + 1 < n {
-                a[i * d + i + 1] = rnd();
-                a[(i + 1) * d + i] = rnd();
-            }
-        }
-        for r in 0..m {
-            for i in 0..n {
-                if (i + r) % 3 != 2 {
-                    let g = rnd();
-                    a[i * d + n + r] = g;
-                    a[(n + r) * d + i] = g + 0.1 * rnd();
-                }
-            }
-        }
-        a
-    }
-
-    /// `D_r A D_c` with row and column scales spanning `10^-span..10^span` (not powers of two).
-    fn scaled(a: &[f64], d: usize, span: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-        let dr: Vec<f64> = (0..d)
-            .map(|i| 10f64.powf(span * ((i * 7 % d) as f64 / d as f64 * 2.0 - 1.0)))
-            .collect();
-        let dc: Vec<f64> = (0..d)
-            .map(|j| 10f64.powf(span * ((j * 5 % d) as f64 / d as f64 * 2.0 - 1.0)) * 1.37)
-            .collect();
-        let mut s = a.to_vec();
-        for i in 0..d {
-            for j in 0..d {
-                s[i * d + j] *= dr[i] * dc[j];
-            }
-        }
-        (s, dr, dc)
-    }
-
-    /// Regular matrices whose rows and columns are scaled by up to 1e+-12 (the stage equations
-    /// of a badly scaled mechanism at tiny h): factored, and solved to a relative accuracy that
-    /// does not depend on the scaling. Before the equilibration, every scaled case failed as
-    /// "singular" (pivot below 1e-14 max |A|).
-    #[test]
-    fn badly_scaled_regular_matrices_are_solved() {
-        let (n, m) = (12, 4);
-        let d = n + m;
-        let order: Vec<usize> = (0..d).collect();
-        for seed in 1..=3 {
-            let a = saddle(n, m, seed);
-            for span in [0.0, 4.0, 8.0, 12.0] {
-                let (s, _, dc) = scaled(&a, d, span);
-                let mut lu = SmallLu::with_ordering(order.clone(), order.clone());
-                fill(&mut lu, &s);
-                lu.factor()
-                    .unwrap_or_else(|e| panic!("seed {seed}, span 1e{span}: {e:?}"));
-                // x = D_c^-1 y with y of unit size, so the scaled system has a well-scaled answer
-                let y: Vec<f64> = (0..d).map(|i| 1.0 + (i as f64 * 0.37).sin()).collect();
-                let x: Vec<f64> = (0..d).map(|j| y[j] / dc[j]).collect();
-                let mut b: Vec<f64> = (0..d)
-                    .map(|i| (0..d).map(|j| s[i * d + j] * x[j]).sum())
-                    .collect();
-                lu.solve(&mut b);
-                let err = (0..d)
-                    .map(|j| ((b[j] - x[j]) * dc[j]).abs())
-                    .fold(0.0, f64::max);
-                assert!(err < 1e-12, "seed {seed}, span 1e{span}: error {err:e}");
-            }
-        }
-    }
-
-    /// Singular matrices stay singular at every scaling: a rank-deficient multiplier block
-    /// (two constraint rows equal: redundant constraints) and a zero column, scaled by up to
-    /// 1e+-12.
-    #[test]
-    fn singular_matrices_are_reported_at_every_scaling() {
-        let (n, m) = (12, 4);
-        let d = n + m;
-        let order: Vec<usize> = (0..d).collect();
-        let a = saddle(n, m, 7);
-        // redundant: constraint row n + 3 repeats row n + 1 (and so does its column)
-        let mut red = a.clone();
-        for i in 0..n {
-            red[(n + 3) * d + i] = red[(n + 1) * d + i];
-            red[i * d + n + 3] = red[i * d + n + 1];
-        }
-        // a multiplier that enters no equation
-        let mut zc = a.clone();
-        for i in 0..d {
-            zc[i * d + n + 2] = 0.0;
-        }
-        for span in [0.0, 4.0, 8.0, 12.0] {
-            for (what, base) in [("redundant", &red), ("zero column", &zc)] {
-                let (s, ..) = scaled(base, d, span);
-                let mut lu = SmallLu::with_ordering(order.clone(), order.clone());
-                fill(&mut lu, &s);
-                match lu.factor() {
-                    Err(LuError::Singular { row, col }) => {
-                        assert!(row >= n && col >= n, "{what}, 1e{span}: ({row}, {col})")
-                    }
-                    other => panic!("{what}, span 1e{span}: expected singular, got {other:?}"),
-                }
-            }
-        }
-    }
-}
+mod tests;

@@ -1,14 +1,16 @@
-//! Allocation-free dense factorisations (faer's in-place LU and Cholesky on preallocated
-//! workspaces).
+//! Allocation-free dense factorisations: the one dense LU ([`DenseLu`], `lu.rs`: static or
+//! threshold pivoting with a scale-invariant pivot test, for the small sparse-ish matrices of
+//! the solvers) and the Cholesky factorisation ([`DenseCholesky`]) on preallocated workspaces.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
-use faer::linalg::lu::partial_pivoting as pplu;
-use faer::perm::PermRef;
-use faer::{Mat, MatMut, MatRef, Par};
-use nalgebra::DMatrix;
+use faer::{MatMut, Par};
 
 pub use mbd_model::numeric::{max_abs, max_abs_diff};
+
+mod lu;
+
+pub use lu::{DenseLu, PIVOT_THRESHOLD, PIVOT_TOL};
 
 /// faer's scratch memory (wrapped for `Debug`).
 struct Scratch(MemBuffer);
@@ -30,114 +32,38 @@ pub enum FactorError {
     NotPositiveDefinite(usize),
 }
 
-/// LU with partial pivoting of an `n x n` matrix, reusing its storage: `factor` then `solve`
-/// allocate nothing.
-#[derive(Debug)]
-pub struct DenseLu {
-    n: usize,
-    lu: Mat<f64>,
-    perm: Vec<usize>,
-    perm_inv: Vec<usize>,
-    mem: Scratch,
-    factored: bool,
-    /// Relative pivot threshold below which the matrix counts as singular.
-    pub pivot_tol: f64,
+/// Why an LU factorisation failed, in the caller's numbering of rows (equations) and columns
+/// (unknowns).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LuError {
+    /// No usable pivot for unknown `col`; `row` is the equation the elimination paired with it
+    /// (or could not pair).
+    #[error("singular matrix: no pivot for column {col} (row {row})")]
+    Singular {
+        /// The caller's row.
+        row: usize,
+        /// The caller's column (unknown).
+        col: usize,
+    },
+    /// Entry `(row, col)` is NaN or infinite.
+    #[error("non-finite matrix entry ({row}, {col})")]
+    NonFinite {
+        /// The caller's row.
+        row: usize,
+        /// The caller's column.
+        col: usize,
+    },
 }
 
-impl Clone for DenseLu {
-    /// A copy with the same matrix or factors (and fresh scratch memory).
-    fn clone(&self) -> Self {
-        let mut c = DenseLu::new(self.n);
-        c.lu.copy_from(&self.lu);
-        c.perm.copy_from_slice(&self.perm);
-        c.perm_inv.copy_from_slice(&self.perm_inv);
-        c.factored = self.factored;
-        c.pivot_tol = self.pivot_tol;
-        c
-    }
-}
-
-impl DenseLu {
-    /// Workspace for `n x n` systems.
-    pub fn new(n: usize) -> Self {
-        let req = StackReq::any_of(&[
-            pplu::factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()),
-            pplu::solve::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
-        ]);
-        DenseLu {
-            n,
-            lu: Mat::zeros(n, n),
-            perm: vec![0; n],
-            perm_inv: vec![0; n],
-            mem: Scratch(MemBuffer::new(req)),
-            factored: false,
-            pivot_tol: 1e-14,
-        }
-    }
-
-    /// Dimension.
-    pub fn dim(&self) -> usize {
-        self.n
-    }
-
-    /// Factors the matrix stored column-major in `a` (an `n x n` nalgebra matrix).
-    pub fn factor(&mut self, a: &DMatrix<f64>) -> Result<(), FactorError> {
-        let n = self.n;
-        let src = MatRef::from_column_major_slice(a.as_slice(), n, n);
-        self.lu.copy_from(src);
-        self.factor_in_place()
-    }
-
-    /// Mutable access to the matrix to be factored: fill it, then call
-    /// [`DenseLu::factor_in_place`].
-    pub fn matrix_mut(&mut self) -> MatMut<'_, f64> {
-        self.factored = false;
-        self.lu.as_mut()
-    }
-
-    /// Factors the matrix written through [`DenseLu::matrix_mut`].
-    pub fn factor_in_place(&mut self) -> Result<(), FactorError> {
-        let n = self.n;
-        self.factored = false;
-        if n == 0 {
-            self.factored = true;
-            return Ok(());
-        }
-        let scale = (0..n)
-            .flat_map(|j| (0..n).map(move |i| (i, j)))
-            .fold(0.0f64, |m, (i, j)| m.max(self.lu[(i, j)].abs()));
-        let stack = MemStack::new(&mut self.mem.0);
-        pplu::factor::lu_in_place(
-            self.lu.as_mut(),
-            &mut self.perm,
-            &mut self.perm_inv,
-            Par::Seq,
-            stack,
-            Default::default(),
-        );
-        let tol = self.pivot_tol * scale.max(f64::MIN_POSITIVE) * n as f64;
-        for i in 0..n {
-            let p = self.lu[(i, i)];
-            if !(p.abs() > tol) {
-                return Err(FactorError::Singular(i));
-            }
-        }
-        self.factored = true;
-        Ok(())
-    }
-
-    /// Solves `A x = b` in place (`b` has length `n`). Call after a successful factorisation.
-    pub fn solve_in_place(&mut self, b: &mut [f64]) {
-        let n = self.n;
-        if n == 0 || !self.factored {
-            return;
-        }
-        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
-        let rhs = MatMut::from_column_major_slice_mut(b, n, 1);
-        let stack = MemStack::new(&mut self.mem.0);
-        let lu = self.lu.as_ref();
-        pplu::solve::solve_in_place(lu, lu, perm, rhs, Par::Seq, stack);
-    }
+/// The power of two `2^-e` with `v 2^-e` in `[1, 2)`, for finite `v > 0` (clamped to the
+/// normal range, so it is never zero or infinite): the exact scale factor of the
+/// equilibrations.
+#[inline]
+pub fn pow2_inverse(v: f64) -> f64 {
+    let e = ((v.to_bits() >> 52) & 0x7ff) as i64; // biased exponent of v
+                                                  // 2^-(e - 1023) has biased exponent 2046 - e
+    let b = (2046 - e).clamp(1, 2046) as u64;
+    f64::from_bits(b << 52)
 }
 
 /// Below this dimension [`DenseCholesky`] uses a plain unblocked factorisation: for the
@@ -337,23 +263,6 @@ impl DenseCholesky {
 #[cfg(test)]
 mod tests {
     use super::*;
-    #[test]
-    fn lu_solves_and_detects_singular() {
-        let a = DMatrix::from_row_slice(3, 3, &[2.0, 1.0, 0.0, 1.0, 3.0, 1.0, 0.0, 1.0, 4.0]);
-        let mut lu = DenseLu::new(3);
-        lu.factor(&a).unwrap();
-        let x = [1.0, -2.0, 0.5];
-        let mut b: Vec<f64> = (0..3)
-            .map(|i| (0..3).map(|j| a[(i, j)] * x[j]).sum())
-            .collect();
-        lu.solve_in_place(&mut b);
-        for i in 0..3 {
-            assert!((b[i] - x[i]).abs() < 1e-14);
-        }
-        let s = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 4.0]);
-        let mut lu = DenseLu::new(2);
-        assert!(matches!(lu.factor(&s), Err(FactorError::Singular(_))));
-    }
     #[test]
     fn cholesky_solves_and_detects_indefinite() {
         let mut c = DenseCholesky::new(2);

@@ -1,0 +1,167 @@
+//! The dense stage Jacobian: assembled into the project's dense LU with the coordinate-blocked
+//! elimination order (`docs/symplectic.md`, "The linear solve").
+
+use super::{with_time, Galerkin};
+use mbd_model::System;
+use mbd_solve::linalg::DenseLu;
+use mbd_solve::SolveError;
+
+/// The LU of the stage Jacobian with the elimination order that keeps it sparse: for each
+/// coordinate `i`, the momentum rows `(nu, i)`, `nu = 0..s-1`, paired with the displacement
+/// unknowns `Z_(nu+1), i` (their `s x s` block is the stiffness matrix `K` when the Hessians
+/// are sparse); then the constraint rows with the multipliers (their Schur complement).
+pub(super) fn stage_lu(n: usize, m: usize, s: usize) -> DenseLu {
+    let mut order: Vec<usize> = Vec::with_capacity(s * (n + m));
+    for i in 0..n {
+        for nu in 0..s {
+            order.push(nu * n + i);
+        }
+    }
+    order.extend(s * n..s * (n + m));
+    DenseLu::with_ordering(order.clone(), order)
+}
+
+impl Galerkin {
+    /// Jacobian of the stage equations at `self.x` (after `residual` at the same point), factored.
+    pub(super) fn jacobian_dense(
+        &mut self,
+        sys: &System,
+        t: f64,
+        h: f64,
+    ) -> Result<(), SolveError> {
+        let (n, m, s) = (self.n, self.m, self.tab.s);
+        let s1 = s + 1;
+        sys.phi_q(&self.qn[s * n..(s + 1) * n], &mut self.phiq[s]);
+        let any_hessian = self.has_forces || self.pre.is_some() || self.nonconservative;
+        for j in 0..s {
+            if !any_hessian {
+                self.hess_nz[j] = false;
+                continue;
+            }
+            let qj = &self.qj[j * n..(j + 1) * n];
+            if self.has_forces {
+                sys.potential_hessian(qj, &mut self.hq[j]);
+            } else {
+                self.hq[j].fill(0.0);
+            }
+            if let Some(pre) = &mut self.pre {
+                pre.approximate_hessian(sys, qj, &mut self.wh)
+                    .map_err(|e| with_time(e, t))?;
+                for (a, b) in self.hq[j].iter_mut().zip(self.wh.iter()) {
+                    *a += self.gk * b;
+                }
+            }
+            if self.nonconservative {
+                self.nc_jacobian(sys, j, t + self.tab.c[j] * h, h);
+            }
+            self.hess_nz[j] = self.hq[j].iter().any(|&x| x != 0.0)
+                || (self.nonconservative && self.hv[j].iter().any(|&x| x != 0.0));
+        }
+        let h2 = h * h;
+        let tab = &self.tab;
+        let jm = &mut self.lu;
+        jm.clear();
+        for nu in 0..s {
+            for mu in 1..=s {
+                let (ro, co) = (nu * n, (mu - 1) * n);
+                let kk = tab.k[nu * s1 + mu];
+                for i in 0..n {
+                    jm.add(ro + i, co + i, kk);
+                }
+                for j in 0..s {
+                    if !self.hess_nz[j] {
+                        continue;
+                    }
+                    let ca = tab.b[j] * tab.a[j * s1 + nu] * tab.a[j * s1 + mu];
+                    let cv = tab.b[j] * tab.a[j * s1 + nu] * tab.d[j * s1 + mu] / h;
+                    for l in 0..n {
+                        for i in 0..n {
+                            let mut v = ca * self.hq[j][(i, l)];
+                            if self.nonconservative {
+                                v += cv * self.hv[j][(i, l)];
+                            }
+                            jm.add(ro + i, co + l, -(h2 * self.minv[i] * v));
+                        }
+                    }
+                }
+            }
+            // multiplier columns
+            let co = s * n + nu * m;
+            for r in 0..m {
+                for i in 0..n {
+                    let g = self.phiq[nu][(r, i)];
+                    if g != 0.0 {
+                        jm.set(nu * n + i, co + r, -h2 * self.minv[i] * g);
+                    }
+                }
+            }
+        }
+        // constraint curvature at the interior control points
+        for nu in 1..s {
+            let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
+            sys.constraint_hessian(&self.qn[nu * n..(nu + 1) * n], lam, &mut self.hc);
+            let jm = &mut self.lu;
+            let o = (nu - 1) * n;
+            for l in 0..n {
+                for i in 0..n {
+                    let c = self.hc[(i, l)];
+                    if c != 0.0 {
+                        jm.add(nu * n + i, o + l, -(h2 * self.minv[i] * c));
+                    }
+                }
+            }
+        }
+        {
+            let jm = &mut self.lu;
+            for nu in 1..=s {
+                let ro = s * n + (nu - 1) * m;
+                let co = (nu - 1) * n;
+                for r in 0..m {
+                    for l in 0..n {
+                        let g = self.phiq[nu][(r, l)];
+                        if g != 0.0 {
+                            jm.set(ro + r, co + l, g);
+                        }
+                    }
+                }
+            }
+        }
+        self.jacobians += 1;
+        self.jac_valid = false;
+        let res = self.lu.factor_lu();
+        self.stage_error(sys, t, h, res)
+    }
+
+    /// Central-difference Jacobians of the non-conservative forces at Gauss point `j`:
+    /// `hq[j] -= dQnc/dq`, `hv[j] = -dQnc/dv`.
+    fn nc_jacobian(&mut self, sys: &System, j: usize, tj: f64, h: f64) {
+        let n = self.n;
+        let [q, v, fp, fm] = &mut self.tn;
+        q.copy_from_slice(&self.qj[j * n..(j + 1) * n]);
+        for i in 0..n {
+            v[i] = self.hvj[j * n + i] / h;
+        }
+        for l in 0..n {
+            let dq = 1e-6 * (1.0 + q[l].abs());
+            let q0 = q[l];
+            q[l] = q0 + dq;
+            sys.nonconservative_forces(q, v, tj, fp);
+            q[l] = q0 - dq;
+            sys.nonconservative_forces(q, v, tj, fm);
+            q[l] = q0;
+            for i in 0..n {
+                self.hq[j][(i, l)] -= (fp[i] - fm[i]) / (2.0 * dq);
+            }
+            let dv = 1e-6 * (1.0 + v[l].abs());
+            let v0 = v[l];
+            v[l] = v0 + dv;
+            sys.nonconservative_forces(q, v, tj, fp);
+            v[l] = v0 - dv;
+            sys.nonconservative_forces(q, v, tj, fm);
+            v[l] = v0;
+            for i in 0..n {
+                self.hv[j][(i, l)] = -(fp[i] - fm[i]) / (2.0 * dv);
+            }
+        }
+    }
+}

@@ -1,0 +1,259 @@
+//! The predictor and the simplified Newton iteration of the stage equations
+//! (`docs/symplectic.md`, "Predictor and Newton").
+
+use super::Galerkin;
+use mbd_model::System;
+use mbd_solve::linalg::max_abs as norm_inf;
+use mbd_solve::{SolveError, State, StepStats};
+
+impl Galerkin {
+    /// Initial guess of the unknowns.
+    pub(super) fn predict(
+        &mut self,
+        sys: &System,
+        state: &State,
+        h: f64,
+    ) -> Result<(), SolveError> {
+        let (n, m, s) = (self.n, self.m, self.tab.s);
+        let s1 = s + 1;
+        let usable = self.hist_valid
+            && (self.hist_t - state.t).abs() <= 1e-9 * h
+            && (self.hist_h - h).abs() <= 1e-9 * h
+            && self.hist_q.as_slice() == state.q.as_slice();
+        let p = self.opts.predictor_order;
+        if usable && p > 0 && self.hist_len > p {
+            // multistep: the degree-p polynomial through the last p + 1 solutions at t_k + h,
+            // x_{k+1} = sum_i (-1)^i C(p+1, i+1) x_{k-i}
+            let dim = self.dim;
+            self.x.fill(0.0);
+            let mut c = (p + 1) as f64;
+            for i in 0..=p {
+                let xi = &self.hist_multi[i * dim..(i + 1) * dim];
+                for (a, b) in self.x.iter_mut().zip(xi) {
+                    *a += c * b;
+                }
+                // next coefficient: -C(p+1, i+2) = -C(p+1, i+1) (p - i) / (i + 2)
+                c = -c * (p - i) as f64 / (i + 2) as f64;
+            }
+        } else if usable {
+            // extrapolate the previous step's polynomial: Q_nu ~ sum_mu l_mu(1 + tau_nu) Q'_mu,
+            // written in displacements from q_k = Q'_s
+            for nu in 1..=s {
+                for i in 0..n {
+                    let zs = self.hist_multi[(s - 1) * n + i];
+                    let mut acc = 0.0;
+                    for mu in 0..=s {
+                        let zm = if mu == 0 {
+                            0.0
+                        } else {
+                            self.hist_multi[(mu - 1) * n + i]
+                        };
+                        acc += self.tab.e[(nu - 1) * s1 + mu] * (zm - zs);
+                    }
+                    self.x[(nu - 1) * n + i] = acc;
+                }
+            }
+            self.x[s * n..].copy_from_slice(&self.hist_multi[s * n..self.dim]);
+        } else {
+            let (q, v) = (state.q.as_slice(), state.v.as_slice());
+            match (&mut self.acc, &mut self.sparse) {
+                (Some(acc), _) => {
+                    acc.solve(sys, q, v, state.t, &mut self.acc_a, &mut self.acc_l)?
+                }
+                (None, Some(sp)) => {
+                    sp.acc
+                        .solve(sys, q, v, state.t, &mut self.acc_a, &mut self.acc_l)?
+                }
+                (None, None) => {}
+            }
+            for nu in 1..=s {
+                let th = self.tab.tau[nu] * h;
+                for i in 0..n {
+                    self.x[(nu - 1) * n + i] = th * state.v[i] + 0.5 * th * th * self.acc_a[i];
+                }
+            }
+            for nu in 0..s {
+                for r in 0..m {
+                    self.x[s * n + nu * m + r] = self.tab.w[nu] * self.acc_l[r];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn newton(&mut self, sys: &System, t: f64, h: f64) -> Result<StepStats, SolveError> {
+        let o = self.opts.newton;
+        // Tolerance: relative to the positions, not the angles (which grow without bound on
+        // rotating bodies), plus the round-off floor of the constraints, which is set by the
+        // angles: cos and sin of theta carry an error of about eps |theta|. (NaN-safe: the
+        // state was checked finite, but a NaN here would make every test below pass.)
+        let pscale = 1.0 + position_scale(&self.qk);
+        let qscale = 1.0 + norm_inf(&self.qk);
+        let tol = o.tol * pscale + 4.0 * f64::EPSILON * qscale;
+        let sn = self.tab.s * self.n;
+        self.residual(sys, t, h)?;
+        let mut res = norm_inf(&self.r);
+        let mut evals = 1;
+        let mut it = 0;
+        let fail = |res: f64, it: usize, s: usize| SolveError::Newton {
+            t,
+            residual: res,
+            iterations: it,
+            context: format!("symplectic ({s},{s}) stage equations, h = {h}"),
+        };
+        if !res.is_finite() {
+            return Err(fail(res, 0, self.tab.s));
+        }
+        // simplified Newton: one Jacobian per step (or the last step's, if reuse is on), kept
+        // while it contracts by 4x per iteration, recomputed every `jacobian_every` iterations
+        let mut need_jacobian = !(self.opts.reuse_jacobian
+            && self.jac_valid
+            && (self.jac_h - h).abs() <= 1e-12 * h
+            && self.jac_gk == self.gk);
+        let mut chord = !need_jacobian;
+        let mut since_jacobian = 0usize;
+        let mut prev_step = f64::INFINITY;
+        // Converged when the residual and the last displacement update are both below the
+        // tolerance (or by the contraction estimate below), so never on the predictor alone:
+        // its error is smooth in time and, accepted unchanged, accumulates coherently from step
+        // to step (docs/symplectic.md, "Newton").
+        let mut last_dz = f64::INFINITY;
+        while !(res <= tol && last_dz <= tol) {
+            if it >= o.max_iter {
+                return Err(fail(res, it, self.tab.s));
+            }
+            if need_jacobian || since_jacobian >= o.jacobian_every {
+                self.jacobian(sys, t, h)?;
+                self.jac_valid = true;
+                self.jac_h = h;
+                self.jac_gk = self.gk;
+                since_jacobian = 0;
+                need_jacobian = false;
+                chord = false;
+                prev_step = f64::INFINITY;
+            }
+            since_jacobian += 1;
+            for i in 0..self.dim {
+                self.dx[i] = -self.r[i];
+            }
+            let mut dx = std::mem::take(&mut self.dx);
+            self.solve_stage(&mut dx);
+            self.dx = dx;
+            if res <= tol {
+                // The residual is converged, but no update has been made yet (the predictor's
+                // residual was already below the tolerance) or the last one was not below the
+                // tolerance: the error left is then about the size of this update, smooth in
+                // time, and would accumulate from step to step. This update is applied without
+                // a new residual: what it leaves is quadratic in it (or theta times it), and the
+                // forces and Phi_q at the interior points that the end momentum uses are those
+                // of the previous iterate, whose displacements differ by this update (of the
+                // order of the tolerance): an error of that order times h in the momentum.
+                for (x, d) in self.x.iter_mut().zip(&self.dx) {
+                    *x += d;
+                }
+                self.place_control_points();
+                it += 1;
+                break;
+            }
+            // simplified-Newton stopping rule (Hairer & Wanner, IV.8): with the contraction
+            // theta estimated from two updates with the same Jacobian, the error left after
+            // this update is about theta / (1 - theta) |dZ|; when that is below the tolerance
+            // the update is applied and only the constraints are checked at the result (the
+            // momentum rows, with Phi_q at the interior control points, are not re-evaluated)
+            let dz = norm_inf(&self.dx[..sn]);
+            if prev_step.is_finite() && dz.is_finite() {
+                let theta = dz / prev_step;
+                let left = theta / (1.0 - theta) * dz;
+                if theta < 0.5 && left <= 0.1 * tol {
+                    for (x, d) in self.x.iter_mut().zip(&self.dx) {
+                        *x += d;
+                    }
+                    self.kinematics(sys, t, h)?;
+                    self.constraint_rows(sys, t, h);
+                    evals += 1;
+                    it += 1;
+                    let cres = norm_inf(&self.r[sn..]);
+                    if cres <= tol {
+                        res = cres.max(left);
+                        break;
+                    }
+                    // the constraints are not met yet: complete the residual and go on
+                    self.momentum_rows(sys, h);
+                    res = norm_inf(&self.r);
+                    prev_step = dz;
+                    continue;
+                }
+            }
+            self.xt.copy_from_slice(&self.x);
+            let mut lambda = 1.0;
+            let mut halvings = 0;
+            let res_before = res;
+            loop {
+                for i in 0..self.dim {
+                    self.x[i] = self.xt[i] + lambda * self.dx[i];
+                }
+                self.residual(sys, t, h)?;
+                evals += 1;
+                let rn = norm_inf(&self.r);
+                if (rn.is_finite() && rn < res) || halvings >= o.max_halvings {
+                    res = rn;
+                    break;
+                }
+                lambda *= 0.5;
+                halvings += 1;
+            }
+            it += 1;
+            let step = lambda * norm_inf(&self.dx[..sn]);
+            let poor = step > 0.25 * prev_step && step > 1e3 * f64::EPSILON * qscale;
+            // (a residual that grew but is below the tolerance is round-off: the update from
+            // an already converged predictor is kept)
+            let worse = res > res_before && res > tol;
+            if poor || !res.is_finite() || (chord && worse) {
+                // the Jacobian does not contract well: recompute it here
+                need_jacobian = true;
+                last_dz = step;
+                if !res.is_finite() || worse {
+                    last_dz = f64::INFINITY;
+                    self.x.copy_from_slice(&self.xt);
+                    self.residual(sys, t, h)?;
+                    evals += 1;
+                    res = norm_inf(&self.r);
+                }
+                prev_step = f64::INFINITY;
+                continue;
+            }
+            prev_step = step;
+            last_dz = step;
+            if !res.is_finite() {
+                return Err(fail(res, it, self.tab.s));
+            }
+            if step <= o.step_tol * qscale {
+                // stagnated at round-off: accept if the residual is sane
+                if res <= 1e-8 * qscale {
+                    break;
+                }
+                return Err(fail(res, it, self.tab.s));
+            }
+        }
+        Ok(StepStats {
+            newton_iterations: it,
+            residual: res,
+            rhs_evals: evals,
+            objective_evals: 0,
+            ..Default::default()
+        })
+    }
+}
+
+/// `max |x_i|, |y_i|` over the bodies (every third coordinate is an angle); NaN if any is NaN.
+fn position_scale(q: &[f64]) -> f64 {
+    let mut m = 0.0f64;
+    for c in q.chunks(3) {
+        let a = norm_inf(&c[..2.min(c.len())]);
+        if a.is_nan() {
+            return f64::NAN;
+        }
+        m = m.max(a);
+    }
+    m
+}

@@ -1,0 +1,124 @@
+//! The sparse stage solve: the same trajectory as the dense one, constraints held on a long
+//! chain, and its limits reported as errors.
+mod common;
+use mbd_model::models;
+use mbd_solve::{Integrator, LinearSolver, SolveError, State};
+use mbd_symplectic::{Galerkin, SymplecticOptions};
+
+fn opts(s: usize, solver: LinearSolver) -> SymplecticOptions {
+    SymplecticOptions {
+        linear_solver: solver,
+        ..SymplecticOptions::new(s)
+    }
+}
+
+/// `steps` steps of `h` from the consistent initial state.
+fn run(sys: &mbd_model::System, o: SymplecticOptions, h: f64, steps: usize) -> (State, bool) {
+    let mut g = Galerkin::new(sys, o).unwrap();
+    let mut st = State::consistent(sys, 0.0).unwrap();
+    for _ in 0..steps {
+        g.step(sys, &mut st, h).unwrap();
+    }
+    (st, g.is_sparse())
+}
+
+/// 30-link chain (60 constraint equations), 200 steps of 1e-3: the sparse and the dense
+/// stage solves give the same positions and velocities to 1e-10 (they differ only in the
+/// rounding of the linear solves, which Newton's last update removes to the tolerance).
+#[test]
+fn sparse_and_dense_paths_agree_on_a_30_link_chain() {
+    let sys = models::n_link_chain(30).unwrap();
+    for s in [1, 2] {
+        let (d, dense_sparse) = run(&sys, opts(s, LinearSolver::Dense), 1e-3, 200);
+        let (sp, sparse_sparse) = run(&sys, opts(s, LinearSolver::Sparse), 1e-3, 200);
+        assert!(!dense_sparse && sparse_sparse);
+        let dq = (&d.q - &sp.q).amax();
+        let dv = (&d.v - &sp.v).amax();
+        eprintln!("({s},{s}): max |dq| = {dq:e}, max |dv| = {dv:e}");
+        assert!(dq < 1e-10 && dv < 1e-10, "({s},{s}): dq {dq:e}, dv {dv:e}");
+        // and the motion is not trivial: the chain fell and swung
+        let d0 = State::consistent(&sys, 0.0).unwrap();
+        assert!((&d.q - &d0.q).amax() > 1e-3);
+    }
+}
+
+/// Andrews' squeezer (a spring-damper and a driving torque; 7 bodies), forced onto the sparse
+/// path: the force Hessians come from coloured central differences instead of the exact
+/// Hessian, which changes only Newton's convergence, not the solution: 2000 steps of 1e-4
+/// agree with the dense path to 1e-10.
+#[test]
+fn sparse_and_dense_paths_agree_with_force_elements() {
+    let sys = models::andrews_squeezer().unwrap();
+    for s in [1, 2] {
+        let (d, _) = run(&sys, opts(s, LinearSolver::Dense), 1e-4, 2000);
+        let (sp, sparse) = run(&sys, opts(s, LinearSolver::Sparse), 1e-4, 2000);
+        assert!(sparse);
+        let dq = (&d.q - &sp.q).amax();
+        let dv = (&d.v - &sp.v).amax();
+        let vmax = d.v.amax();
+        eprintln!("squeezer ({s},{s}): max |dq| = {dq:e}, max |dv| = {dv:e} (max |v| = {vmax:e})");
+        assert!(
+            dq < 1e-10 && dv < 1e-10 * (1.0 + vmax),
+            "({s},{s}): dq {dq:e}, dv {dv:e}"
+        );
+    }
+}
+
+/// A 30-link chain with rotary and point spring-dampers (60 equations: the sparse path by
+/// default), 200 steps of 1e-3: the same trajectory as the dense path to 1e-10.
+#[test]
+fn sparse_and_dense_paths_agree_on_a_damped_spring_chain() {
+    let sys = common::damped_spring_chain(30);
+    for s in [1, 2] {
+        let (d, dense) = run(&sys, opts(s, LinearSolver::Dense), 1e-3, 200);
+        let (sp, sparse) = run(&sys, SymplecticOptions::new(s), 1e-3, 200);
+        assert!(!dense && sparse);
+        let dq = (&d.q - &sp.q).amax();
+        let dv = (&d.v - &sp.v).amax();
+        eprintln!("damped chain ({s},{s}): max |dq| = {dq:e}, max |dv| = {dv:e}");
+        assert!(dq < 1e-10 && dv < 1e-10, "({s},{s}): dq {dq:e}, dv {dv:e}");
+    }
+}
+
+/// 100-link chain (200 equations, the sparse path by default), 300 steps of 1e-3: the
+/// position and velocity constraints hold at the Newton tolerance.
+#[test]
+fn constraints_hold_on_a_100_link_chain() {
+    let sys = models::n_link_chain(100).unwrap();
+    let m = sys.n_constraints();
+    for s in [1, 2] {
+        let (st, sparse) = run(&sys, SymplecticOptions::new(s), 1e-3, 300);
+        assert!(sparse, "the default takes the sparse path at m = {m}");
+        let mut phi = vec![0.0; m];
+        sys.phi(st.q.as_slice(), st.t, &mut phi);
+        let mut pd = vec![0.0; m];
+        sys.phi_dot(st.q.as_slice(), st.v.as_slice(), st.t, &mut pd);
+        let p = phi.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let v = pd.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        eprintln!("({s},{s}): max |Phi| = {p:e}, max |Phi_dot| = {v:e}");
+        assert!(
+            p < 1e-11 && v < 1e-11,
+            "({s},{s}): |Phi| {p:e}, |Phi_dot| {v:e}"
+        );
+    }
+}
+
+/// The sparse path is not available with the preadjustment (its Hessian is dense): forcing it
+/// is an error; `Auto` falls back to the dense path.
+#[test]
+fn unsupported_sparse_settings_are_errors() {
+    let chain = models::n_link_chain(30).unwrap();
+    match Galerkin::new(&chain, opts(2, LinearSolver::Sparse).with_gamma(1.0)) {
+        Err(SolveError::Unsupported(msg)) => assert!(msg.contains("gamma"), "{msg}"),
+        other => panic!("{other:?}"),
+    }
+    let g = Galerkin::new(&chain, SymplecticOptions::new(2).with_gamma(1.0)).unwrap();
+    assert!(!g.is_sparse());
+    let small = models::n_link_chain(24).unwrap();
+    let g = Galerkin::new(&small, opts(2, LinearSolver::Auto)).unwrap();
+    assert!(!g.is_sparse(), "48 equations: dense by default");
+    let big = models::n_link_chain(25).unwrap();
+    assert!(Galerkin::new(&big, SymplecticOptions::new(1))
+        .unwrap()
+        .is_sparse());
+}
