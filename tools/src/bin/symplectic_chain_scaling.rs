@@ -1,23 +1,23 @@
 //! Time per step of the (1,1) and (2,2) schemes against plain RK4 (`Index1Rk` with the RK4
 //! tableau, sparse index-1 solve above the threshold) on `n_link_chain(N)`, all through
-//! `mbd_solve::run` in the same process, h = 1e-3. Prints a table with the ratios and the cost
+//! `mbd::solve::run` in the same process, h = 1e-3. Prints a table with the ratios and the cost
 //! exponent between consecutive N. Each figure is the best of three timed runs (the machine
 //! may be shared), after one untimed run.
 //!
-//! `cargo run --release -p mbd-symplectic --example chain_scaling [N ...] [--reuse] [--dense]`
+//! `cargo run --release -p mbd-tools --bin symplectic_chain_scaling [N ...] [--reuse] [--dense]`
 //! (`--reuse`: `reuse_jacobian = true`; `--dense`: force the dense stage solve.)
-use mbd_model::models;
-use mbd_solve::{
+use mbd::model::models;
+use mbd::solve::{
     run, ButcherTableau, Index1Options, Index1Rk, Integrator, LinearSolver, NoObserver, RunConfig,
     State,
 };
-use mbd_symplectic::{Galerkin, SymplecticOptions};
+use mbd::symplectic::{Galerkin, SymplecticOptions};
 use std::time::Instant;
 
 /// Best wall time per step (microseconds) of `steps` steps of `h` through `run`.
 fn per_step(
     integ: &mut dyn Integrator,
-    sys: &mbd_model::System,
+    sys: &mbd::model::System,
     s0: &State,
     steps: usize,
 ) -> Result<f64, Box<dyn std::error::Error>> {

@@ -1,10 +1,10 @@
 //! Constraint residuals of the (1,1) and (2,2) schemes over `10^5` steps of the manipulator at
 //! `h = 0.01` (the issue's `<= 1e-12` at every step), with the Newton work per step.
 //!
-//! `cargo run --release -p mbd-symplectic --example long_constraints [steps]`
-use mbd_model::models;
-use mbd_solve::{Integrator, State};
-use mbd_symplectic::{Galerkin, SymplecticOptions};
+//! `cargo run --release -p mbd-tools --bin symplectic_long_constraints [steps]`
+use mbd::model::models;
+use mbd::solve::{Integrator, State};
+use mbd::symplectic::{Galerkin, SymplecticOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let steps: usize = std::env::args()

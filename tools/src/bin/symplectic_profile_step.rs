@@ -1,10 +1,10 @@
 //! Steps the (2,2) scheme on the manipulator in a loop (for profiling) and prints the time per
 //! step and the Newton work.
 //!
-//! `cargo run --release -p mbd-symplectic --example profile_step [s] [steps] [predictor_order]`
-use mbd_model::models;
-use mbd_solve::{Integrator, State};
-use mbd_symplectic::{Galerkin, SymplecticOptions};
+//! `cargo run --release -p mbd-tools --bin symplectic_profile_step [s] [steps] [predictor_order]`
+use mbd::model::models;
+use mbd::solve::{Integrator, State};
+use mbd::symplectic::{Galerkin, SymplecticOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let s: usize = std::env::args()
