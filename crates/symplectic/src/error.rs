@@ -9,14 +9,6 @@ pub enum SymplecticError {
     /// An error of the integrator or the model.
     #[error(transparent)]
     Solve(#[from] SolveError),
-    /// The reference trajectory does not match the run (length or sample times).
-    #[error("reference trajectory '{method}' does not match the run: {detail}")]
-    Reference {
-        /// The reference's method string.
-        method: String,
-        /// What does not match.
-        detail: String,
-    },
     /// The secant iteration for `gamma_opt` failed.
     #[error("gamma calibration failed after {iterations} secant iterations at gamma = {gamma}: {reason} (dW history: {history:?})")]
     Calibration {

@@ -15,8 +15,8 @@
 //!   settings. `gamma = 0` is the plain scheme bit for bit; [`kappa`] gives `kappa_s`.
 //! * [`Preadjustment`]: `W_s`, its gradient and the tangential force on any model.
 //! * [`calibrate_gamma`]: `gamma_opt` by the secant method on the averaged signed trajectory
-//!   error `dW(gamma)` against a reference; [`error_measures`] gives paper A's `E|dx|`, `E|dy|`,
-//!   `E|dH|` and the signed means.
+//!   error `dW(gamma)` against a reference, measured by the caller (paper A's `E|dx|`, `E|dy|`,
+//!   `E|dH|` and signed means are `mbd_analysis::trajectory_errors`).
 //!
 //! The control points default to the Gauss-Lobatto points ([`Nodes::Lobatto`]), which for
 //! `s <= 2` are the paper's equally spaced points; equally spaced points for `s >= 3` limit the
@@ -51,9 +51,7 @@ mod options;
 mod preadjust;
 mod tables;
 
-pub use calibrate::{
-    calibrate_gamma, error_measures, Calibration, CalibrationSettings, ErrorMeasures,
-};
+pub use calibrate::{calibrate_gamma, Calibration, CalibrationSettings};
 pub use error::SymplecticError;
 pub use galerkin::Galerkin;
 pub use options::{kappa, phase_constant, Nodes, SymplecticOptions};

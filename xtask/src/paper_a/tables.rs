@@ -111,17 +111,15 @@ pub(super) fn table1(ctx: &Ctx) -> Result<Section, String> {
     );
     for s in [3usize, 4] {
         for gamma in [0.0, 1.0] {
-            let m = error_measures(
-                &p.sys,
-                &p.s0,
+            let m = measure_run(
+                &p,
                 h,
                 n,
                 &r,
-                &SymplecticOptions::new(s)
+                SymplecticOptions::new(s)
                     .with_gamma(gamma)
                     .with_nodes(Nodes::Equispaced),
-            )
-            .map_err(|e| e.to_string())?;
+            )?;
             te.row(vec![
                 format!("({s},{s})"),
                 format!("{gamma}"),

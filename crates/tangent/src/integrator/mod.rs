@@ -318,7 +318,7 @@ impl TangentRk {
                 parameter: "state: ||(Phi, Phidot)||_inf",
                 value: r,
                 reason: "the state is not on the constraint manifold (above consistency_tol); \
-                         project it first (System::project)",
+                         project it first (mbd_solve::project_state)",
             });
         }
         Ok(())

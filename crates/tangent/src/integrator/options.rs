@@ -46,7 +46,7 @@ pub struct TangentOptions {
     pub singular_tol: f64,
     /// Largest `||(Phi, Phidot)||_inf` accepted for the state handed to a step (it is projected
     /// onto the manifold by the first chart map). Larger is an error: project the state first
-    /// (`System::project`). Default 1e-8.
+    /// (`mbd_solve::project_state`). Default 1e-8.
     pub consistency_tol: f64,
     /// Inexact stage maps: after an accepted step of the same size, the chart maps of the
     /// interior Runge-Kutta stages stop at `max(newton.tol, stage_tol_ratio * E)`, where `E` is
