@@ -12,7 +12,6 @@ mod paper_a;
 mod paper_b;
 mod paper_c;
 mod paper_values;
-mod plot;
 mod report;
 
 use clap::{Parser, Subcommand, ValueEnum};

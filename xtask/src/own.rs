@@ -1,8 +1,8 @@
 //! The project's own experiments: convergence orders of every solver, work-precision on the
 //! manipulator, long-time energy behaviour, cost of one step against the RK4 peer.
 
-use crate::plot::{Figure, Series};
 use crate::report::{fmt_e, num, Claim, Ctx, Experiment, FigureRef, Part, Section, Table};
+use mbd_analysis::plot::{Figure, Series};
 use mbd_analysis::{fit_order, MeasureObserver};
 use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd_model::{models, System};
@@ -205,7 +205,8 @@ fn orders(ctx: &Ctx) -> Result<Section, String> {
             ));
         }
     }
-    fig.save(&ctx.figure_path("own_orders.svg"))?;
+    fig.save(&ctx.figure_path("own_orders.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef { file: "own_orders.svg".into(), caption: "Position error at t = 1 s against step size, every solver, single pendulum and manipulator".into() });
     sec.tables.push(table);
     sec.summary = json!({ "orders": rows });
@@ -366,8 +367,11 @@ fn work_precision(ctx: &Ctx) -> Result<Section, String> {
             Claim::check(text, best <= target, format!("best error {}", fmt_e(best)))
         });
     }
-    fig.save(&ctx.figure_path("own_work_precision.svg"))?;
-    fig_h.save(&ctx.figure_path("own_error_vs_h.svg"))?;
+    fig.save(&ctx.figure_path("own_work_precision.svg"))
+        .map_err(|e| e.to_string())?;
+    fig_h
+        .save(&ctx.figure_path("own_error_vs_h.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef {
         file: "own_work_precision.svg".into(),
         caption: "Error at t = 2 s against wall time, every solver, manipulator".into(),
@@ -446,7 +450,8 @@ fn long_time(ctx: &Ctx) -> Result<Section, String> {
             series.iter().step_by(stride).map(|r| (r[0], r[1])).unzip();
         fig.series.push(Series::line(spec.name, xs, ys));
     }
-    fig.save(&ctx.figure_path("own_long_time_energy.svg"))?;
+    fig.save(&ctx.figure_path("own_long_time_energy.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef {
         file: "own_long_time_energy.svg".into(),
         caption: "Relative energy error against time over the long run".into(),

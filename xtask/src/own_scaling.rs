@@ -3,8 +3,8 @@
 //! N-link chain, through the public run loop, as ratios to plain RK4 timed in the same loop.
 
 use crate::own::solvers;
-use crate::plot::{Figure, Series};
 use crate::report::{num, Claim, Ctx, FigureRef, Section, Table};
+use mbd_analysis::plot::{Figure, Series};
 use mbd_model::{models, System};
 use mbd_solve::{
     run, ButcherTableau, Index1Options, Index1Rk, Integrator, NoObserver, RunConfig, State,
@@ -232,7 +232,8 @@ pub fn scaling(ctx: &Ctx) -> Result<Section, String> {
             ),
         });
     }
-    fig.save(&ctx.figure_path("own_scaling.svg"))?;
+    fig.save(&ctx.figure_path("own_scaling.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef {
         file: "own_scaling.svg".into(),
         caption: "Cost per step against chain length, every solver meant to scale (log-log)".into(),

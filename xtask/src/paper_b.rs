@@ -4,8 +4,8 @@
 //! e(H) and runtime, the figure of constraint residuals against time, the Baumgarte tuning
 //! sweep, and the convergence order.
 
-use crate::plot::{Figure, Series};
 use crate::report::{fmt_e, num, Claim, Ctx, Experiment, FigureRef, Part, Section, Table};
+use mbd_analysis::plot::{Figure, Series};
 use mbd_analysis::{fit_order, MeasureObserver, RunMeasures};
 use mbd_model::{models, System};
 use mbd_rk4::{Rk4, Rk4Options};
@@ -198,7 +198,8 @@ fn table(ctx: &Ctx) -> Result<Section, String> {
             per.push((solver, out));
         }
         let file = format!("paper_b_residuals_{}.svg", pname.replace('-', "_"));
-        fig.save(&ctx.figure_path(&file))?;
+        fig.save(&ctx.figure_path(&file))
+            .map_err(|e| e.to_string())?;
         sec.figures.push(FigureRef {
             file,
             caption: format!(

@@ -38,6 +38,8 @@ mod error;
 mod measures;
 mod order;
 mod output;
+#[cfg(feature = "plot")]
+pub mod plot;
 mod trajectory;
 
 pub use error::AnalysisError;

@@ -70,7 +70,8 @@ pub(super) fn fig3(ctx: &Ctx) -> Result<Section, String> {
         double.push(json!({"s": s, "order_energy_double_pendulum": num(order)}));
         fig = fig.with(Series::points(format!("(s,s) = ({s},{s})"), hs, es));
     }
-    fig.save(&ctx.figure_path("paper_a_fig3.svg"))?;
+    fig.save(&ctx.figure_path("paper_a_fig3.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef {
         file: "paper_a_fig3.svg".into(),
         caption: "Energy error E|dH| against h for s = 1..4 (log-log); slopes 2s".into(),
@@ -215,7 +216,8 @@ pub(super) fn fig4(ctx: &Ctx) -> Result<Section, String> {
         gammas.clone(),
         m.iter().map(|e| e.mean_abs_dh).collect(),
     ));
-    fig.save(&ctx.figure_path("paper_a_fig4.svg"))?;
+    fig.save(&ctx.figure_path("paper_a_fig4.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef {
         file: "paper_a_fig4.svg".into(),
         caption: format!(
@@ -313,8 +315,10 @@ pub(super) fn fig5_6(ctx: &Ctx) -> Result<Section, String> {
             json!({"gamma": gammas, "abs": abs.iter().map(|v| num(*v)).collect::<Vec<_>>(), "dW": dw.iter().map(|v| num(*v)).collect::<Vec<_>>(), "gamma_opt": num(cal.gamma_opt)}),
         );
     }
-    f5.save(&ctx.figure_path("paper_a_fig5.svg"))?;
-    f6.save(&ctx.figure_path("paper_a_fig6.svg"))?;
+    f5.save(&ctx.figure_path("paper_a_fig5.svg"))
+        .map_err(|e| e.to_string())?;
+    f6.save(&ctx.figure_path("paper_a_fig6.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef {
         file: "paper_a_fig5.svg".into(),
         caption: "E|dx| + E|dy| against gamma, normalised by the gamma = 0 value (a V with its minimum near gamma_opt)".into(),
@@ -367,7 +371,8 @@ pub(super) fn fig7(ctx: &Ctx) -> Result<Section, String> {
         win(&t),
         win(&curves[1]),
     ));
-    fig.save(&ctx.figure_path("paper_a_fig7.svg"))?;
+    fig.save(&ctx.figure_path("paper_a_fig7.svg"))
+        .map_err(|e| e.to_string())?;
     let err = |c: &[f64]| {
         c.iter()
             .zip(&x_ref)

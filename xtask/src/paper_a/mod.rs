@@ -12,10 +12,10 @@ use tables::{table1, table2, table3};
 mod figures;
 use figures::{fig3, fig4, fig5_6, fig7};
 
-use crate::plot::{Figure, Series};
 use crate::report::{
     fmt_e, num, Claim, Ctx, Experiment, FigureRef, PaperValue, Part, Section, Table,
 };
+use mbd_analysis::plot::{Figure, Series};
 use mbd_analysis::{trajectory_errors, MeasureObserver, Trajectory};
 use mbd_model::{models, System};
 use mbd_solve::{

@@ -210,7 +210,8 @@ pub(super) fn orders(ctx: &Ctx) -> Result<Section, String> {
         (fitted[0] - 4.0).abs() <= 0.5,
         format!("fitted {:.2}; pure firefly {:.2}", fitted[0], fitted[1]),
     ));
-    fig.save(&ctx.figure_path("paper_c_orders.svg"))?;
+    fig.save(&ctx.figure_path("paper_c_orders.svg"))
+        .map_err(|e| e.to_string())?;
     sec.figures.push(FigureRef {
         file: "paper_c_orders.svg".into(),
         caption: "FA-DAE: position error against step size, polished and pure firefly".into(),

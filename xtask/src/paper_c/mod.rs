@@ -7,10 +7,10 @@ use table1::{table1_polished, table1_pure};
 mod checks;
 use checks::{determinism, orders, table2};
 
-use crate::plot::{Figure, Series};
 use crate::report::{
     fmt_e, num, Claim, Ctx, Experiment, FigureRef, PaperValue, Part, Section, Table,
 };
+use mbd_analysis::plot::{Figure, Series};
 use mbd_analysis::{fit_order, MeasureObserver, RunMeasures};
 use mbd_firefly_gauss::{FaDaeOptions, FaDaeStats, FireflyGauss, RefinedAcceleration};
 use mbd_model::numeric::{max_abs, max_abs_diff};

@@ -219,14 +219,16 @@ fn figures(ctx: &Ctx, sec: &mut Section, s: &[[f64; 9]], h: f64) -> Result<(), S
         "y [m]",
     )
     .with(Series::line("end of link 2", col(1), col(2)));
-    f2.save(&ctx.figure_path("paper_c_fig2.svg"))?;
+    f2.save(&ctx.figure_path("paper_c_fig2.svg"))
+        .map_err(|e| e.to_string())?;
     let f3 = Figure::new(
         format!("Fig. 3: total energy (FA-DAE, h = {h} s)"),
         "time t [s]",
         "total energy H [J]",
     )
     .with(Series::line("H = T + V", t.clone(), col(3)));
-    f3.save(&ctx.figure_path("paper_c_fig3.svg"))?;
+    f3.save(&ctx.figure_path("paper_c_fig3.svg"))
+        .map_err(|e| e.to_string())?;
     let f4 = Figure::new(
         format!("Fig. 4: kinetic and potential energy (FA-DAE, h = {h} s)"),
         "time t [s]",
@@ -235,7 +237,8 @@ fn figures(ctx: &Ctx, sec: &mut Section, s: &[[f64; 9]], h: f64) -> Result<(), S
     .with(Series::line("total energy", t.clone(), col(3)))
     .with(Series::line("kinetic energy", t.clone(), col(4)))
     .with(Series::line("potential energy", t.clone(), col(5)));
-    f4.save(&ctx.figure_path("paper_c_fig4.svg"))?;
+    f4.save(&ctx.figure_path("paper_c_fig4.svg"))
+        .map_err(|e| e.to_string())?;
     let floor = |v: Vec<f64>| v.into_iter().map(|x| x.max(1e-18)).collect::<Vec<_>>();
     let f5 = Figure::new(
         format!("Fig. 5: constraint residuals (FA-DAE, h = {h} s; zeros shown at 1e-18)"),
@@ -246,7 +249,8 @@ fn figures(ctx: &Ctx, sec: &mut Section, s: &[[f64; 9]], h: f64) -> Result<(), S
     .with(Series::line("|Phi|", t.clone(), floor(col(6))))
     .with(Series::line("|Phidot|", t.clone(), floor(col(7))))
     .with(Series::line("|Phiddot|", t, floor(col(8))));
-    f5.save(&ctx.figure_path("paper_c_fig5.svg"))?;
+    f5.save(&ctx.figure_path("paper_c_fig5.svg"))
+        .map_err(|e| e.to_string())?;
     for (file, caption) in [
         (
             "paper_c_fig2.svg",
