@@ -85,6 +85,15 @@ pub enum ModelError {
     /// The model has no moving body.
     #[error("the model has no bodies")]
     Empty,
+    /// An element of a model file is inconsistent with the body it attaches to (e.g. a joint
+    /// point off a point mass's centre) or misses a field its kind needs.
+    #[error("{element}: {message}")]
+    InvalidElement {
+        /// The body, joint or force at fault, e.g. `joint 'pivot'`.
+        element: String,
+        /// What is wrong, naming the field and the body.
+        message: String,
+    },
     /// A model file could not be read or parsed.
     #[error("model file ({format}): {message}")]
     Parse {

@@ -10,7 +10,7 @@ use crate::timefn::TimeFunction;
 use serde::{Deserialize, Serialize};
 
 /// Which coordinate an [`JointKind::Absolute`] constraint fixes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Coordinate {
     /// Global x of the point.

@@ -65,7 +65,7 @@ pub use body::{Body, BodyHandle, BodyRef};
 pub use builder::SystemBuilder;
 pub use cache::AngleCache;
 pub use error::ModelError;
-pub use file::{ForceSpec, JointSpec, ModelFile};
+pub use file::{BodyKind, BodySpec, ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};
 pub use joint::{Coordinate, Joint, JointKind};
 pub use scale::MAX_INERTIA_RATIO;

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 /// A scalar function of time with its first two derivatives, serialisable for model files.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum TimeFunction {
     /// `c`.

@@ -1,0 +1,128 @@
+//! Model files: the same model as the builder, in JSON or TOML (serde). Bodies are referred to by
+//! name; `"ground"` is the fixed frame.
+//!
+//! ```toml
+//! gravity = [0.0, -9.81]
+//!
+//! [[bodies]]
+//! name = "rod"
+//! mass = 1.0
+//! inertia = 0.083333333333
+//! position = [0.0, -0.5, -1.5707963267948966]
+//!
+//! [[joints]]
+//! type = "revolute"
+//! name = "pivot"
+//! body_a = "ground"
+//! point_a = [0.0, 0.0]
+//! body_b = "rod"
+//! point_b = [-0.5, 0.0]
+//! ```
+
+mod resolve;
+mod spec;
+
+pub use spec::{BodyKind, BodySpec, ForceSpec, JointSpec};
+
+use crate::builder::SystemBuilder;
+use crate::error::ModelError;
+use crate::system::System;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// A whole model as stored in a file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// Gravity vector `[gx, gy]`, m/s^2 (default zero).
+    #[serde(default)]
+    pub gravity: [f64; 2],
+    /// The bodies.
+    pub bodies: Vec<BodySpec>,
+    /// The joints.
+    #[serde(default)]
+    pub joints: Vec<JointSpec>,
+    /// The force elements.
+    #[serde(default)]
+    pub forces: Vec<ForceSpec>,
+}
+
+impl ModelFile {
+    /// Parses JSON.
+    pub fn from_json(s: &str) -> Result<Self, ModelError> {
+        serde_json::from_str(s).map_err(|e| ModelError::Parse {
+            format: "json",
+            message: e.to_string(),
+        })
+    }
+    /// Parses TOML.
+    pub fn from_toml(s: &str) -> Result<Self, ModelError> {
+        toml::from_str(s).map_err(|e| ModelError::Parse {
+            format: "toml",
+            message: e.to_string(),
+        })
+    }
+    /// Serialises to pretty JSON.
+    pub fn to_json(&self) -> Result<String, ModelError> {
+        serde_json::to_string_pretty(self).map_err(|e| ModelError::Parse {
+            format: "json",
+            message: e.to_string(),
+        })
+    }
+    /// Serialises to TOML.
+    pub fn to_toml(&self) -> Result<String, ModelError> {
+        toml::to_string(self).map_err(|e| ModelError::Parse {
+            format: "toml",
+            message: e.to_string(),
+        })
+    }
+
+    /// Resolves body names into a builder (errors name the element and the unknown body):
+    /// converts body-frame points and poses to the centre of mass, and turns each point mass
+    /// into a body with a nominal inertia `m l^2` plus an `absolute` angle joint
+    /// `<name>:point_mass` holding its angle at 0 (see `docs/model-files.md`).
+    pub fn to_builder(&self) -> Result<SystemBuilder, ModelError> {
+        self.to_builder_impl()
+    }
+
+    /// The JSON Schema (draft 2020-12) of model files, generated from these types; checked in
+    /// as `schema/model.schema.json`.
+    pub fn json_schema() -> String {
+        let schema = schemars::schema_for!(ModelFile);
+        let mut s = serde_json::to_string_pretty(&schema).unwrap_or_default();
+        s.push('\n');
+        s
+    }
+
+    /// Resolves and validates into a [`System`].
+    pub fn build(&self) -> Result<System, ModelError> {
+        self.to_builder()?.build()
+    }
+}
+
+impl System {
+    /// Loads a model from a JSON string.
+    pub fn from_json(s: &str) -> Result<System, ModelError> {
+        ModelFile::from_json(s)?.build()
+    }
+    /// Loads a model from a TOML string.
+    pub fn from_toml(s: &str) -> Result<System, ModelError> {
+        ModelFile::from_toml(s)?.build()
+    }
+    /// Loads a model file, JSON or TOML by its extension (`.json`, `.toml`).
+    pub fn from_path(path: impl AsRef<std::path::Path>) -> Result<System, ModelError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| ModelError::Parse {
+            format: "io",
+            message: format!("{}: {e}", path.display()),
+        })?;
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("json") => Self::from_json(&text),
+            Some("toml") => Self::from_toml(&text),
+            _ => Err(ModelError::Parse {
+                format: "io",
+                message: format!("{}: unknown extension (use .json or .toml)", path.display()),
+            }),
+        }
+    }
+}
