@@ -496,3 +496,57 @@ impl<O: Observer> Observer for DenseOutput<O> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The quintic Hermite interpolant reproduces a quintic polynomial (and its derivative)
+    /// from values, first and second derivatives at both ends.
+    #[test]
+    fn quintic_hermite_is_exact_for_quintics() {
+        let p =
+            |t: f64| 1.0 - 2.0 * t + 0.5 * t * t + 3.0 * t.powi(3) - t.powi(4) + 0.7 * t.powi(5);
+        let dp = |t: f64| -2.0 + t + 9.0 * t * t - 4.0 * t.powi(3) + 3.5 * t.powi(4);
+        let ddp = |t: f64| 1.0 + 18.0 * t - 12.0 * t * t + 14.0 * t.powi(3);
+        let (t0, t1) = (0.3, 1.1);
+        let mut s = Segment::new(1);
+        s.t0 = t0;
+        s.t1 = t1;
+        s.q0[0] = p(t0);
+        s.v0[0] = dp(t0);
+        s.a0[0] = ddp(t0);
+        s.q1[0] = p(t1);
+        s.v1[0] = dp(t1);
+        s.a1[0] = ddp(t1);
+        let (mut q, mut v) = ([0.0], [0.0]);
+        for k in 0..=20 {
+            let t = t0 + (t1 - t0) * k as f64 / 20.0;
+            s.eval(t, &mut q, &mut v);
+            assert!(
+                (q[0] - p(t)).abs() < 1e-14,
+                "q at {t}: {} vs {}",
+                q[0],
+                p(t)
+            );
+            assert!(
+                (v[0] - dp(t)).abs() < 1e-13,
+                "v at {t}: {} vs {}",
+                v[0],
+                dp(t)
+            );
+        }
+    }
+
+    #[test]
+    fn output_times_must_be_sorted_and_finite() {
+        let sys = mbd_model::models::pendulum(1.0, 1.0, 0.3, 9.81).unwrap();
+        let d = DenseOutput::new(&sys, crate::NoObserver);
+        assert!(matches!(
+            d.at_times([0.2, 0.1]),
+            Err(SolveError::InvalidParameter { value, .. }) if value == 0.1
+        ));
+        let d = DenseOutput::new(&sys, crate::NoObserver);
+        assert!(d.at_times([f64::NAN]).is_err());
+    }
+}
