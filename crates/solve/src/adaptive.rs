@@ -84,12 +84,13 @@ pub struct AdaptiveConfig {
 impl AdaptiveConfig {
     /// A run to `t_end` with `atol = rtol = tol` and default settings otherwise.
     pub fn new(t_end: f64, tol: f64) -> Self {
-        let mut controller = StepController::default();
-        controller.atol = tol;
-        controller.rtol = tol;
         AdaptiveConfig {
             t_end,
-            controller,
+            controller: StepController {
+                atol: tol,
+                rtol: tol,
+                ..Default::default()
+            },
             h0: None,
             h_max: f64::INFINITY,
             max_steps: 10_000_000,
