@@ -193,10 +193,10 @@ impl AdaptiveConfig {
 /// with error norm `err` (previous accepted: `err_prev`), `h <- h safety err^-(1/(q+1) -
 /// 0.75 beta) err_prev^beta` clamped to `[fac_min, fac_max]` (no growth right after a
 /// rejection); after a rejection `h <- h max(fac_min, safety err^-(1/(q+1) - 0.75 beta))`.
-/// The last step lands exactly on `t_end`. Errors: a step below `controller.h_min`
-/// ([`SolveError::InvalidStep`] reported through [`SolveError::InvalidParameter`] with the
-/// time), more than `max_steps` attempts, a non-finite state, constraint drift beyond the
-/// guard. [`RunStats::steps`] counts accepted steps, [`RunStats::rejected_steps`] rejections.
+/// The last step lands exactly on `t_end`. Errors: a step below `controller.h_min` or more
+/// than `max_steps` attempts ([`SolveError::InvalidParameter`] whose `value` is the time at
+/// which it happened), a non-finite state or error estimate ([`SolveError::NonFinite`]),
+/// constraint drift beyond the guard ([`SolveError::ConstraintDrift`]). [`RunStats::steps`] counts accepted steps, [`RunStats::rejected_steps`] rejections.
 pub fn run_adaptive<I, O>(
     integrator: &mut I,
     sys: &System,
