@@ -41,6 +41,128 @@ pub use mbd_solve as solve;
 pub use mbd_symplectic as symplectic;
 pub use mbd_tangent as tangent;
 
+/// Everything the workspace's crates can fail with, in one type: every crate's error converts
+/// into it with `?` (`From`), so a program mixing solvers needs one error type.
+///
+/// ```
+/// use mbd::prelude::*;
+///
+/// fn simulate() -> Result<f64, mbd::Error> {
+///     let sys = models::pendulum(1.0, 1.0, 0.3, 9.81)?; // ModelError
+///     let mut state = State::consistent(&sys, 0.0)?; // SolveError
+///     let mut integ = TangentRk::new(&sys, ButcherTableau::dopri5(), TangentOptions::default())?;
+///     let mut rec = Recorder::new();
+///     run(&mut integ, &sys, &mut state, RunConfig::new(1.0, 0.01), &mut rec)?;
+///     Ok(state.t)
+/// }
+/// assert!((simulate()? - 1.0).abs() < 1e-12);
+/// // a bad step size is a typed error naming the parameter
+/// let sys = models::pendulum(1.0, 1.0, 0.3, 9.81)?;
+/// let mut state = State::consistent(&sys, 0.0)?;
+/// let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
+/// let err: mbd::Error = run(&mut rk, &sys, &mut state, RunConfig::new(1.0, -0.1), &mut NoObserver)
+///     .unwrap_err()
+///     .into();
+/// assert!(matches!(err, mbd::Error::Solve(SolveError::InvalidStep { .. })));
+/// # Ok::<(), mbd::Error>(())
+/// ```
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum Error {
+    /// Building or reading a model ([`model::ModelError`]).
+    Model(model::ModelError),
+    /// The run loop, the index-1 solve, Newton, RK4 ([`solve::SolveError`]).
+    Solve(solve::SolveError),
+    /// The symplectic integrator and its calibration ([`symplectic::SymplecticError`]).
+    Symplectic(symplectic::SymplecticError),
+    /// The tangent-space integrator ([`tangent::TangentError`]).
+    Tangent(tangent::TangentError),
+    /// The firefly optimiser ([`firefly::FireflyError`]).
+    Firefly(firefly::FireflyError),
+    /// The firefly-Gauss solver ([`firefly_gauss::FaDaeError`]).
+    FaDae(firefly_gauss::FaDaeError),
+    /// Measures, trajectories and output ([`analysis::AnalysisError`]).
+    Analysis(analysis::AnalysisError),
+}
+
+impl Error {
+    fn inner(&self) -> &(dyn std::error::Error + 'static) {
+        match self {
+            Error::Model(e) => e,
+            Error::Solve(e) => e,
+            Error::Symplectic(e) => e,
+            Error::Tangent(e) => e,
+            Error::Firefly(e) => e,
+            Error::FaDae(e) => e,
+            Error::Analysis(e) => e,
+        }
+    }
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Display::fmt(self.inner(), f)
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        // the wrapper is transparent: the inner error's message is ours, its source is ours
+        self.inner().source()
+    }
+}
+
+macro_rules! from_error {
+    ($($variant:ident($ty:ty)),* $(,)?) => {
+        $(impl From<$ty> for Error {
+            fn from(e: $ty) -> Self {
+                Error::$variant(e)
+            }
+        })*
+    };
+}
+
+from_error!(
+    Model(model::ModelError),
+    Solve(solve::SolveError),
+    Symplectic(symplectic::SymplecticError),
+    Tangent(tangent::TangentError),
+    Firefly(firefly::FireflyError),
+    FaDae(firefly_gauss::FaDaeError),
+    Analysis(analysis::AnalysisError),
+);
+
+/// What a program needs for the common path: a model, a consistent state, a solver, the run
+/// loop (fixed or adaptive steps), observers (with closures whose argument types are
+/// inferred), dense output and events, and the one error type.
+///
+/// ```
+/// use mbd::prelude::*;
+///
+/// let sys = models::pendulum(1.0, 1.0, 0.5, 9.81)?;
+/// let mut state = State::consistent(&sys, 0.0)?;
+/// let mut integ = TangentRk::new(&sys, ButcherTableau::dopri5(), TangentOptions::default())?;
+/// let mut max_speed = 0.0f64;
+/// let stats = run_adaptive(&mut integ, &sys, &mut state, AdaptiveConfig::new(2.0, 1e-9),
+///     &mut observe(|s| max_speed = max_speed.max(s.v[0].hypot(s.v[1]))))?;
+/// assert!(stats.steps > 0 && (state.t - 2.0).abs() < 1e-12);
+/// assert!(max_speed > 0.5);
+/// # Ok::<(), mbd::Error>(())
+/// ```
+pub mod prelude {
+    pub use crate::Error;
+    pub use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
+    pub use mbd_model::{models, System};
+    pub use mbd_rk4::{Rk4, Rk4Options};
+    pub use mbd_solve::{
+        observe, observer, run, run_adaptive, AdaptiveConfig, AdaptiveIntegrator, ButcherTableau,
+        Crossing, DenseOutput, Event, EventHit, Every, Flow, Index1Options, Index1Rk, Integrator,
+        NoObserver, Observer, ProjectionSettings, Recorder, RunConfig, RunStats, SolveError, State,
+    };
+    pub use mbd_symplectic::{Galerkin, SymplecticOptions};
+    pub use mbd_tangent::{TangentOptions, TangentRk};
+}
+
 /// The README's usage example, compiled and run as a doctest.
 #[doc = include_str!("../README.md")]
 mod readme {}

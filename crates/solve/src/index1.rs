@@ -4,12 +4,13 @@
 //! independent reference solver for the other methods.
 
 use crate::accel::AccelerationSolver;
+use crate::adaptive::{AdaptiveIntegrator, StepAttempt};
 use crate::error::SolveError;
 use crate::integrator::{Integrator, StepStats};
 use crate::projection::{ProjectionSettings, Projector};
 use crate::sparse::{LinearSolver, SparseAccelerationSolver};
 use crate::state::State;
-use crate::tableau::{ButcherTableau, ExplicitRk};
+use crate::tableau::{ButcherTableau, ExplicitRk, StepController};
 use mbd_model::System;
 
 /// Settings of [`Index1Rk`].
@@ -98,6 +99,8 @@ pub struct Index1Rk {
     lambda: Vec<f64>,
     phi: Vec<f64>,
     phid: Vec<f64>,
+    /// Start of an adaptive attempt (restored on rejection).
+    y0: Vec<f64>,
     n: usize,
 }
 
@@ -144,6 +147,7 @@ impl Index1Rk {
             lambda: vec![0.0; m],
             phi: vec![0.0; m],
             phid: vec![0.0; m],
+            y0: vec![0.0; 2 * n],
             n,
         })
     }
@@ -217,6 +221,58 @@ impl Integrator for Index1Rk {
             stats.residual = s.residual;
         }
         Ok(stats)
+    }
+}
+
+/// Adaptive steps with the tableau's embedded estimate (DOPRI5, Bogacki-Shampine, Heun-Euler)
+/// through [`crate::run_adaptive`]. The error norm is the RMS over the `2n` components of
+/// `(q, v)` of `err_i / (atol + rtol max(|y0_i|, |y1_i|))`, taken before any projection; a
+/// rejected attempt restores the start state.
+impl AdaptiveIntegrator for Index1Rk {
+    fn embedded_order(&self) -> Option<u32> {
+        match (&self.rk.tableau.b_hat, self.rk.tableau.embedded_order) {
+            (Some(_), q) if q > 0 => Some(q),
+            _ => None,
+        }
+    }
+
+    fn attempt_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        ctrl: &StepController,
+    ) -> Result<StepAttempt, SolveError> {
+        state.check(sys)?;
+        if self.embedded_order().is_none() {
+            return Err(SolveError::Unsupported(format!(
+                "'{}' has no embedded error estimate",
+                self.rk.tableau.name
+            )));
+        }
+        let n = self.n;
+        let t = state.t;
+        self.y0[..n].copy_from_slice(state.q.as_slice());
+        self.y0[n..].copy_from_slice(state.v.as_slice());
+        let stats = self.step(sys, state, h)?;
+        // `self.y` holds the RK end point (before projection)
+        let mut sum = 0.0;
+        for i in 0..2 * n {
+            let sc = ctrl.atol + ctrl.rtol * self.y0[i].abs().max(self.y[i].abs());
+            sum += (self.rk.err[i] / sc).powi(2);
+        }
+        let error_norm = (sum / (2 * n).max(1) as f64).sqrt();
+        let accepted = error_norm <= 1.0;
+        if !accepted {
+            state.q.as_mut_slice().copy_from_slice(&self.y0[..n]);
+            state.v.as_mut_slice().copy_from_slice(&self.y0[n..]);
+            state.t = t;
+        }
+        Ok(StepAttempt {
+            accepted,
+            error_norm,
+            stats,
+        })
     }
 }
 

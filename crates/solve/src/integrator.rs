@@ -80,6 +80,88 @@ where
     }
 }
 
+/// A pair of observers: both see every sample; the run stops if either asks to.
+impl<A: Observer, B: Observer> Observer for (A, B) {
+    fn observe(&mut self, sys: &System, state: &State, step: usize) -> Result<Flow, SolveError> {
+        let a = self.0.observe(sys, state, step)?;
+        let b = self.1.observe(sys, state, step)?;
+        Ok(if a == Flow::Stop || b == Flow::Stop {
+            Flow::Stop
+        } else {
+            Flow::Continue
+        })
+    }
+}
+
+/// An observer from a closure over the state alone (see [`observe`]).
+#[derive(Clone, Copy, Debug)]
+pub struct StateFn<F>(pub F);
+
+impl<F: FnMut(&State)> Observer for StateFn<F> {
+    fn observe(&mut self, _: &System, state: &State, _: usize) -> Result<Flow, SolveError> {
+        (self.0)(state);
+        Ok(Flow::Continue)
+    }
+}
+
+/// An observer from a closure `|state| ...` that sees every sample and never stops the run;
+/// the closure's argument type is inferred.
+///
+/// ```
+/// use mbd_model::models;
+/// use mbd_solve::{observe, run, ButcherTableau, Index1Options, Index1Rk, RunConfig, SolveError, State};
+///
+/// let sys = models::pendulum(1.0, 1.0, 0.3, 9.81)?;
+/// let mut state = State::consistent(&sys, 0.0)?;
+/// let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
+/// let mut lowest = f64::INFINITY;
+/// run(&mut rk, &sys, &mut state, RunConfig::new(1.0, 0.01), &mut observe(|s| {
+///     lowest = lowest.min(s.q[1]);
+/// }))?;
+/// assert!(lowest < -0.49 && lowest > -0.51); // the rod's centre passes 0.5 m below the pivot
+/// # Ok::<(), SolveError>(())
+/// ```
+pub fn observe<F: FnMut(&State)>(f: F) -> StateFn<F> {
+    StateFn(f)
+}
+
+/// An observer from a closure `|sys, state, step| -> Result<Flow, SolveError>` with every
+/// argument type inferred (a bare closure passed as `&mut O` needs them annotated).
+///
+/// ```
+/// use mbd_model::models;
+/// use mbd_solve::{observer, run, ButcherTableau, Flow, Index1Options, Index1Rk, RunConfig, SolveError, State};
+///
+/// let sys = models::pendulum(1.0, 1.0, 0.3, 9.81)?;
+/// let mut state = State::consistent(&sys, 0.0)?;
+/// let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
+/// // stop once the rod has swung past the vertical (x changes sign)
+/// let stats = run(&mut rk, &sys, &mut state, RunConfig::new(5.0, 0.01), &mut observer(|_, s, _| {
+///     Ok(if s.q[0] < 0.0 { Flow::Stop } else { Flow::Continue })
+/// }))?;
+/// assert!(stats.stopped_early && state.t < 1.0);
+/// # Ok::<(), SolveError>(())
+/// ```
+pub fn observer<F>(f: F) -> FnObserver<F>
+where
+    F: FnMut(&System, &State, usize) -> Result<Flow, SolveError>,
+{
+    FnObserver(f)
+}
+
+/// An observer from a closure over `(sys, state, step)` (see [`observer`]).
+#[derive(Clone, Copy, Debug)]
+pub struct FnObserver<F>(pub F);
+
+impl<F> Observer for FnObserver<F>
+where
+    F: FnMut(&System, &State, usize) -> Result<Flow, SolveError>,
+{
+    fn observe(&mut self, sys: &System, state: &State, step: usize) -> Result<Flow, SolveError> {
+        (self.0)(sys, state, step)
+    }
+}
+
 /// Ignores every sample.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoObserver;
@@ -201,7 +283,7 @@ impl DriftGuard {
     /// The default relative position tolerance.
     pub const DEFAULT_POSITION_TOL: f64 = 1e-2;
 
-    fn validate(&self) -> Result<(), SolveError> {
+    pub(crate) fn validate(&self) -> Result<(), SolveError> {
         if !(self.position_tol.is_finite() && self.position_tol > 0.0) {
             return Err(SolveError::InvalidParameter {
                 parameter: "drift_guard.position_tol",
@@ -278,8 +360,11 @@ impl RunConfig {
 /// Summary of a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RunStats {
-    /// Steps taken.
+    /// Steps taken (accepted steps of an adaptive run).
     pub steps: usize,
+    /// Steps rejected by the error test of an adaptive run ([`crate::run_adaptive`]); 0 for
+    /// fixed steps.
+    pub rejected_steps: usize,
     /// Total Newton iterations.
     pub newton_iterations: usize,
     /// Total right-hand-side evaluations.
@@ -357,14 +442,14 @@ pub fn step_count(t0: f64, t_end: f64, h: f64) -> Result<usize, SolveError> {
 }
 
 /// The guard's workspace: one residual buffer, allocated once per run.
-struct GuardState {
+pub(crate) struct GuardState {
     guard: DriftGuard,
     scale: Vec<f64>,
     buf: Vec<f64>,
 }
 
 impl GuardState {
-    fn new(sys: &System, guard: DriftGuard) -> Self {
+    pub(crate) fn new(sys: &System, guard: DriftGuard) -> Self {
         let m = sys.n_constraints();
         GuardState {
             guard,
@@ -373,7 +458,7 @@ impl GuardState {
         }
     }
 
-    fn check(&mut self, sys: &System, state: &State) -> Result<(), SolveError> {
+    pub(crate) fn check(&mut self, sys: &System, state: &State) -> Result<(), SolveError> {
         let (q, v, t) = (state.q.as_slice(), state.v.as_slice(), state.t);
         sys.phi(q, t, &mut self.buf);
         self.worst("position", self.guard.position_tol, true, sys, t)?;

@@ -50,7 +50,9 @@
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
 mod accel;
+mod adaptive;
 mod consistent;
+mod dense;
 mod error;
 mod index1;
 mod integrator;
@@ -63,12 +65,14 @@ mod state;
 mod tableau;
 
 pub use accel::AccelerationSolver;
+pub use adaptive::{run_adaptive, AdaptiveConfig, AdaptiveIntegrator, StepAttempt};
 pub use consistent::{consistent_state, project_state, ConsistentOptions, ConsistentState};
+pub use dense::{Crossing, DenseOutput, Event, EventFn, EventHit};
 pub use error::SolveError;
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{
-    run, step_count, DriftGuard, Every, Flow, Integrator, NoObserver, Observer, Recorder,
-    RunConfig, RunStats, StepStats,
+    observe, observer, run, step_count, DriftGuard, Every, Flow, FnObserver, Integrator,
+    NoObserver, Observer, Recorder, RunConfig, RunStats, StateFn, StepStats,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_ROUNDOFF_FACTOR};

@@ -460,3 +460,82 @@ impl TangentRk {
         Ok(h0.max(ctrl.h_min))
     }
 }
+
+/// Adaptive steps of paper B's method through [`mbd_solve::run_adaptive`] (the shared run loop
+/// with its observers, drift guard and [`mbd_solve::RunStats`]). Each attempt centres the chart
+/// at the current state and takes one step; the error norm is
+/// [`AdaptiveSettings::controller`]'s as in [`TangentRk::integrate_adaptive`]. A chart failure
+/// or a singular index-1 solve at a stage point is a rejection with an infinite error norm
+/// (the run loop shrinks the step by `fac_min`).
+impl AdaptiveIntegrator for TangentRk {
+    fn embedded_order(&self) -> Option<u32> {
+        match (&self.rk.tableau.b_hat, self.rk.tableau.embedded_order) {
+            (Some(_), q) if q > 0 => Some(q),
+            _ => None,
+        }
+    }
+
+    fn attempt_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        ctrl: &StepController,
+    ) -> Result<StepAttempt, SolveError> {
+        self.check_sizes(sys, state)?;
+        if !(h.is_finite() && h > 0.0) {
+            return Err(SolveError::InvalidStep { h });
+        }
+        if self.embedded_order().is_none() {
+            return Err(SolveError::Unsupported(format!(
+                "'{}' has no embedded error estimate",
+                self.rk.tableau.name
+            )));
+        }
+        self.load(sys, state)?;
+        let t = state.t;
+        self.centre(sys, t)?;
+        match self.attempt(sys, t, h) {
+            Ok(w) => {
+                self.account(&w);
+                self.path.to_ambient(&self.rk.err, &mut self.ex);
+                for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
+                    *s = a.abs().max(b.abs());
+                }
+                let error_norm = self.error_norm(ctrl);
+                let stats = StepStats {
+                    newton_iterations: w.iterations,
+                    residual: w.residual,
+                    rhs_evals: w.rhs_evals,
+                    condition: w.condition,
+                    ..Default::default()
+                };
+                let accepted = error_norm <= 1.0;
+                if accepted {
+                    std::mem::swap(&mut self.cur, &mut self.xnew);
+                    self.commit_history(h, t + h, w.end_initial_residual);
+                    self.cur_t = t + h;
+                    self.cur_ok = true;
+                    self.stats.steps += 1;
+                    self.stats.max_residual = self.stats.max_residual.max(w.residual);
+                    self.store(state);
+                    state.t = t + h;
+                }
+                Ok(StepAttempt {
+                    accepted,
+                    error_norm,
+                    stats,
+                })
+            }
+            Err(Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_)) => {
+                self.stats.chart_failures += 1;
+                Ok(StepAttempt {
+                    accepted: false,
+                    error_norm: f64::INFINITY,
+                    stats: StepStats::default(),
+                })
+            }
+            Err(Attempt::Hard(e)) => Err(e),
+        }
+    }
+}

@@ -7,8 +7,8 @@ use crate::kernels::axpy;
 use crate::sparse_chart::SparseChart;
 use mbd_model::System;
 use mbd_solve::{
-    AccelerationSolver, ButcherTableau, ExplicitRk, Flow, Integrator, Observer, SolveError,
-    SparseAccelerationSolver, State, StepController, StepStats,
+    AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Flow, Integrator, Observer,
+    SolveError, SparseAccelerationSolver, State, StepAttempt, StepController, StepStats,
 };
 mod adaptive;
 mod attempt;

@@ -1,0 +1,333 @@
+//! Adaptive steps through the shared run loop: the [`AdaptiveIntegrator`] trait (attempt a
+//! step, report its scaled error) and [`run_adaptive`], which drives it with a PI step-size
+//! controller, the same observers, drift guard and [`RunStats`] as the fixed-step [`run`].
+//!
+//! [`run`]: crate::run
+
+use crate::error::SolveError;
+use crate::integrator::{
+    DriftGuard, Flow, GuardState, Integrator, Observer, RunConfig, RunStats, StepStats,
+};
+use crate::state::State;
+use crate::tableau::StepController;
+use mbd_model::System;
+
+/// The outcome of [`AdaptiveIntegrator::attempt_step`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepAttempt {
+    /// Whether the step was accepted (the state advanced).
+    pub accepted: bool,
+    /// The scaled error norm of the embedded estimate (accepted iff `<= 1`); infinite for a
+    /// step that failed for another recoverable reason (e.g. a chart map that did not
+    /// converge), which the controller treats as a large error.
+    pub error_norm: f64,
+    /// Work of the attempt.
+    pub stats: StepStats,
+}
+
+/// A one-step method with an embedded error estimate, driven by [`run_adaptive`].
+pub trait AdaptiveIntegrator: Integrator {
+    /// The order `q` of the embedded (lower-order) solution the controller's exponent uses
+    /// (`1/(q+1)`); `None` if the method has no error estimate.
+    fn embedded_order(&self) -> Option<u32>;
+
+    /// Attempts one step of size `h` from `state`. If the scaled error norm (with `ctrl`'s
+    /// `atol`, `rtol`) is at most 1 the step is accepted: `state` advances to `state.t + h`.
+    /// Otherwise `state` is left unchanged. Errors are for unrecoverable failures only.
+    fn attempt_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        ctrl: &StepController,
+    ) -> Result<StepAttempt, SolveError>;
+}
+
+impl<I: AdaptiveIntegrator + ?Sized> AdaptiveIntegrator for Box<I> {
+    fn embedded_order(&self) -> Option<u32> {
+        (**self).embedded_order()
+    }
+    fn attempt_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        ctrl: &StepController,
+    ) -> Result<StepAttempt, SolveError> {
+        (**self).attempt_step(sys, state, h, ctrl)
+    }
+}
+
+/// Settings of [`run_adaptive`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveConfig {
+    /// End time (the start is the state's time).
+    pub t_end: f64,
+    /// Tolerances, safety factor, shrink/growth limits and the smallest step.
+    pub controller: StepController,
+    /// First step; `None` = `0.1 (t_end - t0) tol^(1/(q+1))` with `tol = max(atol, rtol)`
+    /// (the controller corrects it within a few steps).
+    pub h0: Option<f64>,
+    /// Largest step (default infinite).
+    pub h_max: f64,
+    /// Limit on accepted plus rejected steps (default `10^7`).
+    pub max_steps: usize,
+    /// `beta` of the PI controller (`None` = Gustafsson's `0.4/(q+1)`; `Some(0.0)` = I
+    /// controller), as in `mbd_tangent::AdaptiveSettings::pi_beta`.
+    pub pi_beta: Option<f64>,
+    /// The constraint-drift guard, checked after every accepted step (default on).
+    pub drift_guard: Option<DriftGuard>,
+    /// As [`RunConfig::condition_limit`].
+    pub condition_limit: f64,
+}
+
+impl AdaptiveConfig {
+    /// A run to `t_end` with `atol = rtol = tol` and default settings otherwise.
+    pub fn new(t_end: f64, tol: f64) -> Self {
+        AdaptiveConfig {
+            t_end,
+            controller: StepController {
+                atol: tol,
+                rtol: tol,
+                ..Default::default()
+            },
+            h0: None,
+            h_max: f64::INFINITY,
+            max_steps: 10_000_000,
+            pi_beta: None,
+            drift_guard: Some(DriftGuard::default()),
+            condition_limit: RunConfig::DEFAULT_CONDITION_LIMIT,
+        }
+    }
+
+    /// The same run with the given first step.
+    pub fn with_h0(mut self, h0: f64) -> Self {
+        self.h0 = Some(h0);
+        self
+    }
+
+    /// The same run with the given largest step.
+    pub fn with_h_max(mut self, h_max: f64) -> Self {
+        self.h_max = h_max;
+        self
+    }
+
+    /// The same run without the drift guard.
+    pub fn without_drift_guard(mut self) -> Self {
+        self.drift_guard = None;
+        self
+    }
+
+    fn validate(&self, t0: f64) -> Result<(), SolveError> {
+        let bad = |parameter, value, reason| {
+            Err(SolveError::InvalidParameter {
+                parameter,
+                value,
+                reason,
+            })
+        };
+        let c = &self.controller;
+        if !(self.t_end.is_finite() && t0.is_finite() && self.t_end > t0) {
+            return Err(SolveError::InvalidInterval {
+                t0,
+                t_end: self.t_end,
+                reason: "end time must be finite and after the start time",
+            });
+        }
+        if !(c.atol.is_finite() && c.atol >= 0.0 && c.rtol.is_finite() && c.rtol >= 0.0) {
+            return bad(
+                "controller.atol/rtol",
+                c.atol.min(c.rtol),
+                "must be non-negative and finite",
+            );
+        }
+        if !(c.atol > 0.0 || c.rtol > 0.0) {
+            return bad(
+                "controller.atol",
+                c.atol,
+                "atol and rtol cannot both be zero",
+            );
+        }
+        if !(c.safety > 0.0 && c.safety <= 1.0) {
+            return bad("controller.safety", c.safety, "must lie in (0, 1]");
+        }
+        if !(c.fac_min > 0.0 && c.fac_min < 1.0) {
+            return bad("controller.fac_min", c.fac_min, "must lie in (0, 1)");
+        }
+        if !(c.fac_max > 1.0 && c.fac_max.is_finite()) {
+            return bad(
+                "controller.fac_max",
+                c.fac_max,
+                "must be finite and above 1",
+            );
+        }
+        if !(c.h_min.is_finite() && c.h_min > 0.0) {
+            return bad("controller.h_min", c.h_min, "must be positive and finite");
+        }
+        if let Some(h0) = self.h0 {
+            if !(h0.is_finite() && h0 > 0.0) {
+                return bad("h0", h0, "must be positive and finite");
+            }
+        }
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return bad("h_max", self.h_max, "must be positive");
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", 0.0, "must be at least 1");
+        }
+        if !(self.condition_limit > 0.0) {
+            return bad(
+                "condition_limit",
+                self.condition_limit,
+                "must be positive (infinity turns the count off)",
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Integrates from `state.t` to `cfg.t_end` with adaptive steps, calling `observer` with the
+/// initial state (step 0) and after every accepted step (with the accepted-step index).
+///
+/// Step control as in `mbd_tangent::TangentRk::integrate_adaptive`: after an accepted step
+/// with error norm `err` (previous accepted: `err_prev`), `h <- h safety err^-(1/(q+1) -
+/// 0.75 beta) err_prev^beta` clamped to `[fac_min, fac_max]` (no growth right after a
+/// rejection); after a rejection `h <- h max(fac_min, safety err^-(1/(q+1) - 0.75 beta))`.
+/// The last step lands exactly on `t_end`. Errors: a step below `controller.h_min` or more
+/// than `max_steps` attempts ([`SolveError::InvalidParameter`] whose `value` is the time at
+/// which it happened), a non-finite state or error estimate ([`SolveError::NonFinite`]),
+/// constraint drift beyond the guard ([`SolveError::ConstraintDrift`]). [`RunStats::steps`] counts accepted steps, [`RunStats::rejected_steps`] rejections.
+pub fn run_adaptive<I, O>(
+    integrator: &mut I,
+    sys: &System,
+    state: &mut State,
+    cfg: AdaptiveConfig,
+    observer: &mut O,
+) -> Result<RunStats, SolveError>
+where
+    I: AdaptiveIntegrator + ?Sized,
+    O: Observer + ?Sized,
+{
+    state.check(sys)?;
+    let t0 = state.t;
+    cfg.validate(t0)?;
+    let q = integrator.embedded_order().ok_or_else(|| {
+        SolveError::Unsupported(format!(
+            "adaptive stepping needs an embedded error estimate; '{}' has none \
+             (use DOPRI5 or Bogacki-Shampine)",
+            integrator.name()
+        ))
+    })?;
+    let k = q as f64 + 1.0;
+    let beta = cfg.pi_beta.unwrap_or(0.4 / k);
+    if !(beta >= 0.0 && beta < 1.0 / (1.75 * k)) {
+        return Err(SolveError::InvalidParameter {
+            parameter: "pi_beta",
+            value: beta,
+            reason: "must lie in [0, 1 / (1.75 (q+1))) for the embedded order q",
+        });
+    }
+    let mut guard = match cfg.drift_guard {
+        Some(g) => {
+            g.validate()?;
+            Some(GuardState::new(sys, g))
+        }
+        None => None,
+    };
+    let ctrl = cfg.controller;
+    let expo = 1.0 / k - 0.75 * beta;
+    let span = cfg.t_end - t0;
+    let mut h = match cfg.h0 {
+        Some(h0) => h0,
+        None => 0.1 * span * ctrl.atol.max(ctrl.rtol).powf(1.0 / k),
+    }
+    .min(cfg.h_max)
+    .min(span)
+    .max(ctrl.h_min);
+    integrator.reset();
+    let mut stats = RunStats::default();
+    if observer.observe(sys, state, 0)? == Flow::Stop {
+        stats.stopped_early = true;
+        return Ok(stats);
+    }
+    let mut err_prev = 1e-4f64;
+    let mut last_rejected = false;
+    let mut attempts = 0usize;
+    while state.t < cfg.t_end {
+        attempts += 1;
+        if attempts > cfg.max_steps {
+            return Err(SolveError::InvalidParameter {
+                parameter: "max_steps (limit of attempted steps reached at the run's time)",
+                value: state.t,
+                reason: "raise AdaptiveConfig::max_steps or loosen the tolerance",
+            });
+        }
+        let t = state.t;
+        let remaining = cfg.t_end - t;
+        let last = h >= remaining * (1.0 - 1e-12);
+        let hs = if last { remaining } else { h };
+        if hs < ctrl.h_min && !last {
+            return Err(SolveError::InvalidParameter {
+                parameter: "step size (fell below controller.h_min at the time given)",
+                value: t,
+                reason: "the error test keeps failing: singularity, stiffness or a tolerance \
+                         below round-off",
+            });
+        }
+        let a = integrator.attempt_step(sys, state, hs, &ctrl)?;
+        stats.newton_iterations += a.stats.newton_iterations;
+        stats.rhs_evals += a.stats.rhs_evals;
+        stats.objective_evals += a.stats.objective_evals;
+        let en = a.error_norm;
+        if en.is_nan() {
+            return Err(SolveError::NonFinite {
+                t,
+                what: "embedded error estimate",
+            });
+        }
+        let grow = if en == 0.0 {
+            ctrl.fac_max
+        } else {
+            ctrl.safety * en.powf(-expo)
+        };
+        if !a.accepted {
+            stats.rejected_steps += 1;
+            last_rejected = true;
+            h = hs * grow.clamp(ctrl.fac_min, 1.0);
+            continue;
+        }
+        state.t = if last { cfg.t_end } else { t + hs };
+        if !state.is_finite() {
+            return Err(SolveError::NonFinite {
+                t: state.t,
+                what: "state after step",
+            });
+        }
+        if let Some(g) = guard.as_mut() {
+            g.check(sys, state)?;
+        }
+        stats.steps += 1;
+        stats.max_residual = stats.max_residual.max(a.stats.residual);
+        stats.max_condition = stats.max_condition.max(a.stats.condition);
+        if a.stats.condition > cfg.condition_limit {
+            stats.near_singular_steps += 1;
+            stats.first_near_singular.get_or_insert(state.t);
+        }
+        let mut fac = if en == 0.0 {
+            ctrl.fac_max
+        } else {
+            (grow * err_prev.powf(beta)).clamp(ctrl.fac_min, ctrl.fac_max)
+        };
+        err_prev = en.max(1e-4);
+        if last_rejected {
+            fac = fac.min(1.0);
+        }
+        last_rejected = false;
+        h = (hs * fac).min(cfg.h_max);
+        if observer.observe(sys, state, stats.steps)? == Flow::Stop {
+            stats.stopped_early = true;
+            break;
+        }
+    }
+    Ok(stats)
+}
