@@ -507,6 +507,29 @@ impl Preadjustment {
         Ok(e)
     }
 
+    /// `A + H_sigma` at `q` (`H_sigma = sum_k sigma_k Hess Phi_k`, `sigma = S^-1 gamma_c(q, v)`)
+    /// into `out` (overwritten): `6 d^2 e / dv^2`, used for the Newton Jacobian.
+    pub fn modified_velocity_hessian(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
+        self.check_v(v)?;
+        self.prepare(sys, q)?;
+        self.modified_prepared(sys, q, v);
+        if self.m > 0 {
+            sys.constraint_hessian(q, &self.sigma, out);
+        } else {
+            out.fill(0.0);
+        }
+        for (a, b) in out.iter_mut().zip(self.amat.iter()) {
+            *a += b;
+        }
+        Ok(())
+    }
+
     /// Gradients of [`Preadjustment::modified_term`], into `dq` and `dv`; returns `e(q, v)`.
     /// With `sigma = S^-1 gamma_c`, `H_sigma = sum_k sigma_k Hess Phi_k`, `u = M^-1 f_T` and
     /// `w = M^-1 Phi_q^T sigma` (derivation in `docs/symplectic.md`):

