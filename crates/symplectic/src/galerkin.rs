@@ -1,6 +1,6 @@
 //! The (s,s) constrained Galerkin variational integrator, optionally preadjusted.
 
-use crate::options::{kappa, Nodes, SymplecticOptions, MAX_PREDICTOR_ORDER};
+use crate::options::{kappa, Nodes, PreadjustMode, SymplecticOptions, MAX_PREDICTOR_ORDER};
 use crate::preadjust::Preadjustment;
 use crate::tables::Tables;
 use dense::stage_lu;
@@ -57,6 +57,14 @@ pub struct Galerkin {
     wgrad: Vec<f64>,
     wh: DMatrix<f64>,
     pre: Option<Preadjustment>,
+    /// The modified-Lagrangian workspace (`PreadjustMode::ModifiedLagrangian`, `s = 1`).
+    ml: Option<Preadjustment>,
+    /// `h^2 d e / d q` at the two control points of the step.
+    mlq: [Vec<f64>; 2],
+    /// `h^2 (d e / d v (Q_0) + d e / d v (Q_1)) / 2`.
+    mlv: Vec<f64>,
+    mlt: Vec<f64>,
+    mlvel: Vec<f64>,
     tn: [Vec<f64>; 4],
     proj: DenseCholesky,
     vm: Vec<f64>,
@@ -92,12 +100,19 @@ impl Galerkin {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let dim = s * (n + m);
         let tab = Tables::new(s, options.nodes);
-        let sparse_ok = options.gamma == 0.0;
+        let modlag = options.preadjust == PreadjustMode::ModifiedLagrangian;
+        if modlag && !sys.is_conservative() {
+            return Err(SolveError::Unsupported(
+                "the modified-Lagrangian preadjustment (preadjust) needs a conservative model"
+                    .into(),
+            ));
+        }
+        let sparse_ok = options.gamma == 0.0 && !modlag;
         let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
-                "the sparse symplectic stage solve needs gamma = 0 (the preadjustment's \
-                 Hessian is dense)"
+                "the sparse symplectic stage solve needs gamma = 0 and preadjust = Paper (the \
+                 preadjustment's Hessian is dense)"
                     .into(),
             ));
         }
@@ -115,7 +130,20 @@ impl Galerkin {
         } else {
             None
         };
+        let ml = if modlag {
+            let mut p = Preadjustment::new(sys, 1)?;
+            p.fd_step = options.fd_step;
+            Some(p)
+        } else {
+            None
+        };
+        let nl = if modlag { n } else { 0 };
         Ok(Galerkin {
+            ml,
+            mlq: [vec![0.0; nl], vec![0.0; nl]],
+            mlv: vec![0.0; nl],
+            mlt: vec![0.0; nl],
+            mlvel: vec![0.0; nl],
             opts: options,
             tab,
             n,
@@ -330,6 +358,28 @@ impl Galerkin {
                 }
             }
         }
+        if let Some(ml) = &mut self.ml {
+            // s = 1: the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h
+            let h2 = h * h;
+            for i in 0..n {
+                self.mlvel[i] = self.hvj[i] / h;
+            }
+            self.mlv.fill(0.0);
+            for c in 0..2 {
+                ml.modified_gradients(
+                    sys,
+                    &self.qn[c * n..(c + 1) * n],
+                    &self.mlvel,
+                    &mut self.mlq[c],
+                    &mut self.mlt,
+                )
+                .map_err(|e| with_time(e, t))?;
+                for i in 0..n {
+                    self.mlq[c][i] *= h2;
+                    self.mlv[i] += 0.5 * h2 * self.mlt[i];
+                }
+            }
+        }
         Ok(())
     }
 
@@ -388,6 +438,12 @@ impl Galerkin {
                     res += self.hvk[i];
                 }
                 self.r[nu * n + i] = res;
+            }
+        }
+        if self.ml.is_some() {
+            // s = 1: h M^-1 D_1 of h (E(Q_0, v) + E(Q_1, v)) / 2, v = (Q_1 - Q_0) / h
+            for i in 0..n {
+                self.r[i] += h * self.minv[i] * (0.5 * h * self.mlq[0][i] - self.mlv[i]);
             }
         }
     }
@@ -453,6 +509,9 @@ impl Integrator for Galerkin {
         if self.opts.gamma != 0.0 {
             name += &format!(" gamma = {}", self.opts.gamma);
         }
+        if self.ml.is_some() {
+            name += " modified Lagrangian";
+        }
         if self.opts.nodes == Nodes::Equispaced && s > 2 {
             name += " equispaced";
         }
@@ -517,6 +576,12 @@ impl Integrator for Galerkin {
         for (&bj, gj) in self.tab.b.iter().zip(self.gj.chunks_exact(n)) {
             for (fi, &g) in f.iter_mut().zip(gj) {
                 *fi += bj * g;
+            }
+        }
+        if self.ml.is_some() {
+            // (D_1 + D_2) of h (E(Q_0, v) + E(Q_1, v)) / 2 = h (dE/dq (Q_0) + dE/dq (Q_1)) / 2
+            for i in 0..n {
+                f[i] -= 0.5 * (self.mlq[0][i] + self.mlq[1][i]);
             }
         }
         if let Some(sp) = &self.sparse {

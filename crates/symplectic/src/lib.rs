@@ -13,6 +13,8 @@
 //!   position and velocity level to the Newton tolerance.
 //! * [`SymplecticOptions`]: `s`, `gamma`, the control-point placement [`Nodes`] and the Newton
 //!   settings. `gamma = 0` is the plain scheme bit for bit; [`kappa`] gives `kappa_s`.
+//!   [`PreadjustMode::ModifiedLagrangian`] (s = 1) replaces `W_s` by a parameter-free modified
+//!   Lagrangian with velocity terms (issue 13; `docs/symplectic.md` section 5a).
 //! * [`Preadjustment`]: `W_s`, its gradient and the tangential force on any model.
 //! * [`calibrate_gamma`]: `gamma_opt` by the secant method on the averaged signed trajectory
 //!   error `dW(gamma)` against a reference, measured by the caller (paper A's `E|dx|`, `E|dy|`,
@@ -54,6 +56,6 @@ mod tables;
 pub use calibrate::{calibrate_gamma, Calibration, CalibrationSettings};
 pub use error::SymplecticError;
 pub use galerkin::Galerkin;
-pub use options::{kappa, phase_constant, Nodes, SymplecticOptions};
+pub use options::{kappa, phase_constant, Nodes, PreadjustMode, SymplecticOptions};
 pub use preadjust::Preadjustment;
 pub use tables::lobatto_nodes;

@@ -18,6 +18,20 @@ pub enum Nodes {
     Equispaced,
 }
 
+/// Which preadjustment of the discrete Lagrangian is used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PreadjustMode {
+    /// Paper A's `-gamma kappa_s h^(2s) W_s(q)` with [`SymplecticOptions::gamma`] (`gamma = 0`:
+    /// the plain scheme). Default.
+    #[default]
+    Paper,
+    /// The parameter-free modified Lagrangian of issue 13 for `s = 1`:
+    /// `L~ = L - h^2/24 f_T^T M^-1 f_T + h^2/12 v^T A v + h^2/24 gamma_c^T S^-1 gamma_c`, each
+    /// term averaged over the two control points (`docs/symplectic.md`, "Modified-Lagrangian
+    /// preadjustment"). Needs `s = 1`, `gamma = 0`, a conservative model and the dense path.
+    ModifiedLagrangian,
+}
+
 /// Settings of [`crate::Galerkin`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SymplecticOptions {
@@ -25,6 +39,9 @@ pub struct SymplecticOptions {
     pub s: usize,
     /// The preadjustment parameter `gamma` (0: the plain scheme; 1: `gamma_T`).
     pub gamma: f64,
+    /// Which preadjustment: paper A's `W_s` scaled by `gamma` (default) or the parameter-free
+    /// modified Lagrangian (`s = 1` only).
+    pub preadjust: PreadjustMode,
     /// Placement of the control points.
     pub nodes: Nodes,
     /// Newton settings for the stage equations. With `tol_k = tol (1 + max |x, y|) + 4 eps
@@ -40,7 +57,8 @@ pub struct SymplecticOptions {
     /// `docs/symplectic.md` for why the predictor is never accepted without an update.
     pub newton: NewtonOptions,
     /// Relative step of the central differences used for the third derivatives of `V` and `Phi`
-    /// in `grad W_s` (`s >= 2` with `gamma != 0`), Richardson-extrapolated (error `O(eps^4)`).
+    /// in `grad W_s` (`s >= 2` with `gamma != 0`), Richardson-extrapolated (error `O(eps^4)`);
+    /// also the step of the position gradient of the modified-Lagrangian term.
     pub fd_step: f64,
     /// Start a step with the factored Jacobian of the previous step (same `h`) instead of a new
     /// one; it is recomputed as soon as the simplified Newton iteration contracts by less than
@@ -69,6 +87,7 @@ impl Default for SymplecticOptions {
         SymplecticOptions {
             s: 2,
             gamma: 0.0,
+            preadjust: PreadjustMode::Paper,
             nodes: Nodes::Lobatto,
             newton: NewtonOptions {
                 tol: 1e-14,
@@ -98,6 +117,11 @@ impl SymplecticOptions {
         self.gamma = gamma;
         self
     }
+    /// Sets the preadjustment mode.
+    pub fn with_preadjust(mut self, mode: PreadjustMode) -> Self {
+        self.preadjust = mode;
+        self
+    }
     /// Sets the control-point placement.
     pub fn with_nodes(mut self, nodes: Nodes) -> Self {
         self.nodes = nodes;
@@ -124,6 +148,24 @@ impl SymplecticOptions {
                 value: self.gamma,
                 reason: "must be finite",
             });
+        }
+        if self.preadjust == PreadjustMode::ModifiedLagrangian {
+            if self.s != 1 {
+                return Err(SolveError::InvalidParameter {
+                    parameter: "preadjust",
+                    value: self.s as f64,
+                    reason: "the modified-Lagrangian preadjustment is derived for s = 1 only \
+                             (s >= 2: not derived yet)",
+                });
+            }
+            if self.gamma != 0.0 {
+                return Err(SolveError::InvalidParameter {
+                    parameter: "gamma",
+                    value: self.gamma,
+                    reason: "gamma scales paper A's W_s; it must be 0 with the \
+                             modified-Lagrangian preadjustment",
+                });
+            }
         }
         if !(self.fd_step.is_finite() && self.fd_step > 0.0 && self.fd_step < 1.0) {
             return Err(SolveError::InvalidParameter {

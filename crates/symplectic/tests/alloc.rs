@@ -2,7 +2,7 @@
 //! preadjustment on, on the dense and on the sparse path.
 use mbd_model::models;
 use mbd_solve::{Integrator, LinearSolver, State};
-use mbd_symplectic::{Galerkin, SymplecticOptions};
+use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -38,6 +38,17 @@ fn steps_allocate_nothing() {
         let n = ALLOCS.with(|c| c.get()) - before;
         assert_eq!(n, 0, "s={s} gamma={gamma}: {n} allocations in 100 steps");
     }
+    // the modified-Lagrangian preadjustment (s = 1)
+    let opts = SymplecticOptions::new(1).with_preadjust(PreadjustMode::ModifiedLagrangian);
+    let mut g = Galerkin::new(&sys, opts).unwrap();
+    let mut st = s0.clone();
+    g.step(&sys, &mut st, 0.01).unwrap();
+    let before = ALLOCS.with(|c| c.get());
+    for _ in 0..100 {
+        g.step(&sys, &mut st, 0.01).unwrap();
+    }
+    let n = ALLOCS.with(|c| c.get()) - before;
+    assert_eq!(n, 0, "modified Lagrangian: {n} allocations in 100 steps");
 }
 
 /// The sparse path (a 30-link chain, sparse stage LU, sparse projection): after the first

@@ -96,6 +96,30 @@ impl Galerkin {
                 }
             }
         }
+        // modified Lagrangian (s = 1): the velocity part of h M^-1 D_1 E_d,
+        // -h M^-1 (h^2 / 12) (B(Q_0) + B(Q_1)) v, B = A + H_sigma = 6 d^2 e / dv^2, differentiated
+        // in Z_1 = h v with B frozen; the rest of the modified terms' Jacobian is O(h^2) smaller
+        // and left out (docs/symplectic.md, section 5a)
+        if let Some(ml) = &mut self.ml {
+            for c in 0..2 {
+                ml.modified_velocity_hessian(
+                    sys,
+                    &self.qn[c * n..(c + 1) * n],
+                    &self.mlvel,
+                    &mut self.wh,
+                )
+                .map_err(|e| with_time(e, t))?;
+                let jm = &mut self.lu;
+                for l in 0..n {
+                    for i in 0..n {
+                        let b = self.wh[(i, l)];
+                        if b != 0.0 {
+                            jm.add(i, l, -(h2 / 12.0) * self.minv[i] * b);
+                        }
+                    }
+                }
+            }
+        }
         // constraint curvature at the interior control points
         for nu in 1..s {
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
