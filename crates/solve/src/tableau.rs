@@ -328,6 +328,61 @@ pub struct StepController {
     pub h_min: f64,
 }
 
+impl StepController {
+    /// Checks every field; an error names the field (`controller.<field>`).
+    pub fn validate(&self) -> Result<(), SolveError> {
+        let bad = |parameter, value, reason| {
+            Err(SolveError::InvalidParameter {
+                parameter,
+                value,
+                reason,
+            })
+        };
+        if !(self.atol.is_finite() && self.atol >= 0.0) {
+            return bad(
+                "controller.atol",
+                self.atol,
+                "must be non-negative and finite",
+            );
+        }
+        if !(self.rtol.is_finite() && self.rtol >= 0.0) {
+            return bad(
+                "controller.rtol",
+                self.rtol,
+                "must be non-negative and finite",
+            );
+        }
+        if !(self.atol > 0.0 || self.rtol > 0.0) {
+            return bad(
+                "controller.atol",
+                self.atol,
+                "atol and rtol cannot both be zero",
+            );
+        }
+        if !(self.safety > 0.0 && self.safety <= 1.0) {
+            return bad("controller.safety", self.safety, "must lie in (0, 1]");
+        }
+        if !(self.fac_min > 0.0 && self.fac_min < 1.0) {
+            return bad("controller.fac_min", self.fac_min, "must lie in (0, 1)");
+        }
+        if !(self.fac_max > 1.0 && self.fac_max.is_finite()) {
+            return bad(
+                "controller.fac_max",
+                self.fac_max,
+                "must be finite and above 1",
+            );
+        }
+        if !(self.h_min.is_finite() && self.h_min > 0.0) {
+            return bad(
+                "controller.h_min",
+                self.h_min,
+                "must be positive and finite",
+            );
+        }
+        Ok(())
+    }
+}
+
 impl Default for StepController {
     fn default() -> Self {
         StepController {

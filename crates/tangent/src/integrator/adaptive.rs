@@ -67,35 +67,7 @@ impl AdaptiveSettings {
                 reason,
             })
         };
-        if !(c.atol.is_finite() && c.atol >= 0.0) {
-            return bad("controller.atol", c.atol, "must be non-negative and finite");
-        }
-        if !(c.rtol.is_finite() && c.rtol >= 0.0) {
-            return bad("controller.rtol", c.rtol, "must be non-negative and finite");
-        }
-        if !(c.atol > 0.0 || c.rtol > 0.0) {
-            return bad(
-                "controller.atol",
-                c.atol,
-                "atol and rtol cannot both be zero",
-            );
-        }
-        if !(c.safety > 0.0 && c.safety <= 1.0) {
-            return bad("controller.safety", c.safety, "must lie in (0, 1]");
-        }
-        if !(c.fac_min > 0.0 && c.fac_min < 1.0) {
-            return bad("controller.fac_min", c.fac_min, "must lie in (0, 1)");
-        }
-        if !(c.fac_max > 1.0 && c.fac_max.is_finite()) {
-            return bad(
-                "controller.fac_max",
-                c.fac_max,
-                "must be finite and above 1",
-            );
-        }
-        if !(c.h_min.is_finite() && c.h_min > 0.0) {
-            return bad("controller.h_min", c.h_min, "must be positive and finite");
-        }
+        c.validate()?;
         if let Some(h0) = self.h0 {
             if !(h0.is_finite() && h0 > 0.0) {
                 return bad("h0", h0, "must be positive and finite");
