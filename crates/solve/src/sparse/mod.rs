@@ -22,7 +22,7 @@ mod schur;
 pub use accel::SparseAccelerationSolver;
 pub use cholesky::SparseCholesky;
 pub use lu::{SparseLu, SPARSE_PIVOT_TOL};
-pub use schur::ConstraintSchur;
+pub use schur::{ConstraintSchur, RowIncidence};
 
 /// Constraint count above which [`LinearSolver::Auto`] picks the sparse path (index-1 solve,
 /// projection, and the solvers built on them). Below it the dense kernels are faster: for the

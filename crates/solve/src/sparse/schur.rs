@@ -18,6 +18,43 @@ struct Contribution {
     idx: usize,
 }
 
+/// Which bodies each constraint equation acts on: the incidence every sparse pattern of the
+/// workspace is built from (`S`, the tangent chart's `Df Df^T`, the symplectic stage system).
+#[derive(Clone, Debug)]
+pub struct RowIncidence {
+    /// Per equation: its joint's `(first, second)` body (coordinate block), `None` = ground.
+    pub row_bodies: Vec<(Option<usize>, Option<usize>)>,
+    /// Per body: the equations acting on it, with the body's offset (0 or 3) in the equation's
+    /// element-local gradient ([`mbd_model::System::phi_q_local`]).
+    pub by_body: Vec<Vec<(usize, usize)>>,
+}
+
+impl RowIncidence {
+    /// The incidence of `sys` (allocates; once per pattern).
+    pub fn new(sys: &System) -> Self {
+        let mut row_bodies = vec![(None, None); sys.n_constraints()];
+        for j in 0..sys.joints().len() {
+            let jb = sys.joint_bodies(JointHandle(j));
+            for r in sys.joint_rows(JointHandle(j)) {
+                row_bodies[r] = jb;
+            }
+        }
+        let mut by_body: Vec<Vec<(usize, usize)>> = vec![Vec::new(); sys.n_coords() / 3];
+        for (r, &(a, b)) in row_bodies.iter().enumerate() {
+            if let Some(a) = a {
+                by_body[a].push((r, 0));
+            }
+            if let Some(b) = b {
+                by_body[b].push((r, 3));
+            }
+        }
+        RowIncidence {
+            row_bodies,
+            by_body,
+        }
+    }
+}
+
 /// `Phi_q` stored row by row in element-local form (each equation acts on at most two bodies:
 /// six numbers per row) and the sparse Cholesky factorisation of `S = Phi_q W Phi_q^T` for a
 /// positive diagonal weight `W` (`M^-1` for the index-1 solve and the projections).
@@ -40,23 +77,10 @@ impl ConstraintSchur {
     /// Analyses the pattern of `S` for `sys` (allocates; done once).
     pub fn new(sys: &System) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let mut row_bodies = vec![(None, None); m];
-        for j in 0..sys.joints().len() {
-            let jb = sys.joint_bodies(JointHandle(j));
-            for r in sys.joint_rows(JointHandle(j)) {
-                row_bodies[r] = jb;
-            }
-        }
-        // rows touching each body, with the offset of the body in the row's local gradient
-        let mut by_body: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n / 3];
-        for (r, &(a, b)) in row_bodies.iter().enumerate() {
-            if let Some(a) = a {
-                by_body[a].push((r, 0));
-            }
-            if let Some(b) = b {
-                by_body[b].push((r, 3));
-            }
-        }
+        let RowIncidence {
+            row_bodies,
+            by_body,
+        } = RowIncidence::new(sys);
         let mut pattern = Vec::new();
         for rows in &by_body {
             for &(r1, _) in rows {

@@ -5,9 +5,9 @@
 //! bodies (see `docs/symplectic.md`, "Sparse stage solve").
 
 use super::Galerkin;
-use mbd_model::{BodyRef, JointHandle, System};
+use mbd_model::{BodyRef, System};
 use mbd_solve::linalg::LuError;
-use mbd_solve::sparse::{ConstraintSchur, SparseLu};
+use mbd_solve::sparse::{ConstraintSchur, RowIncidence, SparseLu};
 use mbd_solve::{SolveError, SparseAccelerationSolver};
 
 /// No slot: the entry belongs to ground.
@@ -101,13 +101,7 @@ impl SparseStage {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let nb = n / 3;
         let dim = s * (n + m);
-        let mut row_bodies = vec![(None, None); m];
-        for j in 0..sys.joints().len() {
-            let jb = sys.joint_bodies(JointHandle(j));
-            for r in sys.joint_rows(JointHandle(j)) {
-                row_bodies[r] = jb;
-            }
-        }
+        let row_bodies = RowIncidence::new(sys).row_bodies;
         let mut entries: Vec<(usize, usize)> = Vec::new();
         for nu in 0..s {
             for mu in 1..=s {

@@ -172,14 +172,7 @@ impl TangentChart {
             // the travel is the first correction
             return true;
         }
-        // one pass: the travel and the size of the start (for the rounding floor); a NaN in
-        // `x` cannot reach here (its residual would not be finite)
-        let (mut travel, mut size) = (0.0f64, 0.0f64);
-        for (a, b) in x.iter().zip(start) {
-            travel = fast_max(travel, (a - b).abs());
-            size = fast_max(size, b.abs());
-        }
-        travel <= TRAVEL_FACTOR * self.first_step + 16.0 * f64::EPSILON * (1.0 + size)
+        travel_within(x, start, self.first_step)
     }
 
     /// The chord iteration on `x` from its residual `f`.
@@ -233,32 +226,17 @@ impl TangentChart {
             }
             // predicted stop (stage points only): the residual after this correction is about
             // theta * res with theta the contraction just observed
-            let theta = res / prev;
-            if predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: theta * res,
-                    initial_residual: res0,
-                    exact: false,
-                });
+            if let Some(ms) = predicted_stop(predicted, res, prev, tol, it, res0) {
+                return Ok(ms);
             }
             prev = res;
             res = self.residual_cached(sys, x, t, f);
             // stall at the round-off floor (no progress, not slow convergence)
-            if res > tol && res <= stall_cap && res >= 0.9 * prev {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: res,
-                    initial_residual: res0,
-                    exact: false,
-                });
+            if let Some(ms) = stalled(res, prev, tol, stall_cap, it, res0) {
+                return Ok(ms);
             }
-            if res > newton.divergence * prev && res > tol {
-                return Err(ChartFailure {
-                    t,
-                    residual: res,
-                    iterations: it,
-                });
+            if let Some(e) = diverged(t, res, prev, tol, newton.divergence, it) {
+                return Err(e);
             }
         }
     }
@@ -303,25 +281,14 @@ impl TangentChart {
             if it == 1 {
                 self.first_step = max_abs(&self.wx);
             }
-            let theta = res / prev;
-            if predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: theta * res,
-                    initial_residual: res0,
-                    exact: false,
-                });
+            if let Some(ms) = predicted_stop(predicted, res, prev, tol, it, res0) {
+                return Ok(ms);
             }
             prev = res;
             self.fprev.copy_from_slice(f);
             res = self.residual_cached(sys, x, t, f);
-            if res > tol && res <= stall_cap && res >= 0.9 * prev {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: res,
-                    initial_residual: res0,
-                    exact: false,
-                });
+            if let Some(ms) = stalled(res, prev, tol, stall_cap, it, res0) {
+                return Ok(ms);
             }
             if self.pb_active && (res.is_nan() || res >= prev) {
                 // the updated matrix made no progress: undo the step, restart from R^-T
@@ -336,12 +303,8 @@ impl TangentChart {
                 have_w = false;
                 continue;
             }
-            if res > newton.divergence * prev && res > tol {
-                return Err(ChartFailure {
-                    t,
-                    residual: res,
-                    iterations: it,
-                });
+            if let Some(e) = diverged(t, res, prev, tol, newton.divergence, it) {
+                return Err(e);
             }
             if res <= tol {
                 continue;
@@ -382,6 +345,73 @@ pub(crate) fn fast_max(a: f64, b: f64) -> f64 {
     } else {
         a
     }
+}
+
+/// The predicted stop of a stage map, decided after a correction and before `f` is evaluated
+/// again: the residual after it is about `theta res` with `theta = res / prev` the contraction
+/// just observed ([`TangentChart::map_predicted`]).
+pub(crate) fn predicted_stop(
+    predicted: bool,
+    res: f64,
+    prev: f64,
+    tol: f64,
+    it: usize,
+    res0: f64,
+) -> Option<MapStats> {
+    let theta = res / prev;
+    (predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol).then_some(MapStats {
+        iterations: it,
+        residual: theta * res,
+        initial_residual: res0,
+        exact: false,
+    })
+}
+
+/// A stall at the round-off floor (no progress below `stall_cap`, not slow convergence): the
+/// map is accepted with the residual it reached.
+pub(crate) fn stalled(
+    res: f64,
+    prev: f64,
+    tol: f64,
+    stall_cap: f64,
+    it: usize,
+    res0: f64,
+) -> Option<MapStats> {
+    (res > tol && res <= stall_cap && res >= 0.9 * prev).then_some(MapStats {
+        iterations: it,
+        residual: res,
+        initial_residual: res0,
+        exact: false,
+    })
+}
+
+/// Divergence: the residual grew by more than `divergence` over the last iteration.
+pub(crate) fn diverged(
+    t: f64,
+    res: f64,
+    prev: f64,
+    tol: f64,
+    divergence: f64,
+    it: usize,
+) -> Option<ChartFailure> {
+    (res > divergence * prev && res > tol).then_some(ChartFailure {
+        t,
+        residual: res,
+        iterations: it,
+    })
+}
+
+/// Whether an iteration that ended at `x` from `start` travelled at most [`TRAVEL_FACTOR`]
+/// times its first step (plus a rounding floor relative to the size of `start`).
+pub(crate) fn travel_within(x: &[f64], start: &[f64], first_step: f64) -> bool {
+    // one pass: the travel and the size of the start (for the rounding floor); a NaN in
+    // `x` cannot reach here (its residual would not be finite)
+    let (mut travel, mut size) = (0.0f64, 0.0f64);
+    for (a, b) in x.iter().zip(start) {
+        travel = fast_max(travel, (a - b).abs());
+        size = fast_max(size, b.abs());
+    }
+    travel <= TRAVEL_FACTOR * first_step + 16.0 * f64::EPSILON * (1.0 + size)
 }
 
 /// The verdict at the head of a chord iteration: failed (residual not finite, or `max_iter`

@@ -2,11 +2,12 @@
 //! the projector `P = I - Df^T G^-1 Df` and the chord iteration on `eta`, all through one sparse
 //! Cholesky factorisation of `G = Df(x_c) Df(x_c)^T` per centre (`docs/tangent.md` section 9).
 
-use crate::chart::{fast_max, TRAVEL_FACTOR};
+use crate::chart::{diverged, fast_max, predicted_stop, stalled, travel_within};
 use crate::chart::{loop_head, ChartFailure, MapStats, NewtonSettings, ROUNDOFF_FACTOR};
-use mbd_model::{AngleCache, JointHandle, System};
+use mbd_model::numeric::max_abs;
+use mbd_model::{AngleCache, System};
 use mbd_solve::linalg::FactorError;
-use mbd_solve::sparse::SparseCholesky;
+use mbd_solve::sparse::{RowIncidence, SparseCholesky};
 use mbd_solve::SolveError;
 
 mod rank;
@@ -101,22 +102,10 @@ impl SparseChart {
     /// `Phi_q Phi_q^T` (allocates once).
     pub fn new(sys: &System) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let mut row_bodies = vec![(None, None); m];
-        for j in 0..sys.joints().len() {
-            let jb = sys.joint_bodies(JointHandle(j));
-            for r in sys.joint_rows(JointHandle(j)) {
-                row_bodies[r] = jb;
-            }
-        }
-        let mut by_body: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n / 3];
-        for (r, &(a, b)) in row_bodies.iter().enumerate() {
-            if let Some(a) = a {
-                by_body[a].push((r, 0));
-            }
-            if let Some(b) = b {
-                by_body[b].push((r, 3));
-            }
-        }
+        let RowIncidence {
+            row_bodies,
+            by_body,
+        } = RowIncidence::new(sys);
         let mut pattern = Vec::new();
         let mut pos_pattern = Vec::new();
         for rows in &by_body {
@@ -406,7 +395,7 @@ impl SparseChart {
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
         sys.phi_and_phi_dot(q, v, t, p, pd);
-        max_norm(&out[..2 * m])
+        max_abs(&out[..2 * m])
     }
 
     /// [`SparseChart::residual`] with rotated `sin`/`cos` ([`AngleCache`]).
@@ -415,7 +404,7 @@ impl SparseChart {
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
         sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
-        max_norm(&out[..2 * m])
+        max_abs(&out[..2 * m])
     }
 
     /// Maps `y` (length `2n`, in `ker Df(x_c)`) to the point `x` of the manifold at time `t`:
@@ -469,19 +458,12 @@ impl SparseChart {
         self.f = f;
         self.d = d;
         let ms = out?;
-        if ms.iterations > 1 {
-            let (mut travel, mut size) = (0.0f64, 0.0f64);
-            for (a, b) in x.iter().zip(&self.x0) {
-                travel = fast_max(travel, (a - b).abs());
-                size = fast_max(size, b.abs());
-            }
-            if travel > TRAVEL_FACTOR * self.first_step + 16.0 * f64::EPSILON * (1.0 + size) {
-                return Err(ChartFailure {
-                    t,
-                    residual: ms.residual,
-                    iterations: ms.iterations,
-                });
-            }
+        if ms.iterations > 1 && !travel_within(x, &self.x0, self.first_step) {
+            return Err(ChartFailure {
+                t,
+                residual: ms.residual,
+                iterations: ms.iterations,
+            });
         }
         Ok(ms)
     }
@@ -527,44 +509,17 @@ impl SparseChart {
                     .zip(&self.x0)
                     .fold(0.0f64, |s, (a, b)| fast_max(s, (a - b).abs()));
             }
-            let theta = res / prev;
-            if predicted && prev.is_finite() && theta <= 0.5 && theta * res <= tol {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: theta * res,
-                    initial_residual: res0,
-                    exact: false,
-                });
+            if let Some(ms) = predicted_stop(predicted, res, prev, tol, it, res0) {
+                return Ok(ms);
             }
             prev = res;
             res = self.residual_cached(sys, x, t, f);
-            if res > tol && res <= stall_cap && res >= 0.9 * prev {
-                return Ok(MapStats {
-                    iterations: it,
-                    residual: res,
-                    initial_residual: res0,
-                    exact: false,
-                });
+            if let Some(ms) = stalled(res, prev, tol, stall_cap, it, res0) {
+                return Ok(ms);
             }
-            if res > newton.divergence * prev && res > tol {
-                return Err(ChartFailure {
-                    t,
-                    residual: res,
-                    iterations: it,
-                });
+            if let Some(e) = diverged(t, res, prev, tol, newton.divergence, it) {
+                return Err(e);
             }
         }
     }
-}
-
-/// `max |v_i|`, NaN if some entry is not finite.
-fn max_norm(v: &[f64]) -> f64 {
-    let mut r = 0.0f64;
-    for &e in v {
-        if !e.is_finite() {
-            return f64::NAN;
-        }
-        r = r.max(e.abs());
-    }
-    r
 }
