@@ -267,3 +267,22 @@ pub fn kitchen_sink() -> Result<System, ModelError> {
     b.add_force(Force::torque("pulse", h[3], TimeFunction::linear(0.0, 2.0)));
     b.build()
 }
+
+/// A one-link pendulum model file (TOML), valid as written; tests corrupt copies of it.
+pub const PENDULUM_TOML: &str = r#"
+gravity = [0.0, -9.81]
+
+[[bodies]]
+name = "link1"
+mass = 1.0
+inertia = 0.08333333333333333
+position = [0.0, -0.5, -1.5707963267948966]
+
+[[joints]]
+type = "revolute"
+name = "pin1"
+body_a = "ground"
+point_a = [0.0, 0.0]
+body_b = "link1"
+point_b = [-0.5, 0.0]
+"#;
