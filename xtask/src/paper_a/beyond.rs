@@ -10,8 +10,6 @@ use mbd_symplectic::PreadjustMode;
 const AMPLITUDES_DEG: [f64; 4] = [10.0, 45.0, 90.0, 120.0];
 /// Samples per zero crossing (quintic interpolation: its error stays below the schemes').
 const CROSSING_POINTS: usize = 6;
-/// Errors at or below this are treated as round-off by the order fit.
-const FLOOR: f64 = 1e-12;
 
 /// The preadjustments compared.
 #[derive(Clone, Copy, Debug, PartialEq)]
