@@ -195,8 +195,8 @@ fn period_study(ctx: &Ctx, sec: &mut Section) -> Result<Vec<PeriodRow>, String> 
 struct DoubleRow {
     s: usize,
     pre: Pre,
-    /// For gamma_opt rows: where the value comes from.
-    source: Option<&'static str>,
+    /// For gamma_opt rows: where the value comes from (summary.json key, table label).
+    source: Option<(&'static str, &'static str)>,
     m: Option<ErrorMeasures>,
     unavailable: Option<String>,
 }
@@ -230,16 +230,19 @@ fn double_pendulum(ctx: &Ctx, sec: &mut Section) -> Result<Vec<DoubleRow>, Strin
             .map(|row| row.1[2]);
         let cal = calibrate(&p, hc, nc, &rc, s)?;
         let direct = calibrate(&p, h, n, &r, s)?;
-        let mut cases: Vec<(Pre, Option<&'static str>)> =
+        let mut cases: Vec<(Pre, Option<(&'static str, &'static str)>)> =
             vec![(Pre::None, None), (Pre::GammaT, None)];
         if let Some(g) = paper_gamma {
-            cases.push((Pre::GammaOpt(g), Some("paper")));
+            cases.push((Pre::GammaOpt(g), Some(("paper", "paper"))));
         }
         cases.push((
             Pre::GammaOpt(cal.gamma_opt),
-            Some("calibrated (h = 0.01, Table 2 span)"),
+            Some(("calibrated_h0.01", "calibrated at h = 0.01, Table 2 span")),
         ));
-        cases.push((Pre::GammaOpt(direct.gamma_opt), Some("calibrated in place")));
+        cases.push((
+            Pre::GammaOpt(direct.gamma_opt),
+            Some(("calibrated_in_place", "calibrated in place")),
+        ));
         cases.push((Pre::Modified, None));
         for (pre, source) in cases {
             let opts = pre.options(s);
@@ -321,12 +324,12 @@ pub(super) fn beyond(ctx: &Ctx) -> Result<Section, String> {
                 format!("{:.2} / {:.2}", row.1[0] / row.2[0], row.1[1] / row.2[1])
             });
         let label = match r.source {
-            Some(src) => format!("{} ({src})", r.pre.key()),
+            Some((_, src)) => format!("{} ({src})", r.pre.key()),
             None => r.pre.key().to_string(),
         };
         let mut row_json = json!({"s": r.s, "preadjustment": r.pre.key(), "gamma": num(r.pre.gamma()),
             "available": r.unavailable.is_none()});
-        if let (Some(src), Value::Object(o)) = (r.source, &mut row_json) {
+        if let (Some((src, _)), Value::Object(o)) = (r.source, &mut row_json) {
             o.insert("gamma_source".into(), json!(src));
         }
         match (&r.m, &r.unavailable) {
@@ -340,7 +343,7 @@ pub(super) fn beyond(ctx: &Ctx) -> Result<Section, String> {
                     fmt_e(m.mean_abs_dy),
                     format!("{gy:.2}"),
                     fmt_e(m.mean_abs_dh),
-                    if r.source == Some("paper") {
+                    if r.source.is_some_and(|(k, _)| k == "paper") {
                         paper_gain
                     } else {
                         "-".into()
