@@ -9,6 +9,8 @@
 //!   order);
 //! * [`fit_order`]: the convergence order (least-squares slope and local orders, dropping points
 //!   at the round-off floor);
+//! * [`period`]: oscillation periods from zero crossings of samples (interpolated, least-squares
+//!   slope of the crossing times) and the exact pendulum period ([`period::pendulum_period`]);
 //! * [`TimeSeries`] and [`CsvObserver`]: CSV/JSON output.
 //!
 //! ```
@@ -38,6 +40,7 @@ mod error;
 mod measures;
 mod order;
 mod output;
+pub mod period;
 #[cfg(feature = "plot")]
 pub mod plot;
 mod trajectory;

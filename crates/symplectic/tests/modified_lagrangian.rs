@@ -1,6 +1,7 @@
 //! The parameter-free modified-Lagrangian preadjustment of the (1,1) scheme (issue 13):
 //! pendulum period error of order 4 at 45 and 90 degrees (plain: order 2), paper A's double
 //! pendulum against a DOPRI5 reference, constraints over a long run, typed errors.
+use mbd_analysis::period;
 use mbd_model::{models, System};
 use mbd_solve::{reference_trajectory, ButcherTableau, Integrator, SolveError, State};
 use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
@@ -15,27 +16,14 @@ fn opts(modlag: bool) -> SymplecticOptions {
     }
 }
 
-fn agm(mut a: f64, mut b: f64) -> f64 {
-    for _ in 0..60 {
-        let (a1, b1) = (0.5 * (a + b), (a * b).sqrt());
-        a = a1;
-        b = b1;
-    }
-    a
-}
-
-/// Exact period of a uniform rod (length l, pivot at one end: equivalent length 2l/3).
-fn exact_period(l: f64, g: f64, theta0: f64) -> f64 {
-    2.0 * PI * (2.0 * l / 3.0 / g).sqrt() / agm(1.0, (0.5 * theta0).cos())
-}
-
 /// Relative period error: crossings of psi = theta + pi/2 through 0, located by the cubic through
-/// the four samples around each crossing, and the half-period as the least-squares slope of the
-/// crossing times over about `periods` periods.
+/// the four samples around each crossing, and the period as twice the least-squares slope of the
+/// crossing times over about `periods` periods (`mbd_analysis::period`), against the exact
+/// period of the uniform rod (AGM).
 fn period_error(theta0: f64, h: f64, modlag: bool, periods: f64) -> f64 {
     let (l, g) = (1.0, 9.81);
     let sys = models::pendulum(1.0, l, theta0, g).unwrap();
-    let te = exact_period(l, g, theta0);
+    let te = period::pendulum_period((1.5 * g / l).sqrt(), theta0).unwrap();
     let mut st = State::consistent(&sys, 0.0).unwrap();
     let mut sch = Galerkin::new(&sys, opts(modlag)).unwrap();
     let n = (periods * te / h).ceil() as usize + 4;
@@ -45,38 +33,7 @@ fn period_error(theta0: f64, h: f64, modlag: bool, periods: f64) -> f64 {
         sch.step(&sys, &mut st, h).unwrap();
         psi.push(st.q[2] + PI / 2.0);
     }
-    let mut crossings = Vec::new();
-    for k in 1..n - 1 {
-        if psi[k] == 0.0 || psi[k].signum() != psi[k + 1].signum() {
-            // cubic through (k-1, k, k+1, k+2) in s = local time / h, root in [0, 1] by bisection
-            let p = [psi[k - 1], psi[k], psi[k + 1], psi[k + 2]];
-            let f = |s: f64| {
-                let (a, b, c, d) = (s + 1.0, s, s - 1.0, s - 2.0);
-                -p[0] * b * c * d / 6.0 + p[1] * a * c * d / 2.0 - p[2] * a * b * d / 2.0
-                    + p[3] * a * b * c / 6.0
-            };
-            let (mut lo, mut hi) = (0.0, 1.0);
-            for _ in 0..80 {
-                let mid = 0.5 * (lo + hi);
-                if f(lo).signum() == f(mid).signum() {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            crossings.push((k as f64 + 0.5 * (lo + hi)) * h);
-        }
-    }
-    let nc = crossings.len() as f64;
-    let im = (nc - 1.0) / 2.0;
-    let tm = crossings.iter().sum::<f64>() / nc;
-    let (mut sxy, mut sxx) = (0.0, 0.0);
-    for (i, &t) in crossings.iter().enumerate() {
-        let di = i as f64 - im;
-        sxy += di * (t - tm);
-        sxx += di * di;
-    }
-    2.0 * sxy / sxx / te - 1.0
+    period::oscillation_period(&psi, 0.0, h, 4).unwrap() / te - 1.0
 }
 
 #[test]

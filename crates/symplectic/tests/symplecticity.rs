@@ -2,68 +2,11 @@
 //! constrained step), the phase error of the linearised pendulum (orders 2s with gamma = 0 and
 //! 2s + 2 with gamma = 1) and the measured phase constants behind kappa_s.
 mod common;
-use mbd_model::{models, System};
-use mbd_solve::{Integrator, State};
-use mbd_symplectic::{kappa, phase_constant, Galerkin, SymplecticOptions};
-use nalgebra::{DMatrix, DVector};
+use common::reduced::{chain_q, jacobian, symplecticity_defect};
+use mbd_model::models;
+use mbd_symplectic::{kappa, phase_constant};
+use nalgebra::DMatrix;
 use std::f64::consts::FRAC_PI_2;
-
-/// A chain of uniform rods (m = 1, L = 1) in joint angles: q(theta), T = dq/dtheta.
-fn chain_q(theta: &[f64]) -> (DVector<f64>, DMatrix<f64>) {
-    let k = theta.len();
-    let mut q = DVector::zeros(3 * k);
-    let mut t = DMatrix::zeros(3 * k, k);
-    let mut tip = [0.0, 0.0];
-    for i in 0..k {
-        let (s, c) = theta[i].sin_cos();
-        q[3 * i] = tip[0] + 0.5 * c;
-        q[3 * i + 1] = tip[1] + 0.5 * s;
-        q[3 * i + 2] = theta[i];
-        for j in 0..=i {
-            let (sj, cj) = theta[j].sin_cos();
-            let f = if j == i { 0.5 } else { 1.0 };
-            t[(3 * i, j)] = -f * sj;
-            t[(3 * i + 1, j)] = f * cj;
-        }
-        t[(3 * i + 2, i)] = 1.0;
-        tip = [tip[0] + c, tip[1] + s];
-    }
-    (q, t)
-}
-
-/// One step of the scheme as a map of reduced coordinates `(theta, p_theta)`.
-fn reduced_step(sys: &System, opts: SymplecticOptions, h: f64, z: &[f64]) -> Vec<f64> {
-    let k = z.len() / 2;
-    let (q, t) = chain_q(&z[..k]);
-    let m = DMatrix::from_diagonal(sys.mass_diag());
-    let mr = t.transpose() * &m * &t;
-    let p = DVector::from_column_slice(&z[k..]);
-    let thd = mr.lu().solve(&p).unwrap();
-    let v = &t * thd;
-    let mut st = State::new(sys, 0.0, q, v).unwrap();
-    let mut g = Galerkin::new(sys, opts).unwrap();
-    g.step(sys, &mut st, h).unwrap();
-    let th: Vec<f64> = (0..k).map(|i| st.q[3 * i + 2]).collect();
-    let (_, t1) = chain_q(&th);
-    let p1 = t1.transpose() * &m * &st.v;
-    th.into_iter().chain(p1.iter().copied()).collect()
-}
-
-fn jacobian(sys: &System, opts: SymplecticOptions, h: f64, z: &[f64], d: f64) -> DMatrix<f64> {
-    let n = z.len();
-    let mut j = DMatrix::zeros(n, n);
-    for c in 0..n {
-        let mut zp = z.to_vec();
-        zp[c] += d;
-        let fp = reduced_step(sys, opts, h, &zp);
-        zp[c] -= 2.0 * d;
-        let fm = reduced_step(sys, opts, h, &zp);
-        for r in 0..n {
-            j[(r, c)] = (fp[r] - fm[r]) / (2.0 * d);
-        }
-    }
-    j
-}
 
 #[test]
 fn pendulum_map_preserves_area() {
@@ -80,16 +23,11 @@ fn pendulum_map_preserves_area() {
 #[test]
 fn double_pendulum_map_is_symplectic() {
     let sys = models::paper_a_double_pendulum().unwrap();
-    let mut omega = DMatrix::zeros(4, 4);
-    omega[(0, 2)] = 1.0;
-    omega[(1, 3)] = 1.0;
-    omega[(2, 0)] = -1.0;
-    omega[(3, 1)] = -1.0;
     for (s, gamma) in [(1, 0.0), (2, 0.0), (3, 0.0), (2, 1.0)] {
         let z = [-FRAC_PI_2 + 0.5, -FRAC_PI_2 + 0.9, 0.3, -0.2];
         let opts = common::tight(s).with_gamma(gamma);
         let j = jacobian(&sys, opts, 0.04, &z, 1e-5);
-        let defect = (j.transpose() * &omega * &j - &omega).abs().max();
+        let defect = symplecticity_defect(&j);
         println!("double pendulum s={s} gamma={gamma}: |J^T Omega J - Omega| = {defect:.3e}");
         assert!(defect < 1e-8, "s={s} gamma={gamma}: {defect}");
     }

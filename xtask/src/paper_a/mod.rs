@@ -11,6 +11,8 @@ mod tables;
 use tables::{table1, table2, table3};
 mod figures;
 use figures::{fig3, fig4, fig5_6, fig7};
+mod beyond;
+use beyond::beyond;
 
 use crate::report::{
     fmt_e, num, Claim, Ctx, Experiment, FigureRef, PaperValue, Part, Section, Table,
@@ -71,6 +73,12 @@ pub fn experiments() -> Vec<Experiment> {
             part: Part::PaperA,
             title: "Fig. 7: x of body 2 over time (reference, gamma = 0, gamma_opt)",
             run: fig7,
+        },
+        Experiment {
+            id: "paper-a-beyond",
+            part: Part::PaperA,
+            title: "Beyond the paper: the modified-Lagrangian preadjustment against gamma_T and gamma_opt",
+            run: beyond,
         },
     ]
 }

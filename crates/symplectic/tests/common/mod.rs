@@ -3,6 +3,8 @@ use mbd_model::System;
 use mbd_solve::{Integrator, State};
 use mbd_symplectic::{Galerkin, SymplecticOptions};
 
+pub mod reduced;
+
 /// Least-squares slope of log(err) against log(h).
 pub fn slope(h: &[f64], e: &[f64]) -> f64 {
     let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
