@@ -166,8 +166,7 @@ impl<W: Write> CsvObserver<W> {
         self.row.clear();
         self.row.push(s.t);
         self.row.extend(s.q.iter().chain(s.v.iter()).copied());
-        self.row
-            .push(sys.energy(s.q.as_slice(), s.v.as_slice()));
+        self.row.push(sys.energy(s.q.as_slice(), s.v.as_slice()));
         if self.residuals {
             self.phi.resize(sys.n_constraints(), 0.0);
             sys.phi(s.q.as_slice(), s.t, &mut self.phi);
@@ -267,10 +266,19 @@ mod tests {
         csv.finish(&sys, &s).unwrap();
         let (head, rows) = parse(std::str::from_utf8(&csv.into_inner()).unwrap());
         let b = &sys.bodies()[0].name;
-        let want: Vec<String> = ["t", "B.x", "B.y", "B.theta", "d_B.x", "d_B.y", "d_B.theta", "H"]
-            .iter()
-            .map(|c| c.replace('B', b))
-            .collect();
+        let want: Vec<String> = [
+            "t",
+            "B.x",
+            "B.y",
+            "B.theta",
+            "d_B.x",
+            "d_B.y",
+            "d_B.theta",
+            "H",
+        ]
+        .iter()
+        .map(|c| c.replace('B', b))
+        .collect();
         assert_eq!(head, want);
         // steps 0..=5, and finish() does not repeat the final state
         assert_eq!(rows.len(), 6);

@@ -305,7 +305,10 @@ pub fn animate(args: &AnimateArgs) -> Result<(), CliError> {
     let title = format!(
         "{} ({})",
         args.model.display(),
-        args.csv.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()
+        args.csv
+            .file_name()
+            .map(|f| f.to_string_lossy())
+            .unwrap_or_default()
     );
     let html = page(&title, &sys, t, q)?;
     std::fs::write(&args.out, html).map_err(|e| CliError::write(&args.out, e))

@@ -70,11 +70,7 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
         sys.dof()
     );
     let _ = writeln!(s, "consistent initial state at t = 0:");
-    let _ = writeln!(
-        s,
-        "  {:<24} {:>14} {:>14}",
-        "coordinate", "q", "v"
-    );
+    let _ = writeln!(s, "  {:<24} {:>14} {:>14}", "coordinate", "q", "v");
     for (k, name) in sys.coordinate_names().iter().enumerate() {
         let _ = writeln!(s, "  {:<24} {:>14.9} {:>14.9}", name, c.q[k], c.v[k]);
     }

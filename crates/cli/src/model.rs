@@ -32,8 +32,9 @@ fn model_error(path: &Path, text: &str, e: &ModelError) -> CliError {
         ModelError::Parse { message, .. } => (message.trim_end().to_string(), String::new()),
         other => {
             let message = other.to_string();
-            let location = quoted_name(&message)
-                .and_then(|name| {
+            let location = candidate_names(&message)
+                .into_iter()
+                .find_map(|name| {
                     let line = line_of_name(text, name)?;
                     Some(format!(" (see line {line}, where '{name}' is defined)"))
                 })
@@ -46,6 +47,22 @@ fn model_error(path: &Path, text: &str, e: &ModelError) -> CliError {
         message,
         location,
     }
+}
+
+/// Names of the element a message may be about: the last word before the first `:` (as in
+/// `rod: parameter 'mass' ...` or `joint 'pin': ...`), then the first quoted word.
+fn candidate_names(message: &str) -> Vec<&str> {
+    let mut v = Vec::new();
+    if let Some((head, _)) = message.split_once(':') {
+        if let Some(last) = head.split_whitespace().last() {
+            let last = last.trim_matches('\'');
+            if !last.is_empty() {
+                v.push(last);
+            }
+        }
+    }
+    v.extend(quoted_name(message));
+    v
 }
 
 /// The first `'quoted'` word of a message.
@@ -69,12 +86,20 @@ mod tests {
 
     #[test]
     fn element_errors_point_at_the_line_of_the_element() {
-        let text = "gravity = [0.0, -9.81]\n\n[[bodies]]\nname = \"rod\"\nmass = -1.0\ninertia = 0.1\n";
+        let text =
+            "gravity = [0.0, -9.81]\n\n[[bodies]]\nname = \"rod\"\nmass = -1.0\ninertia = 0.1\n";
         let e = System::from_toml(text).unwrap_err();
         let msg = model_error(Path::new("m.toml"), text, &e).to_string();
         assert!(msg.contains("invalid model file 'm.toml'"), "{msg}");
         assert!(msg.contains("mass"), "{msg}");
         assert!(msg.contains("line 4"), "{msg}");
+    }
+
+    #[test]
+    fn candidates_come_from_the_element_prefix_then_quotes() {
+        assert_eq!(candidate_names("rod: parameter 'mass'"), ["rod", "mass"]);
+        assert_eq!(candidate_names("joint 'pin': x"), ["pin", "pin"]);
+        assert!(candidate_names("nothing here").is_empty());
     }
 
     #[test]

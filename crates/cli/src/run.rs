@@ -129,17 +129,14 @@ impl Observer for Progress {
 }
 
 fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
-    let csv = |w: Box<dyn Write>| {
-        Sink::Csv(
-            CsvObserver::new(w)
-                .with_residuals()
-                .with_every(every),
-        )
-    };
+    let csv = |w: Box<dyn Write>| Sink::Csv(CsvObserver::new(w).with_residuals().with_every(every));
     let Some(out) = &args.out else {
         return Ok(csv(Box::new(std::io::BufWriter::new(std::io::stdout()))));
     };
-    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
     let json = match ext.as_deref() {
         Some("csv") => false,
         Some("json") => true,
@@ -264,9 +261,7 @@ fn finish(
 ) -> Result<(), CliError> {
     let out = out_path(args);
     match sink {
-        Sink::Csv(mut c) => c
-            .finish(sys, state)
-            .map_err(|e| CliError::write(&out, e)),
+        Sink::Csv(mut c) => c.finish(sys, state).map_err(|e| CliError::write(&out, e)),
         Sink::Json {
             mut fmt,
             mut rows,
@@ -304,5 +299,7 @@ fn finish(
 fn write_json(path: &Path, file: std::fs::File, doc: &serde_json::Value) -> Result<(), CliError> {
     let mut w = std::io::BufWriter::new(file);
     serde_json::to_writer(&mut w, doc).map_err(|e| CliError::write(path, e))?;
-    writeln!(w).and_then(|()| w.flush()).map_err(|e| CliError::write(path, e))
+    writeln!(w)
+        .and_then(|()| w.flush())
+        .map_err(|e| CliError::write(path, e))
 }

@@ -175,7 +175,10 @@ mod tests {
     #[test]
     fn bad_names_say_what_to_use() {
         let e = "rk5".parse::<SolverSpec>().unwrap_err();
-        assert!(e.contains("unknown solver 'rk5'") && e.contains("tangent:dopri5"), "{e}");
+        assert!(
+            e.contains("unknown solver 'rk5'") && e.contains("tangent:dopri5"),
+            "{e}"
+        );
         let e = "symplectic:x".parse::<SolverSpec>().unwrap_err();
         assert!(e.contains("S must be a whole number"), "{e}");
         let e = "symplectic:2:gamma=abc".parse::<SolverSpec>().unwrap_err();

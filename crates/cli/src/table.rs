@@ -28,7 +28,10 @@ impl Table {
             line,
             message,
         };
-        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
         let names: Vec<String> = match lines.next() {
             Some((_, head)) => head.split(',').map(|c| c.trim().to_string()).collect(),
             None => return Err(bad(1, "the file is empty".into())),
@@ -49,11 +52,7 @@ impl Table {
             if row.len() != names.len() {
                 return Err(bad(
                     i + 1,
-                    format!(
-                        "{} values for {} columns",
-                        row.len(),
-                        names.len()
-                    ),
+                    format!("{} values for {} columns", row.len(), names.len()),
                 ));
             }
             rows.push(row);
@@ -97,10 +96,17 @@ mod tests {
         assert_eq!(t.column("a.x").unwrap(), vec![1.0, 2.0]);
         let e = t.column("b").unwrap_err().to_string();
         assert!(e.contains("'b'") && e.contains("t, a.x"), "{e}");
-        let e = Table::parse("r.csv", "t,a\n0,1\n1,zz\n").unwrap_err().to_string();
+        let e = Table::parse("r.csv", "t,a\n0,1\n1,zz\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 3") && e.contains("'zz'"), "{e}");
-        let e = Table::parse("r.csv", "t,a\n0,1,2\n").unwrap_err().to_string();
-        assert!(e.contains("line 2") && e.contains("3 values for 2 columns"), "{e}");
+        let e = Table::parse("r.csv", "t,a\n0,1,2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("line 2") && e.contains("3 values for 2 columns"),
+            "{e}"
+        );
         assert!(Table::parse("r.csv", "").is_err());
         assert!(Table::parse("r.csv", "1,2\n3,4\n").is_err());
     }

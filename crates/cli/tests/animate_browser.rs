@@ -139,14 +139,25 @@ fn page_draws_the_trajectory_at_the_requested_time() {
             .map(|n| row[head.iter().position(|h| h == n).unwrap()])
             .collect();
 
-        let dom = chrome(&bin, &d.join(format!("profile-dom-{k}")), &["--dump-dom".into(), url(t)]);
+        let dom = chrome(
+            &bin,
+            &d.join(format!("profile-dom-{k}")),
+            &["--dump-dom".into(), url(t)],
+        );
         let svg = elements(&dom, "svg");
         let stage = svg
             .iter()
             .find(|a| a.get("id").map(String::as_str) == Some("stage"))
             .unwrap_or_else(|| panic!("no #stage in the DOM:\n{dom}"));
-        let (scale, ox, oy) = (num(stage, "data-scale"), num(stage, "data-ox"), num(stage, "data-oy"));
-        assert!((num(stage, "data-t") - row[0]).abs() < 1e-12, "frame shown for t = {t}");
+        let (scale, ox, oy) = (
+            num(stage, "data-scale"),
+            num(stage, "data-ox"),
+            num(stage, "data-oy"),
+        );
+        assert!(
+            (num(stage, "data-t") - row[0]).abs() < 1e-12,
+            "frame shown for t = {t}"
+        );
         let px = |p: [f64; 2]| (ox + scale * p[0], oy - scale * p[1]);
 
         let circles = elements(&dom, "circle");
@@ -154,17 +165,25 @@ fn page_draws_the_trajectory_at_the_requested_time() {
         for (i, b) in sys.bodies().iter().enumerate() {
             let c = circles
                 .iter()
-                .find(|a| a.get("class").map(String::as_str) == Some("com") && a.get("data-body") == Some(&b.name))
+                .find(|a| {
+                    a.get("class").map(String::as_str) == Some("com")
+                        && a.get("data-body") == Some(&b.name)
+                })
                 .unwrap_or_else(|| panic!("no centre of mass drawn for {}", b.name));
             let (ex, ey) = px([q[3 * i], q[3 * i + 1]]);
             let (cx, cy) = (num(c, "cx"), num(c, "cy"));
-            assert!((cx - ex).abs() <= 1.0 && (cy - ey).abs() <= 1.0,
-                "{} at t = {t}: drawn ({cx}, {cy}), expected ({ex}, {ey})", b.name);
+            assert!(
+                (cx - ex).abs() <= 1.0 && (cy - ey).abs() <= 1.0,
+                "{} at t = {t}: drawn ({cx}, {cy}), expected ({ex}, {ey})",
+                b.name
+            );
             checked += 1;
         }
         // joints: where the model's attachment point on the second body is
         for j in sys.joints() {
-            let mbd_model::JointKind::Revolute { a, pa, b, pb } = &j.kind else { continue };
+            let mbd_model::JointKind::Revolute { a, pa, b, pb } = &j.kind else {
+                continue;
+            };
             let w = match (b.index(), a.index()) {
                 (Some(bi), _) => sys.point_position(mbd_model::BodyHandle(bi), *pb, &q),
                 (None, Some(ai)) => sys.point_position(mbd_model::BodyHandle(ai), *pa, &q),
@@ -175,21 +194,36 @@ fn page_draws_the_trajectory_at_the_requested_time() {
                 .find(|c| c.get("data-joint") == Some(&j.name))
                 .unwrap_or_else(|| panic!("joint {} not drawn", j.name));
             let (ex, ey) = px([w[0], w[1]]);
-            assert!((num(c, "cx") - ex).abs() <= 1.0 && (num(c, "cy") - ey).abs() <= 1.0,
-                "joint {} at t = {t}", j.name);
+            assert!(
+                (num(c, "cx") - ex).abs() <= 1.0 && (num(c, "cy") - ey).abs() <= 1.0,
+                "joint {} at t = {t}",
+                j.name
+            );
             checked += 1;
         }
-        assert_eq!(checked, 3 + 3, "three bodies and three revolute joints checked");
+        assert_eq!(
+            checked,
+            3 + 3,
+            "three bodies and three revolute joints checked"
+        );
 
         let png = d.join(format!("shot-{k}.png"));
         chrome(
             &bin,
             &d.join(format!("profile-shot-{k}")),
-            &[format!("--screenshot={}", png.display()), "--window-size=800,600".into(), url(t)],
+            &[
+                format!("--screenshot={}", png.display()),
+                "--window-size=800,600".into(),
+                url(t),
+            ],
         );
-        let bytes = std::fs::read(&png).unwrap_or_else(|e| panic!("no screenshot {}: {e}", png.display()));
+        let bytes =
+            std::fs::read(&png).unwrap_or_else(|e| panic!("no screenshot {}: {e}", png.display()));
         assert!(bytes.starts_with(b"\x89PNG"), "not a PNG");
         shots.push(bytes);
     }
-    assert_ne!(shots[0], shots[1], "the screenshots at two times are identical");
+    assert_ne!(
+        shots[0], shots[1],
+        "the screenshots at two times are identical"
+    );
 }

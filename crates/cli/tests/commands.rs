@@ -59,7 +59,11 @@ fn every_solver_runs_every_example_model() {
             let out = run_model(&model, solver, step, &csv);
             let what = format!("{} with {solver} {step:?}", model.display());
             assert_eq!(out.code, 0, "{what}: {}", out.stderr);
-            assert!(out.stderr.contains("mbd run: ") && out.stderr.contains("e(H) = "), "{what}: {}", out.stderr);
+            assert!(
+                out.stderr.contains("mbd run: ") && out.stderr.contains("e(H) = "),
+                "{what}: {}",
+                out.stderr
+            );
             let (head, rows) = read_csv(&csv);
             assert_eq!(head, want, "{what}");
             let t: Vec<f64> = rows.iter().map(|r| r[0]).collect();
@@ -107,7 +111,10 @@ fn every_k_writes_every_kth_step_and_the_last() {
     let t: Vec<f64> = read_csv(&csv).1.iter().map(|r| r[0]).collect();
     let want = [0.0, 0.03, 0.06, 0.09, 0.1];
     assert_eq!(t.len(), want.len(), "{t:?}");
-    assert!(t.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12), "{t:?}");
+    assert!(
+        t.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+        "{t:?}"
+    );
     assert!(out.stderr.contains("10 steps"), "{}", out.stderr);
 }
 
@@ -118,22 +125,37 @@ fn json_output_has_metadata_and_rows() {
     let model = common::repo().join("examples/models/slider_crank_spring.toml");
     let out = run_model(&model, "tangent:rk4", &["--h", "0.005"], &json);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["solver"], "tangent:rk4");
     assert_eq!(v["h"], 0.005);
     assert!(v["tol"].is_null());
-    assert!(v["model"].as_str().unwrap().ends_with("slider_crank_spring.toml"));
+    assert!(v["model"]
+        .as_str()
+        .unwrap()
+        .ends_with("slider_crank_spring.toml"));
     let cols: Vec<String> = serde_json::from_value(v["columns"].clone()).unwrap();
     assert_eq!(cols, expected_columns(&model));
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 5);
-    assert!(rows.iter().all(|r| r.as_array().unwrap().len() == cols.len()));
+    assert!(rows
+        .iter()
+        .all(|r| r.as_array().unwrap().len() == cols.len()));
     assert_eq!(v["summary"]["steps"], 4);
 }
 
 #[test]
 fn stdout_gets_the_csv_without_out() {
-    let out = mbd(["run", "examples/models/pendulum.toml", "--solver", "rk4", "--t-end", "0.02", "--h", "0.01"]);
+    let out = mbd([
+        "run",
+        "examples/models/pendulum.toml",
+        "--solver",
+        "rk4",
+        "--t-end",
+        "0.02",
+        "--h",
+        "0.01",
+    ]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let lines: Vec<&str> = out.stdout.lines().collect();
     assert_eq!(lines.len(), 4);
@@ -155,10 +177,18 @@ fn check_prints_the_degrees_of_freedom_and_initial_state() {
         "crank.theta",
         "|q_consistent - q_file|_max = ",
     ] {
-        assert!(out.stdout.contains(needle), "lacks {needle:?}:\n{}", out.stdout);
+        assert!(
+            out.stdout.contains(needle),
+            "lacks {needle:?}:\n{}",
+            out.stdout
+        );
     }
     let out = mbd(["check", "examples/models/manipulator.json"]);
-    assert!(out.stdout.contains("degrees of freedom: 2"), "{}", out.stdout);
+    assert!(
+        out.stdout.contains("degrees of freedom: 2"),
+        "{}",
+        out.stdout
+    );
 }
 
 #[test]
@@ -178,7 +208,11 @@ fn plot_writes_an_svg_and_leaves_the_csv_alone() {
     assert_eq!(out.code, 0, "{}", out.stderr);
     let svg = std::fs::read_to_string(d.join("pendulum.svg")).unwrap();
     assert!(svg.contains("<svg") && svg.contains("max_abs_phi"));
-    assert_eq!(std::fs::read(&csv).unwrap(), before, "the data CSV was overwritten");
+    assert_eq!(
+        std::fs::read(&csv).unwrap(),
+        before,
+        "the data CSV was overwritten"
+    );
 }
 
 #[test]
@@ -196,7 +230,14 @@ fn animate_writes_a_self_contained_page() {
     ]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let page = std::fs::read_to_string(&html).unwrap();
-    for forbidden in ["<script src", "<link", "fetch(", "XMLHttpRequest", "@import", "https://"] {
+    for forbidden in [
+        "<script src",
+        "<link",
+        "fetch(",
+        "XMLHttpRequest",
+        "@import",
+        "https://",
+    ] {
         assert!(!page.contains(forbidden), "page contains {forbidden:?}");
     }
     assert!(page.contains("id=\"slider\"") && page.contains("id=\"play\""));
@@ -211,6 +252,10 @@ fn help_shows_examples() {
     for cmd in ["run", "check", "plot", "animate"] {
         let out = mbd([cmd, "--help"]);
         assert_eq!(out.code, 0, "{cmd}");
-        assert!(out.stdout.contains(&format!("mbd {cmd} ")), "{cmd} --help:\n{}", out.stdout);
+        assert!(
+            out.stdout.contains(&format!("mbd {cmd} ")),
+            "{cmd} --help:\n{}",
+            out.stdout
+        );
     }
 }
