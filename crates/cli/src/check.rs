@@ -11,7 +11,7 @@ pub fn check(args: &CheckArgs) -> Result<String, CliError> {
     let sys = crate::model::load(&args.model)?;
     let c = mbd_solve::consistent_state(&sys, 0.0).map_err(|source| CliError::Initial {
         path: args.model.display().to_string(),
-        source,
+        source: Box::new(source),
     })?;
     Ok(report(&args.model.display().to_string(), &sys, &c))
 }

@@ -35,7 +35,7 @@ pub enum CliError {
         path: String,
         /// The projection's error.
         #[source]
-        source: mbd_solve::SolveError,
+        source: Box<mbd_solve::SolveError>,
     },
     /// The solver could not be built or failed during the run.
     #[error("solver '{solver}' failed: {source}{hint}")]
@@ -44,7 +44,7 @@ pub enum CliError {
         solver: String,
         /// The error.
         #[source]
-        source: mbd_solve::SolveError,
+        source: Box<mbd_solve::SolveError>,
         /// What to try, or empty.
         hint: String,
     },

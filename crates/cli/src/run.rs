@@ -173,7 +173,7 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
     };
     CliError::Solve {
         solver: solver.to_string(),
-        source,
+        source: Box::new(source),
         hint: hint.into(),
     }
 }
@@ -190,7 +190,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     let sys = crate::model::load(&args.model)?;
     let mut state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {
         path: args.model.display().to_string(),
-        source,
+        source: Box::new(source),
     })?;
     let every = usize::try_from(args.every).unwrap_or(usize::MAX);
     let sink = open_sink(args, every)?;
