@@ -313,3 +313,61 @@ pub fn animate(args: &AnimateArgs) -> Result<(), CliError> {
     let html = page(&title, &sys, t, q)?;
     std::fs::write(&args.out, html).map_err(|e| CliError::write(&args.out, e))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn geometry_and_view_of_the_slider_crank() {
+        let sys = mbd_model::models::slider_crank().unwrap();
+        let joints = joint_geom(&sys);
+        let springs = spring_geom(&sys);
+        let bodies = body_geom(&sys, &joints, &springs);
+        // every body has its centre of mass and its joint points, without repeats
+        for (i, b) in bodies.iter().enumerate() {
+            assert!(b.outline.contains(&[0.0, 0.0]), "{}", b.name);
+            for j in &joints {
+                if j.b == i as i64 {
+                    assert!(b.outline.contains(&j.pb.unwrap()), "{} {}", b.name, j.name);
+                }
+            }
+        }
+        let (q, _) = sys.initial_guess();
+        let mut q2 = q.as_slice().to_vec();
+        q2[0] += 3.0; // a frame far to the right
+        let frames = vec![q.as_slice().to_vec(), q2];
+        let v = fit_view(&frames, &bodies, &joints, &springs);
+        for f in &frames {
+            for (i, b) in bodies.iter().enumerate() {
+                for &p in &b.outline {
+                    let w = world(f, i as i64, p);
+                    let (x, y) = (v.ox + v.scale * w[0], v.oy - v.scale * w[1]);
+                    assert!((MARGIN - 1e-9..=WIDTH - MARGIN + 1e-9).contains(&x), "{x}");
+                    assert!((MARGIN - 1e-9..=HEIGHT - MARGIN + 1e-9).contains(&y), "{y}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn names_cannot_break_out_of_the_page() {
+        let mut b = mbd_model::SystemBuilder::new();
+        let h = b.add_body(mbd_model::Body::new("</script><b>x").rod(1.0, 1.0));
+        b.add_joint(mbd_model::Joint::revolute(
+            "pin",
+            mbd_model::BodyRef::Ground,
+            [0.0, 0.0],
+            h,
+            [-0.5, 0.0],
+        ));
+        let sys = b.build().unwrap();
+        let html = page("<title>", &sys, vec![0.0], vec![vec![0.5, 0.0, 0.0]]).unwrap();
+        assert_eq!(
+            html.matches("</script>").count(),
+            2,
+            "only the page's own scripts close"
+        );
+        assert!(html.contains("&lt;title&gt;"));
+    }
+}
