@@ -88,18 +88,130 @@ impl TimeSeries {
 
 /// An [`Observer`] that streams `t, q..., v..., H` rows as CSV to a writer, keeping nothing in
 /// memory (for long runs).
+///
+/// Columns: `t`, the coordinates by name (`body.x`, `body.y`, `body.theta`, see
+/// [`System::coordinate_names`]), the velocities (`d_body.x`, ...), the energy `H`, and with
+/// [`CsvObserver::with_residuals`] the constraint residuals `max_abs_phi` (`||Phi(q, t)||_inf`)
+/// and `max_abs_phidot` (`||Phi_q v + Phi_t||_inf`). With [`CsvObserver::with_every`] only
+/// every `k`-th step is written; [`CsvObserver::finish`] then adds the final state.
+///
+/// ```
+/// use mbd_analysis::CsvObserver;
+/// use mbd_solve::{run, ButcherTableau, Index1Options, Index1Rk, RunConfig, State};
+///
+/// let sys = mbd_model::models::pendulum(1.0, 1.0, 0.3, 9.81)?;
+/// let mut s = State::consistent(&sys, 0.0)?;
+/// let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default())?;
+/// let mut csv = CsvObserver::new(Vec::new()).with_residuals().with_every(3);
+/// run(&mut rk, &sys, &mut s, RunConfig::new(0.1, 0.01), &mut csv)?;
+/// csv.finish(&sys, &s)?;
+/// let text = String::from_utf8(csv.into_inner()).unwrap();
+/// let lines: Vec<&str> = text.lines().collect();
+/// assert!(lines[0].ends_with(",H,max_abs_phi,max_abs_phidot"));
+/// assert_eq!(lines.len(), 1 + 5); // header, steps 0, 3, 6, 9 and the final step 10
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub struct CsvObserver<W: Write> {
     w: W,
     header_written: bool,
+    residuals: bool,
+    every: usize,
+    row: Vec<f64>,
+    phi: Vec<f64>,
+    last_written: Option<(usize, f64)>,
+    last_step: Option<usize>,
 }
 
 impl<W: Write> CsvObserver<W> {
-    /// Streams to `w` (wrap files in a `BufWriter`).
+    /// Streams to `w` (wrap files in a `BufWriter`): every sample, without residual columns.
     pub fn new(w: W) -> Self {
         CsvObserver {
             w,
             header_written: false,
+            residuals: false,
+            every: 1,
+            row: Vec::new(),
+            phi: Vec::new(),
+            last_written: None,
+            last_step: None,
         }
+    }
+    /// Adds the columns `max_abs_phi` and `max_abs_phidot` (constraint residuals at position
+    /// and velocity level, max-norm).
+    pub fn with_residuals(mut self) -> Self {
+        self.residuals = true;
+        self
+    }
+    /// Writes only the samples of steps `0, k, 2k, ...` (`k = 0` is treated as 1); call
+    /// [`CsvObserver::finish`] after the run to add the final state.
+    pub fn with_every(mut self, k: usize) -> Self {
+        self.every = k.max(1);
+        self
+    }
+    /// The column names for `sys` (the CSV header).
+    pub fn columns(&self, sys: &System) -> Vec<String> {
+        let mut h = vec!["t".to_string()];
+        let names = sys.coordinate_names();
+        h.extend(names.iter().cloned());
+        h.extend(names.iter().map(|n| format!("d_{n}")));
+        h.push("H".into());
+        if self.residuals {
+            h.push("max_abs_phi".into());
+            h.push("max_abs_phidot".into());
+        }
+        h
+    }
+    /// The values of one row for state `s` (in the order of [`CsvObserver::columns`]).
+    pub fn row(&mut self, sys: &System, s: &State) -> &[f64] {
+        self.row.clear();
+        self.row.push(s.t);
+        self.row.extend(s.q.iter().chain(s.v.iter()).copied());
+        self.row.push(sys.energy(s.q.as_slice(), s.v.as_slice()));
+        if self.residuals {
+            self.phi.resize(sys.n_constraints(), 0.0);
+            sys.phi(s.q.as_slice(), s.t, &mut self.phi);
+            let a = mbd_model::numeric::max_abs(&self.phi);
+            sys.phi_dot(s.q.as_slice(), s.v.as_slice(), s.t, &mut self.phi);
+            let b = mbd_model::numeric::max_abs(&self.phi);
+            self.row.push(a);
+            self.row.push(b);
+        }
+        &self.row
+    }
+    fn write_state(&mut self, sys: &System, s: &State, step: usize) -> std::io::Result<()> {
+        if !self.header_written {
+            let h = self.columns(sys);
+            writeln!(self.w, "{}", h.join(","))?;
+            self.header_written = true;
+        }
+        self.row(sys, s);
+        let mut first = true;
+        for x in &self.row {
+            if first {
+                write!(self.w, "{x:e}")?;
+                first = false;
+            } else {
+                write!(self.w, ",{x:e}")?;
+            }
+        }
+        writeln!(self.w)?;
+        self.last_written = Some((step, s.t));
+        Ok(())
+    }
+    /// Ends a run: writes the final state `s` unless it was the last row written (the run
+    /// loop's last step is not a multiple of [`CsvObserver::with_every`]'s `k`), then flushes.
+    /// Errors name the time of the row that could not be written.
+    pub fn finish(&mut self, sys: &System, s: &State) -> Result<(), SolveError> {
+        let err = |e: std::io::Error| SolveError::Observer {
+            t: s.t,
+            message: e.to_string(),
+        };
+        let written = matches!(self.last_written, Some((_, t)) if t == s.t);
+        if !written {
+            let step = self.last_step.map_or(0, |k| k + 1);
+            self.write_state(sys, s, step).map_err(err)?;
+        }
+        self.w.flush().map_err(err)
     }
     /// The writer back.
     pub fn into_inner(self) -> W {
@@ -108,25 +220,132 @@ impl<W: Write> CsvObserver<W> {
 }
 
 impl<W: Write> Observer for CsvObserver<W> {
-    fn observe(&mut self, sys: &System, s: &State, _step: usize) -> Result<Flow, SolveError> {
-        let err = |e: std::io::Error| SolveError::Observer {
-            t: s.t,
-            message: e.to_string(),
-        };
-        if !self.header_written {
-            let mut h = vec!["t".to_string()];
-            let names = sys.coordinate_names();
-            h.extend(names.iter().cloned());
-            h.extend(names.iter().map(|n| format!("d_{n}")));
-            h.push("H".into());
-            writeln!(self.w, "{}", h.join(",")).map_err(err)?;
-            self.header_written = true;
+    fn observe(&mut self, sys: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
+        self.last_step = Some(step);
+        if step % self.every == 0 {
+            self.write_state(sys, s, step)
+                .map_err(|e| SolveError::Observer {
+                    t: s.t,
+                    message: e.to_string(),
+                })?;
         }
-        write!(self.w, "{:e}", s.t).map_err(err)?;
-        for x in s.q.iter().chain(s.v.iter()) {
-            write!(self.w, ",{x:e}").map_err(err)?;
-        }
-        writeln!(self.w, ",{:e}", sys.energy(s.q.as_slice(), s.v.as_slice())).map_err(err)?;
         Ok(Flow::Continue)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mbd_solve::{run, ButcherTableau, Index1Options, Index1Rk, RunConfig};
+
+    fn pendulum() -> System {
+        mbd_model::models::pendulum(1.0, 1.0, 0.3, 9.81).unwrap()
+    }
+
+    fn parse(text: &str) -> (Vec<String>, Vec<Vec<f64>>) {
+        let mut lines = text.lines();
+        let head = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        (head, rows)
+    }
+
+    fn integrate(csv: &mut CsvObserver<Vec<u8>>, t_end: f64) -> (System, State) {
+        let sys = pendulum();
+        let mut s = State::consistent(&sys, 0.0).unwrap();
+        let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default()).unwrap();
+        run(&mut rk, &sys, &mut s, RunConfig::new(t_end, 0.01), csv).unwrap();
+        (sys, s)
+    }
+
+    #[test]
+    fn default_columns_and_rows_match_the_states() {
+        let mut csv = CsvObserver::new(Vec::new());
+        let (sys, s) = integrate(&mut csv, 0.05);
+        csv.finish(&sys, &s).unwrap();
+        let (head, rows) = parse(std::str::from_utf8(&csv.into_inner()).unwrap());
+        let b = &sys.bodies()[0].name;
+        let want: Vec<String> = [
+            "t",
+            "B.x",
+            "B.y",
+            "B.theta",
+            "d_B.x",
+            "d_B.y",
+            "d_B.theta",
+            "H",
+        ]
+        .iter()
+        .map(|c| c.replace('B', b))
+        .collect();
+        assert_eq!(head, want);
+        // steps 0..=5, and finish() does not repeat the final state
+        assert_eq!(rows.len(), 6);
+        let last = &rows[5];
+        assert_eq!(last[0], s.t);
+        assert_eq!(&last[1..4], s.q.as_slice());
+        assert_eq!(&last[4..7], s.v.as_slice());
+        assert_eq!(last[7], sys.energy(s.q.as_slice(), s.v.as_slice()));
+        for (k, r) in rows.iter().enumerate() {
+            assert!((r[0] - 0.01 * k as f64).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn every_and_finish_sample_the_run_and_its_end() {
+        let mut csv = CsvObserver::new(Vec::new()).with_every(4).with_residuals();
+        let (sys, s) = integrate(&mut csv, 0.1);
+        csv.finish(&sys, &s).unwrap();
+        let (head, rows) = parse(std::str::from_utf8(&csv.into_inner()).unwrap());
+        assert_eq!(head[head.len() - 2..], ["max_abs_phi", "max_abs_phidot"]);
+        let ts: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+        let want = [0.0, 0.04, 0.08, 0.1];
+        assert_eq!(ts.len(), want.len(), "{ts:?}");
+        for (a, b) in ts.iter().zip(want) {
+            assert!((a - b).abs() < 1e-14, "{ts:?}");
+        }
+        // the residuals are those of the states: RK4 on the index-1 form drifts a little
+        let mut phi = vec![0.0; sys.n_constraints()];
+        sys.phi(s.q.as_slice(), s.t, &mut phi);
+        let want_phi = mbd_model::numeric::max_abs(&phi);
+        let last = rows.last().unwrap();
+        assert_eq!(last[last.len() - 2], want_phi);
+        assert!(rows[0][head.len() - 2] < 1e-12);
+    }
+
+    #[test]
+    fn columns_and_row_agree_with_the_header() {
+        let sys = pendulum();
+        let s = State::consistent(&sys, 0.0).unwrap();
+        let mut csv = CsvObserver::new(std::io::sink()).with_residuals();
+        let cols = csv.columns(&sys);
+        let row = csv.row(&sys, &s).to_vec();
+        assert_eq!(cols.len(), row.len());
+        assert_eq!(cols.len(), 1 + 2 * sys.n_coords() + 3);
+    }
+
+    struct Broken;
+    impl Write for Broken {
+        fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+            Err(std::io::Error::other("disk full"))
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_failing_writer_is_an_observer_error_with_the_time() {
+        let sys = pendulum();
+        let s = State::consistent(&sys, 0.0).unwrap();
+        let mut csv = CsvObserver::new(Broken);
+        match csv.observe(&sys, &s, 0) {
+            Err(SolveError::Observer { t, message }) => {
+                assert_eq!(t, 0.0);
+                assert!(message.contains("disk full"), "{message}");
+            }
+            other => panic!("expected an observer error, got {other:?}"),
+        }
     }
 }

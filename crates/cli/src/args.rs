@@ -1,0 +1,174 @@
+//! The command line, declared with clap's derive API.
+
+use crate::solver::SolverSpec;
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+const MAIN_EXAMPLE: &str = "\
+Examples:
+  mbd check examples/models/slider_crank_spring.toml
+  mbd run examples/models/slider_crank_spring.toml --solver symplectic:2 --t-end 5 --h 1e-3 --out slider.csv
+  mbd plot slider.csv --y slider.x --y crank.theta -o slider.svg
+  mbd animate slider.csv --model examples/models/slider_crank_spring.toml -o slider.html
+
+Solvers: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified, tangent:rk4,
+tangent:dopri5 (fixed --h or adaptive --tol), firefly-gauss. See docs/cli.md.";
+
+const RUN_EXAMPLE: &str = "\
+Examples:
+  mbd run examples/models/pendulum.toml --solver rk4 --t-end 2 --h 1e-3 --out pendulum.csv
+  mbd run examples/models/four_bar.toml --solver symplectic:2:gamma=1 --t-end 5 --h 1e-3 --out fb.json --every 10
+  mbd run examples/models/manipulator.json --solver tangent:dopri5 --t-end 3 --tol 1e-8 --out arm.csv
+
+Columns: t, every coordinate (body.x, body.y, body.theta), every velocity (d_body.x, ...),
+the energy H, and the constraint residuals max_abs_phi = max|Phi| and
+max_abs_phidot = max|Phi_q v + Phi_t|. Without --out the CSV goes to standard output.";
+
+const CHECK_EXAMPLE: &str = "\
+Example:
+  mbd check examples/models/slider_crank_spring.toml";
+
+const PLOT_EXAMPLE: &str = "\
+Example:
+  mbd plot slider.csv --y slider.x --y crank.x -o slider.svg
+  mbd plot slider.csv --x crank.theta --y d_crank.theta";
+
+const ANIMATE_EXAMPLE: &str = "\
+Example:
+  mbd animate slider.csv --model examples/models/slider_crank_spring.toml -o slider.html
+
+Open the page in a browser; append #t=1.25 to its address to open it paused at t = 1.25 s.";
+
+/// `mbd`: simulate planar rigid multibody systems from model files.
+#[derive(Debug, Parser)]
+#[command(name = "mbd", version, about, after_help = MAIN_EXAMPLE)]
+pub struct Cli {
+    /// The command.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate a model with one of the solvers and write the trajectory (CSV or JSON).
+    #[command(after_help = RUN_EXAMPLE)]
+    Run(RunArgs),
+    /// Validate a model file; print its bodies, joints, degrees of freedom and consistent
+    /// initial state.
+    #[command(after_help = CHECK_EXAMPLE)]
+    Check(CheckArgs),
+    /// Plot columns of a result CSV as an SVG figure.
+    #[command(after_help = PLOT_EXAMPLE)]
+    Plot(PlotArgs),
+    /// Write a self-contained HTML page animating a result CSV with the model's geometry.
+    #[command(after_help = ANIMATE_EXAMPLE)]
+    Animate(AnimateArgs),
+}
+
+/// Arguments of `mbd run`.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("step").required(true).args(["h", "tol"])))]
+pub struct RunArgs {
+    /// Model file (.toml or .json).
+    pub model: PathBuf,
+    /// Solver: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified, tangent:rk4,
+    /// tangent:dopri5, firefly-gauss.
+    #[arg(long, short, value_parser = parse_solver)]
+    pub solver: SolverSpec,
+    /// End time in s (the run starts at t0 = 0).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_t_end)]
+    pub t_end: f64,
+    /// Fixed step size in s.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_h, conflicts_with = "tol")]
+    pub h: Option<f64>,
+    /// Error tolerance for adaptive steps (solvers with an embedded error estimate:
+    /// tangent:dopri5).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_tol)]
+    pub tol: Option<f64>,
+    /// Output file: .csv or .json (default: CSV on standard output).
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
+    /// Write every K-th step (and always the first and the last state).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub every: u64,
+}
+
+/// Arguments of `mbd check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Model file (.toml or .json).
+    pub model: PathBuf,
+}
+
+/// Arguments of `mbd plot`.
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// A CSV written by `mbd run`.
+    pub csv: PathBuf,
+    /// Column(s) to plot against x (repeat --y for several curves).
+    #[arg(long, required = true)]
+    pub y: Vec<String>,
+    /// Column on the horizontal axis.
+    #[arg(long, default_value = "t")]
+    pub x: String,
+    /// Output SVG (default: the CSV's name with extension .svg).
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
+}
+
+/// Arguments of `mbd animate`.
+#[derive(Debug, Args)]
+pub struct AnimateArgs {
+    /// A CSV written by `mbd run` for this model.
+    pub csv: PathBuf,
+    /// The model file the CSV was computed from.
+    #[arg(long, short)]
+    pub model: PathBuf,
+    /// Output HTML page.
+    #[arg(long, short)]
+    pub out: PathBuf,
+}
+
+fn parse_solver(s: &str) -> Result<SolverSpec, String> {
+    s.parse()
+}
+
+fn parse_number(s: &str) -> Result<f64, String> {
+    s.trim()
+        .parse::<f64>()
+        .map_err(|_| format!("'{s}' is not a number"))
+}
+
+fn parse_h(s: &str) -> Result<f64, String> {
+    let h = parse_number(s)?;
+    if h.is_finite() && h > 0.0 {
+        Ok(h)
+    } else {
+        Err(format!(
+            "the step size must be a positive number of seconds, e.g. --h 1e-3 (got {s})"
+        ))
+    }
+}
+
+fn parse_tol(s: &str) -> Result<f64, String> {
+    let t = parse_number(s)?;
+    if t.is_finite() && t > 0.0 && t < 1.0 {
+        Ok(t)
+    } else {
+        Err(format!(
+            "the tolerance must lie in (0, 1), e.g. --tol 1e-8 (got {s})"
+        ))
+    }
+}
+
+fn parse_t_end(s: &str) -> Result<f64, String> {
+    let t = parse_number(s)?;
+    if t.is_finite() && t > 0.0 {
+        Ok(t)
+    } else {
+        Err(format!(
+            "the end time must be after the start time t0 = 0, e.g. --t-end 5 (got {s})"
+        ))
+    }
+}

@@ -1,0 +1,73 @@
+//! # mbd-cli
+//!
+//! The `mbd` command-line program: simulate planar rigid multibody models from model files
+//! (`docs/model-files.md`) with any solver of the workspace, and look at the results.
+//!
+//! * `mbd run MODEL --solver SOLVER --t-end T (--h H | --tol TOL) [--out FILE.csv|FILE.json]
+//!   [--every K]` integrates and writes `t`, the coordinates, velocities, energy and
+//!   constraint residuals;
+//! * `mbd check MODEL` validates a model and prints its bodies, joints, degrees of freedom and
+//!   consistent initial state;
+//! * `mbd plot RESULT.csv --y COL [--y COL ...] [--x t] [-o out.svg]` draws an SVG figure;
+//! * `mbd animate RESULT.csv --model MODEL -o anim.html` writes a self-contained animated page.
+//!
+//! `docs/cli.md` describes the commands, the output columns and the solvers. The library side
+//! is usable too, e.g. to parse solver names the way `--solver` does:
+//!
+//! ```
+//! use mbd_cli::solver::SolverSpec;
+//!
+//! let spec: SolverSpec = "symplectic:2:gamma=1".parse()?;
+//! assert_eq!(spec, SolverSpec::Symplectic { s: 2, gamma: 1.0, modified: false });
+//! assert!(!spec.has_error_estimate());
+//! let sys = mbd_model::models::slider_crank()?;
+//! let integrator = spec.build(&sys)?;
+//! assert!(integrator.name().contains("symplectic"));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![warn(missing_docs)]
+
+pub mod animate;
+pub mod args;
+pub mod check;
+pub mod error;
+pub mod model;
+pub mod plot;
+pub mod run;
+pub mod solver;
+pub mod table;
+
+pub use args::{Cli, Command};
+pub use error::CliError;
+
+/// Runs one parsed command line, printing results on standard output and the run summary on
+/// standard error.
+pub fn execute(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Run(args) => {
+            let summary = run::run(&args)?;
+            eprintln!("{}", summary.line(&args.solver));
+            if let Some(w) = summary.stats.warning() {
+                eprintln!("warning: {w}");
+            }
+            if let Some(out) = &args.out {
+                eprintln!("wrote {}", out.display());
+            }
+            Ok(())
+        }
+        Command::Check(args) => {
+            print!("{}", check::check(&args)?);
+            Ok(())
+        }
+        Command::Plot(args) => {
+            let out = plot::plot(&args)?;
+            eprintln!("wrote {}", out.display());
+            Ok(())
+        }
+        Command::Animate(args) => {
+            animate::animate(&args)?;
+            eprintln!("wrote {}", args.out.display());
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,305 @@
+//! `mbd run`: integrate a model and write the trajectory.
+
+use crate::args::RunArgs;
+use crate::error::CliError;
+use crate::solver::SolverSpec;
+use indicatif::{ProgressBar, ProgressStyle};
+use mbd_analysis::{CsvObserver, MeasureObserver};
+use mbd_model::System;
+use mbd_solve::{AdaptiveConfig, Flow, Observer, RunConfig, RunStats, SolveError, State};
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What a run did, for the summary line.
+#[derive(Clone, Debug)]
+pub struct RunSummary {
+    /// The run loop's statistics.
+    pub stats: RunStats,
+    /// Energy and constraint errors over the samples (every step).
+    pub measures: mbd_analysis::RunMeasures,
+    /// Wall-clock time of the integration, s.
+    pub wall_time: f64,
+    /// Rows written.
+    pub rows: usize,
+}
+
+impl RunSummary {
+    /// The one-line summary printed on standard error.
+    pub fn line(&self, solver: &SolverSpec) -> String {
+        format!(
+            "mbd run: {} steps ({} rejected) with {solver}, {} rows; e(H) = {:.3e}, \
+             e(Phi) = {:.3e}, e(Phidot) = {:.3e}; wall time {:.3} s",
+            self.stats.steps,
+            self.stats.rejected_steps,
+            self.rows,
+            self.measures.e_h,
+            self.measures.e_phi,
+            self.measures.e_phidot,
+            self.wall_time
+        )
+    }
+}
+
+/// Where the rows go.
+enum Sink {
+    Csv(CsvObserver<Box<dyn Write>>),
+    Json {
+        fmt: CsvObserver<std::io::Sink>,
+        every: usize,
+        rows: Vec<Vec<f64>>,
+        last_t: Option<f64>,
+        file: std::fs::File,
+    },
+}
+
+impl Observer for Sink {
+    fn observe(&mut self, sys: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
+        match self {
+            Sink::Csv(c) => c.observe(sys, s, step),
+            Sink::Json {
+                fmt,
+                every,
+                rows,
+                last_t,
+                ..
+            } => {
+                if step % *every == 0 {
+                    rows.push(fmt.row(sys, s).to_vec());
+                    *last_t = Some(s.t);
+                }
+                Ok(Flow::Continue)
+            }
+        }
+    }
+}
+
+/// Counts the rows a sink writes (mirrors the sinks' sampling rule).
+struct RowCount {
+    every: usize,
+    rows: usize,
+    last_t: Option<f64>,
+}
+
+impl Observer for RowCount {
+    fn observe(&mut self, _: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
+        if step % self.every == 0 {
+            self.rows += 1;
+            self.last_t = Some(s.t);
+        }
+        Ok(Flow::Continue)
+    }
+}
+
+/// A progress bar over simulated time, drawn only when standard error is a terminal.
+struct Progress {
+    bar: Option<ProgressBar>,
+    t_end: f64,
+}
+
+impl Progress {
+    const TICKS: u64 = 1000;
+
+    fn new(t_end: f64) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::new(Self::TICKS);
+            if let Ok(style) =
+                ProgressStyle::with_template("{bar:40} {percent:>3}% t = {msg} s  [{elapsed}]")
+            {
+                bar.set_style(style);
+            }
+            bar
+        });
+        Progress { bar, t_end }
+    }
+}
+
+impl Observer for Progress {
+    fn observe(&mut self, _: &System, s: &State, _: usize) -> Result<Flow, SolveError> {
+        if let Some(bar) = &self.bar {
+            let frac = (s.t / self.t_end).clamp(0.0, 1.0);
+            let pos = (frac * Self::TICKS as f64) as u64;
+            if pos != bar.position() {
+                bar.set_position(pos);
+                bar.set_message(format!("{:.4}", s.t));
+            }
+        }
+        Ok(Flow::Continue)
+    }
+}
+
+fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
+    let csv = |w: Box<dyn Write>| Sink::Csv(CsvObserver::new(w).with_residuals().with_every(every));
+    let Some(out) = &args.out else {
+        return Ok(csv(Box::new(std::io::BufWriter::new(std::io::stdout()))));
+    };
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let json = match ext.as_deref() {
+        Some("csv") => false,
+        Some("json") => true,
+        _ => {
+            return Err(CliError::Usage(format!(
+                "--out '{}': the output file must end in .csv or .json",
+                out.display()
+            )))
+        }
+    };
+    // created before the run, so an unwritable path fails at once
+    let file = std::fs::File::create(out).map_err(|e| CliError::write(out, e))?;
+    Ok(if json {
+        Sink::Json {
+            fmt: CsvObserver::new(std::io::sink()).with_residuals(),
+            every,
+            rows: Vec::new(),
+            last_t: None,
+            file,
+        }
+    } else {
+        csv(Box::new(std::io::BufWriter::new(file)))
+    })
+}
+
+fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
+    let hint = match &source {
+        SolveError::ConstraintDrift { .. } => {
+            "; the constraints drifted: take a smaller --h, or a solver that holds them \
+             (rk4-projected, symplectic:S, tangent:rk4)"
+        }
+        SolveError::Observer { .. } => "; check the output path and the free disk space",
+        _ => "; try a smaller --h (or --tol), or another --solver",
+    };
+    CliError::Solve {
+        solver: solver.to_string(),
+        source: Box::new(source),
+        hint: hint.into(),
+    }
+}
+
+/// Runs the simulation, writes the output and returns the summary.
+pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
+    if args.tol.is_some() && !args.solver.has_error_estimate() {
+        return Err(CliError::Usage(format!(
+            "--tol needs a solver with an embedded error estimate, and '{}' has none: give a \
+             fixed step with --h, or use --solver tangent:dopri5 with --tol",
+            args.solver
+        )));
+    }
+    let sys = crate::model::load(&args.model)?;
+    let mut state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {
+        path: args.model.display().to_string(),
+        source: Box::new(source),
+    })?;
+    let every = usize::try_from(args.every).unwrap_or(usize::MAX);
+    let sink = open_sink(args, every)?;
+    let measures = MeasureObserver::new(&sys, false);
+    let count = RowCount {
+        every,
+        rows: 0,
+        last_t: None,
+    };
+    let progress = Progress::new(args.t_end);
+    let bar = progress.bar.clone();
+    let mut obs = (measures, (count, (sink, progress)));
+    let started = Instant::now();
+    let result = match (args.h, args.tol) {
+        (_, Some(tol)) => mbd_tangent::TangentRk::dopri5(&sys).and_then(|mut dp| {
+            mbd_solve::run_adaptive(
+                &mut dp,
+                &sys,
+                &mut state,
+                AdaptiveConfig::new(args.t_end, tol),
+                &mut obs,
+            )
+        }),
+        (Some(h), None) => args.solver.build(&sys).and_then(|mut integ| {
+            mbd_solve::run(
+                &mut integ,
+                &sys,
+                &mut state,
+                RunConfig::new(args.t_end, h),
+                &mut obs,
+            )
+        }),
+        (None, None) => {
+            return Err(CliError::Usage(
+                "give a step size with --h (or a tolerance with --tol)".into(),
+            ))
+        }
+    };
+    let wall_time = started.elapsed().as_secs_f64();
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let stats = result.map_err(|e| solve_error(&args.solver, e))?;
+    let (measures, (count, (sink, _))) = obs;
+    let final_written = count.last_t == Some(state.t);
+    let rows = count.rows + usize::from(!final_written);
+    finish(args, &sys, &state, sink, stats, &measures, wall_time)?;
+    Ok(RunSummary {
+        stats,
+        measures: measures.measures(),
+        wall_time,
+        rows,
+    })
+}
+
+fn out_path(args: &RunArgs) -> PathBuf {
+    args.out.clone().unwrap_or_else(|| PathBuf::from("-"))
+}
+
+fn finish(
+    args: &RunArgs,
+    sys: &System,
+    state: &State,
+    sink: Sink,
+    stats: RunStats,
+    measures: &MeasureObserver,
+    wall_time: f64,
+) -> Result<(), CliError> {
+    let out = out_path(args);
+    match sink {
+        Sink::Csv(mut c) => c.finish(sys, state).map_err(|e| CliError::write(&out, e)),
+        Sink::Json {
+            mut fmt,
+            mut rows,
+            last_t,
+            file,
+            ..
+        } => {
+            if last_t != Some(state.t) {
+                rows.push(fmt.row(sys, state).to_vec());
+            }
+            let m = measures.measures();
+            let doc = serde_json::json!({
+                "model": args.model.display().to_string(),
+                "solver": args.solver.to_string(),
+                "h": args.h,
+                "tol": args.tol,
+                "t_end": args.t_end,
+                "every": args.every,
+                "columns": fmt.columns(sys),
+                "rows": rows,
+                "summary": {
+                    "steps": stats.steps,
+                    "rejected_steps": stats.rejected_steps,
+                    "e_h": m.e_h,
+                    "e_phi": m.e_phi,
+                    "e_phidot": m.e_phidot,
+                    "wall_time_s": wall_time,
+                },
+            });
+            write_json(&out, file, &doc)
+        }
+    }
+}
+
+fn write_json(path: &Path, file: std::fs::File, doc: &serde_json::Value) -> Result<(), CliError> {
+    let mut w = std::io::BufWriter::new(file);
+    serde_json::to_writer(&mut w, doc).map_err(|e| CliError::write(path, e))?;
+    writeln!(w)
+        .and_then(|()| w.flush())
+        .map_err(|e| CliError::write(path, e))
+}

@@ -1,0 +1,113 @@
+//! Reading result CSVs (a header line of column names, then rows of numbers).
+
+use crate::error::CliError;
+use std::path::Path;
+
+/// A CSV result: named columns of numbers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// The file it was read from (for messages).
+    pub path: String,
+    /// Column names.
+    pub names: Vec<String>,
+    /// Rows, each as long as `names`.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Table {
+    /// Reads a CSV file; errors name the file and the line.
+    pub fn read(path: &Path) -> Result<Table, CliError> {
+        let text = std::fs::read_to_string(path).map_err(|e| CliError::read(path, e))?;
+        Table::parse(&path.display().to_string(), &text)
+    }
+
+    /// Parses CSV text (`path` is used in messages).
+    pub fn parse(path: &str, text: &str) -> Result<Table, CliError> {
+        let bad = |line: usize, message: String| CliError::Csv {
+            path: path.to_string(),
+            line,
+            message,
+        };
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        let names: Vec<String> = match lines.next() {
+            Some((_, head)) => head.split(',').map(|c| c.trim().to_string()).collect(),
+            None => return Err(bad(1, "the file is empty".into())),
+        };
+        if names.iter().any(|n| n.parse::<f64>().is_ok()) {
+            return Err(bad(1, "the first line must name the columns".into()));
+        }
+        let mut rows = Vec::new();
+        for (i, l) in lines {
+            let row: Vec<f64> = l
+                .split(',')
+                .map(|x| {
+                    let x = x.trim();
+                    x.parse::<f64>()
+                        .map_err(|_| bad(i + 1, format!("'{x}' is not a number")))
+                })
+                .collect::<Result<_, _>>()?;
+            if row.len() != names.len() {
+                return Err(bad(
+                    i + 1,
+                    format!("{} values for {} columns", row.len(), names.len()),
+                ));
+            }
+            rows.push(row);
+        }
+        if rows.is_empty() {
+            return Err(bad(2, "no rows of data".into()));
+        }
+        Ok(Table {
+            path: path.to_string(),
+            names,
+            rows,
+        })
+    }
+
+    /// The index of column `name`, or an error listing the available columns.
+    pub fn column_index(&self, name: &str) -> Result<usize, CliError> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .ok_or_else(|| CliError::UnknownColumn {
+                column: name.to_string(),
+                path: self.path.clone(),
+                available: self.names.join(", "),
+            })
+    }
+
+    /// The values of column `name`.
+    pub fn column(&self, name: &str) -> Result<Vec<f64>, CliError> {
+        let k = self.column_index(name)?;
+        Ok(self.rows.iter().map(|r| r[k]).collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_reports_bad_lines() {
+        let t = Table::parse("r.csv", "t,a.x\n0,1\n0.1,2e0\n").unwrap();
+        assert_eq!(t.column("a.x").unwrap(), vec![1.0, 2.0]);
+        let e = t.column("b").unwrap_err().to_string();
+        assert!(e.contains("'b'") && e.contains("t, a.x"), "{e}");
+        let e = Table::parse("r.csv", "t,a\n0,1\n1,zz\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 3") && e.contains("'zz'"), "{e}");
+        let e = Table::parse("r.csv", "t,a\n0,1,2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("line 2") && e.contains("3 values for 2 columns"),
+            "{e}"
+        );
+        assert!(Table::parse("r.csv", "").is_err());
+        assert!(Table::parse("r.csv", "1,2\n3,4\n").is_err());
+    }
+}

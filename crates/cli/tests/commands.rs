@@ -1,0 +1,261 @@
+//! The commands on the example models: every solver runs and writes the documented columns;
+//! `check`, `plot` and `animate` produce what they promise.
+
+mod common;
+use common::{example_models, mbd, pendulum_csv, scratch};
+use std::path::Path;
+
+fn expected_columns(model: &Path) -> Vec<String> {
+    let sys = mbd_model::System::from_path(model).unwrap();
+    let names = sys.coordinate_names();
+    let mut c = vec!["t".to_string()];
+    c.extend(names.iter().cloned());
+    c.extend(names.iter().map(|n| format!("d_{n}")));
+    c.extend(["H", "max_abs_phi", "max_abs_phidot"].map(String::from));
+    c
+}
+
+fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let mut lines = text.lines();
+    let head = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    (head, rows)
+}
+
+fn run_model(model: &Path, solver: &str, step: &[&str], out: &Path) -> common::Out {
+    let mut a: Vec<std::ffi::OsString> = vec![
+        "run".into(),
+        model.into(),
+        "--solver".into(),
+        solver.into(),
+        "--t-end".into(),
+        "0.02".into(),
+    ];
+    a.extend(step.iter().map(Into::into));
+    a.extend(["--out".into(), out.into()]);
+    mbd(a)
+}
+
+#[test]
+fn every_solver_runs_every_example_model() {
+    let d = scratch("all");
+    let solvers: &[(&str, &[&str])] = &[
+        ("rk4", &["--h", "0.01"]),
+        ("rk4-projected", &["--h", "0.01"]),
+        ("symplectic:2", &["--h", "0.01"]),
+        ("symplectic:1:gamma=1", &["--h", "0.01"]),
+        ("tangent:rk4", &["--h", "0.01"]),
+        ("tangent:dopri5", &["--h", "0.01"]),
+        ("tangent:dopri5", &["--tol", "1e-6"]),
+        ("firefly-gauss", &["--h", "0.01"]),
+    ];
+    for model in example_models() {
+        let want = expected_columns(&model);
+        for (k, (solver, step)) in solvers.iter().enumerate() {
+            let csv = d.join(format!("{k}.csv"));
+            let out = run_model(&model, solver, step, &csv);
+            let what = format!("{} with {solver} {step:?}", model.display());
+            assert_eq!(out.code, 0, "{what}: {}", out.stderr);
+            assert!(
+                out.stderr.contains("mbd run: ") && out.stderr.contains("e(H) = "),
+                "{what}: {}",
+                out.stderr
+            );
+            let (head, rows) = read_csv(&csv);
+            assert_eq!(head, want, "{what}");
+            let t: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+            assert_eq!(t[0], 0.0, "{what}");
+            assert!((t[t.len() - 1] - 0.02).abs() < 1e-12, "{what}: {t:?}");
+            if step[0] == "--h" {
+                assert_eq!(rows.len(), 3, "{what}");
+            }
+            // the constraint residuals are columns of small numbers
+            let phi = head.iter().position(|c| c == "max_abs_phi").unwrap();
+            assert!(rows.iter().all(|r| r[phi].abs() < 1e-6), "{what}");
+        }
+    }
+}
+
+#[test]
+fn modified_lagrangian_runs_on_a_conservative_model() {
+    let d = scratch("modified");
+    let model = common::repo().join("examples/models/pendulum.toml");
+    let csv = d.join("m.csv");
+    let out = run_model(&model, "symplectic:1:modified", &["--h", "0.01"], &csv);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(read_csv(&csv).1.len(), 3);
+}
+
+#[test]
+fn every_k_writes_every_kth_step_and_the_last() {
+    let d = scratch("every");
+    let csv = d.join("e.csv");
+    let out = mbd([
+        "run".as_ref(),
+        "examples/models/pendulum.toml".as_ref(),
+        "--solver".as_ref(),
+        "symplectic:2".as_ref(),
+        "--t-end".as_ref(),
+        "0.1".as_ref(),
+        "--h".as_ref(),
+        "0.01".as_ref(),
+        "--every".as_ref(),
+        "3".as_ref(),
+        "--out".as_ref(),
+        csv.as_os_str(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let t: Vec<f64> = read_csv(&csv).1.iter().map(|r| r[0]).collect();
+    let want = [0.0, 0.03, 0.06, 0.09, 0.1];
+    assert_eq!(t.len(), want.len(), "{t:?}");
+    assert!(
+        t.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+        "{t:?}"
+    );
+    assert!(out.stderr.contains("10 steps"), "{}", out.stderr);
+}
+
+#[test]
+fn json_output_has_metadata_and_rows() {
+    let d = scratch("json");
+    let json = d.join("r.json");
+    let model = common::repo().join("examples/models/slider_crank_spring.toml");
+    let out = run_model(&model, "tangent:rk4", &["--h", "0.005"], &json);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["solver"], "tangent:rk4");
+    assert_eq!(v["h"], 0.005);
+    assert!(v["tol"].is_null());
+    assert!(v["model"]
+        .as_str()
+        .unwrap()
+        .ends_with("slider_crank_spring.toml"));
+    let cols: Vec<String> = serde_json::from_value(v["columns"].clone()).unwrap();
+    assert_eq!(cols, expected_columns(&model));
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 5);
+    assert!(rows
+        .iter()
+        .all(|r| r.as_array().unwrap().len() == cols.len()));
+    assert_eq!(v["summary"]["steps"], 4);
+}
+
+#[test]
+fn stdout_gets_the_csv_without_out() {
+    let out = mbd([
+        "run",
+        "examples/models/pendulum.toml",
+        "--solver",
+        "rk4",
+        "--t-end",
+        "0.02",
+        "--h",
+        "0.01",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let lines: Vec<&str> = out.stdout.lines().collect();
+    assert_eq!(lines.len(), 4);
+    assert!(lines[0].starts_with("t,"));
+    // no progress bar when stderr is not a terminal: just the summary line
+    assert_eq!(out.stderr.lines().count(), 1, "{}", out.stderr);
+}
+
+#[test]
+fn check_prints_the_degrees_of_freedom_and_initial_state() {
+    let out = mbd(["check", "examples/models/slider_crank_spring.toml"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    for needle in [
+        "bodies (3):",
+        "crank_pivot",
+        "prismatic",
+        "degrees of freedom: 1",
+        "consistent initial state",
+        "crank.theta",
+        "|q_consistent - q_file|_max = ",
+    ] {
+        assert!(
+            out.stdout.contains(needle),
+            "lacks {needle:?}:\n{}",
+            out.stdout
+        );
+    }
+    let out = mbd(["check", "examples/models/manipulator.json"]);
+    assert!(
+        out.stdout.contains("degrees of freedom: 2"),
+        "{}",
+        out.stdout
+    );
+}
+
+#[test]
+fn plot_writes_an_svg_and_leaves_the_csv_alone() {
+    let d = scratch("plot");
+    let csv = pendulum_csv(&d);
+    let before = std::fs::read(&csv).unwrap();
+    // default output: the CSV's name with .svg, next to it
+    let out = mbd([
+        "plot".as_ref(),
+        csv.as_os_str(),
+        "--y".as_ref(),
+        "H".as_ref(),
+        "--y".as_ref(),
+        "max_abs_phi".as_ref(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let svg = std::fs::read_to_string(d.join("pendulum.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("max_abs_phi"));
+    assert_eq!(
+        std::fs::read(&csv).unwrap(),
+        before,
+        "the data CSV was overwritten"
+    );
+}
+
+#[test]
+fn animate_writes_a_self_contained_page() {
+    let d = scratch("animate");
+    let csv = pendulum_csv(&d);
+    let html = d.join("a.html");
+    let out = mbd([
+        "animate".as_ref(),
+        csv.as_os_str(),
+        "--model".as_ref(),
+        "examples/models/pendulum.toml".as_ref(),
+        "-o".as_ref(),
+        html.as_os_str(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let page = std::fs::read_to_string(&html).unwrap();
+    for forbidden in [
+        "<script src",
+        "<link",
+        "fetch(",
+        "XMLHttpRequest",
+        "@import",
+        "https://",
+    ] {
+        assert!(!page.contains(forbidden), "page contains {forbidden:?}");
+    }
+    assert!(page.contains("id=\"slider\"") && page.contains("id=\"play\""));
+    assert!(page.contains("\"t\":[0.0,"), "trajectory embedded");
+}
+
+#[test]
+fn help_shows_examples() {
+    let out = mbd(["--help"]);
+    assert_eq!(out.code, 0);
+    assert!(out.stdout.contains("Examples:") && out.stdout.contains("mbd run examples/models/"));
+    for cmd in ["run", "check", "plot", "animate"] {
+        let out = mbd([cmd, "--help"]);
+        assert_eq!(out.code, 0, "{cmd}");
+        assert!(
+            out.stdout.contains(&format!("mbd {cmd} ")),
+            "{cmd} --help:\n{}",
+            out.stdout
+        );
+    }
+}

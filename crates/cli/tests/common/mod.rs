@@ -1,0 +1,91 @@
+//! Helpers shared by the command-line tests: run the `mbd` binary, find example models, make
+//! scratch directories.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// What one run of the binary gave.
+pub struct Out {
+    pub code: i32,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+/// Runs `mbd` with the arguments, in the repository root (so `examples/models/...` resolves).
+pub fn mbd<I, S>(args: I) -> Out
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let out = Command::new(env!("CARGO_BIN_EXE_mbd"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("the mbd binary runs");
+    Out {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// The repository root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A fresh scratch directory for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("mbd-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch directory");
+    d
+}
+
+/// The example model files.
+pub fn example_models() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(repo().join("examples/models"))
+        .expect("examples/models exists")
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| {
+            matches!(
+                p.extension().and_then(|e| e.to_str()),
+                Some("toml" | "json")
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// Asserts the exit code and that stderr contains every needle.
+pub fn assert_fails(out: &Out, code: i32, needles: &[&str]) {
+    assert_eq!(out.code, code, "exit code; stderr:\n{}", out.stderr);
+    for n in needles {
+        assert!(
+            out.stderr.contains(n),
+            "stderr lacks {n:?}; stderr:\n{}",
+            out.stderr
+        );
+    }
+}
+
+/// A CSV of a short pendulum run, written to `dir`.
+pub fn pendulum_csv(dir: &Path) -> PathBuf {
+    let csv = dir.join("pendulum.csv");
+    let out = mbd([
+        "run".as_ref(),
+        "examples/models/pendulum.toml".as_ref(),
+        "--solver".as_ref(),
+        "rk4".as_ref(),
+        "--t-end".as_ref(),
+        "0.1".as_ref(),
+        "--h".as_ref(),
+        "0.01".as_ref(),
+        "--out".as_ref(),
+        csv.as_os_str(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    csv
+}

@@ -1,0 +1,310 @@
+//! Every bad input gives the documented exit code (2 usage, 1 runtime) and a message that
+//! names what is at fault.
+
+mod common;
+use common::{assert_fails, mbd, pendulum_csv, scratch};
+use std::path::Path;
+
+const PENDULUM: &str = "examples/models/pendulum.toml";
+
+fn run_with(extra: &[&str]) -> common::Out {
+    let mut a = vec!["run", PENDULUM];
+    a.extend_from_slice(extra);
+    mbd(a)
+}
+
+#[test]
+fn unknown_solver() {
+    let out = run_with(&["--solver", "rk5", "--t-end", "1", "--h", "0.01"]);
+    assert_fails(
+        &out,
+        2,
+        &["unknown solver 'rk5'", "tangent:dopri5", "firefly-gauss"],
+    );
+}
+
+#[test]
+fn bad_symplectic_options() {
+    let out = run_with(&["--solver", "symplectic:0", "--t-end", "1", "--h", "0.01"]);
+    assert_fails(&out, 2, &["S must be a whole number"]);
+    let out = run_with(&[
+        "--solver",
+        "symplectic:2:modified",
+        "--t-end",
+        "1",
+        "--h",
+        "0.01",
+    ]);
+    assert_fails(&out, 2, &["symplectic:1:modified"]);
+}
+
+#[test]
+fn negative_and_zero_step() {
+    for h in ["-0.01", "0", "nan"] {
+        let out = run_with(&["--solver", "rk4", "--t-end", "1", "--h", h]);
+        assert_fails(&out, 2, &["--h", "step size must be a positive number"]);
+    }
+    let out = run_with(&["--solver", "rk4", "--t-end", "1", "--h", "abc"]);
+    assert_fails(&out, 2, &["'abc' is not a number"]);
+}
+
+#[test]
+fn end_time_not_after_start() {
+    for t in ["0", "-1"] {
+        let out = run_with(&["--solver", "rk4", "--t-end", t, "--h", "0.01"]);
+        assert_fails(
+            &out,
+            2,
+            &["--t-end", "end time must be after the start time t0 = 0"],
+        );
+    }
+}
+
+#[test]
+fn step_and_tolerance_together_or_neither() {
+    let out = run_with(&[
+        "--solver",
+        "tangent:dopri5",
+        "--t-end",
+        "1",
+        "--h",
+        "0.01",
+        "--tol",
+        "1e-6",
+    ]);
+    assert_fails(&out, 2, &["cannot be used with"]);
+    let out = run_with(&["--solver", "tangent:dopri5", "--t-end", "1"]);
+    assert_fails(&out, 2, &["--h", "--tol"]);
+}
+
+#[test]
+fn tolerance_with_a_solver_without_error_estimate() {
+    let out = run_with(&["--solver", "rk4", "--t-end", "1", "--tol", "1e-6"]);
+    assert_fails(
+        &out,
+        2,
+        &[
+            "--tol needs a solver with an embedded error estimate",
+            "'rk4'",
+            "tangent:dopri5",
+        ],
+    );
+    let out = run_with(&["--solver", "tangent:dopri5", "--t-end", "1", "--tol", "2"]);
+    assert_fails(&out, 2, &["tolerance must lie in (0, 1)"]);
+}
+
+#[test]
+fn missing_model_file() {
+    let out = mbd([
+        "run",
+        "no/such/model.toml",
+        "--solver",
+        "rk4",
+        "--t-end",
+        "1",
+        "--h",
+        "0.01",
+    ]);
+    assert_fails(&out, 1, &["cannot read model file 'no/such/model.toml'"]);
+    let out = mbd(["check", "no/such/model.toml"]);
+    assert_fails(&out, 1, &["cannot read model file 'no/such/model.toml'"]);
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+const GOOD_BODY: &str =
+    "gravity = [0.0, -9.81]\n\n[[bodies]]\nname = \"rod\"\nmass = 1.0\ninertia = 0.1\n";
+
+#[test]
+fn malformed_model_syntax_gives_line_and_column() {
+    let d = scratch("syntax");
+    let toml = write(
+        &d,
+        "bad.toml",
+        "gravity = [0.0, -9.81]\n\n[[bodies]]\nname = \"rod\"\nmass = = 1.0\n",
+    );
+    let out = mbd(["check", &toml]);
+    assert_fails(
+        &out,
+        1,
+        &["invalid model file", "bad.toml", "line 5", "column"],
+    );
+    let json = write(
+        &d,
+        "bad.json",
+        "{\n  \"bodies\": [\n    { \"name\": \"rod\", \"mass\": 1.0,, }\n  ]\n}\n",
+    );
+    let out = mbd(["check", &json]);
+    assert_fails(
+        &out,
+        1,
+        &["invalid model file", "bad.json", "line 3", "column"],
+    );
+}
+
+#[test]
+fn unknown_field_is_named_with_its_line() {
+    let d = scratch("field");
+    let toml = write(
+        &d,
+        "field.toml",
+        &GOOD_BODY.replace("mass = 1.0", "masss = 1.0"),
+    );
+    let out = mbd(["check", &toml]);
+    assert_fails(
+        &out,
+        1,
+        &["invalid model file", "unknown field", "masss", "line 5"],
+    );
+}
+
+#[test]
+fn bad_value_names_the_element_field_and_line() {
+    let d = scratch("value");
+    let toml = write(
+        &d,
+        "value.toml",
+        &GOOD_BODY.replace("mass = 1.0", "mass = -2.0"),
+    );
+    let out = mbd(["check", &toml]);
+    assert_fails(&out, 1, &["invalid model file", "rod", "mass", "line 4"]);
+    let out = mbd([
+        "run", &toml, "--solver", "rk4", "--t-end", "1", "--h", "0.01",
+    ]);
+    assert_fails(&out, 1, &["invalid model file", "mass"]);
+}
+
+#[test]
+fn model_file_with_unknown_extension() {
+    let d = scratch("ext");
+    let p = write(&d, "model.yaml", GOOD_BODY);
+    let out = mbd(["check", &p]);
+    assert_fails(&out, 1, &["model.yaml", "end in .toml or .json"]);
+}
+
+#[test]
+fn unknown_plot_column_lists_the_available_ones() {
+    let d = scratch("plotcol");
+    let csv = pendulum_csv(&d);
+    let out = mbd([
+        "plot".as_ref(),
+        csv.as_os_str(),
+        "--y".as_ref(),
+        "nope".as_ref(),
+    ]);
+    assert_fails(
+        &out,
+        1,
+        &[
+            "column 'nope' is not in",
+            "available columns: t, ",
+            "max_abs_phi",
+        ],
+    );
+    let out = mbd([
+        "plot".as_ref(),
+        csv.as_os_str(),
+        "--x".as_ref(),
+        "time".as_ref(),
+        "--y".as_ref(),
+        "H".as_ref(),
+    ]);
+    assert_fails(&out, 1, &["column 'time' is not in"]);
+}
+
+#[test]
+fn animate_csv_from_another_model() {
+    let d = scratch("mismatch");
+    let csv = pendulum_csv(&d);
+    let html = d.join("a.html");
+    let out = mbd([
+        "animate".as_ref(),
+        csv.as_os_str(),
+        "--model".as_ref(),
+        "examples/models/slider_crank_spring.toml".as_ref(),
+        "-o".as_ref(),
+        html.as_os_str(),
+    ]);
+    assert_fails(
+        &out,
+        1,
+        &["does not match model", "missing column(s) crank.x"],
+    );
+    assert!(!html.exists());
+}
+
+#[test]
+fn result_file_that_is_not_a_csv() {
+    let d = scratch("notcsv");
+    let p = write(&d, "x.csv", "t,a\n0,1\n0.1,oops\n");
+    let out = mbd(["plot", &p, "--y", "a"]);
+    assert_fails(&out, 1, &["line 3", "'oops' is not a number"]);
+    let out = mbd(["plot", "no/such.csv", "--y", "a"]);
+    assert_fails(&out, 1, &["cannot read 'no/such.csv'"]);
+}
+
+#[test]
+fn unwritable_output_paths() {
+    let d = scratch("unwritable");
+    // a path below a regular file cannot be created, not even by root
+    let blocker = d.join("file");
+    std::fs::write(&blocker, "x").unwrap();
+    let target = blocker.join("out.csv");
+    let out = mbd([
+        "run".as_ref(),
+        PENDULUM.as_ref(),
+        "--solver".as_ref(),
+        "rk4".as_ref(),
+        "--t-end".as_ref(),
+        "0.1".as_ref(),
+        "--h".as_ref(),
+        "0.01".as_ref(),
+        "--out".as_ref(),
+        target.as_os_str(),
+    ]);
+    let shown = format!("cannot write '{}'", target.display());
+    assert_fails(&out, 1, &[&shown, "writable"]);
+
+    let csv = pendulum_csv(&d);
+    let svg = blocker.join("f.svg");
+    let out = mbd([
+        "plot".as_ref(),
+        csv.as_os_str(),
+        "--y".as_ref(),
+        "H".as_ref(),
+        "-o".as_ref(),
+        svg.as_os_str(),
+    ]);
+    assert_fails(&out, 1, &[&format!("'{}'", svg.display())]);
+
+    let html = blocker.join("a.html");
+    let out = mbd([
+        "animate".as_ref(),
+        csv.as_os_str(),
+        "--model".as_ref(),
+        PENDULUM.as_ref(),
+        "-o".as_ref(),
+        html.as_os_str(),
+    ]);
+    assert_fails(&out, 1, &[&format!("cannot write '{}'", html.display())]);
+}
+
+#[test]
+fn output_extension_must_be_csv_or_json() {
+    let out = run_with(&[
+        "--solver", "rk4", "--t-end", "0.1", "--h", "0.01", "--out", "x.txt",
+    ]);
+    assert_fails(&out, 2, &["x.txt", ".csv or .json"]);
+}
+
+#[test]
+fn every_must_be_positive() {
+    let out = run_with(&[
+        "--solver", "rk4", "--t-end", "0.1", "--h", "0.01", "--every", "0",
+    ]);
+    assert_fails(&out, 2, &["--every"]);
+}
