@@ -286,6 +286,65 @@ def spring_test(hs=(0.1, 0.05, 0.025), periods=10):
                   + ' '.join('%+.4e' % e for e in errs) + '  orders ' + ' '.join('%.2f' % o for o in ords), flush=True)
 
 
+def energy_test(periods=10):
+    """max |H(q_k, M^-1 p_k) - H_0| over `periods` periods, rod at 90 deg."""
+    S = rod()
+    th0 = math.radians(90.0)
+    Te = exact_period(S, th0)
+    for s, pre, hs in ((1, None, (0.1, 0.05)), (1, 'e2', (0.1, 0.05)), (2, None, (0.2, 0.1)), (2, 'e4', (0.2, 0.1))):
+        out = []
+        for h in hs:
+            sch = Scheme(S, s, pre)
+            q = np.array(S.chi(th0), float)
+            p = np.zeros(S.n)
+            H = lambda q, p: 0.5 * p @ (S.Minv * p) + S.V(q)
+            H0, dH = H(q, p), 0.0
+            for _ in range(int(periods * Te / h)):
+                q, p = sch.step(q, p, h)
+                dH = max(dH, abs(H(q, p) - H0))
+            out.append(dH)
+        print('  rod 90 deg s=%d %-5s h = %s: max|dH| = %s  order %.2f'
+              % (s, pre or 'plain', hs, ' '.join('%.3e' % x for x in out), math.log2(out[0] / out[1])), flush=True)
+
+
+def double_pendulum():
+    """paper A's double pendulum (two 1 kg 1 m rods, both released at rest 30 deg from the
+    downward vertical), h = 0.04, 20 s: E|dx|, E|dy| over both bodies and all steps against
+    DOP853 (rtol = atol = 1e-13) on the angle ODE."""
+    xs = sp.symbols('x1 y1 p1 x2 y2 p2')
+    x1, y1, p1, x2, y2, p2 = xs
+    V = G_ACC * (y1 + y2)
+    Phi = [x1 - sp.cos(p1) / 2, y1 - sp.sin(p1) / 2,
+           x2 - sp.cos(p2) / 2 - (x1 + sp.cos(p1) / 2), y2 - sp.sin(p2) / 2 - (y1 + sp.sin(p1) / 2)]
+    chi = lambda t: [sp.cos(t) / 2, sp.sin(t) / 2, t, sp.cos(t) + sp.cos(t) / 2, sp.sin(t) + sp.sin(t) / 2, t]  # unused (one angle)
+    S = System(list(xs), [1, 1, 1 / 12] * 2, V, Phi, chi, lambda q: q[2], 'dp')
+    a0 = -math.pi / 2 + math.radians(30)
+    # reduced angle ODE
+    t1, t2, w1, w2 = sp.symbols('t1 t2 w1 w2')
+    pos = sp.Matrix([sp.cos(t1) / 2, sp.sin(t1) / 2, t1, sp.cos(t1) + sp.cos(t2) / 2, sp.sin(t1) + sp.sin(t2) / 2, t2])
+    Jm = pos.jacobian(sp.Matrix([t1, t2]))
+    Mm = sp.diag(1, 1, sp.Rational(1, 12), 1, 1, sp.Rational(1, 12))
+    Mh = sp.simplify(Jm.T * Mm * Jm)
+    om = sp.Matrix([w1, w2])
+    Lr = (om.T * Mh * om)[0] / 2 - G_ACC * (pos[1] + pos[4])
+    rhs = sp.Matrix([sp.diff(Lr, t) for t in (t1, t2)]) - sp.Matrix([[sp.diff(Lr, w, t) for t in (t1, t2)] for w in (w1, w2)]) * om
+    fM, frhs, fpos = sp.lambdify([t1, t2], Mh), sp.lambdify([t1, t2, w1, w2], rhs), sp.lambdify([t1, t2], pos)
+    f = lambda t, z: np.concatenate([z[2:], np.linalg.solve(np.array(fM(z[0], z[1]), float), np.array(frhs(*z), float).ravel())])
+    h, n = 0.04, 500
+    ref = solve_ivp(f, (0, n * h), [a0, a0, 0, 0], method='DOP853', rtol=1e-13, atol=1e-13, t_eval=np.arange(n + 1) * h)
+    refq = [np.array(fpos(ref.y[0, k], ref.y[1, k]), float).ravel() for k in range(n + 1)]
+    q0 = refq[0]
+    for s, pre in ((1, None), (1, 'e2'), (2, None)):
+        sch = Scheme(S, s, pre)
+        q, p = q0.copy(), np.zeros(6)
+        ex = ey = 0.0
+        for k in range(1, n + 1):
+            q, p = sch.step(q, p, h)
+            ex += abs(q[0] - refq[k][0]) + abs(q[3] - refq[k][3])
+            ey += abs(q[1] - refq[k][1]) + abs(q[4] - refq[k][4])
+        print('  double pendulum h = 0.04, 20 s, s=%d %-5s: E|dx| = %.4e, E|dy| = %.4e' % (s, pre or 'plain', ex / (2 * n), ey / (2 * n)), flush=True)
+
+
 if __name__ == '__main__':
     what = sys.argv[1] if len(sys.argv) > 1 else 'all'
     amps = (10.0, 45.0, 90.0, 120.0)
@@ -299,3 +358,7 @@ if __name__ == '__main__':
             table(S, 2, 'e4', (0.2, 0.1, 0.05), amps, 20)
     if what in ('spring', 'all'):
         spring_test()
+    if what in ('energy', 'all'):
+        energy_test()
+    if what in ('dp', 'all'):
+        double_pendulum()
