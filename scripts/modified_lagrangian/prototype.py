@@ -347,6 +347,55 @@ def double_pendulum():
         print('  double pendulum h = 0.04, 20 s, s=%d %-5s: E|dx| = %.4e, E|dy| = %.4e' % (s, pre or 'plain', ex / (2 * n), ey / (2 * n)), flush=True)
 
 
+def unconstrained_test(hs=(0.1, 0.05, 0.025), T=6.0):
+    """(2,2) on a 2-DOF unconstrained non-linear system with M = diag(1, 2) (a third coordinate
+    z = 0 is constrained linearly to reuse the code): global error at t = T against DOP853, plain
+    vs + h^4 e4 with the candidate n-DOF tensor form of the 1-DOF e4 (section 3)."""
+    x, y, z = sp.symbols('x y z')
+    V = (3 * x**2 + 5 * y**2) / 2 + 2 * x**2 * y - y**3 + x**4 / 2
+    S = System([x, y, z], [1.0, 2.0, 1.0], V, [z], lambda t: [t, 0 * t, 0 * t], lambda q: q[0], 'hh')
+    qs = [x, y, z]
+    a = sp.symbols('a0:3')
+    b = sp.symbols('b0:3')
+    D3 = sum(sp.diff(V, qs[i], qs[j], qs[k]) * a[i] * b[j] * b[k] for i in range(3) for j in range(3) for k in range(3))
+    D4 = sum(sp.diff(V, qs[i], qs[j], qs[k], qs[l]) * b[i] * b[j] * b[k] * b[l]
+             for i in range(3) for j in range(3) for k in range(3) for l in range(3))
+    fD3 = sp.lambdify([qs, a, b], D3, 'numpy')
+    fD4 = sp.lambdify([qs, b], D4, 'numpy')
+    Mi = S.Minv.copy()
+    Mi[2] = 0.0  # the dummy coordinate is frozen: no motion in z
+
+    def e4(q, v):
+        g, H = S.gradV(q), S.hessV(q)
+        u = Mi * g
+        return (-(u @ H @ u) / 1440 + fD3(q, u, v) / 720 - (H @ v) @ (Mi * (H @ v)) / 1440 - fD4(q, v) / 4320)
+
+    class Pre(Scheme):
+        def Ed(self, Q0, Q1, h):
+            if self.pre is None:
+                return 0.0
+            v = (Q1 - Q0) / h
+            return h**5 / 2 * (e4(Q0, v) + e4(Q1, v))
+
+    gV = sp.lambdify([x, y], [sp.diff(V, x), sp.diff(V, y) / 2])
+    q0, v0 = np.array([0.4, 0.3, 0.0]), np.array([0.5, -0.6, 0.0])
+    ref = solve_ivp(lambda t, w: [w[2], w[3], *[-c for c in gV(w[0], w[1])]], (0, T), [q0[0], q0[1], v0[0], v0[1]],
+                    method='DOP853', rtol=2.3e-14, atol=1e-14)
+    qT = ref.y[:2, -1]
+    for pre in (None, 'e4'):
+        errs = []
+        for h in hs:
+            sch = Pre(S, 2, None)
+            sch.pre = pre
+            q, p = q0.copy(), S.M * v0
+            for _ in range(int(round(T / h))):
+                q, p = sch.step(q, p, h)
+            errs.append(np.max(np.abs(q[:2] - qT)))
+        print('  unconstrained 2-DOF (2,2) %-5s h = %s: |q(T) - q_ref(T)| = %s  orders %s' % (
+            pre or 'plain', hs, ' '.join('%.4e' % e for e in errs),
+            ' '.join('%.2f' % math.log2(errs[k] / errs[k + 1]) for k in range(len(errs) - 1))), flush=True)
+
+
 if __name__ == '__main__':
     what = sys.argv[1] if len(sys.argv) > 1 else 'all'
     amps = (10.0, 45.0, 90.0, 120.0)
@@ -370,5 +419,7 @@ if __name__ == '__main__':
         spring_test()
     if what in ('energy', 'all'):
         energy_test()
+    if what in ('free', 'all'):
+        unconstrained_test()
     if what in ('dp', 'all'):
         double_pendulum()
