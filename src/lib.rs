@@ -151,6 +151,7 @@ from_error!(
 /// ```
 pub mod prelude {
     pub use crate::Error;
+    pub use mbd_analysis::{CsvObserver, MeasureObserver};
     pub use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
     pub use mbd_model::{models, System};
     pub use mbd_rk4::{Rk4, Rk4Options};
@@ -159,7 +160,7 @@ pub mod prelude {
         Crossing, DenseOutput, Event, EventHit, Every, Flow, Index1Options, Index1Rk, Integrator,
         NoObserver, Observer, ProjectionSettings, Recorder, RunConfig, RunStats, SolveError, State,
     };
-    pub use mbd_symplectic::{Galerkin, SymplecticOptions};
+    pub use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
     pub use mbd_tangent::{TangentOptions, TangentRk};
 }
 

@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyHandle, BodyRef};
 use crate::error::ModelError;
 use crate::force::{Force, ForceKind};
-use crate::joint::{Joint, JointKind};
+use crate::joint::{Coordinate, Joint, JointKind};
 use crate::system::*;
 use nalgebra::DVector;
 
@@ -14,6 +14,19 @@ pub struct SystemBuilder {
     pub(crate) joints: Vec<Joint>,
     pub(crate) forces: Vec<Force>,
     pub(crate) gravity: [f64; 2],
+    /// Per body: the frame its local points are given in and whether it is a point mass.
+    pub(crate) frames: Vec<BodyFrame>,
+    /// The first handle given to [`SystemBuilder::set_body_frame`] without a body.
+    unknown_frame: Option<usize>,
+}
+
+/// How a body was added (builder side only: the [`System`] keeps centre-of-mass poses).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct BodyFrame {
+    /// The centre of mass in the body frame.
+    com: [f64; 2],
+    /// A point mass: rotation eliminated, attached at its centre only.
+    point_mass: bool,
 }
 
 impl SystemBuilder {
@@ -26,10 +39,50 @@ impl SystemBuilder {
         self.gravity = g;
         self
     }
-    /// Adds a body and returns its handle.
+    /// Adds a body and returns its handle. Its local points (in joints and forces) are
+    /// relative to its centre of mass, unless [`SystemBuilder::set_body_frame`] says otherwise.
     pub fn add_body(&mut self, body: Body) -> BodyHandle {
         self.bodies.push(body);
+        self.frames.push(BodyFrame::default());
         BodyHandle(self.bodies.len() - 1)
+    }
+    /// Adds a point mass `mass` at `position` with `velocity`: a body whose rotation
+    /// [`SystemBuilder::build`] eliminates by an absolute-angle joint named
+    /// `<name>:point_mass` (added after the other joints), with a nominal inertia `m l^2`
+    /// (`l`: the largest distance-joint length, spring rest length or attachment-point distance
+    /// of the model, 1 m if none; it scales nothing). Joints and forces attach to it at its
+    /// centre only (`[0, 0]`, or the centre of mass of its [`SystemBuilder::set_body_frame`]);
+    /// joints and forces on its angle (weld, prismatic, angle driver, absolute angle, torque,
+    /// rotary spring) are errors of `build`.
+    pub fn add_point_mass(
+        &mut self,
+        name: impl Into<String>,
+        mass: f64,
+        position: [f64; 2],
+        velocity: [f64; 2],
+    ) -> BodyHandle {
+        let h = self.add_body(Body {
+            name: name.into(),
+            mass,
+            inertia: f64::NAN,
+            position: [position[0], position[1], 0.0],
+            velocity: [velocity[0], velocity[1], 0.0],
+        });
+        self.frames[h.0].point_mass = true;
+        h
+    }
+    /// Gives `body`'s local points in a body frame whose centre of mass is at `com` (like a CAD
+    /// part): the body's `position` and `velocity` are then those of the frame's origin, and
+    /// every local point on it (joints and forces, added before or after) is in that frame.
+    /// [`SystemBuilder::build`] converts all of them to the centre of mass. An unknown handle
+    /// or a non-finite `com` is an error of `build`.
+    pub fn set_body_frame(&mut self, body: BodyHandle, com: [f64; 2]) -> &mut Self {
+        if let Some(f) = self.frames.get_mut(body.0) {
+            f.com = com;
+        } else {
+            self.unknown_frame.get_or_insert(body.0);
+        }
+        self
     }
     /// Adds a joint and returns its handle.
     pub fn add_joint(&mut self, joint: Joint) -> JointHandle {
@@ -44,9 +97,180 @@ impl SystemBuilder {
     /// Validates the model and assembles it. Checks names, parameters, attachments, and the rank
     /// of `Phi_q` at the bodies' initial positions (redundant constraints are an error naming the
     /// joints involved).
-    pub fn build(self) -> Result<System, ModelError> {
+    pub fn build(mut self) -> Result<System, ModelError> {
+        self.lower_frames()?;
         System::new(self)
     }
+}
+
+impl SystemBuilder {
+    /// Lowers body frames and point masses (see [`SystemBuilder::add_point_mass`] and
+    /// [`SystemBuilder::set_body_frame`]): centre-of-mass poses and local points, the point
+    /// masses' nominal inertia and angle joints. The one implementation the model-file
+    /// resolver uses too.
+    fn lower_frames(&mut self) -> Result<(), ModelError> {
+        if let Some(i) = self.unknown_frame {
+            return Err(ModelError::InvalidElement {
+                element: format!("body #{i}"),
+                message: format!(
+                    "set_body_frame on a body that does not exist (the model has {} bodies)",
+                    self.bodies.len()
+                ),
+            });
+        }
+        let frames = std::mem::take(&mut self.frames);
+        let frame = |r: BodyRef| r.index().and_then(|i| frames.get(i).copied());
+        let names: Vec<String> = self.bodies.iter().map(|b| b.name.clone()).collect();
+        let name = |r: BodyRef| r.index().map_or("ground", |i| names[i].as_str());
+        for (body, f) in self.bodies.iter_mut().zip(&frames) {
+            let c = f.com;
+            if !(c[0].is_finite() && c[1].is_finite()) {
+                return Err(invalid(
+                    format!("body '{}'", body.name),
+                    format!("body frame: centre of mass {c:?} must be finite"),
+                ));
+            }
+            // r_com = r_o + R(theta) c;  v_com = v_o + omega x R(theta) c
+            let (sn, cs) = body.position[2].sin_cos();
+            let rc = [cs * c[0] - sn * c[1], sn * c[0] + cs * c[1]];
+            let w = body.velocity[2];
+            body.position[0] += rc[0];
+            body.position[1] += rc[1];
+            body.velocity[0] -= w * rc[1];
+            body.velocity[1] += w * rc[0];
+        }
+        // a local point in its body's frame, relative to the centre of mass; on a point mass it
+        // must be the centre
+        let local = |element: &str, field: &str, r: BodyRef, p: &mut [f64; 2]| {
+            let Some(f) = frame(r) else { return Ok(()) };
+            let given = *p;
+            *p = [p[0] - f.com[0], p[1] - f.com[1]];
+            if f.point_mass && *p != [0.0, 0.0] {
+                return Err(invalid(
+                    element.to_string(),
+                    format!(
+                        "field '{field}' = {given:?} on point mass '{}': a point mass attaches \
+                         only at its centre ({:?})",
+                        name(r),
+                        f.com
+                    ),
+                ));
+            }
+            Ok(())
+        };
+        let no_rotation = |element: &str, kind: &str, bodies: &[BodyRef]| {
+            for &r in bodies {
+                if frame(r).is_some_and(|f| f.point_mass) {
+                    let b = name(r);
+                    return Err(invalid(
+                        element.to_string(),
+                        format!(
+                            "a {kind} acts on the angle of point mass '{b}', which has no \
+                             rotation; make '{b}' a rigid body"
+                        ),
+                    ));
+                }
+            }
+            Ok(())
+        };
+        let nominal = self.nominal_length();
+        for j in &mut self.joints {
+            let element = format!("joint '{}'", j.name);
+            match &mut j.kind {
+                JointKind::Revolute { a, pa, b, pb } | JointKind::Distance { a, pa, b, pb, .. } => {
+                    local(&element, "point_a", *a, pa)?;
+                    local(&element, "point_b", *b, pb)?;
+                }
+                JointKind::Prismatic { a, pa, b, pb, .. } => {
+                    no_rotation(&element, "prismatic joint", &[*a, *b])?;
+                    local(&element, "point_a", *a, pa)?;
+                    local(&element, "point_b", *b, pb)?;
+                }
+                JointKind::Weld { a, pa, b, pb, .. } => {
+                    no_rotation(&element, "weld joint", &[*a, *b])?;
+                    local(&element, "point_a", *a, pa)?;
+                    local(&element, "point_b", *b, pb)?;
+                }
+                JointKind::Absolute {
+                    body,
+                    point,
+                    coordinate,
+                    ..
+                } => {
+                    if *coordinate == Coordinate::Angle {
+                        no_rotation(&element, "absolute angle joint", &[*body])?;
+                    }
+                    local(&element, "point", *body, point)?;
+                }
+                JointKind::AngleDriver { a, b, .. } => {
+                    no_rotation(&element, "angle driver", &[*a, *b])?;
+                }
+            }
+        }
+        for f in &mut self.forces {
+            let element = format!("force '{}'", f.name);
+            match &mut f.kind {
+                ForceKind::SpringDamper { a, pa, b, pb, .. } => {
+                    local(&element, "point_a", *a, pa)?;
+                    local(&element, "point_b", *b, pb)?;
+                }
+                ForceKind::RotarySpringDamper { a, b, .. } => {
+                    no_rotation(&element, "rotary spring-damper", &[*a, *b])?;
+                }
+                ForceKind::Force { body, point, .. } => local(&element, "point", *body, point)?,
+                ForceKind::Torque { body, .. } => no_rotation(&element, "torque", &[*body])?,
+            }
+        }
+        for (i, f) in frames.iter().enumerate() {
+            if f.point_mass {
+                let b = &mut self.bodies[i];
+                b.inertia = b.mass * nominal * nominal;
+                self.joints.push(Joint::absolute(
+                    format!("{}:point_mass", b.name),
+                    BodyHandle(i),
+                    [0.0, 0.0],
+                    Coordinate::Angle,
+                    0.0,
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The nominal length `l` of point masses (inertia `m l^2`): the largest distance-joint
+    /// length, spring rest length or attachment-point distance from a frame origin, 1 m if
+    /// none. So a point mass neither changes [`System::length_scale`] nor trips the
+    /// inertia-scale check.
+    fn nominal_length(&self) -> f64 {
+        let mut l = 0.0f64;
+        let n = |p: &[f64; 2]| p[0].hypot(p[1]);
+        for j in &self.joints {
+            match &j.kind {
+                JointKind::Distance { pa, pb, length, .. } => {
+                    l = l.max(*length).max(n(pa)).max(n(pb))
+                }
+                JointKind::Revolute { pa, pb, .. }
+                | JointKind::Prismatic { pa, pb, .. }
+                | JointKind::Weld { pa, pb, .. } => l = l.max(n(pa)).max(n(pb)),
+                JointKind::Absolute { point, .. } => l = l.max(n(point)),
+                JointKind::AngleDriver { .. } => {}
+            }
+        }
+        for f in &self.forces {
+            if let ForceKind::SpringDamper { rest_length, .. } = &f.kind {
+                l = l.max(*rest_length);
+            }
+        }
+        if l.is_finite() && l > 0.0 {
+            l
+        } else {
+            1.0
+        }
+    }
+}
+
+fn invalid(element: String, message: String) -> ModelError {
+    ModelError::InvalidElement { element, message }
 }
 
 fn check_finite(element: &str, parameter: &'static str, value: f64) -> Result<(), ModelError> {
@@ -117,6 +341,8 @@ impl System {
             mut joints,
             forces,
             gravity,
+            frames: _,
+            unknown_frame: _,
         } = b;
         if bodies.is_empty() {
             return Err(ModelError::Empty);

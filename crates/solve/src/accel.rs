@@ -10,6 +10,7 @@
 
 use crate::error::SolveError;
 use crate::linalg::DenseCholesky;
+use crate::sparse::{LinearSolver, SparseAccelerationSolver};
 use mbd_model::System;
 use nalgebra::DMatrix;
 
@@ -170,6 +171,98 @@ impl AccelerationSolver {
             a[k] = self.w[k] - minv[k] * dot;
         }
         Ok(())
+    }
+}
+
+/// The index-1 solve on the path [`LinearSolver`] picks: the dense solver is used inline on the
+/// hot path of small systems, the sparse one is boxed.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug)]
+pub(crate) enum Accel {
+    Dense(AccelerationSolver),
+    Sparse(Box<SparseAccelerationSolver>),
+}
+
+impl Accel {
+    /// The solver [`LinearSolver::use_sparse`] picks for `sys` (the one policy of the crate).
+    pub(crate) fn new(sys: &System, linear: LinearSolver) -> Result<Self, SolveError> {
+        Ok(if linear.use_sparse(sys.n_constraints()) {
+            Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?))
+        } else {
+            Accel::Dense(AccelerationSolver::new(sys))
+        })
+    }
+
+    /// Accelerations `a` and multipliers `lambda` at `(q, v, t)`.
+    pub(crate) fn solve(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        a: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<(), SolveError> {
+        match self {
+            Accel::Dense(acc) => acc.solve(sys, q, v, t, a, lambda),
+            Accel::Sparse(sp) => sp.solve(sys, q, v, t, a, lambda),
+        }
+    }
+
+    /// Whether the sparse path was picked.
+    pub(crate) fn is_sparse(&self) -> bool {
+        matches!(self, Accel::Sparse(_))
+    }
+
+    /// Condition estimate of the last index-1 matrix.
+    pub(crate) fn condition(&self) -> f64 {
+        match self {
+            Accel::Dense(acc) => acc.condition_estimate(),
+            Accel::Sparse(sp) => sp.condition_estimate(),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn stage(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        baum: Option<(f64, f64)>,
+        phi: &mut [f64],
+        phid: &mut [f64],
+        a: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<(), SolveError> {
+        let stab = |sys: &System, gamma: &mut [f64], phi: &mut [f64], phid: &mut [f64]| {
+            if let Some((al, be)) = baum {
+                sys.phi_and_phi_dot(q, v, t, phi, phid);
+                for k in 0..gamma.len() {
+                    gamma[k] -= 2.0 * al * phid[k] + be * be * phi[k];
+                }
+            }
+        };
+        match self {
+            Accel::Dense(acc) => {
+                sys.forces_into(q, v, t, &mut acc.forces);
+                if acc.gamma.is_empty() {
+                    let minv = sys.inv_mass_diag();
+                    for i in 0..a.len() {
+                        a[i] = minv[i] * acc.forces[i];
+                    }
+                    return Ok(());
+                }
+                sys.phi_q_gamma(q, v, t, &mut acc.phi_q, &mut acc.gamma);
+                stab(sys, &mut acc.gamma, phi, phid);
+                acc.finish(sys, t, a, lambda)
+            }
+            Accel::Sparse(sp) => {
+                sp.prepare(sys, q, v, t);
+                stab(sys, &mut sp.gamma, phi, phid);
+                sp.finish(sys, t, a, lambda)
+            }
+        }
     }
 }
 

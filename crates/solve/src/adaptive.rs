@@ -23,6 +23,11 @@ pub struct StepAttempt {
     pub error_norm: f64,
     /// Work of the attempt.
     pub stats: StepStats,
+    /// For a rejection that is not the error test's (infinite `error_norm`, e.g. a chart map
+    /// that did not converge): the factor the next attempt's step is multiplied by, without
+    /// touching the controller's memory; must lie in (0, 1) (otherwise, and for `None`, the
+    /// default: the controller's `fac_min`).
+    pub shrink: Option<f64>,
 }
 
 /// A one-step method with an embedded error estimate, driven by [`run_adaptive`].
@@ -164,10 +169,13 @@ impl AdaptiveConfig {
 /// with error norm `err` (previous accepted: `err_prev`), `h <- h safety err^-(1/(q+1) -
 /// 0.75 beta) err_prev^beta` clamped to `[fac_min, fac_max]` (no growth right after a
 /// rejection); after a rejection `h <- h max(fac_min, safety err^-(1/(q+1) - 0.75 beta))`.
-/// The last step lands exactly on `t_end`. Errors: a step below `controller.h_min` or more
-/// than `max_steps` attempts ([`SolveError::InvalidParameter`] whose `value` is the time at
-/// which it happened), a non-finite state or error estimate ([`SolveError::NonFinite`]),
-/// constraint drift beyond the guard ([`SolveError::ConstraintDrift`]). [`RunStats::steps`] counts accepted steps, [`RunStats::rejected_steps`] rejections.
+/// A rejection with an infinite error norm and a [`StepAttempt::shrink`] factor multiplies the
+/// step by that factor instead. The last step lands exactly on `t_end`. Errors: a step below
+/// `controller.h_min` ([`SolveError::StepSizeTooSmall`]), more than `max_steps` attempts
+/// ([`SolveError::TooManyAttempts`]), a non-finite state or error estimate
+/// ([`SolveError::NonFinite`]), constraint drift beyond the guard
+/// ([`SolveError::ConstraintDrift`]). [`RunStats::steps`] counts accepted steps,
+/// [`RunStats::rejected_steps`] rejections.
 pub fn run_adaptive<I, O>(
     integrator: &mut I,
     sys: &System,
@@ -227,10 +235,9 @@ where
     while state.t < cfg.t_end {
         attempts += 1;
         if attempts > cfg.max_steps {
-            return Err(SolveError::InvalidParameter {
-                parameter: "max_steps (limit of attempted steps reached at the run's time)",
-                value: state.t,
-                reason: "raise AdaptiveConfig::max_steps or loosen the tolerance",
+            return Err(SolveError::TooManyAttempts {
+                t: state.t,
+                attempts: cfg.max_steps,
             });
         }
         let t = state.t;
@@ -238,11 +245,10 @@ where
         let last = h >= remaining * (1.0 - 1e-12);
         let hs = if last { remaining } else { h };
         if hs < ctrl.h_min && !last {
-            return Err(SolveError::InvalidParameter {
-                parameter: "step size (fell below controller.h_min at the time given)",
-                value: t,
-                reason: "the error test keeps failing: singularity, stiffness or a tolerance \
-                         below round-off",
+            return Err(SolveError::StepSizeTooSmall {
+                t,
+                h: hs,
+                h_min: ctrl.h_min,
             });
         }
         let a = integrator.attempt_step(sys, state, hs, &ctrl)?;
@@ -264,7 +270,10 @@ where
         if !a.accepted {
             stats.rejected_steps += 1;
             last_rejected = true;
-            h = hs * grow.clamp(ctrl.fac_min, 1.0);
+            h = match a.shrink {
+                Some(f) if en == f64::INFINITY && f > 0.0 && f < 1.0 => hs * f,
+                _ => hs * grow.clamp(ctrl.fac_min, 1.0),
+            };
             continue;
         }
         state.t = if last { cfg.t_end } else { t + hs };

@@ -14,9 +14,10 @@
 //! Illinois variant of regula falsi, safeguarded by bisection, until the bracket is shorter than
 //! [`DenseOutput::with_time_tol`] (default `1e-13` times `max(1, |t|)`).
 
-use crate::accel::AccelerationSolver;
+use crate::accel::Accel;
 use crate::error::SolveError;
 use crate::integrator::{Flow, Observer, Recorder};
+use crate::sparse::LinearSolver;
 use crate::state::State;
 use mbd_model::System;
 
@@ -197,7 +198,7 @@ impl Segment {
 pub struct DenseOutput<O> {
     /// The observer every step sample is forwarded to.
     pub inner: O,
-    acc: AccelerationSolver,
+    acc: Accel,
     lambda: Vec<f64>,
     seg: Segment,
     /// Whether `seg.*0` holds a state (false before step 0).
@@ -227,12 +228,17 @@ impl<O> std::fmt::Debug for DenseOutput<O> {
 
 impl<O: Observer> DenseOutput<O> {
     /// Dense output for `sys`, forwarding every step sample to `inner` (use
-    /// [`crate::NoObserver`] for none).
+    /// [`crate::NoObserver`] for none). The acceleration solve takes the path
+    /// [`LinearSolver::Auto`] picks (sparse above [`crate::SPARSE_THRESHOLD`] constraints), as
+    /// the solvers do; should the sparse pattern analysis fail (it cannot for the joints of
+    /// `mbd-model`), the dense path is used. [`DenseOutput::with_linear`] chooses explicitly.
     pub fn new(sys: &System, inner: O) -> Self {
         let n = sys.n_coords();
+        let acc = Accel::new(sys, LinearSolver::Auto)
+            .unwrap_or_else(|_| Accel::Dense(crate::AccelerationSolver::new(sys)));
         DenseOutput {
             inner,
-            acc: AccelerationSolver::new(sys),
+            acc,
             lambda: vec![0.0; sys.n_constraints()],
             seg: Segment::new(n),
             started: false,
@@ -274,6 +280,20 @@ impl<O: Observer> DenseOutput<O> {
         Ok(self)
     }
 
+    /// The same dense output with the acceleration solve on the path `linear` picks for `sys`
+    /// (the system given to [`DenseOutput::new`]). Errors if the sparse pattern analysis fails.
+    pub fn with_linear(mut self, sys: &System, linear: LinearSolver) -> Result<Self, SolveError> {
+        if sys.n_coords() != self.seg.q0.len() {
+            return Err(SolveError::Dimension {
+                what: "DenseOutput::with_linear system coordinates",
+                expected: self.seg.q0.len(),
+                got: sys.n_coords(),
+            });
+        }
+        self.acc = Accel::new(sys, linear)?;
+        Ok(self)
+    }
+
     /// Adds an event to locate.
     pub fn with_event(mut self, event: Event) -> Self {
         self.events.push(event);
@@ -301,6 +321,11 @@ impl<O> DenseOutput<O> {
     /// The states interpolated at the output times.
     pub fn samples(&self) -> &Recorder {
         &self.samples
+    }
+
+    /// Whether the acceleration solve takes the sparse path ([`DenseOutput::with_linear`]).
+    pub fn is_sparse(&self) -> bool {
+        self.acc.is_sparse()
     }
 
     /// The zero crossings located so far, in time order.

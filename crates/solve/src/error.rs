@@ -32,6 +32,32 @@ pub enum SolveError {
         /// What is required.
         reason: &'static str,
     },
+    /// The adaptive step-size controller asked for a step below its smallest allowed step.
+    #[error(
+        "adaptive step size h = {h:e} at t = {t} fell below h_min = {h_min:e}: the error test \
+         keeps failing there (a singularity, stiffness, or a tolerance below round-off); \
+         loosen the tolerance or lower StepController::h_min"
+    )]
+    StepSizeTooSmall {
+        /// Time of the step.
+        t: f64,
+        /// The step size asked for.
+        h: f64,
+        /// The smallest step allowed.
+        h_min: f64,
+    },
+    /// An adaptive run used up its budget of step attempts (accepted plus rejected).
+    #[error(
+        "adaptive run stopped at t = {t} after {attempts} step attempts (accepted plus \
+         rejected) without reaching the end time: raise AdaptiveConfig::max_steps or loosen \
+         the tolerance"
+    )]
+    TooManyAttempts {
+        /// Time reached.
+        t: f64,
+        /// Attempts made (the limit).
+        attempts: usize,
+    },
     /// Newton's method did not converge.
     #[error(
         "Newton failed at t = {t}: residual {residual:e} after {iterations} iterations ({context})"

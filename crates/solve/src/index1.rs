@@ -3,12 +3,12 @@
 //! baseline (`mbd-rk4`) and, with a high-order tableau and a small step plus projection, an
 //! independent reference solver for the other methods.
 
-use crate::accel::AccelerationSolver;
+use crate::accel::Accel;
 use crate::adaptive::{AdaptiveIntegrator, StepAttempt};
 use crate::error::SolveError;
 use crate::integrator::{Integrator, StepStats};
 use crate::projection::{ProjectionSettings, Projector};
-use crate::sparse::{LinearSolver, SparseAccelerationSolver};
+use crate::sparse::LinearSolver;
 use crate::state::State;
 use crate::tableau::{ButcherTableau, ExplicitRk, StepController};
 use mbd_model::System;
@@ -24,67 +24,6 @@ pub struct Index1Options {
     /// Dense or sparse index-1 solve and projection (default: sparse above
     /// [`crate::SPARSE_THRESHOLD`] constraints).
     pub linear: LinearSolver,
-}
-
-// the dense solver is used inline on the hot path of small systems; the sparse one is boxed
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug)]
-enum Accel {
-    Dense(AccelerationSolver),
-    Sparse(Box<SparseAccelerationSolver>),
-}
-
-impl Accel {
-    /// Condition estimate of the last index-1 matrix.
-    fn condition(&self) -> f64 {
-        match self {
-            Accel::Dense(acc) => acc.condition_estimate(),
-            Accel::Sparse(sp) => sp.condition_estimate(),
-        }
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn stage(
-        &mut self,
-        sys: &System,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        baum: Option<(f64, f64)>,
-        phi: &mut [f64],
-        phid: &mut [f64],
-        a: &mut [f64],
-        lambda: &mut [f64],
-    ) -> Result<(), SolveError> {
-        let stab = |sys: &System, gamma: &mut [f64], phi: &mut [f64], phid: &mut [f64]| {
-            if let Some((al, be)) = baum {
-                sys.phi_and_phi_dot(q, v, t, phi, phid);
-                for k in 0..gamma.len() {
-                    gamma[k] -= 2.0 * al * phid[k] + be * be * phi[k];
-                }
-            }
-        };
-        match self {
-            Accel::Dense(acc) => {
-                sys.forces_into(q, v, t, &mut acc.forces);
-                if acc.gamma.is_empty() {
-                    let minv = sys.inv_mass_diag();
-                    for i in 0..a.len() {
-                        a[i] = minv[i] * acc.forces[i];
-                    }
-                    return Ok(());
-                }
-                sys.phi_q_gamma(q, v, t, &mut acc.phi_q, &mut acc.gamma);
-                stab(sys, &mut acc.gamma, phi, phid);
-                acc.finish(sys, t, a, lambda)
-            }
-            Accel::Sparse(sp) => {
-                sp.prepare(sys, q, v, t);
-                stab(sys, &mut sp.gamma, phi, phid);
-                sp.finish(sys, t, a, lambda)
-            }
-        }
-    }
 }
 
 /// Explicit RK on the index-1 equations, allocation-free per step.
@@ -132,11 +71,7 @@ impl Index1Rk {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         Ok(Index1Rk {
             rk: ExplicitRk::new(tableau, 2 * n)?,
-            acc: if options.linear.use_sparse(m) {
-                Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?))
-            } else {
-                Accel::Dense(AccelerationSolver::new(sys))
-            },
+            acc: Accel::new(sys, options.linear)?,
             projector: match options.projection {
                 Some(p) => Some(Projector::with_linear(sys, p, options.linear)?),
                 None => None,
@@ -272,6 +207,7 @@ impl AdaptiveIntegrator for Index1Rk {
             accepted,
             error_norm,
             stats,
+            shrink: None,
         })
     }
 }

@@ -72,3 +72,34 @@ fn adaptive_needs_an_embedded_pair() {
     .unwrap_err();
     assert!(matches!(e, SolveError::InvalidInterval { .. }), "{e}");
 }
+
+/// A step the controller shrinks below `h_min` is `StepSizeTooSmall` naming the time and the
+/// step; running out of attempts is `TooManyAttempts`.
+#[test]
+fn adaptive_failures_have_their_own_errors() {
+    let sys = models::pendulum(1.0, 1.0, 0.5, 9.81).unwrap();
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    let mut rk = Index1Rk::new(&sys, ButcherTableau::dopri5(), Index1Options::default()).unwrap();
+    let mut cfg = AdaptiveConfig::new(1.0, 1e-14).with_h0(0.5);
+    cfg.controller.h_min = 1e-2;
+    let mut s = s0.clone();
+    let e = run_adaptive(&mut rk, &sys, &mut s, cfg, &mut NoObserver).unwrap_err();
+    match &e {
+        SolveError::StepSizeTooSmall { t, h, h_min } => {
+            assert_eq!(*t, 0.0);
+            assert!(*h < 1e-2 && *h_min == 1e-2, "{e}");
+        }
+        other => panic!("expected StepSizeTooSmall, got {other:?}"),
+    }
+    assert!(e.to_string().contains("t = 0") && e.to_string().contains("h_min"));
+
+    let mut cfg = AdaptiveConfig::new(1.0, 1e-12);
+    cfg.max_steps = 5;
+    let mut s = s0.clone();
+    let e = run_adaptive(&mut rk, &sys, &mut s, cfg, &mut NoObserver).unwrap_err();
+    assert!(
+        matches!(e, SolveError::TooManyAttempts { attempts: 5, t } if t > 0.0 && t < 1.0),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("max_steps"));
+}

@@ -7,16 +7,6 @@ use thiserror::Error;
 /// What can go wrong in [`crate::TangentRk::integrate_adaptive`].
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum TangentError {
-    /// The error controller asked for a step below `controller.h_min`.
-    #[error("adaptive step size h = {h:e} at t = {t} fell below h_min = {h_min:e}")]
-    StepSizeTooSmall {
-        /// Time of the step.
-        t: f64,
-        /// The step size asked for.
-        h: f64,
-        /// The smallest step allowed.
-        h_min: f64,
-    },
     /// The chart map (or a stage point's index-1 solve) kept failing while the step shrank:
     /// `failures` times in a row at one point, or down to `h_min`.
     #[error("tangent chart failed {failures} times in a row (last step h = {h:e}): {source}")]
@@ -29,15 +19,8 @@ pub enum TangentError {
         /// Failures in a row at that point.
         failures: usize,
     },
-    /// More than `max_steps` step attempts.
-    #[error("more than {max_steps} step attempts before reaching the end time (at t = {t})")]
-    TooManySteps {
-        /// Time reached.
-        t: f64,
-        /// The limit.
-        max_steps: usize,
-    },
-    /// Any other failure (bad input, singular configuration, model errors).
+    /// Any other failure: bad input, a singular configuration, model errors, and the run
+    /// loop's [`SolveError::StepSizeTooSmall`] and [`SolveError::TooManyAttempts`].
     #[error(transparent)]
     Solve(#[from] SolveError),
 }

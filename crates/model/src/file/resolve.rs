@@ -1,5 +1,7 @@
-//! From a model file to a builder and back: names to handles, body frames to centres of mass,
-//! point masses to constrained bodies.
+//! From a model file to a builder and back: names to handles. Body frames (`com`) and point
+//! masses go to the builder as they are ([`SystemBuilder::set_body_frame`],
+//! [`SystemBuilder::add_point_mass`]), which lowers them to centres of mass and constrained
+//! bodies: one implementation for files and Rust models.
 
 use super::spec::{BodyKind, BodySpec, ForceSpec, JointSpec};
 use super::ModelFile;
@@ -7,53 +9,15 @@ use crate::body::{Body, BodyHandle, BodyRef};
 use crate::builder::SystemBuilder;
 use crate::error::ModelError;
 use crate::force::{Force, ForceKind};
-use crate::joint::{Coordinate, Joint, JointKind};
+use crate::joint::{Joint, JointKind};
 use crate::system::System;
 
 /// Body names resolved, with each body's frame offset and kind.
 struct Resolver<'a> {
     file: &'a ModelFile,
-    /// The bodies as the builder gets them (centre-of-mass poses, nominal point-mass inertia).
+    /// The bodies as the file gives them (frame-origin poses; a point mass's inertia is set by
+    /// the builder).
     bodies: Vec<Body>,
-}
-
-/// The nominal length `l` of a file's point masses (inertia `m l^2`): the largest distance-joint
-/// length, spring rest length or attachment-point distance from a centre of mass, 1 m if none.
-/// So a point mass neither changes [`System::length_scale`] nor trips the inertia-scale check.
-fn nominal_length(file: &ModelFile) -> f64 {
-    let mut l = 0.0f64;
-    let n = |p: &[f64; 2]| p[0].hypot(p[1]);
-    for j in &file.joints {
-        match j {
-            JointSpec::Distance {
-                length,
-                point_a,
-                point_b,
-                ..
-            } => l = l.max(*length).max(n(point_a)).max(n(point_b)),
-            JointSpec::Revolute {
-                point_a, point_b, ..
-            }
-            | JointSpec::Prismatic {
-                point_a, point_b, ..
-            }
-            | JointSpec::Weld {
-                point_a, point_b, ..
-            } => l = l.max(n(point_a)).max(n(point_b)),
-            JointSpec::Absolute { point, .. } => l = l.max(n(point)),
-            JointSpec::AngleDriver { .. } => {}
-        }
-    }
-    for f in &file.forces {
-        if let ForceSpec::SpringDamper { rest_length, .. } = f {
-            l = l.max(*rest_length);
-        }
-    }
-    if l.is_finite() && l > 0.0 {
-        l
-    } else {
-        1.0
-    }
 }
 
 fn invalid(element: String, message: String) -> ModelError {
@@ -62,7 +26,6 @@ fn invalid(element: String, message: String) -> ModelError {
 
 impl<'a> Resolver<'a> {
     fn new(file: &'a ModelFile) -> Result<Self, ModelError> {
-        let l = nominal_length(file);
         let mut bodies = Vec::with_capacity(file.bodies.len());
         for s in &file.bodies {
             let element = format!("body '{}'", s.name);
@@ -85,7 +48,8 @@ impl<'a> Resolver<'a> {
                         ),
                     ))
                 }
-                (BodyKind::PointMass, None) => s.mass * l * l,
+                // set by the builder (nominal inertia)
+                (BodyKind::PointMass, None) => f64::NAN,
             };
             if s.kind == BodyKind::PointMass {
                 if s.position[2] != 0.0 {
@@ -107,29 +71,12 @@ impl<'a> Resolver<'a> {
                     ));
                 }
             }
-            let (mut position, mut velocity) = (s.position, s.velocity);
-            if let Some(c) = s.com {
-                if !(c[0].is_finite() && c[1].is_finite()) {
-                    return Err(invalid(
-                        element,
-                        format!("field 'com' = {c:?} must be finite"),
-                    ));
-                }
-                // r_com = r_o + R(theta) c;  v_com = v_o + omega x R(theta) c
-                let (sn, cs) = s.position[2].sin_cos();
-                let rc = [cs * c[0] - sn * c[1], sn * c[0] + cs * c[1]];
-                let w = s.velocity[2];
-                position[0] += rc[0];
-                position[1] += rc[1];
-                velocity[0] -= w * rc[1];
-                velocity[1] += w * rc[0];
-            }
             bodies.push(Body {
                 name: s.name.clone(),
                 mass: s.mass,
                 inertia,
-                position,
-                velocity,
+                position: s.position,
+                velocity: s.velocity,
             });
         }
         Ok(Resolver { file, bodies })
@@ -157,104 +104,6 @@ impl<'a> Resolver<'a> {
                 body: name.to_string(),
             })
     }
-
-    /// A local point given in `body`'s frame, relative to its centre of mass; on a point mass it
-    /// must be the centre.
-    fn point(
-        &self,
-        element: &str,
-        field: &str,
-        body: &str,
-        p: [f64; 2],
-    ) -> Result<[f64; 2], ModelError> {
-        let Some((_, s)) = self.spec(body) else {
-            return Ok(p);
-        };
-        let c = s.com.unwrap_or([0.0, 0.0]);
-        let local = [p[0] - c[0], p[1] - c[1]];
-        if s.kind == BodyKind::PointMass && local != [0.0, 0.0] {
-            return Err(invalid(
-                element.to_string(),
-                format!(
-                    "field '{field}' = {p:?} on point mass '{body}': a point mass attaches only \
-                     at its centre ({c:?})"
-                ),
-            ));
-        }
-        Ok(local)
-    }
-
-    fn no_rotation(&self, element: String, kind: &str, bodies: &[&str]) -> Result<(), ModelError> {
-        for b in bodies {
-            if let Some((_, s)) = self.spec(b) {
-                if s.kind == BodyKind::PointMass {
-                    return Err(invalid(
-                        element,
-                        format!(
-                            "a {kind} acts on the angle of point mass '{b}', which has no \
-                             rotation; make '{b}' a rigid body"
-                        ),
-                    ));
-                }
-            }
-        }
-        Ok(())
-    }
-
-    /// Joints that constrain a body's angle cannot attach to a point mass.
-    fn check_rotation(&self, j: &JointSpec) -> Result<(), ModelError> {
-        match j {
-            JointSpec::Prismatic {
-                name,
-                body_a,
-                body_b,
-                ..
-            } => self.no_rotation(
-                format!("joint '{name}'"),
-                "prismatic joint",
-                &[body_a, body_b],
-            ),
-            JointSpec::Weld {
-                name,
-                body_a,
-                body_b,
-                ..
-            } => self.no_rotation(format!("joint '{name}'"), "weld joint", &[body_a, body_b]),
-            JointSpec::AngleDriver {
-                name,
-                body_a,
-                body_b,
-                ..
-            } => self.no_rotation(format!("joint '{name}'"), "angle driver", &[body_a, body_b]),
-            JointSpec::Absolute {
-                name,
-                body,
-                coordinate: Coordinate::Angle,
-                ..
-            } => self.no_rotation(format!("joint '{name}'"), "absolute angle joint", &[body]),
-            _ => Ok(()),
-        }
-    }
-
-    /// Torques and rotary springs cannot act on a point mass.
-    fn check_force_rotation(&self, f: &ForceSpec) -> Result<(), ModelError> {
-        match f {
-            ForceSpec::RotarySpringDamper {
-                name,
-                body_a,
-                body_b,
-                ..
-            } => self.no_rotation(
-                format!("force '{name}'"),
-                "rotary spring-damper",
-                &[body_a, body_b],
-            ),
-            ForceSpec::Torque { name, body, .. } => {
-                self.no_rotation(format!("force '{name}'"), "torque", &[body])
-            }
-            _ => Ok(()),
-        }
-    }
 }
 
 impl ModelFile {
@@ -263,11 +112,18 @@ impl ModelFile {
         let r = Resolver::new(self)?;
         let mut b = SystemBuilder::new();
         b.set_gravity(self.gravity);
-        for body in &r.bodies {
-            b.add_body(body.clone());
+        for (body, spec) in r.bodies.iter().zip(&self.bodies) {
+            let h = if spec.kind == BodyKind::PointMass {
+                let (p, v) = (body.position, body.velocity);
+                b.add_point_mass(body.name.clone(), body.mass, [p[0], p[1]], [v[0], v[1]])
+            } else {
+                b.add_body(body.clone())
+            };
+            if let Some(c) = spec.com {
+                b.set_body_frame(h, c);
+            }
         }
         for j in &self.joints {
-            r.check_rotation(j)?;
             let joint = match j {
                 JointSpec::Revolute {
                     name,
@@ -278,9 +134,9 @@ impl ModelFile {
                 } => Joint::revolute(
                     name.clone(),
                     r.find(&format!("joint '{name}'"), body_a)?,
-                    r.point(&format!("joint '{name}'"), "point_a", body_a, *point_a)?,
+                    *point_a,
                     r.find(&format!("joint '{name}'"), body_b)?,
-                    r.point(&format!("joint '{name}'"), "point_b", body_b, *point_b)?,
+                    *point_b,
                 ),
                 JointSpec::Prismatic {
                     name,
@@ -293,9 +149,9 @@ impl ModelFile {
                 } => Joint::prismatic(
                     name.clone(),
                     r.find(&format!("joint '{name}'"), body_a)?,
-                    r.point(&format!("joint '{name}'"), "point_a", body_a, *point_a)?,
+                    *point_a,
                     r.find(&format!("joint '{name}'"), body_b)?,
-                    r.point(&format!("joint '{name}'"), "point_b", body_b, *point_b)?,
+                    *point_b,
                     *axis,
                     *angle,
                 ),
@@ -309,9 +165,9 @@ impl ModelFile {
                 } => Joint::weld(
                     name.clone(),
                     r.find(&format!("joint '{name}'"), body_a)?,
-                    r.point(&format!("joint '{name}'"), "point_a", body_a, *point_a)?,
+                    *point_a,
                     r.find(&format!("joint '{name}'"), body_b)?,
-                    r.point(&format!("joint '{name}'"), "point_b", body_b, *point_b)?,
+                    *point_b,
                     *angle,
                 ),
                 JointSpec::Distance {
@@ -324,9 +180,9 @@ impl ModelFile {
                 } => Joint::distance(
                     name.clone(),
                     r.find(&format!("joint '{name}'"), body_a)?,
-                    r.point(&format!("joint '{name}'"), "point_a", body_a, *point_a)?,
+                    *point_a,
                     r.find(&format!("joint '{name}'"), body_b)?,
-                    r.point(&format!("joint '{name}'"), "point_b", body_b, *point_b)?,
+                    *point_b,
                     *length,
                 ),
                 JointSpec::Absolute {
@@ -338,7 +194,7 @@ impl ModelFile {
                 } => Joint::absolute(
                     name.clone(),
                     r.find(&format!("joint '{name}'"), body)?,
-                    r.point(&format!("joint '{name}'"), "point", body, *point)?,
+                    *point,
                     *coordinate,
                     *value,
                 ),
@@ -357,7 +213,6 @@ impl ModelFile {
             b.add_joint(joint);
         }
         for f in &self.forces {
-            r.check_force_rotation(f)?;
             let force = match f {
                 ForceSpec::SpringDamper {
                     name,
@@ -371,9 +226,9 @@ impl ModelFile {
                 } => Force::spring_damper(
                     name.clone(),
                     r.find(&format!("force '{name}'"), body_a)?,
-                    r.point(&format!("force '{name}'"), "point_a", body_a, *point_a)?,
+                    *point_a,
                     r.find(&format!("force '{name}'"), body_b)?,
-                    r.point(&format!("force '{name}'"), "point_b", body_b, *point_b)?,
+                    *point_b,
                     *stiffness,
                     *damping,
                     *rest_length,
@@ -402,7 +257,7 @@ impl ModelFile {
                 } => Force::force(
                     name.clone(),
                     r.find(&format!("force '{name}'"), body)?,
-                    r.point(&format!("force '{name}'"), "point", body, *point)?,
+                    *point,
                     fx.clone(),
                     fy.clone(),
                 ),
@@ -413,17 +268,6 @@ impl ModelFile {
                 ),
             };
             b.add_force(force);
-        }
-        for (i, spec) in self.bodies.iter().enumerate() {
-            if spec.kind == BodyKind::PointMass {
-                b.add_joint(Joint::absolute(
-                    format!("{}:point_mass", spec.name),
-                    BodyHandle(i),
-                    [0.0, 0.0],
-                    Coordinate::Angle,
-                    0.0,
-                ));
-            }
         }
         Ok(b)
     }

@@ -2,6 +2,7 @@
 //! [`TangentRk::integrate_adaptive`] (PI control of the embedded error estimate).
 
 use super::*;
+use mbd_solve::{run_adaptive, AdaptiveConfig, RunConfig};
 
 /// Settings of [`TangentRk::integrate_adaptive`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -129,17 +130,21 @@ impl TangentRk {
     /// embedded error estimate (e.g. DOPRI5 5(4), Bogacki-Shampine 3(2)), calling `observer`
     /// with the initial state (step 0) and after every accepted step.
     ///
-    /// Step control (`docs/tangent.md` section 6): the first step from Hairer, Norsett and
-    /// Wanner's estimate (`f(x0)` and one explicit Euler trial step) unless
-    /// [`AdaptiveSettings::h0`] is given; after an accepted step a PI controller
-    /// (`h <- h safety err^-(1/(q+1) - 0.75 beta) err_prev^beta`, clamped to
+    /// The steps are driven by [`mbd_solve::run_adaptive`] (the one step-control loop of the
+    /// workspace) through this solver's [`AdaptiveIntegrator`] attempts, without its drift
+    /// guard (the chart keeps the constraints). Step control (`docs/tangent.md` section 6):
+    /// the first step from Hairer, Norsett and Wanner's estimate (`f(x0)` and one explicit
+    /// Euler trial step) unless [`AdaptiveSettings::h0`] is given; after an accepted step a PI
+    /// controller (`h <- h safety err^-(1/(q+1) - 0.75 beta) err_prev^beta`, clamped to
     /// `[fac_min, fac_max]`, no growth right after a rejection), after a rejected one
     /// `h <- h max(fac_min, safety err^-(1/(q+1) - 0.75 beta))`. A chart failure (the chart map
     /// did not converge) or a singular index-1 solve at a stage point multiplies the step by
     /// [`AdaptiveSettings::chart_shrink`] without touching the controller's memory; more than
-    /// [`AdaptiveSettings::max_chart_failures`] of them in a row, or a step below
-    /// `controller.h_min`, is an error ([`TangentError::Chart`],
-    /// [`TangentError::StepSizeTooSmall`]). A singular configuration at an accepted point is
+    /// [`AdaptiveSettings::max_chart_failures`] of them in a row, or one whose shrunk step
+    /// would fall below `controller.h_min`, is [`TangentError::Chart`]. An error-test step
+    /// below `controller.h_min` is [`SolveError::StepSizeTooSmall`], more than
+    /// [`AdaptiveSettings::max_steps`] attempts [`SolveError::TooManyAttempts`] (both inside
+    /// [`TangentError::Solve`]). A singular configuration at an accepted point is
     /// [`SolveError::Singular`] at once (no retry with smaller steps).
     pub fn integrate_adaptive<O: Observer + ?Sized>(
         &mut self,
@@ -160,173 +165,134 @@ impl TangentRk {
             }
             .into());
         }
-        let q_order = match (&self.rk.tableau.b_hat, self.rk.tableau.embedded_order) {
-            (Some(_), q) if q > 0 => q,
-            _ => {
-                return Err(SolveError::Unsupported(format!(
-                "adaptive stepping needs a tableau with an embedded error estimate; '{}' has none \
-                     (use DOPRI5 or Bogacki-Shampine)",
+        if self.embedded_order().is_none() {
+            return Err(SolveError::Unsupported(format!(
+                "adaptive stepping needs a tableau with an embedded error estimate; '{}' has \
+                 none (use DOPRI5 or Bogacki-Shampine)",
                 self.rk.tableau.name
             ))
-                .into())
-            }
-        };
-        self.load(sys, state)?;
-        self.adaptive_loop(sys, state, t_end, settings, observer, q_order)
-    }
-
-    /// The step loop of [`TangentRk::integrate_adaptive`] (`state` loaded, settings checked).
-    pub(super) fn adaptive_loop<O: Observer + ?Sized>(
-        &mut self,
-        sys: &System,
-        state: &mut State,
-        t_end: f64,
-        settings: &AdaptiveSettings,
-        observer: &mut O,
-        q_order: u32,
-    ) -> Result<AdaptiveStats, TangentError> {
-        let t0 = state.t;
-        let ctrl = settings.controller;
-        let mut st = AdaptiveStats {
-            h_min: f64::INFINITY,
-            ..Default::default()
-        };
-        if observer.observe(sys, state, 0)? == Flow::Stop {
-            st.stopped_early = true;
-            st.h_min = 0.0;
-            return Ok(st);
+            .into());
         }
-        let mut h = match settings.h0 {
+        self.load(sys, state)?;
+        let mut st = AdaptiveStats::default();
+        let h0 = match settings.h0 {
             Some(h0) => h0,
             None => {
                 let h0 = self.initial_step(sys, t0, t_end - t0, settings)?;
                 st.h_initial_estimate = h0;
-                st.rhs_evals += 2;
                 h0
             }
         };
-        h = h.min(settings.h_max);
-        // the PI controller: exponents and memory (the error norm of the last accepted step)
-        let k = q_order as f64 + 1.0;
-        let beta = settings.pi_beta.unwrap_or(0.4 / k);
-        if beta >= 1.0 / (1.75 * k) {
-            return Err(SolveError::InvalidParameter {
-                parameter: "pi_beta",
-                value: beta,
-                reason: "must lie in [0, 1 / (1.75 (q+1))) for the tableau's embedded order q",
-            }
-            .into());
-        }
-        let expo = 1.0 / k - 0.75 * beta;
-        let mut err_prev = 1e-4f64;
-        let mut t = t0;
-        let mut last_rejected = false;
-        let mut chart_failures_here = 0usize;
-        let mut centred_at = f64::NAN;
-        let mut attempts = 0usize;
-        while t < t_end {
-            attempts += 1;
-            if attempts > settings.max_steps {
-                return Err(TangentError::TooManySteps {
-                    t,
-                    max_steps: settings.max_steps,
-                });
-            }
-            let remaining = t_end - t;
-            let last = h >= remaining * (1.0 - 1e-12);
-            let hs = if last { remaining } else { h };
-            if hs < ctrl.h_min && !last {
-                return Err(TangentError::StepSizeTooSmall {
-                    t,
-                    h: hs,
-                    h_min: ctrl.h_min,
-                });
-            }
-            if centred_at != t {
-                self.centre(sys, t)?;
-                centred_at = t;
-            }
-            match self.attempt(sys, t, hs) {
-                Ok(w) => {
-                    self.account(&w);
-                    st.rhs_evals += w.rhs_evals;
-                    st.newton_iterations += w.iterations;
-                    st.exact_maps += w.exact_maps;
-                    // error estimate mapped to x: e = U err_xi
-                    self.path.to_ambient(&self.rk.err, &mut self.ex);
-                    for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
-                        *s = a.abs().max(b.abs());
-                    }
-                    let en = self.error_norm(&ctrl);
-                    if !en.is_finite() {
-                        return Err(SolveError::NonFinite {
-                            t,
-                            what: "embedded error estimate",
-                        }
-                        .into());
-                    }
-                    chart_failures_here = 0;
-                    let grow = ctrl.safety * en.powf(-expo);
-                    if en <= 1.0 {
-                        std::mem::swap(&mut self.cur, &mut self.xnew);
-                        t = if last { t_end } else { t + hs };
-                        self.commit_history(hs, t, w.end_initial_residual);
-                        self.cur_t = t;
-                        self.cur_ok = true;
-                        st.accepted += 1;
-                        st.h_min = st.h_min.min(hs);
-                        st.h_max = st.h_max.max(hs);
-                        st.max_residual = st.max_residual.max(w.residual);
-                        self.stats.steps += 1;
-                        self.stats.max_residual = self.stats.max_residual.max(w.residual);
-                        state.t = t;
-                        self.store(state);
-                        // PI control (Gustafsson; Hairer-Wanner's DOPRI5 form)
-                        let mut fac = if en == 0.0 {
-                            ctrl.fac_max
-                        } else {
-                            (grow * err_prev.powf(beta)).clamp(ctrl.fac_min, ctrl.fac_max)
-                        };
-                        err_prev = en.max(1e-4);
-                        if last_rejected {
-                            fac = fac.min(1.0);
-                        }
-                        last_rejected = false;
-                        h = (hs * fac).min(settings.h_max);
-                        if observer.observe(sys, state, st.accepted)? == Flow::Stop {
-                            st.stopped_early = true;
-                            break;
-                        }
-                    } else {
-                        st.rejected += 1;
-                        last_rejected = true;
-                        h = hs * grow.clamp(ctrl.fac_min, 1.0);
-                    }
-                }
-                Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_))) => {
-                    self.stats.chart_failures += 1;
-                    st.chart_rejections += 1;
-                    chart_failures_here += 1;
-                    last_rejected = true;
-                    h = settings.chart_shrink * hs;
-                    if h < ctrl.h_min || chart_failures_here > settings.max_chart_failures {
-                        return Err(TangentError::Chart {
-                            source: match fail {
-                                Attempt::Chart(f) => f.into_error(),
-                                Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
-                            },
-                            h: hs,
-                            failures: chart_failures_here,
-                        });
-                    }
-                }
-                Err(Attempt::Hard(e)) => return Err(e.into()),
-            }
-        }
-        if st.accepted == 0 {
-            st.h_min = 0.0;
-        }
+        let cfg = AdaptiveConfig {
+            t_end,
+            controller: settings.controller,
+            h0: Some(h0),
+            h_max: settings.h_max,
+            max_steps: settings.max_steps,
+            pi_beta: settings.pi_beta,
+            drift_guard: None,
+            condition_limit: RunConfig::DEFAULT_CONDITION_LIMIT,
+        };
+        let exact_before = self.stats.exact_maps;
+        let mut driver = Driver {
+            rk: self,
+            chart_shrink: settings.chart_shrink,
+            max_chart_failures: settings.max_chart_failures,
+            failures_here: 0,
+            centred_at: f64::NAN,
+            chart_error: None,
+            chart_rejections: 0,
+            h_min: f64::INFINITY,
+            h_max: 0.0,
+        };
+        let run = run_adaptive(&mut driver, sys, state, cfg, observer);
+        let Driver {
+            chart_error,
+            chart_rejections,
+            h_min,
+            h_max,
+            ..
+        } = driver;
+        let rs = run.map_err(|source| match chart_error {
+            Some((h, failures)) => TangentError::Chart {
+                source,
+                h,
+                failures,
+            },
+            None => TangentError::Solve(source),
+        })?;
+        st.accepted = rs.steps;
+        st.rejected = rs.rejected_steps - chart_rejections;
+        st.chart_rejections = chart_rejections;
+        st.exact_maps = self.stats.exact_maps - exact_before;
+        st.rhs_evals = rs.rhs_evals + if settings.h0.is_none() { 2 } else { 0 };
+        st.newton_iterations = rs.newton_iterations;
+        st.h_min = if rs.steps == 0 { 0.0 } else { h_min };
+        st.h_max = h_max;
+        st.max_residual = rs.max_residual;
+        st.stopped_early = rs.stopped_early;
         Ok(st)
+    }
+
+    /// One adaptive attempt of size `h` from `state` (loaded and checked): `Ok(Ok(attempt))`
+    /// for an attempt the error test judged, `Ok(Err(failure))` for a recoverable failure (the
+    /// chart map, or a stage point's index-1 solve), `Err` for a hard one. Centres the chart
+    /// at `state` first if `recentre`.
+    fn attempt_adaptive(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        ctrl: &StepController,
+        recentre: bool,
+    ) -> Result<Result<StepAttempt, SolveError>, SolveError> {
+        let t = state.t;
+        if recentre {
+            self.centre(sys, t)?;
+        }
+        match self.attempt(sys, t, h) {
+            Ok(w) => {
+                self.account(&w);
+                // error estimate mapped to x: e = U err_xi
+                self.path.to_ambient(&self.rk.err, &mut self.ex);
+                for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
+                    *s = a.abs().max(b.abs());
+                }
+                let error_norm = self.error_norm(ctrl);
+                let stats = StepStats {
+                    newton_iterations: w.iterations,
+                    residual: w.residual,
+                    rhs_evals: w.rhs_evals,
+                    condition: w.condition,
+                    ..Default::default()
+                };
+                let accepted = error_norm <= 1.0;
+                if accepted {
+                    std::mem::swap(&mut self.cur, &mut self.xnew);
+                    self.commit_history(h, t + h, w.end_initial_residual);
+                    self.cur_t = t + h;
+                    self.cur_ok = true;
+                    self.stats.steps += 1;
+                    self.stats.max_residual = self.stats.max_residual.max(w.residual);
+                    self.store(state);
+                    state.t = t + h;
+                }
+                Ok(Ok(StepAttempt {
+                    accepted,
+                    error_norm,
+                    stats,
+                    shrink: None,
+                }))
+            }
+            Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_))) => {
+                self.stats.chart_failures += 1;
+                Ok(Err(match fail {
+                    Attempt::Chart(f) => f.into_error(),
+                    Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
+                }))
+            }
+            Err(Attempt::Hard(e)) => Err(e),
+        }
     }
 
     /// The scaled error norm of the estimate `ex` (mapped to `x`) with the scale in `scale`
@@ -465,49 +431,90 @@ impl AdaptiveIntegrator for TangentRk {
             )));
         }
         self.load(sys, state)?;
-        let t = state.t;
-        self.centre(sys, t)?;
-        match self.attempt(sys, t, h) {
-            Ok(w) => {
-                self.account(&w);
-                self.path.to_ambient(&self.rk.err, &mut self.ex);
-                for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
-                    *s = a.abs().max(b.abs());
+        Ok(self
+            .attempt_adaptive(sys, state, h, ctrl, true)?
+            .unwrap_or(StepAttempt {
+                accepted: false,
+                error_norm: f64::INFINITY,
+                stats: StepStats::default(),
+                shrink: None,
+            }))
+    }
+}
+
+/// [`TangentRk::integrate_adaptive`]'s view of the solver for [`run_adaptive`]: the chart is
+/// centred once per point (not again after a rejection), chart failures shrink the step by
+/// [`AdaptiveSettings::chart_shrink`] up to [`AdaptiveSettings::max_chart_failures`] in a row,
+/// and the statistics only the tangent solver knows are collected.
+struct Driver<'a> {
+    rk: &'a mut TangentRk,
+    chart_shrink: f64,
+    max_chart_failures: usize,
+    /// Chart failures in a row at the current point.
+    failures_here: usize,
+    /// The time the chart was last centred at.
+    centred_at: f64,
+    /// The step and failure count of the chart failure that ended the run.
+    chart_error: Option<(f64, usize)>,
+    chart_rejections: usize,
+    h_min: f64,
+    h_max: f64,
+}
+
+impl Integrator for Driver<'_> {
+    fn name(&self) -> String {
+        self.rk.name()
+    }
+    fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        self.rk.step(sys, state, h)
+    }
+    /// Keeps the solver's history and statistics (`integrate_adaptive` never reset them).
+    fn reset(&mut self) {}
+    fn order(&self) -> Option<u32> {
+        self.rk.order()
+    }
+}
+
+impl AdaptiveIntegrator for Driver<'_> {
+    fn embedded_order(&self) -> Option<u32> {
+        self.rk.embedded_order()
+    }
+
+    fn attempt_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        ctrl: &StepController,
+    ) -> Result<StepAttempt, SolveError> {
+        self.rk.load(sys, state)?;
+        let recentre = self.centred_at != state.t;
+        self.centred_at = state.t;
+        match self.rk.attempt_adaptive(sys, state, h, ctrl, recentre)? {
+            Ok(a) => {
+                self.failures_here = 0;
+                if a.accepted {
+                    self.h_min = self.h_min.min(h);
+                    self.h_max = self.h_max.max(h);
                 }
-                let error_norm = self.error_norm(ctrl);
-                let stats = StepStats {
-                    newton_iterations: w.iterations,
-                    residual: w.residual,
-                    rhs_evals: w.rhs_evals,
-                    condition: w.condition,
-                    ..Default::default()
-                };
-                let accepted = error_norm <= 1.0;
-                if accepted {
-                    std::mem::swap(&mut self.cur, &mut self.xnew);
-                    self.commit_history(h, t + h, w.end_initial_residual);
-                    self.cur_t = t + h;
-                    self.cur_ok = true;
-                    self.stats.steps += 1;
-                    self.stats.max_residual = self.stats.max_residual.max(w.residual);
-                    self.store(state);
-                    state.t = t + h;
-                }
-                Ok(StepAttempt {
-                    accepted,
-                    error_norm,
-                    stats,
-                })
+                Ok(a)
             }
-            Err(Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_)) => {
-                self.stats.chart_failures += 1;
+            Err(source) => {
+                self.chart_rejections += 1;
+                self.failures_here += 1;
+                if self.chart_shrink * h < ctrl.h_min
+                    || self.failures_here > self.max_chart_failures
+                {
+                    self.chart_error = Some((h, self.failures_here));
+                    return Err(source);
+                }
                 Ok(StepAttempt {
                     accepted: false,
                     error_norm: f64::INFINITY,
                     stats: StepStats::default(),
+                    shrink: Some(self.chart_shrink),
                 })
             }
-            Err(Attempt::Hard(e)) => Err(e),
         }
     }
 }

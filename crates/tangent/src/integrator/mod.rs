@@ -7,7 +7,7 @@ use crate::kernels::axpy;
 use crate::sparse_chart::SparseChart;
 use mbd_model::System;
 use mbd_solve::{
-    AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Flow, Integrator, Observer,
+    AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Integrator, Observer,
     SolveError, SparseAccelerationSolver, State, StepAttempt, StepController, StepStats,
 };
 mod adaptive;
