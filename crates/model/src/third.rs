@@ -6,7 +6,7 @@
 //! `D^3 f(a, b, .)` follow by polarisation:
 //! `D^3 f(a, b, .) = 1/4 [D^3 f(a + b, a + b, .) - D^3 f(a - b, a - b, .)]`.
 
-use crate::jet::{Frame, Scalar, ThirdJet, NV};
+use crate::jet::{Frame, Scalar, TanJet, ThirdJet, NV};
 use crate::system::{Attach, System};
 
 impl System {
@@ -95,6 +95,98 @@ impl System {
                 }
             }
             Self::scatter_grad(at, &g, scale, out);
+        }
+    }
+    /// `L = potential * V + sum_k weights_k Phi_k`: its Hessian-vector product
+    /// `Hess L(q) w` (length n) into `out` (overwritten), one forward pass per element without
+    /// forming a Hessian (`potential = 0` for the constraints alone).
+    pub fn lagrangian_hessian_vector(
+        &self,
+        q: &[f64],
+        w: &[f64],
+        potential: f64,
+        weights: &[f64],
+        out: &mut [f64],
+    ) {
+        out.fill(0.0);
+        if potential != 0.0 {
+            for (fi, f) in self.forces.iter().enumerate() {
+                let at = self.force_attach[fi];
+                let e = f.potential(&Self::loc_tan(q, w, at.a, 0), &Self::loc_tan(q, w, at.b, 3));
+                Self::scatter_grad(at, &e.dg, potential, out);
+            }
+        }
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            let ne = j.n_equations();
+            if weights[o..o + ne].iter().all(|&x| x == 0.0) {
+                continue;
+            }
+            let mut e = [TanJet::cst(0.0); 3];
+            j.eval(
+                &Self::loc_tan(q, w, at.a, 0),
+                &Self::loc_tan(q, w, at.b, 3),
+                &mut e,
+            );
+            let mut g = [0.0; NV];
+            for k in 0..ne {
+                for l in 0..NV {
+                    g[l] += weights[o + k] * e[k].dg[l];
+                }
+            }
+            Self::scatter_grad(at, &g, 1.0, out);
+        }
+    }
+
+    /// `L = potential * V + sum_k weights_k Phi_k` along `v`: `Hess L(q) v` into `hv` and
+    /// `D^3 L(q)(v, v, .)` into `d3` (both length n, overwritten), in one forward pass per
+    /// element.
+    pub fn lagrangian_third(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        potential: f64,
+        weights: &[f64],
+        hv: &mut [f64],
+        d3: &mut [f64],
+    ) {
+        hv.fill(0.0);
+        d3.fill(0.0);
+        if potential != 0.0 {
+            for (fi, f) in self.forces.iter().enumerate() {
+                let at = self.force_attach[fi];
+                let e = f.potential(
+                    &Self::loc_third(q, v, at.a, 0),
+                    &Self::loc_third(q, v, at.b, 3),
+                );
+                Self::scatter_grad(at, &e.g1, potential, hv);
+                Self::scatter_grad(at, &e.g2, potential, d3);
+            }
+        }
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            let ne = j.n_equations();
+            if weights[o..o + ne].iter().all(|&x| x == 0.0) {
+                continue;
+            }
+            let mut e = [ThirdJet::cst(0.0); 3];
+            j.eval(
+                &Self::loc_third(q, v, at.a, 0),
+                &Self::loc_third(q, v, at.b, 3),
+                &mut e,
+            );
+            let (mut g1, mut g2) = ([0.0; NV], [0.0; NV]);
+            for k in 0..ne {
+                let w = weights[o + k];
+                for l in 0..NV {
+                    g1[l] += w * e[k].g1[l];
+                    g2[l] += w * e[k].g2[l];
+                }
+            }
+            Self::scatter_grad(at, &g1, 1.0, hv);
+            Self::scatter_grad(at, &g2, 1.0, d3);
         }
     }
 }
@@ -307,6 +399,36 @@ mod tests {
             sys.add_potential_third(&q, &v, -2.0, &mut acc);
             for i in 0..n {
                 assert!((acc[i] - (1.0 - 2.0 * out[i])).abs() < 1e-12 * (1.0 + out[i].abs()));
+            }
+        }
+    }
+    #[test]
+    fn lagrangian_products_match_assembled_hessians() {
+        for sys in [
+            forces_system(),
+            joints_system(),
+            models::manipulator().unwrap(),
+        ] {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let (q, v) = point(n);
+            let w: Vec<f64> = (0..m).map(|r| 0.7 - 0.3 * r as f64).collect();
+            let mut hm = DMatrix::zeros(n, n);
+            sys.potential_hessian(&q, &mut hm);
+            hm *= 0.5;
+            sys.add_constraint_hessian(&q, &w, 1.0, &mut hm);
+            let dense = &hm * nalgebra::DVector::from_column_slice(&v);
+            let (mut hv, mut hv2, mut d3) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            sys.lagrangian_hessian_vector(&q, &v, 0.5, &w, &mut hv);
+            sys.lagrangian_third(&q, &v, 0.5, &w, &mut hv2, &mut d3);
+            let (mut p3, mut c3) = (vec![0.0; n], vec![0.0; n]);
+            sys.potential_third(&q, &v, &mut p3);
+            sys.constraint_third(&q, &v, &w, &mut c3);
+            for i in 0..n {
+                let tol = 1e-12 * (1.0 + dense[i].abs());
+                assert!((hv[i] - dense[i]).abs() < tol, "Hess L v [{i}]");
+                assert!((hv2[i] - dense[i]).abs() < tol, "lagrangian_third hv [{i}]");
+                let e3 = 0.5 * p3[i] + c3[i];
+                assert!((d3[i] - e3).abs() < 1e-12 * (1.0 + e3.abs()), "D3 L [{i}]");
             }
         }
     }

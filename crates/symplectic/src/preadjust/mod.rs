@@ -43,7 +43,6 @@ pub struct Preadjustment {
     mu0: Vec<f64>,
     u: Vec<f64>,
     amat: DMatrix<f64>,
-    hs: DMatrix<f64>,
     av: Vec<Vec<f64>>,
     bv: Vec<Vec<f64>>,
     sig: Vec<Vec<f64>>,
@@ -59,6 +58,11 @@ pub struct Preadjustment {
     /// Jacobian is evaluated where the residual was).
     at: Vec<f64>,
     at_valid: bool,
+    /// Whether `amat` holds `A` at `at`.
+    a_valid: bool,
+    nmu0: Vec<f64>,
+    hv: Vec<f64>,
+    d3: Vec<f64>,
     rheonomic: bool,
 }
 
@@ -104,9 +108,8 @@ impl Preadjustment {
             mu0: vec![0.0; m],
             u: vec![0.0; n],
             amat: DMatrix::zeros(n, n),
-            hs: DMatrix::zeros(n, n),
             av: vec![vec![0.0; n]; s + 1],
-            bv: vec![vec![0.0; n]; s.max(1)],
+            bv: vec![vec![0.0; n]; s + 1],
             sig: vec![vec![0.0; m]; s.max(1)],
             tn: std::array::from_fn(|_| vec![0.0; n]),
             tm: std::array::from_fn(|_| vec![0.0; m]),
@@ -117,6 +120,10 @@ impl Preadjustment {
             cm: vec![0.0; m],
             at: vec![0.0; n],
             at_valid: false,
+            a_valid: false,
+            nmu0: vec![0.0; m],
+            hv: vec![0.0; n],
+            d3: vec![0.0; n],
             rheonomic: sys.is_rheonomic(),
         })
     }
@@ -160,7 +167,9 @@ impl Preadjustment {
         self.at_valid && self.at.as_slice() == q
     }
 
-    /// Evaluates `g`, `G`, `S`, `mu0`, `u` and `A` at `q` (nothing when they are held for `q`).
+    /// Evaluates `g`, `G`, the Cholesky factor of `S`, `mu0` and `u` at `q` (nothing when they
+    /// are held for `q`). `A` is assembled only on demand ([`Preadjustment::ensure_a`]): the
+    /// gradients use Hessian-vector products instead.
     fn prepare(&mut self, sys: &System, q: &[f64]) -> Result<(), SolveError> {
         let (n, m) = (self.n, self.m);
         if q.len() != n {
@@ -174,6 +183,7 @@ impl Preadjustment {
             return Ok(());
         }
         self.at_valid = false;
+        self.a_valid = false;
         sys.potential_gradient(q, &mut self.g);
         if m > 0 {
             sys.phi_q(q, &mut self.gq);
@@ -204,25 +214,42 @@ impl Preadjustment {
             let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * self.mu0[r]).sum();
             self.u[k] = self.minv[k] * (acc - self.g[k]);
         }
-        sys.potential_hessian(q, &mut self.amat);
-        if m > 0 {
-            sys.add_constraint_hessian(q, &self.mu0, -1.0, &mut self.amat);
+        for r in 0..m {
+            self.nmu0[r] = -self.mu0[r];
         }
         self.at.copy_from_slice(q);
         self.at_valid = true;
         Ok(())
     }
 
-    /// Krylov vectors `a_0 = u`, `a_{i+1} = Pi A a_i` for `i < count`.
-    pub(crate) fn krylov(&mut self, count: usize) {
+    /// Assembles `A = Hess V - mu0 . Hess Phi` after `prepare(q)` (once per point).
+    fn ensure_a(&mut self, sys: &System, q: &[f64]) {
+        if self.a_valid {
+            return;
+        }
+        sys.potential_hessian(q, &mut self.amat);
+        if self.m > 0 {
+            sys.add_constraint_hessian(q, &self.mu0, -1.0, &mut self.amat);
+        }
+        self.a_valid = true;
+    }
+
+    /// `out = A x` without assembling `A` (one Hessian-vector pass), after `prepare(q)`.
+    fn a_times(&self, sys: &System, q: &[f64], x: &[f64], out: &mut [f64]) {
+        sys.lagrangian_hessian_vector(q, x, 1.0, &self.nmu0, out);
+    }
+
+    /// Krylov vectors `a_0 = u`, `a_{i+1} = Pi b_i` with `b_i = A a_i`, for `i < count`
+    /// (`b_i` in `bv[i]`).
+    pub(crate) fn krylov(&mut self, sys: &System, q: &[f64], count: usize) {
         self.av[0].copy_from_slice(&self.u);
         for i in 0..count {
-            let mut t = std::mem::take(&mut self.tn[0]);
-            matvec(&self.amat, &self.av[i], &mut t);
+            let mut b = std::mem::take(&mut self.bv[i]);
+            self.a_times(sys, q, &self.av[i], &mut b);
             let mut next = std::mem::take(&mut self.av[i + 1]);
-            self.apply_pi(&t, &mut next);
+            self.apply_pi(&b, &mut next);
             self.av[i + 1] = next;
-            self.tn[0] = t;
+            self.bv[i] = b;
         }
     }
 

@@ -1,7 +1,9 @@
 //! The modified-Lagrangian term `e(q, v)` of the (1,1) scheme, its gradients (exact third
 //! derivatives) and its velocity Hessian.
 
-use super::{dot, matvec, Preadjustment};
+#[cfg(test)]
+use super::matvec;
+use super::{dot, Preadjustment};
 use mbd_model::System;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
@@ -28,14 +30,12 @@ impl Preadjustment {
         Ok(())
     }
 
-    /// `e(q, v)` after `prepare(q)`; leaves `gamma_c` in `gc` and `S^-1 gamma_c` in `sigma`.
+    /// `e(q, v)` after `prepare(q)`; leaves `gamma_c` in `gc`, `S^-1 gamma_c` in `sigma`,
+    /// `sigma - mu0` in `cm`, `(A + H_sigma) v` in `hv` and `D^3 (V + (sigma - mu0) . Phi)(v, v, .)`
+    /// in `d3` (one third-order pass over the elements, no Hessian assembled).
     fn modified_prepared(&mut self, sys: &System, q: &[f64], v: &[f64]) -> f64 {
         let (n, m) = (self.n, self.m);
         let uu: f64 = (0..n).map(|k| self.mass[k] * self.u[k] * self.u[k]).sum();
-        let mut t = std::mem::take(&mut self.tn[0]);
-        matvec(&self.amat, v, &mut t);
-        let vav = dot(v, &t);
-        self.tn[0] = t;
         let mut gg = 0.0;
         if m > 0 {
             // gamma(q, v, t) = -(v^T Hess Phi_k v) + time part: the time part cancels
@@ -52,6 +52,12 @@ impl Preadjustment {
             self.chol.solve_in_place(&mut self.sigma);
             gg = dot(&self.gc, &self.sigma);
         }
+        for r in 0..m {
+            self.cm[r] = self.sigma[r] - self.mu0[r];
+        }
+        sys.lagrangian_third(q, v, 1.0, &self.cm, &mut self.hv, &mut self.d3);
+        // v^T A v = v^T (A + H_sigma) v - sigma . gamma_c
+        let vav = dot(v, &self.hv) - gg;
         -uu / 24.0 + vav / 12.0 + gg / 24.0
     }
 
@@ -90,11 +96,13 @@ impl Preadjustment {
         }
         self.prepare(sys, q)?;
         let e = self.modified_prepared(sys, q, v);
+        self.ensure_a(sys, q);
         matvec(&self.amat, v, dv);
         if self.m > 0 {
-            sys.constraint_hessian(q, &self.sigma, &mut self.hs);
+            let mut hs = DMatrix::zeros(n, n);
+            sys.constraint_hessian(q, &self.sigma, &mut hs);
             let mut t = std::mem::take(&mut self.tn[0]);
-            matvec(&self.hs, v, &mut t);
+            matvec(&hs, v, &mut t);
             for k in 0..n {
                 dv[k] += t[k];
             }
@@ -116,13 +124,10 @@ impl Preadjustment {
         self.check_v(v)?;
         self.prepare(sys, q)?;
         self.modified_prepared(sys, q, v);
+        // A + H_sigma = Hess V + (sigma - mu0) . Hess Phi, one assembly
+        sys.potential_hessian(q, out);
         if self.m > 0 {
-            sys.constraint_hessian(q, &self.sigma, out);
-        } else {
-            out.fill(0.0);
-        }
-        for (a, b) in out.iter_mut().zip(self.amat.iter()) {
-            *a += b;
+            sys.add_constraint_hessian(q, &self.cm, 1.0, out);
         }
         Ok(())
     }
@@ -155,34 +160,19 @@ impl Preadjustment {
         }
         self.prepare(sys, q)?;
         let e = self.modified_prepared(sys, q, v);
-        // (A + H_sigma) applied to v and to u - w
-        if m > 0 {
-            sys.constraint_hessian(q, &self.sigma, &mut self.hs);
-        } else {
-            self.hs.fill(0.0);
+        for k in 0..n {
+            dv[k] = self.hv[k] / 6.0;
         }
-        {
-            let amat = self.amat.as_slice();
-            let hs = self.hs.as_mut_slice();
-            for (a, b) in hs.iter_mut().zip(amat) {
-                *a += b;
-            }
-        }
-        matvec(&self.hs, v, dv);
-        dv.iter_mut().for_each(|x| *x /= 6.0);
+        // (A + H_sigma)(u - w), w = M^-1 Phi_q^T sigma, one Hessian-vector pass
         let uw = &mut self.tn[1];
         for k in 0..n {
             let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * self.sigma[r]).sum();
             uw[k] = self.u[k] - self.minv[k] * acc;
         }
-        matvec(&self.hs, &self.tn[1], dq);
-        // third derivatives along v (exact): D^3 (V + (sigma - mu0) . Phi)(v, v, .)
-        sys.add_potential_third(q, v, 1.0, dq);
-        if m > 0 {
-            for r in 0..m {
-                self.cm[r] = self.sigma[r] - self.mu0[r];
-            }
-            sys.add_constraint_third(q, v, &self.cm, 1.0, dq);
+        sys.lagrangian_hessian_vector(q, &self.tn[1], 1.0, &self.cm, dq);
+        // third derivatives along v (exact, from modified_prepared)
+        for k in 0..n {
+            dq[k] += self.d3[k];
         }
         dq.iter_mut().for_each(|x| *x /= 12.0);
         Ok(e)

@@ -9,10 +9,10 @@ impl Preadjustment {
     /// `W_s(q)`.
     pub fn value(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
         self.prepare(sys, q)?;
-        Ok(self.value_prepared())
+        Ok(self.value_prepared(sys, q))
     }
 
-    fn value_prepared(&mut self) -> f64 {
+    fn value_prepared(&mut self, sys: &System, q: &[f64]) -> f64 {
         let s = self.s;
         if s == 1 {
             return 0.5
@@ -20,15 +20,14 @@ impl Preadjustment {
                     .map(|k| self.mass[k] * self.u[k] * self.u[k])
                     .sum::<f64>();
         }
-        self.krylov(s - 2);
-        let mut t = std::mem::take(&mut self.tn[0]);
-        matvec(&self.amat, &self.av[s - 2], &mut t);
-        let w = 0.5 * dot(&self.u, &t);
-        self.tn[0] = t;
-        w
+        // W_s = 1/2 u^T b_{s-2}, b_i = A a_i
+        self.krylov(sys, q, s - 1);
+        0.5 * dot(&self.u, &self.bv[s - 2])
     }
 
-    /// `grad W_s(q)` into `out`; returns `W_s(q)`.
+    /// `grad W_s(q)` into `out`; returns `W_s(q)`. Matrix-free: every product with `A` or
+    /// with a weighted constraint Hessian is one Hessian-vector pass over the elements
+    /// ([`System::lagrangian_hessian_vector`]), the third derivatives are exact.
     pub fn gradient(
         &mut self,
         sys: &System,
@@ -39,42 +38,28 @@ impl Preadjustment {
         let (n, m, s) = (self.n, self.m, self.s);
         if s == 1 {
             // grad W_1 = -A u (exact: only second derivatives enter)
-            matvec(&self.amat, &self.u, out);
+            self.a_times(sys, q, &self.u, out);
             out.iter_mut().for_each(|x| *x = -*x);
-            return Ok(self.value_prepared());
+            return Ok(self.value_prepared(sys, q));
         }
         let l = s - 2;
-        self.krylov(l + 1);
-        // b_k = A a_k, sigma_k = S^-1 G M^-1 b_k (k = 0..=l)
-        for k in 0..=l {
-            let mut b = std::mem::take(&mut self.bv[k]);
-            matvec(&self.amat, &self.av[k], &mut b);
-            let mut sg = std::mem::take(&mut self.sig[k]);
-            if m > 0 {
+        // a_0..a_{l+1}, b_k = A a_k (k = 0..=l); sigma_k = S^-1 G M^-1 b_k
+        self.krylov(sys, q, l + 1);
+        if m > 0 {
+            for k in 0..=l {
+                let mut sg = std::mem::take(&mut self.sig[k]);
+                let b = std::mem::take(&mut self.bv[k]);
                 self.sgm(&b, &mut sg);
+                self.bv[k] = b;
+                self.sig[k] = sg;
             }
-            self.bv[k] = b;
-            self.sig[k] = sg;
         }
         let w = 0.5 * dot(&self.u, &self.bv[l]);
-        // (1)+(3): -A a_{l+1} - sum_j (sigma_{l-j} . H) a_j
-        matvec(&self.amat, &self.av[l + 1], out);
-        out.iter_mut().for_each(|x| *x = -*x);
+        // (2b): h_k = 1/2 sum_i a_i^T H_k a_{l-i} (polarised gamma); rho = S^-1 h
+        let mut h = std::mem::take(&mut self.tm[1]);
+        h.iter_mut().for_each(|x| *x = 0.0);
         if m > 0 {
-            for j in 0..=l {
-                sys.constraint_hessian(q, &self.sig[l - j], &mut self.hs);
-                let mut t = std::mem::take(&mut self.tn[0]);
-                matvec(&self.hs, &self.av[j], &mut t);
-                for i in 0..n {
-                    out[i] -= t[i];
-                }
-                self.tn[0] = t;
-            }
-            // (2b): h_k = 1/2 sum_i a_i^T H_k a_{l-i}; rho = S^-1 h;
-            //        + (rho . H) a_0 - A M^-1 G^T rho
-            let mut h = std::mem::take(&mut self.tm[1]);
             let mut g1 = std::mem::take(&mut self.tm[2]);
-            h.iter_mut().for_each(|x| *x = 0.0);
             for i in 0..=l {
                 let (ai, ac) = (&self.av[i], &self.av[l - i]);
                 let vp = &mut self.tn[1];
@@ -93,26 +78,36 @@ impl Preadjustment {
                     h[r] += 0.125 * g1[r];
                 }
             }
+            self.tm[2] = g1;
             self.chol.solve_in_place(&mut h); // rho
-            sys.constraint_hessian(q, &h, &mut self.hs);
-            let mut t = std::mem::take(&mut self.tn[0]);
-            matvec(&self.hs, &self.av[0], &mut t);
-            for i in 0..n {
-                out[i] += t[i];
-            }
+        }
+        // (1)+(2b'): -A (a_{l+1} + M^-1 G^T rho)
+        {
             let t2 = &mut self.tn[2];
             for k in 0..n {
                 let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * h[r]).sum();
-                t2[k] = self.minv[k] * acc;
+                t2[k] = self.av[l + 1][k] + self.minv[k] * acc;
             }
-            matvec(&self.amat, t2, &mut t);
-            for i in 0..n {
-                out[i] -= t[i];
-            }
-            self.tn[0] = t;
-            self.tm[1] = h;
-            self.tm[2] = g1;
         }
+        self.a_times(sys, q, &self.tn[2], out);
+        out.iter_mut().for_each(|x| *x = -*x);
+        // (3)+(2b''): -sum_j (sigma_{l-j} . H) a_j + (rho . H) a_0
+        if m > 0 {
+            let mut t = std::mem::take(&mut self.tn[0]);
+            let mut wts = std::mem::take(&mut self.cm);
+            for j in 0..=l {
+                for r in 0..m {
+                    wts[r] = self.sig[l - j][r] - if j == 0 { h[r] } else { 0.0 };
+                }
+                sys.lagrangian_hessian_vector(q, &self.av[j], 0.0, &wts, &mut t);
+                for i in 0..n {
+                    out[i] -= t[i];
+                }
+            }
+            self.cm = wts;
+            self.tn[0] = t;
+        }
+        self.tm[1] = h;
         // (2a): 1/2 sum_i (D_{a_i} A~) a_{l-i}, A~ = Hess V - mu0 . Hess Phi with mu0 frozen
         // (exact third derivatives)
         for i in 0..=l {
@@ -163,6 +158,7 @@ impl Preadjustment {
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
         self.prepare(sys, q)?;
+        self.ensure_a(sys, q);
         let n = self.n;
         for c in 0..n {
             if self.amat.column(c).iter().all(|&a| a == 0.0) {
