@@ -13,11 +13,26 @@
 //!   constraint) without forming the Hessian,
 //! * [`Dual`] gives the value and the first derivative along one direction only (the cheapest
 //!   way to the velocity constraint `Phi_q v`),
+//! * [`ThirdJet`] gives, besides the gradient, `H w`, `w^T H w` and the third-derivative
+//!   contraction `D^3 f(w, w, .)` along a direction `w` (for the gradients of preadjustment
+//!   terms that contain Hessians),
 //!
-//! so the Jacobian, `gamma` and the Hessians are exact (to round-off) and consistent with the
+//! so the Jacobian, `gamma`, the Hessians and the third derivatives are exact (to round-off) and consistent with the
 //! equation by construction. Finite-difference tests check them all.
 
 use std::ops::{Add, Mul, Neg, Sub};
+
+mod dir;
+mod dual;
+mod hess;
+mod tan;
+mod third;
+
+pub use dir::DirJet;
+pub use dual::Dual;
+pub use hess::HessJet;
+pub use tan::TanJet;
+pub use third::ThirdJet;
 
 /// Number of local variables of one element: `(x, y, theta)` of body a, then of body b.
 pub const NV: usize = 6;
@@ -55,559 +70,6 @@ impl Scalar for f64 {
         f64::sqrt(self)
     }
 }
-
-/// Value, gradient (6 local variables) and first/second derivative along one direction.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirJet {
-    /// Value.
-    pub v: f64,
-    /// Gradient with respect to the 6 local variables.
-    pub g: [f64; NV],
-    /// First derivative along the seeded direction (`g . dir`).
-    pub d1: f64,
-    /// Second derivative along the seeded direction (`dir^T H dir`).
-    pub d2: f64,
-}
-
-impl DirJet {
-    /// Independent variable number `i` with value `x` and direction component `dir`.
-    #[inline(always)]
-    pub fn var(i: usize, x: f64, dir: f64) -> Self {
-        let mut g = [0.0; NV];
-        g[i] = 1.0;
-        DirJet {
-            v: x,
-            g,
-            d1: dir,
-            d2: 0.0,
-        }
-    }
-    #[inline(always)]
-    fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
-        let mut g = [0.0; NV];
-        for k in 0..NV {
-            g[k] = df * self.g[k];
-        }
-        DirJet {
-            v: f,
-            g,
-            d1: df * self.d1,
-            d2: ddf * self.d1 * self.d1 + df * self.d2,
-        }
-    }
-}
-
-impl Add for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        let mut g = self.g;
-        for k in 0..NV {
-            g[k] += o.g[k];
-        }
-        DirJet {
-            v: self.v + o.v,
-            g,
-            d1: self.d1 + o.d1,
-            d2: self.d2 + o.d2,
-        }
-    }
-}
-impl Sub for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        let mut g = self.g;
-        for k in 0..NV {
-            g[k] -= o.g[k];
-        }
-        DirJet {
-            v: self.v - o.v,
-            g,
-            d1: self.d1 - o.d1,
-            d2: self.d2 - o.d2,
-        }
-    }
-}
-impl Mul for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        let mut g = [0.0; NV];
-        for k in 0..NV {
-            g[k] = self.g[k] * o.v + o.g[k] * self.v;
-        }
-        DirJet {
-            v: self.v * o.v,
-            g,
-            d1: self.d1 * o.v + self.v * o.d1,
-            d2: self.d2 * o.v + 2.0 * self.d1 * o.d1 + self.v * o.d2,
-        }
-    }
-}
-impl Neg for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self * -1.0
-    }
-}
-impl Add<f64> for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
-impl Mul<f64> for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, c: f64) -> Self {
-        let mut g = self.g;
-        for x in g.iter_mut() {
-            *x *= c;
-        }
-        DirJet {
-            v: self.v * c,
-            g,
-            d1: self.d1 * c,
-            d2: self.d2 * c,
-        }
-    }
-}
-impl Scalar for DirJet {
-    #[inline(always)]
-    fn cst(v: f64) -> Self {
-        DirJet {
-            v,
-            g: [0.0; NV],
-            d1: 0.0,
-            d2: 0.0,
-        }
-    }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = self.v.sin_cos();
-        (self.chain(s, c, -s), self.chain(c, -s, -c))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        let r = self.v.sqrt();
-        self.chain(r, 0.5 / r, -0.25 / (r * self.v))
-    }
-}
-
-/// Value, gradient, derivative along a direction `w` and the gradient of that derivative, with
-/// respect to the 6 local variables: `H w` (for the velocity constraint's Jacobian
-/// `(Phi_q w)_q`) at about a fifth of the cost of a [`HessJet`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TanJet {
-    /// Value.
-    pub v: f64,
-    /// Gradient.
-    pub g: [f64; NV],
-    /// Derivative along the seeded direction (`g . w`).
-    pub d: f64,
-    /// Gradient of `d` (`H w`).
-    pub dg: [f64; NV],
-}
-
-impl TanJet {
-    /// Independent variable number `i` with value `x` and direction component `w`.
-    #[inline(always)]
-    pub fn var(i: usize, x: f64, w: f64) -> Self {
-        let mut g = [0.0; NV];
-        g[i] = 1.0;
-        TanJet {
-            v: x,
-            g,
-            d: w,
-            dg: [0.0; NV],
-        }
-    }
-    /// `f(self)` from `f`, `f'` and `f''` at the value: `d f = f' d`,
-    /// `grad(f' d) = f'' d grad + f' grad d`.
-    #[inline(always)]
-    fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
-        let mut out = TanJet {
-            v: f,
-            g: [0.0; NV],
-            d: df * self.d,
-            dg: [0.0; NV],
-        };
-        let c = ddf * self.d;
-        for i in 0..NV {
-            out.g[i] = df * self.g[i];
-            out.dg[i] = c * self.g[i] + df * self.dg[i];
-        }
-        out
-    }
-}
-
-impl Add for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, o: Self) -> Self {
-        self.v += o.v;
-        self.d += o.d;
-        for i in 0..NV {
-            self.g[i] += o.g[i];
-            self.dg[i] += o.dg[i];
-        }
-        self
-    }
-}
-impl Sub for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, o: Self) -> Self {
-        self.v -= o.v;
-        self.d -= o.d;
-        for i in 0..NV {
-            self.g[i] -= o.g[i];
-            self.dg[i] -= o.dg[i];
-        }
-        self
-    }
-}
-impl Mul for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        let mut out = TanJet {
-            v: self.v * o.v,
-            g: [0.0; NV],
-            d: self.d * o.v + self.v * o.d,
-            dg: [0.0; NV],
-        };
-        for i in 0..NV {
-            out.g[i] = self.g[i] * o.v + self.v * o.g[i];
-            out.dg[i] = self.dg[i] * o.v + self.d * o.g[i] + self.g[i] * o.d + self.v * o.dg[i];
-        }
-        out
-    }
-}
-impl Neg for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self * -1.0
-    }
-}
-impl Add<f64> for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
-impl Mul<f64> for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(mut self, c: f64) -> Self {
-        self.v *= c;
-        self.d *= c;
-        for i in 0..NV {
-            self.g[i] *= c;
-            self.dg[i] *= c;
-        }
-        self
-    }
-}
-impl Scalar for TanJet {
-    #[inline(always)]
-    fn cst(v: f64) -> Self {
-        TanJet {
-            v,
-            g: [0.0; NV],
-            d: 0.0,
-            dg: [0.0; NV],
-        }
-    }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = self.v.sin_cos();
-        (self.chain(s, c, -s), self.chain(c, -s, -c))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        let r = self.v.sqrt();
-        self.chain(r, 0.5 / r, -0.25 / (r * self.v))
-    }
-}
-
-/// Value, gradient and full Hessian with respect to the 6 local variables.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HessJet {
-    /// Value.
-    pub v: f64,
-    /// Gradient.
-    pub g: [f64; NV],
-    /// Hessian (symmetric).
-    pub h: [[f64; NV]; NV],
-}
-
-impl HessJet {
-    /// Independent variable number `i` with value `x`.
-    #[inline(always)]
-    pub fn var(i: usize, x: f64) -> Self {
-        let mut g = [0.0; NV];
-        g[i] = 1.0;
-        HessJet {
-            v: x,
-            g,
-            h: [[0.0; NV]; NV],
-        }
-    }
-    #[inline(always)]
-    fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
-        let mut out = HessJet {
-            v: f,
-            g: [0.0; NV],
-            h: [[0.0; NV]; NV],
-        };
-        for i in 0..NV {
-            out.g[i] = df * self.g[i];
-            for j in 0..NV {
-                // `g_i * g_j` first so the Hessian stays exactly symmetric in floating point
-                out.h[i][j] = ddf * (self.g[i] * self.g[j]) + df * self.h[i][j];
-            }
-        }
-        out
-    }
-}
-
-impl Add for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, o: Self) -> Self {
-        self.v += o.v;
-        for i in 0..NV {
-            self.g[i] += o.g[i];
-            for j in 0..NV {
-                self.h[i][j] += o.h[i][j];
-            }
-        }
-        self
-    }
-}
-impl Sub for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        self + o * -1.0
-    }
-}
-impl Mul for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        let mut out = HessJet {
-            v: self.v * o.v,
-            g: [0.0; NV],
-            h: [[0.0; NV]; NV],
-        };
-        for i in 0..NV {
-            out.g[i] = self.g[i] * o.v + o.g[i] * self.v;
-            for j in 0..NV {
-                out.h[i][j] = self.h[i][j] * o.v
-                    + o.h[i][j] * self.v
-                    + self.g[i] * o.g[j]
-                    + o.g[i] * self.g[j];
-            }
-        }
-        out
-    }
-}
-impl Neg for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self * -1.0
-    }
-}
-impl Add<f64> for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
-impl Mul<f64> for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(mut self, c: f64) -> Self {
-        self.v *= c;
-        for i in 0..NV {
-            self.g[i] *= c;
-            for j in 0..NV {
-                self.h[i][j] *= c;
-            }
-        }
-        self
-    }
-}
-impl Scalar for HessJet {
-    #[inline(always)]
-    fn cst(v: f64) -> Self {
-        HessJet {
-            v,
-            g: [0.0; NV],
-            h: [[0.0; NV]; NV],
-        }
-    }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = self.v.sin_cos();
-        (self.chain(s, c, -s), self.chain(c, -s, -c))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        let r = self.v.sqrt();
-        self.chain(r, 0.5 / r, -0.25 / (r * self.v))
-    }
-}
-
-/// Value and first derivative along one direction (a dual number): the velocity constraint
-/// `Phi_q v` at the cost of about two `f64` evaluations, without the gradient.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Dual {
-    /// Value.
-    pub v: f64,
-    /// Derivative along the seeded direction.
-    pub d: f64,
-}
-
-impl Dual {
-    /// A variable with value `x` and direction component `dir`.
-    #[inline(always)]
-    pub fn var(x: f64, dir: f64) -> Self {
-        Dual { v: x, d: dir }
-    }
-}
-
-impl Add for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        Dual {
-            v: self.v + o.v,
-            d: self.d + o.d,
-        }
-    }
-}
-impl Sub for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        Dual {
-            v: self.v - o.v,
-            d: self.d - o.d,
-        }
-    }
-}
-impl Mul for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        Dual {
-            v: self.v * o.v,
-            d: self.d * o.v + self.v * o.d,
-        }
-    }
-}
-impl Neg for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Dual {
-            v: -self.v,
-            d: -self.d,
-        }
-    }
-}
-impl Add<f64> for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
-impl Mul<f64> for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, c: f64) -> Self {
-        Dual {
-            v: self.v * c,
-            d: self.d * c,
-        }
-    }
-}
-impl Scalar for Dual {
-    #[inline(always)]
-    fn cst(v: f64) -> Self {
-        Dual { v, d: 0.0 }
-    }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = self.v.sin_cos();
-        (
-            Dual {
-                v: s,
-                d: c * self.d,
-            },
-            Dual {
-                v: c,
-                d: -s * self.d,
-            },
-        )
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        let r = self.v.sqrt();
-        Dual {
-            v: r,
-            d: 0.5 / r * self.d,
-        }
-    }
-}
-
 /// A body's coordinates `(x, y, theta)` with `cos theta` and `sin theta` evaluated once, so the
 /// points and directions of one element share them (and ground costs no trigonometry).
 #[derive(Clone, Copy, Debug)]
@@ -725,6 +187,31 @@ mod tests {
             assert!((tj.g[i] - h.g[i]).abs() < 1e-14, "TanJet grad {i}");
             let hw: f64 = (0..6).map(|j| h.h[i][j] * dir[j]).sum();
             assert!((tj.dg[i] - hw).abs() < 1e-13, "TanJet H w {i}");
+        }
+        // ThirdJet: H w, w^T H w and grad(w^T H w) against differences of the HessJet
+        let t3 = f(std::array::from_fn(|i| ThirdJet::var(i, x0[i], dir[i])));
+        assert!((t3.v - h.v).abs() < 1e-15);
+        assert!((t3.d1 - d.d1).abs() < 1e-14);
+        assert!((t3.d2 - vhv).abs() < 1e-12);
+        let quad = |x: [f64; 6]| -> f64 {
+            let hh = f(std::array::from_fn(|k| HessJet::var(k, x[k]))).h;
+            (0..6)
+                .map(|i| (0..6).map(|j| dir[i] * hh[i][j] * dir[j]).sum::<f64>())
+                .sum()
+        };
+        for i in 0..6 {
+            assert!((t3.g[i] - h.g[i]).abs() < 1e-14, "ThirdJet grad {i}");
+            let hw: f64 = (0..6).map(|j| h.h[i][j] * dir[j]).sum();
+            assert!((t3.g1[i] - hw).abs() < 1e-13, "ThirdJet H w {i}");
+            let (mut xp, mut xm) = (x0, x0);
+            xp[i] += e;
+            xm[i] -= e;
+            let fd3 = (quad(xp) - quad(xm)) / (2.0 * e);
+            assert!(
+                (t3.g2[i] - fd3).abs() < 1e-7,
+                "ThirdJet D3 {i}: {} vs {fd3}",
+                t3.g2[i]
+            );
         }
         let du = f(std::array::from_fn(|i| Dual::var(x0[i], dir[i])));
         assert!((du.v - d.v).abs() < 1e-15);

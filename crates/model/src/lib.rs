@@ -59,6 +59,7 @@ pub mod models;
 pub mod numeric;
 mod scale;
 mod system;
+mod third;
 mod timefn;
 
 pub use body::{Body, BodyHandle, BodyRef};

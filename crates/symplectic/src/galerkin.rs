@@ -56,9 +56,9 @@ pub struct Galerkin {
     hc: DMatrix<f64>,
     wgrad: Vec<f64>,
     wh: DMatrix<f64>,
-    pre: Option<Preadjustment>,
+    pre: Vec<Preadjustment>,
     /// The modified-Lagrangian workspace (`PreadjustMode::ModifiedLagrangian`, `s = 1`).
-    ml: Option<Preadjustment>,
+    ml: Vec<Preadjustment>,
     /// `h^2 d e / d q` at the two control points of the step.
     mlq: [Vec<f64>; 2],
     /// `h^2 (d e / d v (Q_0) + d e / d v (Q_1)) / 2`.
@@ -123,19 +123,26 @@ impl Galerkin {
         };
         // the dense matrices are not allocated on the sparse path
         let (nd, md) = if use_sparse { (0, 0) } else { (n, m) };
+        // one workspace per Gauss point (W_s) or per control point (modified Lagrangian), so
+        // each keeps its evaluation while its point does not move
+        let workspaces = |count: usize, degree: usize| -> Result<Vec<Preadjustment>, SolveError> {
+            (0..count)
+                .map(|_| {
+                    let mut p = Preadjustment::new(sys, degree)?;
+                    p.fd_step = options.fd_step;
+                    Ok(p)
+                })
+                .collect()
+        };
         let pre = if options.gamma != 0.0 {
-            let mut p = Preadjustment::new(sys, s)?;
-            p.fd_step = options.fd_step;
-            Some(p)
+            workspaces(s, s)?
         } else {
-            None
+            Vec::new()
         };
         let ml = if modlag {
-            let mut p = Preadjustment::new(sys, 1)?;
-            p.fd_step = options.fd_step;
-            Some(p)
+            workspaces(2, 1)?
         } else {
-            None
+            Vec::new()
         };
         let nl = if modlag { n } else { 0 };
         Ok(Galerkin {
@@ -340,7 +347,7 @@ impl Galerkin {
             let qj = &self.qj[j * n..(j + 1) * n];
             let gj = &mut self.gj[j * n..(j + 1) * n];
             sys.potential_gradient(qj, gj);
-            if let Some(pre) = &mut self.pre {
+            if let Some(pre) = self.pre.get_mut(j) {
                 pre.gradient(sys, qj, &mut self.wgrad)
                     .map_err(|e| with_time(e, t))?;
                 for i in 0..n {
@@ -358,14 +365,19 @@ impl Galerkin {
                 }
             }
         }
-        if let Some(ml) = &mut self.ml {
+        if !self.ml.is_empty() {
             // s = 1: the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h
             let h2 = h * h;
+            // the end point of the last step is this step's start point: reuse its evaluation
+            if !self.ml[0].is_prepared_at(&self.qn[..n]) && self.ml[1].is_prepared_at(&self.qn[..n])
+            {
+                self.ml.swap(0, 1);
+            }
             for i in 0..n {
                 self.mlvel[i] = self.hvj[i] / h;
             }
             self.mlv.fill(0.0);
-            for c in 0..2 {
+            for (c, ml) in self.ml.iter_mut().enumerate() {
                 ml.modified_gradients(
                     sys,
                     &self.qn[c * n..(c + 1) * n],
@@ -440,7 +452,7 @@ impl Galerkin {
                 self.r[nu * n + i] = res;
             }
         }
-        if self.ml.is_some() {
+        if !self.ml.is_empty() {
             // s = 1: h M^-1 D_1 of h (E(Q_0, v) + E(Q_1, v)) / 2, v = (Q_1 - Q_0) / h
             for i in 0..n {
                 self.r[i] += h * self.minv[i] * (0.5 * h * self.mlq[0][i] - self.mlv[i]);
@@ -509,7 +521,7 @@ impl Integrator for Galerkin {
         if self.opts.gamma != 0.0 {
             name += &format!(" gamma = {}", self.opts.gamma);
         }
-        if self.ml.is_some() {
+        if !self.ml.is_empty() {
             name += " modified Lagrangian";
         }
         if self.opts.nodes == Nodes::Equispaced && s > 2 {
@@ -578,7 +590,7 @@ impl Integrator for Galerkin {
                 *fi += bj * g;
             }
         }
-        if self.ml.is_some() {
+        if !self.ml.is_empty() {
             // (D_1 + D_2) of h (E(Q_0, v) + E(Q_1, v)) / 2 = h (dE/dq (Q_0) + dE/dq (Q_1)) / 2
             for i in 0..n {
                 f[i] -= 0.5 * (self.mlq[0][i] + self.mlq[1][i]);

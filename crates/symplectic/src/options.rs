@@ -56,9 +56,11 @@ pub struct SymplecticOptions {
     /// the update at least 4x (`jacobian_every = 1`: full Newton; default 6). See
     /// `docs/symplectic.md` for why the predictor is never accepted without an update.
     pub newton: NewtonOptions,
-    /// Relative step of the central differences used for the third derivatives of `V` and `Phi`
-    /// in `grad W_s` (`s >= 2` with `gamma != 0`), Richardson-extrapolated (error `O(eps^4)`);
-    /// also the step of the position gradient of the modified-Lagrangian term.
+    /// Relative step of the finite-difference checks of the preadjustment's derivatives
+    /// ([`crate::Preadjustment::fd_step`]). The integrator itself no longer differentiates
+    /// numerically: the third derivatives of `V` and `Phi` in `grad W_s` and in the
+    /// modified-Lagrangian gradient are exact (`mbd_model::System::potential_third`,
+    /// `constraint_third`). Still validated (finite, in `(0, 1)`).
     pub fd_step: f64,
     /// Start a step with the factored Jacobian of the previous step (same `h`) instead of a new
     /// one; it is recomputed as soon as the simplified Newton iteration contracts by less than

@@ -32,7 +32,7 @@ impl Galerkin {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let s1 = s + 1;
         sys.phi_q(&self.qn[s * n..(s + 1) * n], &mut self.phiq[s]);
-        let any_hessian = self.has_forces || self.pre.is_some() || self.nonconservative;
+        let any_hessian = self.has_forces || !self.pre.is_empty() || self.nonconservative;
         for j in 0..s {
             if !any_hessian {
                 self.hess_nz[j] = false;
@@ -44,7 +44,7 @@ impl Galerkin {
             } else {
                 self.hq[j].fill(0.0);
             }
-            if let Some(pre) = &mut self.pre {
+            if let Some(pre) = self.pre.get_mut(j) {
                 pre.approximate_hessian(sys, qj, &mut self.wh)
                     .map_err(|e| with_time(e, t))?;
                 for (a, b) in self.hq[j].iter_mut().zip(self.wh.iter()) {
@@ -100,15 +100,16 @@ impl Galerkin {
         // -h M^-1 (h^2 / 12) (B(Q_0) + B(Q_1)) v, B = A + H_sigma = 6 d^2 e / dv^2, differentiated
         // in Z_1 = h v with B frozen; the rest of the modified terms' Jacobian is O(h^2) smaller
         // and left out (docs/symplectic.md, section 5a)
-        if let Some(ml) = &mut self.ml {
+        if !self.ml.is_empty() {
             for c in 0..2 {
-                ml.modified_velocity_hessian(
-                    sys,
-                    &self.qn[c * n..(c + 1) * n],
-                    &self.mlvel,
-                    &mut self.wh,
-                )
-                .map_err(|e| with_time(e, t))?;
+                self.ml[c]
+                    .modified_velocity_hessian(
+                        sys,
+                        &self.qn[c * n..(c + 1) * n],
+                        &self.mlvel,
+                        &mut self.wh,
+                    )
+                    .map_err(|e| with_time(e, t))?;
                 let jm = &mut self.lu;
                 for l in 0..n {
                     for i in 0..n {

@@ -1,0 +1,154 @@
+//! [`DirJet`]: value, gradient and two derivatives along one direction.
+
+use super::{Scalar, NV};
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// Value, gradient (6 local variables) and first/second derivative along one direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirJet {
+    /// Value.
+    pub v: f64,
+    /// Gradient with respect to the 6 local variables.
+    pub g: [f64; NV],
+    /// First derivative along the seeded direction (`g . dir`).
+    pub d1: f64,
+    /// Second derivative along the seeded direction (`dir^T H dir`).
+    pub d2: f64,
+}
+
+impl DirJet {
+    /// Independent variable number `i` with value `x` and direction component `dir`.
+    #[inline(always)]
+    pub fn var(i: usize, x: f64, dir: f64) -> Self {
+        let mut g = [0.0; NV];
+        g[i] = 1.0;
+        DirJet {
+            v: x,
+            g,
+            d1: dir,
+            d2: 0.0,
+        }
+    }
+    #[inline(always)]
+    fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
+        let mut g = [0.0; NV];
+        for k in 0..NV {
+            g[k] = df * self.g[k];
+        }
+        DirJet {
+            v: f,
+            g,
+            d1: df * self.d1,
+            d2: ddf * self.d1 * self.d1 + df * self.d2,
+        }
+    }
+}
+
+impl Add for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        let mut g = self.g;
+        for k in 0..NV {
+            g[k] += o.g[k];
+        }
+        DirJet {
+            v: self.v + o.v,
+            g,
+            d1: self.d1 + o.d1,
+            d2: self.d2 + o.d2,
+        }
+    }
+}
+impl Sub for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        let mut g = self.g;
+        for k in 0..NV {
+            g[k] -= o.g[k];
+        }
+        DirJet {
+            v: self.v - o.v,
+            g,
+            d1: self.d1 - o.d1,
+            d2: self.d2 - o.d2,
+        }
+    }
+}
+impl Mul for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        let mut g = [0.0; NV];
+        for k in 0..NV {
+            g[k] = self.g[k] * o.v + o.g[k] * self.v;
+        }
+        DirJet {
+            v: self.v * o.v,
+            g,
+            d1: self.d1 * o.v + self.v * o.d1,
+            d2: self.d2 * o.v + 2.0 * self.d1 * o.d1 + self.v * o.d2,
+        }
+    }
+}
+impl Neg for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self * -1.0
+    }
+}
+impl Add<f64> for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, c: f64) -> Self {
+        self.v += c;
+        self
+    }
+}
+impl Sub<f64> for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(mut self, c: f64) -> Self {
+        self.v -= c;
+        self
+    }
+}
+impl Mul<f64> for DirJet {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, c: f64) -> Self {
+        let mut g = self.g;
+        for x in g.iter_mut() {
+            *x *= c;
+        }
+        DirJet {
+            v: self.v * c,
+            g,
+            d1: self.d1 * c,
+            d2: self.d2 * c,
+        }
+    }
+}
+impl Scalar for DirJet {
+    #[inline(always)]
+    fn cst(v: f64) -> Self {
+        DirJet {
+            v,
+            g: [0.0; NV],
+            d1: 0.0,
+            d2: 0.0,
+        }
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (self.chain(s, c, -s), self.chain(c, -s, -c))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let r = self.v.sqrt();
+        self.chain(r, 0.5 / r, -0.25 / (r * self.v))
+    }
+}

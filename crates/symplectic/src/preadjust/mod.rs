@@ -1,0 +1,269 @@
+//! The preadjustment potential `W_s(q)` of paper A and its gradient.
+//!
+//! With `g = grad V`, `G = Phi_q`, `S = G M^-1 G^T` and the symmetric `M^-1`-projector
+//! `Pi = M^-1 - M^-1 G^T S^-1 G M^-1` (so `Pi = M^-1 P` with `P = I - G^T S^-1 G M^-1`):
+//!
+//! * tangential force `f_T = P (-g)`, its velocity-like image `u = M^-1 f_T = -Pi g`,
+//! * rest multipliers `mu0 = S^-1 G M^-1 g` (so `f_T = -g + G^T mu0`),
+//! * tangential stiffness `K_T = -d f_T / dq = P A + G^T S^-1 B` with the symmetric
+//!   `A = Hess V - sum_k mu0_k Hess Phi_k`, so `P K_T = P A`,
+//! * `W_1 = 1/2 f_T^T M^-1 f_T = 1/2 u^T M u`,
+//!   `W_s = 1/2 f_T^T M^-1 (P K_T M^-1)^(s-1) f_T = 1/2 u^T A (Pi A)^(s-2) u` for `s >= 2`.
+//!
+//! For `s = 1, 2` this is exactly the `W_s` of methods.md 2.2; for `s >= 3` the projector `P`
+//! between the factors keeps the modal form `W_s = 1/2 sum_i omega_i^(2s+2) eta_i^2` about an
+//! equilibrium (without it the normal components of `K_T` would enter). The gradient is exact:
+//! the third derivatives of `V` and `Phi` it needs for `s >= 2` come from
+//! [`System::potential_third`] and [`System::constraint_third`]. The Newton Jacobian uses `A (Pi A)^s`, the exact Hessian of `W_s`
+//! at an equilibrium (`f_T = 0`).
+
+use mbd_model::System;
+use mbd_solve::linalg::DenseCholesky;
+use mbd_solve::SolveError;
+use nalgebra::DMatrix;
+
+mod modified;
+mod paper;
+
+/// Workspace evaluating `W_s`, its gradient and an approximate Hessian (allocation-free after
+/// [`Preadjustment::new`]).
+#[derive(Debug)]
+pub struct Preadjustment {
+    s: usize,
+    n: usize,
+    m: usize,
+    mass: Vec<f64>,
+    minv: Vec<f64>,
+    /// Relative step of the finite-difference checks of the derivatives (tests); the
+    /// derivatives used by the integrator are exact.
+    pub fd_step: f64,
+    g: Vec<f64>,
+    gq: DMatrix<f64>,
+    chol: DenseCholesky,
+    mu0: Vec<f64>,
+    u: Vec<f64>,
+    amat: DMatrix<f64>,
+    av: Vec<Vec<f64>>,
+    bv: Vec<Vec<f64>>,
+    sig: Vec<Vec<f64>>,
+    tn: [Vec<f64>; 4],
+    tm: [Vec<f64>; 3],
+    zero: Vec<f64>,
+    gc: Vec<f64>,
+    gc0: Vec<f64>,
+    sigma: Vec<f64>,
+    cm: Vec<f64>,
+    /// The point of the last successful `prepare` (its results are reused when `q` repeats
+    /// bit for bit: the control point `q_1` of one step is `q_0` of the next, and the Newton
+    /// Jacobian is evaluated where the residual was).
+    at: Vec<f64>,
+    at_valid: bool,
+    /// Whether `amat` holds `A` at `at`.
+    a_valid: bool,
+    nmu0: Vec<f64>,
+    hv: Vec<f64>,
+    d3: Vec<f64>,
+    rheonomic: bool,
+}
+
+pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
+    let n = a.nrows();
+    out.iter_mut().for_each(|o| *o = 0.0);
+    for (j, &xj) in x.iter().enumerate() {
+        if xj == 0.0 {
+            continue;
+        }
+        let col = &a.as_slice()[j * n..(j + 1) * n];
+        for i in 0..n {
+            out[i] += col[i] * xj;
+        }
+    }
+}
+
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+impl Preadjustment {
+    /// A workspace for `W_s` on `sys`.
+    pub fn new(sys: &System, s: usize) -> Result<Self, SolveError> {
+        if s == 0 {
+            return Err(SolveError::InvalidParameter {
+                parameter: "s",
+                value: 0.0,
+                reason: "W_s needs s >= 1",
+            });
+        }
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        Ok(Preadjustment {
+            s,
+            n,
+            m,
+            mass: sys.mass_diag().as_slice().to_vec(),
+            minv: sys.inv_mass_diag().as_slice().to_vec(),
+            fd_step: 2e-3,
+            g: vec![0.0; n],
+            gq: DMatrix::zeros(m, n),
+            chol: DenseCholesky::new(m),
+            mu0: vec![0.0; m],
+            u: vec![0.0; n],
+            amat: DMatrix::zeros(n, n),
+            av: vec![vec![0.0; n]; s + 1],
+            bv: vec![vec![0.0; n]; s + 1],
+            sig: vec![vec![0.0; m]; s.max(1)],
+            tn: std::array::from_fn(|_| vec![0.0; n]),
+            tm: std::array::from_fn(|_| vec![0.0; m]),
+            zero: vec![0.0; n],
+            gc: vec![0.0; m],
+            gc0: vec![0.0; m],
+            sigma: vec![0.0; m],
+            cm: vec![0.0; m],
+            at: vec![0.0; n],
+            at_valid: false,
+            a_valid: false,
+            nmu0: vec![0.0; m],
+            hv: vec![0.0; n],
+            d3: vec![0.0; n],
+            rheonomic: sys.is_rheonomic(),
+        })
+    }
+
+    /// The degree `s`.
+    pub fn s(&self) -> usize {
+        self.s
+    }
+
+    /// `x -> Pi x` (`Pi = M^-1 P`); uses `tm[0]`.
+    pub(crate) fn apply_pi(&mut self, x: &[f64], out: &mut [f64]) {
+        let (n, m) = (self.n, self.m);
+        for i in 0..n {
+            out[i] = self.minv[i] * x[i];
+        }
+        if m == 0 {
+            return;
+        }
+        let t = &mut self.tm[0];
+        for r in 0..m {
+            t[r] = (0..n).map(|k| self.gq[(r, k)] * out[k]).sum();
+        }
+        self.chol.solve_in_place(t);
+        for k in 0..n {
+            let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * t[r]).sum();
+            out[k] -= self.minv[k] * acc;
+        }
+    }
+
+    /// `out = S^-1 G M^-1 x` (length m).
+    pub(crate) fn sgm(&mut self, x: &[f64], out: &mut [f64]) {
+        let (n, m) = (self.n, self.m);
+        for r in 0..m {
+            out[r] = (0..n).map(|k| self.gq[(r, k)] * self.minv[k] * x[k]).sum();
+        }
+        self.chol.solve_in_place(out);
+    }
+
+    /// Whether the workspace holds the evaluation at exactly `q` (bit for bit).
+    pub(crate) fn is_prepared_at(&self, q: &[f64]) -> bool {
+        self.at_valid && self.at.as_slice() == q
+    }
+
+    /// Evaluates `g`, `G`, the Cholesky factor of `S`, `mu0` and `u` at `q` (nothing when they
+    /// are held for `q`). `A` is assembled only on demand ([`Preadjustment::ensure_a`]): the
+    /// gradients use Hessian-vector products instead.
+    fn prepare(&mut self, sys: &System, q: &[f64]) -> Result<(), SolveError> {
+        let (n, m) = (self.n, self.m);
+        if q.len() != n {
+            return Err(SolveError::Dimension {
+                what: "q for W_s",
+                expected: n,
+                got: q.len(),
+            });
+        }
+        if self.is_prepared_at(q) {
+            return Ok(());
+        }
+        self.at_valid = false;
+        self.a_valid = false;
+        sys.potential_gradient(q, &mut self.g);
+        if m > 0 {
+            sys.phi_q(q, &mut self.gq);
+            {
+                let gq = &self.gq;
+                let minv = &self.minv;
+                let mut sm = self.chol.matrix_mut();
+                for c in 0..m {
+                    for r in c..m {
+                        sm[(r, c)] = (0..n).map(|k| gq[(r, k)] * minv[k] * gq[(c, k)]).sum();
+                    }
+                }
+            }
+            self.chol
+                .factor_in_place()
+                .map_err(|_| SolveError::Singular {
+                    t: f64::NAN,
+                    what: "Phi_q M^-1 Phi_q^T in W_s",
+                    detail: "redundant constraints or a singular configuration".into(),
+                })?;
+            let g = std::mem::take(&mut self.g);
+            let mut mu0 = std::mem::take(&mut self.mu0);
+            self.sgm(&g, &mut mu0);
+            self.g = g;
+            self.mu0 = mu0;
+        }
+        for k in 0..n {
+            let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * self.mu0[r]).sum();
+            self.u[k] = self.minv[k] * (acc - self.g[k]);
+        }
+        for r in 0..m {
+            self.nmu0[r] = -self.mu0[r];
+        }
+        self.at.copy_from_slice(q);
+        self.at_valid = true;
+        Ok(())
+    }
+
+    /// Assembles `A = Hess V - mu0 . Hess Phi` after `prepare(q)` (once per point).
+    fn ensure_a(&mut self, sys: &System, q: &[f64]) {
+        if self.a_valid {
+            return;
+        }
+        sys.potential_hessian(q, &mut self.amat);
+        if self.m > 0 {
+            sys.add_constraint_hessian(q, &self.mu0, -1.0, &mut self.amat);
+        }
+        self.a_valid = true;
+    }
+
+    /// `out = A x` without assembling `A` (one Hessian-vector pass), after `prepare(q)`.
+    fn a_times(&self, sys: &System, q: &[f64], x: &[f64], out: &mut [f64]) {
+        sys.lagrangian_hessian_vector(q, x, 1.0, &self.nmu0, out);
+    }
+
+    /// Krylov vectors `a_0 = u`, `a_{i+1} = Pi b_i` with `b_i = A a_i`, for `i < count`
+    /// (`b_i` in `bv[i]`).
+    pub(crate) fn krylov(&mut self, sys: &System, q: &[f64], count: usize) {
+        self.av[0].copy_from_slice(&self.u);
+        for i in 0..count {
+            let mut b = std::mem::take(&mut self.bv[i]);
+            self.a_times(sys, q, &self.av[i], &mut b);
+            let mut next = std::mem::take(&mut self.av[i + 1]);
+            self.apply_pi(&b, &mut next);
+            self.av[i + 1] = next;
+            self.bv[i] = b;
+        }
+    }
+
+    /// The tangential force `f_T(q) = P(q) (-grad V(q))` into `out`.
+    pub fn tangential_force(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), SolveError> {
+        self.prepare(sys, q)?;
+        for k in 0..self.n {
+            out[k] = self.mass[k] * self.u[k];
+        }
+        Ok(())
+    }
+}

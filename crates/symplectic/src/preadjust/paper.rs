@@ -1,0 +1,196 @@
+//! Paper A's `W_s`: value, gradient (exact third derivatives) and the Newton Hessian.
+
+use super::{dot, matvec, Preadjustment};
+use mbd_model::System;
+use mbd_solve::SolveError;
+use nalgebra::DMatrix;
+
+impl Preadjustment {
+    /// `W_s(q)`.
+    pub fn value(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
+        self.prepare(sys, q)?;
+        Ok(self.value_prepared(sys, q))
+    }
+
+    fn value_prepared(&mut self, sys: &System, q: &[f64]) -> f64 {
+        let s = self.s;
+        if s == 1 {
+            return 0.5
+                * (0..self.n)
+                    .map(|k| self.mass[k] * self.u[k] * self.u[k])
+                    .sum::<f64>();
+        }
+        // W_s = 1/2 u^T b_{s-2}, b_i = A a_i
+        self.krylov(sys, q, s - 1);
+        0.5 * dot(&self.u, &self.bv[s - 2])
+    }
+
+    /// `grad W_s(q)` into `out`; returns `W_s(q)`. Matrix-free: every product with `A` or
+    /// with a weighted constraint Hessian is one Hessian-vector pass over the elements
+    /// ([`System::lagrangian_hessian_vector`]), the third derivatives are exact.
+    pub fn gradient(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        out: &mut [f64],
+    ) -> Result<f64, SolveError> {
+        self.prepare(sys, q)?;
+        let (n, m, s) = (self.n, self.m, self.s);
+        if s == 1 {
+            // grad W_1 = -A u (exact: only second derivatives enter)
+            self.a_times(sys, q, &self.u, out);
+            out.iter_mut().for_each(|x| *x = -*x);
+            return Ok(self.value_prepared(sys, q));
+        }
+        let l = s - 2;
+        // a_0..a_{l+1}, b_k = A a_k (k = 0..=l); sigma_k = S^-1 G M^-1 b_k
+        self.krylov(sys, q, l + 1);
+        if m > 0 {
+            for k in 0..=l {
+                let mut sg = std::mem::take(&mut self.sig[k]);
+                let b = std::mem::take(&mut self.bv[k]);
+                self.sgm(&b, &mut sg);
+                self.bv[k] = b;
+                self.sig[k] = sg;
+            }
+        }
+        let w = 0.5 * dot(&self.u, &self.bv[l]);
+        // (2b): h_k = 1/2 sum_i a_i^T H_k a_{l-i} (polarised gamma); rho = S^-1 h
+        let mut h = std::mem::take(&mut self.tm[1]);
+        h.iter_mut().for_each(|x| *x = 0.0);
+        if m > 0 {
+            let mut g1 = std::mem::take(&mut self.tm[2]);
+            for i in 0..=l {
+                let (ai, ac) = (&self.av[i], &self.av[l - i]);
+                let vp = &mut self.tn[1];
+                for k in 0..n {
+                    vp[k] = ai[k] + ac[k];
+                }
+                sys.gamma(q, vp, 0.0, &mut g1);
+                for r in 0..m {
+                    h[r] -= 0.125 * g1[r];
+                }
+                for k in 0..n {
+                    vp[k] = ai[k] - ac[k];
+                }
+                sys.gamma(q, vp, 0.0, &mut g1);
+                for r in 0..m {
+                    h[r] += 0.125 * g1[r];
+                }
+            }
+            self.tm[2] = g1;
+            self.chol.solve_in_place(&mut h); // rho
+        }
+        // (1)+(2b'): -A (a_{l+1} + M^-1 G^T rho)
+        {
+            let t2 = &mut self.tn[2];
+            for k in 0..n {
+                let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * h[r]).sum();
+                t2[k] = self.av[l + 1][k] + self.minv[k] * acc;
+            }
+        }
+        self.a_times(sys, q, &self.tn[2], out);
+        out.iter_mut().for_each(|x| *x = -*x);
+        // (3)+(2b''): -sum_j (sigma_{l-j} . H) a_j + (rho . H) a_0
+        if m > 0 {
+            let mut t = std::mem::take(&mut self.tn[0]);
+            let mut wts = std::mem::take(&mut self.cm);
+            for j in 0..=l {
+                for r in 0..m {
+                    wts[r] = self.sig[l - j][r] - if j == 0 { h[r] } else { 0.0 };
+                }
+                sys.lagrangian_hessian_vector(q, &self.av[j], 0.0, &wts, &mut t);
+                for i in 0..n {
+                    out[i] -= t[i];
+                }
+            }
+            self.cm = wts;
+            self.tn[0] = t;
+        }
+        self.tm[1] = h;
+        // (2a): 1/2 sum_i (D_{a_i} A~) a_{l-i}, A~ = Hess V - mu0 . Hess Phi with mu0 frozen
+        // (exact third derivatives)
+        for i in 0..=l {
+            let j = l - i;
+            if i > j {
+                break;
+            }
+            let factor = if i == j { 0.5 } else { 1.0 };
+            self.third_derivative(sys, q, i, j, factor, out);
+        }
+        Ok(w)
+    }
+
+    /// `out += factor * (D_{a_i} A~) a_j = factor * D^3 (V - mu0 . Phi)(a_i, a_j, .)` (`mu0`
+    /// frozen), exact: [`System::potential_third`] and [`System::constraint_third`] along
+    /// `a_i` when `i = j`, by polarisation along `a_i +- a_j` otherwise.
+    fn third_derivative(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        i: usize,
+        j: usize,
+        factor: f64,
+        out: &mut [f64],
+    ) {
+        let n = self.n;
+        let mut dir = std::mem::take(&mut self.tn[1]);
+        let signs: &[f64] = if i == j { &[1.0] } else { &[1.0, -1.0] };
+        for &sg in signs {
+            for k in 0..n {
+                dir[k] = self.av[i][k] + if i == j { 0.0 } else { sg * self.av[j][k] };
+            }
+            let c = if i == j { factor } else { 0.25 * sg * factor };
+            sys.add_potential_third(q, &dir, c, out);
+            if self.m > 0 {
+                sys.add_constraint_third(q, &dir, &self.mu0, -c, out);
+            }
+        }
+        self.tn[1] = dir;
+    }
+
+    /// An approximate Hessian of `W_s` for Newton: `A (Pi A)^s` (exact at an equilibrium),
+    /// symmetrised, into `out` (overwritten).
+    pub fn approximate_hessian(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
+        self.prepare(sys, q)?;
+        self.ensure_a(sys, q);
+        let n = self.n;
+        for c in 0..n {
+            if self.amat.column(c).iter().all(|&a| a == 0.0) {
+                // a coordinate that enters V and the constraints linearly (e.g. the position
+                // of a body with revolute joints under gravity): a zero column and row
+                for r in 0..n {
+                    out[(r, c)] = 0.0;
+                }
+                continue;
+            }
+            let mut x = std::mem::take(&mut self.tn[2]);
+            for r in 0..n {
+                x[r] = self.amat[(r, c)];
+            }
+            let mut y = std::mem::take(&mut self.tn[3]);
+            for _ in 0..self.s {
+                self.apply_pi(&x, &mut y);
+                matvec(&self.amat, &y, &mut x);
+            }
+            for r in 0..n {
+                out[(r, c)] = x[r];
+            }
+            self.tn[2] = x;
+            self.tn[3] = y;
+        }
+        for c in 0..n {
+            for r in c + 1..n {
+                let v = 0.5 * (out[(r, c)] + out[(c, r)]);
+                out[(r, c)] = v;
+                out[(c, r)] = v;
+            }
+        }
+        Ok(())
+    }
+}
