@@ -1,5 +1,14 @@
 //! The modified-Lagrangian term `e(q, v)` of the (1,1) scheme, its gradients (exact third
 //! derivatives) and its velocity Hessian.
+//!
+//! The (1,1) scheme evaluates the potential at the chord's midpoint, so its `h^2` term is the
+//! midpoint form derived in `docs/modified-lagrangian.md` section 2:
+//!
+//! `e = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v - 1/8 v^T Hess V v + 1/24 gamma_c^T S^-1 gamma_c`
+//!
+//! (the trapezoid form without the `-1/8 v^T Hess V v` term, first found by prototype, is right
+//! only where `Hess V = 0`, e.g. gravity alone). In code the velocity terms are one quadratic
+//! form: `1/12 v^T A v - 1/8 v^T Hess V v = 1/12 v^T (POTENTIAL_WEIGHT Hess V - mu0 . Hess Phi) v`.
 
 #[cfg(test)]
 use super::matvec;
@@ -8,11 +17,15 @@ use mbd_model::System;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
+/// Weight of `Hess V` in the velocity quadratic form of `e` (times 1/12): `1 - 12/8`.
+pub(crate) const POTENTIAL_WEIGHT: f64 = -0.5;
+
 impl Preadjustment {
     /// The velocity-dependent modified-Lagrangian term of the (1,1) scheme (without its `h^2`):
-    /// `e(q, v) = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v + 1/24 gamma_c^T S^-1 gamma_c` with
-    /// `gamma_c,k = v^T Hess Phi_k v` (see `docs/symplectic.md`, "Modified-Lagrangian
-    /// preadjustment"). Independent of the `s` of the workspace.
+    /// `e(q, v) = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v - 1/8 v^T Hess V v
+    /// + 1/24 gamma_c^T S^-1 gamma_c` with `gamma_c,k = v^T Hess Phi_k v` (derivation in
+    /// `docs/modified-lagrangian.md`, use in `docs/symplectic.md` section 5a). Independent of the
+    /// `s` of the workspace.
     pub fn modified_term(&mut self, sys: &System, q: &[f64], v: &[f64]) -> Result<f64, SolveError> {
         self.check_v(v)?;
         self.prepare(sys, q)?;
@@ -31,8 +44,10 @@ impl Preadjustment {
     }
 
     /// `e(q, v)` after `prepare(q)`; leaves `gamma_c` in `gc`, `S^-1 gamma_c` in `sigma`,
-    /// `sigma - mu0` in `cm`, `(A + H_sigma) v` in `hv` and `D^3 (V + (sigma - mu0) . Phi)(v, v, .)`
-    /// in `d3` (one third-order pass over the elements, no Hessian assembled).
+    /// `sigma - mu0` in `cm`, `B v` in `hv` with `B = A + H_sigma - 3/2 Hess V =
+    /// POTENTIAL_WEIGHT Hess V + (sigma - mu0) . Hess Phi`, and
+    /// `D^3 (POTENTIAL_WEIGHT V + (sigma - mu0) . Phi)(v, v, .)` in `d3` (one third-order pass over
+    /// the elements, no Hessian assembled).
     fn modified_prepared(&mut self, sys: &System, q: &[f64], v: &[f64]) -> f64 {
         let (n, m) = (self.n, self.m);
         let uu: f64 = (0..n).map(|k| self.mass[k] * self.u[k] * self.u[k]).sum();
@@ -55,8 +70,8 @@ impl Preadjustment {
         for r in 0..m {
             self.cm[r] = self.sigma[r] - self.mu0[r];
         }
-        sys.lagrangian_third(q, v, 1.0, &self.cm, &mut self.hv, &mut self.d3);
-        // v^T A v = v^T (A + H_sigma) v - sigma . gamma_c
+        sys.lagrangian_third(q, v, POTENTIAL_WEIGHT, &self.cm, &mut self.hv, &mut self.d3);
+        // v^T (A - 3/2 Hess V) v = v^T B v - sigma . gamma_c
         let vav = dot(v, &self.hv) - gg;
         -uu / 24.0 + vav / 12.0 + gg / 24.0
     }
@@ -98,22 +113,26 @@ impl Preadjustment {
         let e = self.modified_prepared(sys, q, v);
         self.ensure_a(sys, q);
         matvec(&self.amat, v, dv);
+        // + H_sigma v - 3/2 Hess V v
+        let mut hs = DMatrix::zeros(n, n);
+        sys.potential_hessian(q, &mut hs);
+        // amat already holds Hess V once: the weight left to add is POTENTIAL_WEIGHT - 1 = -3/2
+        hs *= POTENTIAL_WEIGHT - 1.0;
         if self.m > 0 {
-            let mut hs = DMatrix::zeros(n, n);
-            sys.constraint_hessian(q, &self.sigma, &mut hs);
-            let mut t = std::mem::take(&mut self.tn[0]);
-            matvec(&hs, v, &mut t);
-            for k in 0..n {
-                dv[k] += t[k];
-            }
-            self.tn[0] = t;
+            sys.add_constraint_hessian(q, &self.sigma, 1.0, &mut hs);
+        }
+        let mut t = vec![0.0; n];
+        matvec(&hs, v, &mut t);
+        for k in 0..n {
+            dv[k] += t[k];
         }
         dv.iter_mut().for_each(|x| *x /= 6.0);
         Ok(e)
     }
 
-    /// `A + H_sigma` at `q` (`H_sigma = sum_k sigma_k Hess Phi_k`, `sigma = S^-1 gamma_c(q, v)`)
-    /// into `out` (overwritten): `6 d^2 e / dv^2`, used for the Newton Jacobian.
+    /// `B = A + H_sigma - 3/2 Hess V` at `q` (`H_sigma = sum_k sigma_k Hess Phi_k`,
+    /// `sigma = S^-1 gamma_c(q, v)`) into `out` (overwritten): `6 d^2 e / dv^2` with `sigma`
+    /// frozen, used for the Newton Jacobian.
     pub fn modified_velocity_hessian(
         &mut self,
         sys: &System,
@@ -124,8 +143,9 @@ impl Preadjustment {
         self.check_v(v)?;
         self.prepare(sys, q)?;
         self.modified_prepared(sys, q, v);
-        // A + H_sigma = Hess V + (sigma - mu0) . Hess Phi, one assembly
+        // B = POTENTIAL_WEIGHT Hess V + (sigma - mu0) . Hess Phi, one assembly
         sys.potential_hessian(q, out);
+        *out *= POTENTIAL_WEIGHT;
         if self.m > 0 {
             sys.add_constraint_hessian(q, &self.cm, 1.0, out);
         }
@@ -136,11 +156,11 @@ impl Preadjustment {
     /// With `sigma = S^-1 gamma_c`, `H_sigma = sum_k sigma_k Hess Phi_k`, `u = M^-1 f_T` and
     /// `w = M^-1 Phi_q^T sigma` (derivation in `docs/symplectic.md`):
     ///
-    /// * `d e / d v = 1/6 (A v + H_sigma v)` (exact),
-    /// * `d e / d q = 1/12 [(A + H_sigma)(u - w) + D^3(V + (sigma - mu0) . Phi)(v, v)]`, where
-    ///   the third-derivative term is the derivative along `v` of `Hess(V + (sigma - mu0) . Phi) v`
-    ///   (`sigma`, `mu0` frozen), exact ([`System::potential_third`],
-    ///   [`System::constraint_third`]).
+    /// * `d e / d v = 1/6 (A + H_sigma - 3/2 Hess V) v` (exact),
+    /// * `d e / d q = 1/12 [(A + H_sigma)(u - w) + D^3(-1/2 V + (sigma - mu0) . Phi)(v, v)]`,
+    ///   where the third-derivative term is the derivative along `v` of
+    ///   `Hess(-1/2 V + (sigma - mu0) . Phi) v` (`sigma`, `mu0` frozen), exact
+    ///   ([`System::lagrangian_third`]).
     pub fn modified_gradients(
         &mut self,
         sys: &System,
@@ -184,34 +204,153 @@ mod modlag_tests {
     use super::*;
     use mbd_model::models;
 
-    /// The analytic position gradient of the modified-Lagrangian term against central
-    /// differences of the term itself, away from equilibrium and with a generic velocity.
+    /// A uniform rod (1 kg, 1 m) pinned at one end to the origin, released 45 degrees from the
+    /// downward vertical, with a spring (30 N/m, rest length 0.5 m) from its tip to the ground
+    /// point (0.6, -1.6): a non-linear potential, so `Hess V != 0` (gravity alone has none).
+    pub(crate) fn rod_with_spring() -> System {
+        use mbd_model::{Body, BodyRef, Force, Joint, SystemBuilder};
+        let th = std::f64::consts::FRAC_PI_4;
+        let mut b = SystemBuilder::new();
+        b.set_gravity([0.0, -9.81]);
+        let rod = b.add_body(Body::new("rod").rod(1.0, 1.0).position(
+            0.5 * th.sin(),
+            -0.5 * th.cos(),
+            th - std::f64::consts::FRAC_PI_2,
+        ));
+        b.add_joint(Joint::revolute(
+            "pin",
+            BodyRef::Ground,
+            [0.0, 0.0],
+            rod,
+            [-0.5, 0.0],
+        ));
+        b.add_force(Force::spring_damper(
+            "spring",
+            rod,
+            [0.5, 0.0],
+            BodyRef::Ground,
+            [0.6, -1.6],
+            30.0,
+            0.0,
+            0.5,
+        ));
+        b.build().unwrap()
+    }
+
+    /// The analytic gradients of the modified-Lagrangian term against central differences of
+    /// the term itself, away from equilibrium and with a generic velocity: on the double
+    /// pendulum (gravity) and on a rod with a spring (where the `-1/8 v^T Hess V v` term and its
+    /// third derivatives matter).
     #[test]
     fn modified_gradient_matches_differences() {
-        let sys = models::paper_a_double_pendulum().unwrap();
-        let st = mbd_solve::State::consistent(&sys, 0.0).unwrap();
-        let n = sys.n_coords();
-        let q: Vec<f64> = st.q.iter().copied().collect();
-        let v: Vec<f64> = (0..n)
-            .map(|i| 0.7 * ((i as f64) * 1.3 + 0.4).sin())
-            .collect();
-        let mut p = Preadjustment::new(&sys, 1).unwrap();
-        let (mut a, mut av, mut b, mut bv) =
-            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        let ea = p.modified_gradients(&sys, &q, &v, &mut a, &mut av).unwrap();
-        let eb = p
-            .modified_gradients_fd(&sys, &q, &v, &mut b, &mut bv)
-            .unwrap();
-        assert_eq!(ea, eb);
-        let scale = b.iter().fold(0.0f64, |x, &y| x.max(y.abs()));
-        for i in 0..n {
-            assert!(
-                (a[i] - b[i]).abs() < 1e-7 * scale,
-                "dq[{i}]: {} vs {}",
-                a[i],
-                b[i]
-            );
-            assert!((av[i] - bv[i]).abs() < 1e-12 * (1.0 + bv[i].abs()));
+        for sys in [
+            models::paper_a_double_pendulum().unwrap(),
+            rod_with_spring(),
+        ] {
+            let st = mbd_solve::State::consistent(&sys, 0.0).unwrap();
+            let n = sys.n_coords();
+            let q: Vec<f64> = st.q.iter().copied().collect();
+            let v: Vec<f64> = (0..n)
+                .map(|i| 0.7 * ((i as f64) * 1.3 + 0.4).sin())
+                .collect();
+            let mut p = Preadjustment::new(&sys, 1).unwrap();
+            let (mut a, mut av, mut b, mut bv) =
+                (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            let ea = p.modified_gradients(&sys, &q, &v, &mut a, &mut av).unwrap();
+            let eb = p
+                .modified_gradients_fd(&sys, &q, &v, &mut b, &mut bv)
+                .unwrap();
+            assert_eq!(ea, eb);
+            let scale = b.iter().fold(0.0f64, |x, &y| x.max(y.abs()));
+            for i in 0..n {
+                assert!(
+                    (a[i] - b[i]).abs() < 1e-7 * scale,
+                    "dq[{i}]: {} vs {}",
+                    a[i],
+                    b[i]
+                );
+                assert!(
+                    (av[i] - bv[i]).abs() < 1e-12 * (1.0 + bv[i].abs()),
+                    "dv[{i}]: {} vs {}",
+                    av[i],
+                    bv[i]
+                );
+            }
         }
+    }
+
+    /// Largest position error over `[0, 2 s]` (sampled every 0.05 s) of the (1,1) scheme on the
+    /// rod with a spring, against a DOPRI5 reference on the grid of `h_ref`.
+    fn spring_rod_error(modified: bool, h: f64, h_ref: f64, reference: &[Vec<f64>]) -> f64 {
+        use crate::{Galerkin, PreadjustMode, SymplecticOptions};
+        use mbd_solve::Integrator;
+        let sys = rod_with_spring();
+        let mut st = mbd_solve::State::consistent(&sys, 0.0).unwrap();
+        let mut o = SymplecticOptions::new(1);
+        if modified {
+            o = o.with_preadjust(PreadjustMode::ModifiedLagrangian);
+        }
+        let mut g = Galerkin::new(&sys, o).unwrap();
+        let (per_sample, every) = ((0.05 / h).round() as usize, (0.05 / h_ref).round() as usize);
+        let mut err = 0.0f64;
+        for k in 1..=40 {
+            for _ in 0..per_sample {
+                g.step(&sys, &mut st, h).unwrap();
+            }
+            let r = &reference[k * every];
+            for i in 0..3 {
+                err = err.max((st.q[i] - r[i]).abs());
+            }
+        }
+        err
+    }
+
+    /// With a non-linear potential (a spring) the midpoint form of `e` restores order 4; the
+    /// trapezoid form (no `-1/8 v^T Hess V v`) gave order 1.8 to 2 here in the prototype
+    /// (`docs/modified-lagrangian.md` section 4), and the plain scheme has order 2.
+    #[test]
+    fn spring_rod_converges_with_order_four() {
+        let sys = rod_with_spring();
+        let s0 = mbd_solve::State::consistent(&sys, 0.0).unwrap();
+        let h_ref = 0.0125;
+        let reference = mbd_solve::reference_trajectory(
+            &sys,
+            &s0,
+            h_ref,
+            160,
+            32,
+            mbd_solve::ButcherTableau::dopri5(),
+        )
+        .unwrap();
+        let plain: Vec<f64> = [0.05, 0.025]
+            .iter()
+            .map(|&h| spring_rod_error(false, h, h_ref, &reference.q))
+            .collect();
+        let modified: Vec<f64> = [0.05, 0.025]
+            .iter()
+            .map(|&h| spring_rod_error(true, h, h_ref, &reference.q))
+            .collect();
+        let order = |e: &[f64]| (e[0] / e[1]).log2();
+        eprintln!(
+            "rod + spring, max |dq| over 2 s at h = 0.05 / 0.025: plain {:.3e} / {:.3e} (order \
+             {:.2}), modified {:.3e} / {:.3e} (order {:.2})",
+            plain[0],
+            plain[1],
+            order(&plain),
+            modified[0],
+            modified[1],
+            order(&modified)
+        );
+        assert!(
+            (1.8..2.3).contains(&order(&plain)),
+            "plain order {}",
+            order(&plain)
+        );
+        assert!(
+            order(&modified) > 3.6,
+            "modified order {}",
+            order(&modified)
+        );
+        assert!(modified[1] * 20.0 < plain[1]);
     }
 }
