@@ -22,6 +22,37 @@
 
 use std::ops::{Add, Mul, Neg, Sub};
 
+/// `-x` (as `x * -1.0`, bit-identical to negating every component), `x + c` and `x - c` (the
+/// value shifts, the derivatives do not) for a jet type with a `v` field and `Mul<f64>`.
+macro_rules! scalar_shift_ops {
+    ($t:ty) => {
+        impl std::ops::Neg for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                self * -1.0
+            }
+        }
+        impl std::ops::Add<f64> for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn add(mut self, c: f64) -> Self {
+                self.v += c;
+                self
+            }
+        }
+        impl std::ops::Sub<f64> for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn sub(mut self, c: f64) -> Self {
+                self.v -= c;
+                self
+            }
+        }
+    };
+}
+use scalar_shift_ops;
+
 mod dir;
 mod dual;
 mod hess;

@@ -1,7 +1,7 @@
 //! [`DirJet`]: value, gradient and two derivatives along one direction.
 
 use super::{Scalar, NV};
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, Mul, Sub};
 
 /// Value, gradient (6 local variables) and first/second derivative along one direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,29 +92,6 @@ impl Mul for DirJet {
         }
     }
 }
-impl Neg for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self * -1.0
-    }
-}
-impl Add<f64> for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for DirJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
 impl Mul<f64> for DirJet {
     type Output = Self;
     #[inline(always)]
@@ -131,6 +108,7 @@ impl Mul<f64> for DirJet {
         }
     }
 }
+super::scalar_shift_ops!(DirJet);
 impl Scalar for DirJet {
     #[inline(always)]
     fn cst(v: f64) -> Self {

@@ -1,7 +1,7 @@
 //! [`Dual`]: value and one directional derivative.
 
 use super::Scalar;
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, Mul, Sub};
 
 /// Value and first derivative along one direction (a dual number): the velocity constraint
 /// `Phi_q v` at the cost of about two `f64` evaluations, without the gradient.
@@ -51,32 +51,6 @@ impl Mul for Dual {
         }
     }
 }
-impl Neg for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Dual {
-            v: -self.v,
-            d: -self.d,
-        }
-    }
-}
-impl Add<f64> for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for Dual {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
 impl Mul<f64> for Dual {
     type Output = Self;
     #[inline(always)]
@@ -87,6 +61,7 @@ impl Mul<f64> for Dual {
         }
     }
 }
+super::scalar_shift_ops!(Dual);
 impl Scalar for Dual {
     #[inline(always)]
     fn cst(v: f64) -> Self {

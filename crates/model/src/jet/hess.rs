@@ -1,7 +1,7 @@
 //! [`HessJet`]: value, gradient and the full local Hessian.
 
 use super::{Scalar, NV};
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, Mul, Sub};
 
 /// Value, gradient and full Hessian with respect to the 6 local variables.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -86,29 +86,6 @@ impl Mul for HessJet {
         out
     }
 }
-impl Neg for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self * -1.0
-    }
-}
-impl Add<f64> for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for HessJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
 impl Mul<f64> for HessJet {
     type Output = Self;
     #[inline(always)]
@@ -123,6 +100,7 @@ impl Mul<f64> for HessJet {
         self
     }
 }
+super::scalar_shift_ops!(HessJet);
 impl Scalar for HessJet {
     #[inline(always)]
     fn cst(v: f64) -> Self {

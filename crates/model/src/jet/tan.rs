@@ -1,7 +1,7 @@
 //! [`TanJet`]: value, gradient, one directional derivative and its gradient.
 
 use super::{Scalar, NV};
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, Mul, Sub};
 
 /// Value, gradient, derivative along a direction `w` and the gradient of that derivative, with
 /// respect to the 6 local variables: `H w` (for the velocity constraint's Jacobian
@@ -93,29 +93,6 @@ impl Mul for TanJet {
         out
     }
 }
-impl Neg for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self * -1.0
-    }
-}
-impl Add<f64> for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for TanJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
 impl Mul<f64> for TanJet {
     type Output = Self;
     #[inline(always)]
@@ -129,6 +106,7 @@ impl Mul<f64> for TanJet {
         self
     }
 }
+super::scalar_shift_ops!(TanJet);
 impl Scalar for TanJet {
     #[inline(always)]
     fn cst(v: f64) -> Self {

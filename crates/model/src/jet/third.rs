@@ -4,7 +4,7 @@
 //! coefficients carry gradients).
 
 use super::{Scalar, NV};
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, Mul, Sub};
 
 /// Value `f`, gradient, `d1 = f' w`, `g1 = grad d1 = H w`, `d2 = w^T H w` and
 /// `g2 = grad d2 = D^3 f(w, w, .)`, with respect to the 6 local variables.
@@ -113,29 +113,6 @@ impl Mul for ThirdJet {
         out
     }
 }
-impl Neg for ThirdJet {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self * -1.0
-    }
-}
-impl Add<f64> for ThirdJet {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, c: f64) -> Self {
-        self.v += c;
-        self
-    }
-}
-impl Sub<f64> for ThirdJet {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, c: f64) -> Self {
-        self.v -= c;
-        self
-    }
-}
 impl Mul<f64> for ThirdJet {
     type Output = Self;
     #[inline(always)]
@@ -151,6 +128,7 @@ impl Mul<f64> for ThirdJet {
         self
     }
 }
+super::scalar_shift_ops!(ThirdJet);
 impl Scalar for ThirdJet {
     #[inline(always)]
     fn cst(v: f64) -> Self {
