@@ -1,0 +1,187 @@
+//! One step of the scheme through the [`Integrator`] trait: predictor, Newton iteration on the
+//! stage equations, end momentum and its projection.
+
+use super::*;
+
+impl Integrator for Galerkin {
+    fn name(&self) -> String {
+        let s = self.tab.s;
+        let mut name = format!("symplectic ({s},{s})");
+        if self.opts.gamma != 0.0 {
+            name += &format!(" gamma = {}", self.opts.gamma);
+        }
+        if !self.ml.is_empty() {
+            name += " modified Lagrangian";
+        }
+        if self.opts.nodes == Nodes::Equispaced && s > 2 {
+            name += " equispaced";
+        }
+        name
+    }
+
+    fn order(&self) -> Option<u32> {
+        let s = self.tab.s as u32;
+        Some(match self.opts.nodes {
+            Nodes::Lobatto => 2 * s,
+            Nodes::Equispaced => (2 * s).min(if s % 2 == 1 { s + 1 } else { s + 2 }),
+        })
+    }
+
+    fn reset(&mut self) {
+        self.hist_valid = false;
+        self.hist_len = 0;
+        self.end_phiq_valid = false;
+        self.jac_valid = false;
+    }
+
+    fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(SolveError::InvalidStep { h });
+        }
+        state.check(sys)?;
+        if sys.n_coords() != self.n || sys.n_constraints() != self.m {
+            return Err(SolveError::Dimension {
+                what: "system (the integrator was built for another model)",
+                expected: self.n,
+                got: sys.n_coords(),
+            });
+        }
+        if !state.is_finite() {
+            return Err(SolveError::NonFinite {
+                t: state.t,
+                what: "state before step",
+            });
+        }
+        let (n, m, s) = (self.n, self.m, self.tab.s);
+        let t = state.t;
+        self.qk.copy_from_slice(state.q.as_slice());
+        for i in 0..n {
+            self.hvk[i] = h * state.v[i];
+        }
+        // (reuse: Phi_q at the end of the previous step, which is where this one starts)
+        let reuse = self.end_phiq_valid && self.hist_q == self.qk;
+        self.start_phiq(sys, reuse);
+        self.end_phiq_valid = false;
+        self.gk = self.opts.gamma * self.kappa * h.powi(2 * s as i32);
+        self.predict(sys, state, h)?;
+        let stats = self.newton(sys, t, h)?;
+        // End momentum from the discrete momentum balance, the sum of the stage equations
+        // (docs/symplectic.md, "End momentum"): p- = D_s L_d equals
+        //   p_k - h sum_j b_j grad U(q_j) - h sum_(nu<s) Phi_q(Q_nu)^T lt_nu
+        // at the solution, but this form does not divide the Newton error of the displacements
+        // by h, and the momentum identity holds to the rounding of the increment instead of to
+        // that of the coefficients (whose last-bit errors would add a bias of about eps |p| per
+        // step, the same sign every step). As a velocity: v- = v_k - h M^-1 (...).
+        let f = &mut self.tn[0];
+        f.fill(0.0);
+        for (&bj, gj) in self.tab.b.iter().zip(self.gj.chunks_exact(n)) {
+            for (fi, &g) in f.iter_mut().zip(gj) {
+                *fi += bj * g;
+            }
+        }
+        if !self.ml.is_empty() {
+            // (D_1 + D_2) of h (E(Q_0, v) + E(Q_1, v)) / 2 = h (dE/dq (Q_0) + dE/dq (Q_1)) / 2
+            for i in 0..n {
+                f[i] -= 0.5 * (self.mlq[0][i] + self.mlq[1][i]);
+            }
+        }
+        if let Some(sp) = &self.sparse {
+            let lts = self.x[s * n..].chunks_exact(m);
+            for (grads, lt) in self.grads[..s].iter().zip(lts) {
+                add_transpose(grads, &sp.row_bodies, lt, f);
+            }
+        } else if m > 0 {
+            let lts = self.x[s * n..].chunks_exact(m);
+            for (phiq, lt) in self.phiq[..s].iter().zip(lts) {
+                // (Phi_q^T lt)_i: column i of the column-major m x n Phi_q
+                for (fi, col) in f.iter_mut().zip(phiq.as_slice().chunks_exact(m)) {
+                    *fi += col.iter().zip(lt).map(|(a, b)| a * b).sum::<f64>();
+                }
+            }
+        }
+        for (((vm, &v), &mi), &fi) in self
+            .vm
+            .iter_mut()
+            .zip(state.v.iter())
+            .zip(&self.minv)
+            .zip(f.iter())
+        {
+            *vm = v - h * mi * fi;
+        }
+        let qn1 = &self.qn[s * n..(s + 1) * n];
+        let t1 = t + h;
+        if let Some(sp) = &mut self.sparse {
+            // M^-1-orthogonal projection onto Phi_q v + Phi_t = 0, O(N) (docs/symplectic.md)
+            sp.schur.update(sys, qn1);
+            self.grads[s].copy_from_slice(sp.schur.grads());
+            self.end_phiq_valid = true;
+            sp.schur
+                .factor(&self.minv)
+                .map_err(|_| SolveError::Singular {
+                    t: t1,
+                    what: "momentum projection matrix Phi_q M^-1 Phi_q^T",
+                    detail: "redundant constraints or a singular configuration".into(),
+                })?;
+            sys.phi_t(t1, &mut self.mu);
+            sp.schur.apply(&self.vm, &mut sp.pv);
+            for (mu, &pv) in self.mu.iter_mut().zip(&sp.pv) {
+                *mu += pv;
+            }
+            sp.schur.solve_in_place(&mut self.mu);
+            sp.schur
+                .add_weighted_transpose(-1.0, &self.minv, &self.mu, &mut self.vm);
+        } else if m > 0 {
+            sys.phi_q(qn1, &mut self.phiq[s]);
+            self.end_phiq_valid = true;
+            let g = &self.phiq[s];
+            {
+                let mut sm = self.proj.matrix_mut();
+                for c in 0..m {
+                    for r in c..m {
+                        sm[(r, c)] = (0..n).map(|k| g[(r, k)] * self.minv[k] * g[(c, k)]).sum();
+                    }
+                }
+            }
+            self.proj
+                .factor_in_place()
+                .map_err(|_| SolveError::Singular {
+                    t: t1,
+                    what: "momentum projection matrix Phi_q M^-1 Phi_q^T",
+                    detail: "redundant constraints or a singular configuration".into(),
+                })?;
+            sys.phi_t(t1, &mut self.mu);
+            for r in 0..m {
+                self.mu[r] += (0..n).map(|k| g[(r, k)] * self.vm[k]).sum::<f64>();
+            }
+            self.proj.solve_in_place(&mut self.mu);
+            for k in 0..n {
+                let acc: f64 = (0..m).map(|r| g[(r, k)] * self.mu[r]).sum();
+                self.vm[k] -= self.minv[k] * acc;
+            }
+        }
+        for i in 0..n {
+            state.q[i] = qn1[i];
+            state.v[i] = self.vm[i];
+        }
+        state.t = t1;
+        // history for the predictor
+        let contiguous = self.hist_valid
+            && (self.hist_t - t).abs() <= 1e-9 * h
+            && (self.hist_h - h).abs() <= 1e-9 * h
+            && self.hist_q.as_slice() == self.qk.as_slice();
+        let dim = self.dim;
+        let keep = if contiguous {
+            self.hist_len.min(MAX_PREDICTOR_ORDER)
+        } else {
+            0
+        };
+        self.hist_multi.copy_within(0..keep * dim, dim);
+        self.hist_multi[..dim].copy_from_slice(&self.x);
+        self.hist_len = keep + 1;
+        self.hist_q.copy_from_slice(state.q.as_slice());
+        self.hist_t = state.t;
+        self.hist_h = h;
+        self.hist_valid = true;
+        Ok(stats)
+    }
+}
