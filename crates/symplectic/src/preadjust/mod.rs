@@ -64,6 +64,14 @@ pub struct Preadjustment {
     hv: Vec<f64>,
     d3: Vec<f64>,
     rheonomic: bool,
+    /// The velocity of the last `modified_prepared` at `at` (valid while `mv_valid`): its
+    /// results (`sigma`, `cm`, `hv`, `d3`) are reused by the Newton Jacobian, which is
+    /// evaluated where the residual was.
+    mv: Vec<f64>,
+    mv_valid: bool,
+    /// `gc` holds `gamma(q, v, 0)` from the fused `Phi_q` pass of `prepare_with` (consumed by
+    /// the next `modified_prepared`).
+    gc_fresh: bool,
 }
 
 pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
@@ -125,6 +133,9 @@ impl Preadjustment {
             hv: vec![0.0; n],
             d3: vec![0.0; n],
             rheonomic: sys.is_rheonomic(),
+            mv: vec![0.0; n],
+            mv_valid: false,
+            gc_fresh: false,
         })
     }
 
@@ -171,6 +182,17 @@ impl Preadjustment {
     /// are held for `q`). `A` is assembled only on demand ([`Preadjustment::ensure_a`]): the
     /// gradients use Hessian-vector products instead.
     fn prepare(&mut self, sys: &System, q: &[f64]) -> Result<(), SolveError> {
+        self.prepare_with(sys, q, None)
+    }
+
+    /// [`Preadjustment::prepare`]; with `Some(v)` (scleronomic models) the constraint pass also
+    /// leaves `gamma(q, v, 0)` in `gc` (`System::phi_q_gamma`, one pass instead of two).
+    fn prepare_with(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: Option<&[f64]>,
+    ) -> Result<(), SolveError> {
         let (n, m) = (self.n, self.m);
         if q.len() != n {
             return Err(SolveError::Dimension {
@@ -184,9 +206,17 @@ impl Preadjustment {
         }
         self.at_valid = false;
         self.a_valid = false;
+        self.mv_valid = false;
+        self.gc_fresh = false;
         sys.potential_gradient(q, &mut self.g);
         if m > 0 {
-            sys.phi_q(q, &mut self.gq);
+            match v {
+                Some(v) if !self.rheonomic => {
+                    sys.phi_q_gamma(q, v, 0.0, &mut self.gq, &mut self.gc);
+                    self.gc_fresh = true;
+                }
+                _ => sys.phi_q(q, &mut self.gq),
+            }
             {
                 let gq = &self.gq;
                 let minv = &self.minv;

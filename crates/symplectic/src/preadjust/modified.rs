@@ -54,7 +54,9 @@ impl Preadjustment {
         let mut gg = 0.0;
         if m > 0 {
             // gamma(q, v, t) = -(v^T Hess Phi_k v) + time part: the time part cancels
-            sys.gamma(q, v, 0.0, &mut self.gc);
+            if !self.gc_fresh {
+                sys.gamma(q, v, 0.0, &mut self.gc);
+            }
             if self.rheonomic {
                 sys.gamma(q, &self.zero, 0.0, &mut self.gc0);
                 for r in 0..m {
@@ -70,7 +72,10 @@ impl Preadjustment {
         for r in 0..m {
             self.cm[r] = self.sigma[r] - self.mu0[r];
         }
+        self.gc_fresh = false;
         sys.lagrangian_third(q, v, POTENTIAL_WEIGHT, &self.cm, &mut self.hv, &mut self.d3);
+        self.mv.copy_from_slice(v);
+        self.mv_valid = true;
         // v^T (A - 3/2 Hess V) v = v^T B v - sigma . gamma_c
         let vav = dot(v, &self.hv) - gg;
         -uu / 24.0 + vav / 12.0 + gg / 24.0
@@ -140,16 +145,37 @@ impl Preadjustment {
         v: &[f64],
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
+        out.fill(0.0);
+        self.add_modified_velocity_hessian(sys, q, v, 1.0, out)
+    }
+
+    /// `out += scale * B(q, v)` ([`Preadjustment::modified_velocity_hessian`]), without the
+    /// overwrite: the Newton Jacobian sums `B` at both control points into one matrix.
+    pub fn add_modified_velocity_hessian(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        scale: f64,
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
         self.check_v(v)?;
         self.prepare(sys, q)?;
-        self.modified_prepared(sys, q, v);
-        // B = POTENTIAL_WEIGHT Hess V + (sigma - mu0) . Hess Phi, one assembly
-        sys.potential_hessian(q, out);
-        *out *= POTENTIAL_WEIGHT;
-        if self.m > 0 {
-            sys.add_constraint_hessian(q, &self.cm, 1.0, out);
+        // (the Jacobian is evaluated where the residual was: `cm` is then held for this v)
+        if !(self.mv_valid && self.mv.as_slice() == v) {
+            self.modified_prepared(sys, q, v);
         }
+        self.add_assembled_b(sys, q, scale, out);
         Ok(())
+    }
+
+    /// `out += scale * (POTENTIAL_WEIGHT Hess V + (sigma - mu0) . Hess Phi)` after
+    /// `modified_prepared(q, v)`: one assembly.
+    fn add_assembled_b(&self, sys: &System, q: &[f64], scale: f64, out: &mut DMatrix<f64>) {
+        sys.add_potential_hessian(q, scale * POTENTIAL_WEIGHT, out);
+        if self.m > 0 {
+            sys.add_constraint_hessian(q, &self.cm, scale, out);
+        }
     }
 
     /// Gradients of [`Preadjustment::modified_term`], into `dq` and `dv`; returns `e(q, v)`.
@@ -178,7 +204,7 @@ impl Preadjustment {
                 got: dq.len().min(dv.len()),
             });
         }
-        self.prepare(sys, q)?;
+        self.prepare_with(sys, q, Some(v))?;
         let e = self.modified_prepared(sys, q, v);
         for k in 0..n {
             dv[k] = self.hv[k] / 6.0;

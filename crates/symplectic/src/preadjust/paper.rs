@@ -95,6 +95,7 @@ impl Preadjustment {
         if m > 0 {
             let mut t = std::mem::take(&mut self.tn[0]);
             let mut wts = std::mem::take(&mut self.cm);
+            self.mv_valid = false;
             for j in 0..=l {
                 for r in 0..m {
                     wts[r] = self.sig[l - j][r] - if j == 0 { h[r] } else { 0.0 };
