@@ -72,8 +72,16 @@ pub struct Preadjustment {
     /// `gc` holds `gamma(q, v, 0)` from the fused `Phi_q` pass of `prepare_with` (consumed by
     /// the next `modified_prepared`).
     gc_fresh: bool,
+    /// The coordinates where `A` has a nonzero column, and `k x k` blocks on them (column-major,
+    /// `n x n` capacity) for the Newton Hessian of `W_s`.
+    kset: Vec<usize>,
+    kpi: Vec<f64>,
+    ka: Vec<f64>,
+    kx: Vec<f64>,
+    ky: Vec<f64>,
 }
 
+#[cfg(test)]
 pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
     let n = a.nrows();
     out.iter_mut().for_each(|o| *o = 0.0);
@@ -136,6 +144,11 @@ impl Preadjustment {
             mv: vec![0.0; n],
             mv_valid: false,
             gc_fresh: false,
+            kset: Vec::with_capacity(n),
+            kpi: vec![0.0; n * n],
+            ka: vec![0.0; n * n],
+            kx: vec![0.0; n * n],
+            ky: vec![0.0; n * n],
         })
     }
 

@@ -1,6 +1,6 @@
 //! Paper A's `W_s`: value, gradient (exact third derivatives) and the Newton Hessian.
 
-use super::{dot, matvec, Preadjustment};
+use super::{dot, Preadjustment};
 use mbd_model::System;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
@@ -152,6 +152,12 @@ impl Preadjustment {
 
     /// An approximate Hessian of `W_s` for Newton: `A (Pi A)^s` (exact at an equilibrium),
     /// symmetrised, into `out` (overwritten).
+    ///
+    /// `A` is symmetric, so its zero columns (coordinates that enter `V` and the constraints
+    /// linearly, e.g. the positions of bodies with revolute joints under gravity) are zero rows
+    /// too, and `A (Pi A)^s` lives on the block `K x K` of the other coordinates:
+    /// `A_KK (Pi_KK A_KK)^s`, with `Pi_KK = M^-1_KK - (G M^-1)_K^T S^-1 (G M^-1)_K` from `|K|`
+    /// Cholesky solves. Dense products of size `|K|` only.
     pub fn approximate_hessian(
         &mut self,
         sys: &System,
@@ -160,36 +166,54 @@ impl Preadjustment {
     ) -> Result<(), SolveError> {
         self.prepare(sys, q)?;
         self.ensure_a(sys, q);
-        let n = self.n;
+        let (n, m) = (self.n, self.m);
+        self.kset.clear();
         for c in 0..n {
-            if self.amat.column(c).iter().all(|&a| a == 0.0) {
-                // a coordinate that enters V and the constraints linearly (e.g. the position
-                // of a body with revolute joints under gravity): a zero column and row
-                for r in 0..n {
-                    out[(r, c)] = 0.0;
-                }
-                continue;
+            if self.amat.column(c).iter().any(|&a| a != 0.0) {
+                self.kset.push(c);
             }
-            let mut x = std::mem::take(&mut self.tn[2]);
-            for r in 0..n {
-                x[r] = self.amat[(r, c)];
-            }
-            let mut y = std::mem::take(&mut self.tn[3]);
-            for _ in 0..self.s {
-                self.apply_pi(&x, &mut y);
-                matvec(&self.amat, &y, &mut x);
-            }
-            for r in 0..n {
-                out[(r, c)] = x[r];
-            }
-            self.tn[2] = x;
-            self.tn[3] = y;
         }
-        for c in 0..n {
-            for r in c + 1..n {
-                let v = 0.5 * (out[(r, c)] + out[(c, r)]);
-                out[(r, c)] = v;
-                out[(c, r)] = v;
+        let k = self.kset.len();
+        // Pi_KK (column-major k x k in kpi)
+        let mut x = std::mem::take(&mut self.tm[1]);
+        for (cj, &c) in self.kset.iter().enumerate() {
+            for r in 0..m {
+                x[r] = self.gq[(r, c)] * self.minv[c];
+            }
+            if m > 0 {
+                self.chol.solve_in_place(&mut x);
+            }
+            for (ri, &r) in self.kset.iter().enumerate() {
+                let gcol = &self.gq.as_slice()[r * m..(r + 1) * m];
+                let acc = dot(gcol, &x);
+                let d = if r == c { self.minv[c] } else { 0.0 };
+                self.kpi[cj * k + ri] = d - self.minv[r] * acc;
+            }
+        }
+        self.tm[1] = x;
+        // X = A_KK, then X <- A_KK (Pi_KK X), s times
+        for (cj, &c) in self.kset.iter().enumerate() {
+            for (ri, &r) in self.kset.iter().enumerate() {
+                self.ka[cj * k + ri] = self.amat[(r, c)];
+            }
+        }
+        self.kx[..k * k].copy_from_slice(&self.ka[..k * k]);
+        let mul = |a: &[f64], b: &[f64], o: &mut [f64]| {
+            // o = a b, k x k column-major
+            for cj in 0..k {
+                for ri in 0..k {
+                    o[cj * k + ri] = (0..k).map(|l| a[l * k + ri] * b[cj * k + l]).sum();
+                }
+            }
+        };
+        for _ in 0..self.s {
+            mul(&self.kpi, &self.kx, &mut self.ky);
+            mul(&self.ka, &self.ky, &mut self.kx);
+        }
+        out.fill(0.0);
+        for (cj, &c) in self.kset.iter().enumerate() {
+            for (ri, &r) in self.kset.iter().enumerate() {
+                out[(r, c)] = 0.5 * (self.kx[cj * k + ri] + self.kx[ri * k + cj]);
             }
         }
         Ok(())
