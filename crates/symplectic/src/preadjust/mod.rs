@@ -75,6 +75,8 @@ pub struct Preadjustment {
     /// The coordinates where `A` has a nonzero column, and `k x k` blocks on them (column-major,
     /// `n x n` capacity) for the Newton Hessian of `W_s`.
     kset: Vec<usize>,
+    /// Scratch: the nonzero rows of a column of `Phi_q`.
+    rows: Vec<usize>,
     kpi: Vec<f64>,
     ka: Vec<f64>,
     kx: Vec<f64>,
@@ -92,6 +94,20 @@ pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
         let col = &a.as_slice()[j * n..(j + 1) * n];
         for i in 0..n {
             out[i] += col[i] * xj;
+        }
+    }
+}
+
+/// `out = G x` for the column-major `m x n` matrix `G`, by columns (zero entries of `x`
+/// skipped).
+fn gm_times(g: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
+    let m = g.nrows();
+    out.fill(0.0);
+    for (col, &xk) in g.as_slice().chunks_exact(m).zip(x) {
+        if xk != 0.0 {
+            for (o, &gr) in out.iter_mut().zip(col) {
+                *o += gr * xk;
+            }
         }
     }
 }
@@ -145,6 +161,7 @@ impl Preadjustment {
             mv_valid: false,
             gc_fresh: false,
             kset: Vec::with_capacity(n),
+            rows: Vec::with_capacity(m),
             kpi: vec![0.0; n * n],
             ka: vec![0.0; n * n],
             kx: vec![0.0; n * n],
@@ -167,22 +184,21 @@ impl Preadjustment {
             return;
         }
         let t = &mut self.tm[0];
-        for r in 0..m {
-            t[r] = (0..n).map(|k| self.gq[(r, k)] * out[k]).sum();
-        }
+        gm_times(&self.gq, out, t);
         self.chol.solve_in_place(t);
-        for k in 0..n {
-            let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * t[r]).sum();
-            out[k] -= self.minv[k] * acc;
+        for (k, col) in self.gq.as_slice().chunks_exact(m).enumerate() {
+            out[k] -= self.minv[k] * dot(col, t);
         }
     }
 
     /// `out = S^-1 G M^-1 x` (length m).
     pub(crate) fn sgm(&mut self, x: &[f64], out: &mut [f64]) {
-        let (n, m) = (self.n, self.m);
-        for r in 0..m {
-            out[r] = (0..n).map(|k| self.gq[(r, k)] * self.minv[k] * x[k]).sum();
+        let n = self.n;
+        let t = &mut self.tn[3];
+        for k in 0..n {
+            t[k] = self.minv[k] * x[k];
         }
+        gm_times(&self.gq, t, out);
         self.chol.solve_in_place(out);
     }
 
@@ -233,10 +249,23 @@ impl Preadjustment {
             {
                 let gq = &self.gq;
                 let minv = &self.minv;
+                let rows = &mut self.rows;
                 let mut sm = self.chol.matrix_mut();
                 for c in 0..m {
                     for r in c..m {
-                        sm[(r, c)] = (0..n).map(|k| gq[(r, k)] * minv[k] * gq[(c, k)]).sum();
+                        sm[(r, c)] = 0.0;
+                    }
+                }
+                // S = sum_k minv_k G_:k G_:k^T over the few nonzero rows of each column
+                for (k, col) in gq.as_slice().chunks_exact(m).enumerate() {
+                    rows.clear();
+                    rows.extend((0..m).filter(|&r| col[r] != 0.0));
+                    for (i, &c) in rows.iter().enumerate() {
+                        let gc = minv[k] * col[c];
+                        for &r in &rows[i..] {
+                            // rows ascending: r >= c, the lower triangle
+                            sm[(r, c)] += col[r] * gc;
+                        }
                     }
                 }
             }
@@ -254,7 +283,11 @@ impl Preadjustment {
             self.mu0 = mu0;
         }
         for k in 0..n {
-            let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * self.mu0[r]).sum();
+            let acc = if m > 0 {
+                dot(&self.gq.as_slice()[k * m..(k + 1) * m], &self.mu0)
+            } else {
+                0.0
+            };
             self.u[k] = self.minv[k] * (acc - self.g[k]);
         }
         for r in 0..m {
