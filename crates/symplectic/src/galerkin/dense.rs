@@ -21,6 +21,10 @@ pub(super) fn stage_lu(n: usize, m: usize, s: usize) -> DenseLu {
     DenseLu::with_ordering(order.clone(), order)
 }
 
+/// Relative size below which the `W_s` term is left out of the Newton Jacobian (see
+/// `jacobian_dense`).
+const W_JACOBIAN_SKIP: f64 = 1e-4;
+
 impl Galerkin {
     /// Jacobian of the stage equations at `self.x` (after `residual` at the same point), factored.
     pub(super) fn jacobian_dense(
@@ -45,10 +49,17 @@ impl Galerkin {
                 self.hq[j].fill(0.0);
             }
             if let Some(pre) = self.pre.get_mut(j) {
-                pre.approximate_hessian(sys, qj, &mut self.wh)
-                    .map_err(|e| with_time(e, t))?;
-                for (a, b) in self.hq[j].iter_mut().zip(self.wh.iter()) {
-                    *a += self.gk * b;
+                // The W_s term of the momentum rows' Jacobian is h^2 gk M^-1 A (Pi A)^s, at
+                // most h^2 |gk| rho^(s+1) against the identity blocks (rho bounds the spectral
+                // radius of M^-1 A). Below W_JACOBIAN_SKIP it would change Newton's contraction
+                // by that factor at most, so it is left out (the solution does not depend on it)
+                let rho = pre.hessian_bound(sys, qj).map_err(|e| with_time(e, t))?;
+                if h * h * self.gk.abs() * rho.powi(s as i32 + 1) > W_JACOBIAN_SKIP {
+                    pre.approximate_hessian(sys, qj, &mut self.wh)
+                        .map_err(|e| with_time(e, t))?;
+                    for (a, b) in self.hq[j].iter_mut().zip(self.wh.iter()) {
+                        *a += self.gk * b;
+                    }
                 }
             }
             if self.nonconservative {
@@ -74,13 +85,23 @@ impl Galerkin {
                     }
                     let ca = tab.b[j] * tab.a[j * s1 + nu] * tab.a[j * s1 + mu];
                     let cv = tab.b[j] * tab.a[j * s1 + nu] * tab.d[j * s1 + mu] / h;
+                    let (hq, hv) = (self.hq[j].as_slice(), self.hv[j].as_slice());
                     for l in 0..n {
-                        for i in 0..n {
-                            let mut v = ca * self.hq[j][(i, l)];
-                            if self.nonconservative {
-                                v += cv * self.hv[j][(i, l)];
+                        let hql = &hq[l * n..(l + 1) * n];
+                        if self.nonconservative {
+                            let hvl = &hv[l * n..(l + 1) * n];
+                            for i in 0..n {
+                                let v = ca * hql[i] + cv * hvl[i];
+                                jm.add(ro + i, co + l, -(h2 * self.minv[i] * v));
                             }
-                            jm.add(ro + i, co + l, -(h2 * self.minv[i] * v));
+                        } else {
+                            // (zeros skipped: adding them changes nothing; e.g. the position
+                            // columns of revolute-jointed bodies under W_s)
+                            for (i, &hil) in hql.iter().enumerate() {
+                                if hil != 0.0 {
+                                    jm.add(ro + i, co + l, -(h2 * self.minv[i] * (ca * hil)));
+                                }
+                            }
                         }
                     }
                 }

@@ -150,6 +150,21 @@ impl Preadjustment {
         self.tn[1] = dir;
     }
 
+    /// A bound on the spectral radius of `M^-1 A` (Gershgorin: `max_i minv_i sum_l |A_il|`; the
+    /// eigenvalues are those of the symmetric `M^-1/2 A M^-1/2`), so the Newton Hessian
+    /// [`Preadjustment::approximate_hessian`] is at most `bound^(s+1)` in the mass metric.
+    pub fn hessian_bound(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
+        self.prepare(sys, q)?;
+        self.ensure_a(sys, q);
+        let n = self.n;
+        let mut rho = 0.0f64;
+        for i in 0..n {
+            let row: f64 = (0..n).map(|l| self.amat[(i, l)].abs()).sum();
+            rho = rho.max(self.minv[i] * row);
+        }
+        Ok(rho)
+    }
+
     /// An approximate Hessian of `W_s` for Newton: `A (Pi A)^s` (exact at an equilibrium),
     /// symmetrised, into `out` (overwritten).
     ///
