@@ -61,6 +61,15 @@ impl Preadjustment {
         if m > 0 {
             let mut g1 = std::mem::take(&mut self.tm[2]);
             for i in 0..=l {
+                if 2 * i == l && !self.rheonomic {
+                    // a^T H_k a = -gamma_k(q, a) (no time part): one pass, not two (the
+                    // polarisation's a - a = 0 gives nothing; gamma(2a) = 4 gamma(a) exactly)
+                    sys.gamma(q, &self.av[i], 0.0, &mut g1);
+                    for r in 0..m {
+                        h[r] -= 0.5 * g1[r];
+                    }
+                    continue;
+                }
                 let (ai, ac) = (&self.av[i], &self.av[l - i]);
                 let vp = &mut self.tn[1];
                 for k in 0..n {
