@@ -118,11 +118,11 @@ impl Galerkin {
             }
         }
         // modified Lagrangian (s = 1): the velocity part of h M^-1 D_1 E_d,
-        // -h M^-1 (h^2 / 12) (B(Q_0) + B(Q_1)) v, B = A + H_sigma - 3/2 Hess V = 6 d^2 e / dv^2,
-        // differentiated in Z_1 = h v with B frozen, and B(Q_1) ~ B(Q_0) (one assembly instead
-        // of two; the difference is O(h v) relative, like the position derivatives of the
-        // modified terms, which are left out: docs/symplectic.md, section 5a). The converged
-        // solution does not depend on it.
+        // -(h^2 / 12) M^-1 (E(Q_0) + E(Q_1)) in Z_1 = h v, E = 6 d^2 e / dv^2 =
+        // B + 2 C S^-1 C^T (B = A + H_sigma - 3/2 Hess V, C = [Hess Phi_k v]_k), with
+        // E(Q_1) ~ E(Q_0) (one assembly instead of two; the difference is O(h v) relative, like
+        // the position derivatives of the modified terms, which are left out: docs/symplectic.md,
+        // section 5a). The converged solution does not depend on it.
         if !self.ml.is_empty() {
             self.wh.fill(0.0);
             self.ml[0]

@@ -17,11 +17,12 @@
 //! [`System::potential_third`] and [`System::constraint_third`]. The Newton Jacobian uses `A (Pi A)^s`, the exact Hessian of `W_s`
 //! at an equilibrium (`f_T = 0`).
 
+use chol::SmallCholesky;
 use mbd_model::System;
-use mbd_solve::linalg::DenseCholesky;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
+mod chol;
 mod modified;
 mod paper;
 
@@ -39,7 +40,7 @@ pub struct Preadjustment {
     pub fd_step: f64,
     g: Vec<f64>,
     gq: DMatrix<f64>,
-    chol: DenseCholesky,
+    chol: SmallCholesky,
     mu0: Vec<f64>,
     u: Vec<f64>,
     amat: DMatrix<f64>,
@@ -75,6 +76,10 @@ pub struct Preadjustment {
     /// The coordinates where `A` has a nonzero column, and `k x k` blocks on them (column-major,
     /// `n x n` capacity) for the Newton Hessian of `W_s`.
     kset: Vec<usize>,
+    /// Scratch `m x n` matrices: `Phi_q` (discarded) and `(Phi_q v)_q` (rows `v^T Hess Phi_k`)
+    /// for the modified Jacobian.
+    gscr: DMatrix<f64>,
+    ct: DMatrix<f64>,
     /// Scratch: the nonzero rows of a column of `Phi_q`.
     rows: Vec<usize>,
     kpi: Vec<f64>,
@@ -136,7 +141,7 @@ impl Preadjustment {
             fd_step: 2e-3,
             g: vec![0.0; n],
             gq: DMatrix::zeros(m, n),
-            chol: DenseCholesky::new(m),
+            chol: SmallCholesky::new(m),
             mu0: vec![0.0; m],
             u: vec![0.0; n],
             amat: DMatrix::zeros(n, n),
@@ -161,6 +166,8 @@ impl Preadjustment {
             mv_valid: false,
             gc_fresh: false,
             kset: Vec::with_capacity(n),
+            gscr: DMatrix::zeros(m, n),
+            ct: DMatrix::zeros(m, n),
             rows: Vec::with_capacity(m),
             kpi: vec![0.0; n * n],
             ka: vec![0.0; n * n],
@@ -185,7 +192,7 @@ impl Preadjustment {
         }
         let t = &mut self.tm[0];
         gm_times(&self.gq, out, t);
-        self.chol.solve_in_place(t);
+        self.chol.solve(t);
         for (k, col) in self.gq.as_slice().chunks_exact(m).enumerate() {
             out[k] -= self.minv[k] * dot(col, t);
         }
@@ -199,7 +206,7 @@ impl Preadjustment {
             t[k] = self.minv[k] * x[k];
         }
         gm_times(&self.gq, t, out);
-        self.chol.solve_in_place(out);
+        self.chol.solve(out);
     }
 
     /// Whether the workspace holds the evaluation at exactly `q` (bit for bit).
@@ -250,12 +257,8 @@ impl Preadjustment {
                 let gq = &self.gq;
                 let minv = &self.minv;
                 let rows = &mut self.rows;
-                let mut sm = self.chol.matrix_mut();
-                for c in 0..m {
-                    for r in c..m {
-                        sm[(r, c)] = 0.0;
-                    }
-                }
+                let chol = &mut self.chol;
+                chol.clear();
                 // S = sum_k minv_k G_:k G_:k^T over the few nonzero rows of each column
                 for (k, col) in gq.as_slice().chunks_exact(m).enumerate() {
                     rows.clear();
@@ -264,18 +267,16 @@ impl Preadjustment {
                         let gc = minv[k] * col[c];
                         for &r in &rows[i..] {
                             // rows ascending: r >= c, the lower triangle
-                            sm[(r, c)] += col[r] * gc;
+                            chol.add(r, c, col[r] * gc);
                         }
                     }
                 }
             }
-            self.chol
-                .factor_in_place()
-                .map_err(|_| SolveError::Singular {
-                    t: f64::NAN,
-                    what: "Phi_q M^-1 Phi_q^T in W_s",
-                    detail: "redundant constraints or a singular configuration".into(),
-                })?;
+            self.chol.factor().map_err(|_| SolveError::Singular {
+                t: f64::NAN,
+                what: "Phi_q M^-1 Phi_q^T in W_s",
+                detail: "redundant constraints or a singular configuration".into(),
+            })?;
             let g = std::mem::take(&mut self.g);
             let mut mu0 = std::mem::take(&mut self.mu0);
             self.sgm(&g, &mut mu0);

@@ -66,7 +66,7 @@ impl Preadjustment {
                 self.gc.iter_mut().for_each(|x| *x = -*x);
             }
             self.sigma.copy_from_slice(&self.gc);
-            self.chol.solve_in_place(&mut self.sigma);
+            self.chol.solve(&mut self.sigma);
             gg = dot(&self.gc, &self.sigma);
         }
         for r in 0..m {
@@ -135,9 +135,10 @@ impl Preadjustment {
         Ok(e)
     }
 
-    /// `B = A + H_sigma - 3/2 Hess V` at `q` (`H_sigma = sum_k sigma_k Hess Phi_k`,
-    /// `sigma = S^-1 gamma_c(q, v)`) into `out` (overwritten): `6 d^2 e / dv^2` with `sigma`
-    /// frozen, used for the Newton Jacobian.
+    /// `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` at `q` into `out` (overwritten), with
+    /// `B = A + H_sigma - 3/2 Hess V` (`H_sigma = sum_k sigma_k Hess Phi_k`,
+    /// `sigma = S^-1 gamma_c(q, v)`) and `C = [Hess Phi_k v]_k` (the derivative of `sigma` in
+    /// `v`), used for the Newton Jacobian.
     pub fn modified_velocity_hessian(
         &mut self,
         sys: &System,
@@ -166,6 +167,43 @@ impl Preadjustment {
             self.modified_prepared(sys, q, v);
         }
         self.add_assembled_b(sys, q, scale, out);
+        if self.m > 0 {
+            // + 2 C S^-1 C^T, C = [Hess Phi_k v]_k: the derivative of sigma = S^-1 gamma_c(v)
+            // (gamma_c,k = v^T Hess Phi_k v, d gamma_c / dv = 2 C^T), so that
+            // 6 d^2 e / dv^2 = B + 2 C S^-1 C^T exactly (q fixed)
+            let m = self.m;
+            sys.phi_q_dot_jacobian(q, v, &mut self.gscr, &mut self.ct);
+            // the coordinates where C^T has a nonzero column, and Y = L^-1 C^T on them
+            // (C S^-1 C^T = Y^T Y), packed into the discarded Phi_q
+            // (above the inline size of the factor: y = S^-1 c, paired with c)
+            let tri = self.chol.has_factor();
+            self.kset.clear();
+            let y = self.gscr.as_mut_slice();
+            for (i, ci) in self.ct.as_slice().chunks_exact(m).enumerate() {
+                if ci.iter().any(|&c| c != 0.0) {
+                    let o = self.kset.len() * m;
+                    y[o..o + m].copy_from_slice(ci);
+                    if tri {
+                        self.chol.forward(&mut y[o..o + m]);
+                    } else {
+                        self.chol.solve(&mut y[o..o + m]);
+                    }
+                    self.kset.push(i);
+                }
+            }
+            let ct = self.ct.as_slice();
+            for (a, &i) in self.kset.iter().enumerate() {
+                for (b, &l) in self.kset.iter().enumerate() {
+                    let ya = &y[a * m..(a + 1) * m];
+                    let d = if !tri {
+                        dot(&ct[l * m..(l + 1) * m], ya)
+                    } else {
+                        dot(&y[b * m..(b + 1) * m], ya)
+                    };
+                    out[(l, i)] += 2.0 * scale * d;
+                }
+            }
+        }
         Ok(())
     }
 
