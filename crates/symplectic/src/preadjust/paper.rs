@@ -44,7 +44,20 @@ impl Preadjustment {
         }
         let l = s - 2;
         // a_0..a_{l+1}, b_k = A a_k (k = 0..=l); sigma_k = S^-1 G M^-1 b_k
-        self.krylov(sys, q, l + 1);
+        if l == 0 {
+            // s = 2: b_0 = A u and the third-derivative term D^3 (V - mu0 . Phi)(u, u, .) from
+            // one third-order pass (System::lagrangian_third) instead of a Hessian-vector pass
+            // and two third-order passes
+            self.av[0].copy_from_slice(&self.u);
+            let mut b = std::mem::take(&mut self.bv[0]);
+            sys.lagrangian_third(q, &self.u, 1.0, &self.nmu0, &mut b, &mut self.d3);
+            let mut next = std::mem::take(&mut self.av[1]);
+            self.apply_pi(&b, &mut next);
+            self.av[1] = next;
+            self.bv[0] = b;
+        } else {
+            self.krylov(sys, q, l + 1);
+        }
         if m > 0 {
             for k in 0..=l {
                 let mut sg = std::mem::take(&mut self.sig[k]);
@@ -120,6 +133,12 @@ impl Preadjustment {
         self.tm[1] = h;
         // (2a): 1/2 sum_i (D_{a_i} A~) a_{l-i}, A~ = Hess V - mu0 . Hess Phi with mu0 frozen
         // (exact third derivatives)
+        if l == 0 {
+            for (o, &d) in out.iter_mut().zip(&self.d3) {
+                *o += 0.5 * d;
+            }
+            return Ok(w);
+        }
         for i in 0..=l {
             let j = l - i;
             if i > j {
