@@ -90,6 +90,12 @@ pub struct Galerkin {
     jac_h: f64,
     jac_gk: f64,
     jacobians: usize,
+    /// Whether the `W_s` term is left out of the Newton Jacobian (`dense.rs`), and for how
+    /// many more Jacobians that decision stands (0: check again), made at `h^2 |gk|` =
+    /// `w_skip_scale`.
+    w_skip: bool,
+    w_skip_left: usize,
+    w_skip_scale: f64,
 }
 impl Galerkin {
     /// A scheme for `sys` with the given options (validated). Models with non-conservative
@@ -217,6 +223,9 @@ impl Galerkin {
             jac_h: f64::NAN,
             jac_gk: f64::NAN,
             jacobians: 0,
+            w_skip: false,
+            w_skip_left: 0,
+            w_skip_scale: f64::NAN,
         })
     }
 

@@ -25,6 +25,9 @@ pub(super) fn stage_lu(n: usize, m: usize, s: usize) -> DenseLu {
 /// `jacobian_dense`).
 const W_JACOBIAN_SKIP: f64 = 1e-4;
 
+/// Jacobians between two checks of the `W_s` term's size.
+const W_SKIP_RECHECK: usize = 8;
+
 impl Galerkin {
     /// Jacobian of the stage equations at `self.x` (after `residual` at the same point), factored.
     pub(super) fn jacobian_dense(
@@ -37,6 +40,33 @@ impl Galerkin {
         let s1 = s + 1;
         sys.phi_q(&self.qn[s * n..(s + 1) * n], &mut self.phiq[s]);
         let any_hessian = self.has_forces || !self.pre.is_empty() || self.nonconservative;
+        // The W_s term of the momentum rows' Jacobian is h^2 gk M^-1 A (Pi A)^s, at most
+        // h^2 |gk| rho^(s+1) against the identity blocks (rho: a bound on the spectral radius
+        // of M^-1 A at the Gauss points). Below W_JACOBIAN_SKIP it would change Newton's
+        // contraction by that factor at most, so it is left out (the solution does not depend
+        // on it). The bound needs A assembled: it is checked every W_SKIP_RECHECK Jacobians
+        // and whenever h or gk change.
+        let scale = h * h * self.gk.abs();
+        if !self.pre.is_empty() && (self.w_skip_left == 0 || scale != self.w_skip_scale) {
+            let mut worst = 0.0f64;
+            for j in 0..s {
+                let qj = &self.qj[j * n..(j + 1) * n];
+                let rho = self.pre[j]
+                    .hessian_bound(sys, qj)
+                    .map_err(|e| with_time(e, t))?;
+                let size = scale * rho.powi(s as i32 + 1);
+                // (NaN-safe: a NaN bound keeps the term)
+                worst = if size.is_nan() {
+                    f64::INFINITY
+                } else {
+                    worst.max(size)
+                };
+            }
+            self.w_skip = worst <= W_JACOBIAN_SKIP;
+            self.w_skip_left = W_SKIP_RECHECK;
+            self.w_skip_scale = scale;
+        }
+        self.w_skip_left = self.w_skip_left.saturating_sub(1);
         for j in 0..s {
             if !any_hessian {
                 self.hess_nz[j] = false;
@@ -49,12 +79,7 @@ impl Galerkin {
                 self.hq[j].fill(0.0);
             }
             if let Some(pre) = self.pre.get_mut(j) {
-                // The W_s term of the momentum rows' Jacobian is h^2 gk M^-1 A (Pi A)^s, at
-                // most h^2 |gk| rho^(s+1) against the identity blocks (rho bounds the spectral
-                // radius of M^-1 A). Below W_JACOBIAN_SKIP it would change Newton's contraction
-                // by that factor at most, so it is left out (the solution does not depend on it)
-                let rho = pre.hessian_bound(sys, qj).map_err(|e| with_time(e, t))?;
-                if h * h * self.gk.abs() * rho.powi(s as i32 + 1) > W_JACOBIAN_SKIP {
+                if !self.w_skip {
                     pre.approximate_hessian(sys, qj, &mut self.wh)
                         .map_err(|e| with_time(e, t))?;
                     for (a, b) in self.hq[j].iter_mut().zip(self.wh.iter()) {

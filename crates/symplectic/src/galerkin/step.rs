@@ -32,6 +32,7 @@ impl Integrator for Galerkin {
         self.hist_len = 0;
         self.end_phiq_valid = false;
         self.jac_valid = false;
+        self.w_skip_left = 0;
     }
 
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
