@@ -38,7 +38,11 @@ impl Galerkin {
     ) -> Result<(), SolveError> {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let s1 = s + 1;
-        sys.phi_q(&self.qn[s * n..(s + 1) * n], &mut self.phiq[s]);
+        let qs = &self.qn[s * n..(s + 1) * n];
+        match self.ml.get(1).and_then(|ml| ml.phi_q_at(qs)) {
+            Some(g) => self.phiq[s].copy_from(g),
+            None => sys.phi_q(qs, &mut self.phiq[s]),
+        }
         let any_hessian = self.has_forces || !self.pre.is_empty() || self.nonconservative;
         // The W_s term of the momentum rows' Jacobian is h^2 gk M^-1 A (Pi A)^s, at most
         // h^2 |gk| rho^(s+1) against the identity blocks (rho: a bound on the spectral radius
