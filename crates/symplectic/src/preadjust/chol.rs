@@ -72,7 +72,9 @@ impl SmallCholesky {
                 let l = rowj(k);
                 d -= l * l;
             }
-            if !(d > 0.0) || !(d0 / d * CHOLESKY_PIVOT_TOL <= 1.0) {
+            // (NaN-safe: a NaN fails both comparisons)
+            let pivot_ok = d > 0.0 && d0 / d * CHOLESKY_PIVOT_TOL <= 1.0;
+            if !pivot_ok {
                 return Err(NotPositiveDefinite);
             }
             let ljj = d.sqrt();
