@@ -150,6 +150,34 @@ impl DenseCholesky {
         }
     }
 
+    /// `A_rc += v` for `r >= c` (the lower triangle; entry by entry, e.g. summing a sparse
+    /// product into it after [`DenseCholesky::clear`]).
+    #[inline]
+    pub fn add(&mut self, r: usize, c: usize, v: f64) {
+        debug_assert!(r >= c && r < self.m);
+        self.factored = false;
+        self.a[r + c * self.m] += v;
+    }
+
+    /// `b <- L^-1 b` with the factor `A = L L^T` (so `x^T A^-1 y = (L^-1 x) . (L^-1 y)`: a
+    /// quadratic form in `A^-1` from one triangular solve per vector). Leaves `b` unchanged
+    /// when nothing is factored.
+    pub fn forward_in_place(&self, b: &mut [f64]) {
+        let m = self.m;
+        if m == 0 || !self.factored {
+            return;
+        }
+        // both factorisation paths leave L in the lower triangle of `a`
+        let a = &self.a;
+        for i in 0..m {
+            let mut x = b[i];
+            for k in 0..i {
+                x -= a[i + k * m] * b[k];
+            }
+            b[i] = x / a[i + i * m];
+        }
+    }
+
     /// The matrix to be factored (lower triangle is read): fill it, then call
     /// [`DenseCholesky::factor_in_place`].
     pub fn matrix_mut(&mut self) -> MatMut<'_, f64> {
@@ -359,9 +387,34 @@ mod tests {
                     rhs[i] += sij * x[j];
                 }
             }
+            let mut sx = rhs.clone();
             c.solve_in_place(&mut rhs);
             for i in 0..m {
                 assert!((rhs[i] - x[i]).abs() < 1e-12, "m = {m}");
+            }
+            // forward_in_place: (L^-1 (S x)) . (L^-1 y) = x . y for any y, on both paths
+            let y: Vec<f64> = (0..m).map(|i| (i as f64 * 1.1 + 0.2).cos()).collect();
+            let mut ly = y.clone();
+            c.forward_in_place(&mut sx);
+            c.forward_in_place(&mut ly);
+            let lhs: f64 = sx.iter().zip(&ly).map(|(a, b)| a * b).sum();
+            let xy: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
+            assert!(
+                (lhs - xy).abs() < 1e-12 * (1.0 + xy.abs()),
+                "m = {m}: {lhs} vs {xy}"
+            );
+            // add() sums into the lower triangle like add_rank_one
+            let mut d = DenseCholesky::new(m);
+            d.clear();
+            for cidx in 0..m {
+                for r in cidx..m {
+                    d.add(r, cidx, s[r + cidx * m]);
+                }
+            }
+            for cidx in 0..m {
+                for r in cidx..m {
+                    assert_eq!(d.a[r + cidx * m], s[r + cidx * m]);
+                }
             }
         }
     }

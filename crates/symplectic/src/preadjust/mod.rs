@@ -17,12 +17,11 @@
 //! [`System::potential_third`] and [`System::constraint_third`]. The Newton Jacobian uses `A (Pi A)^s`, the exact Hessian of `W_s`
 //! at an equilibrium (`f_T = 0`).
 
-use chol::SmallCholesky;
 use mbd_model::System;
+use mbd_solve::linalg::DenseCholesky;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
-mod chol;
 mod modified;
 mod paper;
 
@@ -40,7 +39,7 @@ pub struct Preadjustment {
     pub fd_step: f64,
     g: Vec<f64>,
     gq: DMatrix<f64>,
-    chol: SmallCholesky,
+    chol: DenseCholesky,
     mu0: Vec<f64>,
     u: Vec<f64>,
     amat: DMatrix<f64>,
@@ -141,7 +140,7 @@ impl Preadjustment {
             fd_step: 2e-3,
             g: vec![0.0; n],
             gq: DMatrix::zeros(m, n),
-            chol: SmallCholesky::new(m),
+            chol: DenseCholesky::new(m),
             mu0: vec![0.0; m],
             u: vec![0.0; n],
             amat: DMatrix::zeros(n, n),
@@ -192,7 +191,7 @@ impl Preadjustment {
         }
         let t = &mut self.tm[0];
         gm_times(&self.gq, out, t);
-        self.chol.solve(t);
+        self.chol.solve_in_place(t);
         for (k, col) in self.gq.as_slice().chunks_exact(m).enumerate() {
             out[k] -= self.minv[k] * dot(col, t);
         }
@@ -206,7 +205,7 @@ impl Preadjustment {
             t[k] = self.minv[k] * x[k];
         }
         gm_times(&self.gq, t, out);
-        self.chol.solve(out);
+        self.chol.solve_in_place(out);
     }
 
     /// Whether the workspace holds the evaluation at exactly `q` (bit for bit).
@@ -272,11 +271,13 @@ impl Preadjustment {
                     }
                 }
             }
-            self.chol.factor().map_err(|_| SolveError::Singular {
-                t: f64::NAN,
-                what: "Phi_q M^-1 Phi_q^T in W_s",
-                detail: "redundant constraints or a singular configuration".into(),
-            })?;
+            self.chol
+                .factor_in_place()
+                .map_err(|_| SolveError::Singular {
+                    t: f64::NAN,
+                    what: "Phi_q M^-1 Phi_q^T in W_s",
+                    detail: "redundant constraints or a singular configuration".into(),
+                })?;
             let g = std::mem::take(&mut self.g);
             let mut mu0 = std::mem::take(&mut self.mu0);
             self.sgm(&g, &mut mu0);
@@ -337,7 +338,7 @@ impl Preadjustment {
 
     /// `b <- S^-1 b` with the factor of `S = Phi_q M^-1 Phi_q^T` at the prepared point.
     pub(crate) fn solve_s(&mut self, b: &mut [f64]) {
-        self.chol.solve(b);
+        self.chol.solve_in_place(b);
     }
 
     /// The tangential force `f_T(q) = P(q) (-grad V(q))` into `out`.

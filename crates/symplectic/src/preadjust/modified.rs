@@ -66,7 +66,7 @@ impl Preadjustment {
                 self.gc.iter_mut().for_each(|x| *x = -*x);
             }
             self.sigma.copy_from_slice(&self.gc);
-            self.chol.solve(&mut self.sigma);
+            self.chol.solve_in_place(&mut self.sigma);
             gg = dot(&self.gc, &self.sigma);
         }
         for r in 0..m {
@@ -175,31 +175,19 @@ impl Preadjustment {
             sys.phi_q_dot_jacobian(q, v, &mut self.gscr, &mut self.ct);
             // the coordinates where C^T has a nonzero column, and Y = L^-1 C^T on them
             // (C S^-1 C^T = Y^T Y), packed into the discarded Phi_q
-            // (above the inline size of the factor: y = S^-1 c, paired with c)
-            let tri = self.chol.has_factor();
             self.kset.clear();
             let y = self.gscr.as_mut_slice();
             for (i, ci) in self.ct.as_slice().chunks_exact(m).enumerate() {
                 if ci.iter().any(|&c| c != 0.0) {
                     let o = self.kset.len() * m;
                     y[o..o + m].copy_from_slice(ci);
-                    if tri {
-                        self.chol.forward(&mut y[o..o + m]);
-                    } else {
-                        self.chol.solve(&mut y[o..o + m]);
-                    }
+                    self.chol.forward_in_place(&mut y[o..o + m]);
                     self.kset.push(i);
                 }
             }
-            let ct = self.ct.as_slice();
             for (a, &i) in self.kset.iter().enumerate() {
                 for (b, &l) in self.kset.iter().enumerate() {
-                    let ya = &y[a * m..(a + 1) * m];
-                    let d = if !tri {
-                        dot(&ct[l * m..(l + 1) * m], ya)
-                    } else {
-                        dot(&y[b * m..(b + 1) * m], ya)
-                    };
+                    let d = dot(&y[b * m..(b + 1) * m], &y[a * m..(a + 1) * m]);
                     out[(l, i)] += 2.0 * scale * d;
                 }
             }

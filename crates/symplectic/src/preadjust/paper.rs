@@ -101,7 +101,7 @@ impl Preadjustment {
                 }
             }
             self.tm[2] = g1;
-            self.chol.solve(&mut h); // rho
+            self.chol.solve_in_place(&mut h); // rho
         }
         // (1)+(2b'): -A (a_{l+1} + M^-1 G^T rho)
         {
@@ -224,7 +224,7 @@ impl Preadjustment {
                 x[r] = self.gq[(r, c)] * self.minv[c];
             }
             if m > 0 {
-                self.chol.solve(&mut x);
+                self.chol.solve_in_place(&mut x);
             }
             for (ri, &r) in self.kset.iter().enumerate() {
                 let gcol = &self.gq.as_slice()[r * m..(r + 1) * m];
