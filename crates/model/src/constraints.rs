@@ -395,47 +395,13 @@ impl System {
 
 #[cfg(test)]
 mod phi_q_dot_jacobian_tests {
-    use crate::{models, Body, BodyRef, Coordinate, Joint, SystemBuilder, TimeFunction};
+    use crate::models;
     use nalgebra::DMatrix;
-
-    fn all_joint_kinds() -> crate::System {
-        let mut b = SystemBuilder::new();
-        let b1 = b.add_body(Body::new("b1").rod(1.0, 1.0).position(0.3, -0.2, 0.4));
-        let b2 = b.add_body(Body::new("b2").rod(2.0, 0.7).position(1.1, 0.5, -0.9));
-        let b3 = b.add_body(Body::new("b3").rod(0.5, 0.4).position(-0.6, 1.3, 2.1));
-        let b4 = b.add_body(Body::new("b4").rod(0.8, 0.9).position(0.2, 2.0, -0.3));
-        b.add_joint(Joint::revolute(
-            "r",
-            BodyRef::Ground,
-            [0.1, 0.2],
-            b1,
-            [-0.5, 0.1],
-        ));
-        b.add_joint(Joint::distance("d", b1, [0.5, 0.0], b2, [-0.3, 0.2], 0.8));
-        b.add_joint(Joint::prismatic(
-            "p",
-            b2,
-            [0.1, 0.0],
-            b3,
-            [0.0, 0.1],
-            [1.0, 0.5],
-            0.2,
-        ));
-        b.add_joint(Joint::weld("w", b3, [0.2, 0.0], b4, [-0.4, 0.1], 0.3));
-        b.add_joint(Joint::absolute("a", b4, [0.3, 0.0], Coordinate::Y, 1.0));
-        b.add_joint(Joint::angle_driver(
-            "drv",
-            BodyRef::Ground,
-            b2,
-            TimeFunction::linear(0.1, 2.0),
-        ));
-        b.build().unwrap()
-    }
 
     #[test]
     fn matches_finite_differences_of_phi_q_v() {
         let systems = [
-            all_joint_kinds(),
+            crate::fixtures::every_joint_kind(),
             models::slider_crank().unwrap(),
             models::four_bar().unwrap(),
             models::manipulator().unwrap(),
@@ -491,7 +457,10 @@ mod phi_q_dot_jacobian_tests {
     /// Newton-like sequence of nearby configurations (rotations, large jumps, invalidation).
     #[test]
     fn angle_cache_matches_exact_evaluation() {
-        for sys in [all_joint_kinds(), models::manipulator().unwrap()] {
+        for sys in [
+            crate::fixtures::every_joint_kind(),
+            models::manipulator().unwrap(),
+        ] {
             let (n, m) = (sys.n_coords(), sys.n_constraints());
             let mut cache = crate::AngleCache::new(&sys);
             let mut q: Vec<f64> = (0..n).map(|i| 0.3 + 0.17 * i as f64).collect();

@@ -50,6 +50,8 @@ mod constraints;
 mod dynamics;
 mod error;
 mod file;
+#[cfg(test)]
+mod fixtures;
 mod force;
 mod init;
 mod jet;

@@ -193,55 +193,8 @@ impl System {
 
 #[cfg(test)]
 mod tests {
-    use crate::{
-        models, Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, TimeFunction,
-    };
+    use crate::{models, Body, BodyRef, Force, Joint, System, SystemBuilder, TimeFunction};
     use nalgebra::DMatrix;
-
-    /// Every joint kind (revolute, prismatic, weld, distance, absolute x / y / angle, angle
-    /// driver) on four bodies.
-    fn joints_system() -> System {
-        let mut b = SystemBuilder::new();
-        let b1 = b.add_body(Body::new("b1").rod(1.0, 1.0).position(0.3, -0.2, 0.4));
-        let b2 = b.add_body(Body::new("b2").rod(2.0, 0.7).position(1.1, 0.5, -0.9));
-        let b3 = b.add_body(Body::new("b3").rod(0.5, 0.4).position(-0.6, 1.3, 2.1));
-        let b4 = b.add_body(Body::new("b4").rod(0.8, 0.9).position(0.2, 2.0, -0.3));
-        let b5 = b.add_body(Body::new("b5").rod(0.6, 0.5).position(-1.0, -1.0, 0.8));
-        b.add_joint(Joint::revolute(
-            "r",
-            BodyRef::Ground,
-            [0.1, 0.2],
-            b1,
-            [-0.5, 0.1],
-        ));
-        b.add_joint(Joint::distance("d", b1, [0.5, 0.0], b2, [-0.3, 0.2], 0.8));
-        b.add_joint(Joint::prismatic(
-            "p",
-            b2,
-            [0.1, 0.0],
-            b3,
-            [0.0, 0.1],
-            [1.0, 0.5],
-            0.2,
-        ));
-        b.add_joint(Joint::weld("w", b3, [0.2, 0.0], b4, [-0.4, 0.1], 0.3));
-        b.add_joint(Joint::absolute("ay", b4, [0.3, 0.0], Coordinate::Y, 1.0));
-        b.add_joint(Joint::absolute("ax", b5, [0.2, -0.1], Coordinate::X, -1.0));
-        b.add_joint(Joint::absolute(
-            "aa",
-            b5,
-            [0.0, 0.0],
-            Coordinate::Angle,
-            0.8,
-        ));
-        b.add_joint(Joint::angle_driver(
-            "drv",
-            BodyRef::Ground,
-            b2,
-            TimeFunction::linear(0.1, 2.0),
-        ));
-        b.build().unwrap()
-    }
 
     /// Every conservative force kind (springs with and without rest length, rotary spring,
     /// constant force and torque) besides gravity, and a damper and a time-dependent load
@@ -361,7 +314,7 @@ mod tests {
     #[test]
     fn constraint_third_matches_hessian_differences() {
         let systems = [
-            joints_system(),
+            crate::fixtures::every_joint_kind(),
             forces_system(),
             models::slider_crank().unwrap(),
             models::manipulator().unwrap(),
@@ -410,7 +363,7 @@ mod tests {
     fn lagrangian_products_match_assembled_hessians() {
         for sys in [
             forces_system(),
-            joints_system(),
+            crate::fixtures::every_joint_kind(),
             models::manipulator().unwrap(),
         ] {
             let (n, m) = (sys.n_coords(), sys.n_constraints());
