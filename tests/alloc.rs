@@ -3,49 +3,26 @@
 use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{Integrator, State};
-use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
-use std::cell::Cell;
-
-struct Counting;
-thread_local! {
-    // per thread: the test harness may allocate on its own threads meanwhile (seen under load)
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { SysAlloc.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { SysAlloc.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { SysAlloc.realloc(p, l, n) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+mod counting;
+use counting::allocations;
 
 fn count_step_allocations<I: Integrator>(mut integ: I, sys: &mbd::model::System) -> usize {
     let mut s = State::consistent(sys, 0.0).unwrap();
     integ.step(sys, &mut s, 0.01).unwrap(); // warm-up
-    let before = ALLOCS.with(|c| c.get());
+    let before = allocations();
     for _ in 0..100 {
         integ.step(sys, &mut s, 0.01).unwrap();
     }
-    ALLOCS.with(|c| c.get()) - before
+    allocations() - before
 }
 
 // One test function: the allocation counter is global, so concurrent tests would pollute it.
 #[test]
 fn steps_allocate_nothing() {
     // the counter counts
-    let before = ALLOCS.with(|c| c.get());
+    let before = allocations();
     std::hint::black_box(vec![1u8; 16]);
-    assert!(ALLOCS.with(|c| c.get()) > before);
+    assert!(allocations() > before);
     rk4_steps_allocate_nothing();
     sparse_rk4_steps_allocate_nothing();
 }

@@ -7,35 +7,13 @@ use mbd::solve::{
     NoObserver, RunConfig, State,
 };
 use mbd::tangent::{TangentOptions, TangentRk};
-use std::alloc::{GlobalAlloc, Layout, System as SysAlloc};
-use std::cell::Cell;
-
-struct Counting;
-thread_local! {
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { SysAlloc.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { SysAlloc.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { SysAlloc.realloc(p, l, n) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+mod counting;
+use counting::allocations;
 
 fn count(f: impl FnOnce() -> usize) -> (usize, usize) {
-    let before = ALLOCS.with(|c| c.get());
+    let before = allocations();
     let steps = f();
-    (ALLOCS.with(|c| c.get()) - before, steps)
+    (allocations() - before, steps)
 }
 
 #[test]

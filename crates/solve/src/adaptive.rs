@@ -124,14 +124,6 @@ impl AdaptiveConfig {
     }
 
     fn validate(&self, t0: f64) -> Result<(), SolveError> {
-        let bad = |parameter, value, reason| {
-            Err(SolveError::InvalidParameter {
-                parameter,
-                value,
-                reason,
-            })
-        };
-        let c = &self.controller;
         if !(self.t_end.is_finite() && t0.is_finite() && self.t_end > t0) {
             return Err(SolveError::InvalidInterval {
                 t0,
@@ -139,7 +131,21 @@ impl AdaptiveConfig {
                 reason: "end time must be finite and after the start time",
             });
         }
-        c.validate()?;
+        self.validate_settings()
+    }
+
+    /// Checks every setting but the interval (`t_end` is not read): the controller, `h0`,
+    /// `h_max`, `max_steps` and `condition_limit`. `run_adaptive` checks these and the interval;
+    /// the `pi_beta` bound depends on the integrator's embedded order and is checked there.
+    pub fn validate_settings(&self) -> Result<(), SolveError> {
+        let bad = |parameter, value, reason| {
+            Err(SolveError::InvalidParameter {
+                parameter,
+                value,
+                reason,
+            })
+        };
+        self.controller.validate()?;
         if let Some(h0) = self.h0 {
             if !(h0.is_finite() && h0 > 0.0) {
                 return bad("h0", h0, "must be positive and finite");

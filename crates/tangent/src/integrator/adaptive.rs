@@ -58,9 +58,25 @@ impl AdaptiveSettings {
         s
     }
 
-    /// Checks every setting.
+    /// The run loop's configuration for these settings: the same controller, step limits and
+    /// `pi_beta`, no drift guard (the chart keeps the constraints), the default condition limit.
+    fn config(&self, t_end: f64, h0: Option<f64>) -> AdaptiveConfig {
+        AdaptiveConfig {
+            t_end,
+            controller: self.controller,
+            h0,
+            h_max: self.h_max,
+            max_steps: self.max_steps,
+            pi_beta: self.pi_beta,
+            drift_guard: None,
+            condition_limit: RunConfig::DEFAULT_CONDITION_LIMIT,
+        }
+    }
+
+    /// Checks every setting: those shared with [`AdaptiveConfig`] by
+    /// [`AdaptiveConfig::validate_settings`], then `pi_beta`, `chart_shrink` and
+    /// `max_chart_failures`.
     pub fn validate(&self) -> Result<(), SolveError> {
-        let c = &self.controller;
         let bad = |parameter, value, reason| {
             Err(SolveError::InvalidParameter {
                 parameter,
@@ -68,18 +84,7 @@ impl AdaptiveSettings {
                 reason,
             })
         };
-        c.validate()?;
-        if let Some(h0) = self.h0 {
-            if !(h0.is_finite() && h0 > 0.0) {
-                return bad("h0", h0, "must be positive and finite");
-            }
-        }
-        if self.h_max.is_nan() || self.h_max <= 0.0 {
-            return bad("h_max", self.h_max, "must be positive");
-        }
-        if self.max_steps == 0 {
-            return bad("max_steps", 0.0, "must be at least 1");
-        }
+        self.config(f64::NAN, self.h0).validate_settings()?;
         if let Some(b) = self.pi_beta {
             // the bound for the tableau's embedded order is checked when it is known
             if !(0.0..0.5).contains(&b) {
@@ -183,16 +188,7 @@ impl TangentRk {
                 h0
             }
         };
-        let cfg = AdaptiveConfig {
-            t_end,
-            controller: settings.controller,
-            h0: Some(h0),
-            h_max: settings.h_max,
-            max_steps: settings.max_steps,
-            pi_beta: settings.pi_beta,
-            drift_guard: None,
-            condition_limit: RunConfig::DEFAULT_CONDITION_LIMIT,
-        };
+        let cfg = settings.config(t_end, Some(h0));
         let exact_before = self.stats.exact_maps;
         let mut driver = Driver {
             rk: self,
