@@ -53,6 +53,7 @@ mod file;
 #[cfg(test)]
 mod fixtures;
 mod force;
+mod hessian_pair;
 mod init;
 mod jet;
 mod joint;
@@ -70,6 +71,7 @@ pub use cache::AngleCache;
 pub use error::ModelError;
 pub use file::{BodyKind, BodySpec, ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};
+pub use hessian_pair::LagrangianWeights;
 pub use joint::{Coordinate, Joint, JointKind};
 pub use scale::MAX_INERTIA_RATIO;
 pub use system::{ForceHandle, JointHandle, System};

@@ -60,11 +60,13 @@ pub struct Galerkin {
     pre: Vec<Preadjustment>,
     /// The modified-Lagrangian workspace (`PreadjustMode::ModifiedLagrangian`, `s = 1`).
     ml: Vec<Preadjustment>,
-    /// `h^2 d e / d q` at the two control points of the step.
-    mlq: [Vec<f64>; 2],
-    /// `h^2 (d e / d v (Q_0) + d e / d v (Q_1)) / 2`.
+    /// `h^2 d e / d q` at the chord midpoint `(Q_0 + Q_1) / 2` of the step.
+    mlq: Vec<f64>,
+    /// `h^2 d e / d v` there.
     mlv: Vec<f64>,
-    mlt: Vec<f64>,
+    /// The chord midpoint `(Q_0 + Q_1) / 2`.
+    mlmid: Vec<f64>,
+    /// The step's constant velocity `(Q_1 - Q_0) / h`.
     mlvel: Vec<f64>,
     tn: [Vec<f64>; 4],
     proj: DenseCholesky,
@@ -147,16 +149,16 @@ impl Galerkin {
             Vec::new()
         };
         let ml = if modlag {
-            workspaces(2, 1)?
+            workspaces(1, 1)?
         } else {
             Vec::new()
         };
         let nl = if modlag { n } else { 0 };
         Ok(Galerkin {
             ml,
-            mlq: [vec![0.0; nl], vec![0.0; nl]],
+            mlq: vec![0.0; nl],
             mlv: vec![0.0; nl],
-            mlt: vec![0.0; nl],
+            mlmid: vec![0.0; nl],
             mlvel: vec![0.0; nl],
             opts: options,
             tab,
@@ -375,31 +377,20 @@ impl Galerkin {
                 }
             }
         }
-        if !self.ml.is_empty() {
-            // s = 1: the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h
+        if let Some(ml) = self.ml.first_mut() {
+            // s = 1: E_d = h^3 e(qbar, v) with the chord midpoint qbar = (Q_0 + Q_1) / 2 and
+            // the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h (one evaluation per
+            // residual; docs/symplectic.md section 5a)
             let h2 = h * h;
-            // the end point of the last step is this step's start point: reuse its evaluation
-            if !self.ml[0].is_prepared_at(&self.qn[..n]) && self.ml[1].is_prepared_at(&self.qn[..n])
-            {
-                self.ml.swap(0, 1);
-            }
             for i in 0..n {
                 self.mlvel[i] = self.hvj[i] / h;
+                self.mlmid[i] = 0.5 * (self.qn[i] + self.qn[n + i]);
             }
-            self.mlv.fill(0.0);
-            for (c, ml) in self.ml.iter_mut().enumerate() {
-                ml.modified_gradients(
-                    sys,
-                    &self.qn[c * n..(c + 1) * n],
-                    &self.mlvel,
-                    &mut self.mlq[c],
-                    &mut self.mlt,
-                )
+            ml.modified_gradients(sys, &self.mlmid, &self.mlvel, &mut self.mlq, &mut self.mlv)
                 .map_err(|e| with_time(e, t))?;
-                for i in 0..n {
-                    self.mlq[c][i] *= h2;
-                    self.mlv[i] += 0.5 * h2 * self.mlt[i];
-                }
+            for i in 0..n {
+                self.mlq[i] *= h2;
+                self.mlv[i] *= h2;
             }
         }
         Ok(())
@@ -463,9 +454,9 @@ impl Galerkin {
             }
         }
         if !self.ml.is_empty() {
-            // s = 1: h M^-1 D_1 of h (E(Q_0, v) + E(Q_1, v)) / 2, v = (Q_1 - Q_0) / h
+            // s = 1: h M^-1 D_1 E_d, D_1 E_d = h^3 (1/2 de/dq - 1/h de/dv) at (qbar, v)
             for i in 0..n {
-                self.r[i] += h * self.minv[i] * (0.5 * h * self.mlq[0][i] - self.mlv[i]);
+                self.r[i] += h * self.minv[i] * (0.5 * h * self.mlq[i] - self.mlv[i]);
             }
         }
     }

@@ -39,10 +39,7 @@ impl Galerkin {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let s1 = s + 1;
         let qs = &self.qn[s * n..(s + 1) * n];
-        match self.ml.get(1).and_then(|ml| ml.phi_q_at(qs)) {
-            Some(g) => self.phiq[s].copy_from(g),
-            None => sys.phi_q(qs, &mut self.phiq[s]),
-        }
+        sys.phi_q(qs, &mut self.phiq[s]);
         let any_hessian = self.has_forces || !self.pre.is_empty() || self.nonconservative;
         // The W_s term of the momentum rows' Jacobian is h^2 gk M^-1 A (Pi A)^s, at most
         // h^2 |gk| rho^(s+1) against the identity blocks (rho: a bound on the spectral radius
@@ -146,23 +143,31 @@ impl Galerkin {
                 }
             }
         }
-        // modified Lagrangian (s = 1): the velocity part of h M^-1 D_1 E_d,
-        // -(h^2 / 12) M^-1 (E(Q_0) + E(Q_1)) in Z_1 = h v, E = 6 d^2 e / dv^2 =
-        // B + 2 C S^-1 C^T (B = A + H_sigma - 3/2 Hess V, C = [Hess Phi_k v]_k), with
-        // E(Q_1) ~ E(Q_0) (one assembly instead of two; the difference is O(h v) relative, like
-        // the position derivatives of the modified terms, which are left out: docs/symplectic.md,
-        // section 5a). The converged solution does not depend on it.
-        if !self.ml.is_empty() {
+        // modified Lagrangian (s = 1): h M^-1 D_1 E_d in Z_1 = h v, with qbar = q_k + Z_1 / 2:
+        // * the velocity part -(h^2 / 6) M^-1 E(qbar), E = 6 d^2 e / dv^2 = B + 2 C S^-1 C^T
+        //   (B = A + H_sigma - 3/2 Hess V, C = [Hess Phi_k v]_k), where the residual evaluated
+        //   e (its factors are reused);
+        // * the leading position part (h^4 / 4) M^-1 d^2 e_0 / dq^2 of the h^3 / 2 de/dq term,
+        //   e_0 = -1/24 f_T^T M^-1 f_T, with d^2 e_0 / dq^2 ~ -1/12 A Pi A (the Newton Hessian
+        //   of W_1 = 1/2 f_T^T M^-1 f_T): O((h^2 rho)^2) against the identity (rho the
+        //   spectral radius of M^-1 A), the one that slows Newton on stiff chains.
+        // The other position derivatives (O(h) relative to the velocity part and quadratic in
+        // v) are left out (docs/symplectic.md, section 5a); the converged solution does not
+        // depend on them.
+        if let Some(ml) = self.ml.first_mut() {
             self.wh.fill(0.0);
-            self.ml[0]
-                .add_modified_velocity_hessian(sys, &self.qn[..n], &self.mlvel, 2.0, &mut self.wh)
+            ml.add_modified_velocity_hessian(sys, &self.mlmid, &self.mlvel, 2.0, &mut self.wh)
+                .map_err(|e| with_time(e, t))?;
+            // (s = 1 has no interior control point: hc is free)
+            ml.approximate_hessian(sys, &self.mlmid, &mut self.hc)
                 .map_err(|e| with_time(e, t))?;
             let jm = &mut self.lu;
+            let h4 = h2 * h2;
             for l in 0..n {
                 for i in 0..n {
-                    let b = self.wh[(i, l)];
+                    let b = -(h2 / 12.0) * self.wh[(i, l)] - (h4 / 48.0) * self.hc[(i, l)];
                     if b != 0.0 {
-                        jm.add(i, l, -(h2 / 12.0) * self.minv[i] * b);
+                        jm.add(i, l, self.minv[i] * b);
                     }
                 }
             }

@@ -81,9 +81,9 @@ impl Integrator for Galerkin {
             }
         }
         if !self.ml.is_empty() {
-            // (D_1 + D_2) of h (E(Q_0, v) + E(Q_1, v)) / 2 = h (dE/dq (Q_0) + dE/dq (Q_1)) / 2
-            for i in 0..n {
-                f[i] -= 0.5 * (self.mlq[0][i] + self.mlq[1][i]);
+            // (D_1 + D_2) E_d = h^3 de/dq (qbar, v) = h mlq
+            for (fi, &g) in f.iter_mut().zip(&self.mlq) {
+                *fi -= g;
             }
         }
         if let Some(sp) = &self.sparse {
@@ -131,23 +131,6 @@ impl Integrator for Galerkin {
             sp.schur.solve_in_place(&mut self.mu);
             sp.schur
                 .add_weighted_transpose(-1.0, &self.minv, &self.mu, &mut self.vm);
-        } else if m > 0 && self.ml.get(1).is_some_and(|ml| ml.phi_q_at(qn1).is_some()) {
-            // modified Lagrangian: the workspace at Q_1 holds Phi_q and the factor of S there
-            let ml = &mut self.ml[1];
-            if let Some(g) = ml.phi_q_at(qn1) {
-                self.phiq[s].copy_from(g);
-            }
-            self.end_phiq_valid = true;
-            let g = &self.phiq[s];
-            sys.phi_t(t1, &mut self.mu);
-            for r in 0..m {
-                self.mu[r] += (0..n).map(|k| g[(r, k)] * self.vm[k]).sum::<f64>();
-            }
-            ml.solve_s(&mut self.mu);
-            for k in 0..n {
-                let acc: f64 = (0..m).map(|r| g[(r, k)] * self.mu[r]).sum();
-                self.vm[k] -= self.minv[k] * acc;
-            }
         } else if m > 0 {
             sys.phi_q(qn1, &mut self.phiq[s]);
             self.end_phiq_valid = true;

@@ -171,7 +171,7 @@ impl Preadjustment {
             kpi: vec![0.0; n * n],
             ka: vec![0.0; n * n],
             kx: vec![0.0; n * n],
-            ky: vec![0.0; n * n],
+            ky: vec![0.0; n * n.max(m)],
         })
     }
 
@@ -329,16 +329,6 @@ impl Preadjustment {
             self.av[i + 1] = next;
             self.bv[i] = b;
         }
-    }
-
-    /// `Phi_q` at the prepared point, if the workspace holds the evaluation at exactly `q`.
-    pub(crate) fn phi_q_at(&self, q: &[f64]) -> Option<&DMatrix<f64>> {
-        self.is_prepared_at(q).then_some(&self.gq)
-    }
-
-    /// `b <- S^-1 b` with the factor of `S = Phi_q M^-1 Phi_q^T` at the prepared point.
-    pub(crate) fn solve_s(&mut self, b: &mut [f64]) {
-        self.chol.solve_in_place(b);
     }
 
     /// The tangential force `f_T(q) = P(q) (-grad V(q))` into `out`.

@@ -13,7 +13,7 @@
 #[cfg(test)]
 use super::matvec;
 use super::{dot, Preadjustment};
-use mbd_model::System;
+use mbd_model::{LagrangianWeights, System};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -150,8 +150,11 @@ impl Preadjustment {
         self.add_modified_velocity_hessian(sys, q, v, 1.0, out)
     }
 
-    /// `out += scale * B(q, v)` ([`Preadjustment::modified_velocity_hessian`]), without the
-    /// overwrite: the Newton Jacobian sums `B` at both control points into one matrix.
+    /// `out += scale * (B + 2 C S^-1 C^T)` at `(q, v)` ([`Preadjustment::modified_velocity_hessian`]),
+    /// without the overwrite, from one Hessian pass over the elements
+    /// ([`System::add_lagrangian_hessian_pair`]); the same pass assembles
+    /// `A = Hess V - mu0 . Hess Phi`, which [`Preadjustment::approximate_hessian`] at the same `q`
+    /// then reuses.
     pub fn add_modified_velocity_hessian(
         &mut self,
         sys: &System,
@@ -166,15 +169,39 @@ impl Preadjustment {
         if !(self.mv_valid && self.mv.as_slice() == v) {
             self.modified_prepared(sys, q, v);
         }
-        self.add_assembled_b(sys, q, scale, out);
-        if self.m > 0 {
+        // one Hessian pass: out += scale B, amat = A (kept for approximate_hessian) and
+        // C^T = (Phi_q v)_q
+        let m = self.m;
+        for r in 0..m {
+            self.tm[2][r] = scale * self.cm[r];
+        }
+        self.amat.fill(0.0);
+        sys.add_lagrangian_hessian_pair(
+            q,
+            v,
+            (
+                LagrangianWeights {
+                    potential: 1.0,
+                    constraints: &self.nmu0,
+                },
+                &mut self.amat,
+            ),
+            (
+                LagrangianWeights {
+                    potential: scale * POTENTIAL_WEIGHT,
+                    constraints: &self.tm[2],
+                },
+                out,
+            ),
+            &mut self.ct,
+        );
+        self.a_valid = true;
+        if m > 0 {
             // + 2 C S^-1 C^T, C = [Hess Phi_k v]_k: the derivative of sigma = S^-1 gamma_c(v)
             // (gamma_c,k = v^T Hess Phi_k v, d gamma_c / dv = 2 C^T), so that
             // 6 d^2 e / dv^2 = B + 2 C S^-1 C^T exactly (q fixed)
-            let m = self.m;
-            sys.phi_q_dot_jacobian(q, v, &mut self.gscr, &mut self.ct);
             // the coordinates where C^T has a nonzero column, and Y = L^-1 C^T on them
-            // (C S^-1 C^T = Y^T Y), packed into the discarded Phi_q
+            // (C S^-1 C^T = Y^T Y), packed into the scratch gscr
             self.kset.clear();
             let y = self.gscr.as_mut_slice();
             for (i, ci) in self.ct.as_slice().chunks_exact(m).enumerate() {
@@ -193,15 +220,6 @@ impl Preadjustment {
             }
         }
         Ok(())
-    }
-
-    /// `out += scale * (POTENTIAL_WEIGHT Hess V + (sigma - mu0) . Hess Phi)` after
-    /// `modified_prepared(q, v)`: one assembly.
-    fn add_assembled_b(&self, sys: &System, q: &[f64], scale: f64, out: &mut DMatrix<f64>) {
-        sys.add_potential_hessian(q, scale * POTENTIAL_WEIGHT, out);
-        if self.m > 0 {
-            sys.add_constraint_hessian(q, &self.cm, scale, out);
-        }
     }
 
     /// Gradients of [`Preadjustment::modified_term`], into `dq` and `dv`; returns `e(q, v)`.

@@ -211,29 +211,35 @@ impl Preadjustment {
         self.ensure_a(sys, q);
         let (n, m) = (self.n, self.m);
         self.kset.clear();
-        for c in 0..n {
-            if self.amat.column(c).iter().any(|&a| a != 0.0) {
+        for (c, col) in self.amat.as_slice().chunks_exact(n).enumerate() {
+            if col.iter().any(|&a| a != 0.0) {
                 self.kset.push(c);
             }
         }
         let k = self.kset.len();
-        // Pi_KK (column-major k x k in kpi)
-        let mut x = std::mem::take(&mut self.tm[1]);
+        // Pi_KK = M^-1_KK - Y^T Y with Y = L^-1 (G M^-1)_K (S = L L^T): one triangular solve
+        // per column of K, its columns packed into ky (m x k; free until the products below)
         for (cj, &c) in self.kset.iter().enumerate() {
+            let y = &mut self.ky[cj * m..(cj + 1) * m];
             for r in 0..m {
-                x[r] = self.gq[(r, c)] * self.minv[c];
+                y[r] = self.gq[(r, c)] * self.minv[c];
             }
-            if m > 0 {
-                self.chol.solve_in_place(&mut x);
-            }
-            for (ri, &r) in self.kset.iter().enumerate() {
-                let gcol = &self.gq.as_slice()[r * m..(r + 1) * m];
-                let acc = dot(gcol, &x);
-                let d = if r == c { self.minv[c] } else { 0.0 };
-                self.kpi[cj * k + ri] = d - self.minv[r] * acc;
+            self.chol.forward_in_place(y);
+        }
+        for cj in 0..k {
+            for ri in 0..k {
+                let yy = dot(
+                    &self.ky[ri * m..(ri + 1) * m],
+                    &self.ky[cj * m..(cj + 1) * m],
+                );
+                let d = if ri == cj {
+                    self.minv[self.kset[cj]]
+                } else {
+                    0.0
+                };
+                self.kpi[cj * k + ri] = d - yy;
             }
         }
-        self.tm[1] = x;
         // X = A_KK, then X <- A_KK (Pi_KK X), s times
         for (cj, &c) in self.kset.iter().enumerate() {
             for (ri, &r) in self.kset.iter().enumerate() {

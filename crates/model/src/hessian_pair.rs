@@ -1,0 +1,178 @@
+//! Two weighted Lagrangian Hessians and the velocity-constraint Jacobian from one Hessian pass
+//! over the elements: what a Newton matrix needs when it combines the same element Hessians with
+//! two sets of multipliers (e.g. a preadjusted step's `A = Hess V - mu0 . Hess Phi` and
+//! `B = p Hess V + w . Hess Phi`), at the cost of one assembly instead of three passes.
+
+use crate::jet::{HessJet, Scalar, NV};
+use crate::system::System;
+use nalgebra::DMatrix;
+
+/// One weighted Lagrangian `potential * V + sum_k weights_k Phi_k` (`weights` has length m):
+/// the weights of one Hessian of [`System::add_lagrangian_hessian_pair`].
+#[derive(Clone, Copy, Debug)]
+pub struct LagrangianWeights<'a> {
+    /// Weight of the potential `V`.
+    pub potential: f64,
+    /// Weights of the constraint equations (length m).
+    pub constraints: &'a [f64],
+}
+
+impl System {
+    /// In one Hessian pass over the forces and joints at `q`, for the pairs `(a, out_a)` and
+    /// `(b, out_b)`: `out_a += Hess(a.potential V + a.constraints . Phi)`,
+    /// `out_b += Hess(b.potential V + b.constraints . Phi)` (both n x n) and
+    /// `ct = (Phi_q v)_q` (m x n, overwritten; row `k` is `v^T Hess Phi_k`, as in
+    /// [`System::phi_q_dot_jacobian`]).
+    pub fn add_lagrangian_hessian_pair(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        (a, out_a): (LagrangianWeights<'_>, &mut DMatrix<f64>),
+        (b, out_b): (LagrangianWeights<'_>, &mut DMatrix<f64>),
+        ct: &mut DMatrix<f64>,
+    ) {
+        if a.potential != 0.0 || b.potential != 0.0 {
+            for (fi, f) in self.forces.iter().enumerate() {
+                let at = self.force_attach[fi];
+                let e = f.potential(&Self::loc_hess(q, at.a, 0), &Self::loc_hess(q, at.b, 3));
+                for (w, out) in [(a.potential, &mut *out_a), (b.potential, &mut *out_b)] {
+                    if w != 0.0 {
+                        Self::scatter_hess(at, &scaled(&e.h, w), out);
+                    }
+                }
+            }
+        }
+        ct.fill(0.0);
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let mut e = [HessJet::cst(0.0); 3];
+            j.eval(
+                &Self::loc_hess(q, at.a, 0),
+                &Self::loc_hess(q, at.b, 3),
+                &mut e,
+            );
+            // the joint's local velocity
+            let mut vl = [0.0; NV];
+            for (slot, body) in [(0, at.a), (3, at.b)] {
+                if let Some(i) = body {
+                    vl[slot..slot + 3].copy_from_slice(&v[3 * i..3 * i + 3]);
+                }
+            }
+            let o = self.row_offset[ji];
+            let (mut ha, mut hb) = ([[0.0; NV]; NV], [[0.0; NV]; NV]);
+            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+                let (wa, wb) = (a.constraints[o + k], b.constraints[o + k]);
+                let mut hv = [0.0; NV];
+                for r in 0..NV {
+                    for c in 0..NV {
+                        let x = ek.h[r][c];
+                        ha[r][c] += wa * x;
+                        hb[r][c] += wb * x;
+                        hv[r] += x * vl[c];
+                    }
+                }
+                self.scatter_row(ji, o + k, &hv, ct);
+            }
+            Self::scatter_hess(at, &ha, out_a);
+            Self::scatter_hess(at, &hb, out_b);
+        }
+    }
+}
+
+fn scaled(h: &[[f64; NV]; NV], w: f64) -> [[f64; NV]; NV] {
+    let mut out = *h;
+    for row in out.iter_mut() {
+        for x in row.iter_mut() {
+            *x *= w;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LagrangianWeights;
+    use crate::{models, Body, BodyRef, Force, SystemBuilder};
+    use nalgebra::DMatrix;
+
+    /// The pair equals two separate assemblies ([`crate::System::potential_hessian`] and
+    /// [`crate::System::add_constraint_hessian`]) and `ct` equals
+    /// [`crate::System::phi_q_dot_jacobian`], on every joint kind and on a model with springs.
+    #[test]
+    fn pair_matches_separate_assemblies() {
+        let springs = {
+            let mut b = SystemBuilder::new();
+            b.set_gravity([0.0, -9.81]);
+            let r = b.add_body(Body::new("r").rod(1.0, 1.0).position(0.4, -0.3, 0.7));
+            let p = b.add_body(Body::new("p").rod(0.5, 0.6).position(1.2, 0.2, -0.4));
+            b.add_force(Force::spring_damper(
+                "s1",
+                r,
+                [0.5, 0.0],
+                p,
+                [-0.3, 0.0],
+                20.0,
+                0.0,
+                0.4,
+            ));
+            b.add_force(Force::spring_damper(
+                "s2",
+                BodyRef::Ground,
+                [0.0, 0.5],
+                r,
+                [-0.5, 0.0],
+                7.0,
+                0.0,
+                0.2,
+            ));
+            b.build().unwrap()
+        };
+        for sys in [
+            crate::fixtures::every_joint_kind(),
+            models::manipulator().unwrap(),
+            springs,
+        ] {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.2 * (i as f64 * 0.9).sin()).collect();
+            let v: Vec<f64> = (0..n).map(|i| 0.5 * (i as f64 * 1.7 + 0.3).cos()).collect();
+            let wa: Vec<f64> = (0..m).map(|r| 0.7 - 0.3 * r as f64).collect();
+            let wb: Vec<f64> = (0..m).map(|r| -0.2 + 0.11 * r as f64).collect();
+            let (mut a, mut b) = (DMatrix::from_element(n, n, 0.25), DMatrix::zeros(n, n));
+            let mut ct = DMatrix::from_element(m, n, 9.0);
+            sys.add_lagrangian_hessian_pair(
+                &q,
+                &v,
+                (
+                    LagrangianWeights {
+                        potential: 1.0,
+                        constraints: &wa,
+                    },
+                    &mut a,
+                ),
+                (
+                    LagrangianWeights {
+                        potential: -0.5,
+                        constraints: &wb,
+                    },
+                    &mut b,
+                ),
+                &mut ct,
+            );
+            let mut hv = DMatrix::zeros(n, n);
+            sys.potential_hessian(&q, &mut hv);
+            let mut ea = DMatrix::from_element(n, n, 0.25) + &hv;
+            sys.add_constraint_hessian(&q, &wa, 1.0, &mut ea);
+            let mut eb = &hv * -0.5;
+            sys.add_constraint_hessian(&q, &wb, 1.0, &mut eb);
+            let (mut gq, mut ect) = (DMatrix::zeros(m, n), DMatrix::zeros(m, n));
+            sys.phi_q_dot_jacobian(&q, &v, &mut gq, &mut ect);
+            let close = |x: &DMatrix<f64>, y: &DMatrix<f64>, what: &str| {
+                let scale = 1.0 + y.amax();
+                assert!((x - y).amax() < 1e-13 * scale, "{what}: {}", (x - y).amax());
+            };
+            close(&a, &ea, "out_a");
+            close(&b, &eb, "out_b");
+            close(&ct, &ect, "ct");
+        }
+    }
+}
