@@ -39,7 +39,8 @@
 //! partial pivoting). The static path's threshold test compares unscaled entries of one column,
 //! which is invariant under column scaling.
 //!
-//! [`DenseLu::solve`] touches only the recorded nonzeros of `L` and `U`.
+//! The solves ([`DenseLu::solve_in_place`], [`DenseLu::solve_with`],
+//! [`DenseLu::solve_transpose_in_place`]) touch only the recorded nonzeros of `L` and `U`.
 //!
 //! Files: the matrix storage and its entry methods here, the symbolic factorisation in
 //! `symbolic.rs`, the numeric factorisation (both paths and the equilibration) in `factor.rs`,
