@@ -11,14 +11,15 @@ Examples:
   mbd plot slider.csv --y slider.x --y crank.theta -o slider.svg
   mbd animate slider.csv --model examples/models/slider_crank_spring.toml -o slider.html
 
-Solvers: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified, tangent:rk4,
-tangent:dopri5 (fixed --h or adaptive --tol), firefly-gauss. See docs/cli.md.";
+Solvers: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified, index1:dopri5
+and tangent:dopri5 (fixed --h or adaptive --tol), tangent:rk4, firefly-gauss. See docs/cli.md.";
 
 const RUN_EXAMPLE: &str = "\
 Examples:
   mbd run examples/models/pendulum.toml --solver rk4 --t-end 2 --h 1e-3 --out pendulum.csv
   mbd run examples/models/four_bar.toml --solver symplectic:2:gamma=1 --t-end 5 --h 1e-3 --out fb.json --every 10
   mbd run examples/models/manipulator.json --solver tangent:dopri5 --t-end 3 --tol 1e-8 --out arm.csv
+  mbd run examples/models/pendulum.toml --solver index1:dopri5 --t-end 1 --tol 1e-9 --out p.csv
 
 Columns: t, every coordinate (body.x, body.y, body.theta), every velocity (d_body.x, ...),
 the energy H, and the constraint residuals max_abs_phi = max|Phi| and
@@ -72,8 +73,8 @@ pub enum Command {
 pub struct RunArgs {
     /// Model file (.toml or .json).
     pub model: PathBuf,
-    /// Solver: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified, tangent:rk4,
-    /// tangent:dopri5, firefly-gauss.
+    /// Solver: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified,
+    /// index1:dopri5, tangent:rk4, tangent:dopri5, firefly-gauss.
     #[arg(long, short, value_parser = parse_solver)]
     pub solver: SolverSpec,
     /// End time in s (the run starts at t0 = 0).
@@ -83,7 +84,7 @@ pub struct RunArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = parse_h, conflicts_with = "tol")]
     pub h: Option<f64>,
     /// Error tolerance for adaptive steps (solvers with an embedded error estimate:
-    /// tangent:dopri5).
+    /// index1:dopri5, tangent:dopri5).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_tol)]
     pub tol: Option<f64>,
     /// Output file: .csv or .json (default: CSV on standard output).

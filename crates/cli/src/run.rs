@@ -183,7 +183,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     if args.tol.is_some() && !args.solver.has_error_estimate() {
         return Err(CliError::Usage(format!(
             "--tol needs a solver with an embedded error estimate, and '{}' has none: give a \
-             fixed step with --h, or use --solver tangent:dopri5 with --tol",
+             fixed step with --h, or use --solver index1:dopri5 or tangent:dopri5 with --tol",
             args.solver
         )));
     }
@@ -205,7 +205,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     let mut obs = (measures, (count, (sink, progress)));
     let started = Instant::now();
     let result = match (args.h, args.tol) {
-        (_, Some(tol)) => mbd_tangent::TangentRk::dopri5(&sys).and_then(|mut dp| {
+        (_, Some(tol)) => args.solver.build_adaptive(&sys).and_then(|mut dp| {
             mbd_solve::run_adaptive(
                 &mut dp,
                 &sys,

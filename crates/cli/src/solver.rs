@@ -1,14 +1,16 @@
 //! Solver names on the command line and the integrators they build.
 
 use mbd_model::System;
-use mbd_solve::{Integrator, SolveError};
+use mbd_solve::{
+    AdaptiveIntegrator, ButcherTableau, Index1Options, Index1Rk, Integrator, SolveError,
+};
 use std::fmt;
 use std::str::FromStr;
 
 /// The solvers `mbd run --solver` accepts.
 const SOLVERS: &str = "rk4, rk4-projected, symplectic:S[:gamma=G] (e.g. symplectic:2, \
-                       symplectic:2:gamma=1), symplectic:1:modified, tangent:rk4, \
-                       tangent:dopri5, firefly-gauss";
+                       symplectic:2:gamma=1), symplectic:1:modified, index1:dopri5, \
+                       tangent:rk4, tangent:dopri5, firefly-gauss";
 
 /// A solver chosen on the command line.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,6 +29,9 @@ pub enum SolverSpec {
         /// The parameter-free modified-Lagrangian preadjustment (s = 1 only).
         modified: bool,
     },
+    /// DOPRI5 5(4) on the index-1 form, no stabilisation (`index1:dopri5`), fixed or adaptive
+    /// steps.
+    Index1Dopri5,
     /// Paper B's tangent-space parameterisation with RK4 (`tangent:rk4`).
     TangentRk4,
     /// Paper B's tangent-space parameterisation with DOPRI5 (`tangent:dopri5`), fixed or
@@ -39,7 +44,21 @@ pub enum SolverSpec {
 impl SolverSpec {
     /// Whether the solver has an embedded error estimate (so `--tol` works).
     pub fn has_error_estimate(&self) -> bool {
-        matches!(self, SolverSpec::TangentDopri5)
+        matches!(self, SolverSpec::Index1Dopri5 | SolverSpec::TangentDopri5)
+    }
+
+    /// Builds the adaptive integrator for `sys` (for [`mbd_solve::run_adaptive`]); an
+    /// [`SolveError::Unsupported`] error for a solver without an embedded error estimate.
+    pub fn build_adaptive(&self, sys: &System) -> Result<Box<dyn AdaptiveIntegrator>, SolveError> {
+        Ok(match self {
+            SolverSpec::Index1Dopri5 => Box::new(index1_dopri5(sys)?),
+            SolverSpec::TangentDopri5 => Box::new(mbd_tangent::TangentRk::dopri5(sys)?),
+            _ => {
+                return Err(SolveError::Unsupported(format!(
+                    "'{self}' has no embedded error estimate"
+                )))
+            }
+        })
     }
 
     /// Builds the fixed-step integrator for `sys`.
@@ -56,6 +75,7 @@ impl SolverSpec {
                 }
                 Box::new(mbd_symplectic::Galerkin::new(sys, o)?)
             }
+            SolverSpec::Index1Dopri5 => Box::new(index1_dopri5(sys)?),
             SolverSpec::TangentRk4 => Box::new(mbd_tangent::TangentRk::rk4(sys)?),
             SolverSpec::TangentDopri5 => Box::new(mbd_tangent::TangentRk::dopri5(sys)?),
             SolverSpec::FireflyGauss => Box::new(mbd_firefly_gauss::FireflyGauss::new(
@@ -64,6 +84,11 @@ impl SolverSpec {
             )?),
         })
     }
+}
+
+/// DOPRI5 on the index-1 form with the default options (no Baumgarte, no projection).
+fn index1_dopri5(sys: &System) -> Result<Index1Rk, SolveError> {
+    Index1Rk::new(sys, ButcherTableau::dopri5(), Index1Options::default())
 }
 
 impl fmt::Display for SolverSpec {
@@ -78,6 +103,7 @@ impl fmt::Display for SolverSpec {
                 write!(f, "symplectic:{s}")
             }
             SolverSpec::Symplectic { s, gamma, .. } => write!(f, "symplectic:{s}:gamma={gamma}"),
+            SolverSpec::Index1Dopri5 => write!(f, "index1:dopri5"),
             SolverSpec::TangentRk4 => write!(f, "tangent:rk4"),
             SolverSpec::TangentDopri5 => write!(f, "tangent:dopri5"),
             SolverSpec::FireflyGauss => write!(f, "firefly-gauss"),
@@ -95,6 +121,7 @@ impl FromStr for SolverSpec {
         match t.as_str() {
             "rk4" => return Ok(SolverSpec::Rk4),
             "rk4-projected" => return Ok(SolverSpec::Rk4Projected),
+            "index1:dopri5" => return Ok(SolverSpec::Index1Dopri5),
             "tangent:rk4" => return Ok(SolverSpec::TangentRk4),
             "tangent:dopri5" => return Ok(SolverSpec::TangentDopri5),
             "firefly-gauss" => return Ok(SolverSpec::FireflyGauss),
@@ -163,6 +190,7 @@ mod tests {
             "symplectic:2",
             "symplectic:3:gamma=0.5",
             "symplectic:1:modified",
+            "index1:dopri5",
             "tangent:rk4",
             "tangent:dopri5",
             "firefly-gauss",
@@ -176,7 +204,9 @@ mod tests {
     fn bad_names_say_what_to_use() {
         let e = "rk5".parse::<SolverSpec>().unwrap_err();
         assert!(
-            e.contains("unknown solver 'rk5'") && e.contains("tangent:dopri5"),
+            e.contains("unknown solver 'rk5'")
+                && e.contains("index1:dopri5")
+                && e.contains("tangent:dopri5"),
             "{e}"
         );
         let e = "symplectic:x".parse::<SolverSpec>().unwrap_err();
@@ -192,6 +222,7 @@ mod tests {
     #[test]
     fn only_dopri5_has_an_error_estimate() {
         assert!(SolverSpec::TangentDopri5.has_error_estimate());
+        assert!(SolverSpec::Index1Dopri5.has_error_estimate());
         assert!(!SolverSpec::Rk4.has_error_estimate());
         assert!(!SolverSpec::TangentRk4.has_error_estimate());
     }

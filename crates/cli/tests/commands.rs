@@ -47,6 +47,8 @@ fn every_solver_runs_every_example_model() {
         ("rk4-projected", &["--h", "0.01"]),
         ("symplectic:2", &["--h", "0.01"]),
         ("symplectic:1:gamma=1", &["--h", "0.01"]),
+        ("index1:dopri5", &["--h", "0.01"]),
+        ("index1:dopri5", &["--tol", "1e-6"]),
         ("tangent:rk4", &["--h", "0.01"]),
         ("tangent:dopri5", &["--h", "0.01"]),
         ("tangent:dopri5", &["--tol", "1e-6"]),
@@ -87,6 +89,62 @@ fn modified_lagrangian_runs_on_a_conservative_model() {
     let out = run_model(&model, "symplectic:1:modified", &["--h", "0.01"], &csv);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert_eq!(read_csv(&csv).1.len(), 3);
+}
+
+#[test]
+fn adaptive_index1_dopri5_follows_its_tolerance() {
+    let d = scratch("index1");
+    let model = common::repo().join("examples/models/four_bar.toml");
+    let run = |tol: &str| {
+        let json = d.join(format!("four_bar_{tol}.json"));
+        let out = mbd([
+            "run".as_ref(),
+            model.as_os_str(),
+            "--solver".as_ref(),
+            "index1:dopri5".as_ref(),
+            "--t-end".as_ref(),
+            "1".as_ref(),
+            "--tol".as_ref(),
+            tol.as_ref(),
+            "--out".as_ref(),
+            json.as_os_str(),
+        ]);
+        assert_eq!(out.code, 0, "--tol {tol}: {}", out.stderr);
+        assert!(
+            out.stderr.contains("with index1:dopri5"),
+            "--tol {tol}: {}",
+            out.stderr
+        );
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert_eq!(v["solver"], "index1:dopri5");
+        assert!(v["h"].is_null());
+        assert_eq!(v["tol"], tol.parse::<f64>().unwrap());
+        let cols: Vec<String> = serde_json::from_value(v["columns"].clone()).unwrap();
+        assert_eq!(cols, expected_columns(&model));
+        let rows: Vec<Vec<f64>> = serde_json::from_value(v["rows"].clone()).unwrap();
+        assert!(rows.iter().all(|r| r.len() == cols.len()));
+        assert_eq!(rows[0][0], 0.0);
+        assert!((rows[rows.len() - 1][0] - 1.0).abs() < 1e-12);
+        // no stabilisation: the written residuals are the DOPRI5 error's drift
+        let phi = cols.iter().position(|c| c == "max_abs_phi").unwrap();
+        let worst = rows.iter().fold(0.0f64, |m, r| m.max(r[phi].abs()));
+        assert!(worst < 1e-6, "--tol {tol}: max_abs_phi = {worst:e}");
+        let steps = v["summary"]["steps"].as_u64().unwrap();
+        (steps, worst, v["summary"]["e_phi"].as_f64().unwrap())
+    };
+    let (loose_steps, loose_phi, _) = run("1e-6");
+    let (tight_steps, tight_phi, tight_e_phi) = run("1e-9");
+    // the tolerance reaches the index-1 integrator: more steps and much less drift when tighter
+    assert!(
+        tight_steps > 2 * loose_steps,
+        "{tight_steps} vs {loose_steps}"
+    );
+    assert!(
+        tight_phi < loose_phi / 100.0,
+        "{tight_phi:e} vs {loose_phi:e}"
+    );
+    assert!(tight_e_phi < 1e-8, "{tight_e_phi:e}");
 }
 
 #[test]

@@ -19,7 +19,12 @@ fn unknown_solver() {
     assert_fails(
         &out,
         2,
-        &["unknown solver 'rk5'", "tangent:dopri5", "firefly-gauss"],
+        &[
+            "unknown solver 'rk5'",
+            "index1:dopri5",
+            "tangent:dopri5",
+            "firefly-gauss",
+        ],
     );
 }
 
@@ -86,11 +91,24 @@ fn tolerance_with_a_solver_without_error_estimate() {
         &[
             "--tol needs a solver with an embedded error estimate",
             "'rk4'",
+            "index1:dopri5",
             "tangent:dopri5",
         ],
     );
     let out = run_with(&["--solver", "tangent:dopri5", "--t-end", "1", "--tol", "2"]);
     assert_fails(&out, 2, &["tolerance must lie in (0, 1)"]);
+}
+
+#[test]
+fn index1_dopri5_with_a_bad_tolerance() {
+    for tol in ["0", "-0.001", "1", "inf"] {
+        let out = run_with(&["--solver", "index1:dopri5", "--t-end", "1", "--tol", tol]);
+        assert_fails(&out, 2, &["--tol", "tolerance must lie in (0, 1)"]);
+    }
+    let out = run_with(&["--solver", "index1:dopri5", "--t-end", "1", "--tol", "abc"]);
+    assert_fails(&out, 2, &["'abc' is not a number"]);
+    let out = run_with(&["--solver", "index1:rk45", "--t-end", "1", "--tol", "1e-6"]);
+    assert_fails(&out, 2, &["unknown solver 'index1:rk45'", "index1:dopri5"]);
 }
 
 #[test]

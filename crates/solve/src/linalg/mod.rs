@@ -1,4 +1,4 @@
-//! Allocation-free dense factorisations: the one dense LU ([`DenseLu`], `lu.rs`: static or
+//! Allocation-free dense factorisations: the one dense LU ([`DenseLu`], `lu/`: static or
 //! threshold pivoting with a scale-invariant pivot test, for the small sparse-ish matrices of
 //! the solvers) and the Cholesky factorisation ([`DenseCholesky`]) on preallocated workspaces.
 
