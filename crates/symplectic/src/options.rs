@@ -26,9 +26,10 @@ pub enum PreadjustMode {
     #[default]
     Paper,
     /// The parameter-free modified Lagrangian of issue 13 for `s = 1`:
-    /// `L~ = L - h^2/24 f_T^T M^-1 f_T + h^2/12 v^T A v + h^2/24 gamma_c^T S^-1 gamma_c`, each
-    /// term averaged over the two control points (`docs/symplectic.md`, "Modified-Lagrangian
-    /// preadjustment"). Needs `s = 1`, `gamma = 0`, a conservative model and the dense path.
+    /// `L~ = L + h^2 e(q, v)`, `e = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v - 1/8 v^T Hess V v
+    /// + 1/24 gamma_c^T S^-1 gamma_c`, evaluated at the chord midpoint of each step
+    /// (`docs/symplectic.md` section 5a, derivation in `docs/modified-lagrangian.md`). Needs
+    /// `s = 1`, `gamma = 0`, a conservative model and the dense path.
     ModifiedLagrangian,
 }
 
