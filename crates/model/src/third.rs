@@ -8,6 +8,7 @@
 
 use crate::jet::{Frame, Scalar, TanJet, ThirdJet, NV};
 use crate::system::{Attach, System};
+use nalgebra::DMatrix;
 
 impl System {
     #[inline(always)]
@@ -187,6 +188,68 @@ impl System {
             }
             Self::scatter_grad(at, &g1, 1.0, hv);
             Self::scatter_grad(at, &g2, 1.0, d3);
+        }
+    }
+
+    /// Per constraint row `r` at `q` along `v`, in element-local form (as
+    /// [`System::phi_q_local`]: six numbers in the columns of the joint's two bodies), from one
+    /// third-order pass over the joints: the gradient `grads[r]` (row `r` of `Phi_q`),
+    /// `hv[r] = Hess Phi_r v`, `d3[r] = D^3 Phi_r(v, v, .)` and `vhv[r] = v^T Hess Phi_r v`
+    /// (so `gamma = -vhv` plus the time part). Everything a constraint-weighted Hessian term
+    /// needs before its weights are known ([`System::add_local_rows`] applies them).
+    pub fn constraint_third_local(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        grads: &mut [[f64; NV]],
+        hv: &mut [[f64; NV]],
+        d3: &mut [[f64; NV]],
+        vhv: &mut [f64],
+    ) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let mut e = [ThirdJet::cst(0.0); 3];
+            j.eval(
+                &Self::loc_third(q, v, at.a, 0),
+                &Self::loc_third(q, v, at.b, 3),
+                &mut e,
+            );
+            let o = self.row_offset[ji];
+            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+                grads[o + k] = ek.g;
+                hv[o + k] = ek.g1;
+                d3[o + k] = ek.g2;
+                vhv[o + k] = ek.d2;
+            }
+        }
+    }
+
+    /// `out += sum_r weights_r rows_r` for element-local constraint rows (length-n `out`,
+    /// `weights` of length m; see [`System::constraint_third_local`]).
+    pub fn add_local_rows(&self, rows: &[[f64; NV]], weights: &[f64], out: &mut [f64]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            let mut g = [0.0; NV];
+            for k in 0..j.n_equations() {
+                let w = weights[o + k];
+                for l in 0..NV {
+                    g[l] += w * rows[o + k][l];
+                }
+            }
+            Self::scatter_grad(at, &g, 1.0, out);
+        }
+    }
+
+    /// The dense `m x n` matrix of element-local constraint rows (e.g. `Phi_q` from the
+    /// `grads` of [`System::constraint_third_local`]) into `out` (overwritten).
+    pub fn local_rows_dense(&self, rows: &[[f64; NV]], out: &mut DMatrix<f64>) {
+        out.as_mut_slice().fill(0.0);
+        for ji in 0..self.joints.len() {
+            let o = self.row_offset[ji];
+            for k in 0..self.joints[ji].n_equations() {
+                self.scatter_row(ji, o + k, &rows[o + k], out);
+            }
         }
     }
 }
@@ -386,6 +449,54 @@ mod tests {
                 assert!((hv2[i] - dense[i]).abs() < tol, "lagrangian_third hv [{i}]");
                 let e3 = 0.5 * p3[i] + c3[i];
                 assert!((d3[i] - e3).abs() < 1e-12 * (1.0 + e3.abs()), "D3 L [{i}]");
+            }
+        }
+    }
+
+    /// The local third-order rows equal the dense passes: `Phi_q` and `gamma`
+    /// ([`System::phi_q_gamma`]), and, weighted, `Hess(w . Phi) v` and `D^3(w . Phi)(v, v, .)`
+    /// ([`System::lagrangian_third`]).
+    #[test]
+    fn local_third_rows_match_the_dense_passes() {
+        for sys in [
+            crate::fixtures::every_joint_kind(),
+            models::manipulator().unwrap(),
+        ] {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let (q, v) = point(n);
+            let w: Vec<f64> = (0..m).map(|r| 0.7 - 0.3 * r as f64).collect();
+            let (mut g, mut hv, mut d3, mut vhv) = (
+                vec![[0.0; 6]; m],
+                vec![[0.0; 6]; m],
+                vec![[0.0; 6]; m],
+                vec![0.0; m],
+            );
+            sys.constraint_third_local(&q, &v, &mut g, &mut hv, &mut d3, &mut vhv);
+            let mut gq = DMatrix::from_element(m, n, 3.0);
+            sys.local_rows_dense(&g, &mut gq);
+            let (mut gq2, mut gamma) = (DMatrix::zeros(m, n), vec![0.0; m]);
+            sys.phi_q_gamma(&q, &v, 0.0, &mut gq2, &mut gamma);
+            assert!((&gq - &gq2).amax() < 1e-14 * (1.0 + gq2.amax()));
+            for r in 0..m {
+                assert!(
+                    (vhv[r] + gamma[r]).abs() < 1e-13 * (1.0 + gamma[r].abs()),
+                    "row {r}"
+                );
+            }
+            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+            sys.add_local_rows(&hv, &w, &mut a);
+            sys.add_local_rows(&d3, &w, &mut b);
+            let (mut ea, mut eb) = (vec![0.0; n], vec![0.0; n]);
+            sys.lagrangian_third(&q, &v, 0.0, &w, &mut ea, &mut eb);
+            for i in 0..n {
+                assert!(
+                    (a[i] - ea[i]).abs() < 1e-13 * (1.0 + ea[i].abs()),
+                    "Hv [{i}]"
+                );
+                assert!(
+                    (b[i] - eb[i]).abs() < 1e-13 * (1.0 + eb[i].abs()),
+                    "D3 [{i}]"
+                );
             }
         }
     }

@@ -69,9 +69,6 @@ pub struct Preadjustment {
     /// evaluated where the residual was.
     mv: Vec<f64>,
     mv_valid: bool,
-    /// `gc` holds `gamma(q, v, 0)` from the fused `Phi_q` pass of `prepare_with` (consumed by
-    /// the next `modified_prepared`).
-    gc_fresh: bool,
     /// The coordinates where `A` has a nonzero column, and `k x k` blocks on them (column-major,
     /// `n x n` capacity) for the Newton Hessian of `W_s`.
     kset: Vec<usize>,
@@ -81,6 +78,14 @@ pub struct Preadjustment {
     ct: DMatrix<f64>,
     /// Scratch: the nonzero rows of a column of `Phi_q`.
     rows: Vec<usize>,
+    /// Element-local constraint rows along the velocity `rv` from one third-order pass
+    /// (`System::constraint_third_local`; valid at `at` while `rv_valid`): `Phi_q`,
+    /// `Hess Phi_r v`, `D^3 Phi_r(v, v, .)`; `gc` then holds `v^T Hess Phi_r v`.
+    rg: Vec<[f64; 6]>,
+    rhv: Vec<[f64; 6]>,
+    rd3: Vec<[f64; 6]>,
+    rv: Vec<f64>,
+    rv_valid: bool,
     kpi: Vec<f64>,
     ka: Vec<f64>,
     kx: Vec<f64>,
@@ -163,11 +168,15 @@ impl Preadjustment {
             rheonomic: sys.is_rheonomic(),
             mv: vec![0.0; n],
             mv_valid: false,
-            gc_fresh: false,
             kset: Vec::with_capacity(n),
             gscr: DMatrix::zeros(m, n),
             ct: DMatrix::zeros(m, n),
             rows: Vec::with_capacity(m),
+            rg: vec![[0.0; 6]; m],
+            rhv: vec![[0.0; 6]; m],
+            rd3: vec![[0.0; 6]; m],
+            rv: vec![0.0; n],
+            rv_valid: false,
             kpi: vec![0.0; n * n],
             ka: vec![0.0; n * n],
             kx: vec![0.0; n * n],
@@ -220,8 +229,10 @@ impl Preadjustment {
         self.prepare_with(sys, q, None)
     }
 
-    /// [`Preadjustment::prepare`]; with `Some(v)` (scleronomic models) the constraint pass also
-    /// leaves `gamma(q, v, 0)` in `gc` (`System::phi_q_gamma`, one pass instead of two).
+    /// [`Preadjustment::prepare`]; with `Some(v)` (scleronomic models) the constraint pass is
+    /// one third-order pass along `v` (`System::constraint_third_local`) that also leaves
+    /// `v^T Hess Phi_k v` in `gc` and the local rows `Hess Phi_k v`, `D^3 Phi_k(v, v, .)` for
+    /// `modified_prepared` (one pass instead of three).
     fn prepare_with(
         &mut self,
         sys: &System,
@@ -242,13 +253,22 @@ impl Preadjustment {
         self.at_valid = false;
         self.a_valid = false;
         self.mv_valid = false;
-        self.gc_fresh = false;
+        self.rv_valid = false;
         sys.potential_gradient(q, &mut self.g);
         if m > 0 {
             match v {
                 Some(v) if !self.rheonomic => {
-                    sys.phi_q_gamma(q, v, 0.0, &mut self.gq, &mut self.gc);
-                    self.gc_fresh = true;
+                    sys.constraint_third_local(
+                        q,
+                        v,
+                        &mut self.rg,
+                        &mut self.rhv,
+                        &mut self.rd3,
+                        &mut self.gc,
+                    );
+                    sys.local_rows_dense(&self.rg, &mut self.gq);
+                    self.rv.copy_from_slice(v);
+                    self.rv_valid = true;
                 }
                 _ => sys.phi_q(q, &mut self.gq),
             }

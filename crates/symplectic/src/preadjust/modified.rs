@@ -46,24 +46,31 @@ impl Preadjustment {
     /// `e(q, v)` after `prepare(q)`; leaves `gamma_c` in `gc`, `S^-1 gamma_c` in `sigma`,
     /// `sigma - mu0` in `cm`, `B v` in `hv` with `B = A + H_sigma - 3/2 Hess V =
     /// POTENTIAL_WEIGHT Hess V + (sigma - mu0) . Hess Phi`, and
-    /// `D^3 (POTENTIAL_WEIGHT V + (sigma - mu0) . Phi)(v, v, .)` in `d3` (one third-order pass over
-    /// the elements, no Hessian assembled).
+    /// `D^3 (POTENTIAL_WEIGHT V + (sigma - mu0) . Phi)(v, v, .)` in `d3`, no Hessian assembled:
+    /// after `prepare_with(q, Some(v))` the constraints' parts come from its local rows (only the
+    /// forces take a third-order pass here), otherwise from one third-order pass over the
+    /// elements.
     fn modified_prepared(&mut self, sys: &System, q: &[f64], v: &[f64]) -> f64 {
         let (n, m) = (self.n, self.m);
         let uu: f64 = (0..n).map(|k| self.mass[k] * self.u[k] * self.u[k]).sum();
         let mut gg = 0.0;
+        // the local rows of the third-order pass of prepare_with, if they are along this v
+        let rows = m > 0 && self.rv_valid && self.rv.as_slice() == v;
         if m > 0 {
-            // gamma(q, v, t) = -(v^T Hess Phi_k v) + time part: the time part cancels
-            if !self.gc_fresh {
+            // gc = v^T Hess Phi_k v: from the rows, or gamma(q, v, t) = -(v^T Hess Phi_k v) +
+            // time part (which cancels)
+            if !rows {
                 sys.gamma(q, v, 0.0, &mut self.gc);
-            }
-            if self.rheonomic {
-                sys.gamma(q, &self.zero, 0.0, &mut self.gc0);
-                for r in 0..m {
-                    self.gc[r] = self.gc0[r] - self.gc[r];
+                // (gc no longer matches the rows)
+                self.rv_valid = false;
+                if self.rheonomic {
+                    sys.gamma(q, &self.zero, 0.0, &mut self.gc0);
+                    for r in 0..m {
+                        self.gc[r] = self.gc0[r] - self.gc[r];
+                    }
+                } else {
+                    self.gc.iter_mut().for_each(|x| *x = -*x);
                 }
-            } else {
-                self.gc.iter_mut().for_each(|x| *x = -*x);
             }
             self.sigma.copy_from_slice(&self.gc);
             self.chol.solve_in_place(&mut self.sigma);
@@ -72,8 +79,23 @@ impl Preadjustment {
         for r in 0..m {
             self.cm[r] = self.sigma[r] - self.mu0[r];
         }
-        self.gc_fresh = false;
-        sys.lagrangian_third(q, v, POTENTIAL_WEIGHT, &self.cm, &mut self.hv, &mut self.d3);
+        if rows {
+            // the potential's part by a pass over the forces (the zero weights skip the
+            // joints), the constraints' from the rows
+            self.tm[2].fill(0.0);
+            sys.lagrangian_third(
+                q,
+                v,
+                POTENTIAL_WEIGHT,
+                &self.tm[2],
+                &mut self.hv,
+                &mut self.d3,
+            );
+            sys.add_local_rows(&self.rhv, &self.cm, &mut self.hv);
+            sys.add_local_rows(&self.rd3, &self.cm, &mut self.d3);
+        } else {
+            sys.lagrangian_third(q, v, POTENTIAL_WEIGHT, &self.cm, &mut self.hv, &mut self.d3);
+        }
         self.mv.copy_from_slice(v);
         self.mv_valid = true;
         // v^T (A - 3/2 Hess V) v = v^T B v - sigma . gamma_c
