@@ -389,6 +389,7 @@ pub(super) fn beyond(ctx: &Ctx) -> Result<Section, String> {
         })
         .collect();
     claims(ctx, &mut sec, &period_rows, &double_rows);
+    super::beyond_cost::cost_section(ctx, &mut sec)?;
     sec.summary =
         json!({"paper_a": {"beyond": {"double_pendulum": dp_json, "period_orders": po_json}}});
     Ok(sec)

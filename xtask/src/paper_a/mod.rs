@@ -12,6 +12,7 @@ use tables::{table1, table2, table3};
 mod figures;
 use figures::{fig3, fig4, fig5_6, fig7};
 mod beyond;
+mod beyond_cost;
 use beyond::beyond;
 
 use crate::report::{
