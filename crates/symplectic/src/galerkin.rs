@@ -55,6 +55,7 @@ pub struct Galerkin {
     /// The sparse stage solve, if the system takes the sparse path.
     sparse: Option<Box<SparseStage>>,
     hc: DMatrix<f64>,
+    /// `grad W_s` at each Gauss point of the last evaluation (`s x n`).
     wgrad: Vec<f64>,
     wh: DMatrix<f64>,
     pre: Vec<Preadjustment>,
@@ -198,7 +199,7 @@ impl Galerkin {
             },
             sparse,
             hc: DMatrix::zeros(nd, nd),
-            wgrad: vec![0.0; n],
+            wgrad: vec![0.0; s * n],
             wh: DMatrix::zeros(nd, nd),
             pre,
             tn: std::array::from_fn(|_| vec![0.0; n]),
@@ -333,8 +334,22 @@ impl Galerkin {
         }
     }
 
-    /// Control points, Gauss-point positions, displacements and forces at `self.x`.
+    /// Control points, Gauss-point positions, displacements and forces at `self.x`, with the
+    /// preadjustment terms.
     fn kinematics(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
+        self.kinematics_with(sys, t, h, true)
+    }
+
+    /// [`Galerkin::kinematics`]; with `fresh_preadjustment = false` the preadjustment terms
+    /// (`grad W_s` at the Gauss points, the modified-Lagrangian terms) of the last evaluation
+    /// are kept instead of evaluated (the Newton iteration's final constraint check).
+    pub(super) fn kinematics_with(
+        &mut self,
+        sys: &System,
+        t: f64,
+        h: f64,
+        fresh_preadjustment: bool,
+    ) -> Result<(), SolveError> {
         let (n, s) = (self.n, self.tab.s);
         let s1 = s + 1;
         self.place_control_points();
@@ -360,10 +375,12 @@ impl Galerkin {
             let gj = &mut self.gj[j * n..(j + 1) * n];
             sys.potential_gradient(qj, gj);
             if let Some(pre) = self.pre.get_mut(j) {
-                pre.gradient(sys, qj, &mut self.wgrad)
-                    .map_err(|e| with_time(e, t))?;
+                let wg = &mut self.wgrad[j * n..(j + 1) * n];
+                if fresh_preadjustment {
+                    pre.gradient(sys, qj, wg).map_err(|e| with_time(e, t))?;
+                }
                 for i in 0..n {
-                    gj[i] += self.gk * self.wgrad[i];
+                    gj[i] += self.gk * wg[i];
                 }
             }
             if self.nonconservative {
@@ -377,6 +394,16 @@ impl Galerkin {
                 }
             }
         }
+        if fresh_preadjustment {
+            self.modified_terms(sys, t, h)?;
+        }
+        Ok(())
+    }
+
+    /// The modified-Lagrangian terms `h^2 de/dq`, `h^2 de/dv` at the chord midpoint and the
+    /// step's velocity of `self.x` (nothing without the mode).
+    fn modified_terms(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
+        let n = self.n;
         if let Some(ml) = self.ml.first_mut() {
             // s = 1: E_d = h^3 e(qbar, v) with the chord midpoint qbar = (Q_0 + Q_1) / 2 and
             // the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h (one evaluation per

@@ -159,7 +159,11 @@ impl Galerkin {
             // theta estimated from two updates with the same Jacobian, the error left after
             // this update is about theta / (1 - theta) |dZ|; when that is below the tolerance
             // the update is applied and only the constraints are checked at the result (the
-            // momentum rows, with Phi_q at the interior control points, are not re-evaluated)
+            // momentum rows, with Phi_q at the interior control points, are not re-evaluated,
+            // nor are the preadjustment terms: the end momentum takes grad W_s and h^3 de/dq
+            // from the previous iterate, an error of their Hessians times this update, O(h^2)
+            // against the forces' own and far below the tolerance; docs/symplectic.md
+            // sections 5 and 5a)
             let dz = norm_inf(&self.dx[..sn]);
             if prev_step.is_finite() && dz.is_finite() {
                 let theta = dz / prev_step;
@@ -168,7 +172,7 @@ impl Galerkin {
                     for (x, d) in self.x.iter_mut().zip(&self.dx) {
                         *x += d;
                     }
-                    self.kinematics(sys, t, h)?;
+                    self.kinematics_with(sys, t, h, false)?;
                     self.constraint_rows(sys, t, h);
                     evals += 1;
                     it += 1;
@@ -177,7 +181,9 @@ impl Galerkin {
                         res = cres.max(left);
                         break;
                     }
-                    // the constraints are not met yet: complete the residual and go on
+                    // the constraints are not met yet: complete the residual (with the
+                    // preadjustment terms here) and go on
+                    self.kinematics(sys, t, h)?;
                     self.momentum_rows(sys, h);
                     res = norm_inf(&self.r);
                     prev_step = dz;
