@@ -162,12 +162,18 @@ impl Galerkin {
             ml.approximate_hessian(sys, &self.mlmid, &mut self.hc)
                 .map_err(|e| with_time(e, t))?;
             let jm = &mut self.lu;
-            let h4 = h2 * h2;
-            for l in 0..n {
-                for i in 0..n {
-                    let b = -(h2 / 12.0) * self.wh[(i, l)] - (h4 / 48.0) * self.hc[(i, l)];
+            let (cw, ch) = (-h2 / 12.0, -(h2 * h2) / 48.0);
+            // by columns; both blocks are zero outside the coordinates that enter V and the
+            // constraints non-linearly (e.g. the angles of a revolute chain under gravity)
+            let cols = self.wh.as_slice().chunks_exact(n);
+            for (l, (w, a)) in cols.zip(self.hc.as_slice().chunks_exact(n)).enumerate() {
+                if w.iter().chain(a).all(|&x| x == 0.0) {
+                    continue;
+                }
+                for (i, ((&wi, &ai), &mi)) in w.iter().zip(a).zip(&self.minv).enumerate() {
+                    let b = cw * wi + ch * ai;
                     if b != 0.0 {
-                        jm.add(i, l, self.minv[i] * b);
+                        jm.add(i, l, mi * b);
                     }
                 }
             }

@@ -260,9 +260,10 @@ impl Preadjustment {
             mul(&self.ka, &self.ky, &mut self.kx);
         }
         out.fill(0.0);
+        let o = out.as_mut_slice();
         for (cj, &c) in self.kset.iter().enumerate() {
             for (ri, &r) in self.kset.iter().enumerate() {
-                out[(r, c)] = 0.5 * (self.kx[cj * k + ri] + self.kx[ri * k + cj]);
+                o[c * n + r] = 0.5 * (self.kx[cj * k + ri] + self.kx[ri * k + cj]);
             }
         }
         Ok(())
