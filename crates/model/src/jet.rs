@@ -16,6 +16,8 @@
 //! * [`ThirdJet`] gives, besides the gradient, `H w`, `w^T H w` and the third-derivative
 //!   contraction `D^3 f(w, w, .)` along a direction `w` (for the gradients of preadjustment
 //!   terms that contain Hessians),
+//! * [`Taylor4`] gives the Taylor series of `t -> f(q + t w)` to degree 4 (the directional
+//!   derivatives `D^k f(w, ..., w)`, `k <= 4`, without gradients),
 //!
 //! so the Jacobian, `gamma`, the Hessians and the third derivatives are exact (to round-off) and consistent with the
 //! equation by construction. Finite-difference tests check them all.
@@ -57,12 +59,14 @@ mod dir;
 mod dual;
 mod hess;
 mod tan;
+mod taylor;
 mod third;
 
 pub use dir::DirJet;
 pub use dual::Dual;
 pub use hess::HessJet;
 pub use tan::TanJet;
+pub use taylor::Taylor4;
 pub use third::ThirdJet;
 
 /// Number of local variables of one element: `(x, y, theta)` of body a, then of body b.

@@ -47,6 +47,7 @@ mod body;
 mod builder;
 mod cache;
 mod constraints;
+mod directional;
 mod dynamics;
 mod error;
 mod file;

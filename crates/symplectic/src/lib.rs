@@ -57,5 +57,5 @@ pub use calibrate::{calibrate_gamma, Calibration, CalibrationSettings};
 pub use error::SymplecticError;
 pub use galerkin::Galerkin;
 pub use options::{kappa, phase_constant, Nodes, PreadjustMode, SymplecticOptions};
-pub use preadjust::Preadjustment;
+pub use preadjust::{Preadjustment, E4_TERMS};
 pub use tables::lobatto_nodes;

@@ -23,7 +23,10 @@ use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
 mod modified;
+mod modified2;
 mod paper;
+
+pub use modified2::E4_TERMS;
 
 /// Workspace evaluating `W_s`, its gradient and an approximate Hessian (allocation-free after
 /// [`Preadjustment::new`]).

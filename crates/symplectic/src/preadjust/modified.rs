@@ -32,7 +32,7 @@ impl Preadjustment {
         Ok(self.modified_prepared(sys, q, v))
     }
 
-    fn check_v(&self, v: &[f64]) -> Result<(), SolveError> {
+    pub(super) fn check_v(&self, v: &[f64]) -> Result<(), SolveError> {
         if v.len() != self.n {
             return Err(SolveError::Dimension {
                 what: "v for the modified-Lagrangian term",
@@ -292,7 +292,7 @@ impl Preadjustment {
 }
 
 #[cfg(test)]
-mod modlag_tests {
+pub(crate) mod modlag_tests {
     use super::*;
     use mbd_model::models;
 

@@ -1,0 +1,156 @@
+//! Directional derivatives of orders 2 to 4 of the constraints and of the potential,
+//! `D^k f(q)(w, ..., w)`, from one truncated-Taylor pass per element ([`Taylor4`]): what
+//! higher-order modified-Lagrangian terms need (mixed contractions by polarisation, e.g.
+//! `D^2 f(a, b) = [D^2 f(a + b)^2 - D^2 f(a - b)^2] / 4` and
+//! `D^3 f(a, a, b) = [D^3 f(a + b)^3 - D^3 f(a - b)^3 - 2 D^3 f(b)^3] / 6`).
+
+use crate::jet::{Frame, Scalar, Taylor4};
+use crate::system::System;
+
+impl System {
+    #[inline(always)]
+    fn loc_taylor(q: &[f64], w: &[f64], i: Option<usize>) -> Frame<Taylor4> {
+        match i {
+            Some(i) => Frame::new(std::array::from_fn(|k| {
+                Taylor4::var(q[3 * i + k], w[3 * i + k])
+            })),
+            None => Frame::fixed(),
+        }
+    }
+
+    /// `out[r] = [D^2 Phi_r(w, w), D^3 Phi_r(w, w, w), D^4 Phi_r(w, w, w, w)]` at `q` for every
+    /// constraint row `r` (the configuration part: time enters the joint equations only
+    /// additively).
+    pub fn constraint_directional(&self, q: &[f64], w: &[f64], out: &mut [[f64; 3]]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let mut e = [Taylor4::cst(0.0); 3];
+            j.eval(
+                &Self::loc_taylor(q, w, at.a),
+                &Self::loc_taylor(q, w, at.b),
+                &mut e,
+            );
+            let o = self.row_offset[ji];
+            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+                out[o + k] = [ek.derivative(2), ek.derivative(3), ek.derivative(4)];
+            }
+        }
+    }
+
+    /// `[D^2 V(w, w), D^3 V(w, w, w), D^4 V(w, w, w, w)]` at `q` (gravity is linear and
+    /// contributes nothing; non-conservative elements have no potential).
+    pub fn potential_directional(&self, q: &[f64], w: &[f64]) -> [f64; 3] {
+        let mut d = [0.0; 3];
+        for (fi, f) in self.forces.iter().enumerate() {
+            let at = self.force_attach[fi];
+            let e = f.potential(&Self::loc_taylor(q, w, at.a), &Self::loc_taylor(q, w, at.b));
+            for (k, dk) in d.iter_mut().enumerate() {
+                *dk += e.derivative(k + 2);
+            }
+        }
+        d
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{models, Body, BodyRef, Force, SystemBuilder};
+
+    /// Orders 2 and 3 against the exact jets (`v^T Hess v` from `gamma`, `D^3(v, v, v)` from
+    /// the third-order rows and `potential_third`), order 4 against central differences of
+    /// order 3 along `w`; on every joint kind, the manipulator and a model with springs.
+    #[test]
+    fn directional_derivatives_match_the_jets() {
+        let springs = {
+            let mut b = SystemBuilder::new();
+            let r = b.add_body(Body::new("r").rod(1.0, 1.0).position(0.4, -0.3, 0.7));
+            let p = b.add_body(Body::new("p").rod(0.5, 0.6).position(1.2, 0.2, -0.4));
+            b.add_force(Force::spring_damper(
+                "s1",
+                r,
+                [0.5, 0.0],
+                p,
+                [-0.3, 0.0],
+                20.0,
+                0.0,
+                0.4,
+            ));
+            b.add_force(Force::spring_damper(
+                "s2",
+                BodyRef::Ground,
+                [0.0, 0.5],
+                r,
+                [-0.5, 0.0],
+                7.0,
+                0.0,
+                0.2,
+            ));
+            b.build().unwrap()
+        };
+        for sys in [
+            crate::fixtures::every_joint_kind(),
+            models::manipulator().unwrap(),
+            springs,
+        ] {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.2 * (i as f64 * 0.9).sin()).collect();
+            let w: Vec<f64> = (0..n).map(|i| 0.5 * (i as f64 * 1.7 + 0.3).cos()).collect();
+            let mut rows = vec![[0.0; 3]; m];
+            sys.constraint_directional(&q, &w, &mut rows);
+            let (mut g, mut hv, mut d3, mut vhv) = (
+                vec![[0.0; 6]; m],
+                vec![[0.0; 6]; m],
+                vec![[0.0; 6]; m],
+                vec![0.0; m],
+            );
+            sys.constraint_third_local(&q, &w, &mut g, &mut hv, &mut d3, &mut vhv);
+            let (ba, bb): (Vec<_>, Vec<_>) = (0..m)
+                .map(|r| sys.joint_bodies(sys.equation_joint(r).unwrap()))
+                .unzip();
+            let local = |r: usize, x: &[f64]| -> [f64; 6] {
+                let mut l = [0.0; 6];
+                for (slot, body) in [(0, ba[r]), (3, bb[r])] {
+                    if let Some(i) = body {
+                        l[slot..slot + 3].copy_from_slice(&x[3 * i..3 * i + 3]);
+                    }
+                }
+                l
+            };
+            // D^3 Phi_r(w, w, w) = D^3 Phi_r(w, w, .) . w
+            let step = 1e-3;
+            let mut qp = q.clone();
+            let mut d3_at = |t: f64, rows_out: &mut Vec<[f64; 3]>| {
+                for i in 0..n {
+                    qp[i] = q[i] + t * w[i];
+                }
+                sys.constraint_directional(&qp, &w, rows_out);
+            };
+            let (mut p1, mut m1) = (vec![[0.0; 3]; m], vec![[0.0; 3]; m]);
+            d3_at(step, &mut p1);
+            d3_at(-step, &mut m1);
+            for r in 0..m {
+                let wl = local(r, &w);
+                let t3: f64 = d3[r].iter().zip(&wl).map(|(a, b)| a * b).sum();
+                let tol = |x: f64| 1e-12 * (1.0 + x.abs());
+                assert!((rows[r][0] - vhv[r]).abs() < tol(vhv[r]), "D2 row {r}");
+                assert!((rows[r][1] - t3).abs() < tol(t3), "D3 row {r}");
+                let fd4 = (p1[r][1] - m1[r][1]) / (2.0 * step);
+                assert!(
+                    (rows[r][2] - fd4).abs() < 1e-5 * (1.0 + fd4.abs()),
+                    "D4 row {r}: {} vs {fd4}",
+                    rows[r][2]
+                );
+            }
+            let pd = sys.potential_directional(&q, &w);
+            let mut p3 = vec![0.0; n];
+            sys.potential_third(&q, &w, &mut p3);
+            let t3: f64 = p3.iter().zip(&w).map(|(a, b)| a * b).sum();
+            assert!((pd[1] - t3).abs() < 1e-12 * (1.0 + t3.abs()), "D3 V");
+            let mut hm = nalgebra::DMatrix::zeros(n, n);
+            sys.potential_hessian(&q, &mut hm);
+            let wv = nalgebra::DVector::from_column_slice(&w);
+            let t2 = wv.dot(&(&hm * &wv));
+            assert!((pd[0] - t2).abs() < 1e-12 * (1.0 + t2.abs()), "D2 V");
+        }
+    }
+}
