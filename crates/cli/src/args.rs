@@ -11,8 +11,9 @@ Examples:
   mbd plot slider.csv --y slider.x --y crank.theta -o slider.svg
   mbd animate slider.csv --model examples/models/slider_crank_spring.toml -o slider.html
 
-Solvers: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified, index1:dopri5
-and tangent:dopri5 (fixed --h or adaptive --tol), tangent:rk4, firefly-gauss. See docs/cli.md.";
+Solvers: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified,
+symplectic:2:modified, index1:dopri5 and tangent:dopri5 (fixed --h or adaptive --tol),
+tangent:rk4, firefly-gauss. See docs/cli.md.";
 
 const RUN_EXAMPLE: &str = "\
 Examples:
@@ -74,7 +75,7 @@ pub struct RunArgs {
     /// Model file (.toml or .json).
     pub model: PathBuf,
     /// Solver: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified,
-    /// index1:dopri5, tangent:rk4, tangent:dopri5, firefly-gauss.
+    /// symplectic:2:modified, index1:dopri5, tangent:rk4, tangent:dopri5, firefly-gauss.
     #[arg(long, short, value_parser = parse_solver)]
     pub solver: SolverSpec,
     /// End time in s (the run starts at t0 = 0).

@@ -9,7 +9,8 @@ use std::str::FromStr;
 
 /// The solvers `mbd run --solver` accepts.
 const SOLVERS: &str = "rk4, rk4-projected, symplectic:S[:gamma=G] (e.g. symplectic:2, \
-                       symplectic:2:gamma=1), symplectic:1:modified, index1:dopri5, \
+                       symplectic:2:gamma=1), symplectic:1:modified, symplectic:2:modified, \
+                       index1:dopri5, \
                        tangent:rk4, tangent:dopri5, firefly-gauss";
 
 /// A solver chosen on the command line.
@@ -20,13 +21,13 @@ pub enum SolverSpec {
     /// RK4 with post-step projection onto the constraints (`rk4-projected`).
     Rk4Projected,
     /// Paper A's (s,s) Galerkin variational integrator (`symplectic:S[:gamma=G]`,
-    /// `symplectic:1:modified`).
+    /// `symplectic:1:modified`, `symplectic:2:modified`).
     Symplectic {
         /// Number of Gauss points, order `2s`.
         s: usize,
         /// Preadjustment parameter (0: plain scheme).
         gamma: f64,
-        /// The parameter-free modified-Lagrangian preadjustment (s = 1 only).
+        /// The parameter-free modified-Lagrangian preadjustment (s = 1 or 2).
         modified: bool,
     },
     /// DOPRI5 5(4) on the index-1 form, no stabilisation (`index1:dopri5`), fixed or adaptive
@@ -168,10 +169,10 @@ impl FromStr for SolverSpec {
                 ));
             }
         }
-        if modified && (s != 1 || gamma != 0.0) {
+        if modified && (s > 2 || gamma != 0.0) {
             return Err(format!(
-                "solver '{text}': the modified-Lagrangian preadjustment needs S = 1 and no \
-                 gamma: use symplectic:1:modified"
+                "solver '{text}': the modified-Lagrangian preadjustment needs S = 1 or 2 and \
+                 no gamma: use symplectic:1:modified or symplectic:2:modified"
             ));
         }
         Ok(SolverSpec::Symplectic { s, gamma, modified })
@@ -213,8 +214,20 @@ mod tests {
         assert!(e.contains("S must be a whole number"), "{e}");
         let e = "symplectic:2:gamma=abc".parse::<SolverSpec>().unwrap_err();
         assert!(e.contains("gamma must be a finite number"), "{e}");
-        let e = "symplectic:2:modified".parse::<SolverSpec>().unwrap_err();
-        assert!(e.contains("needs S = 1"), "{e}");
+        let e = "symplectic:3:modified".parse::<SolverSpec>().unwrap_err();
+        assert!(e.contains("needs S = 1 or 2"), "{e}");
+        let e = "symplectic:2:modified:gamma=1"
+            .parse::<SolverSpec>()
+            .unwrap_err();
+        assert!(e.contains("no gamma"), "{e}");
+        assert!(matches!(
+            "symplectic:2:modified".parse::<SolverSpec>(),
+            Ok(SolverSpec::Symplectic {
+                s: 2,
+                modified: true,
+                ..
+            })
+        ));
         let e = "symplectic:2:foo".parse::<SolverSpec>().unwrap_err();
         assert!(e.contains("unknown option 'foo'"), "{e}");
     }

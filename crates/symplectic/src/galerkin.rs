@@ -403,8 +403,11 @@ impl Galerkin {
     /// The modified-Lagrangian terms `h^2 de/dq`, `h^2 de/dv` at the chord midpoint and the
     /// step's velocity of `self.x` (nothing without the mode).
     fn modified_terms(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
-        let n = self.n;
-        if let Some(ml) = self.ml.first_mut() {
+        let (n, s) = (self.n, self.tab.s);
+        let Some(ml) = self.ml.first_mut() else {
+            return Ok(());
+        };
+        if s == 1 {
             // s = 1: E_d = h^3 e(qbar, v) with the chord midpoint qbar = (Q_0 + Q_1) / 2 and
             // the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h (one evaluation per
             // residual; docs/symplectic.md section 5a)
@@ -418,6 +421,40 @@ impl Galerkin {
             for i in 0..n {
                 self.mlq[i] *= h2;
                 self.mlv[i] *= h2;
+            }
+            return Ok(());
+        }
+        // s = 2: E_d = h^5 e4(qbar, v) at the chord of the end control points, its gradients
+        // by central differences (modified2.rs; docs/symplectic.md section 5b)
+        for i in 0..n {
+            self.mlvel[i] = (self.qn[s * n + i] - self.qn[i]) / h;
+            self.mlmid[i] = 0.5 * (self.qn[i] + self.qn[s * n + i]);
+        }
+        let h4 = h.powi(4);
+        let vscale = 1.0 + self.mlvel.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        // fourth-order central differences: (8 (f(x+d) - f(x-d)) - (f(x+2d) - f(x-2d))) / 12d
+        for l in 0..n {
+            for (pos, scale) in [(true, 1.0 + self.mlmid[l].abs()), (false, vscale)] {
+                let d = MODIFIED_S2_FD_STEP * scale;
+                let x0 = if pos { self.mlmid[l] } else { self.mlvel[l] };
+                let mut acc = 0.0;
+                for (c, k) in [(8.0, 1.0), (-8.0, -1.0), (-1.0, 2.0), (1.0, -2.0)] {
+                    if pos {
+                        self.mlmid[l] = x0 + k * d;
+                    } else {
+                        self.mlvel[l] = x0 + k * d;
+                    }
+                    acc += c * ml
+                        .modified_term_s2(sys, &self.mlmid, &self.mlvel)
+                        .map_err(|e| with_time(e, t))?;
+                }
+                if pos {
+                    self.mlmid[l] = x0;
+                    self.mlq[l] = h4 * acc / (12.0 * d);
+                } else {
+                    self.mlvel[l] = x0;
+                    self.mlv[l] = h4 * acc / (12.0 * d);
+                }
             }
         }
         Ok(())
@@ -534,6 +571,11 @@ impl Galerkin {
         }
     }
 }
+
+/// Relative step of the central differences that give the gradients of the (2,2) modified
+/// term `e4` (scaled by `1 + |q_l|` in position and `1 + |v|_inf` in velocity): their error,
+/// about `1e-10` relative, enters the step multiplied by `h^4`.
+const MODIFIED_S2_FD_STEP: f64 = 1e-4;
 
 fn with_time(e: SolveError, t: f64) -> SolveError {
     match e {

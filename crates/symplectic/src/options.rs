@@ -153,12 +153,12 @@ impl SymplecticOptions {
             });
         }
         if self.preadjust == PreadjustMode::ModifiedLagrangian {
-            if self.s != 1 {
+            if self.s > 2 {
                 return Err(SolveError::InvalidParameter {
                     parameter: "preadjust",
                     value: self.s as f64,
-                    reason: "the modified-Lagrangian preadjustment is derived for s = 1 only \
-                             (s >= 2: not derived yet)",
+                    reason: "the modified-Lagrangian preadjustment is derived for s = 1 and \
+                             s = 2 only (s >= 3: not derived)",
                 });
             }
             if self.gamma != 0.0 {

@@ -129,7 +129,7 @@ fn constraints_stay_at_tolerance() {
 #[test]
 fn typed_errors() {
     let sys = models::paper_a_double_pendulum().unwrap();
-    let bad_s = SymplecticOptions::new(2).with_preadjust(PreadjustMode::ModifiedLagrangian);
+    let bad_s = SymplecticOptions::new(3).with_preadjust(PreadjustMode::ModifiedLagrangian);
     match Galerkin::new(&sys, bad_s) {
         Err(SolveError::InvalidParameter { parameter, .. }) => assert_eq!(parameter, "preadjust"),
         other => panic!("expected InvalidParameter(preadjust), got {other:?}"),

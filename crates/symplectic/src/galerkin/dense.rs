@@ -154,7 +154,8 @@ impl Galerkin {
         // The other position derivatives (O(h) relative to the velocity part and quadratic in
         // v) are left out (docs/symplectic.md, section 5a); the converged solution does not
         // depend on them.
-        if let Some(ml) = self.ml.first_mut() {
+        if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
+            // (s = 2: the h^4 e4 term is left out of the Newton matrix)
             self.wh.fill(0.0);
             ml.add_modified_velocity_hessian(sys, &self.mlmid, &self.mlvel, 2.0, &mut self.wh)
                 .map_err(|e| with_time(e, t))?;
