@@ -34,13 +34,13 @@ fn bad_symplectic_options() {
     assert_fails(&out, 2, &["S must be a whole number"]);
     let out = run_with(&[
         "--solver",
-        "symplectic:2:modified",
+        "symplectic:3:modified",
         "--t-end",
         "1",
         "--h",
         "0.01",
     ]);
-    assert_fails(&out, 2, &["symplectic:1:modified"]);
+    assert_fails(&out, 2, &["S = 1 or 2", "symplectic:2:modified"]);
 }
 
 #[test]
