@@ -28,8 +28,10 @@ pub enum PreadjustMode {
     /// The parameter-free modified Lagrangian of issue 13 for `s = 1`:
     /// `L~ = L + h^2 e(q, v)`, `e = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v - 1/8 v^T Hess V v
     /// + 1/24 gamma_c^T S^-1 gamma_c`, evaluated at the chord midpoint of each step
-    /// (`docs/symplectic.md` section 5a, derivation in `docs/modified-lagrangian.md`). Needs
-    /// `s = 1`, `gamma = 0`, a conservative model and the dense path.
+    /// (`docs/symplectic.md` section 5a, derivation in `docs/modified-lagrangian.md`); for
+    /// `s = 2` the `h^4` term `e4` of section 5b (23 invariant terms, gradients by central
+    /// differences: a slow reference implementation). Needs `s <= 2`, `gamma = 0`, a
+    /// conservative model and the dense path.
     ModifiedLagrangian,
 }
 
@@ -41,7 +43,7 @@ pub struct SymplecticOptions {
     /// The preadjustment parameter `gamma` (0: the plain scheme; 1: `gamma_T`).
     pub gamma: f64,
     /// Which preadjustment: paper A's `W_s` scaled by `gamma` (default) or the parameter-free
-    /// modified Lagrangian (`s = 1` only).
+    /// modified Lagrangian (`s = 1` or `2`).
     pub preadjust: PreadjustMode,
     /// Placement of the control points.
     pub nodes: Nodes,
