@@ -54,39 +54,14 @@ impl System {
 
 #[cfg(test)]
 mod tests {
-    use crate::{models, Body, BodyRef, Force, SystemBuilder};
+    use crate::models;
 
     /// Orders 2 and 3 against the exact jets (`v^T Hess v` from `gamma`, `D^3(v, v, v)` from
     /// the third-order rows and `potential_third`), order 4 against central differences of
     /// order 3 along `w`; on every joint kind, the manipulator and a model with springs.
     #[test]
     fn directional_derivatives_match_the_jets() {
-        let springs = {
-            let mut b = SystemBuilder::new();
-            let r = b.add_body(Body::new("r").rod(1.0, 1.0).position(0.4, -0.3, 0.7));
-            let p = b.add_body(Body::new("p").rod(0.5, 0.6).position(1.2, 0.2, -0.4));
-            b.add_force(Force::spring_damper(
-                "s1",
-                r,
-                [0.5, 0.0],
-                p,
-                [-0.3, 0.0],
-                20.0,
-                0.0,
-                0.4,
-            ));
-            b.add_force(Force::spring_damper(
-                "s2",
-                BodyRef::Ground,
-                [0.0, 0.5],
-                r,
-                [-0.5, 0.0],
-                7.0,
-                0.0,
-                0.2,
-            ));
-            b.build().unwrap()
-        };
+        let springs = crate::fixtures::two_springs();
         for sys in [
             crate::fixtures::every_joint_kind(),
             models::manipulator().unwrap(),

@@ -1,6 +1,6 @@
 //! Test fixtures shared by the unit tests of several modules.
 
-use crate::{Body, BodyRef, Coordinate, Joint, System, SystemBuilder, TimeFunction};
+use crate::{Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, TimeFunction};
 
 /// Every joint kind (revolute, prismatic, weld, distance, absolute x / y / angle, angle
 /// driver) on five bodies: the fixture of the unit tests that check derivatives element by
@@ -46,4 +46,35 @@ pub(crate) fn every_joint_kind() -> System {
         TimeFunction::linear(0.1, 2.0),
     ));
     b.build().unwrap()
+}
+
+/// Two free bodies (no joints), a spring between them and one to the ground, under gravity: a
+/// potential with non-zero Hessian and higher derivatives, for the unit tests of the potential's
+/// derivatives.
+pub(crate) fn two_springs() -> System {
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, -9.81]);
+    let r = b.add_body(Body::new("r").rod(1.0, 1.0).position(0.4, -0.3, 0.7));
+    let p = b.add_body(Body::new("p").rod(0.5, 0.6).position(1.2, 0.2, -0.4));
+    b.add_force(Force::spring_damper(
+        "s1",
+        r,
+        [0.5, 0.0],
+        p,
+        [-0.3, 0.0],
+        20.0,
+        0.0,
+        0.4,
+    ));
+    b.add_force(Force::spring_damper(
+        "s2",
+        BodyRef::Ground,
+        [0.0, 0.5],
+        r,
+        [-0.5, 0.0],
+        7.0,
+        0.0,
+        0.2,
+    ));
+    b.build().expect("the two-spring fixture is valid")
 }

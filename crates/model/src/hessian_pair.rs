@@ -92,7 +92,7 @@ fn scaled(h: &[[f64; NV]; NV], w: f64) -> [[f64; NV]; NV] {
 #[cfg(test)]
 mod tests {
     use super::LagrangianWeights;
-    use crate::{models, Body, BodyRef, Force, SystemBuilder};
+    use crate::models;
     use nalgebra::DMatrix;
 
     /// The pair equals two separate assemblies ([`crate::System::potential_hessian`] and
@@ -100,33 +100,7 @@ mod tests {
     /// [`crate::System::phi_q_dot_jacobian`], on every joint kind and on a model with springs.
     #[test]
     fn pair_matches_separate_assemblies() {
-        let springs = {
-            let mut b = SystemBuilder::new();
-            b.set_gravity([0.0, -9.81]);
-            let r = b.add_body(Body::new("r").rod(1.0, 1.0).position(0.4, -0.3, 0.7));
-            let p = b.add_body(Body::new("p").rod(0.5, 0.6).position(1.2, 0.2, -0.4));
-            b.add_force(Force::spring_damper(
-                "s1",
-                r,
-                [0.5, 0.0],
-                p,
-                [-0.3, 0.0],
-                20.0,
-                0.0,
-                0.4,
-            ));
-            b.add_force(Force::spring_damper(
-                "s2",
-                BodyRef::Ground,
-                [0.0, 0.5],
-                r,
-                [-0.5, 0.0],
-                7.0,
-                0.0,
-                0.2,
-            ));
-            b.build().unwrap()
-        };
+        let springs = crate::fixtures::two_springs();
         for sys in [
             crate::fixtures::every_joint_kind(),
             models::manipulator().unwrap(),

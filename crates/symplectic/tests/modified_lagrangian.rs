@@ -1,11 +1,10 @@
 //! The parameter-free modified-Lagrangian preadjustment of the (1,1) scheme (issue 13):
 //! pendulum period error of order 4 at 45 and 90 degrees (plain: order 2), paper A's double
 //! pendulum against a DOPRI5 reference, constraints over a long run, typed errors.
-use mbd_analysis::period;
+mod common;
 use mbd_model::{models, System};
 use mbd_solve::{reference_trajectory, ButcherTableau, Integrator, SolveError, State};
 use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
-use std::f64::consts::PI;
 
 fn opts(modlag: bool) -> SymplecticOptions {
     let o = SymplecticOptions::new(1);
@@ -16,24 +15,10 @@ fn opts(modlag: bool) -> SymplecticOptions {
     }
 }
 
-/// Relative period error: crossings of psi = theta + pi/2 through 0, located by the cubic through
-/// the four samples around each crossing, and the period as twice the least-squares slope of the
-/// crossing times over about `periods` periods (`mbd_analysis::period`), against the exact
-/// period of the uniform rod (AGM).
+/// Relative period error of the (1,1) scheme on the rod (the cubic through four samples locates
+/// each crossing).
 fn period_error(theta0: f64, h: f64, modlag: bool, periods: f64) -> f64 {
-    let (l, g) = (1.0, 9.81);
-    let sys = models::pendulum(1.0, l, theta0, g).unwrap();
-    let te = period::pendulum_period((1.5 * g / l).sqrt(), theta0).unwrap();
-    let mut st = State::consistent(&sys, 0.0).unwrap();
-    let mut sch = Galerkin::new(&sys, opts(modlag)).unwrap();
-    let n = (periods * te / h).ceil() as usize + 4;
-    let mut psi = Vec::with_capacity(n + 1);
-    psi.push(st.q[2] + PI / 2.0);
-    for _ in 0..n {
-        sch.step(&sys, &mut st, h).unwrap();
-        psi.push(st.q[2] + PI / 2.0);
-    }
-    period::oscillation_period(&psi, 0.0, h, 4).unwrap() / te - 1.0
+    common::rod_period_error(theta0, h, opts(modlag), periods, 4)
 }
 
 #[test]

@@ -1,33 +1,17 @@
 //! The modified-Lagrangian preadjustment of the (2,2) scheme (`h^5 e4` at the chord midpoint,
 //! `docs/symplectic.md` section 5b): the rod pendulum's period error falls with order 6 at
 //! 45 degrees, where the plain (2,2) scheme's falls with order 4.
-use mbd_analysis::period;
-use mbd_model::models;
-use mbd_solve::{Integrator, State};
-use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
-use std::f64::consts::PI;
+mod common;
+use mbd_symplectic::{PreadjustMode, SymplecticOptions};
 
-/// Relative period error of the (2,2) scheme on the uniform rod (1 kg, 1 m) released at rest
-/// `theta0` from the downward vertical, over about `periods` periods (as in
-/// `modified_lagrangian.rs`).
+/// Relative period error of the (2,2) scheme on the rod (the quintic through six samples
+/// locates each crossing).
 fn period_error(theta0: f64, h: f64, modified: bool, periods: f64) -> f64 {
-    let (l, g) = (1.0, 9.81);
-    let sys = models::pendulum(1.0, l, theta0, g).unwrap();
-    let te = period::pendulum_period((1.5 * g / l).sqrt(), theta0).unwrap();
-    let mut st = State::consistent(&sys, 0.0).unwrap();
     let mut o = SymplecticOptions::new(2);
     if modified {
         o = o.with_preadjust(PreadjustMode::ModifiedLagrangian);
     }
-    let mut sch = Galerkin::new(&sys, o).unwrap();
-    let n = (periods * te / h).ceil() as usize + 4;
-    let mut psi = Vec::with_capacity(n + 1);
-    psi.push(st.q[2] + PI / 2.0);
-    for _ in 0..n {
-        sch.step(&sys, &mut st, h).unwrap();
-        psi.push(st.q[2] + PI / 2.0);
-    }
-    period::oscillation_period(&psi, 0.0, h, 6).unwrap() / te - 1.0
+    common::rod_period_error(theta0, h, o, periods, 6)
 }
 
 #[test]

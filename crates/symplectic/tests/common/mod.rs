@@ -47,3 +47,31 @@ pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
 
 // (shared with the crate's unit tests, which include the file)
 include!("damped.rs");
+
+/// Relative period error of the scheme `opts` on the uniform rod pendulum (1 kg, 1 m,
+/// g = 9.81) released at rest `theta0` from the downward vertical: crossings of
+/// `psi = theta + pi/2` through 0, each located by the polynomial through `points` samples
+/// around it, the period as twice the least-squares slope of the crossing times over about
+/// `periods` periods (`mbd_analysis::period`), against the exact (AGM) period.
+pub fn rod_period_error(
+    theta0: f64,
+    h: f64,
+    opts: SymplecticOptions,
+    periods: f64,
+    points: usize,
+) -> f64 {
+    use mbd_analysis::period;
+    let (l, g) = (1.0, 9.81);
+    let sys = mbd_model::models::pendulum(1.0, l, theta0, g).unwrap();
+    let te = period::pendulum_period((1.5 * g / l).sqrt(), theta0).unwrap();
+    let mut st = State::consistent(&sys, 0.0).unwrap();
+    let mut sch = Galerkin::new(&sys, opts).unwrap();
+    let n = (periods * te / h).ceil() as usize + 4;
+    let mut psi = Vec::with_capacity(n + 1);
+    psi.push(st.q[2] + std::f64::consts::FRAC_PI_2);
+    for _ in 0..n {
+        sch.step(&sys, &mut st, h).unwrap();
+        psi.push(st.q[2] + std::f64::consts::FRAC_PI_2);
+    }
+    period::oscillation_period(&psi, 0.0, h, points).unwrap() / te - 1.0
+}
