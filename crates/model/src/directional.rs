@@ -54,22 +54,15 @@ impl System {
 
 #[cfg(test)]
 mod tests {
-    use crate::models;
 
     /// Orders 2 and 3 against the exact jets (`v^T Hess v` from `gamma`, `D^3(v, v, v)` from
     /// the third-order rows and `potential_third`), order 4 against central differences of
     /// order 3 along `w`; on every joint kind, the manipulator and a model with springs.
     #[test]
     fn directional_derivatives_match_the_jets() {
-        let springs = crate::fixtures::two_springs();
-        for sys in [
-            crate::fixtures::every_joint_kind(),
-            models::manipulator().unwrap(),
-            springs,
-        ] {
+        for sys in crate::fixtures::derivative_test_systems() {
             let (n, m) = (sys.n_coords(), sys.n_constraints());
-            let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.2 * (i as f64 * 0.9).sin()).collect();
-            let w: Vec<f64> = (0..n).map(|i| 0.5 * (i as f64 * 1.7 + 0.3).cos()).collect();
+            let (q, w) = crate::fixtures::generic_point(n);
             let mut rows = vec![[0.0; 3]; m];
             sys.constraint_directional(&q, &w, &mut rows);
             let (mut g, mut hv, mut d3, mut vhv) = (

@@ -78,3 +78,20 @@ pub(crate) fn two_springs() -> System {
     ));
     b.build().expect("the two-spring fixture is valid")
 }
+
+/// The fixtures of the unit tests that compare derivative passes with each other: every joint
+/// kind, the manipulator and [`two_springs`].
+pub(crate) fn derivative_test_systems() -> [System; 3] {
+    [
+        every_joint_kind(),
+        crate::models::manipulator().expect("the manipulator model is valid"),
+        two_springs(),
+    ]
+}
+
+/// A generic configuration and direction for `n` coordinates (no symmetry, no zero entries).
+pub(crate) fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let q = (0..n).map(|i| 0.3 + 0.2 * (i as f64 * 0.9).sin()).collect();
+    let v = (0..n).map(|i| 0.5 * (i as f64 * 1.7 + 0.3).cos()).collect();
+    (q, v)
+}

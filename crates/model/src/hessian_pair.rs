@@ -92,7 +92,6 @@ fn scaled(h: &[[f64; NV]; NV], w: f64) -> [[f64; NV]; NV] {
 #[cfg(test)]
 mod tests {
     use super::LagrangianWeights;
-    use crate::models;
     use nalgebra::DMatrix;
 
     /// The pair equals two separate assemblies ([`crate::System::potential_hessian`] and
@@ -100,15 +99,9 @@ mod tests {
     /// [`crate::System::phi_q_dot_jacobian`], on every joint kind and on a model with springs.
     #[test]
     fn pair_matches_separate_assemblies() {
-        let springs = crate::fixtures::two_springs();
-        for sys in [
-            crate::fixtures::every_joint_kind(),
-            models::manipulator().unwrap(),
-            springs,
-        ] {
+        for sys in crate::fixtures::derivative_test_systems() {
             let (n, m) = (sys.n_coords(), sys.n_constraints());
-            let q: Vec<f64> = (0..n).map(|i| 0.3 + 0.2 * (i as f64 * 0.9).sin()).collect();
-            let v: Vec<f64> = (0..n).map(|i| 0.5 * (i as f64 * 1.7 + 0.3).cos()).collect();
+            let (q, v) = crate::fixtures::generic_point(n);
             let wa: Vec<f64> = (0..m).map(|r| 0.7 - 0.3 * r as f64).collect();
             let wb: Vec<f64> = (0..m).map(|r| -0.2 + 0.11 * r as f64).collect();
             let (mut a, mut b) = (DMatrix::from_element(n, n, 0.25), DMatrix::zeros(n, n));

@@ -69,6 +69,14 @@ fn comb(a: &[f64], ca: f64, b: &[f64], cb: f64) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| ca * x + cb * y).collect()
 }
 
+/// The passes along `a + b` and `a - b`.
+fn along_pm(sys: &System, q: &[f64], a: &[f64], b: &[f64]) -> (Dirs, Dirs) {
+    (
+        Dirs::along(sys, q, &comb(a, 1.0, b, 1.0)),
+        Dirs::along(sys, q, &comb(a, 1.0, b, -1.0)),
+    )
+}
+
 /// Per row `D^2 f(a, b)` from the passes along `a + b` and `a - b`.
 fn bilinear(p: &Dirs, m: &Dirs) -> Vec<f64> {
     p.rows
@@ -126,31 +134,16 @@ impl Preadjustment {
         let nn: Vec<f64> = self.e_times(&gam).iter().map(|x| -x).collect();
         let mu0 = self.mu0.clone();
         let (du, dn) = (Dirs::along(sys, q, &u), Dirs::along(sys, q, &nn));
-        let (dupv, dumv) = (
-            Dirs::along(sys, q, &comb(&u, 1.0, v, 1.0)),
-            Dirs::along(sys, q, &comb(&u, 1.0, v, -1.0)),
-        );
-        let (dnpv, dnmv) = (
-            Dirs::along(sys, q, &comb(&nn, 1.0, v, 1.0)),
-            Dirs::along(sys, q, &comb(&nn, 1.0, v, -1.0)),
-        );
-        let (dnpu, dnmu) = (
-            Dirs::along(sys, q, &comb(&nn, 1.0, &u, 1.0)),
-            Dirs::along(sys, q, &comb(&nn, 1.0, &u, -1.0)),
-        );
+        let (dupv, dumv) = along_pm(sys, q, &u, v);
+        let (dnpv, dnmv) = along_pm(sys, q, &nn, v);
+        let (dnpu, dnmu) = along_pm(sys, q, &nn, &u);
         let beta = bilinear(&dupv, &dumv);
         let k2: Vec<f64> = self.e_times(&beta).iter().map(|x| -x).collect();
         let h_nv = bilinear(&dnpv, &dnmv);
         let kap3: Vec<f64> = (0..m).map(|r| dv.rows[r][1] + 3.0 * h_nv[r]).collect();
         let k3: Vec<f64> = self.e_times(&kap3).iter().map(|x| -x).collect();
-        let (dk2p, dk2m) = (
-            Dirs::along(sys, q, &comb(&k2, 1.0, v, 1.0)),
-            Dirs::along(sys, q, &comb(&k2, 1.0, v, -1.0)),
-        );
-        let (dk3p, dk3m) = (
-            Dirs::along(sys, q, &comb(&k3, 1.0, v, 1.0)),
-            Dirs::along(sys, q, &comb(&k3, 1.0, v, -1.0)),
-        );
+        let (dk2p, dk2m) = along_pm(sys, q, &k2, v);
+        let (dk3p, dk3m) = along_pm(sys, q, &k3, v);
         // D^3 Phi(v, v, u) from the passes along v + u, v - u (= -(u - v): odd) and u
         let vvu: Vec<f64> = (0..m)
             .map(|r| (dupv.rows[r][1] + dumv.rows[r][1] - 2.0 * du.rows[r][1]) / 6.0)
