@@ -121,8 +121,8 @@ class Tensors:
         dP = [sp.derive_by_array(P, qs)]
         for _ in range(3):
             dP.append(sp.derive_by_array(dP[-1], qs))
-        self.fV = [sp.lambdify([qs], x, 'numpy') for x in dV]
-        self.fP = [sp.lambdify([qs], x, 'numpy') for x in dP]
+        self.fV = [sp.lambdify([qs], x, 'numpy', cse=True) for x in dV]
+        self.fP = [sp.lambdify([qs], x, 'numpy', cse=True) for x in dP]
 
     def at(self, q):
         n, m = self.n, self.m
@@ -134,6 +134,20 @@ class Tensors:
     def e4(self, M, q, v, coeffs=None):
         V, P = self.at(q)
         return e4_cart(M, V[0], V[1], V[2], V[3], P[0], P[1], P[2], P[3], v, coeffs=coeffs)
+
+    def e4_grad(self, M, q, v, d=1e-6):
+        """e4 and its central-difference gradients in q and v (the tensors are evaluated once per q)."""
+        n = len(q)
+        V, P = self.at(q)
+        f = lambda vv: e4_cart(M, V[0], V[1], V[2], V[3], P[0], P[1], P[2], P[3], vv)
+        e = f(v)
+        gv, gq = np.zeros(n), np.zeros(n)
+        for i in range(n):
+            dv = np.zeros(n)
+            dv[i] = d
+            gv[i] = (f(v + dv) - f(v - dv)) / (2 * d)
+            gq[i] = (self.e4(M, q + dv, v) - self.e4(M, q - dv, v)) / (2 * d)
+        return e, gq, gv
 
 
 # ------------------------------------------------------------------ checks
