@@ -283,9 +283,13 @@ def check_graph(ns=20, seed=3):
             w = np.array([float(x) for x in D.w])
             v = B @ np.concatenate([w, np.zeros(m)])
             e_c = T.e4(M, q0, v)
+            Vt, Pt = T.at(q0)
+            terms = e4_terms(M, Vt[0], Vt[1], Vt[2], Vt[3], Pt[0], Pt[1], Pt[2], Pt[3], v)
+            scale = sum(abs(float(COEFFS[key]) * terms[key]) for key in COEFFS)
             rel = abs(e_c - float(e_exact)) / max(1.0, abs(float(e_exact)))
             worst = max(worst, rel)
-            print('  graph d=%d m=%d sample %d: oracle %.15e  Cartesian %.15e  rel diff %.1e' % (d, m, k, float(e_exact), e_c, rel), flush=True)
+            print('  graph d=%d m=%d sample %d: oracle %.15e  Cartesian %.15e  rel diff %.1e  (sum of |terms| %.1e, cond(B) %.1e)'
+                  % (d, m, k, float(e_exact), e_c, rel, scale, np.linalg.cond(B)), flush=True)
     return worst
 
 

@@ -45,8 +45,19 @@ def sym_monos(T, k, nvar):
         for i in idx:
             e[i] += 1
         e = tuple(e)
-        out[e] = out.get(e, 0) + Fraction(c) / factorial(k)
+        if isinstance(c, (int, Fraction)):
+            c = Fraction(c) / factorial(k)
+        else:  # a ring element (symbolic data, s2_symbolic.py)
+            c = c * QQ(1, factorial(k))
+        out[e] = out.get(e, 0) + c
     return {e: c for e, c in out.items() if c != 0}
+
+
+def _const(R, c):
+    if isinstance(c, (int, Fraction)):
+        c = Fraction(c)
+        return R(QQ(c.numerator, c.denominator))
+    return c
 
 
 def mono_diff(monos, j):
@@ -60,12 +71,14 @@ def mono_diff(monos, j):
 
 
 class Oracle:
-    def __init__(self, d, m):
+    def __init__(self, d, m, extra=()):
+        """extra: names of additional generators (symbolic data, see s2_symbolic.py)."""
         self.d, self.m, self.n = d, m, d + m
-        names = ['h', 'tau', 's'] + ['a%d' % i for i in range(d)]
+        names = ['h', 'tau', 's'] + ['a%d' % i for i in range(d)] + list(extra)
         self.R, *gens = ring(','.join(names), QQ)
         self.h, self.tau, self.s = gens[:3]
-        self.a = gens[3:]
+        self.a = gens[3:3 + d]
+        self.extra = gens[3 + d:]
 
     # -- truncated arithmetic
     def tr(self, p, N=NH):
@@ -86,7 +99,7 @@ class Oracle:
             pw.append(l)
         out = self.R(0)
         for e, c in monos.items():
-            t = self.R(QQ(c.numerator, c.denominator))
+            t = _const(self.R, c)
             for i in range(nv):
                 if e[i]:
                     t = self.mul(t, pw[i][e[i]], N)
@@ -119,7 +132,7 @@ class Oracle:
     def exact_c4(self, w):
         R, h, tau, d, m = self.R, self.h, self.tau, self.d, self.m
         half = QQ(1, 2)
-        hw = [h * QQ(wi.numerator, wi.denominator) for wi in w]
+        hw = [h * _const(R, wi) for wi in w]
         th = [hw[j] * tau for j in range(d)]
 
         def itau(p):
@@ -170,7 +183,7 @@ class Oracle:
 
     def scheme_c4(self, w):
         R, h, s, d, m = self.R, self.h, self.s, self.d, self.m
-        hw = [h * QQ(wi.numerator, wi.denominator) for wi in w]
+        hw = [h * _const(R, wi) for wi in w]
         q0 = self.chi([-x / 2 for x in hw])
         q1 = self.chi([x / 2 for x in hw])
         qm = self.chi([h**2 * ai for ai in self.a])
@@ -193,7 +206,17 @@ class Oracle:
         F2e = F2.as_expr()
         sol = sp.solve([sp.diff(F2e, ai) for ai in asym], asym, dict=True)[0]
         F4e = F4.as_expr()
+        if self.extra:
+            return sp.expand(F4e.subs(sol)), sol
         return sp.Rational(F4e.subs(sol)), sol
+
+    def e4_symbolic(self, F, Vt, w):
+        """c4^E - c4^S as a sympy expression (data may contain the extra generators)."""
+        import sympy as sp
+        self.setup(F, Vt)
+        cE = self.exact_c4(w).as_expr()
+        cS, sol = self.scheme_c4(w)
+        return sp.expand(cE - cS)
 
     def e4(self, F, Vt, w):
         self.setup(F, Vt)
