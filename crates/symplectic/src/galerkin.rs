@@ -460,6 +460,21 @@ impl Galerkin {
         Ok(())
     }
 
+    /// `Phi_q` at the interior control points `Q_1 .. Q_(s-1)` at `self.x` (after
+    /// `place_control_points`): what the end momentum needs when Newton's last update was
+    /// applied without a new residual (`momentum_rows` evaluates them otherwise).
+    pub(super) fn refresh_interior_phiq(&mut self, sys: &System) {
+        let (n, s) = (self.n, self.tab.s);
+        for nu in 1..s {
+            let q = &self.qn[nu * n..(nu + 1) * n];
+            if self.sparse.is_some() {
+                sys.phi_q_local(q, &mut self.grads[nu]);
+            } else {
+                sys.phi_q(q, &mut self.phiq[nu]);
+            }
+        }
+    }
+
     /// The momentum rows of the residual (after `kinematics`).
     fn momentum_rows(&mut self, sys: &System, h: f64) {
         let (n, m, s) = (self.n, self.m, self.tab.s);
