@@ -18,6 +18,9 @@
 //!   terms that contain Hessians),
 //! * [`Taylor4`] gives the Taylor series of `t -> f(q + t w)` to degree 4 (the directional
 //!   derivatives `D^k f(w, ..., w)`, `k <= 4`, without gradients),
+//! * [`TaylorGrad4`] gives the same series with the gradient of every coefficient with respect
+//!   to the base point (so the gradients of `D^k f(q)(w, ..., w)`, `k <= 4`, with respect to
+//!   `q` and to `w`),
 //!
 //! so the Jacobian, `gamma`, the Hessians and the third derivatives are exact (to round-off) and consistent with the
 //! equation by construction. Finite-difference tests check them all.
@@ -60,6 +63,7 @@ mod dual;
 mod hess;
 mod tan;
 mod taylor;
+mod taylor_grad;
 mod third;
 
 pub use dir::DirJet;
@@ -67,6 +71,7 @@ pub use dual::Dual;
 pub use hess::HessJet;
 pub use tan::TanJet;
 pub use taylor::Taylor4;
+pub use taylor_grad::TaylorGrad4;
 pub use third::ThirdJet;
 
 /// Number of local variables of one element: `(x, y, theta)` of body a, then of body b.

@@ -48,6 +48,7 @@ mod builder;
 mod cache;
 mod constraints;
 mod directional;
+mod directional_grad;
 mod dynamics;
 mod error;
 mod file;

@@ -22,7 +22,7 @@ impl System {
     }
 
     #[inline(always)]
-    fn scatter_grad(at: Attach, g: &[f64; NV], scale: f64, out: &mut [f64]) {
+    pub(crate) fn scatter_grad(at: Attach, g: &[f64; NV], scale: f64, out: &mut [f64]) {
         if let Some(i) = at.a {
             for l in 0..3 {
                 out[3 * i + l] += scale * g[l];
