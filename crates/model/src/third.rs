@@ -241,6 +241,32 @@ impl System {
         }
     }
 
+    /// `out += sum_r Hess Phi_r(q) d_r` for one element-local direction `d_r` per constraint
+    /// row (`dirs` of length m, in the columns of the row's joint as in
+    /// [`System::phi_q_local`]): the gradient in `q` of `sum_r d_r . grad Phi_r`, i.e. what the
+    /// adjoint of `Phi_q` gives back to `q` (one tangent pass per nonzero row).
+    pub fn add_constraint_hessian_rows(&self, q: &[f64], dirs: &[[f64; NV]], out: &mut [f64]) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            for k in 0..j.n_equations() {
+                let d = &dirs[o + k];
+                if d.iter().all(|&x| x == 0.0) {
+                    continue;
+                }
+                let frame = |i: Option<usize>, slot: usize| match i {
+                    Some(i) => Frame::new(std::array::from_fn(|c| {
+                        TanJet::var(slot + c, q[3 * i + c], d[slot + c])
+                    })),
+                    None => Frame::fixed(),
+                };
+                let mut e = [TanJet::cst(0.0); 3];
+                j.eval(&frame(at.a, 0), &frame(at.b, 3), &mut e);
+                Self::scatter_grad(at, &e[k].dg, 1.0, out);
+            }
+        }
+    }
+
     /// The dense `m x n` matrix of element-local constraint rows (e.g. `Phi_q` from the
     /// `grads` of [`System::constraint_third_local`]) into `out` (overwritten).
     pub fn local_rows_dense(&self, rows: &[[f64; NV]], out: &mut DMatrix<f64>) {
@@ -496,6 +522,49 @@ mod tests {
                 assert!(
                     (b[i] - eb[i]).abs() < 1e-13 * (1.0 + eb[i].abs()),
                     "D3 [{i}]"
+                );
+            }
+        }
+    }
+
+    /// `sum_r Hess Phi_r d_r` with element-local directions against the assembled Hessian of
+    /// each row (`constraint_hessian` with a unit multiplier) times the row's direction.
+    #[test]
+    fn hessian_rows_match_assembled_hessians() {
+        for sys in crate::fixtures::derivative_test_systems() {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let (q, _) = crate::fixtures::generic_point(n);
+            let dirs: Vec<[f64; 6]> = (0..m)
+                .map(|r| std::array::from_fn(|l| 0.3 + 0.1 * r as f64 - 0.07 * (l * l) as f64))
+                .collect();
+            let mut got = vec![0.0; n];
+            sys.add_constraint_hessian_rows(&q, &dirs, &mut got);
+            let mut want = vec![0.0; n];
+            let mut h = DMatrix::zeros(n, n);
+            for (r, d) in dirs.iter().enumerate() {
+                let mut e = vec![0.0; m];
+                e[r] = 1.0;
+                sys.constraint_hessian(&q, &e, &mut h);
+                let (a, b) = sys.joint_bodies(sys.equation_joint(r).unwrap());
+                let mut g = vec![0.0; n];
+                for (slot, body) in [(0, a), (3, b)] {
+                    if let Some(i) = body {
+                        for k in 0..3 {
+                            g[3 * i + k] = d[slot + k];
+                        }
+                    }
+                }
+                for i in 0..n {
+                    want[i] += (0..n).map(|l| h[(i, l)] * g[l]).sum::<f64>();
+                }
+            }
+            let scale = want.iter().fold(1.0f64, |a, x| a.max(x.abs()));
+            for i in 0..n {
+                assert!(
+                    (got[i] - want[i]).abs() < 1e-12 * scale,
+                    "{i}: {} vs {}",
+                    got[i],
+                    want[i]
                 );
             }
         }

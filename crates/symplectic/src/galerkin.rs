@@ -424,38 +424,18 @@ impl Galerkin {
             }
             return Ok(());
         }
-        // s = 2: E_d = h^5 e4(qbar, v) at the chord of the end control points, its gradients
-        // by central differences (modified2.rs; docs/symplectic.md section 5b)
+        // s = 2: E_d = h^5 e4(qbar, v) at the chord of the end control points, its exact
+        // gradients by a reverse pass (modified2_grad.rs; docs/symplectic.md section 5b)
         for i in 0..n {
             self.mlvel[i] = (self.qn[s * n + i] - self.qn[i]) / h;
             self.mlmid[i] = 0.5 * (self.qn[i] + self.qn[s * n + i]);
         }
         let h4 = h.powi(4);
-        let vscale = 1.0 + self.mlvel.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        // fourth-order central differences: (8 (f(x+d) - f(x-d)) - (f(x+2d) - f(x-2d))) / 12d
-        for l in 0..n {
-            for (pos, scale) in [(true, 1.0 + self.mlmid[l].abs()), (false, vscale)] {
-                let d = MODIFIED_S2_FD_STEP * scale;
-                let x0 = if pos { self.mlmid[l] } else { self.mlvel[l] };
-                let mut acc = 0.0;
-                for (c, k) in [(8.0, 1.0), (-8.0, -1.0), (-1.0, 2.0), (1.0, -2.0)] {
-                    if pos {
-                        self.mlmid[l] = x0 + k * d;
-                    } else {
-                        self.mlvel[l] = x0 + k * d;
-                    }
-                    acc += c * ml
-                        .modified_term_s2(sys, &self.mlmid, &self.mlvel)
-                        .map_err(|e| with_time(e, t))?;
-                }
-                if pos {
-                    self.mlmid[l] = x0;
-                    self.mlq[l] = h4 * acc / (12.0 * d);
-                } else {
-                    self.mlvel[l] = x0;
-                    self.mlv[l] = h4 * acc / (12.0 * d);
-                }
-            }
+        ml.modified_gradients_s2(sys, &self.mlmid, &self.mlvel, &mut self.mlq, &mut self.mlv)
+            .map_err(|e| with_time(e, t))?;
+        for i in 0..n {
+            self.mlq[i] *= h4;
+            self.mlv[i] *= h4;
         }
         Ok(())
     }
@@ -586,11 +566,6 @@ impl Galerkin {
         }
     }
 }
-
-/// Relative step of the central differences that give the gradients of the (2,2) modified
-/// term `e4` (scaled by `1 + |q_l|` in position and `1 + |v|_inf` in velocity): their error,
-/// about `1e-10` relative, enters the step multiplied by `h^4`.
-const MODIFIED_S2_FD_STEP: f64 = 1e-4;
 
 fn with_time(e: SolveError, t: f64) -> SolveError {
     match e {

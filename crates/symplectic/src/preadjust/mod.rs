@@ -24,6 +24,7 @@ use nalgebra::DMatrix;
 
 mod modified;
 mod modified2;
+mod modified2_grad;
 mod paper;
 
 pub use modified2::E4_TERMS;

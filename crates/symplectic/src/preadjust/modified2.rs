@@ -49,13 +49,13 @@ pub const E4_TERMS: [(&str, f64); 23] = [
 
 /// Directional derivatives of orders 2..4 of every constraint row and of the potential along
 /// one direction.
-struct Dirs {
-    rows: Vec<[f64; 3]>,
-    pot: [f64; 3],
+pub(super) struct Dirs {
+    pub(super) rows: Vec<[f64; 3]>,
+    pub(super) pot: [f64; 3],
 }
 
 impl Dirs {
-    fn along(sys: &System, q: &[f64], w: &[f64]) -> Self {
+    pub(super) fn along(sys: &System, q: &[f64], w: &[f64]) -> Self {
         let mut rows = vec![[0.0; 3]; sys.n_constraints()];
         sys.constraint_directional(q, w, &mut rows);
         Dirs {
@@ -65,7 +65,7 @@ impl Dirs {
     }
 }
 
-fn comb(a: &[f64], ca: f64, b: &[f64], cb: f64) -> Vec<f64> {
+pub(super) fn comb(a: &[f64], ca: f64, b: &[f64], cb: f64) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| ca * x + cb * y).collect()
 }
 
@@ -86,9 +86,72 @@ fn bilinear(p: &Dirs, m: &Dirs) -> Vec<f64> {
         .collect()
 }
 
+/// The intermediate quantities of `e4` at one `(q, v)` (names as in the module doc; `nn` is
+/// `n`, `hmu_v` is `H_mu v`, `pi_hv` is `Pi H v`, `s_beta` is `S^-1 beta`, `d4v` is
+/// `D^4 V(v, v, v, v)`), kept for the reverse pass of the gradient (`modified2_grad.rs`).
+pub(super) struct E4Forward {
+    pub(super) u: Vec<f64>,
+    pub(super) mu0: Vec<f64>,
+    pub(super) sig: Vec<f64>,
+    pub(super) nn: Vec<f64>,
+    pub(super) beta: Vec<f64>,
+    pub(super) k2: Vec<f64>,
+    pub(super) kap3: Vec<f64>,
+    pub(super) k3: Vec<f64>,
+    pub(super) kap3u: Vec<f64>,
+    pub(super) kap4: Vec<f64>,
+    pub(super) hv: Vec<f64>,
+    pub(super) hu: Vec<f64>,
+    pub(super) hn: Vec<f64>,
+    pub(super) hmu_v: Vec<f64>,
+    pub(super) hmu_u: Vec<f64>,
+    pub(super) hsig_v: Vec<f64>,
+    pub(super) hsig_u: Vec<f64>,
+    pub(super) pi_hmu_v: Vec<f64>,
+    pub(super) pi_hv: Vec<f64>,
+    pub(super) pi_hsig_v: Vec<f64>,
+    pub(super) s_beta: Vec<f64>,
+    pub(super) s_kap3: Vec<f64>,
+    pub(super) d3v_u: f64,
+    pub(super) d3v_n: f64,
+    pub(super) d4v: f64,
+}
+
+impl E4Forward {
+    /// The 23 terms, in the order of [`E4_TERMS`].
+    pub(super) fn terms(&self) -> [f64; 23] {
+        let f = self;
+        [
+            dot(&f.hsig_v, &f.pi_hmu_v),
+            dot(&f.hmu_v, &f.pi_hmu_v),
+            dot(&f.u, &f.hmu_u),
+            dot(&f.hmu_v, &f.pi_hv),
+            dot(&f.beta, &f.s_beta),
+            dot(&f.u, &f.hsig_u),
+            dot(&f.kap3, &f.s_beta),
+            dot(&f.hv, &f.k2),
+            dot(&f.mu0, &f.kap3u),
+            dot(&f.sig, &f.kap3u),
+            dot(&f.mu0, &f.kap4),
+            dot(&f.hu, &f.nn),
+            dot(&f.u, &f.hu),
+            f.d3v_u,
+            dot(&f.nn, &f.hn),
+            dot(&f.hv, &f.pi_hsig_v),
+            dot(&f.hv, &f.k3),
+            f.d3v_n,
+            dot(&f.hv, &f.pi_hv),
+            f.d4v,
+            dot(&f.hsig_v, &f.pi_hsig_v),
+            dot(&f.sig, &f.kap4),
+            dot(&f.kap3, &f.s_kap3),
+        ]
+    }
+}
+
 impl Preadjustment {
     /// `E x` (`E = M^-1 G^T S^-1`, x of length m) at the prepared point, into a new vector.
-    fn e_times(&mut self, x: &[f64]) -> Vec<f64> {
+    pub(super) fn e_times(&mut self, x: &[f64]) -> Vec<f64> {
         let (n, m) = (self.n, self.m);
         let mut y = x.to_vec();
         self.chol.solve_in_place(&mut y);
@@ -97,28 +160,26 @@ impl Preadjustment {
             .collect()
     }
 
-    fn s_inv(&mut self, x: &[f64]) -> Vec<f64> {
+    pub(super) fn s_inv(&mut self, x: &[f64]) -> Vec<f64> {
         let mut y = x.to_vec();
         self.chol.solve_in_place(&mut y);
         y
     }
 
-    fn pi_times(&mut self, x: &[f64]) -> Vec<f64> {
+    pub(super) fn pi_times(&mut self, x: &[f64]) -> Vec<f64> {
         let mut y = vec![0.0; self.n];
         self.apply_pi(x, &mut y);
         y
     }
 
-    /// The 23 terms of `e4(q, v)` ([`E4_TERMS`], without their coefficients), at `q` with
-    /// the velocity `v` (tangent, or a step's chord). Allocates: a reference evaluation (tests,
-    /// derivations), not the integrator's hot path.
-    pub fn modified_terms_s2(
+    /// The intermediate quantities of `e4` at `q` with the velocity `v` (after `check_v`;
+    /// prepares the workspace at `q`).
+    pub(super) fn e4_forward(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
-    ) -> Result<[f64; 23], SolveError> {
-        self.check_v(v)?;
+    ) -> Result<E4Forward, SolveError> {
         self.prepare(sys, q)?;
         let (n, m) = (self.n, self.m);
         let u = self.u.clone();
@@ -176,31 +237,48 @@ impl Preadjustment {
         // potential: D^3 V(u, v, v) and D^3 V(n, v, v) by polarisation (odd in the direction)
         let d3v_u = (dupv.pot[1] + dumv.pot[1] - 2.0 * du.pot[1]) / 6.0;
         let d3v_n = (dnpv.pot[1] + dnmv.pot[1] - 2.0 * dn.pot[1]) / 6.0;
-        Ok([
-            dot(&hsig_v, &pi_hmu_v),
-            dot(&hmu_v, &pi_hmu_v),
-            dot(&u, &hmu_u),
-            dot(&hmu_v, &pi_hv),
-            dot(&beta, &s_beta),
-            dot(&u, &hsig_u),
-            dot(&kap3, &s_beta),
-            dot(&hv, &k2),
-            dot(&mu0, &kap3u),
-            dot(&sig, &kap3u),
-            dot(&mu0, &kap4),
-            dot(&hu, &nn),
-            dot(&u, &hu),
+        let d4v = dv.pot[2];
+        Ok(E4Forward {
+            u,
+            mu0,
+            sig,
+            nn,
+            beta,
+            k2,
+            kap3,
+            k3,
+            kap3u,
+            kap4,
+            hv,
+            hu,
+            hn,
+            hmu_v,
+            hmu_u,
+            hsig_v,
+            hsig_u,
+            pi_hmu_v,
+            pi_hv,
+            pi_hsig_v,
+            s_beta,
+            s_kap3,
             d3v_u,
-            dot(&nn, &hn),
-            dot(&hv, &pi_hsig_v),
-            dot(&hv, &k3),
             d3v_n,
-            dot(&hv, &pi_hv),
-            dv.pot[2],
-            dot(&hsig_v, &pi_hsig_v),
-            dot(&sig, &kap4),
-            dot(&kap3, &s_kap3),
-        ])
+            d4v,
+        })
+    }
+
+    /// The 23 terms of `e4(q, v)` ([`E4_TERMS`], without their coefficients), at `q` with
+    /// the velocity `v` (tangent, or a step's chord). Allocates: a reference evaluation (tests,
+    /// derivations), not the integrator's hot path.
+    pub fn modified_terms_s2(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<[f64; 23], SolveError> {
+        self.check_v(v)?;
+        let f = self.e4_forward(sys, q, v)?;
+        Ok(f.terms())
     }
 
     /// The `h^4` modified-Lagrangian term of the (2,2) scheme, `e4(q, v) = sum_i c_i T_i`
