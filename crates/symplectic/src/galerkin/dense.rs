@@ -156,11 +156,12 @@ impl Galerkin {
         // depend on them.
         if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
             // (s = 2: the h^4 e4 term is left out of the Newton matrix)
-            self.wh.fill(0.0);
+            // (the slice's fill is a memset; the matrix's goes entry by entry)
+            self.wh.as_mut_slice().fill(0.0);
             ml.add_modified_velocity_hessian(sys, &self.mlmid, &self.mlvel, 2.0, &mut self.wh)
                 .map_err(|e| with_time(e, t))?;
             // (s = 1 has no interior control point: hc is free)
-            ml.approximate_hessian(sys, &self.mlmid, &mut self.hc)
+            ml.approximate_hessian_1(sys, &self.mlmid, &mut self.hc)
                 .map_err(|e| with_time(e, t))?;
             let jm = &mut self.lu;
             let (cw, ch) = (-h2 / 12.0, -(h2 * h2) / 48.0);

@@ -197,7 +197,7 @@ impl Preadjustment {
         for r in 0..m {
             self.tm[2][r] = scale * self.cm[r];
         }
-        self.amat.fill(0.0);
+        self.amat.as_mut_slice().fill(0.0);
         sys.add_lagrangian_hessian_pair(
             q,
             v,
@@ -367,6 +367,39 @@ pub(crate) mod modlag_tests {
                     av[i],
                     bv[i]
                 );
+            }
+        }
+    }
+
+    /// The fast `A Pi A` of the modified Lagrangian's Newton matrix
+    /// ([`Preadjustment::approximate_hessian_1`]) is the `s = 1` approximate Hessian to rounding,
+    /// and exactly symmetric.
+    #[test]
+    fn approximate_hessian_1_matches_general() {
+        for sys in [
+            models::paper_a_double_pendulum().unwrap(),
+            models::n_link_chain(4).unwrap(),
+            rod_with_spring(),
+        ] {
+            let st = mbd_solve::State::consistent(&sys, 0.0).unwrap();
+            let n = sys.n_coords();
+            let q: Vec<f64> = st.q.iter().copied().collect();
+            let mut p = Preadjustment::new(&sys, 1).unwrap();
+            let (mut a, mut b) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+            p.approximate_hessian(&sys, &q, &mut a).unwrap();
+            p.approximate_hessian_1(&sys, &q, &mut b).unwrap();
+            let scale = a.iter().fold(0.0f64, |x, &y| x.max(y.abs()));
+            assert!(scale > 0.0);
+            for i in 0..n {
+                for l in 0..n {
+                    assert!(
+                        (a[(i, l)] - b[(i, l)]).abs() <= 1e-12 * scale,
+                        "({i}, {l}): {} vs {}",
+                        a[(i, l)],
+                        b[(i, l)]
+                    );
+                    assert_eq!(b[(i, l)], b[(l, i)]);
+                }
             }
         }
     }
