@@ -186,6 +186,13 @@ impl Preadjustment {
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
         self.check_v(v)?;
+        if out.shape() != (self.n, self.n) {
+            return Err(SolveError::Dimension {
+                what: "the modified velocity Hessian",
+                expected: self.n,
+                got: out.nrows(),
+            });
+        }
         self.prepare(sys, q)?;
         // (the Jacobian is evaluated where the residual was: `cm` is then held for this v)
         if !(self.mv_valid && self.mv.as_slice() == v) {
@@ -193,7 +200,7 @@ impl Preadjustment {
         }
         // one Hessian pass: out += scale B, amat = A (kept for approximate_hessian) and
         // C^T = (Phi_q v)_q
-        let m = self.m;
+        let (n, m) = (self.n, self.m);
         for r in 0..m {
             self.tm[2][r] = scale * self.cm[r];
         }
@@ -234,10 +241,15 @@ impl Preadjustment {
                     self.kset.push(i);
                 }
             }
+            // (Y^T Y is symmetric: each dot product once, the same bits both ways)
+            let o = out.as_mut_slice();
             for (a, &i) in self.kset.iter().enumerate() {
-                for (b, &l) in self.kset.iter().enumerate() {
-                    let d = dot(&y[b * m..(b + 1) * m], &y[a * m..(a + 1) * m]);
-                    out[(l, i)] += 2.0 * scale * d;
+                for (b, &l) in self.kset.iter().enumerate().take(a + 1) {
+                    let d = 2.0 * scale * dot(&y[b * m..(b + 1) * m], &y[a * m..(a + 1) * m]);
+                    o[i * n + l] += d;
+                    if l != i {
+                        o[l * n + i] += d;
+                    }
                 }
             }
         }

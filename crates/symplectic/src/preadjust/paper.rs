@@ -282,6 +282,13 @@ impl Preadjustment {
         q: &[f64],
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
+        if out.shape() != (self.n, self.n) {
+            return Err(SolveError::Dimension {
+                what: "the approximate Hessian",
+                expected: self.n,
+                got: out.nrows(),
+            });
+        }
         self.prepare(sys, q)?;
         self.ensure_a(sys, q);
         let (n, m) = (self.n, self.m);
