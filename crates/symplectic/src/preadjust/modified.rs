@@ -186,6 +186,13 @@ impl Preadjustment {
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
         self.check_v(v)?;
+        if out.shape() != (self.n, self.n) {
+            return Err(SolveError::Dimension {
+                what: "the modified velocity Hessian",
+                expected: self.n,
+                got: out.nrows(),
+            });
+        }
         self.prepare(sys, q)?;
         // (the Jacobian is evaluated where the residual was: `cm` is then held for this v)
         if !(self.mv_valid && self.mv.as_slice() == v) {
@@ -193,11 +200,11 @@ impl Preadjustment {
         }
         // one Hessian pass: out += scale B, amat = A (kept for approximate_hessian) and
         // C^T = (Phi_q v)_q
-        let m = self.m;
+        let (n, m) = (self.n, self.m);
         for r in 0..m {
             self.tm[2][r] = scale * self.cm[r];
         }
-        self.amat.fill(0.0);
+        self.amat.as_mut_slice().fill(0.0);
         sys.add_lagrangian_hessian_pair(
             q,
             v,
@@ -234,10 +241,15 @@ impl Preadjustment {
                     self.kset.push(i);
                 }
             }
+            // (Y^T Y is symmetric: each dot product once, the same bits both ways)
+            let o = out.as_mut_slice();
             for (a, &i) in self.kset.iter().enumerate() {
-                for (b, &l) in self.kset.iter().enumerate() {
-                    let d = dot(&y[b * m..(b + 1) * m], &y[a * m..(a + 1) * m]);
-                    out[(l, i)] += 2.0 * scale * d;
+                for (b, &l) in self.kset.iter().enumerate().take(a + 1) {
+                    let d = 2.0 * scale * dot(&y[b * m..(b + 1) * m], &y[a * m..(a + 1) * m]);
+                    o[i * n + l] += d;
+                    if l != i {
+                        o[l * n + i] += d;
+                    }
                 }
             }
         }
@@ -367,6 +379,39 @@ pub(crate) mod modlag_tests {
                     av[i],
                     bv[i]
                 );
+            }
+        }
+    }
+
+    /// The fast `A Pi A` of the modified Lagrangian's Newton matrix
+    /// ([`Preadjustment::approximate_hessian_1`]) is the `s = 1` approximate Hessian to rounding,
+    /// and exactly symmetric.
+    #[test]
+    fn approximate_hessian_1_matches_general() {
+        for sys in [
+            models::paper_a_double_pendulum().unwrap(),
+            models::n_link_chain(4).unwrap(),
+            rod_with_spring(),
+        ] {
+            let st = mbd_solve::State::consistent(&sys, 0.0).unwrap();
+            let n = sys.n_coords();
+            let q: Vec<f64> = st.q.iter().copied().collect();
+            let mut p = Preadjustment::new(&sys, 1).unwrap();
+            let (mut a, mut b) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
+            p.approximate_hessian(&sys, &q, &mut a).unwrap();
+            p.approximate_hessian_1(&sys, &q, &mut b).unwrap();
+            let scale = a.iter().fold(0.0f64, |x, &y| x.max(y.abs()));
+            assert!(scale > 0.0);
+            for i in 0..n {
+                for l in 0..n {
+                    assert!(
+                        (a[(i, l)] - b[(i, l)]).abs() <= 1e-12 * scale,
+                        "({i}, {l}): {} vs {}",
+                        a[(i, l)],
+                        b[(i, l)]
+                    );
+                    assert_eq!(b[(i, l)], b[(l, i)]);
+                }
             }
         }
     }

@@ -268,4 +268,81 @@ impl Preadjustment {
         }
         Ok(())
     }
+
+    /// `A Pi A` into `out` (overwritten): [`Preadjustment::approximate_hessian`] with `s = 1`
+    /// whatever the workspace's `s`, in fewer operations (the modified Lagrangian's Newton
+    /// matrix, `galerkin/dense.rs`). The same matrix up to rounding, symmetric by construction:
+    /// with `Pi_KK = M^-1_KK - Y^T Y`, `Y = L^-1 (G M^-1)_K` as there,
+    /// `A_KK Pi_KK A_KK = A_KK M^-1_KK A_KK - Z^T Z`, `Z = Y A_KK` (`m x |K|`, zeros of `A_KK`
+    /// skipped), so each entry of the upper triangle is one `|K|`-term and one `m`-term dot
+    /// product (no `|K|^3` products).
+    pub(crate) fn approximate_hessian_1(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
+        if out.shape() != (self.n, self.n) {
+            return Err(SolveError::Dimension {
+                what: "the approximate Hessian",
+                expected: self.n,
+                got: out.nrows(),
+            });
+        }
+        self.prepare(sys, q)?;
+        self.ensure_a(sys, q);
+        let (n, m) = (self.n, self.m);
+        self.kset.clear();
+        for (c, col) in self.amat.as_slice().chunks_exact(n).enumerate() {
+            if col.iter().any(|&a| a != 0.0) {
+                self.kset.push(c);
+            }
+        }
+        let k = self.kset.len();
+        // Y (m x k, columns packed into ky) and A_KK (k x k, column-major, into ka)
+        for (cj, &c) in self.kset.iter().enumerate() {
+            let y = &mut self.ky[cj * m..(cj + 1) * m];
+            for r in 0..m {
+                y[r] = self.gq[(r, c)] * self.minv[c];
+            }
+            self.chol.forward_in_place(y);
+            for (ri, &r) in self.kset.iter().enumerate() {
+                self.ka[cj * k + ri] = self.amat[(r, c)];
+            }
+        }
+        // Z = Y A_KK (m x k, columns packed into gscr: free outside
+        // add_modified_velocity_hessian)
+        let z = self.gscr.as_mut_slice();
+        for cj in 0..k {
+            let zc = &mut z[cj * m..(cj + 1) * m];
+            zc.fill(0.0);
+            for (l, &a) in self.ka[cj * k..(cj + 1) * k].iter().enumerate() {
+                if a != 0.0 {
+                    for (zr, &yr) in zc.iter_mut().zip(&self.ky[l * m..(l + 1) * m]) {
+                        *zr += yr * a;
+                    }
+                }
+            }
+        }
+        let o = out.as_mut_slice();
+        o.fill(0.0);
+        for (cj, &c) in self.kset.iter().enumerate() {
+            let ac = &self.ka[cj * k..(cj + 1) * k];
+            let zc = &z[cj * m..(cj + 1) * m];
+            for (ri, &r) in self.kset.iter().enumerate().take(cj + 1) {
+                // (A symmetric: row ri of A_KK is its column ri)
+                let ar = &self.ka[ri * k..(ri + 1) * k];
+                let am: f64 = ar
+                    .iter()
+                    .zip(ac)
+                    .zip(&self.kset)
+                    .map(|((&x, &y), &l)| x * self.minv[l] * y)
+                    .sum();
+                let x = am - dot(&z[ri * m..(ri + 1) * m], zc);
+                o[c * n + r] = x;
+                o[r * n + c] = x;
+            }
+        }
+        Ok(())
+    }
 }
