@@ -11,6 +11,7 @@ use nalgebra::DMatrix;
 use sparse::{add_transpose, SparseStage};
 
 mod dense;
+mod modlag;
 mod newton;
 mod sparse;
 mod step;
@@ -69,6 +70,8 @@ pub struct Galerkin {
     mlmid: Vec<f64>,
     /// The step's constant velocity `(Q_1 - Q_0) / h`.
     mlvel: Vec<f64>,
+    /// When the `s = 2` gradients may be kept between residuals (`modlag.rs`).
+    mlreuse: modlag::Reuse,
     tn: [Vec<f64>; 4],
     proj: DenseCholesky,
     vm: Vec<f64>,
@@ -161,6 +164,7 @@ impl Galerkin {
             mlv: vec![0.0; nl],
             mlmid: vec![0.0; nl],
             mlvel: vec![0.0; nl],
+            mlreuse: modlag::Reuse::new(if modlag && options.s == 2 { n } else { 0 }),
             opts: options,
             tab,
             n,
@@ -400,46 +404,6 @@ impl Galerkin {
         Ok(())
     }
 
-    /// The modified-Lagrangian terms `h^2 de/dq`, `h^2 de/dv` at the chord midpoint and the
-    /// step's velocity of `self.x` (nothing without the mode).
-    fn modified_terms(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
-        let (n, s) = (self.n, self.tab.s);
-        let Some(ml) = self.ml.first_mut() else {
-            return Ok(());
-        };
-        if s == 1 {
-            // s = 1: E_d = h^3 e(qbar, v) with the chord midpoint qbar = (Q_0 + Q_1) / 2 and
-            // the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h (one evaluation per
-            // residual; docs/symplectic.md section 5a)
-            let h2 = h * h;
-            for i in 0..n {
-                self.mlvel[i] = self.hvj[i] / h;
-                self.mlmid[i] = 0.5 * (self.qn[i] + self.qn[n + i]);
-            }
-            ml.modified_gradients(sys, &self.mlmid, &self.mlvel, &mut self.mlq, &mut self.mlv)
-                .map_err(|e| with_time(e, t))?;
-            for i in 0..n {
-                self.mlq[i] *= h2;
-                self.mlv[i] *= h2;
-            }
-            return Ok(());
-        }
-        // s = 2: E_d = h^5 e4(qbar, v) at the chord of the end control points, its exact
-        // gradients by a reverse pass (modified2_grad.rs; docs/symplectic.md section 5b)
-        for i in 0..n {
-            self.mlvel[i] = (self.qn[s * n + i] - self.qn[i]) / h;
-            self.mlmid[i] = 0.5 * (self.qn[i] + self.qn[s * n + i]);
-        }
-        let h4 = h.powi(4);
-        ml.modified_gradients_s2(sys, &self.mlmid, &self.mlvel, &mut self.mlq, &mut self.mlv)
-            .map_err(|e| with_time(e, t))?;
-        for i in 0..n {
-            self.mlq[i] *= h4;
-            self.mlv[i] *= h4;
-        }
-        Ok(())
-    }
-
     /// `Phi_q` at the interior control points `Q_1 .. Q_(s-1)` at `self.x` (after
     /// `place_control_points`): what the end momentum needs when Newton's last update was
     /// applied without a new residual (`momentum_rows` evaluates them otherwise).
@@ -567,7 +531,7 @@ impl Galerkin {
     }
 }
 
-fn with_time(e: SolveError, t: f64) -> SolveError {
+pub(super) fn with_time(e: SolveError, t: f64) -> SolveError {
     match e {
         SolveError::Singular { what, detail, .. } => SolveError::Singular { t, what, detail },
         other => other,

@@ -94,6 +94,13 @@ impl Galerkin {
         self.residual(sys, t, h)?;
         let mut res = norm_inf(&self.r);
         let mut evals = 1;
+        if self.mlreuse.lagged && res <= tol {
+            // the predictor passes with extrapolated modified-Lagrangian gradients
+            // (`modlag.rs`): decide on evaluated ones
+            self.residual(sys, t, h)?;
+            res = norm_inf(&self.r);
+            evals += 1;
+        }
         let mut it = 0;
         let fail = |res: f64, it: usize, s: usize| SolveError::Newton {
             t,
