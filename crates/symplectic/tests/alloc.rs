@@ -38,17 +38,23 @@ fn steps_allocate_nothing() {
         let n = ALLOCS.with(|c| c.get()) - before;
         assert_eq!(n, 0, "s={s} gamma={gamma}: {n} allocations in 100 steps");
     }
-    // the modified-Lagrangian preadjustment (s = 1)
-    let opts = SymplecticOptions::new(1).with_preadjust(PreadjustMode::ModifiedLagrangian);
-    let mut g = Galerkin::new(&sys, opts).unwrap();
-    let mut st = s0.clone();
-    g.step(&sys, &mut st, 0.01).unwrap();
-    let before = ALLOCS.with(|c| c.get());
-    for _ in 0..100 {
+    // the modified-Lagrangian preadjustment (s = 1, and s = 2, whose e4 workspace is allocated
+    // by the first step)
+    for s in [1, 2] {
+        let opts = SymplecticOptions::new(s).with_preadjust(PreadjustMode::ModifiedLagrangian);
+        let mut g = Galerkin::new(&sys, opts).unwrap();
+        let mut st = s0.clone();
         g.step(&sys, &mut st, 0.01).unwrap();
+        let before = ALLOCS.with(|c| c.get());
+        for _ in 0..100 {
+            g.step(&sys, &mut st, 0.01).unwrap();
+        }
+        let n = ALLOCS.with(|c| c.get()) - before;
+        assert_eq!(
+            n, 0,
+            "modified Lagrangian, s = {s}: {n} allocations in 100 steps"
+        );
     }
-    let n = ALLOCS.with(|c| c.get()) - before;
-    assert_eq!(n, 0, "modified Lagrangian: {n} allocations in 100 steps");
 }
 
 /// The sparse path (a 30-link chain, sparse stage LU, sparse projection): after the first

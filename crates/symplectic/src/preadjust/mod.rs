@@ -22,6 +22,7 @@ use mbd_solve::linalg::DenseCholesky;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
+mod e4_work;
 mod modified;
 mod modified2;
 mod modified2_grad;
@@ -94,6 +95,8 @@ pub struct Preadjustment {
     ka: Vec<f64>,
     kx: Vec<f64>,
     ky: Vec<f64>,
+    /// The workspace of the s = 2 modified-Lagrangian term (allocated on first use).
+    e4: Option<Box<e4_work::E4Work>>,
 }
 
 #[cfg(test)]
@@ -185,6 +188,7 @@ impl Preadjustment {
             ka: vec![0.0; n * n],
             kx: vec![0.0; n * n],
             ky: vec![0.0; n * n.max(m)],
+            e4: None,
         })
     }
 

@@ -49,49 +49,60 @@ pub const E4_TERMS: [(&str, f64); 23] = [
 
 /// Directional derivatives of orders 2..4 of every constraint row and of the potential along
 /// one direction.
+#[derive(Debug)]
 pub(super) struct Dirs {
     pub(super) rows: Vec<[f64; 3]>,
     pub(super) pot: [f64; 3],
 }
 
 impl Dirs {
-    pub(super) fn along(sys: &System, q: &[f64], w: &[f64]) -> Self {
-        let mut rows = vec![[0.0; 3]; sys.n_constraints()];
-        sys.constraint_directional(q, w, &mut rows);
+    fn new(m: usize) -> Self {
         Dirs {
-            rows,
-            pot: sys.potential_directional(q, w),
+            rows: vec![[0.0; 3]; m],
+            pot: [0.0; 3],
         }
+    }
+    /// The pass along `w`.
+    pub(super) fn eval(&mut self, sys: &System, q: &[f64], w: &[f64]) {
+        sys.constraint_directional(q, w, &mut self.rows);
+        self.pot = sys.potential_directional(q, w);
     }
 }
 
-pub(super) fn comb(a: &[f64], ca: f64, b: &[f64], cb: f64) -> Vec<f64> {
-    a.iter().zip(b).map(|(x, y)| ca * x + cb * y).collect()
+/// `out = ca a + cb b`.
+pub(super) fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64]) {
+    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+        *o = ca * x + cb * y;
+    }
 }
 
-/// The passes along `a + b` and `a - b`.
-fn along_pm(sys: &System, q: &[f64], a: &[f64], b: &[f64]) -> (Dirs, Dirs) {
-    (
-        Dirs::along(sys, q, &comb(a, 1.0, b, 1.0)),
-        Dirs::along(sys, q, &comb(a, 1.0, b, -1.0)),
-    )
-}
-
-/// Per row `D^2 f(a, b)` from the passes along `a + b` and `a - b`.
-fn bilinear(p: &Dirs, m: &Dirs) -> Vec<f64> {
-    p.rows
-        .iter()
-        .zip(&m.rows)
-        .map(|(x, y)| 0.25 * (x[0] - y[0]))
-        .collect()
-}
+/// The directional passes of `e4`, by index into [`E4Forward::d`]: along `v`, `u`, `n`,
+/// `u + v`, `u - v`, `n + v`, `n - v`, `n + u`, `n - u`, `K2 + v`, `K2 - v`, `K3 + v`, `K3 - v`.
+pub(super) const DV: usize = 0;
+pub(super) const DU: usize = 1;
+pub(super) const DN: usize = 2;
+pub(super) const DUPV: usize = 3;
+pub(super) const DUMV: usize = 4;
+pub(super) const DNPV: usize = 5;
+pub(super) const DNMV: usize = 6;
+pub(super) const DNPU: usize = 7;
+pub(super) const DNMU: usize = 8;
+pub(super) const DK2P: usize = 9;
+pub(super) const DK2M: usize = 10;
+pub(super) const DK3P: usize = 11;
+pub(super) const DK3M: usize = 12;
+/// Number of directional passes.
+pub(super) const N_PASSES: usize = 13;
 
 /// The intermediate quantities of `e4` at one `(q, v)` (names as in the module doc; `nn` is
 /// `n`, `hmu_v` is `H_mu v`, `pi_hv` is `Pi H v`, `s_beta` is `S^-1 beta`, `d4v` is
-/// `D^4 V(v, v, v, v)`), kept for the reverse pass of the gradient (`modified2_grad.rs`).
+/// `D^4 V(v, v, v, v)`), kept for the reverse pass of the gradient (`modified2_grad.rs`): a
+/// workspace allocated once, filled in place by every evaluation.
+#[derive(Debug)]
 pub(super) struct E4Forward {
     pub(super) u: Vec<f64>,
     pub(super) mu0: Vec<f64>,
+    pub(super) gam: Vec<f64>,
     pub(super) sig: Vec<f64>,
     pub(super) nn: Vec<f64>,
     pub(super) beta: Vec<f64>,
@@ -115,9 +126,61 @@ pub(super) struct E4Forward {
     pub(super) d3v_u: f64,
     pub(super) d3v_n: f64,
     pub(super) d4v: f64,
+    /// The directional passes (indices `DV` ..).
+    pub(super) d: Vec<Dirs>,
+    /// Per constraint row, element-local `Hess Phi_r v` and `Hess Phi_r u` (the weighted
+    /// Hessian-vector products `H_mu v`, `H_sigma v`, ... and their adjoints use them).
+    pub(super) rhv_v: Vec<[f64; 6]>,
+    pub(super) rhv_u: Vec<[f64; 6]>,
+    /// Scratch: a direction, local rows, per-row values, m zeros.
+    pub(super) dir: Vec<f64>,
+    rg: Vec<[f64; 6]>,
+    rd3: Vec<[f64; 6]>,
+    rv: Vec<f64>,
+    pub(super) zero_m: Vec<f64>,
 }
 
 impl E4Forward {
+    pub(super) fn new(n: usize, m: usize) -> Self {
+        let (zn, zm) = (|| vec![0.0; n], || vec![0.0; m]);
+        E4Forward {
+            u: zn(),
+            mu0: zm(),
+            gam: zm(),
+            sig: zm(),
+            nn: zn(),
+            beta: zm(),
+            k2: zn(),
+            kap3: zm(),
+            k3: zn(),
+            kap3u: zm(),
+            kap4: zm(),
+            hv: zn(),
+            hu: zn(),
+            hn: zn(),
+            hmu_v: zn(),
+            hmu_u: zn(),
+            hsig_v: zn(),
+            hsig_u: zn(),
+            pi_hmu_v: zn(),
+            pi_hv: zn(),
+            pi_hsig_v: zn(),
+            s_beta: zm(),
+            s_kap3: zm(),
+            d3v_u: 0.0,
+            d3v_n: 0.0,
+            d4v: 0.0,
+            d: (0..N_PASSES).map(|_| Dirs::new(m)).collect(),
+            rhv_v: vec![[0.0; 6]; m],
+            rhv_u: vec![[0.0; 6]; m],
+            dir: zn(),
+            rg: vec![[0.0; 6]; m],
+            rd3: vec![[0.0; 6]; m],
+            rv: zm(),
+            zero_m: zm(),
+        }
+    }
+
     /// The 23 terms, in the order of [`E4_TERMS`].
     pub(super) fn terms(&self) -> [f64; 23] {
         let f = self;
@@ -147,129 +210,166 @@ impl E4Forward {
             dot(&f.kap3, &f.s_kap3),
         ]
     }
+
+    /// The pass `k` along `a + sign b`.
+    fn pass_pm(&mut self, sys: &System, q: &[f64], k: usize, a: Src, b: Src, sign: f64) {
+        let mut dir = std::mem::take(&mut self.dir);
+        comb_into(self.src(a), 1.0, self.src(b), sign, &mut dir);
+        self.d[k].eval(sys, q, &dir);
+        self.dir = dir;
+    }
+
+    fn src(&self, s: Src) -> &[f64] {
+        match s {
+            Src::U => &self.u,
+            Src::N => &self.nn,
+            Src::K2 => &self.k2,
+            Src::K3 => &self.k3,
+        }
+    }
+
+    /// Per row `D^2 f(a, b)` from the passes `p` (along `a + b`) and `m` (along `a - b`).
+    fn bilinear(d: &[Dirs], p: usize, m: usize, out: &mut [f64]) {
+        for ((o, x), y) in out.iter_mut().zip(&d[p].rows).zip(&d[m].rows) {
+            *o = 0.25 * (x[0] - y[0]);
+        }
+    }
+}
+
+/// A direction of a pass (the velocity is passed separately).
+#[derive(Clone, Copy)]
+enum Src {
+    U,
+    N,
+    K2,
+    K3,
 }
 
 impl Preadjustment {
-    /// `E x` (`E = M^-1 G^T S^-1`, x of length m) at the prepared point, into a new vector.
-    pub(super) fn e_times(&mut self, x: &[f64]) -> Vec<f64> {
-        let (n, m) = (self.n, self.m);
-        let mut y = x.to_vec();
-        self.chol.solve_in_place(&mut y);
-        (0..n)
-            .map(|k| self.minv[k] * dot(&self.gq.as_slice()[k * m..(k + 1) * m], &y))
-            .collect()
+    /// `out = -D G^T S^-1 x` (`D = M^-1`; `s` receives `S^-1 x`).
+    pub(super) fn neg_e_into(&mut self, x: &[f64], s: &mut [f64], out: &mut [f64]) {
+        s.copy_from_slice(x);
+        self.chol.solve_in_place(s);
+        self.dgt_into(s, out);
+        out.iter_mut().for_each(|o| *o = -*o);
     }
 
-    pub(super) fn s_inv(&mut self, x: &[f64]) -> Vec<f64> {
-        let mut y = x.to_vec();
-        self.chol.solve_in_place(&mut y);
-        y
+    /// `out = D G^T x` (x of length m).
+    pub(super) fn dgt_into(&self, x: &[f64], out: &mut [f64]) {
+        let m = self.m;
+        if m == 0 {
+            out.fill(0.0);
+            return;
+        }
+        for ((o, col), mi) in out
+            .iter_mut()
+            .zip(self.gq.as_slice().chunks_exact(m))
+            .zip(&self.minv)
+        {
+            *o = mi * dot(col, x);
+        }
     }
 
-    pub(super) fn pi_times(&mut self, x: &[f64]) -> Vec<f64> {
-        let mut y = vec![0.0; self.n];
-        self.apply_pi(x, &mut y);
-        y
+    /// `out = S^-1 x`.
+    pub(super) fn s_inv_into(&mut self, x: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(x);
+        self.chol.solve_in_place(out);
     }
 
-    /// The intermediate quantities of `e4` at `q` with the velocity `v` (after `check_v`;
-    /// prepares the workspace at `q`).
+    /// Evaluates the intermediates of `e4` at `q` with the velocity `v` into `f` (after
+    /// `check_v`; prepares the workspace at `q`). Allocates nothing.
     pub(super) fn e4_forward(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
-    ) -> Result<E4Forward, SolveError> {
+        f: &mut E4Forward,
+    ) -> Result<(), SolveError> {
         self.prepare(sys, q)?;
-        let (n, m) = (self.n, self.m);
-        let u = self.u.clone();
-        let zero_m = vec![0.0; m];
-        let hess = |x: &[f64], pot: f64, w: &[f64]| -> Vec<f64> {
-            let mut out = vec![0.0; n];
-            sys.lagrangian_hessian_vector(q, x, pot, w, &mut out);
-            out
-        };
-        let dv = Dirs::along(sys, q, v);
-        let gam: Vec<f64> = dv.rows.iter().map(|r| r[0]).collect();
-        let sig = self.s_inv(&gam);
-        let nn: Vec<f64> = self.e_times(&gam).iter().map(|x| -x).collect();
-        let mu0 = self.mu0.clone();
-        let (du, dn) = (Dirs::along(sys, q, &u), Dirs::along(sys, q, &nn));
-        let (dupv, dumv) = along_pm(sys, q, &u, v);
-        let (dnpv, dnmv) = along_pm(sys, q, &nn, v);
-        let (dnpu, dnmu) = along_pm(sys, q, &nn, &u);
-        let beta = bilinear(&dupv, &dumv);
-        let k2: Vec<f64> = self.e_times(&beta).iter().map(|x| -x).collect();
-        let h_nv = bilinear(&dnpv, &dnmv);
-        let kap3: Vec<f64> = (0..m).map(|r| dv.rows[r][1] + 3.0 * h_nv[r]).collect();
-        let k3: Vec<f64> = self.e_times(&kap3).iter().map(|x| -x).collect();
-        let (dk2p, dk2m) = along_pm(sys, q, &k2, v);
-        let (dk3p, dk3m) = along_pm(sys, q, &k3, v);
-        // D^3 Phi(v, v, u) from the passes along v + u, v - u (= -(u - v): odd) and u
-        let vvu: Vec<f64> = (0..m)
-            .map(|r| (dupv.rows[r][1] + dumv.rows[r][1] - 2.0 * du.rows[r][1]) / 6.0)
-            .collect();
-        // D^3 Phi(v, v, n) likewise from v + n, v - n (= -(n - v)) and n
-        let vvn: Vec<f64> = (0..m)
-            .map(|r| (dnpv.rows[r][1] + dnmv.rows[r][1] - 2.0 * dn.rows[r][1]) / 6.0)
-            .collect();
-        let h_k2v = bilinear(&dk2p, &dk2m);
-        let h_k3v = bilinear(&dk3p, &dk3m);
-        let h_nu = bilinear(&dnpu, &dnmu);
-        let kap3u: Vec<f64> = (0..m).map(|r| vvu[r] + 2.0 * h_k2v[r] + h_nu[r]).collect();
-        let kap4: Vec<f64> = (0..m)
-            .map(|r| dv.rows[r][2] + 6.0 * vvn[r] + 3.0 * dn.rows[r][0] + 4.0 * h_k3v[r])
-            .collect();
-        // Hessian-vector products
-        let hv = hess(v, 1.0, &zero_m);
-        let hu = hess(&u, 1.0, &zero_m);
-        let hn = hess(&nn, 1.0, &zero_m);
-        let hmu_v = hess(v, 0.0, &mu0);
-        let hmu_u = hess(&u, 0.0, &mu0);
-        let hsig_v = hess(v, 0.0, &sig);
-        let hsig_u = hess(&u, 0.0, &sig);
-        let (pi_hmu_v, pi_hv, pi_hsig_v) = (
-            self.pi_times(&hmu_v),
-            self.pi_times(&hv),
-            self.pi_times(&hsig_v),
-        );
-        let (s_beta, s_kap3) = (self.s_inv(&beta), self.s_inv(&kap3));
+        let m = self.m;
+        f.u.copy_from_slice(&self.u);
+        f.mu0.copy_from_slice(&self.mu0);
+        f.d[DV].eval(sys, q, v);
+        for (g, r) in f.gam.iter_mut().zip(&f.d[DV].rows) {
+            *g = r[0];
+        }
+        self.neg_e_into(&f.gam, &mut f.sig, &mut f.nn);
+        f.d[DU].eval(sys, q, &f.u);
+        f.d[DN].eval(sys, q, &f.nn);
+        // (the pass along a - v is minus the pass along v - a: the odd orders change sign,
+        // which the polarisations below take into account)
+        let mut dir = std::mem::take(&mut f.dir);
+        for (k, a, sign) in [
+            (DUPV, Src::U, 1.0),
+            (DUMV, Src::U, -1.0),
+            (DNPV, Src::N, 1.0),
+            (DNMV, Src::N, -1.0),
+        ] {
+            comb_into(f.src(a), 1.0, v, sign, &mut dir);
+            f.d[k].eval(sys, q, &dir);
+        }
+        f.dir = dir;
+        f.pass_pm(sys, q, DNPU, Src::N, Src::U, 1.0);
+        f.pass_pm(sys, q, DNMU, Src::N, Src::U, -1.0);
+        let mut t = std::mem::take(&mut f.rv);
+        E4Forward::bilinear(&f.d, DUPV, DUMV, &mut f.beta);
+        self.neg_e_into(&f.beta, &mut f.s_beta, &mut f.k2);
+        E4Forward::bilinear(&f.d, DNPV, DNMV, &mut t);
+        for r in 0..m {
+            f.kap3[r] = f.d[DV].rows[r][1] + 3.0 * t[r];
+        }
+        self.neg_e_into(&f.kap3, &mut f.s_kap3, &mut f.k3);
+        let mut dir = std::mem::take(&mut f.dir);
+        for (k, a, sign) in [
+            (DK2P, Src::K2, 1.0),
+            (DK2M, Src::K2, -1.0),
+            (DK3P, Src::K3, 1.0),
+            (DK3M, Src::K3, -1.0),
+        ] {
+            comb_into(f.src(a), 1.0, v, sign, &mut dir);
+            f.d[k].eval(sys, q, &dir);
+        }
+        f.dir = dir;
+        // D^3 Phi(v, v, u) = (D^3(u + v) + D^3(u - v) - 2 D^3(u)) / 6, D^3 Phi(v, v, n) likewise
+        let d = &f.d;
+        for r in 0..m {
+            let vvu = (d[DUPV].rows[r][1] + d[DUMV].rows[r][1] - 2.0 * d[DU].rows[r][1]) / 6.0;
+            let vvn = (d[DNPV].rows[r][1] + d[DNMV].rows[r][1] - 2.0 * d[DN].rows[r][1]) / 6.0;
+            let h_k2v = 0.25 * (d[DK2P].rows[r][0] - d[DK2M].rows[r][0]);
+            let h_k3v = 0.25 * (d[DK3P].rows[r][0] - d[DK3M].rows[r][0]);
+            let h_nu = 0.25 * (d[DNPU].rows[r][0] - d[DNMU].rows[r][0]);
+            f.kap3u[r] = vvu + 2.0 * h_k2v + h_nu;
+            f.kap4[r] = d[DV].rows[r][2] + 6.0 * vvn + 3.0 * d[DN].rows[r][0] + 4.0 * h_k3v;
+        }
+        // Hessian-vector products: of V by passes over the forces, of the weighted constraints
+        // from the element-local rows Hess Phi_r v and Hess Phi_r u
+        sys.lagrangian_hessian_vector(q, v, 1.0, &f.zero_m, &mut f.hv);
+        sys.lagrangian_hessian_vector(q, &f.u, 1.0, &f.zero_m, &mut f.hu);
+        sys.lagrangian_hessian_vector(q, &f.nn, 1.0, &f.zero_m, &mut f.hn);
+        sys.constraint_third_local(q, v, &mut f.rg, &mut f.rhv_v, &mut f.rd3, &mut t);
+        sys.constraint_third_local(q, &f.u, &mut f.rg, &mut f.rhv_u, &mut f.rd3, &mut t);
+        f.rv = t;
+        for (out, rows, w) in [
+            (&mut f.hmu_v, &f.rhv_v, &f.mu0),
+            (&mut f.hsig_v, &f.rhv_v, &f.sig),
+            (&mut f.hmu_u, &f.rhv_u, &f.mu0),
+            (&mut f.hsig_u, &f.rhv_u, &f.sig),
+        ] {
+            out.fill(0.0);
+            sys.add_local_rows(rows, w, out);
+        }
+        self.apply_pi(&f.hmu_v, &mut f.pi_hmu_v);
+        self.apply_pi(&f.hv, &mut f.pi_hv);
+        self.apply_pi(&f.hsig_v, &mut f.pi_hsig_v);
         // potential: D^3 V(u, v, v) and D^3 V(n, v, v) by polarisation (odd in the direction)
-        let d3v_u = (dupv.pot[1] + dumv.pot[1] - 2.0 * du.pot[1]) / 6.0;
-        let d3v_n = (dnpv.pot[1] + dnmv.pot[1] - 2.0 * dn.pot[1]) / 6.0;
-        let d4v = dv.pot[2];
-        Ok(E4Forward {
-            u,
-            mu0,
-            sig,
-            nn,
-            beta,
-            k2,
-            kap3,
-            k3,
-            kap3u,
-            kap4,
-            hv,
-            hu,
-            hn,
-            hmu_v,
-            hmu_u,
-            hsig_v,
-            hsig_u,
-            pi_hmu_v,
-            pi_hv,
-            pi_hsig_v,
-            s_beta,
-            s_kap3,
-            d3v_u,
-            d3v_n,
-            d4v,
-        })
+        f.d3v_u = (d[DUPV].pot[1] + d[DUMV].pot[1] - 2.0 * d[DU].pot[1]) / 6.0;
+        f.d3v_n = (d[DNPV].pot[1] + d[DNMV].pot[1] - 2.0 * d[DN].pot[1]) / 6.0;
+        f.d4v = d[DV].pot[2];
+        Ok(())
     }
 
     /// The 23 terms of `e4(q, v)` ([`E4_TERMS`], without their coefficients), at `q` with
-    /// the velocity `v` (tangent, or a step's chord). Allocates: a reference evaluation (tests,
-    /// derivations), not the integrator's hot path.
+    /// the velocity `v` (tangent, or a step's chord). Allocates its workspace on first use.
     pub fn modified_terms_s2(
         &mut self,
         sys: &System,
@@ -277,8 +377,11 @@ impl Preadjustment {
         v: &[f64],
     ) -> Result<[f64; 23], SolveError> {
         self.check_v(v)?;
-        let f = self.e4_forward(sys, q, v)?;
-        Ok(f.terms())
+        let mut w = self.e4_work(sys);
+        let res = self.e4_forward(sys, q, v, &mut w.f);
+        let terms = w.f.terms();
+        self.e4 = Some(w);
+        res.map(|()| terms)
     }
 
     /// The `h^4` modified-Lagrangian term of the (2,2) scheme, `e4(q, v) = sum_i c_i T_i`

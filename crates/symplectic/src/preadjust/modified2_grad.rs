@@ -1,7 +1,8 @@
 //! Exact gradients of the `h^4` modified-Lagrangian term `e4(q, v)` (`modified2.rs`): one
 //! forward evaluation that keeps its intermediates ([`E4Forward`]), then a reverse
 //! (adjoint) pass through them, so `de4/dq` and `de4/dv` cost a fixed number of passes over the
-//! elements, independent of `n` (central differences took `8 n` evaluations of `e4`).
+//! elements, independent of `n` (central differences took `8 n` evaluations of `e4`). Both
+//! run in a workspace allocated on first use ([`E4Work`]): nothing is allocated per call.
 //!
 //! The reverse pass needs, besides the linear algebra's adjoints, the adjoints of three
 //! primitives:
@@ -11,11 +12,13 @@
 //!   Taylor series with gradients ([`System::constraint_directional_grad`],
 //!   [`System::potential_directional_grad`]);
 //! * a Hessian-vector product `y = H x`, `H = p Hess V + sum_r w_r Hess Phi_r`: with the
-//!   adjoint `yb`, `xb += H yb`, `wb_r += yb^T Hess Phi_r x` and `qb += D^3 L(x, yb, .)`, the
-//!   last from two third-order passes by polarisation,
+//!   adjoint `yb`, `xb += H yb`, `wb_r += yb^T Hess Phi_r x` (from the element-local rows
+//!   `Hess Phi_r x` of the forward pass) and `qb += D^3 L(x, yb, .)`, the last two from two
+//!   third-order passes by polarisation,
 //!   `D^3 L(x, y, .) = [D^3 L(x + y, x + y, .) - D^3 L(x - y, x - y, .)] / 4`;
 //! * `G = Phi_q` itself: every linear-algebra adjoint leaves `Gb` as a sum of outer products
-//!   `alpha beta^T`, collected in element-local form, and `qb += sum_r Hess Phi_r Gb_r`.
+//!   `alpha beta^T`, collected in element-local form, and `qb += sum_r Hess Phi_r Gb_r`
+//!   ([`System::add_constraint_hessian_rows`]).
 //!
 //! The linear-algebra adjoints (`D = M^-1`, `S = G D G^T`, `Pi = D - D G^T S^-1 G D`):
 //!
@@ -27,26 +30,13 @@
 //!   `Gb -= a (D G^T z)^T + z (D G^T a)^T` with `a = S^-1 zb`;
 //! * `u = -D g + D G^T mu0`, `mu0 = S^-1 G D g` (`g = grad V`), and `gb` to `qb` by `Hess V`.
 
-use super::modified2::{comb, Dirs, E4_TERMS};
-use super::Preadjustment;
+use super::e4_work::{gbar_add, local, Adjoints, E4Work};
+use super::modified2::{
+    comb_into, DK2M, DK2P, DK3M, DK3P, DN, DNMU, DNMV, DNPU, DNPV, DU, DUMV, DUPV, DV, E4_TERMS,
+};
+use super::{gm_times, Preadjustment};
 use mbd_model::System;
 use mbd_solve::SolveError;
-
-/// Adjoint weights of one directional pass: of its rows' `[D^2, D^3, D^4]` and of the
-/// potential's.
-struct PassAdj {
-    rows: Vec<[f64; 3]>,
-    pot: [f64; 3],
-}
-
-impl PassAdj {
-    fn new(m: usize) -> Self {
-        PassAdj {
-            rows: vec![[0.0; 3]; m],
-            pot: [0.0; 3],
-        }
-    }
-}
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
     for (a, b) in y.iter_mut().zip(x) {
@@ -54,109 +44,75 @@ fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
     }
 }
 
-/// The element-local column indices of each constraint row (`None`: ground).
-fn local_columns(sys: &System) -> Vec<[Option<usize>; 6]> {
-    (0..sys.n_constraints())
-        .map(|r| {
-            let (a, b) = sys
-                .equation_joint(r)
-                .map_or((None, None), |j| sys.joint_bodies(j));
-            let mut c = [None; 6];
-            for (slot, body) in [(0, a), (3, b)] {
-                if let Some(i) = body {
-                    for k in 0..3 {
-                        c[slot + k] = Some(3 * i + k);
-                    }
-                }
-            }
-            c
-        })
-        .collect()
-}
-
-/// The adjoint of `G = Phi_q` in element-local form: `gbar[r][l]` for the local column `l` of
-/// row `r`.
-struct GBar<'a> {
-    cols: &'a [[Option<usize>; 6]],
-    gbar: Vec<[f64; 6]>,
-}
-
-impl GBar<'_> {
-    /// `Gb += c alpha beta^T`.
-    fn add(&mut self, c: f64, alpha: &[f64], beta: &[f64]) {
-        for ((g, cols), &a) in self.gbar.iter_mut().zip(self.cols).zip(alpha) {
-            if a == 0.0 {
-                continue;
-            }
-            for (gl, col) in g.iter_mut().zip(cols) {
-                if let Some(i) = col {
-                    *gl += c * a * beta[*i];
-                }
-            }
-        }
-    }
-}
-
 impl Preadjustment {
-    /// `D G^T x` (x of length m).
-    fn dgt(&self, x: &[f64]) -> Vec<f64> {
-        let m = self.m;
-        if m == 0 {
-            return vec![0.0; self.n];
+    /// `c a^T Pi b`: leaves the increment of `ab`, `c Pi b`, in `w.tn[0]` and that of `bb`,
+    /// `c Pi a`, in `w.tn[1]`; `Gb` updated.
+    fn adj_pi(
+        &mut self,
+        w: &mut Adjoints,
+        cols: &[[Option<usize>; 6]],
+        c: f64,
+        a: &[f64],
+        b: &[f64],
+    ) {
+        let [pa, pb, ..] = &mut w.tn;
+        let [sa, sb, ..] = &mut w.tm;
+        self.apply_pi(a, pa);
+        self.apply_pi(b, pb);
+        self.sgm(a, sa);
+        self.sgm(b, sb);
+        gbar_add(&mut w.gbar, cols, -c, sb, pa);
+        gbar_add(&mut w.gbar, cols, -c, sa, pb);
+        w.tn.swap(0, 1);
+        for t in &mut w.tn[..2] {
+            t.iter_mut().for_each(|x| *x *= c);
         }
-        self.gq
-            .as_slice()
-            .chunks_exact(m)
-            .zip(&self.minv)
-            .map(|(col, mi)| mi * col.iter().zip(x).map(|(a, b)| a * b).sum::<f64>())
-            .collect()
     }
 
-    /// `S^-1 G D x` (x of length n).
-    fn sgd(&mut self, x: &[f64]) -> Vec<f64> {
-        let mut out = vec![0.0; self.m];
-        self.sgm(x, &mut out);
-        out
+    /// `c a^T S^-1 b`: leaves the increment of `ab`, `c S^-1 b`, in `w.tm[0]` and that of
+    /// `bb`, `c S^-1 a`, in `w.tm[1]`; `Gb` updated.
+    fn adj_s(
+        &mut self,
+        w: &mut Adjoints,
+        cols: &[[Option<usize>; 6]],
+        c: f64,
+        a: &[f64],
+        b: &[f64],
+    ) {
+        let [al, be, ..] = &mut w.tm;
+        let [dal, dbe, ..] = &mut w.tn;
+        self.s_inv_into(a, al);
+        self.s_inv_into(b, be);
+        self.dgt_into(al, dal);
+        self.dgt_into(be, dbe);
+        gbar_add(&mut w.gbar, cols, -c, al, dbe);
+        gbar_add(&mut w.gbar, cols, -c, be, dal);
+        w.tm.swap(0, 1);
+        for t in &mut w.tm[..2] {
+            t.iter_mut().for_each(|x| *x *= c);
+        }
     }
 
-    /// `c a^T Pi b`: returns the increments of `ab` and `bb`, adds to `Gb`.
-    fn adj_pi(&mut self, gb: &mut GBar, c: f64, a: &[f64], b: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let (pa, pb) = (self.pi_times(a), self.pi_times(b));
-        let (sa, sb) = (self.sgd(a), self.sgd(b));
-        gb.add(-c, &sb, &pa);
-        gb.add(-c, &sa, &pb);
-        (
-            pb.iter().map(|x| c * x).collect(),
-            pa.iter().map(|x| c * x).collect(),
-        )
-    }
-
-    /// `c a^T S^-1 b`: returns the increments of `ab` and `bb`, adds to `Gb`.
-    fn adj_s(&mut self, gb: &mut GBar, c: f64, a: &[f64], b: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let (al, be) = (self.s_inv(a), self.s_inv(b));
-        let (dal, dbe) = (self.dgt(&al), self.dgt(&be));
-        gb.add(-c, &al, &dbe);
-        gb.add(-c, &be, &dal);
-        (
-            be.iter().map(|x| c * x).collect(),
-            al.iter().map(|x| c * x).collect(),
-        )
-    }
-
-    /// `y = -D G^T z` with `z = S^-1 x`: the adjoint `xb` from `yb`, adds to `Gb`.
-    fn adj_neg_e(&mut self, gb: &mut GBar, z: &[f64], yb: &[f64]) -> Vec<f64> {
-        let dyb: Vec<f64> = yb.iter().zip(&self.minv).map(|(y, d)| d * y).collect();
-        gb.add(-1.0, z, &dyb);
-        let a: Vec<f64> = self.sgd(yb).iter().map(|x| -x).collect();
-        let (dz, da) = (self.dgt(z), self.dgt(&a));
-        gb.add(-1.0, &a, &dz);
-        gb.add(-1.0, z, &da);
-        a
+    /// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
+    /// adjoint `yb`; `Gb` updated.
+    fn adj_neg_e(&mut self, w: &mut Adjoints, cols: &[[Option<usize>; 6]], z: &[f64], yb: &[f64]) {
+        let [dyb, dz, da, ..] = &mut w.tn;
+        for ((d, y), mi) in dyb.iter_mut().zip(yb).zip(&self.minv) {
+            *d = mi * y;
+        }
+        gbar_add(&mut w.gbar, cols, -1.0, z, dyb);
+        let a = &mut w.tm[0];
+        self.sgm(yb, a);
+        a.iter_mut().for_each(|x| *x = -*x);
+        self.dgt_into(z, dz);
+        self.dgt_into(a, da);
+        gbar_add(&mut w.gbar, cols, -1.0, a, dz);
+        gbar_add(&mut w.gbar, cols, -1.0, z, da);
     }
 
     /// The value of `e4(q, v)` ([`Preadjustment::modified_term_s2`]) and its exact gradients
     /// `de4/dq` into `gq` and `de4/dv` into `gv` (both length n, overwritten), by one forward
-    /// evaluation and a reverse pass (module doc). Allocates.
+    /// evaluation and a reverse pass (module doc). Allocates its workspace on first use only.
     pub fn modified_gradients_s2(
         &mut self,
         sys: &System,
@@ -166,295 +122,368 @@ impl Preadjustment {
         gv: &mut [f64],
     ) -> Result<f64, SolveError> {
         self.check_v(v)?;
-        let (n, m) = (self.n, self.m);
         for (what, got) in [("de4/dq", gq.len()), ("de4/dv", gv.len())] {
-            if got != n {
+            if got != self.n {
                 return Err(SolveError::Dimension {
                     what,
-                    expected: n,
+                    expected: self.n,
                     got,
                 });
             }
         }
-        let f = self.e4_forward(sys, q, v)?;
-        let c: Vec<f64> = E4_TERMS.iter().map(|t| t.1).collect();
-        let e4 = f.terms().iter().zip(&c).map(|(t, c)| t * c).sum();
+        let mut work = self.e4_work(sys);
+        let res = self.e4_forward(sys, q, v, &mut work.f);
+        let out = res.map(|()| self.e4_reverse(sys, q, v, &mut work, gq, gv));
+        self.e4 = Some(work);
+        out
+    }
+
+    /// The reverse pass after `e4_forward` at the same `(q, v)`; returns `e4`.
+    fn e4_reverse(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        work: &mut E4Work,
+        gq: &mut [f64],
+        gv: &mut [f64],
+    ) -> f64 {
+        let m = self.m;
+        let E4Work { f, b: w, cols } = work;
+        let cols = cols.as_slice();
+        let terms = f.terms();
+        let c: [f64; 23] = std::array::from_fn(|i| E4_TERMS[i].1);
+        let e4 = terms.iter().zip(&c).map(|(t, c)| t * c).sum();
         gq.fill(0.0);
         gv.fill(0.0);
-        let cols = local_columns(sys);
-        let mut gb = GBar {
-            cols: &cols,
-            gbar: vec![[0.0; 6]; m],
-        };
-        let zn = || vec![0.0; n];
-        let zm = || vec![0.0; m];
-        let (mut ub, mut nnb, mut k2b, mut k3b, mut gradb) = (zn(), zn(), zn(), zn(), zn());
-        let (mut hvb, mut hub, mut hnb) = (zn(), zn(), zn());
-        let (mut hmu_vb, mut hmu_ub, mut hsig_vb, mut hsig_ub) = (zn(), zn(), zn(), zn());
-        let (mut mu0b, mut sigb, mut betab, mut kap3b, mut kap3ub, mut kap4b) =
-            (zm(), zm(), zm(), zm(), zm(), zm());
-        let pa = || PassAdj::new(m);
-        let (mut a_dv, mut a_du, mut a_dn) = (pa(), pa(), pa());
-        let (mut a_dupv, mut a_dumv, mut a_dnpv, mut a_dnmv) = (pa(), pa(), pa(), pa());
-        let (mut a_dnpu, mut a_dnmu) = (pa(), pa());
-        let (mut a_dk2p, mut a_dk2m, mut a_dk3p, mut a_dk3m) = (pa(), pa(), pa(), pa());
+        w.clear();
 
         // 1. the terms
-        let (x, y) = self.adj_pi(&mut gb, c[0], &f.hsig_v, &f.hmu_v);
-        axpy(&mut hsig_vb, 1.0, &x);
-        axpy(&mut hmu_vb, 1.0, &y);
-        let (x, y) = self.adj_pi(&mut gb, c[1], &f.hmu_v, &f.hmu_v);
-        axpy(&mut hmu_vb, 1.0, &x);
-        axpy(&mut hmu_vb, 1.0, &y);
-        axpy(&mut ub, c[2], &f.hmu_u);
-        axpy(&mut hmu_ub, c[2], &f.u);
-        let (x, y) = self.adj_pi(&mut gb, c[3], &f.hmu_v, &f.hv);
-        axpy(&mut hmu_vb, 1.0, &x);
-        axpy(&mut hvb, 1.0, &y);
-        let (x, y) = self.adj_s(&mut gb, c[4], &f.beta, &f.beta);
-        axpy(&mut betab, 1.0, &x);
-        axpy(&mut betab, 1.0, &y);
-        axpy(&mut ub, c[5], &f.hsig_u);
-        axpy(&mut hsig_ub, c[5], &f.u);
-        let (x, y) = self.adj_s(&mut gb, c[6], &f.kap3, &f.beta);
-        axpy(&mut kap3b, 1.0, &x);
-        axpy(&mut betab, 1.0, &y);
-        axpy(&mut hvb, c[7], &f.k2);
-        axpy(&mut k2b, c[7], &f.hv);
-        axpy(&mut mu0b, c[8], &f.kap3u);
-        axpy(&mut kap3ub, c[8], &f.mu0);
-        axpy(&mut sigb, c[9], &f.kap3u);
-        axpy(&mut kap3ub, c[9], &f.sig);
-        axpy(&mut mu0b, c[10], &f.kap4);
-        axpy(&mut kap4b, c[10], &f.mu0);
-        axpy(&mut hub, c[11], &f.nn);
-        axpy(&mut nnb, c[11], &f.hu);
-        axpy(&mut ub, c[12], &f.hu);
-        axpy(&mut hub, c[12], &f.u);
+        self.adj_pi(w, cols, c[0], &f.hsig_v, &f.hmu_v);
+        axpy(&mut w.hsig_vb, 1.0, &w.tn[0]);
+        axpy(&mut w.hmu_vb, 1.0, &w.tn[1]);
+        self.adj_pi(w, cols, c[1], &f.hmu_v, &f.hmu_v);
+        axpy(&mut w.hmu_vb, 1.0, &w.tn[0]);
+        axpy(&mut w.hmu_vb, 1.0, &w.tn[1]);
+        axpy(&mut w.ub, c[2], &f.hmu_u);
+        axpy(&mut w.hmu_ub, c[2], &f.u);
+        self.adj_pi(w, cols, c[3], &f.hmu_v, &f.hv);
+        axpy(&mut w.hmu_vb, 1.0, &w.tn[0]);
+        axpy(&mut w.hvb, 1.0, &w.tn[1]);
+        self.adj_s(w, cols, c[4], &f.beta, &f.beta);
+        axpy(&mut w.betab, 1.0, &w.tm[0]);
+        axpy(&mut w.betab, 1.0, &w.tm[1]);
+        axpy(&mut w.ub, c[5], &f.hsig_u);
+        axpy(&mut w.hsig_ub, c[5], &f.u);
+        self.adj_s(w, cols, c[6], &f.kap3, &f.beta);
+        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
+        axpy(&mut w.betab, 1.0, &w.tm[1]);
+        axpy(&mut w.hvb, c[7], &f.k2);
+        axpy(&mut w.k2b, c[7], &f.hv);
+        axpy(&mut w.mu0b, c[8], &f.kap3u);
+        axpy(&mut w.kap3ub, c[8], &f.mu0);
+        axpy(&mut w.sigb, c[9], &f.kap3u);
+        axpy(&mut w.kap3ub, c[9], &f.sig);
+        axpy(&mut w.mu0b, c[10], &f.kap4);
+        axpy(&mut w.kap4b, c[10], &f.mu0);
+        axpy(&mut w.hub, c[11], &f.nn);
+        axpy(&mut w.nnb, c[11], &f.hu);
+        axpy(&mut w.ub, c[12], &f.hu);
+        axpy(&mut w.hub, c[12], &f.u);
         // D^3 V(u, v, v) = (D^3 V(u + v) + D^3 V(u - v) - 2 D^3 V(u)) / 6
-        a_dupv.pot[1] += c[13] / 6.0;
-        a_dumv.pot[1] += c[13] / 6.0;
-        a_du.pot[1] -= c[13] / 3.0;
-        axpy(&mut nnb, c[14], &f.hn);
-        axpy(&mut hnb, c[14], &f.nn);
-        let (x, y) = self.adj_pi(&mut gb, c[15], &f.hv, &f.hsig_v);
-        axpy(&mut hvb, 1.0, &x);
-        axpy(&mut hsig_vb, 1.0, &y);
-        axpy(&mut hvb, c[16], &f.k3);
-        axpy(&mut k3b, c[16], &f.hv);
-        a_dnpv.pot[1] += c[17] / 6.0;
-        a_dnmv.pot[1] += c[17] / 6.0;
-        a_dn.pot[1] -= c[17] / 3.0;
-        let (x, y) = self.adj_pi(&mut gb, c[18], &f.hv, &f.hv);
-        axpy(&mut hvb, 1.0, &x);
-        axpy(&mut hvb, 1.0, &y);
-        a_dv.pot[2] += c[19];
-        let (x, y) = self.adj_pi(&mut gb, c[20], &f.hsig_v, &f.hsig_v);
-        axpy(&mut hsig_vb, 1.0, &x);
-        axpy(&mut hsig_vb, 1.0, &y);
-        axpy(&mut sigb, c[21], &f.kap4);
-        axpy(&mut kap4b, c[21], &f.sig);
-        let (x, y) = self.adj_s(&mut gb, c[22], &f.kap3, &f.kap3);
-        axpy(&mut kap3b, 1.0, &x);
-        axpy(&mut kap3b, 1.0, &y);
+        w.pp[DUPV][1] += c[13] / 6.0;
+        w.pp[DUMV][1] += c[13] / 6.0;
+        w.pp[DU][1] -= c[13] / 3.0;
+        axpy(&mut w.nnb, c[14], &f.hn);
+        axpy(&mut w.hnb, c[14], &f.nn);
+        self.adj_pi(w, cols, c[15], &f.hv, &f.hsig_v);
+        axpy(&mut w.hvb, 1.0, &w.tn[0]);
+        axpy(&mut w.hsig_vb, 1.0, &w.tn[1]);
+        axpy(&mut w.hvb, c[16], &f.k3);
+        axpy(&mut w.k3b, c[16], &f.hv);
+        w.pp[DNPV][1] += c[17] / 6.0;
+        w.pp[DNMV][1] += c[17] / 6.0;
+        w.pp[DN][1] -= c[17] / 3.0;
+        self.adj_pi(w, cols, c[18], &f.hv, &f.hv);
+        axpy(&mut w.hvb, 1.0, &w.tn[0]);
+        axpy(&mut w.hvb, 1.0, &w.tn[1]);
+        w.pp[DV][2] += c[19];
+        self.adj_pi(w, cols, c[20], &f.hsig_v, &f.hsig_v);
+        axpy(&mut w.hsig_vb, 1.0, &w.tn[0]);
+        axpy(&mut w.hsig_vb, 1.0, &w.tn[1]);
+        axpy(&mut w.sigb, c[21], &f.kap4);
+        axpy(&mut w.kap4b, c[21], &f.sig);
+        self.adj_s(w, cols, c[22], &f.kap3, &f.kap3);
+        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
+        axpy(&mut w.kap3b, 1.0, &w.tm[1]);
 
         // 2. the Hessian-vector products
-        let u = f.u.clone();
-        let nn = f.nn.clone();
+        let zero = f.zero_m.as_slice();
+        let sc = &mut w.tn[2..8];
+        let (sig, mu0) = (f.sig.as_slice(), f.mu0.as_slice());
+        let (rv, ru) = (f.rhv_v.as_slice(), f.rhv_u.as_slice());
         hvp_adj(
             sys,
             q,
-            &u,
-            0.0,
-            Some((&f.sig, &mut sigb)),
-            &hsig_ub,
-            &mut ub,
+            &f.u,
+            (0.0, sig),
+            Some(WeightAdjoint {
+                rows: ru,
+                wb: &mut w.sigb,
+                cols,
+            }),
+            &w.hsig_ub,
+            &mut w.ub,
             gq,
+            sc,
         );
-        hvp_adj(sys, q, v, 0.0, Some((&f.sig, &mut sigb)), &hsig_vb, gv, gq);
         hvp_adj(
             sys,
             q,
-            &u,
-            0.0,
-            Some((&f.mu0, &mut mu0b)),
-            &hmu_ub,
-            &mut ub,
+            v,
+            (0.0, sig),
+            Some(WeightAdjoint {
+                rows: rv,
+                wb: &mut w.sigb,
+                cols,
+            }),
+            &w.hsig_vb,
+            gv,
             gq,
+            sc,
         );
-        hvp_adj(sys, q, v, 0.0, Some((&f.mu0, &mut mu0b)), &hmu_vb, gv, gq);
-        hvp_adj(sys, q, &nn, 1.0, None, &hnb, &mut nnb, gq);
-        hvp_adj(sys, q, &u, 1.0, None, &hub, &mut ub, gq);
-        hvp_adj(sys, q, v, 1.0, None, &hvb, gv, gq);
+        hvp_adj(
+            sys,
+            q,
+            &f.u,
+            (0.0, mu0),
+            Some(WeightAdjoint {
+                rows: ru,
+                wb: &mut w.mu0b,
+                cols,
+            }),
+            &w.hmu_ub,
+            &mut w.ub,
+            gq,
+            sc,
+        );
+        hvp_adj(
+            sys,
+            q,
+            v,
+            (0.0, mu0),
+            Some(WeightAdjoint {
+                rows: rv,
+                wb: &mut w.mu0b,
+                cols,
+            }),
+            &w.hmu_vb,
+            gv,
+            gq,
+            sc,
+        );
+        hvp_adj(sys, q, &f.nn, (1.0, zero), None, &w.hnb, &mut w.nnb, gq, sc);
+        hvp_adj(sys, q, &f.u, (1.0, zero), None, &w.hub, &mut w.ub, gq, sc);
+        hvp_adj(sys, q, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
 
         // 3. kappa4 = D^4 Phi(v^4) + 6 vvn + 3 D^2 Phi(n, n) + 4 h_k3v,
         //    kappa3u = vvu + 2 h_k2v + h_nu, and the polarisations behind them
         for r in 0..m {
-            let (k4, k3u) = (kap4b[r], kap3ub[r]);
-            a_dv.rows[r][2] += k4;
-            a_dn.rows[r][0] += 3.0 * k4;
+            let (k4, k3u) = (w.kap4b[r], w.kap3ub[r]);
+            w.pr[DV][r][2] += k4;
+            w.pr[DN][r][0] += 3.0 * k4;
             // vvn = (D^3(n + v) + D^3(n - v) - 2 D^3(n)) / 6, weight 6 kappa4b
-            a_dnpv.rows[r][1] += k4;
-            a_dnmv.rows[r][1] += k4;
-            a_dn.rows[r][1] -= 2.0 * k4;
+            w.pr[DNPV][r][1] += k4;
+            w.pr[DNMV][r][1] += k4;
+            w.pr[DN][r][1] -= 2.0 * k4;
             // h_k3v = (D^2(k3 + v) - D^2(k3 - v)) / 4, weight 4 kappa4b
-            a_dk3p.rows[r][0] += k4;
-            a_dk3m.rows[r][0] -= k4;
+            w.pr[DK3P][r][0] += k4;
+            w.pr[DK3M][r][0] -= k4;
             // vvu likewise, weight kappa3ub
-            a_dupv.rows[r][1] += k3u / 6.0;
-            a_dumv.rows[r][1] += k3u / 6.0;
-            a_du.rows[r][1] -= k3u / 3.0;
+            w.pr[DUPV][r][1] += k3u / 6.0;
+            w.pr[DUMV][r][1] += k3u / 6.0;
+            w.pr[DU][r][1] -= k3u / 3.0;
             // h_k2v, weight 2 kappa3ub; h_nu, weight kappa3ub
-            a_dk2p.rows[r][0] += 0.5 * k3u;
-            a_dk2m.rows[r][0] -= 0.5 * k3u;
-            a_dnpu.rows[r][0] += 0.25 * k3u;
-            a_dnmu.rows[r][0] -= 0.25 * k3u;
+            w.pr[DK2P][r][0] += 0.5 * k3u;
+            w.pr[DK2M][r][0] -= 0.5 * k3u;
+            w.pr[DNPU][r][0] += 0.25 * k3u;
+            w.pr[DNMU][r][0] -= 0.25 * k3u;
         }
 
         // 4. the passes along k3 +- v and k2 +- v
-        let mut wb = zn();
-        for (dir, adj, sign) in [(&f.k3, &a_dk3p, 1.0), (&f.k3, &a_dk3m, -1.0)] {
-            pass_adj(sys, q, &comb(dir, 1.0, v, sign), adj, gq, &mut wb);
-            axpy(&mut k3b, 1.0, &wb);
-            axpy(gv, sign, &wb);
+        let [dir, wb, ..] = &mut w.tn;
+        for (k, sign) in [(DK3P, 1.0), (DK3M, -1.0)] {
+            comb_into(&f.k3, 1.0, v, sign, dir);
+            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            axpy(&mut w.k3b, 1.0, wb);
+            axpy(gv, sign, wb);
         }
-        for (dir, adj, sign) in [(&f.k2, &a_dk2p, 1.0), (&f.k2, &a_dk2m, -1.0)] {
-            pass_adj(sys, q, &comb(dir, 1.0, v, sign), adj, gq, &mut wb);
-            axpy(&mut k2b, 1.0, &wb);
-            axpy(gv, sign, &wb);
+        for (k, sign) in [(DK2P, 1.0), (DK2M, -1.0)] {
+            comb_into(&f.k2, 1.0, v, sign, dir);
+            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            axpy(&mut w.k2b, 1.0, wb);
+            axpy(gv, sign, wb);
         }
 
         // 5. k3 = -D G^T S^-1 kappa3, kappa3 = D^3 Phi(v^3) + 3 h_nv
-        let x = self.adj_neg_e(&mut gb, &f.s_kap3, &k3b);
-        axpy(&mut kap3b, 1.0, &x);
+        let k3b = std::mem::take(&mut w.k3b);
+        self.adj_neg_e(w, cols, &f.s_kap3, &k3b);
+        w.k3b = k3b;
+        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
         for r in 0..m {
-            a_dv.rows[r][1] += kap3b[r];
-            a_dnpv.rows[r][0] += 0.75 * kap3b[r];
-            a_dnmv.rows[r][0] -= 0.75 * kap3b[r];
+            w.pr[DV][r][1] += w.kap3b[r];
+            w.pr[DNPV][r][0] += 0.75 * w.kap3b[r];
+            w.pr[DNMV][r][0] -= 0.75 * w.kap3b[r];
         }
         // 6. k2 = -D G^T S^-1 beta, beta = (D^2(u + v) - D^2(u - v)) / 4
-        let x = self.adj_neg_e(&mut gb, &f.s_beta, &k2b);
-        axpy(&mut betab, 1.0, &x);
+        let k2b = std::mem::take(&mut w.k2b);
+        self.adj_neg_e(w, cols, &f.s_beta, &k2b);
+        w.k2b = k2b;
+        axpy(&mut w.betab, 1.0, &w.tm[0]);
         for r in 0..m {
-            a_dupv.rows[r][0] += 0.25 * betab[r];
-            a_dumv.rows[r][0] -= 0.25 * betab[r];
+            w.pr[DUPV][r][0] += 0.25 * w.betab[r];
+            w.pr[DUMV][r][0] -= 0.25 * w.betab[r];
         }
 
         // 7. the passes along n +- u, n +- v, u +- v, u and n
-        for (a, b, adj, sign) in [(&nn, &u, &a_dnpu, 1.0), (&nn, &u, &a_dnmu, -1.0)] {
-            pass_adj(sys, q, &comb(a, 1.0, b, sign), adj, gq, &mut wb);
-            axpy(&mut nnb, 1.0, &wb);
-            axpy(&mut ub, sign, &wb);
+        let [dir, wb, ..] = &mut w.tn;
+        for (k, sign) in [(DNPU, 1.0), (DNMU, -1.0)] {
+            comb_into(&f.nn, 1.0, &f.u, sign, dir);
+            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            axpy(&mut w.nnb, 1.0, wb);
+            axpy(&mut w.ub, sign, wb);
         }
-        for (adj, sign) in [(&a_dnpv, 1.0), (&a_dnmv, -1.0)] {
-            pass_adj(sys, q, &comb(&nn, 1.0, v, sign), adj, gq, &mut wb);
-            axpy(&mut nnb, 1.0, &wb);
-            axpy(gv, sign, &wb);
+        for (k, sign) in [(DNPV, 1.0), (DNMV, -1.0)] {
+            comb_into(&f.nn, 1.0, v, sign, dir);
+            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            axpy(&mut w.nnb, 1.0, wb);
+            axpy(gv, sign, wb);
         }
-        for (adj, sign) in [(&a_dupv, 1.0), (&a_dumv, -1.0)] {
-            pass_adj(sys, q, &comb(&u, 1.0, v, sign), adj, gq, &mut wb);
-            axpy(&mut ub, 1.0, &wb);
-            axpy(gv, sign, &wb);
+        for (k, sign) in [(DUPV, 1.0), (DUMV, -1.0)] {
+            comb_into(&f.u, 1.0, v, sign, dir);
+            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            axpy(&mut w.ub, 1.0, wb);
+            axpy(gv, sign, wb);
         }
-        pass_adj(sys, q, &u, &a_du, gq, &mut wb);
-        axpy(&mut ub, 1.0, &wb);
-        pass_adj(sys, q, &nn, &a_dn, gq, &mut wb);
-        axpy(&mut nnb, 1.0, &wb);
+        pass_adj(sys, q, &f.u, &w.pr[DU], w.pp[DU], gq, wb);
+        axpy(&mut w.ub, 1.0, wb);
+        pass_adj(sys, q, &f.nn, &w.pr[DN], w.pp[DN], gq, wb);
+        axpy(&mut w.nnb, 1.0, wb);
 
         // 8. n = -D G^T sigma, sigma = S^-1 gamma, gamma = D^2 Phi(v, v)
-        let gsig: Vec<f64> = {
-            let mut t = vec![0.0; m];
-            let dn: Vec<f64> = nnb.iter().zip(&self.minv).map(|(x, d)| d * x).collect();
-            super::gm_times(&self.gq, &dn, &mut t);
-            gb.add(-1.0, &f.sig, &dn);
-            t
-        };
-        axpy(&mut sigb, -1.0, &gsig);
-        let a = self.s_inv(&sigb);
-        let (dsig, da) = (self.dgt(&f.sig), self.dgt(&a));
-        gb.add(-1.0, &a, &dsig);
-        gb.add(-1.0, &f.sig, &da);
-        for r in 0..m {
-            a_dv.rows[r][0] += a[r];
+        {
+            let [dn, dsig, da, ..] = &mut w.tn;
+            let [t, a, ..] = &mut w.tm;
+            for ((d, x), mi) in dn.iter_mut().zip(&w.nnb).zip(&self.minv) {
+                *d = mi * x;
+            }
+            gm_times(&self.gq, dn, t);
+            gbar_add(&mut w.gbar, cols, -1.0, &f.sig, dn);
+            axpy(&mut w.sigb, -1.0, t);
+            self.s_inv_into(&w.sigb, a);
+            self.dgt_into(&f.sig, dsig);
+            self.dgt_into(a, da);
+            gbar_add(&mut w.gbar, cols, -1.0, a, dsig);
+            gbar_add(&mut w.gbar, cols, -1.0, &f.sig, da);
+            for r in 0..m {
+                w.pr[DV][r][0] += a[r];
+            }
         }
-        pass_adj(sys, q, v, &a_dv, gq, &mut wb);
-        axpy(gv, 1.0, &wb);
+        let [wb, ..] = &mut w.tn;
+        pass_adj(sys, q, v, &w.pr[DV], w.pp[DV], gq, wb);
+        axpy(gv, 1.0, wb);
 
         // 9. u = -D g + D G^T mu0, mu0 = S^-1 G D g, g = grad V
-        let dub: Vec<f64> = ub.iter().zip(&self.minv).map(|(x, d)| d * x).collect();
         {
-            let mut t = vec![0.0; m];
-            super::gm_times(&self.gq, &dub, &mut t);
-            axpy(&mut mu0b, 1.0, &t);
+            let [dub, da, dg, dmu, t, ..] = &mut w.tn;
+            let [s, a, ..] = &mut w.tm;
+            for ((d, x), mi) in dub.iter_mut().zip(&w.ub).zip(&self.minv) {
+                *d = mi * x;
+            }
+            gm_times(&self.gq, dub, s);
+            axpy(&mut w.mu0b, 1.0, s);
+            axpy(&mut w.gradb, -1.0, dub);
+            gbar_add(&mut w.gbar, cols, 1.0, &f.mu0, dub);
+            self.s_inv_into(&w.mu0b, a);
+            self.dgt_into(a, da);
+            axpy(&mut w.gradb, 1.0, da);
+            for ((d, x), mi) in dg.iter_mut().zip(&self.g).zip(&self.minv) {
+                *d = mi * x;
+            }
+            gbar_add(&mut w.gbar, cols, 1.0, a, dg);
+            self.dgt_into(&f.mu0, dmu);
+            gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
+            gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
+            sys.lagrangian_hessian_vector(q, &w.gradb, 1.0, zero, t);
+            axpy(gq, 1.0, t);
         }
-        axpy(&mut gradb, -1.0, &dub);
-        gb.add(1.0, &f.mu0, &dub);
-        let a = self.s_inv(&mu0b);
-        let da = self.dgt(&a);
-        axpy(&mut gradb, 1.0, &da);
-        let dg: Vec<f64> = self.g.iter().zip(&self.minv).map(|(x, d)| d * x).collect();
-        gb.add(1.0, &a, &dg);
-        let dmu = self.dgt(&f.mu0);
-        gb.add(-1.0, &a, &dmu);
-        gb.add(-1.0, &f.mu0, &da);
-        let mut t = zn();
-        sys.lagrangian_hessian_vector(q, &gradb, 1.0, &zm(), &mut t);
-        axpy(gq, 1.0, &t);
 
         // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r
-        sys.add_constraint_hessian_rows(q, &gb.gbar, gq);
-        Ok(e4)
+        sys.add_constraint_hessian_rows(q, &w.gbar, gq);
+        e4
     }
 }
 
-/// The adjoint of `y = H x`, `H = pot Hess V + sum_r w_r Hess Phi_r` (`w` with its adjoint,
-/// or none), for the adjoint `yb`: `xb += H yb`, `wb_r += yb^T Hess Phi_r x`,
-/// `qb += D^3 L(x, yb, .)`.
+/// The adjoint of the weights of a Hessian-vector product: `rows[r]` is the element-local
+/// `Hess Phi_r x` (columns `cols`), `wb` the weights' adjoint.
+struct WeightAdjoint<'a> {
+    rows: &'a [[f64; 6]],
+    wb: &'a mut [f64],
+    cols: &'a [[Option<usize>; 6]],
+}
+
+/// The adjoint of `y = H x`, `H = p Hess V + sum_r w_r Hess Phi_r` (`(p, w)`), for the adjoint
+/// `yb`: `xb += H yb`, `qb += D^3 L(x, yb, .)` and, with a [`WeightAdjoint`],
+/// `wb_r += yb^T Hess Phi_r x`. Scratch: six n-vectors.
 #[allow(clippy::too_many_arguments)]
 fn hvp_adj(
     sys: &System,
     q: &[f64],
     x: &[f64],
-    pot: f64,
-    w: Option<(&Vec<f64>, &mut Vec<f64>)>,
+    (pot, wts): (f64, &[f64]),
+    wadj: Option<WeightAdjoint>,
     yb: &[f64],
     xb: &mut [f64],
     qb: &mut [f64],
+    scratch: &mut [Vec<f64>],
 ) {
     if yb.iter().all(|&y| y == 0.0) {
         return;
     }
-    let n = x.len();
-    let m = sys.n_constraints();
-    let (xp, xm) = (comb(x, 1.0, yb, 1.0), comb(x, 1.0, yb, -1.0));
-    let zero = vec![0.0; m];
-    let (wv, wb) = match w {
-        Some((wv, wb)) => (wv.as_slice(), Some(wb)),
-        None => (zero.as_slice(), None),
+    let [xp, xm, hp, hm, dp, dm] = scratch else {
+        return;
     };
-    let (mut hp, mut hm, mut dp, mut dm) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    sys.lagrangian_third(q, &xp, pot, wv, &mut hp, &mut dp);
-    sys.lagrangian_third(q, &xm, pot, wv, &mut hm, &mut dm);
-    for i in 0..n {
+    comb_into(x, 1.0, yb, 1.0, xp);
+    comb_into(x, 1.0, yb, -1.0, xm);
+    sys.lagrangian_third(q, xp, pot, wts, hp, dp);
+    sys.lagrangian_third(q, xm, pot, wts, hm, dm);
+    for i in 0..x.len() {
         xb[i] += 0.5 * (hp[i] - hm[i]);
         qb[i] += 0.25 * (dp[i] - dm[i]);
     }
-    if let Some(wb) = wb {
-        let (p, mm) = (Dirs::along(sys, q, &xp), Dirs::along(sys, q, &xm));
-        for r in 0..m {
-            wb[r] += 0.25 * (p.rows[r][0] - mm.rows[r][0]);
+    if let Some(WeightAdjoint { rows, wb, cols }) = wadj {
+        for ((w, row), c) in wb.iter_mut().zip(rows).zip(cols) {
+            let y = local(c, yb);
+            *w += row.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
         }
     }
 }
 
-/// The adjoint of a directional pass along `w`: adds its `q`-gradient to `qb` and writes its
-/// `w`-gradient into `wb` (overwritten).
-fn pass_adj(sys: &System, q: &[f64], w: &[f64], a: &PassAdj, qb: &mut [f64], wb: &mut [f64]) {
+/// The adjoint of a directional pass along `w` with the weights `rows` and `pot`: adds its
+/// `q`-gradient to `qb` and writes its `w`-gradient into `wb` (overwritten).
+fn pass_adj(
+    sys: &System,
+    q: &[f64],
+    w: &[f64],
+    rows: &[[f64; 3]],
+    pot: [f64; 3],
+    qb: &mut [f64],
+    wb: &mut [f64],
+) {
     wb.fill(0.0);
-    sys.constraint_directional_grad(q, w, &a.rows, qb, wb);
-    sys.potential_directional_grad(q, w, a.pot, qb, wb);
+    sys.constraint_directional_grad(q, w, rows, qb, wb);
+    sys.potential_directional_grad(q, w, pot, qb, wb);
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,170 @@
+//! The workspace of the `s = 2` modified-Lagrangian term `e4` and its gradients
+//! (`modified2.rs`, `modified2_grad.rs`): allocated on first use, reused by every evaluation.
+
+use super::modified2::{E4Forward, N_PASSES};
+use super::Preadjustment;
+use mbd_model::System;
+
+/// The workspace of `e4` and its gradients: the forward intermediates, the adjoints and the
+/// element-local columns of the constraint rows.
+#[derive(Debug)]
+pub(crate) struct E4Work {
+    pub(super) f: E4Forward,
+    pub(super) b: Adjoints,
+    /// The element-local column indices of each constraint row (`None`: ground).
+    pub(super) cols: Vec<[Option<usize>; 6]>,
+}
+
+/// Adjoints (suffix `b`) of the intermediates, of the passes, of `G`, and scratch.
+#[derive(Debug)]
+pub(super) struct Adjoints {
+    pub(super) ub: Vec<f64>,
+    pub(super) nnb: Vec<f64>,
+    pub(super) k2b: Vec<f64>,
+    pub(super) k3b: Vec<f64>,
+    pub(super) gradb: Vec<f64>,
+    pub(super) hvb: Vec<f64>,
+    pub(super) hub: Vec<f64>,
+    pub(super) hnb: Vec<f64>,
+    pub(super) hmu_vb: Vec<f64>,
+    pub(super) hmu_ub: Vec<f64>,
+    pub(super) hsig_vb: Vec<f64>,
+    pub(super) hsig_ub: Vec<f64>,
+    pub(super) mu0b: Vec<f64>,
+    pub(super) sigb: Vec<f64>,
+    pub(super) betab: Vec<f64>,
+    pub(super) kap3b: Vec<f64>,
+    pub(super) kap3ub: Vec<f64>,
+    pub(super) kap4b: Vec<f64>,
+    /// Adjoint weights of each pass's rows `[D^2, D^3, D^4]` and of its potential's.
+    pub(super) pr: Vec<Vec<[f64; 3]>>,
+    pub(super) pp: [[f64; 3]; N_PASSES],
+    /// `Gb` in element-local form.
+    pub(super) gbar: Vec<[f64; 6]>,
+    /// Scratch: n-vectors and m-vectors.
+    pub(super) tn: [Vec<f64>; 8],
+    pub(super) tm: [Vec<f64>; 4],
+}
+
+impl Adjoints {
+    pub(super) fn new(n: usize, m: usize) -> Self {
+        let (zn, zm) = (|| vec![0.0; n], || vec![0.0; m]);
+        Adjoints {
+            ub: zn(),
+            nnb: zn(),
+            k2b: zn(),
+            k3b: zn(),
+            gradb: zn(),
+            hvb: zn(),
+            hub: zn(),
+            hnb: zn(),
+            hmu_vb: zn(),
+            hmu_ub: zn(),
+            hsig_vb: zn(),
+            hsig_ub: zn(),
+            mu0b: zm(),
+            sigb: zm(),
+            betab: zm(),
+            kap3b: zm(),
+            kap3ub: zm(),
+            kap4b: zm(),
+            pr: (0..N_PASSES).map(|_| vec![[0.0; 3]; m]).collect(),
+            pp: [[0.0; 3]; N_PASSES],
+            gbar: vec![[0.0; 6]; m],
+            tn: std::array::from_fn(|_| zn()),
+            tm: std::array::from_fn(|_| zm()),
+        }
+    }
+
+    pub(super) fn clear(&mut self) {
+        for x in [
+            &mut self.ub,
+            &mut self.nnb,
+            &mut self.k2b,
+            &mut self.k3b,
+            &mut self.gradb,
+            &mut self.hvb,
+            &mut self.hub,
+            &mut self.hnb,
+            &mut self.hmu_vb,
+            &mut self.hmu_ub,
+            &mut self.hsig_vb,
+            &mut self.hsig_ub,
+            &mut self.mu0b,
+            &mut self.sigb,
+            &mut self.betab,
+            &mut self.kap3b,
+            &mut self.kap3ub,
+            &mut self.kap4b,
+        ] {
+            x.fill(0.0);
+        }
+        for p in &mut self.pr {
+            p.fill([0.0; 3]);
+        }
+        self.pp = [[0.0; 3]; N_PASSES];
+        self.gbar.fill([0.0; 6]);
+    }
+}
+
+/// `Gb += c alpha beta^T` in element-local form.
+pub(super) fn gbar_add(
+    gbar: &mut [[f64; 6]],
+    cols: &[[Option<usize>; 6]],
+    c: f64,
+    al: &[f64],
+    be: &[f64],
+) {
+    for ((g, cols), &a) in gbar.iter_mut().zip(cols).zip(al) {
+        if a == 0.0 {
+            continue;
+        }
+        for (gl, col) in g.iter_mut().zip(cols) {
+            if let Some(i) = col {
+                *gl += c * a * be[*i];
+            }
+        }
+    }
+}
+
+/// The element-local vector of constraint row `r` (columns `cols`) of the global `x`.
+pub(super) fn local(cols: &[Option<usize>; 6], x: &[f64]) -> [f64; 6] {
+    std::array::from_fn(|l| cols[l].map_or(0.0, |i| x[i]))
+}
+
+impl E4Work {
+    fn new(sys: &System) -> Self {
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let cols = (0..m)
+            .map(|r| {
+                let (a, b) = sys
+                    .equation_joint(r)
+                    .map_or((None, None), |j| sys.joint_bodies(j));
+                let mut c = [None; 6];
+                for (slot, body) in [(0, a), (3, b)] {
+                    if let Some(i) = body {
+                        for k in 0..3 {
+                            c[slot + k] = Some(3 * i + k);
+                        }
+                    }
+                }
+                c
+            })
+            .collect();
+        E4Work {
+            f: E4Forward::new(n, m),
+            b: Adjoints::new(n, m),
+            cols,
+        }
+    }
+}
+
+impl Preadjustment {
+    /// The `e4` workspace, taken out of `self` (give it back with `self.e4 = Some(..)`).
+    pub(super) fn e4_work(&mut self, sys: &System) -> Box<E4Work> {
+        match self.e4.take() {
+            Some(w) if w.f.u.len() == self.n && w.cols.len() == self.m => w,
+            _ => Box::new(E4Work::new(sys)),
+        }
+    }
+}
