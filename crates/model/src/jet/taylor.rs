@@ -51,6 +51,23 @@ impl Taylor4 {
     fn coefs(&self) -> [f64; TAYLOR_DEGREE + 1] {
         [self.v, self.c[0], self.c[1], self.c[2], self.c[3]]
     }
+    /// `(sin x, cos x)` by the recurrences `k s_k = sum_j j x_j c_(k-j)`,
+    /// `k c_k = -sum_j j x_j s_(k-j)` (the general case of `sin_cos`).
+    pub(crate) fn sin_cos_series(self) -> (Self, Self) {
+        let x = self.coefs();
+        let (mut s, mut c) = ([0.0; TAYLOR_DEGREE + 1], [0.0; TAYLOR_DEGREE + 1]);
+        (s[0], c[0]) = x[0].sin_cos();
+        for k in 1..=TAYLOR_DEGREE {
+            let (mut ds, mut dc) = (0.0, 0.0);
+            for j in 1..=k {
+                ds += j as f64 * x[j] * c[k - j];
+                dc -= j as f64 * x[j] * s[k - j];
+            }
+            s[k] = ds / k as f64;
+            c[k] = dc / k as f64;
+        }
+        (Taylor4::from_coefs(s), Taylor4::from_coefs(c))
+    }
 }
 
 impl Add for Taylor4 {
@@ -114,18 +131,21 @@ impl Scalar for Taylor4 {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         let x = self.coefs();
-        let (mut s, mut c) = ([0.0; TAYLOR_DEGREE + 1], [0.0; TAYLOR_DEGREE + 1]);
-        (s[0], c[0]) = x[0].sin_cos();
-        for k in 1..=TAYLOR_DEGREE {
-            let (mut ds, mut dc) = (0.0, 0.0);
-            for j in 1..=k {
-                ds += j as f64 * x[j] * c[k - j];
-                dc -= j as f64 * x[j] * s[k - j];
+        if x[2..].iter().all(|&a| a == 0.0) {
+            // a variable theta + t w (a body angle): coefficients sin^(k)(theta) w^k / k!
+            let (sn, cs) = x[0].sin_cos();
+            let ds = [sn, cs, -sn, -cs];
+            let dc = [cs, -sn, -cs, sn];
+            let (mut s, mut c) = ([0.0; TAYLOR_DEGREE + 1], [0.0; TAYLOR_DEGREE + 1]);
+            let mut p = 1.0;
+            for k in 0..=TAYLOR_DEGREE {
+                s[k] = ds[k % 4] * p;
+                c[k] = dc[k % 4] * p;
+                p *= x[1] / (k + 1) as f64;
             }
-            s[k] = ds / k as f64;
-            c[k] = dc / k as f64;
+            return (Taylor4::from_coefs(s), Taylor4::from_coefs(c));
         }
-        (Taylor4::from_coefs(s), Taylor4::from_coefs(c))
+        self.sin_cos_series()
     }
     /// `r^2 = x`: `r_k = (x_k - sum_(j=1..k-1) r_j r_(k-j)) / (2 r_0)`.
     #[inline(always)]
@@ -189,6 +209,36 @@ mod tests {
                 (a - b).abs() < 1e-6 * (1.0 + b.abs()),
                 "order {k}: {a} vs {b}"
             );
+        }
+    }
+
+    /// The closed form for a variable `theta + t w` (body angles) against the general
+    /// recurrence, here and in [`super::super::TaylorGrad4`].
+    #[test]
+    fn sin_cos_of_a_variable_matches_the_recurrence() {
+        for (x, w) in [(0.3, 1.7), (-2.1, -0.4), (5.0, 0.0)] {
+            let t = Taylor4::var(x, w);
+            let (a, b) = (t.sin_cos(), t.sin_cos_series());
+            for k in 0..=TAYLOR_DEGREE {
+                assert!((a.0.coef(k) - b.0.coef(k)).abs() < 1e-14, "sin {k}");
+                assert!((a.1.coef(k) - b.1.coef(k)).abs() < 1e-14, "cos {k}");
+            }
+            let g = super::super::TaylorGrad4::var(2, x, w);
+            let (a, b) = (g.sin_cos(), g.sin_cos_series());
+            for k in 0..=TAYLOR_DEGREE {
+                assert!(
+                    (a.0.coef(k) - b.0.coef(k)).abs() < 1e-14,
+                    "grad jet sin {k}"
+                );
+                assert!(
+                    (a.1.coef(k) - b.1.coef(k)).abs() < 1e-14,
+                    "grad jet cos {k}"
+                );
+                for l in 0..6 {
+                    assert!((a.0.g[k][l] - b.0.g[k][l]).abs() < 1e-14, "d sin {k} {l}");
+                    assert!((a.1.g[k][l] - b.1.g[k][l]).abs() < 1e-14, "d cos {k} {l}");
+                }
+            }
         }
     }
 }

@@ -75,6 +75,40 @@ impl TaylorGrad4 {
             g,
         }
     }
+    /// `(sin x, cos x)` by the recurrences `k s_k = sum_j j x_j c_(k-j)`,
+    /// `k c_k = -sum_j j x_j s_(k-j)` in dual arithmetic (the general case of `sin_cos`).
+    pub(crate) fn sin_cos_series(self) -> (Self, Self) {
+        let x = self.coefs();
+        let gx = &self.g;
+        let (mut s, mut c) = ([0.0; DEG + 1], [0.0; DEG + 1]);
+        let (mut gs, mut gc) = ([[0.0; NV]; DEG + 1], [[0.0; NV]; DEG + 1]);
+        (s[0], c[0]) = x[0].sin_cos();
+        for l in 0..NV {
+            gs[0][l] = c[0] * gx[0][l];
+            gc[0][l] = -s[0] * gx[0][l];
+        }
+        for k in 1..=DEG {
+            let (mut ds, mut dc) = (0.0, 0.0);
+            let (mut dgs, mut dgc) = ([0.0; NV], [0.0; NV]);
+            for j in 1..=k {
+                let jx = j as f64 * x[j];
+                ds += jx * c[k - j];
+                dc -= jx * s[k - j];
+                let jf = j as f64;
+                axpby(&mut dgs, jf * c[k - j], &gx[j], jx, &gc[k - j]);
+                axpby(&mut dgc, -jf * s[k - j], &gx[j], -jx, &gs[k - j]);
+            }
+            let inv = 1.0 / k as f64;
+            s[k] = ds * inv;
+            c[k] = dc * inv;
+            gs[k] = dgs.map(|v| v * inv);
+            gc[k] = dgc.map(|v| v * inv);
+        }
+        (
+            TaylorGrad4::from_parts(s, gs),
+            TaylorGrad4::from_parts(c, gc),
+        )
+    }
 }
 
 /// `k!` for `k = 0..=4`.
@@ -170,34 +204,28 @@ impl Scalar for TaylorGrad4 {
     fn sin_cos(self) -> (Self, Self) {
         let x = self.coefs();
         let gx = &self.g;
-        let (mut s, mut c) = ([0.0; DEG + 1], [0.0; DEG + 1]);
-        let (mut gs, mut gc) = ([[0.0; NV]; DEG + 1], [[0.0; NV]; DEG + 1]);
-        (s[0], c[0]) = x[0].sin_cos();
-        for l in 0..NV {
-            gs[0][l] = c[0] * gx[0][l];
-            gc[0][l] = -s[0] * gx[0][l];
-        }
-        for k in 1..=DEG {
-            let (mut ds, mut dc) = (0.0, 0.0);
-            let (mut dgs, mut dgc) = ([0.0; NV], [0.0; NV]);
-            for j in 1..=k {
-                let jx = j as f64 * x[j];
-                ds += jx * c[k - j];
-                dc -= jx * s[k - j];
-                let jf = j as f64;
-                axpby(&mut dgs, jf * c[k - j], &gx[j], jx, &gc[k - j]);
-                axpby(&mut dgc, -jf * s[k - j], &gx[j], -jx, &gs[k - j]);
+        if x[2..].iter().all(|&a| a == 0.0) && gx[1..].iter().flatten().all(|&a| a == 0.0) {
+            // a variable theta + t w (a body angle): sin(theta + t w) has the coefficients
+            // sin^(k)(theta) w^k / k!, whose theta-derivatives are sin^(k+1)(theta) w^k / k!
+            let (sn, cs) = x[0].sin_cos();
+            let ds = [sn, cs, -sn, -cs];
+            let dc = [cs, -sn, -cs, sn];
+            let (mut s, mut c) = ([0.0; DEG + 1], [0.0; DEG + 1]);
+            let (mut gs, mut gc) = ([[0.0; NV]; DEG + 1], [[0.0; NV]; DEG + 1]);
+            let mut p = 1.0;
+            for k in 0..=DEG {
+                s[k] = ds[k % 4] * p;
+                c[k] = dc[k % 4] * p;
+                gs[k] = gx[0].map(|g| g * ds[(k + 1) % 4] * p);
+                gc[k] = gx[0].map(|g| g * dc[(k + 1) % 4] * p);
+                p *= x[1] / (k + 1) as f64;
             }
-            let inv = 1.0 / k as f64;
-            s[k] = ds * inv;
-            c[k] = dc * inv;
-            gs[k] = dgs.map(|v| v * inv);
-            gc[k] = dgc.map(|v| v * inv);
+            return (
+                TaylorGrad4::from_parts(s, gs),
+                TaylorGrad4::from_parts(c, gc),
+            );
         }
-        (
-            TaylorGrad4::from_parts(s, gs),
-            TaylorGrad4::from_parts(c, gc),
-        )
+        self.sin_cos_series()
     }
     /// `r^2 = x`: `r_k = (x_k - sum_(j=1..k-1) r_j r_(k-j)) / (2 r_0)` in dual arithmetic
     /// (`grad r_0 = grad x_0 / (2 r_0)`).

@@ -1,8 +1,8 @@
 //! The `h^4` modified-Lagrangian term `e4(q, v)` of the constrained (2,2) scheme
 //! (`docs/modified-lagrangian.md` section 3: 23 invariant terms, fitted exactly in a graph frame
 //! and checked against the pendulum family and under changes of coordinates and of the
-//! constraint representation). Value only: the (2,2) preadjustment is not wired into the
-//! integrator yet.
+//! constraint representation). The integrator adds `h^5 e4` at the chord midpoint of a (2,2)
+//! step (`PreadjustMode::ModifiedLagrangian`); its exact gradients are in `modified2_grad.rs`.
 //!
 //! With `G = Phi_q`, `S = G M^-1 G^T`, `Pi` the tangent projector, `E = M^-1 G^T S^-1`,
 //! `mu0 = S^-1 G M^-1 grad V`, `u = -Pi grad V`, `gamma_k = Hess Phi_k(v, v)`,
