@@ -13,8 +13,9 @@
 //!   position and velocity level to the Newton tolerance.
 //! * [`SymplecticOptions`]: `s`, `gamma`, the control-point placement [`Nodes`] and the Newton
 //!   settings. `gamma = 0` is the plain scheme bit for bit; [`kappa`] gives `kappa_s`.
-//!   [`PreadjustMode::ModifiedLagrangian`] (s = 1) replaces `W_s` by a parameter-free modified
-//!   Lagrangian with velocity terms (issue 13; `docs/symplectic.md` section 5a).
+//!   [`PreadjustMode::ModifiedLagrangian`] (s = 1 or 2) replaces `W_s` by a parameter-free
+//!   modified Lagrangian with velocity terms: order 4 and 6, symplectic (issue 13;
+//!   `docs/symplectic.md` sections 5a and 5b).
 //! * [`Preadjustment`]: `W_s`, its gradient and the tangential force on any model.
 //! * [`calibrate_gamma`]: `gamma_opt` by the secant method on the averaged signed trajectory
 //!   error `dW(gamma)` against a reference, measured by the caller (paper A's `E|dx|`, `E|dy|`,

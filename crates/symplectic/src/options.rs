@@ -29,9 +29,9 @@ pub enum PreadjustMode {
     /// with `e = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v - 1/8 v^T Hess V v +
     /// 1/24 gamma_c^T S^-1 gamma_c`, evaluated at the chord midpoint of each step
     /// (`docs/symplectic.md` section 5a, derivation in `docs/modified-lagrangian.md`); for
-    /// `s = 2` the `h^4` term `e4` of section 5b (23 invariant terms, gradients by central
-    /// differences: a slow reference implementation). Needs `s <= 2`, `gamma = 0`, a
-    /// conservative model and the dense path.
+    /// `s = 2` the `h^4` term `e4` of section 5b (23 invariant terms, exact gradients by a
+    /// reverse pass; a (2,2) step costs 2.4x to 6x the plain one by instructions, more on small
+    /// models). Needs `s <= 2`, `gamma = 0`, a conservative model and the dense path.
     ModifiedLagrangian,
 }
 

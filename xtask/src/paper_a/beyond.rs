@@ -293,7 +293,7 @@ fn gains(rows: &[DoubleRow], r: &DoubleRow) -> (f64, f64) {
 
 pub(super) fn beyond(ctx: &Ctx) -> Result<Section, String> {
     let mut sec = Section::default();
-    sec.notes.push("The modified-Lagrangian preadjustment (docs/symplectic.md section 5a) integrates L - h^2 L_2, L_2 the h^2 term of the (1,1) scheme's modified Lagrangian (force-squared, velocity-quadratic and constraint-curvature parts): no parameter, and the h^2 phase error cancels at every amplitude, where the paper's W_s (force only) cancels it only in the small-amplitude limit. For s = 2 the h^4 term e4 (23 invariant terms, docs/modified-lagrangian.md section 3, docs/symplectic.md section 5b) is evaluated at the chord midpoint of the end control points, its gradients by fourth-order central differences.".into());
+    sec.notes.push("The modified-Lagrangian preadjustment (docs/symplectic.md section 5a) integrates L - h^2 L_2, L_2 the h^2 term of the (1,1) scheme's modified Lagrangian (force-squared, velocity-quadratic and constraint-curvature parts): no parameter, and the h^2 phase error cancels at every amplitude, where the paper's W_s (force only) cancels it only in the small-amplitude limit. For s = 2 the h^4 term e4 (23 invariant terms, docs/modified-lagrangian.md section 3, docs/symplectic.md section 5b) is evaluated at the chord midpoint of the end control points, its exact gradients by a reverse (adjoint) pass through its intermediates.".into());
     let period_rows = period_study(ctx, &mut sec)?;
     let double_rows = double_pendulum(ctx, &mut sec)?;
     let values = crate::paper_values::get()?;
