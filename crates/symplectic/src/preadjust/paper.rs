@@ -193,6 +193,31 @@ impl Preadjustment {
         Ok(rho)
     }
 
+    /// The block `K` of the coordinates where `A` is not zero (into `kset`; returns `|K|`),
+    /// `Y = L^-1 (G M^-1)_K` (`S = L L^T`; one triangular solve per column, packed into `ky`,
+    /// m x |K|) and `A_KK` (column-major into `ka`), after `prepare` and `ensure_a`.
+    fn k_block(&mut self) -> usize {
+        let (n, m) = (self.n, self.m);
+        self.kset.clear();
+        for (c, col) in self.amat.as_slice().chunks_exact(n).enumerate() {
+            if col.iter().any(|&a| a != 0.0) {
+                self.kset.push(c);
+            }
+        }
+        let k = self.kset.len();
+        for (cj, &c) in self.kset.iter().enumerate() {
+            let y = &mut self.ky[cj * m..(cj + 1) * m];
+            for r in 0..m {
+                y[r] = self.gq[(r, c)] * self.minv[c];
+            }
+            self.chol.forward_in_place(y);
+            for (ri, &r) in self.kset.iter().enumerate() {
+                self.ka[cj * k + ri] = self.amat[(r, c)];
+            }
+        }
+        k
+    }
+
     /// An approximate Hessian of `W_s` for Newton: `A (Pi A)^s` (exact at an equilibrium),
     /// symmetrised, into `out` (overwritten).
     ///
@@ -210,22 +235,8 @@ impl Preadjustment {
         self.prepare(sys, q)?;
         self.ensure_a(sys, q);
         let (n, m) = (self.n, self.m);
-        self.kset.clear();
-        for (c, col) in self.amat.as_slice().chunks_exact(n).enumerate() {
-            if col.iter().any(|&a| a != 0.0) {
-                self.kset.push(c);
-            }
-        }
-        let k = self.kset.len();
-        // Pi_KK = M^-1_KK - Y^T Y with Y = L^-1 (G M^-1)_K (S = L L^T): one triangular solve
-        // per column of K, its columns packed into ky (m x k; free until the products below)
-        for (cj, &c) in self.kset.iter().enumerate() {
-            let y = &mut self.ky[cj * m..(cj + 1) * m];
-            for r in 0..m {
-                y[r] = self.gq[(r, c)] * self.minv[c];
-            }
-            self.chol.forward_in_place(y);
-        }
+        let k = self.k_block();
+        // Pi_KK = M^-1_KK - Y^T Y (ky is free after this, until the products below)
         for cj in 0..k {
             for ri in 0..k {
                 let yy = dot(
@@ -241,11 +252,6 @@ impl Preadjustment {
             }
         }
         // X = A_KK, then X <- A_KK (Pi_KK X), s times
-        for (cj, &c) in self.kset.iter().enumerate() {
-            for (ri, &r) in self.kset.iter().enumerate() {
-                self.ka[cj * k + ri] = self.amat[(r, c)];
-            }
-        }
         self.kx[..k * k].copy_from_slice(&self.ka[..k * k]);
         let mul = |a: &[f64], b: &[f64], o: &mut [f64]| {
             // o = a b, k x k column-major
@@ -292,24 +298,7 @@ impl Preadjustment {
         self.prepare(sys, q)?;
         self.ensure_a(sys, q);
         let (n, m) = (self.n, self.m);
-        self.kset.clear();
-        for (c, col) in self.amat.as_slice().chunks_exact(n).enumerate() {
-            if col.iter().any(|&a| a != 0.0) {
-                self.kset.push(c);
-            }
-        }
-        let k = self.kset.len();
-        // Y (m x k, columns packed into ky) and A_KK (k x k, column-major, into ka)
-        for (cj, &c) in self.kset.iter().enumerate() {
-            let y = &mut self.ky[cj * m..(cj + 1) * m];
-            for r in 0..m {
-                y[r] = self.gq[(r, c)] * self.minv[c];
-            }
-            self.chol.forward_in_place(y);
-            for (ri, &r) in self.kset.iter().enumerate() {
-                self.ka[cj * k + ri] = self.amat[(r, c)];
-            }
-        }
+        let k = self.k_block();
         // Z = Y A_KK (m x k, columns packed into gscr: free outside
         // add_modified_velocity_hessian)
         let z = self.gscr.as_mut_slice();
