@@ -62,3 +62,45 @@ fn extrapolated_first_residual_does_not_change_the_steps() {
     eprintln!("200 steps: max |q_a - q_b| {worst:.2e}");
     assert!(worst < 1e-11, "{worst}");
 }
+
+/// Bad inputs of the (2,2) mode are typed errors: `gamma != 0`, a model with a damper, the
+/// sparse stage solve, and gradient buffers of the wrong length.
+#[test]
+fn typed_errors_s2() {
+    use mbd_model::models;
+    use mbd_solve::SolveError;
+    use mbd_symplectic::{Galerkin, Preadjustment};
+    let sys = models::paper_a_double_pendulum().unwrap();
+    let o = SymplecticOptions::new(2).with_preadjust(PreadjustMode::ModifiedLagrangian);
+    match Galerkin::new(&sys, o.with_gamma(0.5)) {
+        Err(SolveError::InvalidParameter { parameter, .. }) => assert_eq!(parameter, "gamma"),
+        other => panic!("expected InvalidParameter(gamma), got {other:?}"),
+    }
+    let damped = common::damped_spring_chain(3);
+    match Galerkin::new(&damped, o) {
+        Err(SolveError::Unsupported(msg)) => assert!(msg.contains("conservative"), "{msg}"),
+        other => panic!("expected Unsupported, got {other:?}"),
+    }
+    let sparse = SymplecticOptions {
+        linear_solver: mbd_solve::LinearSolver::Sparse,
+        ..o
+    };
+    assert!(matches!(
+        Galerkin::new(&sys, sparse),
+        Err(SolveError::Unsupported(_))
+    ));
+    let n = sys.n_coords();
+    let (q, v) = (vec![0.1; n], vec![0.2; n]);
+    let mut p = Preadjustment::new(&sys, 2).unwrap();
+    let (mut gq, mut short) = (vec![0.0; n], vec![0.0; n - 1]);
+    match p.modified_gradients_s2(&sys, &q, &v, &mut gq, &mut short) {
+        Err(SolveError::Dimension { what, expected, got }) => {
+            assert_eq!((what, expected, got), ("de4/dv", n, n - 1))
+        }
+        other => panic!("expected Dimension, got {other:?}"),
+    }
+    assert!(matches!(
+        p.modified_gradients_s2(&sys, &q, &v[..n - 1], &mut gq, &mut short),
+        Err(SolveError::Dimension { .. })
+    ));
+}
