@@ -94,7 +94,11 @@ fn typed_errors_s2() {
     let mut p = Preadjustment::new(&sys, 2).unwrap();
     let (mut gq, mut short) = (vec![0.0; n], vec![0.0; n - 1]);
     match p.modified_gradients_s2(&sys, &q, &v, &mut gq, &mut short) {
-        Err(SolveError::Dimension { what, expected, got }) => {
+        Err(SolveError::Dimension {
+            what,
+            expected,
+            got,
+        }) => {
             assert_eq!((what, expected, got), ("de4/dv", n, n - 1))
         }
         other => panic!("expected Dimension, got {other:?}"),
