@@ -135,35 +135,43 @@ pub(super) fn local(cols: &[Option<usize>; 6], x: &[f64]) -> [f64; 6] {
 impl E4Work {
     fn new(sys: &System) -> Self {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let cols = (0..m)
-            .map(|r| {
-                let (a, b) = sys
-                    .equation_joint(r)
-                    .map_or((None, None), |j| sys.joint_bodies(j));
-                let mut c = [None; 6];
-                for (slot, body) in [(0, a), (3, b)] {
-                    if let Some(i) = body {
-                        for k in 0..3 {
-                            c[slot + k] = Some(3 * i + k);
-                        }
-                    }
-                }
-                c
-            })
-            .collect();
-        E4Work {
+        let mut w = E4Work {
             f: E4Forward::new(n, m),
             b: Adjoints::new(n, m),
-            cols,
+            cols: vec![[None; 6]; m],
+        };
+        w.set_cols(sys);
+        w
+    }
+
+    /// The element-local columns of every constraint row of `sys` (in place: the workspace
+    /// follows the system it is used with, not only the one it was made for).
+    fn set_cols(&mut self, sys: &System) {
+        for (r, c) in self.cols.iter_mut().enumerate() {
+            let (a, b) = sys
+                .equation_joint(r)
+                .map_or((None, None), |j| sys.joint_bodies(j));
+            *c = [None; 6];
+            for (slot, body) in [(0, a), (3, b)] {
+                if let Some(i) = body {
+                    for k in 0..3 {
+                        c[slot + k] = Some(3 * i + k);
+                    }
+                }
+            }
         }
     }
 }
 
 impl Preadjustment {
-    /// The `e4` workspace, taken out of `self` (give it back with `self.e4 = Some(..)`).
+    /// The `e4` workspace for `sys`, taken out of `self` (give it back with
+    /// `self.e4 = Some(..)`).
     pub(super) fn e4_work(&mut self, sys: &System) -> Box<E4Work> {
         match self.e4.take() {
-            Some(w) if w.f.u.len() == self.n && w.cols.len() == self.m => w,
+            Some(mut w) if w.f.u.len() == self.n && w.cols.len() == self.m => {
+                w.set_cols(sys);
+                w
+            }
             _ => Box::new(E4Work::new(sys)),
         }
     }

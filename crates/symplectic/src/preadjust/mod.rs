@@ -119,6 +119,9 @@ pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
 fn gm_times(g: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
     let m = g.nrows();
     out.fill(0.0);
+    if m == 0 {
+        return;
+    }
     for (col, &xk) in g.as_slice().chunks_exact(m).zip(x) {
         if xk != 0.0 {
             for (o, &gr) in out.iter_mut().zip(col) {
