@@ -76,6 +76,26 @@ pub fn pendulum(m: f64, l: f64, angle0: f64, g: f64) -> Result<System, ModelErro
     })
 }
 
+/// An elastic pendulum without constraints: one uniform rod (1 kg, 1 m, g = 9.81) hanging from
+/// the ground origin by a spring (50 N/m, rest length 1 m, no damping) attached at its end, at
+/// rest at `(0.9, -1.0)` with angle `-0.8` rad. A conservative model with `m = 0`.
+pub fn elastic_pendulum() -> Result<System, ModelError> {
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, -9.81]);
+    let r = b.add_body(Body::new("rod").rod(1.0, 1.0).position(0.9, -1.0, -0.8));
+    b.add_force(crate::force::Force::spring_damper(
+        "spring",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        r,
+        [-0.5, 0.0],
+        50.0,
+        0.0,
+        1.0,
+    ));
+    b.build()
+}
+
 /// Paper A's two-body pendulum (project choice): two uniform rods, 1 kg, 1 m, g = 9.81, both
 /// released at rest 30 degrees from the downward vertical.
 pub fn paper_a_double_pendulum() -> Result<System, ModelError> {

@@ -23,30 +23,15 @@ fn run(sys: &System, o: SymplecticOptions, h: f64, n: usize) -> (f64, f64) {
     (dh, mp)
 }
 
-/// An elastic pendulum: one free rod hanging from the ground by a spring (rest length 1 m,
-/// 50 N/m) at one end, released off the vertical: no constraint at all (`m = 0`).
-fn elastic_pendulum() -> System {
-    use mbd_model::{Body, BodyRef, Force, SystemBuilder};
-    let mut b = SystemBuilder::new();
-    b.set_gravity([0.0, -9.81]);
-    let r = b.add_body(Body::new("rod").rod(1.0, 1.0).position(0.9, -1.0, -0.8));
-    b.add_force(Force::spring_damper(
-        "spring",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        r,
-        [-0.5, 0.0],
-        50.0,
-        0.0,
-        1.0,
-    ));
-    b.build().unwrap()
-}
-
 #[test]
 fn energy_error_falls_on_other_mechanisms() {
     let cases: [(&str, System, f64, usize); 6] = [
-        ("elastic pendulum", elastic_pendulum(), 0.02, 1000),
+        (
+            "elastic pendulum",
+            models::elastic_pendulum().unwrap(),
+            0.02,
+            1000,
+        ),
         ("four-bar", models::four_bar().unwrap(), 0.01, 1000),
         ("slider-crank", models::slider_crank().unwrap(), 0.01, 1000),
         (

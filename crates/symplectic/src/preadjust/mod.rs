@@ -131,6 +131,17 @@ fn gm_times(g: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
     }
 }
 
+/// `out += c M^-1 G^T x` for the column-major `m x n` matrix `G` (x of length m).
+fn add_dgt(g: &DMatrix<f64>, minv: &[f64], x: &[f64], c: f64, out: &mut [f64]) {
+    let m = g.nrows();
+    if m == 0 {
+        return;
+    }
+    for ((o, col), mi) in out.iter_mut().zip(g.as_slice().chunks_exact(m)).zip(minv) {
+        *o += c * mi * dot(col, x);
+    }
+}
+
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -212,9 +223,7 @@ impl Preadjustment {
         let t = &mut self.tm[0];
         gm_times(&self.gq, out, t);
         self.chol.solve_in_place(t);
-        for (k, col) in self.gq.as_slice().chunks_exact(m).enumerate() {
-            out[k] -= self.minv[k] * dot(col, t);
-        }
+        add_dgt(&self.gq, &self.minv, t, -1.0, out);
     }
 
     /// `out = S^-1 G M^-1 x` (length m).

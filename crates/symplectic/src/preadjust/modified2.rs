@@ -256,18 +256,8 @@ impl Preadjustment {
 
     /// `out = D G^T x` (x of length m).
     pub(super) fn dgt_into(&self, x: &[f64], out: &mut [f64]) {
-        let m = self.m;
-        if m == 0 {
-            out.fill(0.0);
-            return;
-        }
-        for ((o, col), mi) in out
-            .iter_mut()
-            .zip(self.gq.as_slice().chunks_exact(m))
-            .zip(&self.minv)
-        {
-            *o = mi * dot(col, x);
-        }
+        out.fill(0.0);
+        super::add_dgt(&self.gq, &self.minv, x, 1.0, out);
     }
 
     /// `out = S^-1 x`.

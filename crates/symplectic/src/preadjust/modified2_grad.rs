@@ -489,38 +489,8 @@ mod tests {
     use super::*;
     use mbd_model::models;
 
-    /// Two free bodies held by springs (no constraint rows: `m = 0`).
-    fn two_free_bodies_with_springs() -> System {
-        use mbd_model::{Body, BodyRef, Force, SystemBuilder};
-        let mut b = SystemBuilder::new();
-        b.set_gravity([0.0, -9.81]);
-        let r = b.add_body(Body::new("r").rod(1.0, 1.0).position(0.4, -0.3, 0.7));
-        let p = b.add_body(Body::new("p").rod(0.5, 0.6).position(1.2, 0.2, -0.4));
-        b.add_force(Force::spring_damper(
-            "s1",
-            r,
-            [0.5, 0.0],
-            p,
-            [-0.3, 0.0],
-            20.0,
-            0.0,
-            0.4,
-        ));
-        b.add_force(Force::spring_damper(
-            "s2",
-            BodyRef::Ground,
-            [0.0, 0.5],
-            r,
-            [-0.5, 0.0],
-            7.0,
-            0.0,
-            0.4,
-        ));
-        b.build().unwrap()
-    }
-
     /// The reverse-pass gradients against fourth-order central differences of `e4`, on paper
-    /// A's double pendulum, a rod with a spring, a 3-link chain and two free bodies on springs,
+    /// A's double pendulum, a rod with a spring, a 3-link chain and an elastic pendulum (`m = 0`),
     /// at generic states.
     #[test]
     fn gradients_match_differences() {
@@ -528,7 +498,7 @@ mod tests {
             models::paper_a_double_pendulum().unwrap(),
             super::super::modified::modlag_tests::rod_with_spring(),
             models::n_link_chain(3).unwrap(),
-            two_free_bodies_with_springs(),
+            models::elastic_pendulum().unwrap(),
         ];
         for sys in &systems {
             let n = sys.n_coords();
