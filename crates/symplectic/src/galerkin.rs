@@ -70,8 +70,8 @@ pub struct Galerkin {
     mlmid: Vec<f64>,
     /// The step's constant velocity `(Q_1 - Q_0) / h`.
     mlvel: Vec<f64>,
-    /// When the `s = 2` gradients may be kept between residuals (`modlag.rs`).
-    mlreuse: modlag::Reuse,
+    /// The `s = 2` gradients of the last steps, extrapolated at the predictor (`modlag.rs`).
+    mlhist: modlag::GradientHistory,
     tn: [Vec<f64>; 4],
     proj: DenseCholesky,
     vm: Vec<f64>,
@@ -164,7 +164,7 @@ impl Galerkin {
             mlv: vec![0.0; nl],
             mlmid: vec![0.0; nl],
             mlvel: vec![0.0; nl],
-            mlreuse: modlag::Reuse::new(if modlag && options.s == 2 { n } else { 0 }),
+            mlhist: modlag::GradientHistory::new(if modlag && options.s == 2 { n } else { 0 }),
             opts: options,
             tab,
             n,

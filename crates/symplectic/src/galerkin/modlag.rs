@@ -20,7 +20,7 @@ use mbd_solve::SolveError;
 /// linear extrapolation 2.72 on `n_link_chain(10)` against 2.00 with evaluated gradients,
 /// quadratic 2.02, cubic 2.00; the double pendulum 3.21, 3.21, 3.20 against 3.13.)
 #[derive(Debug)]
-pub(super) struct Reuse {
+pub(super) struct GradientHistory {
     /// The scaled gradients `(dE/dq, dE/dv)` of the last four steps (the oldest first).
     hist: [Vec<f64>; 4],
     hist_len: usize,
@@ -30,10 +30,10 @@ pub(super) struct Reuse {
     pub(super) lagged: bool,
 }
 
-impl Reuse {
+impl GradientHistory {
     /// The workspace for `n` coordinates (0: no `s = 2` modified Lagrangian).
     pub(super) fn new(n: usize) -> Self {
-        Reuse {
+        GradientHistory {
             hist: [
                 vec![0.0; 2 * n],
                 vec![0.0; 2 * n],
@@ -102,8 +102,8 @@ impl Galerkin {
         }
         // s = 2: E_d = h^5 e4(qbar, v) at the chord of the end control points, its exact
         // gradients by a reverse pass (modified2_grad.rs; docs/symplectic.md section 5b); at a
-        // continuing step's predictor extrapolated from the last four steps (`Reuse`)
-        let r = &mut self.mlreuse;
+        // continuing step's predictor extrapolated from the last four steps (`GradientHistory`)
+        let r = &mut self.mlhist;
         r.lagged = std::mem::take(&mut r.first) && r.hist_len == 4;
         if r.lagged {
             let [g0, g1, g2, g3] = &r.hist;

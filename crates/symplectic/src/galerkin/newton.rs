@@ -94,7 +94,7 @@ impl Galerkin {
         self.residual(sys, t, h)?;
         let mut res = norm_inf(&self.r);
         let mut evals = 1;
-        if self.mlreuse.lagged && res <= tol {
+        if self.mlhist.lagged && res <= tol {
             // the predictor passes with extrapolated modified-Lagrangian gradients
             // (`modlag.rs`): decide on evaluated ones
             self.residual(sys, t, h)?;

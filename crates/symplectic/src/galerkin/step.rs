@@ -33,7 +33,7 @@ impl Integrator for Galerkin {
         self.end_phiq_valid = false;
         self.jac_valid = false;
         self.w_skip_left = 0;
-        self.mlreuse.clear();
+        self.mlhist.clear();
     }
 
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
@@ -65,7 +65,7 @@ impl Integrator for Galerkin {
         self.start_phiq(sys, reuse);
         self.end_phiq_valid = false;
         self.gk = self.opts.gamma * self.kappa * h.powi(2 * s as i32);
-        self.mlreuse.first = self.hist_valid
+        self.mlhist.first = self.hist_valid
             && (self.hist_t - t).abs() <= 1e-9 * h
             && (self.hist_h - h).abs() <= 1e-9 * h
             && self.hist_q.as_slice() == self.qk.as_slice();
@@ -181,7 +181,7 @@ impl Integrator for Galerkin {
         } else {
             0
         };
-        self.mlreuse.record(contiguous, &self.mlq, &self.mlv);
+        self.mlhist.record(contiguous, &self.mlq, &self.mlv);
         self.hist_multi.copy_within(0..keep * dim, dim);
         self.hist_multi[..dim].copy_from_slice(&self.x);
         self.hist_len = keep + 1;
