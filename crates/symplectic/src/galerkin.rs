@@ -120,12 +120,15 @@ impl Galerkin {
                     .into(),
             ));
         }
-        let sparse_ok = options.gamma == 0.0 && !modlag;
+        // (the s = 2 modified Lagrangian leaves the Newton matrix as it is; s = 1 adds dense
+        // blocks to it: docs/symplectic.md, "Sparse stage solve")
+        let sparse_ok = options.gamma == 0.0 && !(modlag && s == 1);
         let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
-                "the sparse symplectic stage solve needs gamma = 0 and preadjust = Paper (the \
-                 preadjustment's Hessian is dense)"
+                "the sparse symplectic stage solve needs gamma = 0 and not the s = 1 modified \
+                 Lagrangian (both add dense blocks to the Newton matrix); use \
+                 LinearSolver::Dense or Auto"
                     .into(),
             ));
         }
@@ -447,6 +450,7 @@ impl Galerkin {
                     self.r[nu * n + i] = res;
                 }
             }
+            self.add_modified_rows(h);
             return;
         }
         for nu in 0..s {
@@ -476,9 +480,15 @@ impl Galerkin {
                 self.r[nu * n + i] = res;
             }
         }
+        self.add_modified_rows(h);
+    }
+
+    /// The modified-Lagrangian terms of the first momentum rows (nothing without the mode):
+    /// `h M^-1 D_1 E_d`, with `D_1 E_d = h^3 (1/2 de/dq - 1/h de/dv)` at `(qbar, v)` for
+    /// `s = 1` (`h^5` and `e4` for `s = 2`), `mlq`, `mlv` holding the scaled gradients.
+    fn add_modified_rows(&mut self, h: f64) {
         if !self.ml.is_empty() {
-            // s = 1: h M^-1 D_1 E_d, D_1 E_d = h^3 (1/2 de/dq - 1/h de/dv) at (qbar, v)
-            for i in 0..n {
+            for i in 0..self.n {
                 self.r[i] += h * self.minv[i] * (0.5 * h * self.mlq[i] - self.mlv[i]);
             }
         }
