@@ -155,7 +155,12 @@ impl Galerkin {
         } else {
             Vec::new()
         };
-        let ml = if modlag {
+        let ml = if modlag && use_sparse {
+            // (s = 2 only: its e4 evaluation with S held sparse, O(N) per evaluation)
+            let mut p = Preadjustment::new_sparse(sys)?;
+            p.fd_step = options.fd_step;
+            vec![p]
+        } else if modlag {
             workspaces(1, 1)?
         } else {
             Vec::new()

@@ -58,18 +58,28 @@ fn steps_allocate_nothing() {
 }
 
 /// The sparse path (a 30-link chain, sparse stage LU, sparse projection): after the first
-/// steps (which size the LU's factor storage), no step allocates, with one Jacobian per step
-/// and with the Jacobian reused.
+/// steps (which size the LU's factor storage), no step allocates, with one Jacobian per step,
+/// with the Jacobian reused, and with the s = 2 modified Lagrangian.
 #[test]
 fn sparse_steps_allocate_nothing() {
     let sys = models::n_link_chain(30).unwrap();
     let s0 = State::consistent(&sys, 0.0).unwrap();
-    for (s, reuse) in [(1, false), (2, false), (3, false), (2, true)] {
-        let opts = SymplecticOptions {
+    // (the last: the s = 2 modified Lagrangian, its e4 workspace with S held sparse)
+    for (s, reuse, modified) in [
+        (1, false, false),
+        (2, false, false),
+        (3, false, false),
+        (2, true, false),
+        (2, false, true),
+    ] {
+        let mut opts = SymplecticOptions {
             linear_solver: LinearSolver::Sparse,
             reuse_jacobian: reuse,
             ..SymplecticOptions::new(s)
         };
+        if modified {
+            opts = opts.with_preadjust(PreadjustMode::ModifiedLagrangian);
+        }
         let mut g = Galerkin::new(&sys, opts).unwrap();
         assert!(g.is_sparse());
         let mut st = s0.clone();
@@ -81,7 +91,10 @@ fn sparse_steps_allocate_nothing() {
             g.step(&sys, &mut st, 1e-3).unwrap();
         }
         let n = ALLOCS.with(|c| c.get()) - before;
-        assert_eq!(n, 0, "s={s} reuse={reuse}: {n} allocations in 100 steps");
+        assert_eq!(
+            n, 0,
+            "s={s} reuse={reuse} modified={modified}: {n} allocations in 100 steps"
+        );
     }
     // force elements with damping: the coloured force differences allocate nothing either
     let sys = damped_spring_chain(30);

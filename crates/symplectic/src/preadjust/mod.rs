@@ -19,6 +19,7 @@
 
 use mbd_model::System;
 use mbd_solve::linalg::DenseCholesky;
+use mbd_solve::sparse::ConstraintSchur;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -97,6 +98,10 @@ pub struct Preadjustment {
     ky: Vec<f64>,
     /// The workspace of the s = 2 modified-Lagrangian term (allocated on first use).
     e4: Option<Box<e4_work::E4Work>>,
+    /// The sparse layout ([`Preadjustment::new_sparse`]): `Phi_q` in element-local rows and
+    /// the sparse Cholesky factorisation of `S` instead of `gq` and `chol` (which, with the
+    /// other `n x n` and `m x n` matrices, are then empty).
+    schur: Option<Box<ConstraintSchur>>,
 }
 
 #[cfg(test)]
@@ -149,6 +154,21 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
 impl Preadjustment {
     /// A workspace for `W_s` on `sys`.
     pub fn new(sys: &System, s: usize) -> Result<Self, SolveError> {
+        Self::with_layout(sys, s, false)
+    }
+
+    /// A workspace for the `s = 2` modified Lagrangian alone
+    /// ([`Preadjustment::modified_gradients_s2`], [`Preadjustment::modified_term_s2`]) with
+    /// `S = Phi_q M^-1 Phi_q^T` held sparse ([`ConstraintSchur`]): `O(N)` storage and work per
+    /// evaluation on a chain of `N` bodies (the symplectic scheme's sparse stage solve). The
+    /// `W_s` and `s = 1` methods need the dense matrices and return
+    /// [`SolveError::Unsupported`] on it.
+    pub fn new_sparse(sys: &System) -> Result<Self, SolveError> {
+        // (the degree is that of W_s, which the modified Lagrangian does not use)
+        Self::with_layout(sys, 1, true)
+    }
+
+    fn with_layout(sys: &System, s: usize, sparse: bool) -> Result<Self, SolveError> {
         if s == 0 {
             return Err(SolveError::InvalidParameter {
                 parameter: "s",
@@ -157,6 +177,13 @@ impl Preadjustment {
             });
         }
         let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let schur = if sparse {
+            Some(Box::new(ConstraintSchur::new(sys)?))
+        } else {
+            None
+        };
+        // (the dense matrices: empty on the sparse layout)
+        let (nd, md) = if sparse { (0, 0) } else { (n, m) };
         Ok(Preadjustment {
             s,
             n,
@@ -165,11 +192,11 @@ impl Preadjustment {
             minv: sys.inv_mass_diag().as_slice().to_vec(),
             fd_step: 2e-3,
             g: vec![0.0; n],
-            gq: DMatrix::zeros(m, n),
-            chol: DenseCholesky::new(m),
+            gq: DMatrix::zeros(md, nd),
+            chol: DenseCholesky::new(md),
             mu0: vec![0.0; m],
             u: vec![0.0; n],
-            amat: DMatrix::zeros(n, n),
+            amat: DMatrix::zeros(nd, nd),
             av: vec![vec![0.0; n]; s + 1],
             bv: vec![vec![0.0; n]; s + 1],
             sig: vec![vec![0.0; m]; s.max(1)],
@@ -190,20 +217,57 @@ impl Preadjustment {
             mv: vec![0.0; n],
             mv_valid: false,
             kset: Vec::with_capacity(n),
-            gscr: DMatrix::zeros(m, n),
-            ct: DMatrix::zeros(m, n),
+            gscr: DMatrix::zeros(md, nd),
+            ct: DMatrix::zeros(md, nd),
             rows: Vec::with_capacity(m),
             rg: vec![[0.0; 6]; m],
             rhv: vec![[0.0; 6]; m],
             rd3: vec![[0.0; 6]; m],
             rv: vec![0.0; n],
             rv_valid: false,
-            kpi: vec![0.0; n * n],
-            ka: vec![0.0; n * n],
-            kx: vec![0.0; n * n],
-            ky: vec![0.0; n * n.max(m)],
+            kpi: vec![0.0; nd * nd],
+            ka: vec![0.0; nd * nd],
+            kx: vec![0.0; nd * nd],
+            ky: vec![0.0; nd * nd.max(md)],
             e4: None,
+            schur,
         })
+    }
+
+    /// [`SolveError::Unsupported`] on the sparse layout, for the methods that need the dense
+    /// matrices (`what` names the method).
+    pub(crate) fn require_dense(&self, what: &str) -> Result<(), SolveError> {
+        if self.schur.is_some() {
+            return Err(SolveError::Unsupported(format!(
+                "{what} needs the dense layout (Preadjustment::new); this workspace was built by \
+                 Preadjustment::new_sparse for the s = 2 modified Lagrangian"
+            )));
+        }
+        Ok(())
+    }
+
+    /// `x <- S^-1 x` with the last factorisation of `S`.
+    pub(crate) fn s_solve(&mut self, x: &mut [f64]) {
+        match &mut self.schur {
+            Some(sc) => sc.solve_in_place(x),
+            None => self.chol.solve_in_place(x),
+        }
+    }
+
+    /// `out = G x` (`G = Phi_q` at the prepared point).
+    pub(crate) fn g_times(&self, x: &[f64], out: &mut [f64]) {
+        match &self.schur {
+            Some(sc) => sc.apply(x, out),
+            None => gm_times(&self.gq, x, out),
+        }
+    }
+
+    /// `out += c M^-1 G^T x` (x of length m).
+    pub(crate) fn add_dgt_to(&self, x: &[f64], c: f64, out: &mut [f64]) {
+        match &self.schur {
+            Some(sc) => sc.add_weighted_transpose(c, &self.minv, x, out),
+            None => add_dgt(&self.gq, &self.minv, x, c, out),
+        }
     }
 
     /// The degree `s`.
@@ -220,21 +284,23 @@ impl Preadjustment {
         if m == 0 {
             return;
         }
-        let t = &mut self.tm[0];
-        gm_times(&self.gq, out, t);
-        self.chol.solve_in_place(t);
-        add_dgt(&self.gq, &self.minv, t, -1.0, out);
+        let mut t = std::mem::take(&mut self.tm[0]);
+        self.g_times(out, &mut t);
+        self.s_solve(&mut t);
+        self.add_dgt_to(&t, -1.0, out);
+        self.tm[0] = t;
     }
 
     /// `out = S^-1 G M^-1 x` (length m).
     pub(crate) fn sgm(&mut self, x: &[f64], out: &mut [f64]) {
         let n = self.n;
-        let t = &mut self.tn[3];
+        let mut t = std::mem::take(&mut self.tn[3]);
         for k in 0..n {
             t[k] = self.minv[k] * x[k];
         }
-        gm_times(&self.gq, t, out);
-        self.chol.solve_in_place(out);
+        self.g_times(&t, out);
+        self.s_solve(out);
+        self.tn[3] = t;
     }
 
     /// Whether the workspace holds the evaluation at exactly `q` (bit for bit).
@@ -286,13 +352,26 @@ impl Preadjustment {
                         &mut self.rd3,
                         &mut self.gc,
                     );
-                    sys.local_rows_dense(&self.rg, &mut self.gq);
+                    match &mut self.schur {
+                        Some(sc) => sc.grads_mut().copy_from_slice(&self.rg),
+                        None => sys.local_rows_dense(&self.rg, &mut self.gq),
+                    }
                     self.rv.copy_from_slice(v);
                     self.rv_valid = true;
                 }
-                _ => sys.phi_q(q, &mut self.gq),
+                _ => match &mut self.schur {
+                    Some(sc) => sc.update(sys, q),
+                    None => sys.phi_q(q, &mut self.gq),
+                },
             }
-            {
+            let singular = || SolveError::Singular {
+                t: f64::NAN,
+                what: "Phi_q M^-1 Phi_q^T in W_s",
+                detail: "redundant constraints or a singular configuration".into(),
+            };
+            if let Some(sc) = &mut self.schur {
+                sc.factor(&self.minv).map_err(|_| singular())?;
+            } else {
                 let gq = &self.gq;
                 let minv = &self.minv;
                 let rows = &mut self.rows;
@@ -310,27 +389,31 @@ impl Preadjustment {
                         }
                     }
                 }
+                self.chol.factor_in_place().map_err(|_| singular())?;
             }
-            self.chol
-                .factor_in_place()
-                .map_err(|_| SolveError::Singular {
-                    t: f64::NAN,
-                    what: "Phi_q M^-1 Phi_q^T in W_s",
-                    detail: "redundant constraints or a singular configuration".into(),
-                })?;
             let g = std::mem::take(&mut self.g);
             let mut mu0 = std::mem::take(&mut self.mu0);
             self.sgm(&g, &mut mu0);
             self.g = g;
             self.mu0 = mu0;
         }
-        for k in 0..n {
-            let acc = if m > 0 {
-                dot(&self.gq.as_slice()[k * m..(k + 1) * m], &self.mu0)
-            } else {
-                0.0
-            };
-            self.u[k] = self.minv[k] * (acc - self.g[k]);
+        if self.schur.is_some() {
+            // u = M^-1 (G^T mu0 - g)
+            for k in 0..n {
+                self.u[k] = -self.minv[k] * self.g[k];
+            }
+            let mut u = std::mem::take(&mut self.u);
+            self.add_dgt_to(&self.mu0, 1.0, &mut u);
+            self.u = u;
+        } else {
+            for k in 0..n {
+                let acc = if m > 0 {
+                    dot(&self.gq.as_slice()[k * m..(k + 1) * m], &self.mu0)
+                } else {
+                    0.0
+                };
+                self.u[k] = self.minv[k] * (acc - self.g[k]);
+            }
         }
         for r in 0..m {
             self.nmu0[r] = -self.mu0[r];

@@ -27,6 +27,7 @@ impl Preadjustment {
     /// `docs/modified-lagrangian.md`, use in `docs/symplectic.md` section 5a). Independent of the
     /// `s` of the workspace.
     pub fn modified_term(&mut self, sys: &System, q: &[f64], v: &[f64]) -> Result<f64, SolveError> {
+        self.require_dense("Preadjustment::modified_term")?;
         self.check_v(v)?;
         self.prepare(sys, q)?;
         Ok(self.modified_prepared(sys, q, v))
@@ -73,7 +74,9 @@ impl Preadjustment {
                 }
             }
             self.sigma.copy_from_slice(&self.gc);
-            self.chol.solve_in_place(&mut self.sigma);
+            let mut sigma = std::mem::take(&mut self.sigma);
+            self.s_solve(&mut sigma);
+            self.sigma = sigma;
             gg = dot(&self.gc, &self.sigma);
         }
         for r in 0..m {
@@ -168,6 +171,7 @@ impl Preadjustment {
         v: &[f64],
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
+        self.require_dense("Preadjustment::modified_velocity_hessian")?;
         out.fill(0.0);
         self.add_modified_velocity_hessian(sys, q, v, 1.0, out)
     }
@@ -185,6 +189,7 @@ impl Preadjustment {
         scale: f64,
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
+        self.require_dense("Preadjustment::add_modified_velocity_hessian")?;
         self.check_v(v)?;
         if out.shape() != (self.n, self.n) {
             return Err(SolveError::Dimension {
@@ -273,6 +278,7 @@ impl Preadjustment {
         dq: &mut [f64],
         dv: &mut [f64],
     ) -> Result<f64, SolveError> {
+        self.require_dense("Preadjustment::modified_gradients")?;
         self.check_v(v)?;
         let (n, m) = (self.n, self.m);
         if dq.len() != n || dv.len() != n {

@@ -249,7 +249,7 @@ impl Preadjustment {
     /// `out = -D G^T S^-1 x` (`D = M^-1`; `s` receives `S^-1 x`).
     pub(super) fn neg_e_into(&mut self, x: &[f64], s: &mut [f64], out: &mut [f64]) {
         s.copy_from_slice(x);
-        self.chol.solve_in_place(s);
+        self.s_solve(s);
         self.dgt_into(s, out);
         out.iter_mut().for_each(|o| *o = -*o);
     }
@@ -257,13 +257,13 @@ impl Preadjustment {
     /// `out = D G^T x` (x of length m).
     pub(super) fn dgt_into(&self, x: &[f64], out: &mut [f64]) {
         out.fill(0.0);
-        super::add_dgt(&self.gq, &self.minv, x, 1.0, out);
+        self.add_dgt_to(x, 1.0, out);
     }
 
     /// `out = S^-1 x`.
     pub(super) fn s_inv_into(&mut self, x: &[f64], out: &mut [f64]) {
         out.copy_from_slice(x);
-        self.chol.solve_in_place(out);
+        self.s_solve(out);
     }
 
     /// Evaluates the intermediates of `e4` at `q` with the velocity `v` into `f` (after

@@ -34,7 +34,7 @@ use super::e4_work::{gbar_add, local, Adjoints, E4Work};
 use super::modified2::{
     comb_into, DK2M, DK2P, DK3M, DK3P, DN, DNMU, DNMV, DNPU, DNPV, DU, DUMV, DUPV, DV, E4_TERMS,
 };
-use super::{gm_times, Preadjustment};
+use super::Preadjustment;
 use mbd_model::System;
 use mbd_solve::SolveError;
 
@@ -377,7 +377,7 @@ impl Preadjustment {
             for ((d, x), mi) in dn.iter_mut().zip(&w.nnb).zip(&self.minv) {
                 *d = mi * x;
             }
-            gm_times(&self.gq, dn, t);
+            self.g_times(dn, t);
             gbar_add(&mut w.gbar, cols, -1.0, &f.sig, dn);
             axpy(&mut w.sigb, -1.0, t);
             self.s_inv_into(&w.sigb, a);
@@ -400,7 +400,7 @@ impl Preadjustment {
             for ((d, x), mi) in dub.iter_mut().zip(&w.ub).zip(&self.minv) {
                 *d = mi * x;
             }
-            gm_times(&self.gq, dub, s);
+            self.g_times(dub, s);
             axpy(&mut w.mu0b, 1.0, s);
             axpy(&mut w.gradb, -1.0, dub);
             gbar_add(&mut w.gbar, cols, 1.0, &f.mu0, dub);

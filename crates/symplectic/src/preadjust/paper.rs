@@ -8,6 +8,7 @@ use nalgebra::DMatrix;
 impl Preadjustment {
     /// `W_s(q)`.
     pub fn value(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
+        self.require_dense("Preadjustment::value")?;
         self.prepare(sys, q)?;
         Ok(self.value_prepared(sys, q))
     }
@@ -34,6 +35,7 @@ impl Preadjustment {
         q: &[f64],
         out: &mut [f64],
     ) -> Result<f64, SolveError> {
+        self.require_dense("Preadjustment::gradient")?;
         self.prepare(sys, q)?;
         let (n, m, s) = (self.n, self.m, self.s);
         if s == 1 {
@@ -182,6 +184,7 @@ impl Preadjustment {
     /// eigenvalues are those of the symmetric `M^-1/2 A M^-1/2`), so the Newton Hessian
     /// [`Preadjustment::approximate_hessian`] is at most `bound^(s+1)` in the mass metric.
     pub fn hessian_bound(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
+        self.require_dense("Preadjustment::hessian_bound")?;
         self.prepare(sys, q)?;
         self.ensure_a(sys, q);
         let n = self.n;
@@ -232,6 +235,7 @@ impl Preadjustment {
         q: &[f64],
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
+        self.require_dense("Preadjustment::approximate_hessian")?;
         self.prepare(sys, q)?;
         self.ensure_a(sys, q);
         let (n, m) = (self.n, self.m);
@@ -288,6 +292,7 @@ impl Preadjustment {
         q: &[f64],
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
+        self.require_dense("Preadjustment::approximate_hessian_1")?;
         if out.shape() != (self.n, self.n) {
             return Err(SolveError::Dimension {
                 what: "the approximate Hessian",
