@@ -79,6 +79,51 @@ impl System {
     }
 }
 
+impl System {
+    /// The diagonals of the two weighted Lagrangian Hessians of
+    /// [`System::add_lagrangian_hessian_pair`], added into `out_a` and `out_b` (length n), in
+    /// `O(elements)` with nothing assembled (diagonal Newton blocks on a sparse path).
+    pub fn add_lagrangian_hessian_pair_diagonals(
+        &self,
+        q: &[f64],
+        (a, out_a): (LagrangianWeights<'_>, &mut [f64]),
+        (b, out_b): (LagrangianWeights<'_>, &mut [f64]),
+    ) {
+        // (the local diagonal h[l][l] of each of the element's bodies)
+        let scatter = |at: crate::system::Attach, h: &[[f64; NV]; NV], w: f64, out: &mut [f64]| {
+            for (slot, body) in [(0, at.a), (3, at.b)] {
+                if let Some(i) = body {
+                    for l in 0..3 {
+                        out[3 * i + l] += w * h[slot + l][slot + l];
+                    }
+                }
+            }
+        };
+        if a.potential != 0.0 || b.potential != 0.0 {
+            for (fi, f) in self.forces.iter().enumerate() {
+                let at = self.force_attach[fi];
+                let e = f.potential(&Self::loc_hess(q, at.a, 0), &Self::loc_hess(q, at.b, 3));
+                scatter(at, &e.h, a.potential, out_a);
+                scatter(at, &e.h, b.potential, out_b);
+            }
+        }
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let mut e = [HessJet::cst(0.0); 3];
+            j.eval(
+                &Self::loc_hess(q, at.a, 0),
+                &Self::loc_hess(q, at.b, 3),
+                &mut e,
+            );
+            let o = self.row_offset[ji];
+            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+                scatter(at, &ek.h, a.constraints[o + k], out_a);
+                scatter(at, &ek.h, b.constraints[o + k], out_b);
+            }
+        }
+    }
+}
+
 fn scaled(h: &[[f64; NV]; NV], w: f64) -> [[f64; NV]; NV] {
     let mut out = *h;
     for row in out.iter_mut() {
@@ -96,7 +141,8 @@ mod tests {
 
     /// The pair equals two separate assemblies ([`crate::System::potential_hessian`] and
     /// [`crate::System::add_constraint_hessian`]) and `ct` equals
-    /// [`crate::System::phi_q_dot_jacobian`], on every joint kind and on a model with springs.
+    /// [`crate::System::phi_q_dot_jacobian`], and the diagonals alone equal theirs, on every
+    /// joint kind and on a model with springs.
     #[test]
     fn pair_matches_separate_assemblies() {
         for sys in crate::fixtures::derivative_test_systems() {
@@ -140,6 +186,33 @@ mod tests {
             close(&a, &ea, "out_a");
             close(&b, &eb, "out_b");
             close(&ct, &ect, "ct");
+            // the diagonals alone, added to what the buffers hold
+            let (mut da, mut db) = (vec![0.5; n], vec![0.0; n]);
+            sys.add_lagrangian_hessian_pair_diagonals(
+                &q,
+                (
+                    LagrangianWeights {
+                        potential: 1.0,
+                        constraints: &wa,
+                    },
+                    &mut da,
+                ),
+                (
+                    LagrangianWeights {
+                        potential: -0.5,
+                        constraints: &wb,
+                    },
+                    &mut db,
+                ),
+            );
+            for i in 0..n {
+                let tol = 1e-13 * (1.0 + ea[(i, i)].abs() + eb[(i, i)].abs());
+                assert!(
+                    (da[i] - (ea[(i, i)] - 0.25 + 0.5)).abs() < tol,
+                    "diag a {i}"
+                );
+                assert!((db[i] - eb[(i, i)]).abs() < tol, "diag b {i}");
+            }
         }
     }
 }

@@ -72,6 +72,9 @@ pub struct Galerkin {
     mlvel: Vec<f64>,
     /// The `s = 2` gradients of the last steps, extrapolated at the predictor (`modlag.rs`).
     mlhist: modlag::GradientHistory,
+    /// Sparse path, s = 1 modified Lagrangian: the diagonals of its Newton blocks
+    /// (`Preadjustment::modified_newton_diagonals`).
+    mldiag: [Vec<f64>; 2],
     tn: [Vec<f64>; 4],
     proj: DenseCholesky,
     vm: Vec<f64>,
@@ -120,15 +123,14 @@ impl Galerkin {
                     .into(),
             ));
         }
-        // (the s = 2 modified Lagrangian leaves the Newton matrix as it is; s = 1 adds dense
-        // blocks to it: docs/symplectic.md, "Sparse stage solve")
-        let sparse_ok = options.gamma == 0.0 && !(modlag && s == 1);
+        // (W_s adds a dense block to the Newton matrix; the modified Lagrangian's blocks are
+        // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
+        let sparse_ok = options.gamma == 0.0;
         let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
-                "the sparse symplectic stage solve needs gamma = 0 and not the s = 1 modified \
-                 Lagrangian (both add dense blocks to the Newton matrix); use \
-                 LinearSolver::Dense or Auto"
+                "the sparse symplectic stage solve needs gamma = 0 (the Hessian of the paper's \
+                 W_s is dense); use LinearSolver::Dense or Auto"
                     .into(),
             ));
         }
@@ -156,7 +158,7 @@ impl Galerkin {
             Vec::new()
         };
         let ml = if modlag && use_sparse {
-            // (s = 2 only: its e4 evaluation with S held sparse, O(N) per evaluation)
+            // (S held sparse: O(N) per evaluation)
             let mut p = Preadjustment::new_sparse(sys)?;
             p.fd_step = options.fd_step;
             vec![p]
@@ -172,6 +174,11 @@ impl Galerkin {
             mlv: vec![0.0; nl],
             mlmid: vec![0.0; nl],
             mlvel: vec![0.0; nl],
+            mldiag: if modlag && use_sparse && s == 1 {
+                [vec![0.0; n], vec![0.0; n]]
+            } else {
+                [Vec::new(), Vec::new()]
+            },
             mlhist: modlag::GradientHistory::new(if modlag && options.s == 2 { n } else { 0 }),
             opts: options,
             tab,

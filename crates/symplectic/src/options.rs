@@ -82,8 +82,9 @@ pub struct SymplecticOptions {
     /// Dense or sparse stage solve. [`LinearSolver::Auto`] (default) takes the sparse path
     /// (`O(N)` per step on a chain of `N` bodies; `docs/symplectic.md`, "Sparse stage solve")
     /// above [`mbd_solve::SPARSE_THRESHOLD`] constraint equations when it is available: with
-    /// `gamma = 0` and not with the `s = 1` modified Lagrangian (both add dense blocks to the
-    /// Newton matrix; the `s = 2` one does not). Forcing
+    /// `gamma = 0` (the paper's `W_s` adds a dense block to the Newton matrix; the modified
+    /// Lagrangian takes the sparse path, its `s = 1` Newton blocks reduced to diagonals).
+    /// Forcing
     /// [`LinearSolver::Sparse`] where it is not available is an error of [`crate::Galerkin::new`].
     pub linear_solver: LinearSolver,
 }

@@ -59,17 +59,18 @@ fn steps_allocate_nothing() {
 
 /// The sparse path (a 30-link chain, sparse stage LU, sparse projection): after the first
 /// steps (which size the LU's factor storage), no step allocates, with one Jacobian per step,
-/// with the Jacobian reused, and with the s = 2 modified Lagrangian.
+/// with the Jacobian reused, and with the modified Lagrangian (s = 1, 2).
 #[test]
 fn sparse_steps_allocate_nothing() {
     let sys = models::n_link_chain(30).unwrap();
     let s0 = State::consistent(&sys, 0.0).unwrap();
-    // (the last: the s = 2 modified Lagrangian, its e4 workspace with S held sparse)
+    // (the last two: the modified Lagrangian, its workspace with S held sparse)
     for (s, reuse, modified) in [
         (1, false, false),
         (2, false, false),
         (3, false, false),
         (2, true, false),
+        (1, false, true),
         (2, false, true),
     ] {
         let mut opts = SymplecticOptions {

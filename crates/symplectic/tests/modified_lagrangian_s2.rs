@@ -101,55 +101,9 @@ fn typed_errors_s2() {
     ));
 }
 
-/// The (2,2) mode takes the sparse stage solve on a large chain (`LinearSolver::Auto` above
-/// `SPARSE_THRESHOLD` constraint equations; `e4` leaves the Newton matrix unchanged): its steps
-/// equal the dense path's to Newton's tolerance, with the same Newton iterations. (Measured,
-/// 30-link chain, h = 0.01, 40 steps: 2.3e-13 apart, 107 iterations on both; the `e4` term
-/// itself moves the steps 1.9e-7 from the plain scheme's, so a path that dropped it would fail.)
-#[test]
-fn sparse_path_matches_the_dense_path() {
-    use mbd_model::models;
-    use mbd_solve::{Integrator, LinearSolver, State};
-    use mbd_symplectic::Galerkin;
-    let sys = models::n_link_chain(30).unwrap();
-    assert!(sys.n_constraints() >= mbd_solve::SPARSE_THRESHOLD);
-    let o = SymplecticOptions::new(2).with_preadjust(PreadjustMode::ModifiedLagrangian);
-    let mut sparse = Galerkin::new(&sys, o).unwrap();
-    let mut dense = Galerkin::new(
-        &sys,
-        SymplecticOptions {
-            linear_solver: LinearSolver::Dense,
-            ..o
-        },
-    )
-    .unwrap();
-    assert!(sparse.is_sparse() && !dense.is_sparse());
-    let mut plain = Galerkin::new(&sys, SymplecticOptions::new(2)).unwrap();
-    let mut sa = State::consistent(&sys, 0.0).unwrap();
-    let (mut sb, mut sc) = (sa.clone(), sa.clone());
-    let (mut worst, mut its, mut off) = (0.0f64, [0usize; 2], 0.0f64);
-    for _ in 0..40 {
-        its[0] += sparse.step(&sys, &mut sa, 0.01).unwrap().newton_iterations;
-        its[1] += dense.step(&sys, &mut sb, 0.01).unwrap().newton_iterations;
-        plain.step(&sys, &mut sc, 0.01).unwrap();
-        worst = worst.max(common::max_abs_diff(sa.q.as_slice(), sb.q.as_slice()));
-        worst = worst.max(common::max_abs_diff(sa.v.as_slice(), sb.v.as_slice()));
-        off = off.max(common::max_abs_diff(sa.q.as_slice(), sc.q.as_slice()));
-    }
-    eprintln!(
-        "30-link chain, 40 steps: sparse - dense {worst:.2e} ({} / {} Newton iterations); \
-         modified - plain {off:.2e}",
-        its[0], its[1]
-    );
-    assert!(worst < 1e-11, "{worst}");
-    // (the comparison can see the term: it moves the steps far more than the tolerance)
-    assert!(off > 1e3 * worst.max(1e-14), "{off}");
-    assert!(its[0].abs_diff(its[1]) <= 2, "{its:?}");
-}
-
-/// `Preadjustment::new_sparse` (`S` held sparse) gives the dense workspace's `e4` and its
-/// gradients on a 30-link chain at a generic state, to round-off; its `W_s` and `s = 1`
-/// methods are typed errors. (Measured: value 1.6e-14 relative, gradients 9.5e-11 of their
+/// `Preadjustment::new_sparse` (`S` held sparse) gives the dense workspace's `e4`, `e` (s = 1)
+/// and their gradients on a 30-link chain at a generic state, to round-off; its `W_s` methods
+/// are typed errors. (Measured: value 1.6e-14 relative, gradients 9.5e-11 of their
 /// largest entry 1.9e3.)
 #[test]
 fn sparse_workspace_matches_the_dense_one() {
@@ -194,8 +148,19 @@ fn sparse_workspace_matches_the_dense_one() {
         Err(SolveError::Unsupported(msg)) => assert!(msg.contains("gradient"), "{msg}"),
         other => panic!("expected Unsupported, got {other:?}"),
     }
-    assert!(matches!(
-        sparse.modified_gradients(&sys, &q, &v, &mut out, &mut gvs),
-        Err(SolveError::Unsupported(_))
-    ));
+    // the s = 1 term's gradients too
+    let e1d = dense
+        .modified_gradients(&sys, &q, &v, &mut gqd, &mut gvd)
+        .unwrap();
+    let e1s = sparse
+        .modified_gradients(&sys, &q, &v, &mut gqs, &mut gvs)
+        .unwrap();
+    let scale1 = gqd.iter().chain(&gvd).fold(0.0f64, |a, x| a.max(x.abs()));
+    let dg1 = common::max_abs_diff(&gqd, &gqs).max(common::max_abs_diff(&gvd, &gvs));
+    eprintln!(
+        "e (s = 1) {e1d:.6e}: sparse - dense {:.1e}; gradients {dg1:.1e} of {scale1:.2e}",
+        (e1d - e1s).abs()
+    );
+    assert!((e1d - e1s).abs() < 1e-12 * e1d.abs(), "{e1d} vs {e1s}");
+    assert!(dg1 < 1e-12 * scale1, "{dg1} of {scale1}");
 }

@@ -162,7 +162,8 @@ impl Galerkin {
         // bodies 2.20 (no saving: E is dense on K anyway); E without the off-diagonal part
         // 2.93, E between neighbouring bodies 2.85; both diagonal (no fill) 2.91 (paper A's
         // pendulum 3.99 against 2.99). Only dropping both off-diagonals removes the fill, and
-        // the extra iterations cost as much as it saves.
+        // the extra iterations cost as much as it saves here; the sparse path, where the fill
+        // would cost O(N^3), takes the diagonals (sparse.rs, docs/symplectic.md section 5a).
         if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
             // (s = 2: the h^4 e4 term is left out of the Newton matrix)
             // (the slice's fill is a memset; the matrix's goes entry by entry)

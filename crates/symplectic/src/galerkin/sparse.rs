@@ -4,7 +4,7 @@
 //! [`SparseAccelerationSolver`]. Every operation of a step is `O(N)` for a chain of `N`
 //! bodies (see `docs/symplectic.md`, "Sparse stage solve").
 
-use super::Galerkin;
+use super::{with_time, Galerkin};
 use mbd_model::{BodyRef, System};
 use mbd_solve::linalg::LuError;
 use mbd_solve::sparse::{ConstraintSchur, RowIncidence, SparseLu};
@@ -470,6 +470,19 @@ impl Galerkin {
                         }
                     }
                 }
+            }
+        }
+        if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
+            // the s = 1 modified Lagrangian: the diagonals of the blocks of galerkin/dense.rs,
+            // -h^2/12 (2 B) and -h^4/48 A M^-1 A, on the entries (i, Z_1,i) (docs/symplectic.md
+            // section 5a: the dense parts through S^-1 are left out)
+            let [wd, ad] = &mut self.mldiag;
+            ml.modified_newton_diagonals(sys, &self.mlmid, &self.mlvel, wd, ad)
+                .map_err(|e| with_time(e, t))?;
+            let (cw, ch) = (-h2 / 12.0, -(h2 * h2) / 48.0);
+            let vals = sp.lu.values_mut();
+            for i in 0..n {
+                vals[sp.k_slot[i]] += minv[i] * (cw * 2.0 * wd[i] + ch * ad[i]);
             }
         }
         self.jacobians += 1;

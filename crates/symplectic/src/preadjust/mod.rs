@@ -157,12 +157,12 @@ impl Preadjustment {
         Self::with_layout(sys, s, false)
     }
 
-    /// A workspace for the `s = 2` modified Lagrangian alone
-    /// ([`Preadjustment::modified_gradients_s2`], [`Preadjustment::modified_term_s2`]) with
-    /// `S = Phi_q M^-1 Phi_q^T` held sparse ([`ConstraintSchur`]): `O(N)` storage and work per
-    /// evaluation on a chain of `N` bodies (the symplectic scheme's sparse stage solve). The
-    /// `W_s` and `s = 1` methods need the dense matrices and return
-    /// [`SolveError::Unsupported`] on it.
+    /// A workspace for the modified Lagrangian alone ([`Preadjustment::modified_term`],
+    /// [`Preadjustment::modified_gradients`] for `s = 1`, [`Preadjustment::modified_term_s2`],
+    /// [`Preadjustment::modified_gradients_s2`] for `s = 2`) with `S = Phi_q M^-1 Phi_q^T`
+    /// held sparse ([`ConstraintSchur`]): `O(N)` storage and work per evaluation on a chain of
+    /// `N` bodies (the symplectic scheme's sparse stage solve). The `W_s` methods and the dense
+    /// Hessians need the dense matrices and return [`SolveError::Unsupported`] on it.
     pub fn new_sparse(sys: &System) -> Result<Self, SolveError> {
         // (the degree is that of W_s, which the modified Lagrangian does not use)
         Self::with_layout(sys, 1, true)
@@ -240,7 +240,7 @@ impl Preadjustment {
         if self.schur.is_some() {
             return Err(SolveError::Unsupported(format!(
                 "{what} needs the dense layout (Preadjustment::new); this workspace was built by \
-                 Preadjustment::new_sparse for the s = 2 modified Lagrangian"
+                 Preadjustment::new_sparse for the modified Lagrangian"
             )));
         }
         Ok(())

@@ -27,7 +27,6 @@ impl Preadjustment {
     /// `docs/modified-lagrangian.md`, use in `docs/symplectic.md` section 5a). Independent of the
     /// `s` of the workspace.
     pub fn modified_term(&mut self, sys: &System, q: &[f64], v: &[f64]) -> Result<f64, SolveError> {
-        self.require_dense("Preadjustment::modified_term")?;
         self.check_v(v)?;
         self.prepare(sys, q)?;
         Ok(self.modified_prepared(sys, q, v))
@@ -278,7 +277,6 @@ impl Preadjustment {
         dq: &mut [f64],
         dv: &mut [f64],
     ) -> Result<f64, SolveError> {
-        self.require_dense("Preadjustment::modified_gradients")?;
         self.check_v(v)?;
         let (n, m) = (self.n, self.m);
         if dq.len() != n || dv.len() != n {
@@ -294,18 +292,70 @@ impl Preadjustment {
             dv[k] = self.hv[k] / 6.0;
         }
         // (A + H_sigma)(u - w), w = M^-1 Phi_q^T sigma, one Hessian-vector pass
-        let uw = &mut self.tn[1];
-        for k in 0..n {
-            let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * self.sigma[r]).sum();
-            uw[k] = self.u[k] - self.minv[k] * acc;
+        let mut uw = std::mem::take(&mut self.tn[1]);
+        if self.schur.is_some() {
+            uw.copy_from_slice(&self.u);
+            self.add_dgt_to(&self.sigma, -1.0, &mut uw);
+        } else {
+            for k in 0..n {
+                let acc: f64 = (0..m).map(|r| self.gq[(r, k)] * self.sigma[r]).sum();
+                uw[k] = self.u[k] - self.minv[k] * acc;
+            }
         }
-        sys.lagrangian_hessian_vector(q, &self.tn[1], 1.0, &self.cm, dq);
+        sys.lagrangian_hessian_vector(q, &uw, 1.0, &self.cm, dq);
+        self.tn[1] = uw;
         // third derivatives along v (exact, from modified_prepared)
         for k in 0..n {
             dq[k] += self.d3[k];
         }
         dq.iter_mut().for_each(|x| *x /= 12.0);
         Ok(e)
+    }
+}
+
+impl Preadjustment {
+    /// Diagonal approximations of the `s = 1` Newton blocks at `(q, v)`, for the sparse stage
+    /// solve (`docs/symplectic.md` section 5a): `wd = diag(B)` (the velocity Hessian
+    /// `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` without its dense part) and
+    /// `ad_i = A_ii^2 / m_i` (the diagonal of `A M^-1 A`, the sparse part of `A Pi A`, with the
+    /// off-diagonal entries of `A` left out), both `O(N)`. Overwrites `wd` and `ad`.
+    pub(crate) fn modified_newton_diagonals(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        wd: &mut [f64],
+        ad: &mut [f64],
+    ) -> Result<(), SolveError> {
+        self.check_v(v)?;
+        self.prepare_with(sys, q, Some(v))?;
+        // (the Jacobian is evaluated where the residual was: `cm` is then held for this v)
+        if !(self.mv_valid && self.mv.as_slice() == v) {
+            self.modified_prepared(sys, q, v);
+        }
+        wd.fill(0.0);
+        ad.fill(0.0);
+        sys.add_lagrangian_hessian_pair_diagonals(
+            q,
+            (
+                LagrangianWeights {
+                    potential: 1.0,
+                    constraints: &self.nmu0,
+                },
+                ad,
+            ),
+            (
+                LagrangianWeights {
+                    potential: POTENTIAL_WEIGHT,
+                    constraints: &self.cm,
+                },
+                wd,
+            ),
+        );
+        for (a, mi) in ad.iter_mut().zip(&self.minv) {
+            *a = *a * *a * mi;
+        }
+        Ok(())
     }
 }
 
