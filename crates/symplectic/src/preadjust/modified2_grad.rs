@@ -2,15 +2,20 @@
 //! forward evaluation that keeps its intermediates ([`E4Forward`]), then a reverse
 //! (adjoint) pass through them, so `de4/dq` and `de4/dv` cost a fixed number of passes over the
 //! elements, independent of `n` (central differences took `8 n` evaluations of `e4`). Both
-//! run in a workspace allocated on first use ([`E4Work`]): nothing is allocated per call.
+//! run in a workspace allocated on first use ([`E4Work`]): nothing is allocated per call. Every
+//! element pass at `q` takes the bodies' `sin`/`cos` from one table ([`mbd_model::BodyAngles`]).
 //!
 //! The reverse pass needs, besides the linear algebra's adjoints, the adjoints of three
 //! primitives:
 //!
 //! * a directional pass `D^k f(q)(w, .., w)`, `k = 2..4` ([`System::constraint_directional`],
-//!   [`System::potential_directional`]): its gradients in `q` and in `w` come from one pass of
-//!   Taylor series with gradients ([`System::constraint_directional_grad`],
-//!   [`System::potential_directional_grad`]);
+//!   [`System::potential_directional`]): for the gradients the forward evaluation runs it as a
+//!   pass of Taylor series with gradients that keeps the element-local coefficient gradients
+//!   ([`System::constraint_directional_series`], [`System::potential_directional_series`]), and
+//!   the reverse pass only contracts them with its adjoint weights
+//!   ([`System::add_constraint_directional_grads`], [`System::add_potential_directional_grads`]:
+//!   bit for bit [`System::constraint_directional_grad`]'s result, without evaluating the
+//!   elements again);
 //! * a Hessian-vector product `y = H x`, `H = p Hess V + sum_r w_r Hess Phi_r`: with the
 //!   adjoint `yb`, `xb += H yb`, `wb_r += yb^T Hess Phi_r x` (from the element-local rows
 //!   `Hess Phi_r x` of the forward pass) and `qb += D^3 L(x, yb, .)`, the last two from two
@@ -32,10 +37,11 @@
 
 use super::e4_work::{gbar_add, local, Adjoints, E4Work};
 use super::modified2::{
-    comb_into, DK2M, DK2P, DK3M, DK3P, DN, DNMU, DNMV, DNPU, DNPV, DU, DUMV, DUPV, DV, E4_TERMS,
+    comb_into, Dirs, DK2M, DK2P, DK3M, DK3P, DN, DNMU, DNMV, DNPU, DNPV, DU, DUMV, DUPV, DV,
+    E4_TERMS,
 };
 use super::Preadjustment;
-use mbd_model::System;
+use mbd_model::{BodyAngles, System};
 use mbd_solve::SolveError;
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
@@ -132,7 +138,7 @@ impl Preadjustment {
             }
         }
         let mut work = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut work.f);
+        let res = self.e4_forward(sys, q, v, &mut work.f, true);
         let out = res.map(|()| self.e4_reverse(sys, q, v, &mut work, gq, gv));
         self.e4 = Some(work);
         out
@@ -219,12 +225,14 @@ impl Preadjustment {
 
         // 2. the Hessian-vector products
         let zero = f.zero_m.as_slice();
+        let ang = &f.angles;
         let sc = &mut w.tn[2..8];
         let (sig, mu0) = (f.sig.as_slice(), f.mu0.as_slice());
         let (rv, ru) = (f.rhv_v.as_slice(), f.rhv_u.as_slice());
         hvp_adj(
             sys,
             q,
+            ang,
             &f.u,
             (0.0, sig),
             Some(WeightAdjoint {
@@ -240,6 +248,7 @@ impl Preadjustment {
         hvp_adj(
             sys,
             q,
+            ang,
             v,
             (0.0, sig),
             Some(WeightAdjoint {
@@ -255,6 +264,7 @@ impl Preadjustment {
         hvp_adj(
             sys,
             q,
+            ang,
             &f.u,
             (0.0, mu0),
             Some(WeightAdjoint {
@@ -270,6 +280,7 @@ impl Preadjustment {
         hvp_adj(
             sys,
             q,
+            ang,
             v,
             (0.0, mu0),
             Some(WeightAdjoint {
@@ -282,9 +293,31 @@ impl Preadjustment {
             gq,
             sc,
         );
-        hvp_adj(sys, q, &f.nn, (1.0, zero), None, &w.hnb, &mut w.nnb, gq, sc);
-        hvp_adj(sys, q, &f.u, (1.0, zero), None, &w.hub, &mut w.ub, gq, sc);
-        hvp_adj(sys, q, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
+        hvp_adj(
+            sys,
+            q,
+            ang,
+            &f.nn,
+            (1.0, zero),
+            None,
+            &w.hnb,
+            &mut w.nnb,
+            gq,
+            sc,
+        );
+        hvp_adj(
+            sys,
+            q,
+            ang,
+            &f.u,
+            (1.0, zero),
+            None,
+            &w.hub,
+            &mut w.ub,
+            gq,
+            sc,
+        );
+        hvp_adj(sys, q, ang, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
 
         // 3. kappa4 = D^4 Phi(v^4) + 6 vvn + 3 D^2 Phi(n, n) + 4 h_k3v,
         //    kappa3u = vvu + 2 h_k2v + h_nu, and the polarisations behind them
@@ -311,16 +344,14 @@ impl Preadjustment {
         }
 
         // 4. the passes along k3 +- v and k2 +- v
-        let [dir, wb, ..] = &mut w.tn;
+        let [wb, ..] = &mut w.tn;
         for (k, sign) in [(DK3P, 1.0), (DK3M, -1.0)] {
-            comb_into(&f.k3, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.k3b, 1.0, wb);
             axpy(gv, sign, wb);
         }
         for (k, sign) in [(DK2P, 1.0), (DK2M, -1.0)] {
-            comb_into(&f.k2, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.k2b, 1.0, wb);
             axpy(gv, sign, wb);
         }
@@ -346,28 +377,25 @@ impl Preadjustment {
         }
 
         // 7. the passes along n +- u, n +- v, u +- v, u and n
-        let [dir, wb, ..] = &mut w.tn;
+        let [wb, ..] = &mut w.tn;
         for (k, sign) in [(DNPU, 1.0), (DNMU, -1.0)] {
-            comb_into(&f.nn, 1.0, &f.u, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.nnb, 1.0, wb);
             axpy(&mut w.ub, sign, wb);
         }
         for (k, sign) in [(DNPV, 1.0), (DNMV, -1.0)] {
-            comb_into(&f.nn, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.nnb, 1.0, wb);
             axpy(gv, sign, wb);
         }
         for (k, sign) in [(DUPV, 1.0), (DUMV, -1.0)] {
-            comb_into(&f.u, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.ub, 1.0, wb);
             axpy(gv, sign, wb);
         }
-        pass_adj(sys, q, &f.u, &w.pr[DU], w.pp[DU], gq, wb);
+        pass_adj(sys, &f.d[DU], &w.pr[DU], w.pp[DU], gq, wb);
         axpy(&mut w.ub, 1.0, wb);
-        pass_adj(sys, q, &f.nn, &w.pr[DN], w.pp[DN], gq, wb);
+        pass_adj(sys, &f.d[DN], &w.pr[DN], w.pp[DN], gq, wb);
         axpy(&mut w.nnb, 1.0, wb);
 
         // 8. n = -D G^T sigma, sigma = S^-1 gamma, gamma = D^2 Phi(v, v)
@@ -390,7 +418,7 @@ impl Preadjustment {
             }
         }
         let [wb, ..] = &mut w.tn;
-        pass_adj(sys, q, v, &w.pr[DV], w.pp[DV], gq, wb);
+        pass_adj(sys, &f.d[DV], &w.pr[DV], w.pp[DV], gq, wb);
         axpy(gv, 1.0, wb);
 
         // 9. u = -D g + D G^T mu0, mu0 = S^-1 G D g, g = grad V
@@ -414,12 +442,12 @@ impl Preadjustment {
             self.dgt_into(&f.mu0, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
-            sys.lagrangian_hessian_vector(q, &w.gradb, 1.0, zero, t);
+            sys.lagrangian_hessian_vector_at(q, ang, &w.gradb, 1.0, zero, t);
             axpy(gq, 1.0, t);
         }
 
         // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r
-        sys.add_constraint_hessian_rows(q, &w.gbar, gq);
+        sys.add_constraint_hessian_rows_at(q, ang, &w.gbar, gq);
         e4
     }
 }
@@ -439,6 +467,7 @@ struct WeightAdjoint<'a> {
 fn hvp_adj(
     sys: &System,
     q: &[f64],
+    ang: &BodyAngles,
     x: &[f64],
     (pot, wts): (f64, &[f64]),
     wadj: Option<WeightAdjoint>,
@@ -455,8 +484,8 @@ fn hvp_adj(
     };
     comb_into(x, 1.0, yb, 1.0, xp);
     comb_into(x, 1.0, yb, -1.0, xm);
-    sys.lagrangian_third(q, xp, pot, wts, hp, dp);
-    sys.lagrangian_third(q, xm, pot, wts, hm, dm);
+    sys.lagrangian_third_at(q, ang, xp, pot, wts, hp, dp);
+    sys.lagrangian_third_at(q, ang, xm, pot, wts, hm, dm);
     for i in 0..x.len() {
         xb[i] += 0.5 * (hp[i] - hm[i]);
         qb[i] += 0.25 * (dp[i] - dm[i]);
@@ -469,20 +498,20 @@ fn hvp_adj(
     }
 }
 
-/// The adjoint of a directional pass along `w` with the weights `rows` and `pot`: adds its
-/// `q`-gradient to `qb` and writes its `w`-gradient into `wb` (overwritten).
+/// The adjoint of a directional pass `d` (kept with its coefficient gradients by the forward
+/// evaluation) with the weights `rows` and `pot`: adds its `q`-gradient to `qb` and writes its
+/// `w`-gradient into `wb` (overwritten).
 fn pass_adj(
     sys: &System,
-    q: &[f64],
-    w: &[f64],
+    d: &Dirs,
     rows: &[[f64; 3]],
     pot: [f64; 3],
     qb: &mut [f64],
     wb: &mut [f64],
 ) {
     wb.fill(0.0);
-    sys.constraint_directional_grad(q, w, rows, qb, wb);
-    sys.potential_directional_grad(q, w, pot, qb, wb);
+    sys.add_constraint_directional_grads(&d.grads, rows, qb, wb);
+    sys.add_potential_directional_grads(&d.pgrads, pot, qb, wb);
 }
 #[cfg(test)]
 mod tests {
