@@ -133,6 +133,11 @@ pub(super) struct E4Forward {
     pub(super) pi_hmu_v: Vec<f64>,
     pub(super) pi_hv: Vec<f64>,
     pub(super) pi_hsig_v: Vec<f64>,
+    /// `S^-1 G M^-1 x` for `x = H_mu v, H v, H_sigma v` (the projections' solves, which the
+    /// adjoints of the `Pi` terms reuse).
+    pub(super) sg_hmu_v: Vec<f64>,
+    pub(super) sg_hv: Vec<f64>,
+    pub(super) sg_hsig_v: Vec<f64>,
     pub(super) s_beta: Vec<f64>,
     pub(super) s_kap3: Vec<f64>,
     pub(super) d3v_u: f64,
@@ -181,6 +186,9 @@ impl E4Forward {
             pi_hmu_v: zn(),
             pi_hv: zn(),
             pi_hsig_v: zn(),
+            sg_hmu_v: zm(),
+            sg_hv: zm(),
+            sg_hsig_v: zm(),
             s_beta: zm(),
             s_kap3: zm(),
             d3v_u: 0.0,
@@ -278,6 +286,19 @@ impl Preadjustment {
         self.add_dgt_to(x, 1.0, out);
     }
 
+    /// `pi = Pi x` (bit for bit `apply_pi`) and `sg = S^-1 G M^-1 x` (`sgm`, the solve inside
+    /// `Pi x`), by one solve.
+    fn pi_sgm(&mut self, x: &[f64], pi: &mut [f64], sg: &mut [f64]) {
+        for ((p, xi), mi) in pi.iter_mut().zip(x).zip(&self.minv) {
+            *p = mi * xi;
+        }
+        if self.m == 0 {
+            return;
+        }
+        self.sgm(x, sg);
+        self.add_dgt_to(sg, -1.0, pi);
+    }
+
     /// `out = S^-1 x`.
     pub(super) fn s_inv_into(&mut self, x: &[f64], out: &mut [f64]) {
         out.copy_from_slice(x);
@@ -372,9 +393,9 @@ impl Preadjustment {
             out.fill(0.0);
             sys.add_local_rows(rows, w, out);
         }
-        self.apply_pi(&f.hmu_v, &mut f.pi_hmu_v);
-        self.apply_pi(&f.hv, &mut f.pi_hv);
-        self.apply_pi(&f.hsig_v, &mut f.pi_hsig_v);
+        self.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
+        self.pi_sgm(&f.hv, &mut f.pi_hv, &mut f.sg_hv);
+        self.pi_sgm(&f.hsig_v, &mut f.pi_hsig_v, &mut f.sg_hsig_v);
         // potential: D^3 V(u, v, v) and D^3 V(n, v, v) by polarisation (odd in the direction)
         f.d3v_u = (d[DUPV].pot[1] + d[DUMV].pot[1] - 2.0 * d[DU].pot[1]) / 6.0;
         f.d3v_n = (d[DNPV].pot[1] + d[DNMV].pot[1] - 2.0 * d[DN].pot[1]) / 6.0;

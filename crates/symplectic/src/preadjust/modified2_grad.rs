@@ -51,30 +51,6 @@ fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
 }
 
 impl Preadjustment {
-    /// `c a^T Pi b`: leaves the increment of `ab`, `c Pi b`, in `w.tn[0]` and that of `bb`,
-    /// `c Pi a`, in `w.tn[1]`; `Gb` updated.
-    fn adj_pi(
-        &mut self,
-        w: &mut Adjoints,
-        cols: &[[Option<usize>; 6]],
-        c: f64,
-        a: &[f64],
-        b: &[f64],
-    ) {
-        let [pa, pb, ..] = &mut w.tn;
-        let [sa, sb, ..] = &mut w.tm;
-        self.apply_pi(a, pa);
-        self.apply_pi(b, pb);
-        self.sgm(a, sa);
-        self.sgm(b, sb);
-        gbar_add(&mut w.gbar, cols, -c, sb, pa);
-        gbar_add(&mut w.gbar, cols, -c, sa, pb);
-        w.tn.swap(0, 1);
-        for t in &mut w.tn[..2] {
-            t.iter_mut().for_each(|x| *x *= c);
-        }
-    }
-
     /// `c a^T S^-1 b`: leaves the increment of `ab`, `c S^-1 b`, in `w.tm[0]` and that of
     /// `bb`, `c S^-1 a`, in `w.tm[1]`; `Gb` updated.
     fn adj_s(
@@ -165,17 +141,20 @@ impl Preadjustment {
         w.clear();
 
         // 1. the terms
-        self.adj_pi(w, cols, c[0], &f.hsig_v, &f.hmu_v);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[1]);
-        self.adj_pi(w, cols, c[1], &f.hmu_v, &f.hmu_v);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[1]);
+        let hsig_v = (f.pi_hsig_v.as_slice(), f.sg_hsig_v.as_slice());
+        let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
+        let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
+        adj_pi(&mut w.gbar, cols, c[0], hsig_v, hmu_v);
+        axpy(&mut w.hsig_vb, c[0], &f.pi_hmu_v);
+        axpy(&mut w.hmu_vb, c[0], &f.pi_hsig_v);
+        adj_pi(&mut w.gbar, cols, c[1], hmu_v, hmu_v);
+        axpy(&mut w.hmu_vb, c[1], &f.pi_hmu_v);
+        axpy(&mut w.hmu_vb, c[1], &f.pi_hmu_v);
         axpy(&mut w.ub, c[2], &f.hmu_u);
         axpy(&mut w.hmu_ub, c[2], &f.u);
-        self.adj_pi(w, cols, c[3], &f.hmu_v, &f.hv);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hvb, 1.0, &w.tn[1]);
+        adj_pi(&mut w.gbar, cols, c[3], hmu_v, hv);
+        axpy(&mut w.hmu_vb, c[3], &f.pi_hv);
+        axpy(&mut w.hvb, c[3], &f.pi_hmu_v);
         self.adj_s(w, cols, c[4], &f.beta, &f.beta);
         axpy(&mut w.betab, 1.0, &w.tm[0]);
         axpy(&mut w.betab, 1.0, &w.tm[1]);
@@ -202,21 +181,21 @@ impl Preadjustment {
         w.pp[DU][1] -= c[13] / 3.0;
         axpy(&mut w.nnb, c[14], &f.hn);
         axpy(&mut w.hnb, c[14], &f.nn);
-        self.adj_pi(w, cols, c[15], &f.hv, &f.hsig_v);
-        axpy(&mut w.hvb, 1.0, &w.tn[0]);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[1]);
+        adj_pi(&mut w.gbar, cols, c[15], hv, hsig_v);
+        axpy(&mut w.hvb, c[15], &f.pi_hsig_v);
+        axpy(&mut w.hsig_vb, c[15], &f.pi_hv);
         axpy(&mut w.hvb, c[16], &f.k3);
         axpy(&mut w.k3b, c[16], &f.hv);
         w.pp[DNPV][1] += c[17] / 6.0;
         w.pp[DNMV][1] += c[17] / 6.0;
         w.pp[DN][1] -= c[17] / 3.0;
-        self.adj_pi(w, cols, c[18], &f.hv, &f.hv);
-        axpy(&mut w.hvb, 1.0, &w.tn[0]);
-        axpy(&mut w.hvb, 1.0, &w.tn[1]);
+        adj_pi(&mut w.gbar, cols, c[18], hv, hv);
+        axpy(&mut w.hvb, c[18], &f.pi_hv);
+        axpy(&mut w.hvb, c[18], &f.pi_hv);
         w.pp[DV][2] += c[19];
-        self.adj_pi(w, cols, c[20], &f.hsig_v, &f.hsig_v);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[1]);
+        adj_pi(&mut w.gbar, cols, c[20], hsig_v, hsig_v);
+        axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
+        axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
         axpy(&mut w.sigb, c[21], &f.kap4);
         axpy(&mut w.kap4b, c[21], &f.sig);
         self.adj_s(w, cols, c[22], &f.kap3, &f.kap3);
@@ -450,6 +429,20 @@ impl Preadjustment {
         sys.add_constraint_hessian_rows_at(q, ang, &w.gbar, gq);
         e4
     }
+}
+
+/// `c a^T Pi b` with `(Pi a, S^-1 G M^-1 a)` and `(Pi b, S^-1 G M^-1 b)` from the forward
+/// evaluation: `Gb -= c [p_b (Pi a)^T + p_a (Pi b)^T]`; the increments of `ab` and `bb`,
+/// `c Pi b` and `c Pi a`, are the caller's.
+fn adj_pi(
+    gbar: &mut [[f64; 6]],
+    cols: &[[Option<usize>; 6]],
+    c: f64,
+    (pa, sa): (&[f64], &[f64]),
+    (pb, sb): (&[f64], &[f64]),
+) {
+    gbar_add(gbar, cols, -c, sb, pa);
+    gbar_add(gbar, cols, -c, sa, pb);
 }
 
 /// The adjoint of the weights of a Hessian-vector product: `rows[r]` is the element-local
