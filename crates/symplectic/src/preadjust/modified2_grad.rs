@@ -51,30 +51,6 @@ fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
 }
 
 impl Preadjustment {
-    /// `c a^T S^-1 b`: leaves the increment of `ab`, `c S^-1 b`, in `w.tm[0]` and that of
-    /// `bb`, `c S^-1 a`, in `w.tm[1]`; `Gb` updated.
-    fn adj_s(
-        &mut self,
-        w: &mut Adjoints,
-        cols: &[[Option<usize>; 6]],
-        c: f64,
-        a: &[f64],
-        b: &[f64],
-    ) {
-        let [al, be, ..] = &mut w.tm;
-        let [dal, dbe, ..] = &mut w.tn;
-        self.s_inv_into(a, al);
-        self.s_inv_into(b, be);
-        self.dgt_into(al, dal);
-        self.dgt_into(be, dbe);
-        gbar_add(&mut w.gbar, cols, -c, al, dbe);
-        gbar_add(&mut w.gbar, cols, -c, be, dal);
-        w.tm.swap(0, 1);
-        for t in &mut w.tm[..2] {
-            t.iter_mut().for_each(|x| *x *= c);
-        }
-    }
-
     /// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
     /// adjoint `yb`; `Gb` updated.
     fn adj_neg_e(&mut self, w: &mut Adjoints, cols: &[[Option<usize>; 6]], z: &[f64], yb: &[f64]) {
@@ -155,14 +131,16 @@ impl Preadjustment {
         adj_pi(&mut w.gbar, cols, c[3], hmu_v, hv);
         axpy(&mut w.hmu_vb, c[3], &f.pi_hv);
         axpy(&mut w.hvb, c[3], &f.pi_hmu_v);
-        self.adj_s(w, cols, c[4], &f.beta, &f.beta);
-        axpy(&mut w.betab, 1.0, &w.tm[0]);
-        axpy(&mut w.betab, 1.0, &w.tm[1]);
+        let beta = (f.s_beta.as_slice(), f.k2.as_slice());
+        let kap3 = (f.s_kap3.as_slice(), f.k3.as_slice());
+        adj_s(&mut w.gbar, cols, c[4], beta, beta);
+        axpy(&mut w.betab, c[4], &f.s_beta);
+        axpy(&mut w.betab, c[4], &f.s_beta);
         axpy(&mut w.ub, c[5], &f.hsig_u);
         axpy(&mut w.hsig_ub, c[5], &f.u);
-        self.adj_s(w, cols, c[6], &f.kap3, &f.beta);
-        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
-        axpy(&mut w.betab, 1.0, &w.tm[1]);
+        adj_s(&mut w.gbar, cols, c[6], kap3, beta);
+        axpy(&mut w.kap3b, c[6], &f.s_beta);
+        axpy(&mut w.betab, c[6], &f.s_kap3);
         axpy(&mut w.hvb, c[7], &f.k2);
         axpy(&mut w.k2b, c[7], &f.hv);
         axpy(&mut w.mu0b, c[8], &f.kap3u);
@@ -198,9 +176,9 @@ impl Preadjustment {
         axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
         axpy(&mut w.sigb, c[21], &f.kap4);
         axpy(&mut w.kap4b, c[21], &f.sig);
-        self.adj_s(w, cols, c[22], &f.kap3, &f.kap3);
-        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
-        axpy(&mut w.kap3b, 1.0, &w.tm[1]);
+        adj_s(&mut w.gbar, cols, c[22], kap3, kap3);
+        axpy(&mut w.kap3b, c[22], &f.s_kap3);
+        axpy(&mut w.kap3b, c[22], &f.s_kap3);
 
         // 2. the Hessian-vector products
         let zero = f.zero_m.as_slice();
@@ -443,6 +421,21 @@ fn adj_pi(
 ) {
     gbar_add(gbar, cols, -c, sb, pa);
     gbar_add(gbar, cols, -c, sa, pb);
+}
+
+/// `c a^T S^-1 b` with `(S^-1 a, k_a)` and `(S^-1 b, k_b)`, `k_x = -D G^T S^-1 x`, from the
+/// forward evaluation: `Gb -= c [al (D G^T be)^T + be (D G^T al)^T]`, i.e.
+/// `Gb += c [al k_b^T + be k_a^T]`; the increments of `ab` and `bb`, `c S^-1 b` and
+/// `c S^-1 a`, are the caller's.
+fn adj_s(
+    gbar: &mut [[f64; 6]],
+    cols: &[[Option<usize>; 6]],
+    c: f64,
+    (al, ka): (&[f64], &[f64]),
+    (be, kb): (&[f64], &[f64]),
+) {
+    gbar_add(gbar, cols, c, al, kb);
+    gbar_add(gbar, cols, c, be, ka);
 }
 
 /// The adjoint of the weights of a Hessian-vector product: `rows[r]` is the element-local
