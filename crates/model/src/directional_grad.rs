@@ -55,7 +55,7 @@ impl System {
     /// ..., w, e_i) / k!` (`k = 0..=4`, the six columns of the joint's two bodies as in
     /// [`System::phi_q_local`]). From them [`System::add_constraint_directional_grads`] gives
     /// the gradients of any weighted sum of the rows without another pass over the elements.
-    /// One [`TaylorGrad4`] pass per joint; no allocation.
+    /// One `TaylorGrad4` pass per joint; no allocation.
     pub fn constraint_directional_series(
         &self,
         q: &[f64],
@@ -118,7 +118,7 @@ impl System {
     /// keeps, per force element `f` (in the order of [`System::forces`]; `grads` has one entry
     /// per element), the element-local gradients of its potential's series coefficients (as in
     /// [`System::constraint_directional_series`]), for
-    /// [`System::add_potential_directional_grads`]. One [`TaylorGrad4`] pass per force element;
+    /// [`System::add_potential_directional_grads`]. One `TaylorGrad4` pass per force element;
     /// no allocation.
     pub fn potential_directional_series(
         &self,
