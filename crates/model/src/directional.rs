@@ -7,13 +7,79 @@
 use crate::jet::{Frame, Scalar, Taylor4};
 use crate::system::System;
 
+/// The sine and cosine of every body's angle at one configuration `q`, evaluated once
+/// ([`BodyAngles::update`]) and shared by all the element passes at that `q` (the `_at`
+/// variants such as [`System::constraint_directional_at`] and [`System::lagrangian_third_at`]):
+/// they give bit for bit the results of the plain passes without one `sin_cos` per element
+/// and body. Allocated once ([`BodyAngles::new`]); updating allocates nothing unless the
+/// number of bodies changed.
+#[derive(Clone, Debug, Default)]
+pub struct BodyAngles {
+    /// Per body: `[theta, sin theta, cos theta]`.
+    sc: Vec<[f64; 3]>,
+}
+
+impl BodyAngles {
+    /// The table for the bodies of `sys` at the configuration `q` (length `sys.n_coords()`).
+    pub fn new(sys: &System, q: &[f64]) -> Self {
+        let mut a = BodyAngles::default();
+        a.update(sys, q);
+        a
+    }
+
+    /// Evaluates `sin` and `cos` of every body angle of `sys` at `q` (length
+    /// `sys.n_coords()`), in place.
+    pub fn update(&mut self, sys: &System, q: &[f64]) {
+        let nb = sys.bodies.len();
+        debug_assert_eq!(q.len(), 3 * nb);
+        if self.sc.len() != nb {
+            self.sc.resize(nb, [0.0; 3]);
+        }
+        for (i, e) in self.sc.iter_mut().enumerate() {
+            let th = q[3 * i + 2];
+            let (s, c) = th.sin_cos();
+            *e = [th, s, c];
+        }
+    }
+
+    /// Whether the table holds the angles of `q` (the `_at` passes check it in debug builds).
+    pub fn matches(&self, q: &[f64]) -> bool {
+        q.len() == 3 * self.sc.len()
+            && self
+                .sc
+                .iter()
+                .enumerate()
+                .all(|(i, e)| e[0].to_bits() == q[3 * i + 2].to_bits())
+    }
+
+    /// The frame of body `i` with the jet coordinates `vars` (whose angle has the value of
+    /// body `i`'s angle in the table), or with `sin_cos` evaluated when there is no table.
+    #[inline(always)]
+    pub(crate) fn frame<T: Scalar>(angles: Option<&Self>, i: usize, vars: [T; 3]) -> Frame<T> {
+        match angles {
+            Some(a) => {
+                let [_, s, c] = a.sc[i];
+                Frame::with_sin_cos(vars, s, c)
+            }
+            None => Frame::new(vars),
+        }
+    }
+}
+
 impl System {
     #[inline(always)]
-    fn loc_taylor(q: &[f64], w: &[f64], i: Option<usize>) -> Frame<Taylor4> {
+    fn loc_taylor(
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        w: &[f64],
+        i: Option<usize>,
+    ) -> Frame<Taylor4> {
         match i {
-            Some(i) => Frame::new(std::array::from_fn(|k| {
-                Taylor4::var(q[3 * i + k], w[3 * i + k])
-            })),
+            Some(i) => BodyAngles::frame(
+                ang,
+                i,
+                std::array::from_fn(|k| Taylor4::var(q[3 * i + k], w[3 * i + k])),
+            ),
             None => Frame::fixed(),
         }
     }
@@ -22,12 +88,36 @@ impl System {
     /// constraint row `r` (the configuration part: time enters the joint equations only
     /// additively).
     pub fn constraint_directional(&self, q: &[f64], w: &[f64], out: &mut [[f64; 3]]) {
+        self.constraint_directional_impl(q, None, w, out);
+    }
+
+    /// [`System::constraint_directional`] with the body angles' `sin`/`cos` from `angles`
+    /// (evaluated at this `q`): bit for bit the same.
+    pub fn constraint_directional_at(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        w: &[f64],
+        out: &mut [[f64; 3]],
+    ) {
+        debug_assert!(angles.matches(q));
+        self.constraint_directional_impl(q, Some(angles), w, out);
+    }
+
+    #[inline(always)]
+    fn constraint_directional_impl(
+        &self,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        w: &[f64],
+        out: &mut [[f64; 3]],
+    ) {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let mut e = [Taylor4::cst(0.0); 3];
             j.eval(
-                &Self::loc_taylor(q, w, at.a),
-                &Self::loc_taylor(q, w, at.b),
+                &Self::loc_taylor(q, ang, w, at.a),
+                &Self::loc_taylor(q, ang, w, at.b),
                 &mut e,
             );
             let o = self.row_offset[ji];
@@ -40,10 +130,30 @@ impl System {
     /// `[D^2 V(w, w), D^3 V(w, w, w), D^4 V(w, w, w, w)]` at `q` (gravity is linear and
     /// contributes nothing; non-conservative elements have no potential).
     pub fn potential_directional(&self, q: &[f64], w: &[f64]) -> [f64; 3] {
+        self.potential_directional_impl(q, None, w)
+    }
+
+    /// [`System::potential_directional`] with the body angles' `sin`/`cos` from `angles`
+    /// (evaluated at this `q`): bit for bit the same.
+    pub fn potential_directional_at(&self, q: &[f64], angles: &BodyAngles, w: &[f64]) -> [f64; 3] {
+        debug_assert!(angles.matches(q));
+        self.potential_directional_impl(q, Some(angles), w)
+    }
+
+    #[inline(always)]
+    fn potential_directional_impl(
+        &self,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        w: &[f64],
+    ) -> [f64; 3] {
         let mut d = [0.0; 3];
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
-            let e = f.potential(&Self::loc_taylor(q, w, at.a), &Self::loc_taylor(q, w, at.b));
+            let e = f.potential(
+                &Self::loc_taylor(q, ang, w, at.a),
+                &Self::loc_taylor(q, ang, w, at.b),
+            );
             for (k, dk) in d.iter_mut().enumerate() {
                 *dk += e.derivative(k + 2);
             }
@@ -119,6 +229,79 @@ mod tests {
             let wv = nalgebra::DVector::from_column_slice(&w);
             let t2 = wv.dot(&(&hm * &wv));
             assert!((pd[0] - t2).abs() < 1e-12 * (1.0 + t2.abs()), "D2 V");
+        }
+    }
+
+    /// Every pass with precomputed body angles ([`BodyAngles`]) equals the plain pass bit for
+    /// bit (the directional, Hessian-vector, third-order and Hessian-row passes), on every
+    /// joint kind, the manipulator and the spring model; and the table knows its `q`.
+    #[test]
+    fn passes_at_precomputed_angles_are_bitwise_the_plain_ones() {
+        use super::BodyAngles;
+        let same = |a: &[f64], b: &[f64], what: &str| {
+            assert_eq!(a.len(), b.len());
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                assert_eq!(x.to_bits(), y.to_bits(), "{what} [{i}]: {x} vs {y}");
+            }
+        };
+        for sys in crate::fixtures::derivative_test_systems() {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let (q, w) = crate::fixtures::generic_point(n);
+            let ang = BodyAngles::new(&sys, &q);
+            assert!(ang.matches(&q));
+            let mut q2 = q.clone();
+            q2[2] += 1e-3;
+            assert!(!ang.matches(&q2));
+            // directional
+            let (mut r1, mut r2) = (vec![[0.0; 3]; m], vec![[0.0; 3]; m]);
+            sys.constraint_directional(&q, &w, &mut r1);
+            sys.constraint_directional_at(&q, &ang, &w, &mut r2);
+            same(
+                r1.as_flattened(),
+                r2.as_flattened(),
+                "constraint_directional",
+            );
+            let (p1, p2) = (
+                sys.potential_directional(&q, &w),
+                sys.potential_directional_at(&q, &ang, &w),
+            );
+            same(&p1, &p2, "potential_directional");
+            // Hessian-vector products and third derivatives
+            let wts: Vec<f64> = (0..m).map(|r| 0.3 - 0.11 * r as f64).collect();
+            for pot in [0.0, 1.0] {
+                let (mut h1, mut h2) = (vec![0.0; n], vec![0.0; n]);
+                sys.lagrangian_hessian_vector(&q, &w, pot, &wts, &mut h1);
+                sys.lagrangian_hessian_vector_at(&q, &ang, &w, pot, &wts, &mut h2);
+                same(&h1, &h2, "lagrangian_hessian_vector");
+                let (mut d1, mut d2) = (vec![0.0; n], vec![0.0; n]);
+                sys.lagrangian_third(&q, &w, pot, &wts, &mut h1, &mut d1);
+                sys.lagrangian_third_at(&q, &ang, &w, pot, &wts, &mut h2, &mut d2);
+                same(&h1, &h2, "lagrangian_third H w");
+                same(&d1, &d2, "lagrangian_third D3");
+            }
+            let rows = || {
+                (
+                    vec![[0.0; 6]; m],
+                    vec![[0.0; 6]; m],
+                    vec![[0.0; 6]; m],
+                    vec![0.0; m],
+                )
+            };
+            let (mut g1, mut hv1, mut t1, mut v1) = rows();
+            let (mut g2, mut hv2, mut t2, mut v2) = rows();
+            sys.constraint_third_local(&q, &w, &mut g1, &mut hv1, &mut t1, &mut v1);
+            sys.constraint_third_local_at(&q, &ang, &w, &mut g2, &mut hv2, &mut t2, &mut v2);
+            same(g1.as_flattened(), g2.as_flattened(), "third_local grads");
+            same(hv1.as_flattened(), hv2.as_flattened(), "third_local H v");
+            same(t1.as_flattened(), t2.as_flattened(), "third_local D3");
+            same(&v1, &v2, "third_local v H v");
+            let dirs: Vec<[f64; 6]> = (0..m)
+                .map(|r| std::array::from_fn(|l| 0.2 * ((r * 6 + l) as f64 * 0.37).sin()))
+                .collect();
+            let (mut o1, mut o2) = (vec![0.5; n], vec![0.5; n]);
+            sys.add_constraint_hessian_rows(&q, &dirs, &mut o1);
+            sys.add_constraint_hessian_rows_at(&q, &ang, &dirs, &mut o2);
+            same(&o1, &o2, "add_constraint_hessian_rows");
         }
     }
 }

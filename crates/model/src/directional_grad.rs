@@ -5,33 +5,169 @@
 //! modified-Lagrangian terms built from [`System::constraint_directional`] and
 //! [`System::potential_directional`] need).
 
+use crate::directional::BodyAngles;
 use crate::jet::{Frame, Scalar, TaylorGrad4, NV};
 use crate::system::System;
 
+/// The element-local gradients of the five Taylor coefficients of one element equation along
+/// one direction (`TaylorGrad4::g`): entry `[k][i]` is `D^(k+1) f(q)(w, ..., w, e_i) / k!`.
+type SeriesGrads = [[f64; NV]; 5];
+
 impl System {
     #[inline(always)]
-    fn loc_taylor_grad(q: &[f64], w: &[f64], i: Option<usize>, slot: usize) -> Frame<TaylorGrad4> {
+    fn loc_taylor_grad(
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        w: &[f64],
+        i: Option<usize>,
+        slot: usize,
+    ) -> Frame<TaylorGrad4> {
         match i {
-            Some(i) => Frame::new(std::array::from_fn(|k| {
-                TaylorGrad4::var(slot + k, q[3 * i + k], w[3 * i + k])
-            })),
+            Some(i) => BodyAngles::frame(
+                ang,
+                i,
+                std::array::from_fn(|k| TaylorGrad4::var(slot + k, q[3 * i + k], w[3 * i + k])),
+            ),
             None => Frame::fixed(),
         }
     }
 
     /// `gq += c[k-2] grad_q D^k f(w^k)`, `gw += c[k-2] grad_w D^k f(w^k)`, `k = 2..=4`, for one
-    /// element-local series `e` (local gradients).
+    /// element-local series with the coefficient gradients `g` (local gradients).
     #[inline(always)]
-    fn add_weighted_grads(e: &TaylorGrad4, c: [f64; 3], gq: &mut [f64; NV], gw: &mut [f64; NV]) {
+    fn add_weighted_grads(g: &SeriesGrads, c: [f64; 3], gq: &mut [f64; NV], gw: &mut [f64; NV]) {
         for (i, &ck) in c.iter().enumerate() {
             if ck == 0.0 {
                 continue;
             }
-            let (dq, dw) = (e.derivative_grad_q(i + 2), e.derivative_grad_w(i + 2));
+            let dq = TaylorGrad4::derivative_grad_q(g, i + 2);
+            let dw = TaylorGrad4::derivative_grad_w(g, i + 2);
             for l in 0..NV {
                 gq[l] += ck * dq[l];
                 gw[l] += ck * dw[l];
             }
+        }
+    }
+
+    /// [`System::constraint_directional_at`] (the rows `out[r] = [D^2, D^3, D^4] Phi_r(w, ...)`,
+    /// bit for bit) that also keeps, per constraint row `r`, the element-local gradients of the
+    /// series coefficients with respect to the base point, `grads[r][k][i] = D^(k+1) Phi_r(q)(w,
+    /// ..., w, e_i) / k!` (`k = 0..=4`, the six columns of the joint's two bodies as in
+    /// [`System::phi_q_local`]). From them [`System::add_constraint_directional_grads`] gives
+    /// the gradients of any weighted sum of the rows without another pass over the elements.
+    /// One `TaylorGrad4` pass per joint; no allocation.
+    pub fn constraint_directional_series(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        w: &[f64],
+        out: &mut [[f64; 3]],
+        grads: &mut [[[f64; NV]; 5]],
+    ) {
+        debug_assert!(angles.matches(q));
+        debug_assert!(out.len() == self.n_constraints() && grads.len() == out.len());
+        let ang = Some(angles);
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let mut e = [TaylorGrad4::cst(0.0); 3];
+            j.eval(
+                &Self::loc_taylor_grad(q, ang, w, at.a, 0),
+                &Self::loc_taylor_grad(q, ang, w, at.b, 3),
+                &mut e,
+            );
+            let o = self.row_offset[ji];
+            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+                out[o + k] = [ek.derivative(2), ek.derivative(3), ek.derivative(4)];
+                grads[o + k] = ek.g;
+            }
+        }
+    }
+
+    /// Adds to `gq` and `gw` (length n each) the gradients with respect to `q` and to `w` of
+    /// `sum_r sum_(k=2..4) c[r][k-2] D^k Phi_r(q)(w, ..., w)` from the coefficient gradients
+    /// `grads` of [`System::constraint_directional_series`] at `(q, w)`: bit for bit what
+    /// [`System::constraint_directional_grad`] adds, without evaluating the elements.
+    pub fn add_constraint_directional_grads(
+        &self,
+        grads: &[[[f64; NV]; 5]],
+        c: &[[f64; 3]],
+        gq: &mut [f64],
+        gw: &mut [f64],
+    ) {
+        let n = self.n_coords();
+        debug_assert!(gq.len() == n && gw.len() == n);
+        debug_assert!(c.len() == self.n_constraints() && grads.len() == c.len());
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            let ne = j.n_equations();
+            let rows = &c[o..o + ne];
+            if rows.iter().all(|r| r.iter().all(|&x| x == 0.0)) {
+                continue;
+            }
+            let (mut lq, mut lw) = ([0.0; NV], [0.0; NV]);
+            for (g, ck) in grads[o..o + ne].iter().zip(rows) {
+                Self::add_weighted_grads(g, *ck, &mut lq, &mut lw);
+            }
+            Self::scatter_grad(at, &lq, 1.0, gq);
+            Self::scatter_grad(at, &lw, 1.0, gw);
+        }
+    }
+
+    /// [`System::potential_directional_at`] (`[D^2, D^3, D^4] V(w, ...)`, bit for bit) that also
+    /// keeps, per force element `f` (in the order of [`System::forces`]; `grads` has one entry
+    /// per element), the element-local gradients of its potential's series coefficients (as in
+    /// [`System::constraint_directional_series`]), for
+    /// [`System::add_potential_directional_grads`]. One `TaylorGrad4` pass per force element;
+    /// no allocation.
+    pub fn potential_directional_series(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        w: &[f64],
+        grads: &mut [[[f64; NV]; 5]],
+    ) -> [f64; 3] {
+        debug_assert!(angles.matches(q));
+        debug_assert_eq!(grads.len(), self.forces.len());
+        let ang = Some(angles);
+        let mut d = [0.0; 3];
+        for (fi, f) in self.forces.iter().enumerate() {
+            let at = self.force_attach[fi];
+            let e = f.potential(
+                &Self::loc_taylor_grad(q, ang, w, at.a, 0),
+                &Self::loc_taylor_grad(q, ang, w, at.b, 3),
+            );
+            for (k, dk) in d.iter_mut().enumerate() {
+                *dk += e.derivative(k + 2);
+            }
+            grads[fi] = e.g;
+        }
+        d
+    }
+
+    /// Adds to `gq` and `gw` (length n each) the gradients with respect to `q` and to `w` of
+    /// `sum_(k=2..4) c[k-2] D^k V(q)(w, ..., w)` from the coefficient gradients `grads` of
+    /// [`System::potential_directional_series`] at `(q, w)`: bit for bit what
+    /// [`System::potential_directional_grad`] adds, without evaluating the elements.
+    pub fn add_potential_directional_grads(
+        &self,
+        grads: &[[[f64; NV]; 5]],
+        c: [f64; 3],
+        gq: &mut [f64],
+        gw: &mut [f64],
+    ) {
+        let n = self.n_coords();
+        debug_assert!(gq.len() == n && gw.len() == n);
+        debug_assert_eq!(grads.len(), self.forces.len());
+        if c.iter().all(|&x| x == 0.0) {
+            return;
+        }
+        for (fi, g) in grads.iter().enumerate() {
+            let at = self.force_attach[fi];
+            let (mut lq, mut lw) = ([0.0; NV], [0.0; NV]);
+            Self::add_weighted_grads(g, c, &mut lq, &mut lw);
+            Self::scatter_grad(at, &lq, 1.0, gq);
+            Self::scatter_grad(at, &lw, 1.0, gw);
         }
     }
 
@@ -61,13 +197,13 @@ impl System {
             }
             let mut e = [TaylorGrad4::cst(0.0); 3];
             j.eval(
-                &Self::loc_taylor_grad(q, w, at.a, 0),
-                &Self::loc_taylor_grad(q, w, at.b, 3),
+                &Self::loc_taylor_grad(q, None, w, at.a, 0),
+                &Self::loc_taylor_grad(q, None, w, at.b, 3),
                 &mut e,
             );
             let (mut lq, mut lw) = ([0.0; NV], [0.0; NV]);
             for (ek, ck) in e.iter().zip(rows) {
-                Self::add_weighted_grads(ek, *ck, &mut lq, &mut lw);
+                Self::add_weighted_grads(&ek.g, *ck, &mut lq, &mut lw);
             }
             Self::scatter_grad(at, &lq, 1.0, gq);
             Self::scatter_grad(at, &lw, 1.0, gw);
@@ -95,11 +231,11 @@ impl System {
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
             let e = f.potential(
-                &Self::loc_taylor_grad(q, w, at.a, 0),
-                &Self::loc_taylor_grad(q, w, at.b, 3),
+                &Self::loc_taylor_grad(q, None, w, at.a, 0),
+                &Self::loc_taylor_grad(q, None, w, at.b, 3),
             );
             let (mut lq, mut lw) = ([0.0; NV], [0.0; NV]);
-            Self::add_weighted_grads(&e, c, &mut lq, &mut lw);
+            Self::add_weighted_grads(&e.g, c, &mut lq, &mut lw);
             Self::scatter_grad(at, &lq, 1.0, gq);
             Self::scatter_grad(at, &lw, 1.0, gw);
         }
@@ -260,6 +396,50 @@ mod tests {
         };
         for sys in crate::fixtures::derivative_test_systems() {
             check(&sys);
+        }
+    }
+
+    /// The stored-series passes: their rows equal [`System::constraint_directional`] and
+    /// [`System::potential_directional`] bit for bit, and contracting their coefficient
+    /// gradients gives bit for bit what [`System::constraint_directional_grad`] and
+    /// [`System::potential_directional_grad`] add (also with some zero weights).
+    #[test]
+    fn stored_series_match_the_direct_passes_bitwise() {
+        let same = |a: &[f64], b: &[f64], what: &str| {
+            assert_eq!(a.len(), b.len());
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                assert_eq!(x.to_bits(), y.to_bits(), "{what} [{i}]: {x} vs {y}");
+            }
+        };
+        for sys in crate::fixtures::derivative_test_systems() {
+            let (n, m, nf) = (sys.n_coords(), sys.n_constraints(), sys.forces().len());
+            let (q, w) = crate::fixtures::generic_point(n);
+            let ang = crate::BodyAngles::new(&sys, &q);
+            let (mut rows, mut series) = (vec![[0.0; 3]; m], vec![[0.0; 3]; m]);
+            let mut grads = vec![[[0.0; 6]; 5]; m];
+            sys.constraint_directional(&q, &w, &mut rows);
+            sys.constraint_directional_series(&q, &ang, &w, &mut series, &mut grads);
+            same(rows.as_flattened(), series.as_flattened(), "rows");
+            let mut pgrads = vec![[[0.0; 6]; 5]; nf];
+            let pot = sys.potential_directional_series(&q, &ang, &w, &mut pgrads);
+            same(&pot, &sys.potential_directional(&q, &w), "potential");
+            let mut c = weights(m);
+            if m > 1 {
+                c[1] = [0.0, 0.0, 0.0];
+                c[0][1] = 0.0;
+            }
+            let (mut gq1, mut gw1) = (vec![0.1; n], vec![-0.2; n]);
+            let (mut gq2, mut gw2) = (gq1.clone(), gw1.clone());
+            sys.constraint_directional_grad(&q, &w, &c, &mut gq1, &mut gw1);
+            sys.add_constraint_directional_grads(&grads, &c, &mut gq2, &mut gw2);
+            same(&gq1, &gq2, "constraint grad_q");
+            same(&gw1, &gw2, "constraint grad_w");
+            for cp in [[0.7, -0.45, 0.3], [0.0, 1.0, 0.0]] {
+                sys.potential_directional_grad(&q, &w, cp, &mut gq1, &mut gw1);
+                sys.add_potential_directional_grads(&pgrads, cp, &mut gq2, &mut gw2);
+                same(&gq1, &gq2, "potential grad_q");
+                same(&gw1, &gw2, "potential grad_w");
+            }
         }
     }
 }

@@ -92,6 +92,10 @@ pub trait Scalar:
     fn cst(v: f64) -> Self;
     /// `(sin x, cos x)`.
     fn sin_cos(self) -> (Self, Self);
+    /// `(sin x, cos x)` given `s = sin` and `c = cos` of the value of `x` (evaluated once and
+    /// shared by several jets at the same point): bit for bit [`Scalar::sin_cos`] when `(s, c)`
+    /// is `value.sin_cos()`.
+    fn sin_cos_with(self, s: f64, c: f64) -> (Self, Self);
     /// Square root (the caller keeps the argument positive).
     fn sqrt(self) -> Self;
 }
@@ -104,6 +108,10 @@ impl Scalar for f64 {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         f64::sin_cos(self)
+    }
+    #[inline(always)]
+    fn sin_cos_with(self, s: f64, c: f64) -> (Self, Self) {
+        (s, c)
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -127,6 +135,13 @@ impl<T: Scalar> Frame<T> {
     #[inline(always)]
     pub fn new(q: [T; 3]) -> Self {
         let (s, c) = q[2].sin_cos();
+        Frame { q, c, s }
+    }
+    /// A moving frame whose angle `q[2]` has the value `theta` with `(sin theta, cos theta)`
+    /// `= (s, c)` given (see [`Scalar::sin_cos_with`]): no trigonometry.
+    #[inline(always)]
+    pub fn with_sin_cos(q: [T; 3], s: f64, c: f64) -> Self {
+        let (s, c) = q[2].sin_cos_with(s, c);
         Frame { q, c, s }
     }
     /// The ground frame (identity, constant).

@@ -70,6 +70,7 @@ mod timefn;
 pub use body::{Body, BodyHandle, BodyRef};
 pub use builder::SystemBuilder;
 pub use cache::AngleCache;
+pub use directional::BodyAngles;
 pub use error::ModelError;
 pub use file::{BodyKind, BodySpec, ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};

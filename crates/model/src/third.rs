@@ -6,17 +6,44 @@
 //! `D^3 f(a, b, .)` follow by polarisation:
 //! `D^3 f(a, b, .) = 1/4 [D^3 f(a + b, a + b, .) - D^3 f(a - b, a - b, .)]`.
 
+use crate::directional::BodyAngles;
 use crate::jet::{Frame, Scalar, TanJet, ThirdJet, NV};
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 
 impl System {
     #[inline(always)]
-    fn loc_third(q: &[f64], v: &[f64], i: Option<usize>, slot: usize) -> Frame<ThirdJet> {
+    fn loc_third(
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        v: &[f64],
+        i: Option<usize>,
+        slot: usize,
+    ) -> Frame<ThirdJet> {
         match i {
-            Some(i) => Frame::new(std::array::from_fn(|k| {
-                ThirdJet::var(slot + k, q[3 * i + k], v[3 * i + k])
-            })),
+            Some(i) => BodyAngles::frame(
+                ang,
+                i,
+                std::array::from_fn(|k| ThirdJet::var(slot + k, q[3 * i + k], v[3 * i + k])),
+            ),
+            None => Frame::fixed(),
+        }
+    }
+
+    #[inline(always)]
+    fn loc_tan_at(
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        v: &[f64],
+        i: Option<usize>,
+        slot: usize,
+    ) -> Frame<TanJet> {
+        match i {
+            Some(i) => BodyAngles::frame(
+                ang,
+                i,
+                std::array::from_fn(|k| TanJet::var(slot + k, q[3 * i + k], v[3 * i + k])),
+            ),
             None => Frame::fixed(),
         }
     }
@@ -46,11 +73,12 @@ impl System {
 
     /// Adds `scale * D^3 V(q)(v, v, .)` into `out` (see [`System::potential_third`]).
     pub fn add_potential_third(&self, q: &[f64], v: &[f64], scale: f64, out: &mut [f64]) {
+        let ang = None;
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
             let e = f.potential(
-                &Self::loc_third(q, v, at.a, 0),
-                &Self::loc_third(q, v, at.b, 3),
+                &Self::loc_third(q, ang, v, at.a, 0),
+                &Self::loc_third(q, ang, v, at.b, 3),
             );
             Self::scatter_grad(at, &e.g2, scale, out);
         }
@@ -75,6 +103,7 @@ impl System {
         scale: f64,
         out: &mut [f64],
     ) {
+        let ang = None;
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let o = self.row_offset[ji];
@@ -84,8 +113,8 @@ impl System {
             }
             let mut e = [ThirdJet::cst(0.0); 3];
             j.eval(
-                &Self::loc_third(q, v, at.a, 0),
-                &Self::loc_third(q, v, at.b, 3),
+                &Self::loc_third(q, ang, v, at.a, 0),
+                &Self::loc_third(q, ang, v, at.b, 3),
                 &mut e,
             );
             let mut g = [0.0; NV];
@@ -109,11 +138,42 @@ impl System {
         weights: &[f64],
         out: &mut [f64],
     ) {
+        self.lagrangian_hessian_vector_impl(q, None, w, potential, weights, out);
+    }
+
+    /// [`System::lagrangian_hessian_vector`] with the body angles' `sin`/`cos` from `angles`
+    /// (evaluated at this `q`, [`BodyAngles`]): bit for bit the same.
+    pub fn lagrangian_hessian_vector_at(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        w: &[f64],
+        potential: f64,
+        weights: &[f64],
+        out: &mut [f64],
+    ) {
+        debug_assert!(angles.matches(q));
+        self.lagrangian_hessian_vector_impl(q, Some(angles), w, potential, weights, out);
+    }
+
+    #[inline(always)]
+    fn lagrangian_hessian_vector_impl(
+        &self,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        w: &[f64],
+        potential: f64,
+        weights: &[f64],
+        out: &mut [f64],
+    ) {
         out.fill(0.0);
         if potential != 0.0 {
             for (fi, f) in self.forces.iter().enumerate() {
                 let at = self.force_attach[fi];
-                let e = f.potential(&Self::loc_tan(q, w, at.a, 0), &Self::loc_tan(q, w, at.b, 3));
+                let e = f.potential(
+                    &Self::loc_tan_at(q, ang, w, at.a, 0),
+                    &Self::loc_tan_at(q, ang, w, at.b, 3),
+                );
                 Self::scatter_grad(at, &e.dg, potential, out);
             }
         }
@@ -126,8 +186,8 @@ impl System {
             }
             let mut e = [TanJet::cst(0.0); 3];
             j.eval(
-                &Self::loc_tan(q, w, at.a, 0),
-                &Self::loc_tan(q, w, at.b, 3),
+                &Self::loc_tan_at(q, ang, w, at.a, 0),
+                &Self::loc_tan_at(q, ang, w, at.b, 3),
                 &mut e,
             );
             let mut g = [0.0; NV];
@@ -152,14 +212,46 @@ impl System {
         hv: &mut [f64],
         d3: &mut [f64],
     ) {
+        self.lagrangian_third_impl(q, None, v, potential, weights, hv, d3);
+    }
+
+    /// [`System::lagrangian_third`] with the body angles' `sin`/`cos` from `angles` (evaluated
+    /// at this `q`, [`BodyAngles`]): bit for bit the same.
+    #[allow(clippy::too_many_arguments)]
+    pub fn lagrangian_third_at(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        v: &[f64],
+        potential: f64,
+        weights: &[f64],
+        hv: &mut [f64],
+        d3: &mut [f64],
+    ) {
+        debug_assert!(angles.matches(q));
+        self.lagrangian_third_impl(q, Some(angles), v, potential, weights, hv, d3);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn lagrangian_third_impl(
+        &self,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        v: &[f64],
+        potential: f64,
+        weights: &[f64],
+        hv: &mut [f64],
+        d3: &mut [f64],
+    ) {
         hv.fill(0.0);
         d3.fill(0.0);
         if potential != 0.0 {
             for (fi, f) in self.forces.iter().enumerate() {
                 let at = self.force_attach[fi];
                 let e = f.potential(
-                    &Self::loc_third(q, v, at.a, 0),
-                    &Self::loc_third(q, v, at.b, 3),
+                    &Self::loc_third(q, ang, v, at.a, 0),
+                    &Self::loc_third(q, ang, v, at.b, 3),
                 );
                 Self::scatter_grad(at, &e.g1, potential, hv);
                 Self::scatter_grad(at, &e.g2, potential, d3);
@@ -174,8 +266,8 @@ impl System {
             }
             let mut e = [ThirdJet::cst(0.0); 3];
             j.eval(
-                &Self::loc_third(q, v, at.a, 0),
-                &Self::loc_third(q, v, at.b, 3),
+                &Self::loc_third(q, ang, v, at.a, 0),
+                &Self::loc_third(q, ang, v, at.b, 3),
                 &mut e,
             );
             let (mut g1, mut g2) = ([0.0; NV], [0.0; NV]);
@@ -206,12 +298,44 @@ impl System {
         d3: &mut [[f64; NV]],
         vhv: &mut [f64],
     ) {
+        self.constraint_third_local_impl(q, None, v, grads, hv, d3, vhv);
+    }
+
+    /// [`System::constraint_third_local`] with the body angles' `sin`/`cos` from `angles`
+    /// (evaluated at this `q`, [`BodyAngles`]): bit for bit the same.
+    #[allow(clippy::too_many_arguments)]
+    pub fn constraint_third_local_at(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        v: &[f64],
+        grads: &mut [[f64; NV]],
+        hv: &mut [[f64; NV]],
+        d3: &mut [[f64; NV]],
+        vhv: &mut [f64],
+    ) {
+        debug_assert!(angles.matches(q));
+        self.constraint_third_local_impl(q, Some(angles), v, grads, hv, d3, vhv);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn constraint_third_local_impl(
+        &self,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        v: &[f64],
+        grads: &mut [[f64; NV]],
+        hv: &mut [[f64; NV]],
+        d3: &mut [[f64; NV]],
+        vhv: &mut [f64],
+    ) {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let mut e = [ThirdJet::cst(0.0); 3];
             j.eval(
-                &Self::loc_third(q, v, at.a, 0),
-                &Self::loc_third(q, v, at.b, 3),
+                &Self::loc_third(q, ang, v, at.a, 0),
+                &Self::loc_third(q, ang, v, at.b, 3),
                 &mut e,
             );
             let o = self.row_offset[ji];
@@ -246,6 +370,30 @@ impl System {
     /// [`System::phi_q_local`]): the gradient in `q` of `sum_r d_r . grad Phi_r`, i.e. what the
     /// adjoint of `Phi_q` gives back to `q` (one tangent pass per nonzero row).
     pub fn add_constraint_hessian_rows(&self, q: &[f64], dirs: &[[f64; NV]], out: &mut [f64]) {
+        self.add_constraint_hessian_rows_impl(q, None, dirs, out);
+    }
+
+    /// [`System::add_constraint_hessian_rows`] with the body angles' `sin`/`cos` from `angles`
+    /// (evaluated at this `q`, [`BodyAngles`]): bit for bit the same.
+    pub fn add_constraint_hessian_rows_at(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        dirs: &[[f64; NV]],
+        out: &mut [f64],
+    ) {
+        debug_assert!(angles.matches(q));
+        self.add_constraint_hessian_rows_impl(q, Some(angles), dirs, out);
+    }
+
+    #[inline(always)]
+    fn add_constraint_hessian_rows_impl(
+        &self,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        dirs: &[[f64; NV]],
+        out: &mut [f64],
+    ) {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let o = self.row_offset[ji];
@@ -255,9 +403,11 @@ impl System {
                     continue;
                 }
                 let frame = |i: Option<usize>, slot: usize| match i {
-                    Some(i) => Frame::new(std::array::from_fn(|c| {
-                        TanJet::var(slot + c, q[3 * i + c], d[slot + c])
-                    })),
+                    Some(i) => BodyAngles::frame(
+                        ang,
+                        i,
+                        std::array::from_fn(|c| TanJet::var(slot + c, q[3 * i + c], d[slot + c])),
+                    ),
                     None => Frame::fixed(),
                 };
                 let mut e = [TanJet::cst(0.0); 3];

@@ -120,6 +120,10 @@ impl Scalar for TanJet {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         let (s, c) = self.v.sin_cos();
+        self.sin_cos_with(s, c)
+    }
+    #[inline(always)]
+    fn sin_cos_with(self, s: f64, c: f64) -> (Self, Self) {
         (self.chain(s, c, -s), self.chain(c, -s, -c))
     }
     #[inline(always)]

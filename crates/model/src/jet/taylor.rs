@@ -53,10 +53,17 @@ impl Taylor4 {
     }
     /// `(sin x, cos x)` by the recurrences `k s_k = sum_j j x_j c_(k-j)`,
     /// `k c_k = -sum_j j x_j s_(k-j)` (the general case of `sin_cos`).
+    #[cfg(test)]
     pub(crate) fn sin_cos_series(self) -> (Self, Self) {
+        let (s0, c0) = self.v.sin_cos();
+        self.sin_cos_series_with(s0, c0)
+    }
+    /// [`Taylor4::sin_cos_series`] given `sin` and `cos` of the value.
+    #[inline(always)]
+    fn sin_cos_series_with(self, s0: f64, c0: f64) -> (Self, Self) {
         let x = self.coefs();
         let (mut s, mut c) = ([0.0; TAYLOR_DEGREE + 1], [0.0; TAYLOR_DEGREE + 1]);
-        (s[0], c[0]) = x[0].sin_cos();
+        (s[0], c[0]) = (s0, c0);
         for k in 1..=TAYLOR_DEGREE {
             let (mut ds, mut dc) = (0.0, 0.0);
             for j in 1..=k {
@@ -130,10 +137,14 @@ impl Scalar for Taylor4 {
     /// `k s_k = sum_(j=1..k) j x_j c_(k-j)`, `k c_k = -sum_(j=1..k) j x_j s_(k-j)`.
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
+        let (sn, cs) = self.v.sin_cos();
+        self.sin_cos_with(sn, cs)
+    }
+    #[inline(always)]
+    fn sin_cos_with(self, sn: f64, cs: f64) -> (Self, Self) {
         let x = self.coefs();
         if x[2..].iter().all(|&a| a == 0.0) {
             // a variable theta + t w (a body angle): coefficients sin^(k)(theta) w^k / k!
-            let (sn, cs) = x[0].sin_cos();
             let ds = [sn, cs, -sn, -cs];
             let dc = [cs, -sn, -cs, sn];
             let (mut s, mut c) = ([0.0; TAYLOR_DEGREE + 1], [0.0; TAYLOR_DEGREE + 1]);
@@ -145,7 +156,7 @@ impl Scalar for Taylor4 {
             }
             return (Taylor4::from_coefs(s), Taylor4::from_coefs(c));
         }
-        self.sin_cos_series()
+        self.sin_cos_series_with(sn, cs)
     }
     /// `r^2 = x`: `r_k = (x_k - sum_(j=1..k-1) r_j r_(k-j)) / (2 r_0)`.
     #[inline(always)]

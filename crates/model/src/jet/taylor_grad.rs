@@ -47,20 +47,28 @@ impl TaylorGrad4 {
             self.c[k - 1]
         }
     }
-    /// The gradient of `D^k f(q)(w, ..., w)` with respect to the base point `q`:
+    /// The directional derivative `D^k f(w, ..., w) = k! * coefficient k` (as
+    /// [`super::Taylor4::derivative`], bit for bit).
+    #[inline(always)]
+    pub fn derivative(&self, k: usize) -> f64 {
+        FACT[k] * self.coef(k)
+    }
+    /// The gradient of `D^k f(q)(w, ..., w)` with respect to the base point `q`, from the
+    /// coefficient gradients `g` of a series (its field `g`, possibly stored):
     /// `D^(k+1) f(w, ..., w, .) = k! * g[k]`.
     #[inline(always)]
-    pub fn derivative_grad_q(&self, k: usize) -> [f64; NV] {
-        self.g[k].map(|x| FACT[k] * x)
+    pub fn derivative_grad_q(g: &[[f64; NV]; DEG + 1], k: usize) -> [f64; NV] {
+        g[k].map(|x| FACT[k] * x)
     }
-    /// The gradient of `D^k f(q)(w, ..., w)` with respect to the direction `w`:
-    /// `k D^k f(w, ..., w, .) = k! * g[k - 1]` (zero for `k = 0`).
+    /// The gradient of `D^k f(q)(w, ..., w)` with respect to the direction `w`, from the
+    /// coefficient gradients `g` of a series: `k D^k f(w, ..., w, .) = k! * g[k - 1]` (zero for
+    /// `k = 0`).
     #[inline(always)]
-    pub fn derivative_grad_w(&self, k: usize) -> [f64; NV] {
+    pub fn derivative_grad_w(g: &[[f64; NV]; DEG + 1], k: usize) -> [f64; NV] {
         if k == 0 {
             [0.0; NV]
         } else {
-            self.g[k - 1].map(|x| FACT[k] * x)
+            g[k - 1].map(|x| FACT[k] * x)
         }
     }
     #[inline(always)]
@@ -77,12 +85,19 @@ impl TaylorGrad4 {
     }
     /// `(sin x, cos x)` by the recurrences `k s_k = sum_j j x_j c_(k-j)`,
     /// `k c_k = -sum_j j x_j s_(k-j)` in dual arithmetic (the general case of `sin_cos`).
+    #[cfg(test)]
     pub(crate) fn sin_cos_series(self) -> (Self, Self) {
+        let (s0, c0) = self.v.sin_cos();
+        self.sin_cos_series_with(s0, c0)
+    }
+    /// [`TaylorGrad4::sin_cos_series`] given `sin` and `cos` of the value.
+    #[inline(always)]
+    fn sin_cos_series_with(self, s0: f64, c0: f64) -> (Self, Self) {
         let x = self.coefs();
         let gx = &self.g;
         let (mut s, mut c) = ([0.0; DEG + 1], [0.0; DEG + 1]);
         let (mut gs, mut gc) = ([[0.0; NV]; DEG + 1], [[0.0; NV]; DEG + 1]);
-        (s[0], c[0]) = x[0].sin_cos();
+        (s[0], c[0]) = (s0, c0);
         for l in 0..NV {
             gs[0][l] = c[0] * gx[0][l];
             gc[0][l] = -s[0] * gx[0][l];
@@ -202,12 +217,16 @@ impl Scalar for TaylorGrad4 {
     /// `grad s_0 = c_0 grad x_0`, `grad c_0 = -s_0 grad x_0`.
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
+        let (sn, cs) = self.v.sin_cos();
+        self.sin_cos_with(sn, cs)
+    }
+    #[inline(always)]
+    fn sin_cos_with(self, sn: f64, cs: f64) -> (Self, Self) {
         let x = self.coefs();
         let gx = &self.g;
         if x[2..].iter().all(|&a| a == 0.0) && gx[1..].iter().flatten().all(|&a| a == 0.0) {
             // a variable theta + t w (a body angle): sin(theta + t w) has the coefficients
             // sin^(k)(theta) w^k / k!, whose theta-derivatives are sin^(k+1)(theta) w^k / k!
-            let (sn, cs) = x[0].sin_cos();
             let ds = [sn, cs, -sn, -cs];
             let dc = [cs, -sn, -cs, sn];
             let (mut s, mut c) = ([0.0; DEG + 1], [0.0; DEG + 1]);
@@ -225,7 +244,7 @@ impl Scalar for TaylorGrad4 {
                 TaylorGrad4::from_parts(c, gc),
             );
         }
-        self.sin_cos_series()
+        self.sin_cos_series_with(sn, cs)
     }
     /// `r^2 = x`: `r_k = (x_k - sum_(j=1..k-1) r_j r_(k-j)) / (2 r_0)` in dual arithmetic
     /// (`grad r_0 = grad x_0 / (2 r_0)`).
@@ -244,7 +263,8 @@ impl Scalar for TaylorGrad4 {
                 acc -= r[j] * r[k - j];
                 axpby(&mut gacc, -r[k - j], &gr[j], -r[j], &gr[k - j]);
             }
-            r[k] = acc * inv2r0;
+            // the value as `Taylor4` rounds it (so the series' values are bit for bit Taylor4's)
+            r[k] = acc / (2.0 * r[0]);
             // (acc / (2 r_0))' = acc' / (2 r_0) - r_k r_0' / r_0 = (acc' - 2 r_k r_0') / (2 r_0)
             for l in 0..NV {
                 gr[k][l] = (gacc[l] - 2.0 * r[k] * gr[0][l]) * inv2r0;
@@ -336,7 +356,10 @@ mod tests {
             );
         }
         // derivative_grad_w(k) = k! g[k-1] = d/dw D^k f(w^k)
-        let (gw, fw) = (j.derivative_grad_w(3), fd_coefs(2, true)[3] * 6.0);
+        let (gw, fw) = (
+            TaylorGrad4::derivative_grad_w(&j.g, 3),
+            fd_coefs(2, true)[3] * 6.0,
+        );
         assert!((gw[2] - fw).abs() < 1e-8 * (1.0 + fw.abs()));
         eprintln!("TaylorGrad4 against differences of Taylor4: worst relative error {worst:e}");
     }

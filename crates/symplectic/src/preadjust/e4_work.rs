@@ -136,7 +136,7 @@ impl E4Work {
     fn new(sys: &System) -> Self {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let mut w = E4Work {
-            f: E4Forward::new(n, m),
+            f: E4Forward::new(n, m, sys.forces().len()),
             b: Adjoints::new(n, m),
             cols: vec![[None; 6]; m],
         };
@@ -168,7 +168,11 @@ impl Preadjustment {
     /// `self.e4 = Some(..)`).
     pub(super) fn e4_work(&mut self, sys: &System) -> Box<E4Work> {
         match self.e4.take() {
-            Some(mut w) if w.f.u.len() == self.n && w.cols.len() == self.m => {
+            Some(mut w)
+                if w.f.u.len() == self.n
+                    && w.cols.len() == self.m
+                    && w.f.d[0].pgrads.len() == sys.forces().len() =>
+            {
                 w.set_cols(sys);
                 w
             }

@@ -16,7 +16,7 @@
 //! [`System::potential_directional`]), mixed ones by polarisation.
 
 use super::{dot, Preadjustment};
-use mbd_model::System;
+use mbd_model::{BodyAngles, System};
 use mbd_solve::SolveError;
 
 /// The terms of `e4` and their coefficients, in the order of [`Preadjustment::modified_term_s2`]'s
@@ -48,24 +48,36 @@ pub const E4_TERMS: [(&str, f64); 23] = [
 ];
 
 /// Directional derivatives of orders 2..4 of every constraint row and of the potential along
-/// one direction.
+/// one direction, and (for the gradients) the element-local gradients of their series
+/// coefficients, per constraint row and per force element, which the reverse pass contracts
+/// with its adjoint weights.
 #[derive(Debug)]
 pub(super) struct Dirs {
     pub(super) rows: Vec<[f64; 3]>,
     pub(super) pot: [f64; 3],
+    pub(super) grads: Vec<[[f64; 6]; 5]>,
+    pub(super) pgrads: Vec<[[f64; 6]; 5]>,
 }
 
 impl Dirs {
-    fn new(m: usize) -> Self {
+    fn new(m: usize, nf: usize) -> Self {
         Dirs {
             rows: vec![[0.0; 3]; m],
             pot: [0.0; 3],
+            grads: vec![[[0.0; 6]; 5]; m],
+            pgrads: vec![[[0.0; 6]; 5]; nf],
         }
     }
-    /// The pass along `w`.
-    pub(super) fn eval(&mut self, sys: &System, q: &[f64], w: &[f64]) {
-        sys.constraint_directional(q, w, &mut self.rows);
-        self.pot = sys.potential_directional(q, w);
+    /// The pass along `w` (with the coefficient gradients if `grads`: the same values, bit
+    /// for bit).
+    pub(super) fn eval(&mut self, sys: &System, q: &[f64], a: &BodyAngles, w: &[f64], grads: bool) {
+        if grads {
+            sys.constraint_directional_series(q, a, w, &mut self.rows, &mut self.grads);
+            self.pot = sys.potential_directional_series(q, a, w, &mut self.pgrads);
+        } else {
+            sys.constraint_directional_at(q, a, w, &mut self.rows);
+            self.pot = sys.potential_directional_at(q, a, w);
+        }
     }
 }
 
@@ -121,6 +133,11 @@ pub(super) struct E4Forward {
     pub(super) pi_hmu_v: Vec<f64>,
     pub(super) pi_hv: Vec<f64>,
     pub(super) pi_hsig_v: Vec<f64>,
+    /// `S^-1 G M^-1 x` for `x = H_mu v, H v, H_sigma v` (the projections' solves, which the
+    /// adjoints of the `Pi` terms reuse).
+    pub(super) sg_hmu_v: Vec<f64>,
+    pub(super) sg_hv: Vec<f64>,
+    pub(super) sg_hsig_v: Vec<f64>,
     pub(super) s_beta: Vec<f64>,
     pub(super) s_kap3: Vec<f64>,
     pub(super) d3v_u: f64,
@@ -128,6 +145,10 @@ pub(super) struct E4Forward {
     pub(super) d4v: f64,
     /// The directional passes (indices `DV` ..).
     pub(super) d: Vec<Dirs>,
+    /// `sin`/`cos` of the body angles at `q`, shared by every pass.
+    pub(super) angles: BodyAngles,
+    /// Whether the passes keep their coefficient gradients (for the reverse pass).
+    pub(super) grads: bool,
     /// Per constraint row, element-local `Hess Phi_r v` and `Hess Phi_r u` (the weighted
     /// Hessian-vector products `H_mu v`, `H_sigma v`, ... and their adjoints use them).
     pub(super) rhv_v: Vec<[f64; 6]>,
@@ -141,7 +162,7 @@ pub(super) struct E4Forward {
 }
 
 impl E4Forward {
-    pub(super) fn new(n: usize, m: usize) -> Self {
+    pub(super) fn new(n: usize, m: usize, nf: usize) -> Self {
         let (zn, zm) = (|| vec![0.0; n], || vec![0.0; m]);
         E4Forward {
             u: zn(),
@@ -165,12 +186,17 @@ impl E4Forward {
             pi_hmu_v: zn(),
             pi_hv: zn(),
             pi_hsig_v: zn(),
+            sg_hmu_v: zm(),
+            sg_hv: zm(),
+            sg_hsig_v: zm(),
             s_beta: zm(),
             s_kap3: zm(),
             d3v_u: 0.0,
             d3v_n: 0.0,
             d4v: 0.0,
-            d: (0..N_PASSES).map(|_| Dirs::new(m)).collect(),
+            d: (0..N_PASSES).map(|_| Dirs::new(m, nf)).collect(),
+            angles: BodyAngles::default(),
+            grads: false,
             rhv_v: vec![[0.0; 6]; m],
             rhv_u: vec![[0.0; 6]; m],
             dir: zn(),
@@ -215,7 +241,7 @@ impl E4Forward {
     fn pass_pm(&mut self, sys: &System, q: &[f64], k: usize, a: Src, b: Src, sign: f64) {
         let mut dir = std::mem::take(&mut self.dir);
         comb_into(self.src(a), 1.0, self.src(b), sign, &mut dir);
-        self.d[k].eval(sys, q, &dir);
+        self.d[k].eval(sys, q, &self.angles, &dir, self.grads);
         self.dir = dir;
     }
 
@@ -260,6 +286,19 @@ impl Preadjustment {
         self.add_dgt_to(x, 1.0, out);
     }
 
+    /// `pi = Pi x` (bit for bit `apply_pi`) and `sg = S^-1 G M^-1 x` (`sgm`, the solve inside
+    /// `Pi x`), by one solve.
+    fn pi_sgm(&mut self, x: &[f64], pi: &mut [f64], sg: &mut [f64]) {
+        for ((p, xi), mi) in pi.iter_mut().zip(x).zip(&self.minv) {
+            *p = mi * xi;
+        }
+        if self.m == 0 {
+            return;
+        }
+        self.sgm(x, sg);
+        self.add_dgt_to(sg, -1.0, pi);
+    }
+
     /// `out = S^-1 x`.
     pub(super) fn s_inv_into(&mut self, x: &[f64], out: &mut [f64]) {
         out.copy_from_slice(x);
@@ -267,25 +306,30 @@ impl Preadjustment {
     }
 
     /// Evaluates the intermediates of `e4` at `q` with the velocity `v` into `f` (after
-    /// `check_v`; prepares the workspace at `q`). Allocates nothing.
+    /// `check_v`; prepares the workspace at `q`); with `grads`, the passes keep their
+    /// coefficient gradients for the reverse pass. Allocates nothing.
     pub(super) fn e4_forward(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
         f: &mut E4Forward,
+        grads: bool,
     ) -> Result<(), SolveError> {
         self.prepare(sys, q)?;
         let m = self.m;
+        f.grads = grads;
+        f.angles.update(sys, q);
         f.u.copy_from_slice(&self.u);
         f.mu0.copy_from_slice(&self.mu0);
-        f.d[DV].eval(sys, q, v);
+        let (ang, g) = (&f.angles, grads);
+        f.d[DV].eval(sys, q, ang, v, g);
         for (g, r) in f.gam.iter_mut().zip(&f.d[DV].rows) {
             *g = r[0];
         }
         self.neg_e_into(&f.gam, &mut f.sig, &mut f.nn);
-        f.d[DU].eval(sys, q, &f.u);
-        f.d[DN].eval(sys, q, &f.nn);
+        f.d[DU].eval(sys, q, ang, &f.u, g);
+        f.d[DN].eval(sys, q, ang, &f.nn, g);
         // (the pass along a - v is minus the pass along v - a: the odd orders change sign,
         // which the polarisations below take into account)
         let mut dir = std::mem::take(&mut f.dir);
@@ -296,7 +340,7 @@ impl Preadjustment {
             (DNMV, Src::N, -1.0),
         ] {
             comb_into(f.src(a), 1.0, v, sign, &mut dir);
-            f.d[k].eval(sys, q, &dir);
+            f.d[k].eval(sys, q, &f.angles, &dir, grads);
         }
         f.dir = dir;
         f.pass_pm(sys, q, DNPU, Src::N, Src::U, 1.0);
@@ -317,7 +361,7 @@ impl Preadjustment {
             (DK3M, Src::K3, -1.0),
         ] {
             comb_into(f.src(a), 1.0, v, sign, &mut dir);
-            f.d[k].eval(sys, q, &dir);
+            f.d[k].eval(sys, q, &f.angles, &dir, grads);
         }
         f.dir = dir;
         // D^3 Phi(v, v, u) = (D^3(u + v) + D^3(u - v) - 2 D^3(u)) / 6, D^3 Phi(v, v, n) likewise
@@ -333,11 +377,12 @@ impl Preadjustment {
         }
         // Hessian-vector products: of V by passes over the forces, of the weighted constraints
         // from the element-local rows Hess Phi_r v and Hess Phi_r u
-        sys.lagrangian_hessian_vector(q, v, 1.0, &f.zero_m, &mut f.hv);
-        sys.lagrangian_hessian_vector(q, &f.u, 1.0, &f.zero_m, &mut f.hu);
-        sys.lagrangian_hessian_vector(q, &f.nn, 1.0, &f.zero_m, &mut f.hn);
-        sys.constraint_third_local(q, v, &mut f.rg, &mut f.rhv_v, &mut f.rd3, &mut t);
-        sys.constraint_third_local(q, &f.u, &mut f.rg, &mut f.rhv_u, &mut f.rd3, &mut t);
+        let a = &f.angles;
+        sys.lagrangian_hessian_vector_at(q, a, v, 1.0, &f.zero_m, &mut f.hv);
+        sys.lagrangian_hessian_vector_at(q, a, &f.u, 1.0, &f.zero_m, &mut f.hu);
+        sys.lagrangian_hessian_vector_at(q, a, &f.nn, 1.0, &f.zero_m, &mut f.hn);
+        sys.constraint_third_local_at(q, a, v, &mut f.rg, &mut f.rhv_v, &mut f.rd3, &mut t);
+        sys.constraint_third_local_at(q, a, &f.u, &mut f.rg, &mut f.rhv_u, &mut f.rd3, &mut t);
         f.rv = t;
         for (out, rows, w) in [
             (&mut f.hmu_v, &f.rhv_v, &f.mu0),
@@ -348,9 +393,9 @@ impl Preadjustment {
             out.fill(0.0);
             sys.add_local_rows(rows, w, out);
         }
-        self.apply_pi(&f.hmu_v, &mut f.pi_hmu_v);
-        self.apply_pi(&f.hv, &mut f.pi_hv);
-        self.apply_pi(&f.hsig_v, &mut f.pi_hsig_v);
+        self.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
+        self.pi_sgm(&f.hv, &mut f.pi_hv, &mut f.sg_hv);
+        self.pi_sgm(&f.hsig_v, &mut f.pi_hsig_v, &mut f.sg_hsig_v);
         // potential: D^3 V(u, v, v) and D^3 V(n, v, v) by polarisation (odd in the direction)
         f.d3v_u = (d[DUPV].pot[1] + d[DUMV].pot[1] - 2.0 * d[DU].pot[1]) / 6.0;
         f.d3v_n = (d[DNPV].pot[1] + d[DNMV].pot[1] - 2.0 * d[DN].pot[1]) / 6.0;
@@ -368,7 +413,7 @@ impl Preadjustment {
     ) -> Result<[f64; 23], SolveError> {
         self.check_v(v)?;
         let mut w = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut w.f);
+        let res = self.e4_forward(sys, q, v, &mut w.f, false);
         let terms = w.f.terms();
         self.e4 = Some(w);
         res.map(|()| terms)

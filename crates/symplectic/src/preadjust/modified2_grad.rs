@@ -2,15 +2,20 @@
 //! forward evaluation that keeps its intermediates ([`E4Forward`]), then a reverse
 //! (adjoint) pass through them, so `de4/dq` and `de4/dv` cost a fixed number of passes over the
 //! elements, independent of `n` (central differences took `8 n` evaluations of `e4`). Both
-//! run in a workspace allocated on first use ([`E4Work`]): nothing is allocated per call.
+//! run in a workspace allocated on first use ([`E4Work`]): nothing is allocated per call. Every
+//! element pass at `q` takes the bodies' `sin`/`cos` from one table ([`mbd_model::BodyAngles`]).
 //!
 //! The reverse pass needs, besides the linear algebra's adjoints, the adjoints of three
 //! primitives:
 //!
 //! * a directional pass `D^k f(q)(w, .., w)`, `k = 2..4` ([`System::constraint_directional`],
-//!   [`System::potential_directional`]): its gradients in `q` and in `w` come from one pass of
-//!   Taylor series with gradients ([`System::constraint_directional_grad`],
-//!   [`System::potential_directional_grad`]);
+//!   [`System::potential_directional`]): for the gradients the forward evaluation runs it as a
+//!   pass of Taylor series with gradients that keeps the element-local coefficient gradients
+//!   ([`System::constraint_directional_series`], [`System::potential_directional_series`]), and
+//!   the reverse pass only contracts them with its adjoint weights
+//!   ([`System::add_constraint_directional_grads`], [`System::add_potential_directional_grads`]:
+//!   bit for bit [`System::constraint_directional_grad`]'s result, without evaluating the
+//!   elements again);
 //! * a Hessian-vector product `y = H x`, `H = p Hess V + sum_r w_r Hess Phi_r`: with the
 //!   adjoint `yb`, `xb += H yb`, `wb_r += yb^T Hess Phi_r x` (from the element-local rows
 //!   `Hess Phi_r x` of the forward pass) and `qb += D^3 L(x, yb, .)`, the last two from two
@@ -32,10 +37,11 @@
 
 use super::e4_work::{gbar_add, local, Adjoints, E4Work};
 use super::modified2::{
-    comb_into, DK2M, DK2P, DK3M, DK3P, DN, DNMU, DNMV, DNPU, DNPV, DU, DUMV, DUPV, DV, E4_TERMS,
+    comb_into, Dirs, DK2M, DK2P, DK3M, DK3P, DN, DNMU, DNMV, DNPU, DNPV, DU, DUMV, DUPV, DV,
+    E4_TERMS,
 };
 use super::Preadjustment;
-use mbd_model::System;
+use mbd_model::{BodyAngles, System};
 use mbd_solve::SolveError;
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
@@ -45,54 +51,6 @@ fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
 }
 
 impl Preadjustment {
-    /// `c a^T Pi b`: leaves the increment of `ab`, `c Pi b`, in `w.tn[0]` and that of `bb`,
-    /// `c Pi a`, in `w.tn[1]`; `Gb` updated.
-    fn adj_pi(
-        &mut self,
-        w: &mut Adjoints,
-        cols: &[[Option<usize>; 6]],
-        c: f64,
-        a: &[f64],
-        b: &[f64],
-    ) {
-        let [pa, pb, ..] = &mut w.tn;
-        let [sa, sb, ..] = &mut w.tm;
-        self.apply_pi(a, pa);
-        self.apply_pi(b, pb);
-        self.sgm(a, sa);
-        self.sgm(b, sb);
-        gbar_add(&mut w.gbar, cols, -c, sb, pa);
-        gbar_add(&mut w.gbar, cols, -c, sa, pb);
-        w.tn.swap(0, 1);
-        for t in &mut w.tn[..2] {
-            t.iter_mut().for_each(|x| *x *= c);
-        }
-    }
-
-    /// `c a^T S^-1 b`: leaves the increment of `ab`, `c S^-1 b`, in `w.tm[0]` and that of
-    /// `bb`, `c S^-1 a`, in `w.tm[1]`; `Gb` updated.
-    fn adj_s(
-        &mut self,
-        w: &mut Adjoints,
-        cols: &[[Option<usize>; 6]],
-        c: f64,
-        a: &[f64],
-        b: &[f64],
-    ) {
-        let [al, be, ..] = &mut w.tm;
-        let [dal, dbe, ..] = &mut w.tn;
-        self.s_inv_into(a, al);
-        self.s_inv_into(b, be);
-        self.dgt_into(al, dal);
-        self.dgt_into(be, dbe);
-        gbar_add(&mut w.gbar, cols, -c, al, dbe);
-        gbar_add(&mut w.gbar, cols, -c, be, dal);
-        w.tm.swap(0, 1);
-        for t in &mut w.tm[..2] {
-            t.iter_mut().for_each(|x| *x *= c);
-        }
-    }
-
     /// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
     /// adjoint `yb`; `Gb` updated.
     fn adj_neg_e(&mut self, w: &mut Adjoints, cols: &[[Option<usize>; 6]], z: &[f64], yb: &[f64]) {
@@ -132,7 +90,7 @@ impl Preadjustment {
             }
         }
         let mut work = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut work.f);
+        let res = self.e4_forward(sys, q, v, &mut work.f, true);
         let out = res.map(|()| self.e4_reverse(sys, q, v, &mut work, gq, gv));
         self.e4 = Some(work);
         out
@@ -159,25 +117,30 @@ impl Preadjustment {
         w.clear();
 
         // 1. the terms
-        self.adj_pi(w, cols, c[0], &f.hsig_v, &f.hmu_v);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[1]);
-        self.adj_pi(w, cols, c[1], &f.hmu_v, &f.hmu_v);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[1]);
+        let hsig_v = (f.pi_hsig_v.as_slice(), f.sg_hsig_v.as_slice());
+        let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
+        let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
+        adj_pi(&mut w.gbar, cols, c[0], hsig_v, hmu_v);
+        axpy(&mut w.hsig_vb, c[0], &f.pi_hmu_v);
+        axpy(&mut w.hmu_vb, c[0], &f.pi_hsig_v);
+        adj_pi(&mut w.gbar, cols, c[1], hmu_v, hmu_v);
+        axpy(&mut w.hmu_vb, c[1], &f.pi_hmu_v);
+        axpy(&mut w.hmu_vb, c[1], &f.pi_hmu_v);
         axpy(&mut w.ub, c[2], &f.hmu_u);
         axpy(&mut w.hmu_ub, c[2], &f.u);
-        self.adj_pi(w, cols, c[3], &f.hmu_v, &f.hv);
-        axpy(&mut w.hmu_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hvb, 1.0, &w.tn[1]);
-        self.adj_s(w, cols, c[4], &f.beta, &f.beta);
-        axpy(&mut w.betab, 1.0, &w.tm[0]);
-        axpy(&mut w.betab, 1.0, &w.tm[1]);
+        adj_pi(&mut w.gbar, cols, c[3], hmu_v, hv);
+        axpy(&mut w.hmu_vb, c[3], &f.pi_hv);
+        axpy(&mut w.hvb, c[3], &f.pi_hmu_v);
+        let beta = (f.s_beta.as_slice(), f.k2.as_slice());
+        let kap3 = (f.s_kap3.as_slice(), f.k3.as_slice());
+        adj_s(&mut w.gbar, cols, c[4], beta, beta);
+        axpy(&mut w.betab, c[4], &f.s_beta);
+        axpy(&mut w.betab, c[4], &f.s_beta);
         axpy(&mut w.ub, c[5], &f.hsig_u);
         axpy(&mut w.hsig_ub, c[5], &f.u);
-        self.adj_s(w, cols, c[6], &f.kap3, &f.beta);
-        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
-        axpy(&mut w.betab, 1.0, &w.tm[1]);
+        adj_s(&mut w.gbar, cols, c[6], kap3, beta);
+        axpy(&mut w.kap3b, c[6], &f.s_beta);
+        axpy(&mut w.betab, c[6], &f.s_kap3);
         axpy(&mut w.hvb, c[7], &f.k2);
         axpy(&mut w.k2b, c[7], &f.hv);
         axpy(&mut w.mu0b, c[8], &f.kap3u);
@@ -196,35 +159,37 @@ impl Preadjustment {
         w.pp[DU][1] -= c[13] / 3.0;
         axpy(&mut w.nnb, c[14], &f.hn);
         axpy(&mut w.hnb, c[14], &f.nn);
-        self.adj_pi(w, cols, c[15], &f.hv, &f.hsig_v);
-        axpy(&mut w.hvb, 1.0, &w.tn[0]);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[1]);
+        adj_pi(&mut w.gbar, cols, c[15], hv, hsig_v);
+        axpy(&mut w.hvb, c[15], &f.pi_hsig_v);
+        axpy(&mut w.hsig_vb, c[15], &f.pi_hv);
         axpy(&mut w.hvb, c[16], &f.k3);
         axpy(&mut w.k3b, c[16], &f.hv);
         w.pp[DNPV][1] += c[17] / 6.0;
         w.pp[DNMV][1] += c[17] / 6.0;
         w.pp[DN][1] -= c[17] / 3.0;
-        self.adj_pi(w, cols, c[18], &f.hv, &f.hv);
-        axpy(&mut w.hvb, 1.0, &w.tn[0]);
-        axpy(&mut w.hvb, 1.0, &w.tn[1]);
+        adj_pi(&mut w.gbar, cols, c[18], hv, hv);
+        axpy(&mut w.hvb, c[18], &f.pi_hv);
+        axpy(&mut w.hvb, c[18], &f.pi_hv);
         w.pp[DV][2] += c[19];
-        self.adj_pi(w, cols, c[20], &f.hsig_v, &f.hsig_v);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[0]);
-        axpy(&mut w.hsig_vb, 1.0, &w.tn[1]);
+        adj_pi(&mut w.gbar, cols, c[20], hsig_v, hsig_v);
+        axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
+        axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
         axpy(&mut w.sigb, c[21], &f.kap4);
         axpy(&mut w.kap4b, c[21], &f.sig);
-        self.adj_s(w, cols, c[22], &f.kap3, &f.kap3);
-        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
-        axpy(&mut w.kap3b, 1.0, &w.tm[1]);
+        adj_s(&mut w.gbar, cols, c[22], kap3, kap3);
+        axpy(&mut w.kap3b, c[22], &f.s_kap3);
+        axpy(&mut w.kap3b, c[22], &f.s_kap3);
 
         // 2. the Hessian-vector products
         let zero = f.zero_m.as_slice();
+        let ang = &f.angles;
         let sc = &mut w.tn[2..8];
         let (sig, mu0) = (f.sig.as_slice(), f.mu0.as_slice());
         let (rv, ru) = (f.rhv_v.as_slice(), f.rhv_u.as_slice());
         hvp_adj(
             sys,
             q,
+            ang,
             &f.u,
             (0.0, sig),
             Some(WeightAdjoint {
@@ -240,6 +205,7 @@ impl Preadjustment {
         hvp_adj(
             sys,
             q,
+            ang,
             v,
             (0.0, sig),
             Some(WeightAdjoint {
@@ -255,6 +221,7 @@ impl Preadjustment {
         hvp_adj(
             sys,
             q,
+            ang,
             &f.u,
             (0.0, mu0),
             Some(WeightAdjoint {
@@ -270,6 +237,7 @@ impl Preadjustment {
         hvp_adj(
             sys,
             q,
+            ang,
             v,
             (0.0, mu0),
             Some(WeightAdjoint {
@@ -282,9 +250,31 @@ impl Preadjustment {
             gq,
             sc,
         );
-        hvp_adj(sys, q, &f.nn, (1.0, zero), None, &w.hnb, &mut w.nnb, gq, sc);
-        hvp_adj(sys, q, &f.u, (1.0, zero), None, &w.hub, &mut w.ub, gq, sc);
-        hvp_adj(sys, q, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
+        hvp_adj(
+            sys,
+            q,
+            ang,
+            &f.nn,
+            (1.0, zero),
+            None,
+            &w.hnb,
+            &mut w.nnb,
+            gq,
+            sc,
+        );
+        hvp_adj(
+            sys,
+            q,
+            ang,
+            &f.u,
+            (1.0, zero),
+            None,
+            &w.hub,
+            &mut w.ub,
+            gq,
+            sc,
+        );
+        hvp_adj(sys, q, ang, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
 
         // 3. kappa4 = D^4 Phi(v^4) + 6 vvn + 3 D^2 Phi(n, n) + 4 h_k3v,
         //    kappa3u = vvu + 2 h_k2v + h_nu, and the polarisations behind them
@@ -311,16 +301,14 @@ impl Preadjustment {
         }
 
         // 4. the passes along k3 +- v and k2 +- v
-        let [dir, wb, ..] = &mut w.tn;
+        let [wb, ..] = &mut w.tn;
         for (k, sign) in [(DK3P, 1.0), (DK3M, -1.0)] {
-            comb_into(&f.k3, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.k3b, 1.0, wb);
             axpy(gv, sign, wb);
         }
         for (k, sign) in [(DK2P, 1.0), (DK2M, -1.0)] {
-            comb_into(&f.k2, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.k2b, 1.0, wb);
             axpy(gv, sign, wb);
         }
@@ -346,28 +334,25 @@ impl Preadjustment {
         }
 
         // 7. the passes along n +- u, n +- v, u +- v, u and n
-        let [dir, wb, ..] = &mut w.tn;
+        let [wb, ..] = &mut w.tn;
         for (k, sign) in [(DNPU, 1.0), (DNMU, -1.0)] {
-            comb_into(&f.nn, 1.0, &f.u, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.nnb, 1.0, wb);
             axpy(&mut w.ub, sign, wb);
         }
         for (k, sign) in [(DNPV, 1.0), (DNMV, -1.0)] {
-            comb_into(&f.nn, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.nnb, 1.0, wb);
             axpy(gv, sign, wb);
         }
         for (k, sign) in [(DUPV, 1.0), (DUMV, -1.0)] {
-            comb_into(&f.u, 1.0, v, sign, dir);
-            pass_adj(sys, q, dir, &w.pr[k], w.pp[k], gq, wb);
+            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
             axpy(&mut w.ub, 1.0, wb);
             axpy(gv, sign, wb);
         }
-        pass_adj(sys, q, &f.u, &w.pr[DU], w.pp[DU], gq, wb);
+        pass_adj(sys, &f.d[DU], &w.pr[DU], w.pp[DU], gq, wb);
         axpy(&mut w.ub, 1.0, wb);
-        pass_adj(sys, q, &f.nn, &w.pr[DN], w.pp[DN], gq, wb);
+        pass_adj(sys, &f.d[DN], &w.pr[DN], w.pp[DN], gq, wb);
         axpy(&mut w.nnb, 1.0, wb);
 
         // 8. n = -D G^T sigma, sigma = S^-1 gamma, gamma = D^2 Phi(v, v)
@@ -390,7 +375,7 @@ impl Preadjustment {
             }
         }
         let [wb, ..] = &mut w.tn;
-        pass_adj(sys, q, v, &w.pr[DV], w.pp[DV], gq, wb);
+        pass_adj(sys, &f.d[DV], &w.pr[DV], w.pp[DV], gq, wb);
         axpy(gv, 1.0, wb);
 
         // 9. u = -D g + D G^T mu0, mu0 = S^-1 G D g, g = grad V
@@ -414,14 +399,43 @@ impl Preadjustment {
             self.dgt_into(&f.mu0, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
-            sys.lagrangian_hessian_vector(q, &w.gradb, 1.0, zero, t);
+            sys.lagrangian_hessian_vector_at(q, ang, &w.gradb, 1.0, zero, t);
             axpy(gq, 1.0, t);
         }
 
         // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r
-        sys.add_constraint_hessian_rows(q, &w.gbar, gq);
+        sys.add_constraint_hessian_rows_at(q, ang, &w.gbar, gq);
         e4
     }
+}
+
+/// `c a^T Pi b` with `(Pi a, S^-1 G M^-1 a)` and `(Pi b, S^-1 G M^-1 b)` from the forward
+/// evaluation: `Gb -= c [p_b (Pi a)^T + p_a (Pi b)^T]`; the increments of `ab` and `bb`,
+/// `c Pi b` and `c Pi a`, are the caller's.
+fn adj_pi(
+    gbar: &mut [[f64; 6]],
+    cols: &[[Option<usize>; 6]],
+    c: f64,
+    (pa, sa): (&[f64], &[f64]),
+    (pb, sb): (&[f64], &[f64]),
+) {
+    gbar_add(gbar, cols, -c, sb, pa);
+    gbar_add(gbar, cols, -c, sa, pb);
+}
+
+/// `c a^T S^-1 b` with `(S^-1 a, k_a)` and `(S^-1 b, k_b)`, `k_x = -D G^T S^-1 x`, from the
+/// forward evaluation: `Gb -= c [al (D G^T be)^T + be (D G^T al)^T]`, i.e.
+/// `Gb += c [al k_b^T + be k_a^T]`; the increments of `ab` and `bb`, `c S^-1 b` and
+/// `c S^-1 a`, are the caller's.
+fn adj_s(
+    gbar: &mut [[f64; 6]],
+    cols: &[[Option<usize>; 6]],
+    c: f64,
+    (al, ka): (&[f64], &[f64]),
+    (be, kb): (&[f64], &[f64]),
+) {
+    gbar_add(gbar, cols, c, al, kb);
+    gbar_add(gbar, cols, c, be, ka);
 }
 
 /// The adjoint of the weights of a Hessian-vector product: `rows[r]` is the element-local
@@ -439,6 +453,7 @@ struct WeightAdjoint<'a> {
 fn hvp_adj(
     sys: &System,
     q: &[f64],
+    ang: &BodyAngles,
     x: &[f64],
     (pot, wts): (f64, &[f64]),
     wadj: Option<WeightAdjoint>,
@@ -455,8 +470,8 @@ fn hvp_adj(
     };
     comb_into(x, 1.0, yb, 1.0, xp);
     comb_into(x, 1.0, yb, -1.0, xm);
-    sys.lagrangian_third(q, xp, pot, wts, hp, dp);
-    sys.lagrangian_third(q, xm, pot, wts, hm, dm);
+    sys.lagrangian_third_at(q, ang, xp, pot, wts, hp, dp);
+    sys.lagrangian_third_at(q, ang, xm, pot, wts, hm, dm);
     for i in 0..x.len() {
         xb[i] += 0.5 * (hp[i] - hm[i]);
         qb[i] += 0.25 * (dp[i] - dm[i]);
@@ -469,20 +484,20 @@ fn hvp_adj(
     }
 }
 
-/// The adjoint of a directional pass along `w` with the weights `rows` and `pot`: adds its
-/// `q`-gradient to `qb` and writes its `w`-gradient into `wb` (overwritten).
+/// The adjoint of a directional pass `d` (kept with its coefficient gradients by the forward
+/// evaluation) with the weights `rows` and `pot`: adds its `q`-gradient to `qb` and writes its
+/// `w`-gradient into `wb` (overwritten).
 fn pass_adj(
     sys: &System,
-    q: &[f64],
-    w: &[f64],
+    d: &Dirs,
     rows: &[[f64; 3]],
     pot: [f64; 3],
     qb: &mut [f64],
     wb: &mut [f64],
 ) {
     wb.fill(0.0);
-    sys.constraint_directional_grad(q, w, rows, qb, wb);
-    sys.potential_directional_grad(q, w, pot, qb, wb);
+    sys.add_constraint_directional_grads(&d.grads, rows, qb, wb);
+    sys.add_potential_directional_grads(&d.pgrads, pot, qb, wb);
 }
 #[cfg(test)]
 mod tests {
