@@ -4,7 +4,7 @@
 //! `B = p Hess V + w . Hess Phi`), at the cost of one assembly instead of three passes.
 
 use crate::jet::{HessJet, Scalar, NV};
-use crate::system::System;
+use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 
 /// One weighted Lagrangian `potential * V + sum_k weights_k Phi_k` (`weights` has length m):
@@ -17,7 +17,37 @@ pub struct LagrangianWeights<'a> {
     pub constraints: &'a [f64],
 }
 
+/// One element's local Hessians in [`System::element_hessians`]'s pass.
+enum ElementHessian<'e> {
+    /// A force element's potential.
+    Force(Attach, &'e [[f64; NV]; NV]),
+    /// A joint (its index) and its equations.
+    Joint(usize, Attach, &'e [HessJet]),
+}
+
 impl System {
+    /// The Hessian pass over the elements at `q`: every force element's potential (when
+    /// `forces`), then every joint's equations, handed to `visit` one element at a time.
+    fn element_hessians(&self, q: &[f64], forces: bool, mut visit: impl FnMut(ElementHessian)) {
+        if forces {
+            for (fi, f) in self.forces.iter().enumerate() {
+                let at = self.force_attach[fi];
+                let e = f.potential(&Self::loc_hess(q, at.a, 0), &Self::loc_hess(q, at.b, 3));
+                visit(ElementHessian::Force(at, &e.h));
+            }
+        }
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let mut e = [HessJet::cst(0.0); 3];
+            j.eval(
+                &Self::loc_hess(q, at.a, 0),
+                &Self::loc_hess(q, at.b, 3),
+                &mut e,
+            );
+            visit(ElementHessian::Joint(ji, at, &e[..j.n_equations()]));
+        }
+    }
+
     /// In one Hessian pass over the forces and joints at `q`, for the pairs `(a, out_a)` and
     /// `(b, out_b)`: `out_a += Hess(a.potential V + a.constraints . Phi)`,
     /// `out_b += Hess(b.potential V + b.constraints . Phi)` (both n x n) and
@@ -31,26 +61,20 @@ impl System {
         (b, out_b): (LagrangianWeights<'_>, &mut DMatrix<f64>),
         ct: &mut DMatrix<f64>,
     ) {
-        if a.potential != 0.0 || b.potential != 0.0 {
-            for (fi, f) in self.forces.iter().enumerate() {
-                let at = self.force_attach[fi];
-                let e = f.potential(&Self::loc_hess(q, at.a, 0), &Self::loc_hess(q, at.b, 3));
-                for (w, out) in [(a.potential, &mut *out_a), (b.potential, &mut *out_b)] {
-                    if w != 0.0 {
-                        Self::scatter_hess(at, &scaled(&e.h, w), out);
-                    }
-                }
-            }
-        }
         ct.fill(0.0);
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let mut e = [HessJet::cst(0.0); 3];
-            j.eval(
-                &Self::loc_hess(q, at.a, 0),
-                &Self::loc_hess(q, at.b, 3),
-                &mut e,
-            );
+        let forces = a.potential != 0.0 || b.potential != 0.0;
+        self.element_hessians(q, forces, |el| {
+            let (ji, at, e) = match el {
+                ElementHessian::Force(at, h) => {
+                    for (w, out) in [(a.potential, &mut *out_a), (b.potential, &mut *out_b)] {
+                        if w != 0.0 {
+                            Self::scatter_hess(at, &scaled(h, w), out);
+                        }
+                    }
+                    return;
+                }
+                ElementHessian::Joint(ji, at, e) => (ji, at, e),
+            };
             // the joint's local velocity
             let mut vl = [0.0; NV];
             for (slot, body) in [(0, at.a), (3, at.b)] {
@@ -60,7 +84,7 @@ impl System {
             }
             let o = self.row_offset[ji];
             let (mut ha, mut hb) = ([[0.0; NV]; NV], [[0.0; NV]; NV]);
-            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+            for (k, ek) in e.iter().enumerate() {
                 let (wa, wb) = (a.constraints[o + k], b.constraints[o + k]);
                 let mut hv = [0.0; NV];
                 for r in 0..NV {
@@ -75,7 +99,7 @@ impl System {
             }
             Self::scatter_hess(at, &ha, out_a);
             Self::scatter_hess(at, &hb, out_b);
-        }
+        });
     }
 }
 
@@ -90,7 +114,7 @@ impl System {
         (b, out_b): (LagrangianWeights<'_>, &mut [f64]),
     ) {
         // (the local diagonal h[l][l] of each of the element's bodies)
-        let scatter = |at: crate::system::Attach, h: &[[f64; NV]; NV], w: f64, out: &mut [f64]| {
+        let scatter = |at: Attach, h: &[[f64; NV]; NV], w: f64, out: &mut [f64]| {
             for (slot, body) in [(0, at.a), (3, at.b)] {
                 if let Some(i) = body {
                     for l in 0..3 {
@@ -99,28 +123,20 @@ impl System {
                 }
             }
         };
-        if a.potential != 0.0 || b.potential != 0.0 {
-            for (fi, f) in self.forces.iter().enumerate() {
-                let at = self.force_attach[fi];
-                let e = f.potential(&Self::loc_hess(q, at.a, 0), &Self::loc_hess(q, at.b, 3));
-                scatter(at, &e.h, a.potential, out_a);
-                scatter(at, &e.h, b.potential, out_b);
+        let forces = a.potential != 0.0 || b.potential != 0.0;
+        self.element_hessians(q, forces, |el| match el {
+            ElementHessian::Force(at, h) => {
+                scatter(at, h, a.potential, out_a);
+                scatter(at, h, b.potential, out_b);
             }
-        }
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let mut e = [HessJet::cst(0.0); 3];
-            j.eval(
-                &Self::loc_hess(q, at.a, 0),
-                &Self::loc_hess(q, at.b, 3),
-                &mut e,
-            );
-            let o = self.row_offset[ji];
-            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
-                scatter(at, &ek.h, a.constraints[o + k], out_a);
-                scatter(at, &ek.h, b.constraints[o + k], out_b);
+            ElementHessian::Joint(ji, at, e) => {
+                let o = self.row_offset[ji];
+                for (k, ek) in e.iter().enumerate() {
+                    scatter(at, &ek.h, a.constraints[o + k], out_a);
+                    scatter(at, &ek.h, b.constraints[o + k], out_b);
+                }
             }
-        }
+        });
     }
 }
 
