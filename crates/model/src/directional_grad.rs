@@ -7,31 +7,78 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{Frame, Scalar, TaylorGrad4, NV};
-use crate::system::System;
+use crate::system::{Attach, System};
 
 /// The element-local gradients of the five Taylor coefficients of one element equation along
 /// one direction (`TaylorGrad4::g`): entry `[k][i]` is `D^(k+1) f(q)(w, ..., w, e_i) / k!`.
 type SeriesGrads = [[f64; NV]; 5];
 
-impl System {
+/// The [`TaylorGrad4`] frames of one element's bodies, built in place and reused from element
+/// to element (see [`TaylorGrad4::set_var_frame`]): body a in slots `0..3`, body b in `3..6`,
+/// ground constant.
+struct VarFrames {
+    a: Frame<TaylorGrad4>,
+    b: Frame<TaylorGrad4>,
+}
+
+/// The ground frame (constant).
+const GROUND: Frame<TaylorGrad4> = Frame {
+    q: [TaylorGrad4::ZERO; 3],
+    c: TaylorGrad4::ONE,
+    s: TaylorGrad4::ZERO,
+};
+
+impl VarFrames {
     #[inline(always)]
-    fn loc_taylor_grad(
-        q: &[f64],
-        ang: Option<&BodyAngles>,
-        w: &[f64],
-        i: Option<usize>,
-        slot: usize,
-    ) -> Frame<TaylorGrad4> {
-        match i {
-            Some(i) => BodyAngles::frame(
-                ang,
-                i,
-                std::array::from_fn(|k| TaylorGrad4::var(slot + k, q[3 * i + k], w[3 * i + k])),
-            ),
-            None => Frame::fixed(),
+    fn new() -> Self {
+        VarFrames {
+            a: Frame::fixed(),
+            b: Frame::fixed(),
         }
     }
 
+    /// Frame `f` (variables `slot..slot + 3`) of body `i`.
+    #[inline(always)]
+    fn set(
+        f: &mut Frame<TaylorGrad4>,
+        slot: usize,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        w: &[f64],
+        i: usize,
+    ) {
+        let (qi, wi) = (&q[3 * i..3 * i + 3], &w[3 * i..3 * i + 3]);
+        let qi = [qi[0], qi[1], qi[2]];
+        // (sin, cos) of the angle from the table or evaluated, as `BodyAngles::frame` does
+        let sc = BodyAngles::frame(ang, i, qi);
+        TaylorGrad4::set_var_frame(f, slot, qi, [wi[0], wi[1], wi[2]], sc.s, sc.c);
+    }
+
+    /// The frames of the bodies `at` at `q` along `w` (the angles' sines and cosines from `ang`
+    /// or, without it, evaluated here as `Frame::new` does): bit for bit the frames of
+    /// `TaylorGrad4::var` coordinates.
+    #[inline(always)]
+    fn get(
+        &mut self,
+        q: &[f64],
+        ang: Option<&BodyAngles>,
+        w: &[f64],
+        at: Attach,
+    ) -> (&Frame<TaylorGrad4>, &Frame<TaylorGrad4>) {
+        if let Some(i) = at.a {
+            Self::set(&mut self.a, 0, q, ang, w, i);
+        }
+        if let Some(i) = at.b {
+            Self::set(&mut self.b, 3, q, ang, w, i);
+        }
+        (
+            if at.a.is_some() { &self.a } else { &GROUND },
+            if at.b.is_some() { &self.b } else { &GROUND },
+        )
+    }
+}
+
+impl System {
     /// `gq += c[k-2] grad_q D^k f(w^k)`, `gw += c[k-2] grad_w D^k f(w^k)`, `k = 2..=4`, for one
     /// element-local series with the coefficient gradients `g` (local gradients).
     #[inline(always)]
@@ -66,15 +113,13 @@ impl System {
     ) {
         debug_assert!(angles.matches(q));
         debug_assert!(out.len() == self.n_constraints() && grads.len() == out.len());
-        let ang = Some(angles);
+        let mut fr = VarFrames::new();
+        // (eval sets the first n_equations entries, the only ones read)
+        let mut e = [TaylorGrad4::cst(0.0); 3];
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let mut e = [TaylorGrad4::cst(0.0); 3];
-            j.eval(
-                &Self::loc_taylor_grad(q, ang, w, at.a, 0),
-                &Self::loc_taylor_grad(q, ang, w, at.b, 3),
-                &mut e,
-            );
+            let (fa, fb) = fr.get(q, Some(angles), w, at);
+            j.eval(fa, fb, &mut e);
             let o = self.row_offset[ji];
             for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
                 out[o + k] = [ek.derivative(2), ek.derivative(3), ek.derivative(4)];
@@ -129,14 +174,15 @@ impl System {
     ) -> [f64; 3] {
         debug_assert!(angles.matches(q));
         debug_assert_eq!(grads.len(), self.forces.len());
-        let ang = Some(angles);
         let mut d = [0.0; 3];
+        if self.forces.is_empty() {
+            return d;
+        }
+        let mut fr = VarFrames::new();
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
-            let e = f.potential(
-                &Self::loc_taylor_grad(q, ang, w, at.a, 0),
-                &Self::loc_taylor_grad(q, ang, w, at.b, 3),
-            );
+            let (fa, fb) = fr.get(q, Some(angles), w, at);
+            let e = f.potential(fa, fb);
             for (k, dk) in d.iter_mut().enumerate() {
                 *dk += e.derivative(k + 2);
             }
@@ -187,6 +233,8 @@ impl System {
         let n = self.n_coords();
         debug_assert!(q.len() == n && w.len() == n && gq.len() == n && gw.len() == n);
         debug_assert_eq!(c.len(), self.n_constraints());
+        let mut fr = VarFrames::new();
+        let mut e = [TaylorGrad4::cst(0.0); 3];
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let o = self.row_offset[ji];
@@ -195,14 +243,10 @@ impl System {
             if rows.iter().all(|r| r.iter().all(|&x| x == 0.0)) {
                 continue;
             }
-            let mut e = [TaylorGrad4::cst(0.0); 3];
-            j.eval(
-                &Self::loc_taylor_grad(q, None, w, at.a, 0),
-                &Self::loc_taylor_grad(q, None, w, at.b, 3),
-                &mut e,
-            );
+            let (fa, fb) = fr.get(q, None, w, at);
+            j.eval(fa, fb, &mut e);
             let (mut lq, mut lw) = ([0.0; NV], [0.0; NV]);
-            for (ek, ck) in e.iter().zip(rows) {
+            for (ek, ck) in e[..ne].iter().zip(rows) {
                 Self::add_weighted_grads(&ek.g, *ck, &mut lq, &mut lw);
             }
             Self::scatter_grad(at, &lq, 1.0, gq);
@@ -228,12 +272,11 @@ impl System {
         if c.iter().all(|&x| x == 0.0) {
             return;
         }
+        let mut fr = VarFrames::new();
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
-            let e = f.potential(
-                &Self::loc_taylor_grad(q, None, w, at.a, 0),
-                &Self::loc_taylor_grad(q, None, w, at.b, 3),
-            );
+            let (fa, fb) = fr.get(q, None, w, at);
+            let e = f.potential(fa, fb);
             let (mut lq, mut lw) = ([0.0; NV], [0.0; NV]);
             Self::add_weighted_grads(&e.g, c, &mut lq, &mut lw);
             Self::scatter_grad(at, &lq, 1.0, gq);

@@ -9,7 +9,7 @@
 //! `k - 1`. Every coefficient is a small dual number `(value, gradient)` and the recurrences of
 //! [`super::Taylor4`] run in that arithmetic.
 
-use super::{Scalar, NV};
+use super::{Frame, Scalar, NV};
 use std::ops::{Add, Mul, Sub};
 
 /// Degree of the truncated series.
@@ -30,8 +30,20 @@ pub struct TaylorGrad4 {
 }
 
 impl TaylorGrad4 {
-    /// Independent variable number `i`: `x + t w`, gradient `e_i` in the value only.
-    #[inline(always)]
+    /// The constant 0 (as [`Scalar::cst`]).
+    pub(crate) const ZERO: Self = TaylorGrad4 {
+        v: 0.0,
+        c: [0.0; DEG],
+        g: [[0.0; NV]; DEG + 1],
+    };
+    /// The constant 1 (as [`Scalar::cst`]).
+    pub(crate) const ONE: Self = TaylorGrad4 {
+        v: 1.0,
+        ..Self::ZERO
+    };
+    /// Independent variable number `i`: `x + t w`, gradient `e_i` in the value only (the
+    /// passes build their frames by [`TaylorGrad4::set_var_frame`]).
+    #[cfg(test)]
     pub fn var(i: usize, x: f64, w: f64) -> Self {
         let mut j = Self::cst(x);
         j.c[0] = w;
@@ -69,6 +81,45 @@ impl TaylorGrad4 {
             [0.0; NV]
         } else {
             g[k - 1].map(|x| FACT[k] * x)
+        }
+    }
+    /// Makes `f` the frame of a body whose coordinates are the variables `slot..slot + 3`
+    /// (`slot` 0 or 3) at `q` along `w`, with `(sn, cs) = (sin, cos)` of `q[2]`: bit for bit
+    /// `Frame::with_sin_cos([var(slot, q[0], w[0]), ..], sn, cs)`, written in place. Only the
+    /// values, the coefficients and the gradient entries that can be non-zero (slots `slot`,
+    /// `slot + 1` in the value of `x`, `y`; slot `slot + 2` in every coefficient of the angle's
+    /// sine and cosine) are written, so every other gradient entry of `f` must be zero already:
+    /// `f` starts as [`Frame::fixed`] and is only ever set with the same `slot`.
+    #[inline(always)]
+    pub(crate) fn set_var_frame(
+        f: &mut Frame<Self>,
+        slot: usize,
+        q: [f64; 3],
+        w: [f64; 3],
+        sn: f64,
+        cs: f64,
+    ) {
+        for k in 0..3 {
+            let x = &mut f.q[k];
+            x.v = q[k];
+            x.c = [w[k], 0.0, 0.0, 0.0];
+            x.g[0][slot + k] = 1.0;
+        }
+        // the linear case of `sin_cos_with` for a variable (gradient 1 in slot `slot + 2`)
+        let ds = [sn, cs, -sn, -cs];
+        let dc = [cs, -sn, -cs, sn];
+        let l = slot + 2;
+        let mut p = 1.0;
+        for k in 0..=DEG {
+            let (s, c) = (ds[k % 4] * p, dc[k % 4] * p);
+            if k == 0 {
+                (f.s.v, f.c.v) = (s, c);
+            } else {
+                (f.s.c[k - 1], f.c.c[k - 1]) = (s, c);
+            }
+            f.s.g[k][l] = ds[(k + 1) % 4] * p;
+            f.c.g[k][l] = dc[(k + 1) % 4] * p;
+            p *= w[2] / (k + 1) as f64;
         }
     }
     #[inline(always)]
@@ -362,6 +413,43 @@ mod tests {
         );
         assert!((gw[2] - fw).abs() < 1e-8 * (1.0 + fw.abs()));
         eprintln!("TaylorGrad4 against differences of Taylor4: worst relative error {worst:e}");
+    }
+
+    /// [`TaylorGrad4::set_var_frame`] (also over a frame set before with other coordinates)
+    /// equals the frame of [`TaylorGrad4::var`] coordinates entry for entry (the values bit for
+    /// bit; zero entries may differ in sign only).
+    #[test]
+    fn set_var_frame_matches_the_frame_of_variables() {
+        use super::super::Frame;
+        let bits = |a: &TaylorGrad4, b: &TaylorGrad4| {
+            let (fa, fb) = (
+                std::iter::once(a.v)
+                    .chain(a.c)
+                    .chain(a.g.into_iter().flatten()),
+                std::iter::once(b.v)
+                    .chain(b.c)
+                    .chain(b.g.into_iter().flatten()),
+            );
+            fa.zip(fb)
+                .all(|(x, y)| x.to_bits() == y.to_bits() || (x == 0.0 && y == 0.0))
+        };
+        for slot in [0, 3] {
+            let mut f = Frame::fixed();
+            for (q, w) in [(X0, W), (W, X0)] {
+                let (q3, w3) = ([q[0], q[1], q[2]], [w[0], w[1], w[2]]);
+                let (sn, cs) = q3[2].sin_cos();
+                TaylorGrad4::set_var_frame(&mut f, slot, q3, w3, sn, cs);
+                let r = Frame::with_sin_cos(
+                    std::array::from_fn(|k| TaylorGrad4::var(slot + k, q3[k], w3[k])),
+                    sn,
+                    cs,
+                );
+                for k in 0..3 {
+                    assert!(bits(&f.q[k], &r.q[k]), "slot {slot} q[{k}]");
+                }
+                assert!(bits(&f.c, &r.c) && bits(&f.s, &r.s), "slot {slot} sin, cos");
+            }
+        }
     }
 
     /// Each operation alone: `sin_cos`, `sqrt` and a product of two variables against
