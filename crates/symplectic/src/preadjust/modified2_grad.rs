@@ -302,16 +302,9 @@ impl Preadjustment {
 
         // 4. the passes along k3 +- v and k2 +- v
         let [wb, ..] = &mut w.tn;
-        for (k, sign) in [(DK3P, 1.0), (DK3M, -1.0)] {
-            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
-            axpy(&mut w.k3b, 1.0, wb);
-            axpy(gv, sign, wb);
-        }
-        for (k, sign) in [(DK2P, 1.0), (DK2M, -1.0)] {
-            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
-            axpy(&mut w.k2b, 1.0, wb);
-            axpy(gv, sign, wb);
-        }
+        let (d, pr, pp) = (&f.d, &w.pr, &w.pp);
+        pair_adj(sys, (d, pr, pp), [DK3P, DK3M], gq, wb, &mut w.k3b, gv);
+        pair_adj(sys, (d, pr, pp), [DK2P, DK2M], gq, wb, &mut w.k2b, gv);
 
         // 5. k3 = -D G^T S^-1 kappa3, kappa3 = D^3 Phi(v^3) + 3 h_nv
         let k3b = std::mem::take(&mut w.k3b);
@@ -335,21 +328,18 @@ impl Preadjustment {
 
         // 7. the passes along n +- u, n +- v, u +- v, u and n
         let [wb, ..] = &mut w.tn;
-        for (k, sign) in [(DNPU, 1.0), (DNMU, -1.0)] {
-            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
-            axpy(&mut w.nnb, 1.0, wb);
-            axpy(&mut w.ub, sign, wb);
-        }
-        for (k, sign) in [(DNPV, 1.0), (DNMV, -1.0)] {
-            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
-            axpy(&mut w.nnb, 1.0, wb);
-            axpy(gv, sign, wb);
-        }
-        for (k, sign) in [(DUPV, 1.0), (DUMV, -1.0)] {
-            pass_adj(sys, &f.d[k], &w.pr[k], w.pp[k], gq, wb);
-            axpy(&mut w.ub, 1.0, wb);
-            axpy(gv, sign, wb);
-        }
+        let (d, pr, pp) = (&f.d, &w.pr, &w.pp);
+        pair_adj(
+            sys,
+            (d, pr, pp),
+            [DNPU, DNMU],
+            gq,
+            wb,
+            &mut w.nnb,
+            &mut w.ub,
+        );
+        pair_adj(sys, (d, pr, pp), [DNPV, DNMV], gq, wb, &mut w.nnb, gv);
+        pair_adj(sys, (d, pr, pp), [DUPV, DUMV], gq, wb, &mut w.ub, gv);
         pass_adj(sys, &f.d[DU], &w.pr[DU], w.pp[DU], gq, wb);
         axpy(&mut w.ub, 1.0, wb);
         pass_adj(sys, &f.d[DN], &w.pr[DN], w.pp[DN], gq, wb);
@@ -487,6 +477,28 @@ fn hvp_adj(
 /// The adjoint of a directional pass `d` (kept with its coefficient gradients by the forward
 /// evaluation) with the weights `rows` and `pot`: adds its `q`-gradient to `qb` and writes its
 /// `w`-gradient into `wb` (overwritten).
+/// Every pass's stored series (`E4Forward::d`) with its adjoint weights of the constraint rows
+/// and of the potential.
+type PassWeights<'a> = (&'a [Dirs], &'a [Vec<[f64; 3]>], &'a [[f64; 3]]);
+
+/// The adjoint of the pair of passes `[k+, k-]` along `a + b` and `a - b`: the `q` part into
+/// `qb`, `+ / -` the direction adjoint into `ab` and `bb` (`wb` scratch, length n).
+fn pair_adj(
+    sys: &System,
+    (d, pr, pp): PassWeights,
+    ks: [usize; 2],
+    qb: &mut [f64],
+    wb: &mut [f64],
+    ab: &mut [f64],
+    bb: &mut [f64],
+) {
+    for (k, sign) in ks.into_iter().zip([1.0, -1.0]) {
+        pass_adj(sys, &d[k], &pr[k], pp[k], qb, wb);
+        axpy(ab, 1.0, wb);
+        axpy(bb, sign, wb);
+    }
+}
+
 fn pass_adj(
     sys: &System,
     d: &Dirs,
