@@ -143,27 +143,25 @@ impl Galerkin {
         let (nd, md) = if use_sparse { (0, 0) } else { (n, m) };
         // one workspace per Gauss point (W_s) or per control point (modified Lagrangian), so
         // each keeps its evaluation while its point does not move
-        let workspaces = |count: usize, degree: usize| -> Result<Vec<Preadjustment>, SolveError> {
-            (0..count)
-                .map(|_| {
-                    let mut p = Preadjustment::new(sys, degree)?;
-                    p.fd_step = options.fd_step;
-                    Ok(p)
-                })
-                .collect()
+        // (on the sparse path S is held sparse: O(N) per evaluation of the modified terms)
+        let workspace = |degree: usize, sparse: bool| -> Result<Preadjustment, SolveError> {
+            let mut p = if sparse {
+                Preadjustment::new_sparse(sys)?
+            } else {
+                Preadjustment::new(sys, degree)?
+            };
+            p.fd_step = options.fd_step;
+            Ok(p)
         };
         let pre = if options.gamma != 0.0 {
-            workspaces(s, s)?
+            (0..s)
+                .map(|_| workspace(s, false))
+                .collect::<Result<Vec<_>, _>>()?
         } else {
             Vec::new()
         };
-        let ml = if modlag && use_sparse {
-            // (S held sparse: O(N) per evaluation)
-            let mut p = Preadjustment::new_sparse(sys)?;
-            p.fd_step = options.fd_step;
-            vec![p]
-        } else if modlag {
-            workspaces(1, 1)?
+        let ml = if modlag {
+            vec![workspace(1, use_sparse)?]
         } else {
             Vec::new()
         };
