@@ -52,6 +52,12 @@ impl BodyAngles {
                 .all(|(i, e)| e[0].to_bits() == q[3 * i + 2].to_bits())
     }
 
+    /// `[theta, sin theta, cos theta]` of body `i`.
+    #[inline(always)]
+    pub(crate) fn sin_cos_of(&self, i: usize) -> [f64; 3] {
+        self.sc[i]
+    }
+
     /// The frame of body `i` with the jet coordinates `vars` (whose angle has the value of
     /// body `i`'s angle in the table), or with `sin_cos` evaluated when there is no table.
     #[inline(always)]

@@ -1,0 +1,320 @@
+//! Mixed directional derivatives of the constraints and of the potential along several
+//! directions at once, with their gradients, from one [`PolyJet`] pass per element: what the
+//! higher-order modified-Lagrangian terms need (`D^2 Phi(a, b)`, `D^3 Phi(a, a, b)`, ... and
+//! their gradients with respect to `q` and to every direction), without the polarisations of
+//! single-direction passes.
+
+use crate::directional::BodyAngles;
+use crate::jet::{Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
+use crate::system::{Attach, System};
+
+/// The frames of one element's bodies, built in place and reused from element to element
+/// (see [`PolyJet::set_var_frame`]): body a in slots `0..3`, body b in `3..6`, ground constant.
+struct PolyFrames<const K: usize, B> {
+    a: Frame<PolyJet<K, B>>,
+    b: Frame<PolyJet<K, B>>,
+    ground: Frame<PolyJet<K, B>>,
+}
+
+impl<const K: usize, B: Basis<K>> PolyFrames<K, B> {
+    fn new() -> Self {
+        PolyFrames {
+            a: Frame::fixed(),
+            b: Frame::fixed(),
+            ground: Frame::fixed(),
+        }
+    }
+
+    fn set(
+        f: &mut Frame<PolyJet<K, B>>,
+        slot: usize,
+        q: &[f64],
+        ang: &BodyAngles,
+        dirs: &[&[f64]],
+        i: usize,
+    ) {
+        let qi = [q[3 * i], q[3 * i + 1], q[3 * i + 2]];
+        let mut w = [[0.0; 3]; MAX_DIRS];
+        for (wd, d) in w.iter_mut().zip(dirs) {
+            *wd = [d[3 * i], d[3 * i + 1], d[3 * i + 2]];
+        }
+        let [_, s, c] = ang.sin_cos_of(i);
+        PolyJet::set_var_frame(f, slot, qi, &w[..B::ND], s, c);
+    }
+
+    fn get(
+        &mut self,
+        q: &[f64],
+        ang: &BodyAngles,
+        dirs: &[&[f64]],
+        at: Attach,
+    ) -> (&Frame<PolyJet<K, B>>, &Frame<PolyJet<K, B>>) {
+        if let Some(i) = at.a {
+            Self::set(&mut self.a, 0, q, ang, dirs, i);
+        }
+        if let Some(i) = at.b {
+            Self::set(&mut self.b, 3, q, ang, dirs, i);
+        }
+        (
+            if at.a.is_some() {
+                &self.a
+            } else {
+                &self.ground
+            },
+            if at.b.is_some() {
+                &self.b
+            } else {
+                &self.ground
+            },
+        )
+    }
+}
+
+/// The weights that route the adjoints `w` of a jet's coefficients to the direction `j`: the
+/// gradient of `sum_k w[k] c[k]` with respect to direction `j` is the base-point gradient of
+/// `sum_k out[k] c[k]` ([`Basis::DIV`]).
+pub fn poly_direction_weights<const K: usize, B: Basis<K>>(w: &[f64; K], j: usize) -> [f64; K] {
+    let mut out = [0.0; K];
+    for k in 0..K {
+        let d = B::DIV[k][j];
+        if d != u8::MAX {
+            out[d as usize] += w[k];
+        }
+    }
+    out
+}
+
+impl System {
+    /// Per constraint row `r`, the coefficients `vals[r]` of the [`PolyJet`] of `Phi_r(q +
+    /// sum_j x_j dirs[j])` in the basis `B` (`dirs.len() == B::ND`, each of length n) and their
+    /// element-local gradients `grads[r]` with respect to `q` (the six columns of the joint's
+    /// two bodies, as in [`System::phi_q_local`]). The time part of rheonomic constraints is
+    /// left out (it does not depend on `q`). One pass per joint; no allocation.
+    pub fn constraint_poly_series<const K: usize, B: Basis<K>>(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        dirs: &[&[f64]],
+        vals: &mut [[f64; K]],
+        grads: &mut [[[f64; NV]; K]],
+    ) {
+        debug_assert!(angles.matches(q) && dirs.len() == B::ND);
+        debug_assert!(vals.len() == self.n_constraints() && grads.len() == vals.len());
+        let mut fr = PolyFrames::<K, B>::new();
+        let mut e = [PolyJet::<K, B>::cst(0.0); 3];
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let (fa, fb) = fr.get(q, angles, dirs, at);
+            j.eval(fa, fb, &mut e);
+            let o = self.row_offset[ji];
+            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+                vals[o + k] = ek.c;
+                grads[o + k] = ek.g;
+            }
+        }
+    }
+
+    /// The coefficients of the [`PolyJet`] of the potential `V(q + sum_j x_j dirs[j])` in the
+    /// basis `B` (force elements only: gravity is linear, and only its value and first
+    /// coefficients would change, which no caller reads; non-conservative elements have no
+    /// potential), and per force element (in the order of [`System::forces`]) their
+    /// element-local gradients. One pass per force element; no allocation.
+    pub fn potential_poly_series<const K: usize, B: Basis<K>>(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        dirs: &[&[f64]],
+        grads: &mut [[[f64; NV]; K]],
+    ) -> [f64; K] {
+        debug_assert!(angles.matches(q) && dirs.len() == B::ND);
+        debug_assert_eq!(grads.len(), self.forces.len());
+        let mut sum = [0.0; K];
+        if self.forces.is_empty() {
+            return sum;
+        }
+        let mut fr = PolyFrames::<K, B>::new();
+        for (fi, f) in self.forces.iter().enumerate() {
+            let at = self.force_attach[fi];
+            let (fa, fb) = fr.get(q, angles, dirs, at);
+            let e = f.potential(fa, fb);
+            for k in 0..K {
+                sum[k] += e.c[k];
+            }
+            grads[fi] = e.g;
+        }
+        sum
+    }
+
+    /// `out += sum_r sum_k w[r][k] grads[r][k]` (length n) for the element-local coefficient
+    /// gradients of [`System::constraint_poly_series`]: the gradient with respect to `q` of
+    /// the weighted coefficients, or (with [`poly_direction_weights`]) with respect to a
+    /// direction. Rows whose weights are all zero are skipped.
+    pub fn add_constraint_poly_grads<const K: usize>(
+        &self,
+        grads: &[[[f64; NV]; K]],
+        w: &[[f64; K]],
+        out: &mut [f64],
+    ) {
+        debug_assert!(w.len() == self.n_constraints() && grads.len() == w.len());
+        for (ji, j) in self.joints.iter().enumerate() {
+            let o = self.row_offset[ji];
+            let ne = j.n_equations();
+            let mut g = [0.0; NV];
+            let mut any = false;
+            for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
+                for k in 0..K {
+                    if wr[k] != 0.0 {
+                        any = true;
+                        for l in 0..NV {
+                            g[l] += wr[k] * gr[k][l];
+                        }
+                    }
+                }
+            }
+            if any {
+                Self::scatter_grad(self.joint_attach[ji], &g, 1.0, out);
+            }
+        }
+    }
+
+    /// `out += sum_f sum_k w[k] grads[f][k]` for the per-element coefficient gradients of
+    /// [`System::potential_poly_series`] (as [`System::add_constraint_poly_grads`]).
+    pub fn add_potential_poly_grads<const K: usize>(
+        &self,
+        grads: &[[[f64; NV]; K]],
+        w: &[f64; K],
+        out: &mut [f64],
+    ) {
+        debug_assert_eq!(grads.len(), self.forces.len());
+        if w.iter().all(|&x| x == 0.0) {
+            return;
+        }
+        for (fi, gr) in grads.iter().enumerate() {
+            let mut g = [0.0; NV];
+            for k in 0..K {
+                for l in 0..NV {
+                    g[l] += w[k] * gr[k][l];
+                }
+            }
+            Self::scatter_grad(self.force_attach[fi], &g, 1.0, out);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures::{derivative_test_systems, generic_point};
+
+    /// `{1, t, e, t^2, e t, t^3, e t^2, t^4}`.
+    #[derive(Clone, Copy, Debug)]
+    struct Ab;
+    impl Basis<8> for Ab {
+        const ND: usize = 2;
+        const EXP: [[u8; MAX_DIRS]; 8] = [
+            [0, 0, 0, 0, 0, 0],
+            [1, 0, 0, 0, 0, 0],
+            [0, 1, 0, 0, 0, 0],
+            [2, 0, 0, 0, 0, 0],
+            [1, 1, 0, 0, 0, 0],
+            [3, 0, 0, 0, 0, 0],
+            [2, 1, 0, 0, 0, 0],
+            [4, 0, 0, 0, 0, 0],
+        ];
+    }
+
+    /// On systems with every joint kind and with springs: the coefficients against the
+    /// single-direction passes (and their polarisation), and the weighted gradients (with
+    /// respect to `q` and to both directions) against central differences of the coefficients.
+    #[test]
+    fn poly_passes_match_directional_passes_and_differences() {
+        for sys in derivative_test_systems() {
+            let (n, m, nf) = (sys.n_coords(), sys.n_constraints(), sys.forces().len());
+            let (q, v) = generic_point(n);
+            let u: Vec<f64> = (0..n).map(|i| 0.3 - 0.11 * i as f64).collect();
+            let mut ang = BodyAngles::default();
+            let series = |q: &[f64], v: &[f64], u: &[f64]| {
+                let mut ang = BodyAngles::default();
+                ang.update(&sys, q);
+                let (mut vals, mut grads) = (vec![[0.0; 8]; m], vec![[[0.0; NV]; 8]; m]);
+                sys.constraint_poly_series::<8, Ab>(q, &ang, &[v, u], &mut vals, &mut grads);
+                let mut pg = vec![[[0.0; NV]; 8]; nf];
+                let pot = sys.potential_poly_series::<8, Ab>(q, &ang, &[v, u], &mut pg);
+                (vals, grads, pot, pg)
+            };
+            let (vals, grads, pot, pg) = series(&q, &v, &u);
+            ang.update(&sys, &q);
+            let dir = |w: &[f64]| {
+                let mut rows = vec![[0.0; 3]; m];
+                sys.constraint_directional_at(&q, &ang, w, &mut rows);
+                (rows, sys.potential_directional_at(&q, &ang, w))
+            };
+            let (dv, pv) = dir(&v);
+            let upv: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a + b).collect();
+            let umv: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a - b).collect();
+            let (dp, pp) = dir(&upv);
+            let (dm, pm) = dir(&umv);
+            let close = |a: f64, b: f64, what: &str| {
+                assert!(
+                    (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                    "{what}: {a} vs {b}"
+                );
+            };
+            for r in 0..m {
+                close(2.0 * vals[r][3], dv[r][0], "D^2 Phi(v, v)");
+                close(6.0 * vals[r][5], dv[r][1], "D^3 Phi(v^3)");
+                close(24.0 * vals[r][7], dv[r][2], "D^4 Phi(v^4)");
+                close(vals[r][4], 0.25 * (dp[r][0] - dm[r][0]), "D^2 Phi(u, v)");
+            }
+            close(24.0 * pot[7], pv[2], "D^4 V(v^4)");
+            close(pot[4], 0.25 * (pp[0] - pm[0]), "D^2 V(u, v)");
+            // weighted gradients against differences
+            let w: Vec<[f64; 8]> = (0..m)
+                .map(|r| std::array::from_fn(|k| 0.1 * (r + 1) as f64 - 0.07 * k as f64))
+                .collect();
+            let wp: [f64; 8] = std::array::from_fn(|k| 0.2 - 0.05 * k as f64);
+            let total = |vals: &[[f64; 8]], pot: &[f64; 8]| -> f64 {
+                let c: f64 = vals
+                    .iter()
+                    .zip(&w)
+                    .map(|(a, b)| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>())
+                    .sum();
+                c + pot.iter().zip(&wp).map(|(x, y)| x * y).sum::<f64>()
+            };
+            let mut gq = vec![0.0; n];
+            sys.add_constraint_poly_grads(&grads, &w, &mut gq);
+            sys.add_potential_poly_grads(&pg, &wp, &mut gq);
+            let mut gd = [vec![0.0; n], vec![0.0; n]];
+            for (j, g) in gd.iter_mut().enumerate() {
+                let wj: Vec<[f64; 8]> = w
+                    .iter()
+                    .map(|x| poly_direction_weights::<8, Ab>(x, j))
+                    .collect();
+                sys.add_constraint_poly_grads(&grads, &wj, g);
+                sys.add_potential_poly_grads(&pg, &poly_direction_weights::<8, Ab>(&wp, j), g);
+            }
+            let h = 1e-4;
+            for i in 0..n {
+                let mut fd = [0.0; 3];
+                for (s, c) in [(1.0, 8.0), (-1.0, -8.0), (2.0, -1.0), (-2.0, 1.0)] {
+                    for (which, f) in fd.iter_mut().enumerate() {
+                        let (mut qq, mut vv, mut uu) = (q.clone(), v.clone(), u.clone());
+                        [&mut qq, &mut vv, &mut uu][which][i] += s * h;
+                        let (a, _, b, _) = series(&qq, &vv, &uu);
+                        *f += c * total(&a, &b) / (12.0 * h);
+                    }
+                }
+                for (got, want, what) in [
+                    (gq[i], fd[0], "q"),
+                    (gd[0][i], fd[1], "v"),
+                    (gd[1][i], fd[2], "u"),
+                ] {
+                    assert!(
+                        (got - want).abs() <= 1e-7 * (1.0 + want.abs()),
+                        "grad {what}[{i}]: {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+}
