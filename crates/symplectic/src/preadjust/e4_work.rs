@@ -1,7 +1,7 @@
 //! The workspace of the `s = 2` modified-Lagrangian term `e4` and its gradients
 //! (`modified2.rs`, `modified2_grad.rs`): allocated on first use, reused by every evaluation.
 
-use super::modified2::{E4Forward, N_PASSES};
+use super::modified2::E4Forward;
 use super::Preadjustment;
 use mbd_model::System;
 
@@ -36,9 +36,22 @@ pub(super) struct Adjoints {
     pub(super) kap3b: Vec<f64>,
     pub(super) kap3ub: Vec<f64>,
     pub(super) kap4b: Vec<f64>,
-    /// Adjoint weights of each pass's rows `[D^2, D^3, D^4]` and of its potential's.
-    pub(super) pr: Vec<Vec<[f64; 3]>>,
-    pub(super) pp: [[f64; 3]; N_PASSES],
+    /// Adjoint weights of the coefficients of passes A, B, C per constraint row, and of
+    /// passes A and B's potential.
+    pub(super) wa: Vec<[f64; 8]>,
+    pub(super) wb: Vec<[f64; 9]>,
+    pub(super) wc: Vec<[f64; 6]>,
+    pub(super) pa: [f64; 8],
+    pub(super) pb: [f64; 9],
+    /// Pass R (the weighted Hessian-vector products' adjoints): coefficients, gradients and
+    /// contraction weights per row.
+    pub(super) rvals: Vec<[f64; 11]>,
+    pub(super) rgrads: Vec<[[f64; 6]; 11]>,
+    pub(super) rw: Vec<[f64; 11]>,
+    /// Scratch: direction weights per row for passes A, B, C.
+    pub(super) sa: Vec<[f64; 8]>,
+    pub(super) sb: Vec<[f64; 9]>,
+    pub(super) sc: Vec<[f64; 6]>,
     /// `Gb` in element-local form.
     pub(super) gbar: Vec<[f64; 6]>,
     /// Scratch: n-vectors and m-vectors.
@@ -68,8 +81,17 @@ impl Adjoints {
             kap3b: zm(),
             kap3ub: zm(),
             kap4b: zm(),
-            pr: (0..N_PASSES).map(|_| vec![[0.0; 3]; m]).collect(),
-            pp: [[0.0; 3]; N_PASSES],
+            wa: vec![[0.0; 8]; m],
+            wb: vec![[0.0; 9]; m],
+            wc: vec![[0.0; 6]; m],
+            pa: [0.0; 8],
+            pb: [0.0; 9],
+            rvals: vec![[0.0; 11]; m],
+            rgrads: vec![[[0.0; 6]; 11]; m],
+            rw: vec![[0.0; 11]; m],
+            sa: vec![[0.0; 8]; m],
+            sb: vec![[0.0; 9]; m],
+            sc: vec![[0.0; 6]; m],
             gbar: vec![[0.0; 6]; m],
             tn: std::array::from_fn(|_| zn()),
             tm: std::array::from_fn(|_| zm()),
@@ -99,10 +121,11 @@ impl Adjoints {
         ] {
             x.fill(0.0);
         }
-        for p in &mut self.pr {
-            p.fill([0.0; 3]);
-        }
-        self.pp = [[0.0; 3]; N_PASSES];
+        self.wa.fill([0.0; 8]);
+        self.wb.fill([0.0; 9]);
+        self.wc.fill([0.0; 6]);
+        self.pa = [0.0; 8];
+        self.pb = [0.0; 9];
         self.gbar.fill([0.0; 6]);
     }
 }
@@ -171,7 +194,7 @@ impl Preadjustment {
             Some(mut w)
                 if w.f.u.len() == self.n
                     && w.cols.len() == self.m
-                    && w.f.d[0].pgrads.len() == sys.forces().len() =>
+                    && w.f.pa.pgrads.len() == sys.forces().len() =>
             {
                 w.set_cols(sys);
                 w

@@ -9,14 +9,17 @@
 //! `sigma = S^-1 gamma`, `n = -E gamma`, `beta_k = Hess Phi_k(u, v)`, `K2 = -E beta`,
 //! `kappa3_k = D^3 Phi_k(v, v, v) + 3 Hess Phi_k(n, v)`, `K3 = -E kappa3`,
 //! `kappa3u_k = D^3 Phi_k(u, v, v) + 2 Hess Phi_k(K2, v) + Hess Phi_k(n, u)`,
-//! `kappa4_k = D^4 Phi_k(v, v, v, v) + 6 D^3 Phi_k(n, v, v) + 3 Hess Phi_k(n, n)
-//! + 4 Hess Phi_k(K3, v)`, `H = Hess V`, `H_mu = mu0 . Hess Phi`, `H_sigma = sigma . Hess Phi`,
+//! `kappa4_k = D^4 Phi_k(v, v, v, v) + 6 D^3 Phi_k(n, v, v) + 3 Hess Phi_k(n, n) +
+//! 4 Hess Phi_k(K3, v)`, `H = Hess V`, `H_mu = mu0 . Hess Phi`, `H_sigma = sigma . Hess Phi`,
 //! the terms and their coefficients are those of [`E4_TERMS`]. The directional derivatives of
-//! orders 2 to 4 come from truncated-Taylor passes ([`System::constraint_directional`],
-//! [`System::potential_directional`]), mixed ones by polarisation.
+//! orders 2 to 4, mixed ones included, come from three passes of multivariate truncated
+//! Taylor jets ([`mbd_model::PolyJet`], [`System::constraint_poly_series`],
+//! [`System::potential_poly_series`]): pass A along `(v, u)`, pass B along `(v, n, u)` (after
+//! `n`, which needs pass A's `gamma`), pass C along `(v, K2, K3)`; each keeps its coefficients'
+//! gradients for the reverse pass.
 
 use super::{dot, Preadjustment};
-use mbd_model::{BodyAngles, System};
+use mbd_model::{Basis, BodyAngles, System, MAX_DIRS};
 use mbd_solve::SolveError;
 
 /// The terms of `e4` and their coefficients, in the order of [`Preadjustment::modified_term_s2`]'s
@@ -47,40 +50,6 @@ pub const E4_TERMS: [(&str, f64); 23] = [
     ("kappa3 S kappa3", 1.0 / 1440.0),
 ];
 
-/// Directional derivatives of orders 2..4 of every constraint row and of the potential along
-/// one direction, and (for the gradients) the element-local gradients of their series
-/// coefficients, per constraint row and per force element, which the reverse pass contracts
-/// with its adjoint weights.
-#[derive(Debug)]
-pub(super) struct Dirs {
-    pub(super) rows: Vec<[f64; 3]>,
-    pub(super) pot: [f64; 3],
-    pub(super) grads: Vec<[[f64; 6]; 5]>,
-    pub(super) pgrads: Vec<[[f64; 6]; 5]>,
-}
-
-impl Dirs {
-    fn new(m: usize, nf: usize) -> Self {
-        Dirs {
-            rows: vec![[0.0; 3]; m],
-            pot: [0.0; 3],
-            grads: vec![[[0.0; 6]; 5]; m],
-            pgrads: vec![[[0.0; 6]; 5]; nf],
-        }
-    }
-    /// The pass along `w` (with the coefficient gradients if `grads`: the same values, bit
-    /// for bit).
-    pub(super) fn eval(&mut self, sys: &System, q: &[f64], a: &BodyAngles, w: &[f64], grads: bool) {
-        if grads {
-            sys.constraint_directional_series(q, a, w, &mut self.rows, &mut self.grads);
-            self.pot = sys.potential_directional_series(q, a, w, &mut self.pgrads);
-        } else {
-            sys.constraint_directional_at(q, a, w, &mut self.rows);
-            self.pot = sys.potential_directional_at(q, a, w);
-        }
-    }
-}
-
 /// `out = ca a + cb b`.
 pub(super) fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64]) {
     for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
@@ -88,23 +57,117 @@ pub(super) fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64])
     }
 }
 
-/// The directional passes of `e4`, by index into [`E4Forward::d`]: along `v`, `u`, `n`,
-/// `u + v`, `u - v`, `n + v`, `n - v`, `n + u`, `n - u`, `K2 + v`, `K2 - v`, `K3 + v`, `K3 - v`.
-pub(super) const DV: usize = 0;
-pub(super) const DU: usize = 1;
-pub(super) const DN: usize = 2;
-pub(super) const DUPV: usize = 3;
-pub(super) const DUMV: usize = 4;
-pub(super) const DNPV: usize = 5;
-pub(super) const DNMV: usize = 6;
-pub(super) const DNPU: usize = 7;
-pub(super) const DNMU: usize = 8;
-pub(super) const DK2P: usize = 9;
-pub(super) const DK2M: usize = 10;
-pub(super) const DK3P: usize = 11;
-pub(super) const DK3M: usize = 12;
-/// Number of directional passes.
-pub(super) const N_PASSES: usize = 13;
+/// The monomial bases of the passes of `e4` ([`mbd_model::PolyJet`]; `t` stands for the
+/// velocity `v` throughout). Pass A, directions `(v, u)`: `{1, t, e, t^2, e t, t^3, e t^2,
+/// t^4}`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BasisA;
+impl Basis<8> for BasisA {
+    const ND: usize = 2;
+    const EXP: [[u8; MAX_DIRS]; 8] = [
+        [0, 0, 0, 0, 0, 0],
+        [1, 0, 0, 0, 0, 0],
+        [0, 1, 0, 0, 0, 0],
+        [2, 0, 0, 0, 0, 0],
+        [1, 1, 0, 0, 0, 0],
+        [3, 0, 0, 0, 0, 0],
+        [2, 1, 0, 0, 0, 0],
+        [4, 0, 0, 0, 0, 0],
+    ];
+}
+/// Pass A's monomials `t`, `e` (= `u`), `t^2`, `e t`, `t^3`, `e t^2`, `t^4`.
+pub(super) const A_T: usize = 1;
+pub(super) const A_E: usize = 2;
+pub(super) const A_TT: usize = 3;
+pub(super) const A_ET: usize = 4;
+pub(super) const A_TTT: usize = 5;
+pub(super) const A_ETT: usize = 6;
+pub(super) const A_T4: usize = 7;
+
+/// Pass B, directions `(v, n, u)`: `{1, t, e, d, t^2, e t, e^2, e d, e t^2}` (`e` for `n`,
+/// `d` for `u`).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BasisB;
+impl Basis<9> for BasisB {
+    const ND: usize = 3;
+    const EXP: [[u8; MAX_DIRS]; 9] = [
+        [0, 0, 0, 0, 0, 0],
+        [1, 0, 0, 0, 0, 0],
+        [0, 1, 0, 0, 0, 0],
+        [0, 0, 1, 0, 0, 0],
+        [2, 0, 0, 0, 0, 0],
+        [1, 1, 0, 0, 0, 0],
+        [0, 2, 0, 0, 0, 0],
+        [0, 1, 1, 0, 0, 0],
+        [2, 1, 0, 0, 0, 0],
+    ];
+}
+/// Pass B's monomials `e` (= `n`), `e t`, `e^2`, `e d` (`d` = `u`), `e t^2`.
+pub(super) const B_E: usize = 2;
+pub(super) const B_ET: usize = 5;
+pub(super) const B_EE: usize = 6;
+pub(super) const B_ED: usize = 7;
+pub(super) const B_ETT: usize = 8;
+
+/// Pass C, directions `(v, K2, K3)`: `{1, t, a, b, a t, b t}`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BasisC;
+impl Basis<6> for BasisC {
+    const ND: usize = 3;
+    const EXP: [[u8; MAX_DIRS]; 6] = [
+        [0, 0, 0, 0, 0, 0],
+        [1, 0, 0, 0, 0, 0],
+        [0, 1, 0, 0, 0, 0],
+        [0, 0, 1, 0, 0, 0],
+        [1, 1, 0, 0, 0, 0],
+        [1, 0, 1, 0, 0, 0],
+    ];
+}
+/// Pass C's monomials `a t` (`a` = `K2`) and `b t` (`b` = `K3`).
+pub(super) const C_AT: usize = 4;
+pub(super) const C_BT: usize = 5;
+
+/// One pass's coefficients per constraint row and of the potential, with their element-local
+/// gradients (per row, and per force element).
+#[derive(Debug)]
+pub(super) struct Pass<const K: usize> {
+    pub(super) vals: Vec<[f64; K]>,
+    pub(super) grads: Vec<[[f64; 6]; K]>,
+    pub(super) pot: [f64; K],
+    pub(super) pgrads: Vec<[[f64; 6]; K]>,
+}
+
+impl<const K: usize> Pass<K> {
+    pub(super) fn new(m: usize, nf: usize) -> Self {
+        Pass {
+            vals: vec![[0.0; K]; m],
+            grads: vec![[[0.0; 6]; K]; m],
+            pot: [0.0; K],
+            pgrads: vec![[[0.0; 6]; K]; nf],
+        }
+    }
+
+    /// The pass along `dirs` at `q` (constraints and potential).
+    pub(super) fn eval<B: Basis<K>>(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        a: &BodyAngles,
+        dirs: &[&[f64]],
+    ) {
+        sys.constraint_poly_series::<K, B>(q, a, dirs, &mut self.vals, &mut self.grads);
+        self.pot = sys.potential_poly_series::<K, B>(q, a, dirs, &mut self.pgrads);
+    }
+
+    /// `out = sum_f grad_q` of the potential's coefficient `k` (length n; zero without force
+    /// elements): a Hessian-vector product of `V` for a coefficient of degree 1.
+    pub(super) fn pot_grad_into(&self, sys: &System, k: usize, out: &mut [f64]) {
+        out.fill(0.0);
+        let mut w = [0.0; K];
+        w[k] = 1.0;
+        sys.add_potential_poly_grads(&self.pgrads, &w, out);
+    }
+}
 
 /// The intermediate quantities of `e4` at one `(q, v)` (names as in the module doc; `nn` is
 /// `n`, `hmu_v` is `H_mu v`, `pi_hv` is `Pi H v`, `s_beta` is `S^-1 beta`, `d4v` is
@@ -143,21 +206,17 @@ pub(super) struct E4Forward {
     pub(super) d3v_u: f64,
     pub(super) d3v_n: f64,
     pub(super) d4v: f64,
-    /// The directional passes (indices `DV` ..).
-    pub(super) d: Vec<Dirs>,
+    /// The passes ([`BasisA`], [`BasisB`], [`BasisC`]).
+    pub(super) pa: Pass<8>,
+    pub(super) pb: Pass<9>,
+    pub(super) pc: Pass<6>,
     /// `sin`/`cos` of the body angles at `q`, shared by every pass.
     pub(super) angles: BodyAngles,
-    /// Whether the passes keep their coefficient gradients (for the reverse pass).
-    pub(super) grads: bool,
     /// Per constraint row, element-local `Hess Phi_r v` and `Hess Phi_r u` (the weighted
-    /// Hessian-vector products `H_mu v`, `H_sigma v`, ... and their adjoints use them).
+    /// Hessian-vector products `H_mu v`, `H_sigma v`, ...; pass A's gradients of `t` and `e`).
     pub(super) rhv_v: Vec<[f64; 6]>,
     pub(super) rhv_u: Vec<[f64; 6]>,
-    /// Scratch: a direction, local rows, per-row values, m zeros.
-    pub(super) dir: Vec<f64>,
-    rg: Vec<[f64; 6]>,
-    rd3: Vec<[f64; 6]>,
-    rv: Vec<f64>,
+    /// Scratch: m zeros.
     pub(super) zero_m: Vec<f64>,
 }
 
@@ -194,15 +253,12 @@ impl E4Forward {
             d3v_u: 0.0,
             d3v_n: 0.0,
             d4v: 0.0,
-            d: (0..N_PASSES).map(|_| Dirs::new(m, nf)).collect(),
+            pa: Pass::new(m, nf),
+            pb: Pass::new(m, nf),
+            pc: Pass::new(m, nf),
             angles: BodyAngles::default(),
-            grads: false,
             rhv_v: vec![[0.0; 6]; m],
             rhv_u: vec![[0.0; 6]; m],
-            dir: zn(),
-            rg: vec![[0.0; 6]; m],
-            rd3: vec![[0.0; 6]; m],
-            rv: zm(),
             zero_m: zm(),
         }
     }
@@ -236,39 +292,6 @@ impl E4Forward {
             dot(&f.kap3, &f.s_kap3),
         ]
     }
-
-    /// The pass `k` along `a + sign b`.
-    fn pass_pm(&mut self, sys: &System, q: &[f64], k: usize, a: Src, b: Src, sign: f64) {
-        let mut dir = std::mem::take(&mut self.dir);
-        comb_into(self.src(a), 1.0, self.src(b), sign, &mut dir);
-        self.d[k].eval(sys, q, &self.angles, &dir, self.grads);
-        self.dir = dir;
-    }
-
-    fn src(&self, s: Src) -> &[f64] {
-        match s {
-            Src::U => &self.u,
-            Src::N => &self.nn,
-            Src::K2 => &self.k2,
-            Src::K3 => &self.k3,
-        }
-    }
-
-    /// Per row `D^2 f(a, b)` from the passes `p` (along `a + b`) and `m` (along `a - b`).
-    fn bilinear(d: &[Dirs], p: usize, m: usize, out: &mut [f64]) {
-        for ((o, x), y) in out.iter_mut().zip(&d[p].rows).zip(&d[m].rows) {
-            *o = 0.25 * (x[0] - y[0]);
-        }
-    }
-}
-
-/// A direction of a pass (the velocity is passed separately).
-#[derive(Clone, Copy)]
-enum Src {
-    U,
-    N,
-    K2,
-    K3,
 }
 
 impl Preadjustment {
@@ -306,84 +329,50 @@ impl Preadjustment {
     }
 
     /// Evaluates the intermediates of `e4` at `q` with the velocity `v` into `f` (after
-    /// `check_v`; prepares the workspace at `q`); with `grads`, the passes keep their
-    /// coefficient gradients for the reverse pass. Allocates nothing.
+    /// `check_v`; prepares the workspace at `q`); the passes keep their coefficient gradients
+    /// for the reverse pass. Allocates nothing.
     pub(super) fn e4_forward(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
         f: &mut E4Forward,
-        grads: bool,
     ) -> Result<(), SolveError> {
         self.prepare(sys, q)?;
         let m = self.m;
-        f.grads = grads;
         f.angles.update(sys, q);
         f.u.copy_from_slice(&self.u);
         f.mu0.copy_from_slice(&self.mu0);
-        let (ang, g) = (&f.angles, grads);
-        f.d[DV].eval(sys, q, ang, v, g);
-        for (g, r) in f.gam.iter_mut().zip(&f.d[DV].rows) {
-            *g = r[0];
-        }
-        self.neg_e_into(&f.gam, &mut f.sig, &mut f.nn);
-        f.d[DU].eval(sys, q, ang, &f.u, g);
-        f.d[DN].eval(sys, q, ang, &f.nn, g);
-        // (the pass along a - v is minus the pass along v - a: the odd orders change sign,
-        // which the polarisations below take into account)
-        let mut dir = std::mem::take(&mut f.dir);
-        for (k, a, sign) in [
-            (DUPV, Src::U, 1.0),
-            (DUMV, Src::U, -1.0),
-            (DNPV, Src::N, 1.0),
-            (DNMV, Src::N, -1.0),
-        ] {
-            comb_into(f.src(a), 1.0, v, sign, &mut dir);
-            f.d[k].eval(sys, q, &f.angles, &dir, grads);
-        }
-        f.dir = dir;
-        f.pass_pm(sys, q, DNPU, Src::N, Src::U, 1.0);
-        f.pass_pm(sys, q, DNMU, Src::N, Src::U, -1.0);
-        let mut t = std::mem::take(&mut f.rv);
-        E4Forward::bilinear(&f.d, DUPV, DUMV, &mut f.beta);
-        self.neg_e_into(&f.beta, &mut f.s_beta, &mut f.k2);
-        E4Forward::bilinear(&f.d, DNPV, DNMV, &mut t);
+        // pass A along (v, u): gamma, beta, D^3 Phi(v^3), D^4 Phi(v^4), D^3 Phi(v, v, u), the
+        // rows Hess Phi_r v and Hess Phi_r u, and of V: D^4 V(v^4), D^3 V(u, v, v), H v, H u
+        f.pa.eval::<BasisA>(sys, q, &f.angles, &[v, &f.u]);
         for r in 0..m {
-            f.kap3[r] = f.d[DV].rows[r][1] + 3.0 * t[r];
+            let (c, g) = (&f.pa.vals[r], &f.pa.grads[r]);
+            f.gam[r] = 2.0 * c[A_TT];
+            f.beta[r] = c[A_ET];
+            f.rhv_v[r] = g[A_T];
+            f.rhv_u[r] = g[A_E];
+        }
+        f.pa.pot_grad_into(sys, A_T, &mut f.hv);
+        f.pa.pot_grad_into(sys, A_E, &mut f.hu);
+        self.neg_e_into(&f.gam, &mut f.sig, &mut f.nn);
+        self.neg_e_into(&f.beta, &mut f.s_beta, &mut f.k2);
+        // pass B along (v, n, u): D^2 Phi(n, v), D^3 Phi(v, v, n), D^2 Phi(n, n), D^2 Phi(n, u),
+        // and of V: D^3 V(n, v, v), H n
+        f.pb.eval::<BasisB>(sys, q, &f.angles, &[v, &f.nn, &f.u]);
+        f.pb.pot_grad_into(sys, B_E, &mut f.hn);
+        for r in 0..m {
+            f.kap3[r] = 6.0 * f.pa.vals[r][A_TTT] + 3.0 * f.pb.vals[r][B_ET];
         }
         self.neg_e_into(&f.kap3, &mut f.s_kap3, &mut f.k3);
-        let mut dir = std::mem::take(&mut f.dir);
-        for (k, a, sign) in [
-            (DK2P, Src::K2, 1.0),
-            (DK2M, Src::K2, -1.0),
-            (DK3P, Src::K3, 1.0),
-            (DK3M, Src::K3, -1.0),
-        ] {
-            comb_into(f.src(a), 1.0, v, sign, &mut dir);
-            f.d[k].eval(sys, q, &f.angles, &dir, grads);
-        }
-        f.dir = dir;
-        // D^3 Phi(v, v, u) = (D^3(u + v) + D^3(u - v) - 2 D^3(u)) / 6, D^3 Phi(v, v, n) likewise
-        let d = &f.d;
+        // pass C along (v, K2, K3): D^2 Phi(K2, v), D^2 Phi(K3, v)
+        f.pc.eval::<BasisC>(sys, q, &f.angles, &[v, &f.k2, &f.k3]);
         for r in 0..m {
-            let vvu = (d[DUPV].rows[r][1] + d[DUMV].rows[r][1] - 2.0 * d[DU].rows[r][1]) / 6.0;
-            let vvn = (d[DNPV].rows[r][1] + d[DNMV].rows[r][1] - 2.0 * d[DN].rows[r][1]) / 6.0;
-            let h_k2v = 0.25 * (d[DK2P].rows[r][0] - d[DK2M].rows[r][0]);
-            let h_k3v = 0.25 * (d[DK3P].rows[r][0] - d[DK3M].rows[r][0]);
-            let h_nu = 0.25 * (d[DNPU].rows[r][0] - d[DNMU].rows[r][0]);
-            f.kap3u[r] = vvu + 2.0 * h_k2v + h_nu;
-            f.kap4[r] = d[DV].rows[r][2] + 6.0 * vvn + 3.0 * d[DN].rows[r][0] + 4.0 * h_k3v;
+            let (a, b, c) = (&f.pa.vals[r], &f.pb.vals[r], &f.pc.vals[r]);
+            f.kap3u[r] = 2.0 * a[A_ETT] + 2.0 * c[C_AT] + b[B_ED];
+            f.kap4[r] = 24.0 * a[A_T4] + 12.0 * b[B_ETT] + 6.0 * b[B_EE] + 4.0 * c[C_BT];
         }
-        // Hessian-vector products: of V by passes over the forces, of the weighted constraints
-        // from the element-local rows Hess Phi_r v and Hess Phi_r u
-        let a = &f.angles;
-        sys.lagrangian_hessian_vector_at(q, a, v, 1.0, &f.zero_m, &mut f.hv);
-        sys.lagrangian_hessian_vector_at(q, a, &f.u, 1.0, &f.zero_m, &mut f.hu);
-        sys.lagrangian_hessian_vector_at(q, a, &f.nn, 1.0, &f.zero_m, &mut f.hn);
-        sys.constraint_third_local_at(q, a, v, &mut f.rg, &mut f.rhv_v, &mut f.rd3, &mut t);
-        sys.constraint_third_local_at(q, a, &f.u, &mut f.rg, &mut f.rhv_u, &mut f.rd3, &mut t);
-        f.rv = t;
+        // the constraint-weighted Hessian-vector products from the rows
         for (out, rows, w) in [
             (&mut f.hmu_v, &f.rhv_v, &f.mu0),
             (&mut f.hsig_v, &f.rhv_v, &f.sig),
@@ -396,10 +385,9 @@ impl Preadjustment {
         self.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
         self.pi_sgm(&f.hv, &mut f.pi_hv, &mut f.sg_hv);
         self.pi_sgm(&f.hsig_v, &mut f.pi_hsig_v, &mut f.sg_hsig_v);
-        // potential: D^3 V(u, v, v) and D^3 V(n, v, v) by polarisation (odd in the direction)
-        f.d3v_u = (d[DUPV].pot[1] + d[DUMV].pot[1] - 2.0 * d[DU].pot[1]) / 6.0;
-        f.d3v_n = (d[DNPV].pot[1] + d[DNMV].pot[1] - 2.0 * d[DN].pot[1]) / 6.0;
-        f.d4v = d[DV].pot[2];
+        f.d3v_u = 2.0 * f.pa.pot[A_ETT];
+        f.d3v_n = 2.0 * f.pb.pot[B_ETT];
+        f.d4v = 24.0 * f.pa.pot[A_T4];
         Ok(())
     }
 
@@ -413,7 +401,7 @@ impl Preadjustment {
     ) -> Result<[f64; 23], SolveError> {
         self.check_v(v)?;
         let mut w = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut w.f, false);
+        let res = self.e4_forward(sys, q, v, &mut w.f);
         let terms = w.f.terms();
         self.e4 = Some(w);
         res.map(|()| terms)

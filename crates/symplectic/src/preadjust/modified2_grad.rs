@@ -37,11 +37,11 @@
 
 use super::e4_work::{gbar_add, local, Adjoints, E4Work};
 use super::modified2::{
-    comb_into, Dirs, DK2M, DK2P, DK3M, DK3P, DN, DNMU, DNMV, DNPU, DNPV, DU, DUMV, DUPV, DV,
-    E4_TERMS,
+    comb_into, BasisA, BasisB, BasisC, E4Forward, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE,
+    B_ET, B_ETT, C_AT, C_BT, E4_TERMS,
 };
 use super::Preadjustment;
-use mbd_model::{BodyAngles, System};
+use mbd_model::{poly_direction_weights, Basis, BodyAngles, System, MAX_DIRS};
 use mbd_solve::SolveError;
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
@@ -90,7 +90,7 @@ impl Preadjustment {
             }
         }
         let mut work = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut work.f, true);
+        let res = self.e4_forward(sys, q, v, &mut work.f);
         let out = res.map(|()| self.e4_reverse(sys, q, v, &mut work, gq, gv));
         self.e4 = Some(work);
         out
@@ -153,10 +153,8 @@ impl Preadjustment {
         axpy(&mut w.nnb, c[11], &f.hu);
         axpy(&mut w.ub, c[12], &f.hu);
         axpy(&mut w.hub, c[12], &f.u);
-        // D^3 V(u, v, v) = (D^3 V(u + v) + D^3 V(u - v) - 2 D^3 V(u)) / 6
-        w.pp[DUPV][1] += c[13] / 6.0;
-        w.pp[DUMV][1] += c[13] / 6.0;
-        w.pp[DU][1] -= c[13] / 3.0;
+        // D^3 V(u, v, v) = 2 (pass A's e t^2)
+        w.pa[A_ETT] += 2.0 * c[13];
         axpy(&mut w.nnb, c[14], &f.hn);
         axpy(&mut w.hnb, c[14], &f.nn);
         adj_pi(&mut w.gbar, cols, c[15], hv, hsig_v);
@@ -164,13 +162,11 @@ impl Preadjustment {
         axpy(&mut w.hsig_vb, c[15], &f.pi_hv);
         axpy(&mut w.hvb, c[16], &f.k3);
         axpy(&mut w.k3b, c[16], &f.hv);
-        w.pp[DNPV][1] += c[17] / 6.0;
-        w.pp[DNMV][1] += c[17] / 6.0;
-        w.pp[DN][1] -= c[17] / 3.0;
+        w.pb[B_ETT] += 2.0 * c[17];
         adj_pi(&mut w.gbar, cols, c[18], hv, hv);
         axpy(&mut w.hvb, c[18], &f.pi_hv);
         axpy(&mut w.hvb, c[18], &f.pi_hv);
-        w.pp[DV][2] += c[19];
+        w.pa[A_T4] += 24.0 * c[19];
         adj_pi(&mut w.gbar, cols, c[20], hsig_v, hsig_v);
         axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
         axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
@@ -180,172 +176,72 @@ impl Preadjustment {
         axpy(&mut w.kap3b, c[22], &f.s_kap3);
         axpy(&mut w.kap3b, c[22], &f.s_kap3);
 
-        // 2. the Hessian-vector products
-        let zero = f.zero_m.as_slice();
-        let ang = &f.angles;
-        let sc = &mut w.tn[2..8];
-        let (sig, mu0) = (f.sig.as_slice(), f.mu0.as_slice());
-        let (rv, ru) = (f.rhv_v.as_slice(), f.rhv_u.as_slice());
-        hvp_adj(
-            sys,
-            q,
-            ang,
-            &f.u,
-            (0.0, sig),
-            Some(WeightAdjoint {
-                rows: ru,
-                wb: &mut w.sigb,
-                cols,
-            }),
-            &w.hsig_ub,
-            &mut w.ub,
-            gq,
-            sc,
-        );
-        hvp_adj(
-            sys,
-            q,
-            ang,
-            v,
-            (0.0, sig),
-            Some(WeightAdjoint {
-                rows: rv,
-                wb: &mut w.sigb,
-                cols,
-            }),
-            &w.hsig_vb,
-            gv,
-            gq,
-            sc,
-        );
-        hvp_adj(
-            sys,
-            q,
-            ang,
-            &f.u,
-            (0.0, mu0),
-            Some(WeightAdjoint {
-                rows: ru,
-                wb: &mut w.mu0b,
-                cols,
-            }),
-            &w.hmu_ub,
-            &mut w.ub,
-            gq,
-            sc,
-        );
-        hvp_adj(
-            sys,
-            q,
-            ang,
-            v,
-            (0.0, mu0),
-            Some(WeightAdjoint {
-                rows: rv,
-                wb: &mut w.mu0b,
-                cols,
-            }),
-            &w.hmu_vb,
-            gv,
-            gq,
-            sc,
-        );
-        hvp_adj(
-            sys,
-            q,
-            ang,
-            &f.nn,
-            (1.0, zero),
-            None,
-            &w.hnb,
-            &mut w.nnb,
-            gq,
-            sc,
-        );
-        hvp_adj(
-            sys,
-            q,
-            ang,
-            &f.u,
-            (1.0, zero),
-            None,
-            &w.hub,
-            &mut w.ub,
-            gq,
-            sc,
-        );
-        hvp_adj(sys, q, ang, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
-
-        // 3. kappa4 = D^4 Phi(v^4) + 6 vvn + 3 D^2 Phi(n, n) + 4 h_k3v,
-        //    kappa3u = vvu + 2 h_k2v + h_nu, and the polarisations behind them
-        for r in 0..m {
-            let (k4, k3u) = (w.kap4b[r], w.kap3ub[r]);
-            w.pr[DV][r][2] += k4;
-            w.pr[DN][r][0] += 3.0 * k4;
-            // vvn = (D^3(n + v) + D^3(n - v) - 2 D^3(n)) / 6, weight 6 kappa4b
-            w.pr[DNPV][r][1] += k4;
-            w.pr[DNMV][r][1] += k4;
-            w.pr[DN][r][1] -= 2.0 * k4;
-            // h_k3v = (D^2(k3 + v) - D^2(k3 - v)) / 4, weight 4 kappa4b
-            w.pr[DK3P][r][0] += k4;
-            w.pr[DK3M][r][0] -= k4;
-            // vvu likewise, weight kappa3ub
-            w.pr[DUPV][r][1] += k3u / 6.0;
-            w.pr[DUMV][r][1] += k3u / 6.0;
-            w.pr[DU][r][1] -= k3u / 3.0;
-            // h_k2v, weight 2 kappa3ub; h_nu, weight kappa3ub
-            w.pr[DK2P][r][0] += 0.5 * k3u;
-            w.pr[DK2M][r][0] -= 0.5 * k3u;
-            w.pr[DNPU][r][0] += 0.25 * k3u;
-            w.pr[DNMU][r][0] -= 0.25 * k3u;
+        // 2. the Hessian-vector products: the constraint-weighted ones by pass R, those of V
+        //    by polarised third-order passes over the force elements
+        self.hvp_weighted_adj(sys, q, v, f, w, gq, gv);
+        if !sys.forces().is_empty() {
+            let zero = f.zero_m.as_slice();
+            let ang = &f.angles;
+            let sc = &mut w.tn[2..8];
+            for (x, yb, xb) in [
+                (f.nn.as_slice(), &w.hnb, &mut w.nnb),
+                (f.u.as_slice(), &w.hub, &mut w.ub),
+            ] {
+                hvp_adj(sys, q, ang, x, (1.0, zero), None, yb, xb, gq, sc);
+            }
+            hvp_adj(sys, q, ang, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
         }
 
-        // 4. the passes along k3 +- v and k2 +- v
-        let [wb, ..] = &mut w.tn;
-        let (d, pr, pp) = (&f.d, &w.pr, &w.pp);
-        pair_adj(sys, (d, pr, pp), [DK3P, DK3M], gq, wb, &mut w.k3b, gv);
-        pair_adj(sys, (d, pr, pp), [DK2P, DK2M], gq, wb, &mut w.k2b, gv);
+        // 3. kappa4 = 24 A[t^4] + 12 B[e t^2] + 6 B[e^2] + 4 C[b t],
+        //    kappa3u = 2 A[e t^2] + 2 C[a t] + B[e d]
+        for r in 0..m {
+            let (k4, k3u) = (w.kap4b[r], w.kap3ub[r]);
+            w.wa[r][A_T4] += 24.0 * k4;
+            w.wb[r][B_ETT] += 12.0 * k4;
+            w.wb[r][B_EE] += 6.0 * k4;
+            w.wc[r][C_BT] += 4.0 * k4;
+            w.wa[r][A_ETT] += 2.0 * k3u;
+            w.wc[r][C_AT] += 2.0 * k3u;
+            w.wb[r][B_ED] += k3u;
+        }
 
-        // 5. k3 = -D G^T S^-1 kappa3, kappa3 = D^3 Phi(v^3) + 3 h_nv
+        // 4. pass C along (v, K2, K3)
+        contract::<6, BasisC>(
+            sys,
+            (&f.pc, &w.wc, None),
+            &mut w.sc,
+            gq,
+            &mut [&mut *gv, w.k2b.as_mut_slice(), w.k3b.as_mut_slice()],
+        );
+
+        // 5. k3 = -D G^T S^-1 kappa3, kappa3 = 6 A[t^3] + 3 B[e t]
         let k3b = std::mem::take(&mut w.k3b);
         self.adj_neg_e(w, cols, &f.s_kap3, &k3b);
         w.k3b = k3b;
         axpy(&mut w.kap3b, 1.0, &w.tm[0]);
         for r in 0..m {
-            w.pr[DV][r][1] += w.kap3b[r];
-            w.pr[DNPV][r][0] += 0.75 * w.kap3b[r];
-            w.pr[DNMV][r][0] -= 0.75 * w.kap3b[r];
+            w.wa[r][A_TTT] += 6.0 * w.kap3b[r];
+            w.wb[r][B_ET] += 3.0 * w.kap3b[r];
         }
-        // 6. k2 = -D G^T S^-1 beta, beta = (D^2(u + v) - D^2(u - v)) / 4
+        // 6. k2 = -D G^T S^-1 beta, beta = A[e t]
         let k2b = std::mem::take(&mut w.k2b);
         self.adj_neg_e(w, cols, &f.s_beta, &k2b);
         w.k2b = k2b;
         axpy(&mut w.betab, 1.0, &w.tm[0]);
         for r in 0..m {
-            w.pr[DUPV][r][0] += 0.25 * w.betab[r];
-            w.pr[DUMV][r][0] -= 0.25 * w.betab[r];
+            w.wa[r][A_ET] += w.betab[r];
         }
 
-        // 7. the passes along n +- u, n +- v, u +- v, u and n
-        let [wb, ..] = &mut w.tn;
-        let (d, pr, pp) = (&f.d, &w.pr, &w.pp);
-        pair_adj(
+        // 7. pass B along (v, n, u)
+        contract::<9, BasisB>(
             sys,
-            (d, pr, pp),
-            [DNPU, DNMU],
+            (&f.pb, &w.wb, Some(&w.pb)),
+            &mut w.sb,
             gq,
-            wb,
-            &mut w.nnb,
-            &mut w.ub,
+            &mut [&mut *gv, w.nnb.as_mut_slice(), w.ub.as_mut_slice()],
         );
-        pair_adj(sys, (d, pr, pp), [DNPV, DNMV], gq, wb, &mut w.nnb, gv);
-        pair_adj(sys, (d, pr, pp), [DUPV, DUMV], gq, wb, &mut w.ub, gv);
-        pass_adj(sys, &f.d[DU], &w.pr[DU], w.pp[DU], gq, wb);
-        axpy(&mut w.ub, 1.0, wb);
-        pass_adj(sys, &f.d[DN], &w.pr[DN], w.pp[DN], gq, wb);
-        axpy(&mut w.nnb, 1.0, wb);
 
-        // 8. n = -D G^T sigma, sigma = S^-1 gamma, gamma = D^2 Phi(v, v)
+        // 8. n = -D G^T sigma, sigma = S^-1 gamma, gamma = 2 A[t^2]
         {
             let [dn, dsig, da, ..] = &mut w.tn;
             let [t, a, ..] = &mut w.tm;
@@ -361,12 +257,17 @@ impl Preadjustment {
             gbar_add(&mut w.gbar, cols, -1.0, a, dsig);
             gbar_add(&mut w.gbar, cols, -1.0, &f.sig, da);
             for r in 0..m {
-                w.pr[DV][r][0] += a[r];
+                w.wa[r][A_TT] += 2.0 * a[r];
             }
         }
-        let [wb, ..] = &mut w.tn;
-        pass_adj(sys, &f.d[DV], &w.pr[DV], w.pp[DV], gq, wb);
-        axpy(gv, 1.0, wb);
+        // pass A along (v, u)
+        contract::<8, BasisA>(
+            sys,
+            (&f.pa, &w.wa, Some(&w.pa)),
+            &mut w.sa,
+            gq,
+            &mut [&mut *gv, w.ub.as_mut_slice()],
+        );
 
         // 9. u = -D g + D G^T mu0, mu0 = S^-1 G D g, g = grad V
         {
@@ -389,12 +290,12 @@ impl Preadjustment {
             self.dgt_into(&f.mu0, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
-            sys.lagrangian_hessian_vector_at(q, ang, &w.gradb, 1.0, zero, t);
+            sys.lagrangian_hessian_vector_at(q, &f.angles, &w.gradb, 1.0, &f.zero_m, t);
             axpy(gq, 1.0, t);
         }
 
         // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r
-        sys.add_constraint_hessian_rows_at(q, ang, &w.gbar, gq);
+        sys.add_constraint_hessian_rows_at(q, &f.angles, &w.gbar, gq);
         e4
     }
 }
@@ -474,43 +375,102 @@ fn hvp_adj(
     }
 }
 
-/// The adjoint of a directional pass `d` (kept with its coefficient gradients by the forward
-/// evaluation) with the weights `rows` and `pot`: adds its `q`-gradient to `qb` and writes its
-/// `w`-gradient into `wb` (overwritten).
-/// Every pass's stored series (`E4Forward::d`) with its adjoint weights of the constraint rows
-/// and of the potential.
-type PassWeights<'a> = (&'a [Dirs], &'a [Vec<[f64; 3]>], &'a [[f64; 3]]);
+/// Pass R's basis, directions `(v, u, y1, y2, y3, y4)` with the adjoints `y1 = (H_sigma
+/// v)b`, `y2 = (H_mu v)b`, `y3 = (H_sigma u)b`, `y4 = (H_mu u)b`: `{1, t, e, y1, y2, y3, y4,
+/// t y1, t y2, e y3, e y4}` (`t` for `v`, `e` for `u`).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BasisR;
+impl Basis<11> for BasisR {
+    const ND: usize = 6;
+    const EXP: [[u8; MAX_DIRS]; 11] = [
+        [0, 0, 0, 0, 0, 0],
+        [1, 0, 0, 0, 0, 0],
+        [0, 1, 0, 0, 0, 0],
+        [0, 0, 1, 0, 0, 0],
+        [0, 0, 0, 1, 0, 0],
+        [0, 0, 0, 0, 1, 0],
+        [0, 0, 0, 0, 0, 1],
+        [1, 0, 1, 0, 0, 0],
+        [1, 0, 0, 1, 0, 0],
+        [0, 1, 0, 0, 1, 0],
+        [0, 1, 0, 0, 0, 1],
+    ];
+}
+/// Pass R's monomials `y1 .. y4`, then `t y1`, `t y2`, `e y3`, `e y4`.
+const R_Y: [usize; 4] = [3, 4, 5, 6];
+const R_XY: [usize; 4] = [7, 8, 9, 10];
 
-/// The adjoint of the pair of passes `[k+, k-]` along `a + b` and `a - b`: the `q` part into
-/// `qb`, `+ / -` the direction adjoint into `ab` and `bb` (`wb` scratch, length n).
-fn pair_adj(
-    sys: &System,
-    (d, pr, pp): PassWeights,
-    ks: [usize; 2],
-    qb: &mut [f64],
-    wb: &mut [f64],
-    ab: &mut [f64],
-    bb: &mut [f64],
-) {
-    for (k, sign) in ks.into_iter().zip([1.0, -1.0]) {
-        pass_adj(sys, &d[k], &pr[k], pp[k], qb, wb);
-        axpy(ab, 1.0, wb);
-        axpy(bb, sign, wb);
+impl Preadjustment {
+    /// The adjoints of the four constraint-weighted Hessian-vector products `y = H_w x`
+    /// (`H_w = sum_r w_r Hess Phi_r`) for `(x, w) = (v, sigma), (v, mu0), (u, sigma), (u,
+    /// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`]): `qb += D^3 (w . Phi)(x, yb,
+    /// .)` (the `q`-gradients of `x yb`), `xb += H_w yb` (those of `yb`), `wb_r += yb^T Hess
+    /// Phi_r x` (the coefficients of `x yb`).
+    #[allow(clippy::too_many_arguments)]
+    fn hvp_weighted_adj(
+        &self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        f: &E4Forward,
+        w: &mut Adjoints,
+        gq: &mut [f64],
+        gv: &mut [f64],
+    ) {
+        let dirs: [&[f64]; 6] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
+        sys.constraint_poly_series::<11, BasisR>(q, &f.angles, &dirs, &mut w.rvals, &mut w.rgrads);
+        let m = self.m;
+        for r in 0..m {
+            let (s, mu) = (f.sig[r], f.mu0[r]);
+            let c = &w.rvals[r];
+            w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
+            w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
+            let mut x = [0.0; 11];
+            for (k, wt) in R_XY.iter().zip([s, mu, s, mu]) {
+                x[*k] = wt;
+            }
+            w.rw[r] = x;
+        }
+        sys.add_constraint_poly_grads(&w.rgrads, &w.rw, gq);
+        for (pair, out) in [(0, gv), (1, w.ub.as_mut_slice())] {
+            for r in 0..m {
+                let (s, mu) = (f.sig[r], f.mu0[r]);
+                let mut x = [0.0; 11];
+                x[R_Y[2 * pair]] = s;
+                x[R_Y[2 * pair + 1]] = mu;
+                w.rw[r] = x;
+            }
+            sys.add_constraint_poly_grads(&w.rgrads, &w.rw, out);
+        }
     }
 }
 
-fn pass_adj(
+/// The adjoint of a pass ([`Pass`]) with the adjoint weights `wts` of its rows' coefficients
+/// and `pot` of its potential's: adds the `q`-gradient to `qb` and the gradient with respect to
+/// direction `j` to `dirs[j]` ([`poly_direction_weights`]); `scratch` has one entry per row.
+fn contract<const K: usize, B: Basis<K>>(
     sys: &System,
-    d: &Dirs,
-    rows: &[[f64; 3]],
-    pot: [f64; 3],
+    (p, wts, pot): (&Pass<K>, &[[f64; K]], Option<&[f64; K]>),
+    scratch: &mut [[f64; K]],
     qb: &mut [f64],
-    wb: &mut [f64],
+    dirs: &mut [&mut [f64]],
 ) {
-    wb.fill(0.0);
-    sys.add_constraint_directional_grads(&d.grads, rows, qb, wb);
-    sys.add_potential_directional_grads(&d.pgrads, pot, qb, wb);
+    sys.add_constraint_poly_grads(&p.grads, wts, qb);
+    if let Some(pw) = pot {
+        sys.add_potential_poly_grads(&p.pgrads, pw, qb);
+    }
+    for (j, out) in dirs.iter_mut().enumerate() {
+        for (s, x) in scratch.iter_mut().zip(wts) {
+            *s = poly_direction_weights::<K, B>(x, j);
+        }
+        sys.add_constraint_poly_grads(&p.grads, scratch, out);
+        if let Some(pw) = pot {
+            let pj = poly_direction_weights::<K, B>(pw, j);
+            sys.add_potential_poly_grads(&p.pgrads, &pj, out);
+        }
+    }
 }
+
 #[cfg(test)]
 mod tests {
     use super::*;
