@@ -8,21 +8,27 @@ use crate::directional::BodyAngles;
 use crate::jet::{Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
 use crate::system::{Attach, System};
 
-/// The frames of one element's bodies, built in place and reused from element to element
-/// (see [`PolyJet::set_var_frame`]): body a in slots `0..3`, body b in `3..6`, ground constant.
-struct PolyFrames<const K: usize, B> {
+/// The workspace of the [`PolyJet`] passes of one basis: the frames of an element's bodies,
+/// built in place and reused from element to element and from pass to pass (see
+/// [`PolyJet::set_var_frame`]: body a in slots `0..3`, body b in `3..6`, ground constant), and
+/// the element's equations. Make it once (it is large: boxed) and hand it to every pass.
+#[derive(Debug)]
+pub struct PolyWorkspace<const K: usize, B> {
     a: Frame<PolyJet<K, B>>,
     b: Frame<PolyJet<K, B>>,
     ground: Frame<PolyJet<K, B>>,
+    e: [PolyJet<K, B>; 3],
 }
 
-impl<const K: usize, B: Basis<K>> PolyFrames<K, B> {
-    fn new() -> Self {
-        PolyFrames {
+impl<const K: usize, B: Basis<K>> PolyWorkspace<K, B> {
+    /// A fresh workspace.
+    pub fn new() -> Box<Self> {
+        Box::new(PolyWorkspace {
             a: Frame::fixed(),
             b: Frame::fixed(),
             ground: Frame::fixed(),
-        }
+            e: [PolyJet::cst(0.0); 3],
+        })
     }
 
     fn set(
@@ -42,31 +48,36 @@ impl<const K: usize, B: Basis<K>> PolyFrames<K, B> {
         PolyJet::set_var_frame(f, slot, qi, &w[..B::ND], s, c);
     }
 
+    /// Sets the frames of the bodies `at` and returns them with the equations' buffer.
+    #[allow(clippy::type_complexity)]
     fn get(
         &mut self,
         q: &[f64],
         ang: &BodyAngles,
         dirs: &[&[f64]],
         at: Attach,
-    ) -> (&Frame<PolyJet<K, B>>, &Frame<PolyJet<K, B>>) {
+    ) -> (
+        &Frame<PolyJet<K, B>>,
+        &Frame<PolyJet<K, B>>,
+        &mut [PolyJet<K, B>; 3],
+    ) {
         if let Some(i) = at.a {
             Self::set(&mut self.a, 0, q, ang, dirs, i);
         }
         if let Some(i) = at.b {
             Self::set(&mut self.b, 3, q, ang, dirs, i);
         }
-        (
-            if at.a.is_some() {
-                &self.a
-            } else {
-                &self.ground
-            },
-            if at.b.is_some() {
-                &self.b
-            } else {
-                &self.ground
-            },
-        )
+        let fa = if at.a.is_some() {
+            &self.a
+        } else {
+            &self.ground
+        };
+        let fb = if at.b.is_some() {
+            &self.b
+        } else {
+            &self.ground
+        };
+        (fa, fb, &mut self.e)
     }
 }
 
@@ -92,6 +103,7 @@ impl System {
     /// left out (it does not depend on `q`). One pass per joint; no allocation.
     pub fn constraint_poly_series<const K: usize, B: Basis<K>>(
         &self,
+        ws: &mut PolyWorkspace<K, B>,
         q: &[f64],
         angles: &BodyAngles,
         dirs: &[&[f64]],
@@ -100,12 +112,10 @@ impl System {
     ) {
         debug_assert!(angles.matches(q) && dirs.len() == B::ND);
         debug_assert!(vals.len() == self.n_constraints() && grads.len() == vals.len());
-        let mut fr = PolyFrames::<K, B>::new();
-        let mut e = [PolyJet::<K, B>::cst(0.0); 3];
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let (fa, fb) = fr.get(q, angles, dirs, at);
-            j.eval(fa, fb, &mut e);
+            let (fa, fb, e) = ws.get(q, angles, dirs, at);
+            j.eval(fa, fb, e);
             let o = self.row_offset[ji];
             for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
                 vals[o + k] = ek.c;
@@ -121,6 +131,7 @@ impl System {
     /// element-local gradients. One pass per force element; no allocation.
     pub fn potential_poly_series<const K: usize, B: Basis<K>>(
         &self,
+        ws: &mut PolyWorkspace<K, B>,
         q: &[f64],
         angles: &BodyAngles,
         dirs: &[&[f64]],
@@ -132,10 +143,9 @@ impl System {
         if self.forces.is_empty() {
             return sum;
         }
-        let mut fr = PolyFrames::<K, B>::new();
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
-            let (fa, fb) = fr.get(q, angles, dirs, at);
+            let (fa, fb, _) = ws.get(q, angles, dirs, at);
             let e = f.potential(fa, fb);
             for k in 0..K {
                 sum[k] += e.c[k];
@@ -173,6 +183,96 @@ impl System {
             }
             if any {
                 Self::scatter_grad(self.joint_attach[ji], &g, 1.0, out);
+            }
+        }
+    }
+
+    /// The adjoint of a [`System::constraint_poly_series`] pass with the adjoint weights `w`
+    /// of its rows' coefficients, in one sweep over the rows: `qb += sum_r sum_k w[r][k]
+    /// grads[r][k]` (the gradient with respect to `q`) and, for every direction `j <
+    /// dirs.len()`, `dirs[j] += sum_r sum_k w[r][k] grads[r][DIV[k][j]]` (the gradient with
+    /// respect to direction `j`, [`Basis::DIV`]). Rows whose weights are all zero are skipped.
+    pub fn add_constraint_poly_adjoint<const K: usize, B: Basis<K>>(
+        &self,
+        grads: &[[[f64; NV]; K]],
+        w: &[[f64; K]],
+        qb: &mut [f64],
+        dirs: &mut [&mut [f64]],
+    ) {
+        debug_assert!(w.len() == self.n_constraints() && grads.len() == w.len());
+        debug_assert!(dirs.len() <= B::ND);
+        for (ji, j) in self.joints.iter().enumerate() {
+            let o = self.row_offset[ji];
+            let ne = j.n_equations();
+            let mut gq = [0.0; NV];
+            let mut gd = [[0.0; NV]; MAX_DIRS];
+            let mut any = false;
+            for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
+                Self::poly_local_adjoint::<K, B>(gr, wr, dirs.len(), &mut gq, &mut gd, &mut any);
+            }
+            if any {
+                let at = self.joint_attach[ji];
+                Self::scatter_grad(at, &gq, 1.0, qb);
+                for (d, out) in dirs.iter_mut().enumerate() {
+                    Self::scatter_grad(at, &gd[d], 1.0, out);
+                }
+            }
+        }
+    }
+
+    /// [`System::add_constraint_poly_adjoint`] for a [`System::potential_poly_series`] pass
+    /// (one weight vector for every force element).
+    pub fn add_potential_poly_adjoint<const K: usize, B: Basis<K>>(
+        &self,
+        grads: &[[[f64; NV]; K]],
+        w: &[f64; K],
+        qb: &mut [f64],
+        dirs: &mut [&mut [f64]],
+    ) {
+        debug_assert_eq!(grads.len(), self.forces.len());
+        debug_assert!(dirs.len() <= B::ND);
+        for (fi, gr) in grads.iter().enumerate() {
+            let mut gq = [0.0; NV];
+            let mut gd = [[0.0; NV]; MAX_DIRS];
+            let mut any = false;
+            Self::poly_local_adjoint::<K, B>(gr, w, dirs.len(), &mut gq, &mut gd, &mut any);
+            if any {
+                let at = self.force_attach[fi];
+                Self::scatter_grad(at, &gq, 1.0, qb);
+                for (d, out) in dirs.iter_mut().enumerate() {
+                    Self::scatter_grad(at, &gd[d], 1.0, out);
+                }
+            }
+        }
+    }
+
+    /// One element row's share of the adjoints: `gq += sum_k w[k] g[k]`, `gd[j] += sum_k w[k]
+    /// g[DIV[k][j]]` for `j < nd`.
+    #[inline(always)]
+    fn poly_local_adjoint<const K: usize, B: Basis<K>>(
+        g: &[[f64; NV]; K],
+        w: &[f64; K],
+        nd: usize,
+        gq: &mut [f64; NV],
+        gd: &mut [[f64; NV]; MAX_DIRS],
+        any: &mut bool,
+    ) {
+        for k in 0..K {
+            let wk = w[k];
+            if wk == 0.0 {
+                continue;
+            }
+            *any = true;
+            for l in 0..NV {
+                gq[l] += wk * g[k][l];
+            }
+            for (j, gdj) in gd.iter_mut().enumerate().take(nd) {
+                let d = B::DIV[k][j];
+                if d != u8::MAX {
+                    for l in 0..NV {
+                        gdj[l] += wk * g[d as usize][l];
+                    }
+                }
             }
         }
     }
@@ -237,9 +337,10 @@ mod tests {
                 let mut ang = BodyAngles::default();
                 ang.update(&sys, q);
                 let (mut vals, mut grads) = (vec![[0.0; 8]; m], vec![[[0.0; NV]; 8]; m]);
-                sys.constraint_poly_series::<8, Ab>(q, &ang, &[v, u], &mut vals, &mut grads);
+                let mut ws = PolyWorkspace::<8, Ab>::new();
+                sys.constraint_poly_series(&mut ws, q, &ang, &[v, u], &mut vals, &mut grads);
                 let mut pg = vec![[[0.0; NV]; 8]; nf];
-                let pot = sys.potential_poly_series::<8, Ab>(q, &ang, &[v, u], &mut pg);
+                let pot = sys.potential_poly_series(&mut ws, q, &ang, &[v, u], &mut pg);
                 (vals, grads, pot, pg)
             };
             let (vals, grads, pot, pg) = series(&q, &v, &u);

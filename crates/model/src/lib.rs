@@ -72,7 +72,7 @@ pub use body::{Body, BodyHandle, BodyRef};
 pub use builder::SystemBuilder;
 pub use cache::AngleCache;
 pub use directional::BodyAngles;
-pub use directional_poly::poly_direction_weights;
+pub use directional_poly::{poly_direction_weights, PolyWorkspace};
 pub use error::ModelError;
 pub use file::{BodyKind, BodySpec, ForceSpec, JointSpec, ModelFile};
 pub use force::{Force, ForceKind};

@@ -285,10 +285,7 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
         for (d, wd) in w.iter().enumerate().take(B::ND) {
             wa[d] = wd[2];
         }
-        let (mut s, mut c) = (f.s, f.c);
-        Self::set_angle(&mut s, &mut c, slot + 2, &wa, sn, cs);
-        f.s = s;
-        f.c = c;
+        Self::set_angle(&mut f.s, &mut f.c, slot + 2, &wa, sn, cs);
     }
 
     /// `f(self)` for a function with the scaled derivatives `a[k] = f^(k)(x0) / k!` at the

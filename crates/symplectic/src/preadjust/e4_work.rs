@@ -1,7 +1,8 @@
 //! The workspace of the `s = 2` modified-Lagrangian term `e4` and its gradients
 //! (`modified2.rs`, `modified2_grad.rs`): allocated on first use, reused by every evaluation.
 
-use super::modified2::E4Forward;
+use super::modified2::{E4Forward, Pass};
+use super::modified2_grad::BasisR;
 use super::Preadjustment;
 use mbd_model::System;
 
@@ -45,13 +46,9 @@ pub(super) struct Adjoints {
     pub(super) pb: [f64; 9],
     /// Pass R (the weighted Hessian-vector products' adjoints): coefficients, gradients and
     /// contraction weights per row.
-    pub(super) rvals: Vec<[f64; 11]>,
-    pub(super) rgrads: Vec<[[f64; 6]; 11]>,
+    pub(super) rpass: Pass<11, BasisR>,
     pub(super) rw: Vec<[f64; 11]>,
-    /// Scratch: direction weights per row for passes A, B, C.
-    pub(super) sa: Vec<[f64; 8]>,
-    pub(super) sb: Vec<[f64; 9]>,
-    pub(super) sc: Vec<[f64; 6]>,
+
     /// `Gb` in element-local form.
     pub(super) gbar: Vec<[f64; 6]>,
     /// Scratch: n-vectors and m-vectors.
@@ -86,12 +83,9 @@ impl Adjoints {
             wc: vec![[0.0; 6]; m],
             pa: [0.0; 8],
             pb: [0.0; 9],
-            rvals: vec![[0.0; 11]; m],
-            rgrads: vec![[[0.0; 6]; 11]; m],
+            rpass: Pass::new(m, 0),
             rw: vec![[0.0; 11]; m],
-            sa: vec![[0.0; 8]; m],
-            sb: vec![[0.0; 9]; m],
-            sc: vec![[0.0; 6]; m],
+
             gbar: vec![[0.0; 6]; m],
             tn: std::array::from_fn(|_| zn()),
             tm: std::array::from_fn(|_| zm()),

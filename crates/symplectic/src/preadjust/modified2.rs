@@ -19,7 +19,7 @@
 //! gradients for the reverse pass.
 
 use super::{dot, Preadjustment};
-use mbd_model::{Basis, BodyAngles, System, MAX_DIRS};
+use mbd_model::{Basis, BodyAngles, PolyWorkspace, System, MAX_DIRS};
 use mbd_solve::SolveError;
 
 /// The terms of `e4` and their coefficients, in the order of [`Preadjustment::modified_term_s2`]'s
@@ -128,35 +128,43 @@ pub(super) const C_AT: usize = 4;
 pub(super) const C_BT: usize = 5;
 
 /// One pass's coefficients per constraint row and of the potential, with their element-local
-/// gradients (per row, and per force element).
+/// gradients (per row, and per force element), and its jets' workspace.
 #[derive(Debug)]
-pub(super) struct Pass<const K: usize> {
+pub(super) struct Pass<const K: usize, B> {
     pub(super) vals: Vec<[f64; K]>,
     pub(super) grads: Vec<[[f64; 6]; K]>,
     pub(super) pot: [f64; K],
     pub(super) pgrads: Vec<[[f64; 6]; K]>,
+    ws: Box<PolyWorkspace<K, B>>,
 }
 
-impl<const K: usize> Pass<K> {
+impl<const K: usize, B: Basis<K>> Pass<K, B> {
     pub(super) fn new(m: usize, nf: usize) -> Self {
         Pass {
             vals: vec![[0.0; K]; m],
             grads: vec![[[0.0; 6]; K]; m],
             pot: [0.0; K],
             pgrads: vec![[[0.0; 6]; K]; nf],
+            ws: PolyWorkspace::new(),
         }
     }
 
     /// The pass along `dirs` at `q` (constraints and potential).
-    pub(super) fn eval<B: Basis<K>>(
+    pub(super) fn eval(&mut self, sys: &System, q: &[f64], a: &BodyAngles, dirs: &[&[f64]]) {
+        let ws = &mut self.ws;
+        sys.constraint_poly_series(ws, q, a, dirs, &mut self.vals, &mut self.grads);
+        self.pot = sys.potential_poly_series(ws, q, a, dirs, &mut self.pgrads);
+    }
+
+    /// The pass along `dirs` at `q`, constraints only.
+    pub(super) fn eval_constraints(
         &mut self,
         sys: &System,
         q: &[f64],
         a: &BodyAngles,
         dirs: &[&[f64]],
     ) {
-        sys.constraint_poly_series::<K, B>(q, a, dirs, &mut self.vals, &mut self.grads);
-        self.pot = sys.potential_poly_series::<K, B>(q, a, dirs, &mut self.pgrads);
+        sys.constraint_poly_series(&mut self.ws, q, a, dirs, &mut self.vals, &mut self.grads);
     }
 
     /// `out = sum_f grad_q` of the potential's coefficient `k` (length n; zero without force
@@ -207,9 +215,9 @@ pub(super) struct E4Forward {
     pub(super) d3v_n: f64,
     pub(super) d4v: f64,
     /// The passes ([`BasisA`], [`BasisB`], [`BasisC`]).
-    pub(super) pa: Pass<8>,
-    pub(super) pb: Pass<9>,
-    pub(super) pc: Pass<6>,
+    pub(super) pa: Pass<8, BasisA>,
+    pub(super) pb: Pass<9, BasisB>,
+    pub(super) pc: Pass<6, BasisC>,
     /// `sin`/`cos` of the body angles at `q`, shared by every pass.
     pub(super) angles: BodyAngles,
     /// Per constraint row, element-local `Hess Phi_r v` and `Hess Phi_r u` (the weighted
@@ -345,7 +353,7 @@ impl Preadjustment {
         f.mu0.copy_from_slice(&self.mu0);
         // pass A along (v, u): gamma, beta, D^3 Phi(v^3), D^4 Phi(v^4), D^3 Phi(v, v, u), the
         // rows Hess Phi_r v and Hess Phi_r u, and of V: D^4 V(v^4), D^3 V(u, v, v), H v, H u
-        f.pa.eval::<BasisA>(sys, q, &f.angles, &[v, &f.u]);
+        f.pa.eval(sys, q, &f.angles, &[v, &f.u]);
         for r in 0..m {
             let (c, g) = (&f.pa.vals[r], &f.pa.grads[r]);
             f.gam[r] = 2.0 * c[A_TT];
@@ -359,14 +367,14 @@ impl Preadjustment {
         self.neg_e_into(&f.beta, &mut f.s_beta, &mut f.k2);
         // pass B along (v, n, u): D^2 Phi(n, v), D^3 Phi(v, v, n), D^2 Phi(n, n), D^2 Phi(n, u),
         // and of V: D^3 V(n, v, v), H n
-        f.pb.eval::<BasisB>(sys, q, &f.angles, &[v, &f.nn, &f.u]);
+        f.pb.eval(sys, q, &f.angles, &[v, &f.nn, &f.u]);
         f.pb.pot_grad_into(sys, B_E, &mut f.hn);
         for r in 0..m {
             f.kap3[r] = 6.0 * f.pa.vals[r][A_TTT] + 3.0 * f.pb.vals[r][B_ET];
         }
         self.neg_e_into(&f.kap3, &mut f.s_kap3, &mut f.k3);
         // pass C along (v, K2, K3): D^2 Phi(K2, v), D^2 Phi(K3, v)
-        f.pc.eval::<BasisC>(sys, q, &f.angles, &[v, &f.k2, &f.k3]);
+        f.pc.eval(sys, q, &f.angles, &[v, &f.k2, &f.k3]);
         for r in 0..m {
             let (a, b, c) = (&f.pa.vals[r], &f.pb.vals[r], &f.pc.vals[r]);
             f.kap3u[r] = 2.0 * a[A_ETT] + 2.0 * c[C_AT] + b[B_ED];

@@ -41,7 +41,7 @@ use super::modified2::{
     B_ET, B_ETT, C_AT, C_BT, E4_TERMS,
 };
 use super::Preadjustment;
-use mbd_model::{poly_direction_weights, Basis, BodyAngles, System, MAX_DIRS};
+use mbd_model::{Basis, BodyAngles, System, MAX_DIRS};
 use mbd_solve::SolveError;
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
@@ -209,7 +209,6 @@ impl Preadjustment {
         contract::<6, BasisC>(
             sys,
             (&f.pc, &w.wc, None),
-            &mut w.sc,
             gq,
             &mut [&mut *gv, w.k2b.as_mut_slice(), w.k3b.as_mut_slice()],
         );
@@ -236,7 +235,6 @@ impl Preadjustment {
         contract::<9, BasisB>(
             sys,
             (&f.pb, &w.wb, Some(&w.pb)),
-            &mut w.sb,
             gq,
             &mut [&mut *gv, w.nnb.as_mut_slice(), w.ub.as_mut_slice()],
         );
@@ -264,7 +262,6 @@ impl Preadjustment {
         contract::<8, BasisA>(
             sys,
             (&f.pa, &w.wa, Some(&w.pa)),
-            &mut w.sa,
             gq,
             &mut [&mut *gv, w.ub.as_mut_slice()],
         );
@@ -418,11 +415,11 @@ impl Preadjustment {
         gv: &mut [f64],
     ) {
         let dirs: [&[f64]; 6] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
-        sys.constraint_poly_series::<11, BasisR>(q, &f.angles, &dirs, &mut w.rvals, &mut w.rgrads);
+        w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
         let m = self.m;
         for r in 0..m {
             let (s, mu) = (f.sig[r], f.mu0[r]);
-            let c = &w.rvals[r];
+            let c = &w.rpass.vals[r];
             w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
             w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
             let mut x = [0.0; 11];
@@ -431,7 +428,7 @@ impl Preadjustment {
             }
             w.rw[r] = x;
         }
-        sys.add_constraint_poly_grads(&w.rgrads, &w.rw, gq);
+        sys.add_constraint_poly_grads(&w.rpass.grads, &w.rw, gq);
         for (pair, out) in [(0, gv), (1, w.ub.as_mut_slice())] {
             for r in 0..m {
                 let (s, mu) = (f.sig[r], f.mu0[r]);
@@ -440,34 +437,23 @@ impl Preadjustment {
                 x[R_Y[2 * pair + 1]] = mu;
                 w.rw[r] = x;
             }
-            sys.add_constraint_poly_grads(&w.rgrads, &w.rw, out);
+            sys.add_constraint_poly_grads(&w.rpass.grads, &w.rw, out);
         }
     }
 }
 
 /// The adjoint of a pass ([`Pass`]) with the adjoint weights `wts` of its rows' coefficients
 /// and `pot` of its potential's: adds the `q`-gradient to `qb` and the gradient with respect to
-/// direction `j` to `dirs[j]` ([`poly_direction_weights`]); `scratch` has one entry per row.
+/// direction `j` to `dirs[j]`.
 fn contract<const K: usize, B: Basis<K>>(
     sys: &System,
-    (p, wts, pot): (&Pass<K>, &[[f64; K]], Option<&[f64; K]>),
-    scratch: &mut [[f64; K]],
+    (p, wts, pot): (&Pass<K, B>, &[[f64; K]], Option<&[f64; K]>),
     qb: &mut [f64],
     dirs: &mut [&mut [f64]],
 ) {
-    sys.add_constraint_poly_grads(&p.grads, wts, qb);
+    sys.add_constraint_poly_adjoint::<K, B>(&p.grads, wts, qb, dirs);
     if let Some(pw) = pot {
-        sys.add_potential_poly_grads(&p.pgrads, pw, qb);
-    }
-    for (j, out) in dirs.iter_mut().enumerate() {
-        for (s, x) in scratch.iter_mut().zip(wts) {
-            *s = poly_direction_weights::<K, B>(x, j);
-        }
-        sys.add_constraint_poly_grads(&p.grads, scratch, out);
-        if let Some(pw) = pot {
-            let pj = poly_direction_weights::<K, B>(pw, j);
-            sys.add_potential_poly_grads(&p.pgrads, &pj, out);
-        }
+        sys.add_potential_poly_adjoint::<K, B>(&p.pgrads, pw, qb, dirs);
     }
 }
 
