@@ -135,9 +135,16 @@ impl Segment {
     /// `q(t)` and `v(t)` of the quintic Hermite interpolant.
     fn eval(&self, t: f64, q: &mut [f64], v: &mut [f64]) {
         let h = self.t1 - self.t0;
-        if h == 0.0 {
+        // the step's ends exactly (the quintic's velocity at s = 1 is (h v1) / h, which need
+        // not round back to v1)
+        if h == 0.0 || t == self.t1 {
             q.copy_from_slice(&self.q1);
             v.copy_from_slice(&self.v1);
+            return;
+        }
+        if t == self.t0 {
+            q.copy_from_slice(&self.q0);
+            v.copy_from_slice(&self.v0);
             return;
         }
         let s = (t - self.t0) / h;

@@ -24,6 +24,9 @@ use super::{Frame, Scalar, NV};
 use std::marker::PhantomData;
 use std::ops::{Add, Mul, Neg, Sub};
 
+/// `1 / e` for the exponents `e` a basis can have (degree at most 4 in practice).
+const INV: [f64; 6] = [0.0, 1.0, 0.5, 1.0 / 3.0, 0.25, 0.2];
+
 /// Most directions a [`Basis`] may use.
 pub const MAX_DIRS: usize = 6;
 /// The entry of a [`Basis`] table for a product or quotient outside the basis (`u8::MAX`).
@@ -103,9 +106,10 @@ const fn prod_table<const K: usize>(exp: &[[u8; MAX_DIRS]; K]) -> [[u8; K]; K] {
             t[i][j] = index_of(exp, &e);
             j += 1;
         }
-        // closed under division
+        // closed under division, exponents at most 5
         let mut l = 0;
         while l < MAX_DIRS {
+            assert!(exp[i][l] <= 5, "exponents at most 5");
             if exp[i][l] > 0 {
                 let mut e = exp[i];
                 e[l] -= 1;
@@ -235,7 +239,7 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
             while e[j] == 0 {
                 j += 1;
             }
-            p[k] = p[B::DIV[k][j] as usize] * w[j] / e[j] as f64;
+            p[k] = p[B::DIV[k][j] as usize] * w[j] * INV[e[j] as usize];
         }
         p
     }

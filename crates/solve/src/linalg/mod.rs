@@ -88,6 +88,9 @@ pub struct DenseCholesky {
     a: Vec<f64>,
     /// The matrix's diagonal before the last factorisation.
     diag: Vec<f64>,
+    /// `1 / L_jj` of the last factorisation (the small solves multiply: a division's latency
+    /// is several multiplications').
+    inv: Vec<f64>,
     /// `max_j A_jj / L_jj^2` of the last factorisation.
     condition: f64,
     mem: Scratch,
@@ -114,6 +117,7 @@ impl DenseCholesky {
             m,
             a: vec![0.0; m * m],
             diag: vec![0.0; m],
+            inv: vec![0.0; m],
             condition: 0.0,
             mem: Scratch(MemBuffer::new(req)),
             factored: false,
@@ -177,7 +181,7 @@ impl DenseCholesky {
         let a = &self.a;
         for k in 0..m {
             let col = &a[k * m..(k + 1) * m];
-            let x = b[k] / col[k];
+            let x = b[k] * self.inv[k];
             b[k] = x;
             if x != 0.0 {
                 for (bi, &l) in b[k + 1..m].iter_mut().zip(&col[k + 1..]) {
@@ -260,6 +264,7 @@ impl DenseCholesky {
                 return Err(FactorError::NotPositiveDefinite(i));
             }
             worst = worst.max(ratio);
+            self.inv[i] = 1.0 / l;
         }
         self.condition = worst;
         self.factored = true;
@@ -283,7 +288,7 @@ impl DenseCholesky {
                     .zip(&b[i + 1..m])
                     .map(|(l, x)| l * x)
                     .sum();
-                b[i] = (b[i] - acc) / col[i];
+                b[i] = (b[i] - acc) * self.inv[i];
             }
             return;
         }

@@ -6,14 +6,18 @@ use super::modified2_grad::BasisR;
 use super::Preadjustment;
 use mbd_model::System;
 
+/// The element-local columns of a constraint row: the first coordinate of the joint's body a
+/// (local columns 0..3) and of its body b (3..6), `None` for ground.
+pub(super) type Cols = [Option<usize>; 2];
+
 /// The workspace of `e4` and its gradients: the forward intermediates, the adjoints and the
 /// element-local columns of the constraint rows.
 #[derive(Debug)]
 pub(crate) struct E4Work {
     pub(super) f: E4Forward,
     pub(super) b: Adjoints,
-    /// The element-local column indices of each constraint row (`None`: ground).
-    pub(super) cols: Vec<[Option<usize>; 6]>,
+    /// The element-local columns of each constraint row ([`Cols`]).
+    pub(super) cols: Vec<Cols>,
 }
 
 /// Adjoints (suffix `b`) of the intermediates, of the passes, of `G`, and scratch.
@@ -125,28 +129,21 @@ impl Adjoints {
 }
 
 /// `Gb += c alpha beta^T` in element-local form.
-pub(super) fn gbar_add(
-    gbar: &mut [[f64; 6]],
-    cols: &[[Option<usize>; 6]],
-    c: f64,
-    al: &[f64],
-    be: &[f64],
-) {
+pub(super) fn gbar_add(gbar: &mut [[f64; 6]], cols: &[Cols], c: f64, al: &[f64], be: &[f64]) {
     for ((g, cols), &a) in gbar.iter_mut().zip(cols).zip(al) {
         if a == 0.0 {
             continue;
         }
-        for (gl, col) in g.iter_mut().zip(cols) {
-            if let Some(i) = col {
-                *gl += c * a * be[*i];
+        let ca = c * a;
+        for (h, col) in cols.iter().enumerate() {
+            if let Some(i) = *col {
+                let b = &be[i..i + 3];
+                for l in 0..3 {
+                    g[3 * h + l] += ca * b[l];
+                }
             }
         }
     }
-}
-
-/// The element-local vector of constraint row `r` (columns `cols`) of the global `x`.
-pub(super) fn local(cols: &[Option<usize>; 6], x: &[f64]) -> [f64; 6] {
-    std::array::from_fn(|l| cols[l].map_or(0.0, |i| x[i]))
 }
 
 impl E4Work {
@@ -155,7 +152,7 @@ impl E4Work {
         let mut w = E4Work {
             f: E4Forward::new(n, m, sys.forces().len()),
             b: Adjoints::new(n, m),
-            cols: vec![[None; 6]; m],
+            cols: vec![[None; 2]; m],
         };
         w.set_cols(sys);
         w
@@ -168,14 +165,7 @@ impl E4Work {
             let (a, b) = sys
                 .equation_joint(r)
                 .map_or((None, None), |j| sys.joint_bodies(j));
-            *c = [None; 6];
-            for (slot, body) in [(0, a), (3, b)] {
-                if let Some(i) = body {
-                    for k in 0..3 {
-                        c[slot + k] = Some(3 * i + k);
-                    }
-                }
-            }
+            *c = [a.map(|i| 3 * i), b.map(|i| 3 * i)];
         }
     }
 }

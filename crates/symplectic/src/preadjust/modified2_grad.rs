@@ -35,7 +35,7 @@
 //!   `Gb -= a (D G^T z)^T + z (D G^T a)^T` with `a = S^-1 zb`;
 //! * `u = -D g + D G^T mu0`, `mu0 = S^-1 G D g` (`g = grad V`), and `gb` to `qb` by `Hess V`.
 
-use super::e4_work::{gbar_add, local, Adjoints, E4Work};
+use super::e4_work::{gbar_add, Adjoints, Cols, E4Work};
 use super::modified2::{
     comb_into, BasisA, BasisB, BasisC, E4Forward, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE,
     B_ET, B_ETT, C_AT, C_BT, E4_TERMS,
@@ -53,7 +53,7 @@ fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
 impl Preadjustment {
     /// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
     /// adjoint `yb`; `Gb` updated.
-    fn adj_neg_e(&mut self, w: &mut Adjoints, cols: &[[Option<usize>; 6]], z: &[f64], yb: &[f64]) {
+    fn adj_neg_e(&mut self, w: &mut Adjoints, cols: &[Cols], z: &[f64], yb: &[f64]) {
         let [dyb, dz, da, ..] = &mut w.tn;
         for ((d, y), mi) in dyb.iter_mut().zip(yb).zip(&self.minv) {
             *d = mi * y;
@@ -187,9 +187,9 @@ impl Preadjustment {
                 (f.nn.as_slice(), &w.hnb, &mut w.nnb),
                 (f.u.as_slice(), &w.hub, &mut w.ub),
             ] {
-                hvp_adj(sys, q, ang, x, (1.0, zero), None, yb, xb, gq, sc);
+                hvp_adj(sys, q, ang, x, (1.0, zero), yb, xb, gq, sc);
             }
-            hvp_adj(sys, q, ang, v, (1.0, zero), None, &w.hvb, gv, gq, sc);
+            hvp_adj(sys, q, ang, v, (1.0, zero), &w.hvb, gv, gq, sc);
         }
 
         // 3. kappa4 = 24 A[t^4] + 12 B[e t^2] + 6 B[e^2] + 4 C[b t],
@@ -302,7 +302,7 @@ impl Preadjustment {
 /// `c Pi b` and `c Pi a`, are the caller's.
 fn adj_pi(
     gbar: &mut [[f64; 6]],
-    cols: &[[Option<usize>; 6]],
+    cols: &[Cols],
     c: f64,
     (pa, sa): (&[f64], &[f64]),
     (pb, sb): (&[f64], &[f64]),
@@ -317,7 +317,7 @@ fn adj_pi(
 /// `c S^-1 a`, are the caller's.
 fn adj_s(
     gbar: &mut [[f64; 6]],
-    cols: &[[Option<usize>; 6]],
+    cols: &[Cols],
     c: f64,
     (al, ka): (&[f64], &[f64]),
     (be, kb): (&[f64], &[f64]),
@@ -326,17 +326,9 @@ fn adj_s(
     gbar_add(gbar, cols, c, be, ka);
 }
 
-/// The adjoint of the weights of a Hessian-vector product: `rows[r]` is the element-local
-/// `Hess Phi_r x` (columns `cols`), `wb` the weights' adjoint.
-struct WeightAdjoint<'a> {
-    rows: &'a [[f64; 6]],
-    wb: &'a mut [f64],
-    cols: &'a [[Option<usize>; 6]],
-}
-
 /// The adjoint of `y = H x`, `H = p Hess V + sum_r w_r Hess Phi_r` (`(p, w)`), for the adjoint
-/// `yb`: `xb += H yb`, `qb += D^3 L(x, yb, .)` and, with a [`WeightAdjoint`],
-/// `wb_r += yb^T Hess Phi_r x`. Scratch: six n-vectors.
+/// `yb`: `xb += H yb` and `qb += D^3 L(x, yb, .)`, by two third-order passes (polarisation).
+/// Scratch: six n-vectors.
 #[allow(clippy::too_many_arguments)]
 fn hvp_adj(
     sys: &System,
@@ -344,7 +336,6 @@ fn hvp_adj(
     ang: &BodyAngles,
     x: &[f64],
     (pot, wts): (f64, &[f64]),
-    wadj: Option<WeightAdjoint>,
     yb: &[f64],
     xb: &mut [f64],
     qb: &mut [f64],
@@ -363,12 +354,6 @@ fn hvp_adj(
     for i in 0..x.len() {
         xb[i] += 0.5 * (hp[i] - hm[i]);
         qb[i] += 0.25 * (dp[i] - dm[i]);
-    }
-    if let Some(WeightAdjoint { rows, wb, cols }) = wadj {
-        for ((w, row), c) in wb.iter_mut().zip(rows).zip(cols) {
-            let y = local(c, yb);
-            *w += row.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
-        }
     }
 }
 
