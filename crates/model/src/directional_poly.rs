@@ -187,6 +187,38 @@ impl System {
         }
     }
 
+    /// [`System::add_constraint_poly_grads`] for `P` weight sets in one sweep over the rows:
+    /// `outs[p] += sum_r sum_k w[r][p][k] grads[r][k]`.
+    pub fn add_constraint_poly_grads_many<const K: usize, const P: usize>(
+        &self,
+        grads: &[[[f64; NV]; K]],
+        w: &[[[f64; K]; P]],
+        outs: [&mut [f64]; P],
+    ) {
+        debug_assert!(w.len() == self.n_constraints() && grads.len() == w.len());
+        let mut outs = outs;
+        for (ji, j) in self.joints.iter().enumerate() {
+            let o = self.row_offset[ji];
+            let ne = j.n_equations();
+            let mut g = [[0.0; NV]; P];
+            for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
+                for (gp, wp) in g.iter_mut().zip(wr) {
+                    for k in 0..K {
+                        if wp[k] != 0.0 {
+                            for l in 0..NV {
+                                gp[l] += wp[k] * gr[k][l];
+                            }
+                        }
+                    }
+                }
+            }
+            let at = self.joint_attach[ji];
+            for (gp, out) in g.iter().zip(outs.iter_mut()) {
+                Self::scatter_grad(at, gp, 1.0, out);
+            }
+        }
+    }
+
     /// The adjoint of a [`System::constraint_poly_series`] pass with the adjoint weights `w`
     /// of its rows' coefficients, in one sweep over the rows: `qb += sum_r sum_k w[r][k]
     /// grads[r][k]` (the gradient with respect to `q`) and, for every direction `j <

@@ -51,7 +51,7 @@ pub(super) struct Adjoints {
     /// Pass R (the weighted Hessian-vector products' adjoints): coefficients, gradients and
     /// contraction weights per row.
     pub(super) rpass: Pass<11, BasisR>,
-    pub(super) rw: Vec<[f64; 11]>,
+    pub(super) rw: Vec<[[f64; 11]; 3]>,
 
     /// `Gb` in element-local form.
     pub(super) gbar: Vec<[f64; 6]>,
@@ -88,7 +88,7 @@ impl Adjoints {
             pa: [0.0; 8],
             pb: [0.0; 9],
             rpass: Pass::new(m, 0),
-            rw: vec![[0.0; 11]; m],
+            rw: vec![[[0.0; 11]; 3]; m],
 
             gbar: vec![[0.0; 6]; m],
             tn: std::array::from_fn(|_| zn()),

@@ -391,7 +391,13 @@ impl Preadjustment {
             sys.add_local_rows(rows, w, out);
         }
         self.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
-        self.pi_sgm(&f.hv, &mut f.pi_hv, &mut f.sg_hv);
+        if sys.forces().is_empty() {
+            // (H v = 0: gravity is linear)
+            f.pi_hv.fill(0.0);
+            f.sg_hv.fill(0.0);
+        } else {
+            self.pi_sgm(&f.hv, &mut f.pi_hv, &mut f.sg_hv);
+        }
         self.pi_sgm(&f.hsig_v, &mut f.pi_hsig_v, &mut f.sg_hsig_v);
         f.d3v_u = 2.0 * f.pa.pot[A_ETT];
         f.d3v_n = 2.0 * f.pb.pot[B_ETT];

@@ -116,7 +116,10 @@ impl Preadjustment {
         gv.fill(0.0);
         w.clear();
 
-        // 1. the terms
+        // 1. the terms (those with Hess V or D^k V only with force elements: gravity is
+        //    linear, so without them H v, H u, H n and the potential's derivatives are zero and
+        //    so is every contribution of those terms)
+        let pot = !sys.forces().is_empty();
         let hsig_v = (f.pi_hsig_v.as_slice(), f.sg_hsig_v.as_slice());
         let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
         let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
@@ -124,62 +127,59 @@ impl Preadjustment {
         axpy(&mut w.hsig_vb, c[0], &f.pi_hmu_v);
         axpy(&mut w.hmu_vb, c[0], &f.pi_hsig_v);
         adj_pi(&mut w.gbar, cols, c[1], hmu_v, hmu_v);
-        axpy(&mut w.hmu_vb, c[1], &f.pi_hmu_v);
-        axpy(&mut w.hmu_vb, c[1], &f.pi_hmu_v);
+        axpy(&mut w.hmu_vb, 2.0 * c[1], &f.pi_hmu_v);
         axpy(&mut w.ub, c[2], &f.hmu_u);
         axpy(&mut w.hmu_ub, c[2], &f.u);
-        adj_pi(&mut w.gbar, cols, c[3], hmu_v, hv);
-        axpy(&mut w.hmu_vb, c[3], &f.pi_hv);
-        axpy(&mut w.hvb, c[3], &f.pi_hmu_v);
         let beta = (f.s_beta.as_slice(), f.k2.as_slice());
         let kap3 = (f.s_kap3.as_slice(), f.k3.as_slice());
         adj_s(&mut w.gbar, cols, c[4], beta, beta);
-        axpy(&mut w.betab, c[4], &f.s_beta);
-        axpy(&mut w.betab, c[4], &f.s_beta);
+        axpy(&mut w.betab, 2.0 * c[4], &f.s_beta);
         axpy(&mut w.ub, c[5], &f.hsig_u);
         axpy(&mut w.hsig_ub, c[5], &f.u);
         adj_s(&mut w.gbar, cols, c[6], kap3, beta);
         axpy(&mut w.kap3b, c[6], &f.s_beta);
         axpy(&mut w.betab, c[6], &f.s_kap3);
-        axpy(&mut w.hvb, c[7], &f.k2);
-        axpy(&mut w.k2b, c[7], &f.hv);
         axpy(&mut w.mu0b, c[8], &f.kap3u);
         axpy(&mut w.kap3ub, c[8], &f.mu0);
         axpy(&mut w.sigb, c[9], &f.kap3u);
         axpy(&mut w.kap3ub, c[9], &f.sig);
         axpy(&mut w.mu0b, c[10], &f.kap4);
         axpy(&mut w.kap4b, c[10], &f.mu0);
-        axpy(&mut w.hub, c[11], &f.nn);
-        axpy(&mut w.nnb, c[11], &f.hu);
-        axpy(&mut w.ub, c[12], &f.hu);
-        axpy(&mut w.hub, c[12], &f.u);
-        // D^3 V(u, v, v) = 2 (pass A's e t^2)
-        w.pa[A_ETT] += 2.0 * c[13];
-        axpy(&mut w.nnb, c[14], &f.hn);
-        axpy(&mut w.hnb, c[14], &f.nn);
-        adj_pi(&mut w.gbar, cols, c[15], hv, hsig_v);
-        axpy(&mut w.hvb, c[15], &f.pi_hsig_v);
-        axpy(&mut w.hsig_vb, c[15], &f.pi_hv);
-        axpy(&mut w.hvb, c[16], &f.k3);
-        axpy(&mut w.k3b, c[16], &f.hv);
-        w.pb[B_ETT] += 2.0 * c[17];
-        adj_pi(&mut w.gbar, cols, c[18], hv, hv);
-        axpy(&mut w.hvb, c[18], &f.pi_hv);
-        axpy(&mut w.hvb, c[18], &f.pi_hv);
-        w.pa[A_T4] += 24.0 * c[19];
         adj_pi(&mut w.gbar, cols, c[20], hsig_v, hsig_v);
-        axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
-        axpy(&mut w.hsig_vb, c[20], &f.pi_hsig_v);
+        axpy(&mut w.hsig_vb, 2.0 * c[20], &f.pi_hsig_v);
         axpy(&mut w.sigb, c[21], &f.kap4);
         axpy(&mut w.kap4b, c[21], &f.sig);
         adj_s(&mut w.gbar, cols, c[22], kap3, kap3);
-        axpy(&mut w.kap3b, c[22], &f.s_kap3);
-        axpy(&mut w.kap3b, c[22], &f.s_kap3);
+        axpy(&mut w.kap3b, 2.0 * c[22], &f.s_kap3);
+        if pot {
+            adj_pi(&mut w.gbar, cols, c[3], hmu_v, hv);
+            axpy(&mut w.hmu_vb, c[3], &f.pi_hv);
+            axpy(&mut w.hvb, c[3], &f.pi_hmu_v);
+            axpy(&mut w.hvb, c[7], &f.k2);
+            axpy(&mut w.k2b, c[7], &f.hv);
+            axpy(&mut w.hub, c[11], &f.nn);
+            axpy(&mut w.nnb, c[11], &f.hu);
+            axpy(&mut w.ub, c[12], &f.hu);
+            axpy(&mut w.hub, c[12], &f.u);
+            // D^3 V(u, v, v) = 2 (pass A's e t^2)
+            w.pa[A_ETT] += 2.0 * c[13];
+            axpy(&mut w.nnb, c[14], &f.hn);
+            axpy(&mut w.hnb, c[14], &f.nn);
+            adj_pi(&mut w.gbar, cols, c[15], hv, hsig_v);
+            axpy(&mut w.hvb, c[15], &f.pi_hsig_v);
+            axpy(&mut w.hsig_vb, c[15], &f.pi_hv);
+            axpy(&mut w.hvb, c[16], &f.k3);
+            axpy(&mut w.k3b, c[16], &f.hv);
+            w.pb[B_ETT] += 2.0 * c[17];
+            adj_pi(&mut w.gbar, cols, c[18], hv, hv);
+            axpy(&mut w.hvb, 2.0 * c[18], &f.pi_hv);
+            w.pa[A_T4] += 24.0 * c[19];
+        }
 
         // 2. the Hessian-vector products: the constraint-weighted ones by pass R, those of V
         //    by polarised third-order passes over the force elements
         self.hvp_weighted_adj(sys, q, v, f, w, gq, gv);
-        if !sys.forces().is_empty() {
+        if pot {
             let zero = f.zero_m.as_slice();
             let ang = &f.angles;
             let sc = &mut w.tn[2..8];
@@ -401,29 +401,20 @@ impl Preadjustment {
     ) {
         let dirs: [&[f64]; 6] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
         w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
-        let m = self.m;
-        for r in 0..m {
+        for r in 0..self.m {
             let (s, mu) = (f.sig[r], f.mu0[r]);
             let c = &w.rpass.vals[r];
             w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
             w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
-            let mut x = [0.0; 11];
-            for (k, wt) in R_XY.iter().zip([s, mu, s, mu]) {
-                x[*k] = wt;
+            // weights of q (the x yb coefficients), of v (y1, y2) and of u (y3, y4)
+            let mut x = [[0.0; 11]; 3];
+            for (i, wt) in [s, mu, s, mu].into_iter().enumerate() {
+                x[0][R_XY[i]] = wt;
+                x[1 + i / 2][R_Y[i]] = wt;
             }
             w.rw[r] = x;
         }
-        sys.add_constraint_poly_grads(&w.rpass.grads, &w.rw, gq);
-        for (pair, out) in [(0, gv), (1, w.ub.as_mut_slice())] {
-            for r in 0..m {
-                let (s, mu) = (f.sig[r], f.mu0[r]);
-                let mut x = [0.0; 11];
-                x[R_Y[2 * pair]] = s;
-                x[R_Y[2 * pair + 1]] = mu;
-                w.rw[r] = x;
-            }
-            sys.add_constraint_poly_grads(&w.rpass.grads, &w.rw, out);
-        }
+        sys.add_constraint_poly_grads_many(&w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
     }
 }
 
