@@ -6,6 +6,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
+use crate::joint::JointKind;
 use crate::system::{Attach, System};
 
 /// The workspace of the [`PolyJet`] passes of one basis: the frames of an element's bodies,
@@ -81,6 +82,61 @@ impl<const K: usize, B: Basis<K>> PolyWorkspace<K, B> {
     }
 }
 
+/// The two rows `point_a(pa) - point_b(pb)` of a revolute joint in closed form (what the
+/// generic evaluation gives, up to rounding): the point `r + R(theta) p` of a body along the
+/// directions has the coefficients `r + sum_j w_j^r x_j` (position part) plus `R(theta + d
+/// pi/2) p prod_j (w_j^theta)^(e_j) / e_j!` for a monomial of degree `d` (each derivative of
+/// the rotation turns the vector by a quarter turn), whose gradient in `theta` is the next
+/// quarter turn's. A ground point is constant.
+#[allow(clippy::too_many_arguments)]
+fn revolute_rows<const K: usize, B: Basis<K>>(
+    q: &[f64],
+    angles: &BodyAngles,
+    dirs: &[&[f64]],
+    at: Attach,
+    points: [[f64; 2]; 2],
+    vals: &mut [[f64; K]],
+    grads: &mut [[[f64; NV]; K]],
+) {
+    for r in 0..2 {
+        vals[r] = [0.0; K];
+        grads[r] = [[0.0; NV]; K];
+    }
+    for (h, (body, p)) in [at.a, at.b].into_iter().zip(points).enumerate() {
+        let sign = if h == 0 { 1.0 } else { -1.0 };
+        let Some(i) = body else {
+            vals[0][0] += sign * p[0];
+            vals[1][0] += sign * p[1];
+            continue;
+        };
+        let slot = 3 * h;
+        let [_, sn, cs] = angles.sin_cos_of(i);
+        // R(theta) p and its quarter turns
+        let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+        let turns = [r0, [-r0[1], r0[0]], [-r0[0], -r0[1]], [r0[1], -r0[0]]];
+        let mut wth = [0.0; MAX_DIRS];
+        for (wj, d) in wth.iter_mut().zip(dirs) {
+            *wj = d[3 * i + 2];
+        }
+        let pw = PolyJet::<K, B>::angle_powers(&wth);
+        for k in 0..K {
+            let d = B::DEG[k] as usize;
+            let (rk, gk) = (turns[d % 4], turns[(d + 1) % 4]);
+            for c in 0..2 {
+                vals[c][k] += sign * rk[c] * pw[k];
+                grads[c][k][slot + 2] += sign * gk[c] * pw[k];
+            }
+        }
+        for c in 0..2 {
+            vals[c][0] += sign * q[3 * i + c];
+            grads[c][0][slot + c] += sign;
+            for (j, d) in dirs.iter().enumerate() {
+                vals[c][B::LIN[j] as usize] += sign * d[3 * i + c];
+            }
+        }
+    }
+}
+
 /// The weights that route the adjoints `w` of a jet's coefficients to the direction `j`: the
 /// gradient of `sum_k w[k] c[k]` with respect to direction `j` is the base-point gradient of
 /// `sum_k out[k] c[k]` ([`Basis::DIV`]).
@@ -112,11 +168,33 @@ impl System {
     ) {
         debug_assert!(angles.matches(q) && dirs.len() == B::ND);
         debug_assert!(vals.len() == self.n_constraints() && grads.len() == vals.len());
+        self.constraint_poly_series_impl(ws, q, angles, dirs, vals, grads, true);
+    }
+
+    /// [`System::constraint_poly_series`]; `closed_form`: revolute joints by
+    /// [`revolute_rows`] (otherwise every joint by its generic equations, the oracle of the
+    /// tests).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn constraint_poly_series_impl<const K: usize, B: Basis<K>>(
+        &self,
+        ws: &mut PolyWorkspace<K, B>,
+        q: &[f64],
+        angles: &BodyAngles,
+        dirs: &[&[f64]],
+        vals: &mut [[f64; K]],
+        grads: &mut [[[f64; NV]; K]],
+        closed_form: bool,
+    ) {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            if let (true, JointKind::Revolute { pa, pb, .. }) = (closed_form, &j.kind) {
+                let (v, g) = (&mut vals[o..o + 2], &mut grads[o..o + 2]);
+                revolute_rows::<K, B>(q, angles, dirs, at, [*pa, *pb], v, g);
+                continue;
+            }
             let (fa, fb, e) = ws.get(q, angles, dirs, at);
             j.eval(fa, fb, e);
-            let o = self.row_offset[ji];
             for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
                 vals[o + k] = ek.c;
                 grads[o + k] = ek.g;
@@ -353,6 +431,56 @@ mod tests {
             [2, 1, 0, 0, 0, 0],
             [4, 0, 0, 0, 0, 0],
         ];
+    }
+
+    /// The closed-form revolute rows equal the generic evaluation's (to rounding), on systems
+    /// with revolute joints between bodies and to ground.
+    #[test]
+    fn revolute_closed_form_matches_the_generic_rows() {
+        let mut systems = derivative_test_systems().to_vec();
+        systems.push(crate::models::n_link_chain(4).expect("chain"));
+        let mut revolute = 0;
+        for sys in &systems {
+            revolute += sys
+                .joints
+                .iter()
+                .filter(|j| matches!(j.kind, JointKind::Revolute { .. }))
+                .count();
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let (q, v) = generic_point(n);
+            let u: Vec<f64> = (0..n).map(|i| 0.3 - 0.11 * i as f64).collect();
+            let mut ang = BodyAngles::default();
+            ang.update(sys, &q);
+            let mut out = Vec::new();
+            for closed in [true, false] {
+                let (mut vals, mut grads) = (vec![[0.0; 8]; m], vec![[[0.0; NV]; 8]; m]);
+                let mut ws = PolyWorkspace::<8, Ab>::new();
+                sys.constraint_poly_series_impl(
+                    &mut ws,
+                    &q,
+                    &ang,
+                    &[&v, &u],
+                    &mut vals,
+                    &mut grads,
+                    closed,
+                );
+                out.push((vals, grads));
+            }
+            let ((va, ga), (vb, gb)) = (&out[0], &out[1]);
+            for r in 0..m {
+                for k in 0..8 {
+                    let close = |a: f64, b: f64| (a - b).abs() <= 1e-15 * (1.0 + b.abs());
+                    assert!(close(va[r][k], vb[r][k]), "row {r} coef {k}");
+                    for l in 0..NV {
+                        assert!(close(ga[r][k][l], gb[r][k][l]), "row {r} coef {k} grad {l}");
+                    }
+                }
+            }
+        }
+        assert!(
+            revolute >= 6,
+            "the systems have revolute joints ({revolute})"
+        );
     }
 
     /// On systems with every joint kind and with springs: the coefficients against the

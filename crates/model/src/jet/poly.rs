@@ -230,6 +230,11 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
     /// `prod_j w_j^(e_j) / e_j!` for every monomial, from the components `w` of a linear
     /// polynomial along the directions (monomials of degree 1).
     #[inline(always)]
+    pub(crate) fn angle_powers(w: &[f64; MAX_DIRS]) -> [f64; K] {
+        Self::powers(w)
+    }
+
+    #[inline(always)]
     fn powers(w: &[f64; MAX_DIRS]) -> [f64; K] {
         let mut p = [0.0; K];
         p[0] = 1.0;
