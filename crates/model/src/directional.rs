@@ -9,7 +9,7 @@ use crate::system::System;
 
 /// The sine and cosine of every body's angle at one configuration `q`, evaluated once
 /// ([`BodyAngles::update`]) and shared by all the element passes at that `q` (the `_at`
-/// variants such as [`System::constraint_directional_at`] and [`System::lagrangian_third_at`]):
+/// variants such as [`System::lagrangian_third_at`], and [`System::constraint_poly_series`]):
 /// they give bit for bit the results of the plain passes without one `sin_cos` per element
 /// and body. Allocated once ([`BodyAngles::new`]); updating allocates nothing unless the
 /// number of bodies changed.
@@ -97,19 +97,6 @@ impl System {
         self.constraint_directional_impl(q, None, w, out);
     }
 
-    /// [`System::constraint_directional`] with the body angles' `sin`/`cos` from `angles`
-    /// (evaluated at this `q`): bit for bit the same.
-    pub fn constraint_directional_at(
-        &self,
-        q: &[f64],
-        angles: &BodyAngles,
-        w: &[f64],
-        out: &mut [[f64; 3]],
-    ) {
-        debug_assert!(angles.matches(q));
-        self.constraint_directional_impl(q, Some(angles), w, out);
-    }
-
     #[inline(always)]
     fn constraint_directional_impl(
         &self,
@@ -137,13 +124,6 @@ impl System {
     /// contributes nothing; non-conservative elements have no potential).
     pub fn potential_directional(&self, q: &[f64], w: &[f64]) -> [f64; 3] {
         self.potential_directional_impl(q, None, w)
-    }
-
-    /// [`System::potential_directional`] with the body angles' `sin`/`cos` from `angles`
-    /// (evaluated at this `q`): bit for bit the same.
-    pub fn potential_directional_at(&self, q: &[f64], angles: &BodyAngles, w: &[f64]) -> [f64; 3] {
-        debug_assert!(angles.matches(q));
-        self.potential_directional_impl(q, Some(angles), w)
     }
 
     #[inline(always)]
@@ -239,7 +219,7 @@ mod tests {
     }
 
     /// Every pass with precomputed body angles ([`BodyAngles`]) equals the plain pass bit for
-    /// bit (the directional, Hessian-vector, third-order and Hessian-row passes), on every
+    /// bit (the Hessian-vector, third-order and Hessian-row passes), on every
     /// joint kind, the manipulator and the spring model; and the table knows its `q`.
     #[test]
     fn passes_at_precomputed_angles_are_bitwise_the_plain_ones() {
@@ -258,20 +238,6 @@ mod tests {
             let mut q2 = q.clone();
             q2[2] += 1e-3;
             assert!(!ang.matches(&q2));
-            // directional
-            let (mut r1, mut r2) = (vec![[0.0; 3]; m], vec![[0.0; 3]; m]);
-            sys.constraint_directional(&q, &w, &mut r1);
-            sys.constraint_directional_at(&q, &ang, &w, &mut r2);
-            same(
-                r1.as_flattened(),
-                r2.as_flattened(),
-                "constraint_directional",
-            );
-            let (p1, p2) = (
-                sys.potential_directional(&q, &w),
-                sys.potential_directional_at(&q, &ang, &w),
-            );
-            same(&p1, &p2, "potential_directional");
             // Hessian-vector products and third derivatives
             let wts: Vec<f64> = (0..m).map(|r| 0.3 - 0.11 * r as f64).collect();
             for pot in [0.0, 1.0] {
@@ -285,22 +251,6 @@ mod tests {
                 same(&h1, &h2, "lagrangian_third H w");
                 same(&d1, &d2, "lagrangian_third D3");
             }
-            let rows = || {
-                (
-                    vec![[0.0; 6]; m],
-                    vec![[0.0; 6]; m],
-                    vec![[0.0; 6]; m],
-                    vec![0.0; m],
-                )
-            };
-            let (mut g1, mut hv1, mut t1, mut v1) = rows();
-            let (mut g2, mut hv2, mut t2, mut v2) = rows();
-            sys.constraint_third_local(&q, &w, &mut g1, &mut hv1, &mut t1, &mut v1);
-            sys.constraint_third_local_at(&q, &ang, &w, &mut g2, &mut hv2, &mut t2, &mut v2);
-            same(g1.as_flattened(), g2.as_flattened(), "third_local grads");
-            same(hv1.as_flattened(), hv2.as_flattened(), "third_local H v");
-            same(t1.as_flattened(), t2.as_flattened(), "third_local D3");
-            same(&v1, &v2, "third_local v H v");
             let dirs: Vec<[f64; 6]> = (0..m)
                 .map(|r| std::array::from_fn(|l| 0.2 * ((r * 6 + l) as f64 * 0.37).sin()))
                 .collect();

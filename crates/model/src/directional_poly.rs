@@ -10,8 +10,8 @@ use crate::joint::JointKind;
 use crate::system::{Attach, System};
 
 /// The workspace of the [`PolyJet`] passes of one basis: the frames of an element's bodies,
-/// built in place and reused from element to element and from pass to pass (see
-/// [`PolyJet::set_var_frame`]: body a in slots `0..3`, body b in `3..6`, ground constant), and
+/// built in place and reused from element to element and from pass to pass (every
+/// entry that can be non-zero is written: body a in slots `0..3`, body b in `3..6`, ground constant), and
 /// the element's equations. Make it once (it is large: boxed) and hand it to every pass.
 #[derive(Debug)]
 pub struct PolyWorkspace<const K: usize, B> {
@@ -137,20 +137,6 @@ fn revolute_rows<const K: usize, B: Basis<K>>(
     }
 }
 
-/// The weights that route the adjoints `w` of a jet's coefficients to the direction `j`: the
-/// gradient of `sum_k w[k] c[k]` with respect to direction `j` is the base-point gradient of
-/// `sum_k out[k] c[k]` ([`Basis::DIV`]).
-pub fn poly_direction_weights<const K: usize, B: Basis<K>>(w: &[f64; K], j: usize) -> [f64; K] {
-    let mut out = [0.0; K];
-    for k in 0..K {
-        let d = B::DIV[k][j];
-        if d != u8::MAX {
-            out[d as usize] += w[k];
-        }
-    }
-    out
-}
-
 impl System {
     /// Per constraint row `r`, the coefficients `vals[r]` of the [`PolyJet`] of `Phi_r(q +
     /// sum_j x_j dirs[j])` in the basis `B` (`dirs.len() == B::ND`, each of length n) and their
@@ -235,8 +221,7 @@ impl System {
 
     /// `out += sum_r sum_k w[r][k] grads[r][k]` (length n) for the element-local coefficient
     /// gradients of [`System::constraint_poly_series`]: the gradient with respect to `q` of
-    /// the weighted coefficients, or (with [`poly_direction_weights`]) with respect to a
-    /// direction. Rows whose weights are all zero are skipped.
+    /// the weighted coefficients. Rows whose weights are all zero are skipped.
     pub fn add_constraint_poly_grads<const K: usize>(
         &self,
         grads: &[[[f64; NV]; K]],
@@ -416,6 +401,20 @@ mod tests {
     use super::*;
     use crate::fixtures::{derivative_test_systems, generic_point};
 
+    /// The weights that route the adjoints `w` of a jet's coefficients to the direction `j`: the
+    /// gradient of `sum_k w[k] c[k]` with respect to direction `j` is the base-point gradient of
+    /// `sum_k out[k] c[k]` ([`Basis::DIV`]).
+    fn poly_direction_weights<const K: usize, B: Basis<K>>(w: &[f64; K], j: usize) -> [f64; K] {
+        let mut out = [0.0; K];
+        for k in 0..K {
+            let d = B::DIV[k][j];
+            if d != u8::MAX {
+                out[d as usize] += w[k];
+            }
+        }
+        out
+    }
+
     /// `{1, t, e, t^2, e t, t^3, e t^2, t^4}`.
     #[derive(Clone, Copy, Debug)]
     struct Ab;
@@ -507,8 +506,8 @@ mod tests {
             ang.update(&sys, &q);
             let dir = |w: &[f64]| {
                 let mut rows = vec![[0.0; 3]; m];
-                sys.constraint_directional_at(&q, &ang, w, &mut rows);
-                (rows, sys.potential_directional_at(&q, &ang, w))
+                sys.constraint_directional(&q, w, &mut rows);
+                (rows, sys.potential_directional(&q, w))
             };
             let (dv, pv) = dir(&v);
             let upv: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a + b).collect();

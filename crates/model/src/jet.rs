@@ -18,9 +18,11 @@
 //!   terms that contain Hessians),
 //! * [`Taylor4`] gives the Taylor series of `t -> f(q + t w)` to degree 4 (the directional
 //!   derivatives `D^k f(w, ..., w)`, `k <= 4`, without gradients),
-//! * [`TaylorGrad4`] gives the same series with the gradient of every coefficient with respect
-//!   to the base point (so the gradients of `D^k f(q)(w, ..., w)`, `k <= 4`, with respect to
-//!   `q` and to `w`),
+//! * [`PolyJet`] gives the truncated Taylor polynomial of `f(q + sum_j x_j w_j)` in several
+//!   directions at once, restricted to a fixed set of monomials, with the gradient of every
+//!   coefficient with respect to the base point (the mixed directional derivatives
+//!   `D^k f(w_1, ..., w_k)` and their gradients with respect to `q` and to every direction, in
+//!   one pass),
 //!
 //! so the Jacobian, `gamma`, the Hessians and the third derivatives are exact (to round-off) and consistent with the
 //! equation by construction. Finite-difference tests check them all.
@@ -64,7 +66,6 @@ mod hess;
 mod poly;
 mod tan;
 mod taylor;
-mod taylor_grad;
 mod third;
 
 pub use dir::DirJet;
@@ -73,7 +74,6 @@ pub use hess::HessJet;
 pub use poly::{Basis, PolyJet, MAX_DIRS};
 pub use tan::TanJet;
 pub use taylor::Taylor4;
-pub use taylor_grad::TaylorGrad4;
 pub use third::ThirdJet;
 
 /// Number of local variables of one element: `(x, y, theta)` of body a, then of body b.

@@ -301,23 +301,6 @@ impl System {
         self.constraint_third_local_impl(q, None, v, grads, hv, d3, vhv);
     }
 
-    /// [`System::constraint_third_local`] with the body angles' `sin`/`cos` from `angles`
-    /// (evaluated at this `q`, [`BodyAngles`]): bit for bit the same.
-    #[allow(clippy::too_many_arguments)]
-    pub fn constraint_third_local_at(
-        &self,
-        q: &[f64],
-        angles: &BodyAngles,
-        v: &[f64],
-        grads: &mut [[f64; NV]],
-        hv: &mut [[f64; NV]],
-        d3: &mut [[f64; NV]],
-        vhv: &mut [f64],
-    ) {
-        debug_assert!(angles.matches(q));
-        self.constraint_third_local_impl(q, Some(angles), v, grads, hv, d3, vhv);
-    }
-
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn constraint_third_local_impl(

@@ -6,7 +6,7 @@
 //! One pass of such a jet gives all the mixed directional derivatives a basis names, e.g. with
 //! the basis `{1, t, t^2, e, e t, e t^2}` (directions `v` for `t` and `u` for `e`) the
 //! coefficients `D^2 f(u, v)` (of `e t`) and `D^3 f(u, v, v) / 2` (of `e t^2`), where
-//! polarisation takes two or three [`super::TaylorGrad4`] passes per mixed derivative. The
+//! polarisation takes two or three single-direction passes per mixed derivative. The
 //! coefficient of the monomial `prod_j x_j^(e_j)` is `D^p f(w_1^(e_1), ..., w_d^(e_d)) / prod_j
 //! e_j!` (`p = sum_j e_j`), and
 //!

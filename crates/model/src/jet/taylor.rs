@@ -224,7 +224,7 @@ mod tests {
     }
 
     /// The closed form for a variable `theta + t w` (body angles) against the general
-    /// recurrence, here and in [`super::super::TaylorGrad4`].
+    /// recurrence.
     #[test]
     fn sin_cos_of_a_variable_matches_the_recurrence() {
         for (x, w) in [(0.3, 1.7), (-2.1, -0.4), (5.0, 0.0)] {
@@ -233,22 +233,6 @@ mod tests {
             for k in 0..=TAYLOR_DEGREE {
                 assert!((a.0.coef(k) - b.0.coef(k)).abs() < 1e-14, "sin {k}");
                 assert!((a.1.coef(k) - b.1.coef(k)).abs() < 1e-14, "cos {k}");
-            }
-            let g = super::super::TaylorGrad4::var(2, x, w);
-            let (a, b) = (g.sin_cos(), g.sin_cos_series());
-            for k in 0..=TAYLOR_DEGREE {
-                assert!(
-                    (a.0.coef(k) - b.0.coef(k)).abs() < 1e-14,
-                    "grad jet sin {k}"
-                );
-                assert!(
-                    (a.1.coef(k) - b.1.coef(k)).abs() < 1e-14,
-                    "grad jet cos {k}"
-                );
-                for l in 0..6 {
-                    assert!((a.0.g[k][l] - b.0.g[k][l]).abs() < 1e-14, "d sin {k} {l}");
-                    assert!((a.1.g[k][l] - b.1.g[k][l]).abs() < 1e-14, "d cos {k} {l}");
-                }
             }
         }
     }
