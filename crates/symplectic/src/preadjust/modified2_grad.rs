@@ -8,19 +8,19 @@
 //! The reverse pass needs, besides the linear algebra's adjoints, the adjoints of three
 //! primitives:
 //!
-//! * a directional pass `D^k f(q)(w, .., w)`, `k = 2..4` ([`System::constraint_directional`],
-//!   [`System::potential_directional`]): for the gradients the forward evaluation runs it as a
-//!   pass of Taylor series with gradients that keeps the element-local coefficient gradients
-//!   ([`System::constraint_directional_series`], [`System::potential_directional_series`]), and
-//!   the reverse pass only contracts them with its adjoint weights
-//!   ([`System::add_constraint_directional_grads`], [`System::add_potential_directional_grads`]:
-//!   bit for bit [`System::constraint_directional_grad`]'s result, without evaluating the
-//!   elements again);
-//! * a Hessian-vector product `y = H x`, `H = p Hess V + sum_r w_r Hess Phi_r`: with the
-//!   adjoint `yb`, `xb += H yb`, `wb_r += yb^T Hess Phi_r x` (from the element-local rows
-//!   `Hess Phi_r x` of the forward pass) and `qb += D^3 L(x, yb, .)`, the last two from two
-//!   third-order passes by polarisation,
-//!   `D^3 L(x, y, .) = [D^3 L(x + y, x + y, .) - D^3 L(x - y, x - y, .)] / 4`;
+//! * a pass of multivariate Taylor jets ([`mbd_model::PolyJet`]; passes A, B, C of
+//!   `modified2.rs`): the forward evaluation keeps every coefficient's element-local gradient
+//!   with respect to `q`, and the reverse pass contracts them with the coefficients' adjoint
+//!   weights, which gives the gradient with respect to `q` and, through the basis' division
+//!   table, with respect to every direction of the pass
+//!   ([`System::add_constraint_poly_adjoint`], [`System::add_potential_poly_adjoint`]: one
+//!   sweep, no element evaluated again);
+//! * the four constraint-weighted Hessian-vector products `y = H_w x` (`H_w = sum_r w_r Hess
+//!   Phi_r`, `(x, w)` = `(v, sigma)`, `(v, mu0)`, `(u, sigma)`, `(u, mu0)`): with the adjoints
+//!   `yb`, `xb += H_w yb`, `wb_r += yb^T Hess Phi_r x` and `qb += D^3 (w . Phi)(x, yb, .)`, all
+//!   from one jet pass R along `(v, u, yb_1, .., yb_4)` (the coefficients of `x yb` and `yb`
+//!   and their gradients); those of `Hess V` (force elements only) by two third-order passes
+//!   each, `D^3 L(x, y, .) = [D^3 L(x + y, x + y, .) - D^3 L(x - y, x - y, .)] / 4`;
 //! * `G = Phi_q` itself: every linear-algebra adjoint leaves `Gb` as a sum of outer products
 //!   `alpha beta^T`, collected in element-local form, and `qb += sum_r Hess Phi_r Gb_r`
 //!   ([`System::add_constraint_hessian_rows`]).
