@@ -8,6 +8,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{Frame, Scalar, TanJet, ThirdJet, NV};
+use crate::joint::JointKind;
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 
@@ -315,13 +316,47 @@ impl System {
     ) {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+                // closed form (what the generic evaluation gives, up to rounding): a body
+                // point r + R(theta) p has the gradient e_x or e_y plus R'(theta) p in theta,
+                // and only theta-theta second and third derivatives, -R p and -R' p
+                for r in 0..2 {
+                    grads[o + r] = [0.0; NV];
+                    hv[o + r] = [0.0; NV];
+                    d3[o + r] = [0.0; NV];
+                    vhv[o + r] = 0.0;
+                }
+                for (h, (body, p)) in [at.a, at.b].into_iter().zip([*pa, *pb]).enumerate() {
+                    let Some(i) = body else { continue };
+                    let sign = if h == 0 { 1.0 } else { -1.0 };
+                    let (sn, cs) = match ang {
+                        Some(a) => {
+                            let [_, s, c] = a.sin_cos_of(i);
+                            (s, c)
+                        }
+                        None => q[3 * i + 2].sin_cos(),
+                    };
+                    let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+                    let r1 = [-r0[1], r0[0]];
+                    let w = v[3 * i + 2];
+                    let slot = 3 * h;
+                    for c in 0..2 {
+                        grads[o + c][slot + c] = sign;
+                        grads[o + c][slot + 2] = sign * r1[c];
+                        hv[o + c][slot + 2] = -sign * r0[c] * w;
+                        d3[o + c][slot + 2] = -sign * r1[c] * (w * w);
+                        vhv[o + c] -= sign * r0[c] * (w * w);
+                    }
+                }
+                continue;
+            }
             let mut e = [ThirdJet::cst(0.0); 3];
             j.eval(
                 &Self::loc_third(q, ang, v, at.a, 0),
                 &Self::loc_third(q, ang, v, at.b, 3),
                 &mut e,
             );
-            let o = self.row_offset[ji];
             for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
                 grads[o + k] = ek.g;
                 hv[o + k] = ek.g1;
