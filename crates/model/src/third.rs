@@ -185,6 +185,24 @@ impl System {
             if weights[o..o + ne].iter().all(|&x| x == 0.0) {
                 continue;
             }
+            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+                // closed form: the rows' only second derivatives are theta-theta, -R(theta) p
+                // per body point (what the generic evaluation gives, up to rounding)
+                for (body, (p, sign)) in [at.a, at.b].into_iter().zip([(*pa, 1.0), (*pb, -1.0)]) {
+                    let Some(i) = body else { continue };
+                    let (sn, cs) = match ang {
+                        Some(a) => {
+                            let [_, s, c] = a.sin_cos_of(i);
+                            (s, c)
+                        }
+                        None => q[3 * i + 2].sin_cos(),
+                    };
+                    let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+                    let wr = weights[o] * r0[0] + weights[o + 1] * r0[1];
+                    out[3 * i + 2] -= sign * wr * w[3 * i + 2];
+                }
+                continue;
+            }
             let mut e = [TanJet::cst(0.0); 3];
             j.eval(
                 &Self::loc_tan_at(q, ang, w, at.a, 0),
