@@ -4,6 +4,7 @@
 //! `B = p Hess V + w . Hess Phi`), at the cost of one assembly instead of three passes.
 
 use crate::jet::{HessJet, Scalar, NV};
+use crate::joint::JointKind;
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 
@@ -39,6 +40,32 @@ impl System {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let mut e = [HessJet::cst(0.0); 3];
+            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+                // closed form (what the generic evaluation gives, up to rounding): a body
+                // point r + R(theta) p has the gradient e_x or e_y plus R'(theta) p in theta
+                // and the one second derivative -R(theta) p in theta-theta
+                for (h, (body, p)) in [at.a, at.b].into_iter().zip([*pa, *pb]).enumerate() {
+                    let sign = if h == 0 { 1.0 } else { -1.0 };
+                    let Some(i) = body else {
+                        for c in 0..2 {
+                            e[c].v += sign * p[c];
+                        }
+                        continue;
+                    };
+                    let (sn, cs) = q[3 * i + 2].sin_cos();
+                    let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+                    let r1 = [-r0[1], r0[0]];
+                    let slot = 3 * h;
+                    for c in 0..2 {
+                        e[c].v += sign * (q[3 * i + c] + r0[c]);
+                        e[c].g[slot + c] = sign;
+                        e[c].g[slot + 2] = sign * r1[c];
+                        e[c].h[slot + 2][slot + 2] = -sign * r0[c];
+                    }
+                }
+                visit(ElementHessian::Joint(ji, at, &e[..2]));
+                continue;
+            }
             j.eval(
                 &Self::loc_hess(q, at.a, 0),
                 &Self::loc_hess(q, at.b, 3),
