@@ -52,6 +52,18 @@ impl BodyAngles {
                 .all(|(i, e)| e[0].to_bits() == q[3 * i + 2].to_bits())
     }
 
+    /// `R(theta_i) p`: the body-fixed vector `p` of body `i` in global axes, with `sin`/`cos`
+    /// of its angle from the table or, without one, evaluated (the closed-form revolute rows of
+    /// the derivative passes start from it; `R'(theta) p` is its quarter turn `(-y, x)`).
+    #[inline(always)]
+    pub(crate) fn rotate(angles: Option<&Self>, q: &[f64], i: usize, p: [f64; 2]) -> [f64; 2] {
+        let (sn, cs) = match angles {
+            Some(a) => (a.sc[i][1], a.sc[i][2]),
+            None => q[3 * i + 2].sin_cos(),
+        };
+        [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]]
+    }
+
     /// `[theta, sin theta, cos theta]` of body `i`.
     #[inline(always)]
     pub(crate) fn sin_cos_of(&self, i: usize) -> [f64; 3] {

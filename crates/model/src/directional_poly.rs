@@ -110,9 +110,8 @@ fn revolute_rows<const K: usize, B: Basis<K>>(
             continue;
         };
         let slot = 3 * h;
-        let [_, sn, cs] = angles.sin_cos_of(i);
         // R(theta) p and its quarter turns
-        let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+        let r0 = BodyAngles::rotate(Some(angles), q, i, p);
         let turns = [r0, [-r0[1], r0[0]], [-r0[0], -r0[1]], [r0[1], -r0[0]]];
         let mut wth = [0.0; MAX_DIRS];
         for (wj, d) in wth.iter_mut().zip(dirs) {

@@ -3,6 +3,7 @@
 //! two sets of multipliers (e.g. a preadjusted step's `A = Hess V - mu0 . Hess Phi` and
 //! `B = p Hess V + w . Hess Phi`), at the cost of one assembly instead of three passes.
 
+use crate::directional::BodyAngles;
 use crate::jet::{HessJet, Scalar, NV};
 use crate::joint::JointKind;
 use crate::system::{Attach, System};
@@ -52,8 +53,7 @@ impl System {
                         }
                         continue;
                     };
-                    let (sn, cs) = q[3 * i + 2].sin_cos();
-                    let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+                    let r0 = BodyAngles::rotate(None, q, i, p);
                     let r1 = [-r0[1], r0[0]];
                     let slot = 3 * h;
                     for c in 0..2 {

@@ -190,14 +190,7 @@ impl System {
                 // per body point (what the generic evaluation gives, up to rounding)
                 for (body, (p, sign)) in [at.a, at.b].into_iter().zip([(*pa, 1.0), (*pb, -1.0)]) {
                     let Some(i) = body else { continue };
-                    let (sn, cs) = match ang {
-                        Some(a) => {
-                            let [_, s, c] = a.sin_cos_of(i);
-                            (s, c)
-                        }
-                        None => q[3 * i + 2].sin_cos(),
-                    };
-                    let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+                    let r0 = BodyAngles::rotate(ang, q, i, p);
                     let wr = weights[o] * r0[0] + weights[o + 1] * r0[1];
                     out[3 * i + 2] -= sign * wr * w[3 * i + 2];
                 }
@@ -348,14 +341,7 @@ impl System {
                 for (h, (body, p)) in [at.a, at.b].into_iter().zip([*pa, *pb]).enumerate() {
                     let Some(i) = body else { continue };
                     let sign = if h == 0 { 1.0 } else { -1.0 };
-                    let (sn, cs) = match ang {
-                        Some(a) => {
-                            let [_, s, c] = a.sin_cos_of(i);
-                            (s, c)
-                        }
-                        None => q[3 * i + 2].sin_cos(),
-                    };
-                    let r0 = [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]];
+                    let r0 = BodyAngles::rotate(ang, q, i, p);
                     let r1 = [-r0[1], r0[0]];
                     let w = v[3 * i + 2];
                     let slot = 3 * h;
