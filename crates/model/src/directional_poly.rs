@@ -6,7 +6,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
-use crate::joint::JointKind;
+use crate::joint::RevoluteSide;
 use crate::system::{Attach, System};
 
 /// The workspace of the [`PolyJet`] passes of one basis: the frames of an element's bodies,
@@ -93,8 +93,7 @@ fn revolute_rows<const K: usize, B: Basis<K>>(
     q: &[f64],
     angles: &BodyAngles,
     dirs: &[&[f64]],
-    at: Attach,
-    points: [[f64; 2]; 2],
+    sides: [RevoluteSide; 2],
     vals: &mut [[f64; K]],
     grads: &mut [[[f64; NV]; K]],
 ) {
@@ -102,14 +101,18 @@ fn revolute_rows<const K: usize, B: Basis<K>>(
         vals[r] = [0.0; K];
         grads[r] = [[0.0; NV]; K];
     }
-    for (h, (body, p)) in [at.a, at.b].into_iter().zip(points).enumerate() {
-        let sign = if h == 0 { 1.0 } else { -1.0 };
+    for RevoluteSide {
+        body,
+        slot,
+        p,
+        sign,
+    } in sides
+    {
         let Some(i) = body else {
             vals[0][0] += sign * p[0];
             vals[1][0] += sign * p[1];
             continue;
         };
-        let slot = 3 * h;
         // R(theta) p and its quarter turns
         let r0 = BodyAngles::rotate(Some(angles), q, i, p);
         let turns = [r0, [-r0[1], r0[0]], [-r0[0], -r0[1]], [r0[1], -r0[0]]];
@@ -117,7 +120,7 @@ fn revolute_rows<const K: usize, B: Basis<K>>(
         for (wj, d) in wth.iter_mut().zip(dirs) {
             *wj = d[3 * i + 2];
         }
-        let pw = PolyJet::<K, B>::angle_powers(&wth);
+        let pw = PolyJet::<K, B>::powers(&wth);
         for k in 0..K {
             let d = B::DEG[k] as usize;
             let (rk, gk) = (turns[d % 4], turns[(d + 1) % 4]);
@@ -173,9 +176,9 @@ impl System {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let o = self.row_offset[ji];
-            if let (true, JointKind::Revolute { pa, pb, .. }) = (closed_form, &j.kind) {
+            if let Some(sides) = j.revolute_sides(at).filter(|_| closed_form) {
                 let (v, g) = (&mut vals[o..o + 2], &mut grads[o..o + 2]);
-                revolute_rows::<K, B>(q, angles, dirs, at, [*pa, *pb], v, g);
+                revolute_rows::<K, B>(q, angles, dirs, sides, v, g);
                 continue;
             }
             let (fa, fb, e) = ws.get(q, angles, dirs, at);
@@ -399,6 +402,7 @@ impl System {
 mod tests {
     use super::*;
     use crate::fixtures::{derivative_test_systems, generic_point};
+    use crate::joint::JointKind;
 
     /// The weights that route the adjoints `w` of a jet's coefficients to the direction `j`: the
     /// gradient of `sum_k w[k] c[k]` with respect to direction `j` is the base-point gradient of

@@ -5,7 +5,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{HessJet, Scalar, NV};
-use crate::joint::JointKind;
+use crate::joint::RevoluteSide;
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 
@@ -41,12 +41,17 @@ impl System {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let mut e = [HessJet::cst(0.0); 3];
-            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+            if let Some(sides) = j.revolute_sides(at) {
                 // closed form (what the generic evaluation gives, up to rounding): a body
                 // point r + R(theta) p has the gradient e_x or e_y plus R'(theta) p in theta
                 // and the one second derivative -R(theta) p in theta-theta
-                for (h, (body, p)) in [at.a, at.b].into_iter().zip([*pa, *pb]).enumerate() {
-                    let sign = if h == 0 { 1.0 } else { -1.0 };
+                for RevoluteSide {
+                    body,
+                    slot,
+                    p,
+                    sign,
+                } in sides
+                {
                     let Some(i) = body else {
                         for c in 0..2 {
                             e[c].v += sign * p[c];
@@ -55,7 +60,6 @@ impl System {
                     };
                     let r0 = BodyAngles::rotate(None, q, i, p);
                     let r1 = [-r0[1], r0[0]];
-                    let slot = 3 * h;
                     for c in 0..2 {
                         e[c].v += sign * (q[3 * i + c] + r0[c]);
                         e[c].g[slot + c] = sign;

@@ -6,6 +6,7 @@
 
 use crate::body::BodyRef;
 use crate::jet::{direction, dot, point, sub2, Frame, Scalar};
+use crate::system::Attach;
 use crate::timefn::TimeFunction;
 use serde::{Deserialize, Serialize};
 
@@ -108,6 +109,41 @@ pub struct Joint {
     pub name: String,
     /// Kind and parameters.
     pub kind: JointKind,
+}
+
+/// One side of a revolute joint's equations `point_a(pa) - point_b(pb)`: the body (`None`:
+/// ground), its local slot (0 for body a, 3 for body b), the body-fixed point and the sign.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RevoluteSide {
+    pub(crate) body: Option<usize>,
+    pub(crate) slot: usize,
+    pub(crate) p: [f64; 2],
+    pub(crate) sign: f64,
+}
+
+impl Joint {
+    /// The two sides of a revolute joint attached at `at`, `None` for any other kind: what
+    /// the closed-form revolute rows of the derivative passes iterate over (a body point
+    /// `r + R(theta) p` has the derivatives `R^(k)(theta) p` in `theta`, a quarter turn each).
+    pub(crate) fn revolute_sides(&self, at: Attach) -> Option<[RevoluteSide; 2]> {
+        match &self.kind {
+            JointKind::Revolute { pa, pb, .. } => Some([
+                RevoluteSide {
+                    body: at.a,
+                    slot: 0,
+                    p: *pa,
+                    sign: 1.0,
+                },
+                RevoluteSide {
+                    body: at.b,
+                    slot: 3,
+                    p: *pb,
+                    sign: -1.0,
+                },
+            ]),
+            _ => None,
+        }
+    }
 }
 
 impl Joint {

@@ -8,7 +8,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{Frame, Scalar, TanJet, ThirdJet, NV};
-use crate::joint::JointKind;
+use crate::joint::RevoluteSide;
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 
@@ -185,10 +185,10 @@ impl System {
             if weights[o..o + ne].iter().all(|&x| x == 0.0) {
                 continue;
             }
-            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+            if let Some(sides) = j.revolute_sides(at) {
                 // closed form: the rows' only second derivatives are theta-theta, -R(theta) p
                 // per body point (what the generic evaluation gives, up to rounding)
-                for (body, (p, sign)) in [at.a, at.b].into_iter().zip([(*pa, 1.0), (*pb, -1.0)]) {
+                for RevoluteSide { body, p, sign, .. } in sides {
                     let Some(i) = body else { continue };
                     let r0 = BodyAngles::rotate(ang, q, i, p);
                     let wr = weights[o] * r0[0] + weights[o + 1] * r0[1];
@@ -328,7 +328,7 @@ impl System {
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
             let o = self.row_offset[ji];
-            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+            if let Some(sides) = j.revolute_sides(at) {
                 // closed form (what the generic evaluation gives, up to rounding): a body
                 // point r + R(theta) p has the gradient e_x or e_y plus R'(theta) p in theta,
                 // and only theta-theta second and third derivatives, -R p and -R' p
@@ -338,13 +338,17 @@ impl System {
                     d3[o + r] = [0.0; NV];
                     vhv[o + r] = 0.0;
                 }
-                for (h, (body, p)) in [at.a, at.b].into_iter().zip([*pa, *pb]).enumerate() {
+                for RevoluteSide {
+                    body,
+                    slot,
+                    p,
+                    sign,
+                } in sides
+                {
                     let Some(i) = body else { continue };
-                    let sign = if h == 0 { 1.0 } else { -1.0 };
                     let r0 = BodyAngles::rotate(ang, q, i, p);
                     let r1 = [-r0[1], r0[0]];
                     let w = v[3 * i + 2];
-                    let slot = 3 * h;
                     for c in 0..2 {
                         grads[o + c][slot + c] = sign;
                         grads[o + c][slot + 2] = sign * r1[c];

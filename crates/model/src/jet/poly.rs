@@ -230,12 +230,7 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
     /// `prod_j w_j^(e_j) / e_j!` for every monomial, from the components `w` of a linear
     /// polynomial along the directions (monomials of degree 1).
     #[inline(always)]
-    pub(crate) fn angle_powers(w: &[f64; MAX_DIRS]) -> [f64; K] {
-        Self::powers(w)
-    }
-
-    #[inline(always)]
-    fn powers(w: &[f64; MAX_DIRS]) -> [f64; K] {
+    pub(crate) fn powers(w: &[f64; MAX_DIRS]) -> [f64; K] {
         let mut p = [0.0; K];
         p[0] = 1.0;
         for k in 1..K {
@@ -249,23 +244,24 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
         p
     }
 
-    /// `sin` and `cos` of `theta + sum_j w_j x_j` (the angle of a variable frame) with
-    /// `(sin theta, cos theta) = (sn, cs)`, the gradient of `theta` being `e_l`: coefficient
-    /// `k` is `sin^(p)(theta) prod_j w_j^(e_j) / e_j!` (`p` its degree), whose gradient is
-    /// `sin^(p+1)(theta)` times the same in slot `l`. Writes only the coefficients and slot `l`
-    /// of the gradients.
+    /// `sin` and `cos` of `theta + sum_j w_j x_j` with `(sin theta, cos theta) = (sn, cs)`:
+    /// coefficient `k` is `sin^(p)(theta) prod_j w_j^(e_j) / e_j!` (`p` its degree), and its
+    /// derivative with respect to `theta` is `sin^(p+1)(theta)` times the same. Returns the
+    /// coefficients and those derivatives, `[sin, d sin, cos, d cos]`.
     #[inline(always)]
-    fn set_angle(s: &mut Self, c: &mut Self, l: usize, w: &[f64; MAX_DIRS], sn: f64, cs: f64) {
+    fn angle_series(w: &[f64; MAX_DIRS], sn: f64, cs: f64) -> [[f64; K]; 4] {
         let ds = [sn, cs, -sn, -cs];
         let dc = [cs, -sn, -cs, sn];
         let p = Self::powers(w);
+        let mut out = [[0.0; K]; 4];
         for k in 0..K {
             let d = B::DEG[k] as usize;
-            s.c[k] = ds[d % 4] * p[k];
-            c.c[k] = dc[d % 4] * p[k];
-            s.g[k][l] = ds[(d + 1) % 4] * p[k];
-            c.g[k][l] = dc[(d + 1) % 4] * p[k];
+            out[0][k] = ds[d % 4] * p[k];
+            out[1][k] = ds[(d + 1) % 4] * p[k];
+            out[2][k] = dc[d % 4] * p[k];
+            out[3][k] = dc[(d + 1) % 4] * p[k];
         }
+        out
     }
 
     /// Writes into `f` the frame of a body whose coordinates are the variables `slot ..
@@ -294,7 +290,13 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
         for (d, wd) in w.iter().enumerate().take(B::ND) {
             wa[d] = wd[2];
         }
-        Self::set_angle(&mut f.s, &mut f.c, slot + 2, &wa, sn, cs);
+        // the angle's gradient is e_(slot + 2): only that column is written
+        let [sv, sd, cv, cd] = Self::angle_series(&wa, sn, cs);
+        let l = slot + 2;
+        for k in 0..K {
+            (f.s.c[k], f.s.g[k][l]) = (sv[k], sd[k]);
+            (f.c.c[k], f.c.g[k][l]) = (cv[k], cd[k]);
+        }
     }
 
     /// `f(self)` for a function with the scaled derivatives `a[k] = f^(k)(x0) / k!` at the
@@ -424,26 +426,21 @@ impl<const K: usize, B: Basis<K>> Scalar for PolyJet<K, B> {
     }
     fn sin_cos_with(self, sn: f64, cs: f64) -> (Self, Self) {
         // a linear argument theta + sum_j w_j x_j whose coefficients carry no gradient (a
-        // body angle): the closed form of `set_angle` with the value's gradient
+        // body angle): the closed form of `angle_series` times the value's gradient
         let linear = (1..K).all(|k| (B::DEG[k] == 1 || self.c[k] == 0.0) && self.g[k] == [0.0; NV]);
         if linear {
             let mut w = [0.0; MAX_DIRS];
             for (j, wj) in w.iter_mut().enumerate().take(B::ND) {
                 *wj = self.c[B::LIN[j] as usize];
             }
-            let ds = [sn, cs, -sn, -cs];
-            let dc = [cs, -sn, -cs, sn];
-            let p = Self::powers(&w);
+            let [sv, sd, cv, cd] = Self::angle_series(&w, sn, cs);
             let (mut s, mut c) = (Self::cst(0.0), Self::cst(0.0));
             let g0 = self.g[0];
             for k in 0..K {
-                let d = B::DEG[k] as usize;
-                s.c[k] = ds[d % 4] * p[k];
-                c.c[k] = dc[d % 4] * p[k];
-                let (gs, gc) = (ds[(d + 1) % 4] * p[k], dc[(d + 1) % 4] * p[k]);
+                (s.c[k], c.c[k]) = (sv[k], cv[k]);
                 for l in 0..NV {
-                    s.g[k][l] = gs * g0[l];
-                    c.g[k][l] = gc * g0[l];
+                    s.g[k][l] = sd[k] * g0[l];
+                    c.g[k][l] = cd[k] * g0[l];
                 }
             }
             return (s, c);
