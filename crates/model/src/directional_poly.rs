@@ -221,39 +221,9 @@ impl System {
         sum
     }
 
-    /// `out += sum_r sum_k w[r][k] grads[r][k]` (length n) for the element-local coefficient
-    /// gradients of [`System::constraint_poly_series`]: the gradient with respect to `q` of
-    /// the weighted coefficients. Rows whose weights are all zero are skipped.
-    pub fn add_constraint_poly_grads<const K: usize>(
-        &self,
-        grads: &[[[f64; NV]; K]],
-        w: &[[f64; K]],
-        out: &mut [f64],
-    ) {
-        debug_assert!(w.len() == self.n_constraints() && grads.len() == w.len());
-        for (ji, j) in self.joints.iter().enumerate() {
-            let o = self.row_offset[ji];
-            let ne = j.n_equations();
-            let mut g = [0.0; NV];
-            let mut any = false;
-            for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
-                for k in 0..K {
-                    if wr[k] != 0.0 {
-                        any = true;
-                        for l in 0..NV {
-                            g[l] += wr[k] * gr[k][l];
-                        }
-                    }
-                }
-            }
-            if any {
-                Self::scatter_grad(self.joint_attach[ji], &g, 1.0, out);
-            }
-        }
-    }
-
-    /// [`System::add_constraint_poly_grads`] for `P` weight sets in one sweep over the rows:
-    /// `outs[p] += sum_r sum_k w[r][p][k] grads[r][k]`.
+    /// `outs[p] += sum_r sum_k w[r][p][k] grads[r][k]` (length n each) for the element-local
+    /// coefficient gradients of [`System::constraint_poly_series`] and `P` weight sets, in one
+    /// sweep over the rows: gradients with respect to `q` of weighted coefficients.
     pub fn add_constraint_poly_grads_many<const K: usize, const P: usize>(
         &self,
         grads: &[[[f64; NV]; K]],
@@ -373,67 +343,13 @@ impl System {
             }
         }
     }
-
-    /// `out += sum_f sum_k w[k] grads[f][k]` for the per-element coefficient gradients of
-    /// [`System::potential_poly_series`] (as [`System::add_constraint_poly_grads`]).
-    pub fn add_potential_poly_grads<const K: usize>(
-        &self,
-        grads: &[[[f64; NV]; K]],
-        w: &[f64; K],
-        out: &mut [f64],
-    ) {
-        debug_assert_eq!(grads.len(), self.forces.len());
-        if w.iter().all(|&x| x == 0.0) {
-            return;
-        }
-        for (fi, gr) in grads.iter().enumerate() {
-            let mut g = [0.0; NV];
-            for k in 0..K {
-                for l in 0..NV {
-                    g[l] += w[k] * gr[k][l];
-                }
-            }
-            Self::scatter_grad(self.force_attach[fi], &g, 1.0, out);
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fixtures::{derivative_test_systems, generic_point};
+    use crate::fixtures::{derivative_test_systems, generic_point, TwoDirections};
     use crate::joint::JointKind;
-
-    /// The weights that route the adjoints `w` of a jet's coefficients to the direction `j`: the
-    /// gradient of `sum_k w[k] c[k]` with respect to direction `j` is the base-point gradient of
-    /// `sum_k out[k] c[k]` ([`Basis::DIV`]).
-    fn poly_direction_weights<const K: usize, B: Basis<K>>(w: &[f64; K], j: usize) -> [f64; K] {
-        let mut out = [0.0; K];
-        for k in 0..K {
-            let d = B::DIV[k][j];
-            if d != u8::MAX {
-                out[d as usize] += w[k];
-            }
-        }
-        out
-    }
-
-    /// `{1, t, e, t^2, e t, t^3, e t^2, t^4}`.
-    #[derive(Clone, Copy, Debug)]
-    struct Ab;
-    impl Basis<8> for Ab {
-        const ND: usize = 2;
-        const EXP: [[u8; MAX_DIRS]; 8] = [
-            [0, 0, 0, 0, 0, 0],
-            [1, 0, 0, 0, 0, 0],
-            [0, 1, 0, 0, 0, 0],
-            [2, 0, 0, 0, 0, 0],
-            [1, 1, 0, 0, 0, 0],
-            [3, 0, 0, 0, 0, 0],
-            [2, 1, 0, 0, 0, 0],
-            [4, 0, 0, 0, 0, 0],
-        ];
-    }
 
     /// The closed-form revolute rows equal the generic evaluation's (to rounding), on systems
     /// with revolute joints between bodies and to ground.
@@ -456,7 +372,7 @@ mod tests {
             let mut out = Vec::new();
             for closed in [true, false] {
                 let (mut vals, mut grads) = (vec![[0.0; 8]; m], vec![[[0.0; NV]; 8]; m]);
-                let mut ws = PolyWorkspace::<8, Ab>::new();
+                let mut ws = PolyWorkspace::<8, TwoDirections>::new();
                 sys.constraint_poly_series_impl(
                     &mut ws,
                     &q,
@@ -499,7 +415,7 @@ mod tests {
                 let mut ang = BodyAngles::default();
                 ang.update(&sys, q);
                 let (mut vals, mut grads) = (vec![[0.0; 8]; m], vec![[[0.0; NV]; 8]; m]);
-                let mut ws = PolyWorkspace::<8, Ab>::new();
+                let mut ws = PolyWorkspace::<8, TwoDirections>::new();
                 sys.constraint_poly_series(&mut ws, q, &ang, &[v, u], &mut vals, &mut grads);
                 let mut pg = vec![[[0.0; NV]; 8]; nf];
                 let pot = sys.potential_poly_series(&mut ws, q, &ang, &[v, u], &mut pg);
@@ -545,17 +461,11 @@ mod tests {
                 c + pot.iter().zip(&wp).map(|(x, y)| x * y).sum::<f64>()
             };
             let mut gq = vec![0.0; n];
-            sys.add_constraint_poly_grads(&grads, &w, &mut gq);
-            sys.add_potential_poly_grads(&pg, &wp, &mut gq);
-            let mut gd = [vec![0.0; n], vec![0.0; n]];
-            for (j, g) in gd.iter_mut().enumerate() {
-                let wj: Vec<[f64; 8]> = w
-                    .iter()
-                    .map(|x| poly_direction_weights::<8, Ab>(x, j))
-                    .collect();
-                sys.add_constraint_poly_grads(&grads, &wj, g);
-                sys.add_potential_poly_grads(&pg, &poly_direction_weights::<8, Ab>(&wp, j), g);
-            }
+            let (mut gdv, mut gdu) = (vec![0.0; n], vec![0.0; n]);
+            let mut gd = [gdv.as_mut_slice(), gdu.as_mut_slice()];
+            sys.add_constraint_poly_adjoint::<8, TwoDirections>(&grads, &w, &mut gq, &mut gd);
+            sys.add_potential_poly_adjoint::<8, TwoDirections>(&pg, &wp, &mut gq, &mut gd);
+            let gd = [gdv, gdu];
             let h = 1e-4;
             for i in 0..n {
                 let mut fd = [0.0; 3];

@@ -1,5 +1,6 @@
 //! Test fixtures shared by the unit tests of several modules.
 
+use crate::jet::{Basis, MAX_DIRS};
 use crate::{Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, TimeFunction};
 
 /// Every joint kind (revolute, prismatic, weld, distance, absolute x / y / angle, angle
@@ -94,4 +95,22 @@ pub(crate) fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
     let q = (0..n).map(|i| 0.3 + 0.2 * (i as f64 * 0.9).sin()).collect();
     let v = (0..n).map(|i| 0.5 * (i as f64 * 1.7 + 0.3).cos()).collect();
     (q, v)
+}
+
+/// A [`crate::PolyJet`] basis in two directions (`t`, `e`): `{1, t, e, t^2, e t, t^3, e t^2,
+/// t^4}`, the shape of the preadjustment's first pass.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TwoDirections;
+impl Basis<8> for TwoDirections {
+    const ND: usize = 2;
+    const EXP: [[u8; MAX_DIRS]; 8] = [
+        [0, 0, 0, 0, 0, 0],
+        [1, 0, 0, 0, 0, 0],
+        [0, 1, 0, 0, 0, 0],
+        [2, 0, 0, 0, 0, 0],
+        [1, 1, 0, 0, 0, 0],
+        [3, 0, 0, 0, 0, 0],
+        [2, 1, 0, 0, 0, 0],
+        [4, 0, 0, 0, 0, 0],
+    ];
 }

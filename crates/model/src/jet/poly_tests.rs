@@ -3,23 +3,7 @@
 
 use super::super::{dot, point, sub2, Frame, Taylor4};
 use super::*;
-
-/// `{1, t, t^2, t^3, t^4, e, e t, e t^2}`.
-#[derive(Clone, Copy, Debug)]
-struct Two;
-impl Basis<8> for Two {
-    const ND: usize = 2;
-    const EXP: [[u8; MAX_DIRS]; 8] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [2, 0, 0, 0, 0, 0],
-        [1, 1, 0, 0, 0, 0],
-        [3, 0, 0, 0, 0, 0],
-        [2, 1, 0, 0, 0, 0],
-        [4, 0, 0, 0, 0, 0],
-    ];
-}
+use crate::fixtures::TwoDirections;
 
 /// `{1, t, e, d, t^2, e t, e^2, e d, e t^2}`.
 #[derive(Clone, Copy, Debug)]
@@ -147,7 +131,7 @@ fn check<const K: usize, B: Basis<K>>(j: &PolyJet<K, B>, k: usize, want: [f64; 7
 /// of those.
 #[test]
 fn coefficients_match_polarised_series() {
-    let j: PolyJet<8, Two> = poly(X0, &[V, U]);
+    let j: PolyJet<8, TwoDirections> = poly(X0, &[V, U]);
     for (k, p) in [(0, 0), (1, 1), (3, 2), (5, 3), (7, 4)] {
         let mut want = coef(V, p);
         let fact = [1.0, 1.0, 2.0, 6.0, 24.0][p];
@@ -228,13 +212,13 @@ fn var_frames_match() {
 /// The tables of a basis.
 #[test]
 fn tables() {
-    assert_eq!(Two::PROD[1][1], 3); // t t = t^2
-    assert_eq!(Two::PROD[2][2], NONE); // e^2 is not kept
-    assert_eq!(Two::PROD[4][1], 6); // (e t) t = e t^2
-    assert_eq!(Two::DIV[6][0], 4); // e t^2 / t = e t
-    assert_eq!(Two::DIV[6][1], 3); // e t^2 / e = t^2
-    assert_eq!(Two::FACT, [1, 1, 1, 2, 1, 6, 2, 24]);
-    assert_eq!((Two::MAX_DEG, Three::MAX_DEG), (4, 3));
+    assert_eq!(TwoDirections::PROD[1][1], 3); // t t = t^2
+    assert_eq!(TwoDirections::PROD[2][2], NONE); // e^2 is not kept
+    assert_eq!(TwoDirections::PROD[4][1], 6); // (e t) t = e t^2
+    assert_eq!(TwoDirections::DIV[6][0], 4); // e t^2 / t = e t
+    assert_eq!(TwoDirections::DIV[6][1], 3); // e t^2 / e = t^2
+    assert_eq!(TwoDirections::FACT, [1, 1, 1, 2, 1, 6, 2, 24]);
+    assert_eq!((TwoDirections::MAX_DEG, Three::MAX_DEG), (4, 3));
     assert_eq!(Three::LIN, [1, 2, 3, NONE, NONE, NONE]);
 }
 

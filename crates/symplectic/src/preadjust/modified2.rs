@@ -173,7 +173,7 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         out.fill(0.0);
         let mut w = [0.0; K];
         w[k] = 1.0;
-        sys.add_potential_poly_grads(&self.pgrads, &w, out);
+        sys.add_potential_poly_adjoint::<K, B>(&self.pgrads, &w, out, &mut []);
     }
 }
 
