@@ -1,8 +1,9 @@
 //! # mbd
 //!
 //! Planar rigid multibody systems as differential-algebraic equations, with the solvers of three
-//! papers and the analysis that measures them. This facade re-exports the workspace's crates;
-//! depend on a single crate (e.g. `mbd-model` + `mbd-rk4`) if you need only part of it.
+//! papers and the analysis that measures them. This facade holds the front door
+//! ([`Simulation`]) and the solver registry ([`registry`]) and re-exports the workspace's
+//! crates; depend on a single crate (e.g. `mbd-model` + `mbd-rk4`) if you need only part of it.
 //!
 //! | crate | what |
 //! |---|---|
@@ -15,22 +16,30 @@
 //! | [`firefly_gauss`] | paper C: the firefly-Gauss DAE solver |
 //! | [`analysis`] | energy/constraint errors, trajectory errors, convergence orders, CSV/JSON |
 //!
+//! The front door is [`Simulation`]: a model (built in code or read from a file), a solver
+//! named by a spec string of the [`registry`] (`"rk4"`, `"symplectic:2"`, `"tangent:dopri5"`,
+//! ...; `mbd solvers` lists them), and a run with fixed steps ([`solve::RunConfig`]) or
+//! adaptive ones ([`solve::AdaptiveConfig`]), observed by any [`solve::Observer`]. The run
+//! returns [`solve::RunStats`] with the reason it stopped.
+//!
 //! ```
-//! use mbd::analysis::MeasureObserver;
-//! use mbd::model::models;
-//! use mbd::rk4::{Rk4, Rk4Options};
-//! use mbd::solve::{run, RunConfig, State};
+//! use mbd::prelude::*;
 //!
 //! let sys = models::manipulator()?;
-//! let mut state = State::consistent(&sys, 0.0)?;
-//! let mut rk4 = Rk4::new(&sys, Rk4Options::plain())?;
-//! let mut obs = MeasureObserver::new(&sys, false);
-//! run(&mut rk4, &sys, &mut state, RunConfig::new(2.0, 0.01), &mut obs)?;
-//! let m = obs.measures();
-//! assert!(m.e_phi > 1e-12); // plain RK4 drifts off the constraints
-//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! let mut sim = Simulation::new(sys, "rk4")?;
+//! let mut obs = MeasureObserver::new(sim.system(), false);
+//! let stats = sim.run_observed(RunConfig::new(2.0, 0.01), &mut obs)?;
+//! assert_eq!((stats.steps, stats.stop), (200, StopReason::ReachedEnd));
+//! assert!(obs.measures().e_phi > 1e-12); // plain RK4 drifts off the constraints
+//! # Ok::<(), mbd::Error>(())
 //! ```
 #![warn(missing_docs)]
+
+mod registry;
+mod simulation;
+
+pub use registry::registry;
+pub use simulation::{Plan, Simulation};
 
 pub use mbd_analysis as analysis;
 pub use mbd_firefly as firefly;
@@ -75,8 +84,6 @@ pub enum Error {
     Solve(solve::SolveError),
     /// The symplectic integrator and its calibration ([`symplectic::SymplecticError`]).
     Symplectic(symplectic::SymplecticError),
-    /// The tangent-space integrator ([`tangent::TangentError`]).
-    Tangent(tangent::TangentError),
     /// The firefly optimiser ([`firefly::FireflyError`]).
     Firefly(firefly::FireflyError),
     /// The firefly-Gauss solver ([`firefly_gauss::FaDaeError`]).
@@ -91,7 +98,6 @@ impl Error {
             Error::Model(e) => e,
             Error::Solve(e) => e,
             Error::Symplectic(e) => e,
-            Error::Tangent(e) => e,
             Error::Firefly(e) => e,
             Error::FaDae(e) => e,
             Error::Analysis(e) => e,
@@ -126,7 +132,6 @@ from_error!(
     Model(model::ModelError),
     Solve(solve::SolveError),
     Symplectic(symplectic::SymplecticError),
-    Tangent(tangent::TangentError),
     Firefly(firefly::FireflyError),
     FaDae(firefly_gauss::FaDaeError),
     Analysis(analysis::AnalysisError),
@@ -150,7 +155,7 @@ from_error!(
 /// # Ok::<(), mbd::Error>(())
 /// ```
 pub mod prelude {
-    pub use crate::Error;
+    pub use crate::{registry, Error, Plan, Simulation};
     pub use mbd_analysis::{CsvObserver, MeasureObserver};
     pub use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
     pub use mbd_model::{models, System};
@@ -159,6 +164,7 @@ pub mod prelude {
         observe, observer, run, run_adaptive, AdaptiveConfig, AdaptiveIntegrator, ButcherTableau,
         Crossing, DenseOutput, Event, EventHit, Every, Flow, Index1Options, Index1Rk, Integrator,
         NoObserver, Observer, ProjectionSettings, Recorder, RunConfig, RunStats, SolveError, State,
+        StopReason,
     };
     pub use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
     pub use mbd_tangent::{TangentOptions, TangentRk};

@@ -7,7 +7,7 @@ use mbd::solve::{
     run, run_adaptive, AdaptiveConfig, ButcherTableau, DenseOutput, Event, Index1Options, Index1Rk,
     NoObserver, ProjectionSettings, RunConfig, State,
 };
-use mbd::tangent::{AdaptiveSettings, TangentOptions, TangentRk};
+use mbd::tangent::{TangentOptions, TangentRk};
 use std::f64::consts::PI;
 
 const THETA0: f64 = 1.2;
@@ -68,24 +68,6 @@ fn pendulum_period_from_events_adaptive_tangent_dopri5() {
     );
     assert!(stats.steps > 10 && (s.t - 4.5 * exact).abs() < 1e-12);
     assert!(rel < 1e-10, "relative period error {rel:e}");
-
-    // the same through the tangent crate's own adaptive loop (observers work there too)
-    let (sys, mut s, _) = pendulum();
-    let mut dense =
-        DenseOutput::new(&sys, NoObserver).with_event(Event::new("x = 0", |_, q, _| q[0]).rising());
-    integ
-        .integrate_adaptive(
-            &sys,
-            &mut s,
-            4.5 * exact,
-            &AdaptiveSettings::with_tolerance(1e-12),
-            &mut dense,
-        )
-        .unwrap();
-    let (period2, _) = period_from(&dense);
-    let rel2 = (period2 - exact).abs() / exact;
-    println!("tangent DOPRI5 tol 1e-12 via integrate_adaptive: rel {rel2:.2e}");
-    assert!(rel2 < 1e-10, "relative period error {rel2:e}");
 }
 
 #[test]

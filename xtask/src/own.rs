@@ -4,29 +4,28 @@
 use crate::report::{fmt_e, num, Claim, Ctx, Experiment, FigureRef, Part, Section, Table};
 use mbd_analysis::plot::{Figure, Series};
 use mbd_analysis::{fit_order, MeasureObserver};
-use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd_model::{models, System};
-use mbd_rk4::{Rk4, Rk4Options};
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Index1Options, Index1Rk, Integrator, NoObserver,
     RunConfig, SolveError, State,
 };
-use mbd_symplectic::{Galerkin, SymplecticOptions};
-use mbd_tangent::TangentRk;
 use serde_json::json;
 use std::time::Instant;
 
 mod work_precision;
 use work_precision::work_precision;
 
-/// A solver entry: name, nominal order, constructor.
+/// A solver of the comparison: a variant of the solver registry (`mbd::registry()`), with
+/// the run lengths its cost allows.
 pub struct SolverSpec {
-    /// Display name.
+    /// Display name (the registry's label).
     pub name: &'static str,
+    /// The registry's spec string.
+    pub spec: &'static str,
     /// Nominal convergence order.
     pub order: f64,
     /// Builds the integrator for a system.
-    pub make: fn(&System) -> Result<Box<dyn Integrator>, SolveError>,
+    pub solver: mbd::solve::registry::SolverSpec,
     /// Include in the 10^5-step long-time study (too slow for the optimisation-based solver).
     pub long_time: bool,
     /// Smallest step of the work-precision sweep (the optimisation-based solver costs about
@@ -34,67 +33,39 @@ pub struct SolverSpec {
     pub h_min: f64,
 }
 
-/// Every solver of the project, as compared in the own experiments.
+impl SolverSpec {
+    /// Builds the integrator for `sys`.
+    pub fn make(&self, sys: &System) -> Result<Box<dyn Integrator + Send>, SolveError> {
+        self.solver.build(sys)
+    }
+}
+
+/// Solvers whose relative cost per step (the registry's estimate) is above this skip the
+/// long-time study and stop their work-precision sweep at [`WP_H_MIN_COSTLY`].
+const COSTLY: f64 = 50.0;
+/// Smallest work-precision step of a costly solver.
+const WP_H_MIN_COSTLY: f64 = 0.02 / 128.0;
+
+/// Every solver of the registry that the comparisons include
+/// ([`mbd::solve::registry::SolverVariant::compared`]), in registry order.
 pub fn solvers() -> Vec<SolverSpec> {
-    vec![
-        SolverSpec {
-            name: "RK4 (index-1, plain)",
-            order: 4.0,
-            long_time: true,
-            h_min: WP_H_MIN,
-            make: |s| Ok(Box::new(Rk4::new(s, Rk4Options::plain())?)),
-        },
-        SolverSpec {
-            name: "RK4 (index-1, projection)",
-            order: 4.0,
-            long_time: true,
-            h_min: WP_H_MIN,
-            make: |s| Ok(Box::new(Rk4::new(s, Rk4Options::projected())?)),
-        },
-        SolverSpec {
-            name: "symplectic (1,1)",
-            order: 2.0,
-            long_time: true,
-            h_min: WP_H_MIN,
-            make: |s| Ok(Box::new(Galerkin::new(s, SymplecticOptions::new(1))?)),
-        },
-        SolverSpec {
-            name: "symplectic (2,2)",
-            order: 4.0,
-            long_time: true,
-            h_min: WP_H_MIN,
-            make: |s| Ok(Box::new(Galerkin::new(s, SymplecticOptions::new(2))?)),
-        },
-        SolverSpec {
-            name: "tangent-space RK4",
-            order: 4.0,
-            long_time: true,
-            h_min: WP_H_MIN,
-            make: |s| Ok(Box::new(TangentRk::rk4(s)?)),
-        },
-        SolverSpec {
-            name: "tangent-space DOPRI5 (fixed step)",
-            order: 5.0,
-            long_time: false,
-            h_min: WP_H_MIN,
-            make: |s| Ok(Box::new(TangentRk::dopri5(s)?)),
-        },
-        SolverSpec {
-            name: "FA-DAE + Gauss-Newton polish",
-            order: 4.0,
-            long_time: false,
-            h_min: 0.02 / 128.0,
-            make: |s| {
-                let opts = FaDaeOptions {
-                    polish: true,
-                    ..FaDaeOptions::default()
-                };
-                let fa = FireflyGauss::new(s, opts)
-                    .map_err(|e| SolveError::Unsupported(e.to_string()))?;
-                Ok(Box::new(fa))
-            },
-        },
-    ]
+    mbd::registry()
+        .variants()
+        .filter(|(_, v)| v.compared)
+        .filter_map(|(_, v)| {
+            // every variant parses: the registry checks it when the family registers
+            let solver = mbd::registry().parse(v.spec).ok()?;
+            let cheap = v.relative_cost <= COSTLY;
+            Some(SolverSpec {
+                name: v.label,
+                spec: v.spec,
+                order: f64::from(v.order),
+                solver,
+                long_time: cheap,
+                h_min: if cheap { WP_H_MIN } else { WP_H_MIN_COSTLY },
+            })
+        })
+        .collect()
 }
 
 /// Smallest step of the work-precision sweep (0.02 / 2^12): below the round-off floor of every
@@ -134,7 +105,7 @@ fn solve_to(
     h: f64,
 ) -> Result<(Vec<f64>, f64), String> {
     let mut s = State::consistent(sys, 0.0).map_err(|e| e.to_string())?;
-    let mut integ = (spec.make)(sys).map_err(|e| e.to_string())?;
+    let mut integ = spec.make(sys).map_err(|e| e.to_string())?;
     let t = Instant::now();
     run(
         &mut integ,
@@ -244,7 +215,7 @@ fn long_time(ctx: &Ctx) -> Result<Section, String> {
     let mut rows = Vec::new();
     for spec in solvers().into_iter().filter(|s| s.long_time) {
         let mut s = State::consistent(&sys, 0.0).map_err(|e| e.to_string())?;
-        let mut integ = (spec.make)(&sys).map_err(|e| e.to_string())?;
+        let mut integ = spec.make(&sys).map_err(|e| e.to_string())?;
         let mut obs = MeasureObserver::new(&sys, false).with_series();
         run(
             &mut integ,
@@ -378,7 +349,7 @@ fn step_cost(ctx: &Ctx) -> Result<Section, String> {
             .iter()
             .find(|t| t.0 == spec.name)
             .map_or((None, None), |t| (t.1, t.2));
-        let mut integ = (spec.make)(&sys).map_err(|e| e.to_string())?;
+        let mut integ = spec.make(&sys).map_err(|e| e.to_string())?;
         let n = if spec.long_time { steps } else { steps / 100 };
         let (per, per_peer) =
             interleaved_step_cost(&sys, &s0, integ.as_mut(), &mut peer, blocks, n, steps)?;

@@ -1,7 +1,7 @@
 //! The command line, declared with clap's derive API.
 
-use crate::solver::SolverSpec;
 use clap::{Args, Parser, Subcommand};
+use mbd::solve::registry::SolverSpec;
 use std::path::PathBuf;
 
 const MAIN_EXAMPLE: &str = "\
@@ -11,9 +11,7 @@ Examples:
   mbd plot slider.csv --y slider.x --y crank.theta -o slider.svg
   mbd animate slider.csv --model examples/models/slider_crank_spring.toml -o slider.html
 
-Solvers: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified,
-symplectic:2:modified, index1:dopri5 and tangent:dopri5 (fixed --h or adaptive --tol),
-tangent:rk4, firefly-gauss. See docs/cli.md.";
+`mbd solvers` lists the solvers (spec strings for --solver). See docs/cli.md.";
 
 const RUN_EXAMPLE: &str = "\
 Examples:
@@ -34,6 +32,12 @@ const PLOT_EXAMPLE: &str = "\
 Example:
   mbd plot slider.csv --y slider.x --y crank.x -o slider.svg
   mbd plot slider.csv --x crank.theta --y d_crank.theta";
+
+const SOLVERS_EXAMPLE: &str = "\
+Example:
+  mbd solvers
+  mbd solvers --markdown
+  mbd run examples/models/pendulum.toml --solver symplectic:2:gamma=1 --t-end 2 --h 1e-3";
 
 const ANIMATE_EXAMPLE: &str = "\
 Example:
@@ -66,6 +70,18 @@ pub enum Command {
     /// Write a self-contained HTML page animating a result CSV with the model's geometry.
     #[command(after_help = ANIMATE_EXAMPLE)]
     Animate(AnimateArgs),
+    /// List the registered solvers: spec string, order, adaptive, cost scaling, what each
+    /// refuses.
+    #[command(after_help = SOLVERS_EXAMPLE)]
+    Solvers(SolversArgs),
+}
+
+/// Arguments of `mbd solvers`.
+#[derive(Debug, Args)]
+pub struct SolversArgs {
+    /// Print the table as Markdown (the table README.md and docs/cli.md carry).
+    #[arg(long)]
+    pub markdown: bool,
 }
 
 /// Arguments of `mbd run`.
@@ -74,8 +90,7 @@ pub enum Command {
 pub struct RunArgs {
     /// Model file (.toml or .json).
     pub model: PathBuf,
-    /// Solver: rk4, rk4-projected, symplectic:S[:gamma=G], symplectic:1:modified,
-    /// symplectic:2:modified, index1:dopri5, tangent:rk4, tangent:dopri5, firefly-gauss.
+    /// Solver spec string, e.g. rk4, symplectic:2, tangent:dopri5 (`mbd solvers` lists them).
     #[arg(long, short, value_parser = parse_solver)]
     pub solver: SolverSpec,
     /// End time in s (the run starts at t0 = 0).
@@ -84,8 +99,8 @@ pub struct RunArgs {
     /// Fixed step size in s.
     #[arg(long, allow_negative_numbers = true, value_parser = parse_h, conflicts_with = "tol")]
     pub h: Option<f64>,
-    /// Error tolerance for adaptive steps (solvers with an embedded error estimate:
-    /// index1:dopri5, tangent:dopri5).
+    /// Error tolerance for adaptive steps (solvers with an embedded error estimate: `mbd
+    /// solvers` marks them adaptive).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_tol)]
     pub tol: Option<f64>,
     /// Output file: .csv or .json (default: CSV on standard output).
@@ -133,7 +148,9 @@ pub struct AnimateArgs {
 }
 
 fn parse_solver(s: &str) -> Result<SolverSpec, String> {
-    s.parse()
+    mbd::registry()
+        .parse(s)
+        .map_err(|e| format!("{e} (`mbd solvers` lists them)"))
 }
 
 fn parse_number(s: &str) -> Result<f64, String> {

@@ -9,20 +9,19 @@
 //! * `mbd check MODEL` validates a model and prints its bodies, joints, degrees of freedom and
 //!   consistent initial state;
 //! * `mbd plot RESULT.csv --y COL [--y COL ...] [--x t] [-o out.svg]` draws an SVG figure;
-//! * `mbd animate RESULT.csv --model MODEL -o anim.html` writes a self-contained animated page.
+//! * `mbd animate RESULT.csv --model MODEL -o anim.html` writes a self-contained animated page;
+//! * `mbd solvers` lists the solvers of the registry (`mbd::registry()`).
 //!
 //! `docs/cli.md` describes the commands, the output columns and the solvers. The library side
-//! is usable too, e.g. to parse solver names the way `--solver` does:
+//! is usable too, e.g. to run a command line from code:
 //!
 //! ```
-//! use mbd_cli::solver::SolverSpec;
+//! use clap::Parser;
 //!
-//! let spec: SolverSpec = "symplectic:2:gamma=1".parse()?;
-//! assert_eq!(spec, SolverSpec::Symplectic { s: 2, gamma: 1.0, modified: false });
-//! assert!(!spec.has_error_estimate());
-//! let sys = mbd_model::models::slider_crank()?;
-//! let integrator = spec.build(&sys)?;
-//! assert!(integrator.name().contains("symplectic"));
+//! let cli = mbd_cli::Cli::try_parse_from(["mbd", "solvers"])?;
+//! let table = mbd_cli::solvers::table();
+//! assert!(table.contains("tangent:dopri5"));
+//! mbd_cli::execute(cli)?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
@@ -34,7 +33,7 @@ pub mod error;
 pub mod model;
 pub mod plot;
 pub mod run;
-pub mod solver;
+pub mod solvers;
 pub mod table;
 
 pub use args::{Cli, Command};
@@ -67,6 +66,14 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Animate(args) => {
             animate::animate(&args)?;
             eprintln!("wrote {}", args.out.display());
+            Ok(())
+        }
+        Command::Solvers(args) => {
+            if args.markdown {
+                print!("{}", mbd::registry().markdown_table());
+            } else {
+                print!("{}", solvers::table());
+            }
             Ok(())
         }
     }

@@ -2,8 +2,9 @@
 
 use crate::args::RunArgs;
 use crate::error::CliError;
-use crate::solver::SolverSpec;
 use indicatif::{ProgressBar, ProgressStyle};
+use mbd::solve::registry::SolverSpec;
+use mbd::Simulation;
 use mbd_analysis::{CsvObserver, MeasureObserver};
 use mbd_model::System;
 use mbd_solve::{AdaptiveConfig, Flow, Observer, RunConfig, RunStats, SolveError, State};
@@ -180,18 +181,37 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
 
 /// Runs the simulation, writes the output and returns the summary.
 pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
-    if args.tol.is_some() && !args.solver.has_error_estimate() {
+    if args.tol.is_some() && !args.solver.adaptive() {
+        let adaptive: Vec<&str> = mbd::registry()
+            .variants()
+            .filter(|(_, v)| v.adaptive)
+            .map(|(_, v)| v.spec)
+            .collect();
         return Err(CliError::Usage(format!(
             "--tol needs a solver with an embedded error estimate, and '{}' has none: give a \
-             fixed step with --h, or use --solver index1:dopri5 or tangent:dopri5 with --tol",
-            args.solver
+             fixed step with --h, or use --tol with one of: {}",
+            args.solver,
+            adaptive.join(", ")
         )));
     }
     let sys = crate::model::load(&args.model)?;
-    let mut state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {
+    let state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {
         path: args.model.display().to_string(),
         source: Box::new(source),
     })?;
+    let plan: mbd::Plan = match (args.h, args.tol) {
+        (_, Some(tol)) => AdaptiveConfig::new(args.t_end, tol).into(),
+        (Some(h), None) => RunConfig::new(args.t_end, h).into(),
+        (None, None) => {
+            return Err(CliError::Usage(
+                "give a step size with --h (or a tolerance with --tol)".into(),
+            ))
+        }
+    };
+    let integrator = args
+        .solver
+        .build(&sys)
+        .map_err(|e| solve_error(&args.solver, e))?;
     let every = usize::try_from(args.every).unwrap_or(usize::MAX);
     let sink = open_sink(args, every)?;
     let measures = MeasureObserver::new(&sys, false);
@@ -203,47 +223,41 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     let progress = Progress::new(args.t_end);
     let bar = progress.bar.clone();
     let mut obs = (measures, (count, (sink, progress)));
+    let mut sim = Simulation::from_parts(sys, args.solver.spec(), integrator, state)
+        .map_err(|e| solve_error(&args.solver, solve_part(e)))?;
     let started = Instant::now();
-    let result = match (args.h, args.tol) {
-        (_, Some(tol)) => args.solver.build_adaptive(&sys).and_then(|mut dp| {
-            mbd_solve::run_adaptive(
-                &mut dp,
-                &sys,
-                &mut state,
-                AdaptiveConfig::new(args.t_end, tol),
-                &mut obs,
-            )
-        }),
-        (Some(h), None) => args.solver.build(&sys).and_then(|mut integ| {
-            mbd_solve::run(
-                &mut integ,
-                &sys,
-                &mut state,
-                RunConfig::new(args.t_end, h),
-                &mut obs,
-            )
-        }),
-        (None, None) => {
-            return Err(CliError::Usage(
-                "give a step size with --h (or a tolerance with --tol)".into(),
-            ))
-        }
-    };
+    let result = sim.run_observed(plan, &mut obs);
     let wall_time = started.elapsed().as_secs_f64();
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    let stats = result.map_err(|e| solve_error(&args.solver, e))?;
+    let stats = result.map_err(|e| solve_error(&args.solver, solve_part(e)))?;
     let (measures, (count, (sink, _))) = obs;
-    let final_written = count.last_t == Some(state.t);
+    let final_written = count.last_t == Some(sim.state().t);
     let rows = count.rows + usize::from(!final_written);
-    finish(args, &sys, &state, sink, stats, &measures, wall_time)?;
+    finish(
+        args,
+        sim.system(),
+        sim.state(),
+        sink,
+        stats,
+        &measures,
+        wall_time,
+    )?;
     Ok(RunSummary {
         stats,
         measures: measures.measures(),
         wall_time,
         rows,
     })
+}
+
+/// The solver-side error of a run (the run loop returns nothing else).
+fn solve_part(e: mbd::Error) -> SolveError {
+    match e {
+        mbd::Error::Solve(e) => e,
+        other => SolveError::Unsupported(other.to_string()),
+    }
 }
 
 fn out_path(args: &RunArgs) -> PathBuf {

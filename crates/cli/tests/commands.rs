@@ -39,27 +39,57 @@ fn run_model(model: &Path, solver: &str, step: &[&str], out: &Path) -> common::O
     mbd(a)
 }
 
+/// Every registered solver (`mbd::registry()`), with `--h` and, for adaptive ones, `--tol`,
+/// and one spec with options.
+fn every_registered_solver() -> Vec<(String, &'static [&'static str], &'static str)> {
+    let mut v = vec![];
+    for (_, var) in mbd::registry().variants() {
+        v.push((var.spec.to_string(), &["--h", "0.01"][..], var.refuses));
+        if var.adaptive {
+            v.push((var.spec.to_string(), &["--tol", "1e-6"][..], var.refuses));
+        }
+    }
+    v.push(("symplectic:1:gamma=1".into(), &["--h", "0.01"][..], ""));
+    v
+}
+
+#[test]
+fn mbd_solvers_lists_the_registry() {
+    let out = mbd(["solvers"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    for (_, v) in mbd::registry().variants() {
+        assert!(
+            out.stdout.lines().any(|l| l.starts_with(v.spec)),
+            "{} missing from:\n{}",
+            v.spec,
+            out.stdout
+        );
+    }
+}
+
 #[test]
 fn every_solver_runs_every_example_model() {
     let d = scratch("all");
-    let solvers: &[(&str, &[&str])] = &[
-        ("rk4", &["--h", "0.01"]),
-        ("rk4-projected", &["--h", "0.01"]),
-        ("symplectic:2", &["--h", "0.01"]),
-        ("symplectic:1:gamma=1", &["--h", "0.01"]),
-        ("index1:dopri5", &["--h", "0.01"]),
-        ("index1:dopri5", &["--tol", "1e-6"]),
-        ("tangent:rk4", &["--h", "0.01"]),
-        ("tangent:dopri5", &["--h", "0.01"]),
-        ("tangent:dopri5", &["--tol", "1e-6"]),
-        ("firefly-gauss", &["--h", "0.01"]),
-    ];
+    let solvers = every_registered_solver();
     for model in example_models() {
         let want = expected_columns(&model);
-        for (k, (solver, step)) in solvers.iter().enumerate() {
+        let conservative = mbd_model::System::from_path(&model)
+            .unwrap()
+            .is_conservative();
+        for (k, (solver, step, refuses)) in solvers.iter().enumerate() {
             let csv = d.join(format!("{k}.csv"));
             let out = run_model(&model, solver, step, &csv);
             let what = format!("{} with {solver} {step:?}", model.display());
+            if !conservative && refuses.contains("non-conservative") {
+                // a documented refusal: a runtime error that says why
+                assert_eq!(out.code, 1, "{what}: {}", out.stderr);
+                assert!(
+                    out.stderr.contains("conservative"),
+                    "{what}: {}",
+                    out.stderr
+                );
+                continue;
+            }
             assert_eq!(out.code, 0, "{what}: {}", out.stderr);
             assert!(
                 out.stderr.contains("mbd run: ") && out.stderr.contains("e(H) = "),

@@ -89,9 +89,11 @@ mod integrator;
 mod objective;
 mod options;
 mod partition;
+mod registry;
 
 pub use accel::RefinedAcceleration;
 pub use error::FaDaeError;
 pub use integrator::{step_seed, FaDaeStats, FireflyGauss, StepInfo};
 pub use options::{BoxSettings, FaDaeOptions, MissPolicy, PartitionChoice, Predictor};
 pub use partition::Partition;
+pub use registry::SOLVERS;

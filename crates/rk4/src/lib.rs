@@ -25,6 +25,9 @@
 //! ```
 #![warn(missing_docs)]
 
+mod registry;
+pub use registry::SOLVERS;
+
 use mbd_model::System;
 use mbd_solve::{
     ButcherTableau, Index1Options, Index1Rk, Integrator, LinearSolver, ProjectionSettings,

@@ -46,6 +46,21 @@ pub trait AdaptiveIntegrator: Integrator {
         h: f64,
         ctrl: &StepController,
     ) -> Result<StepAttempt, SolveError>;
+
+    /// The first step of a run from `state` over `span` seconds when `cfg` gives none
+    /// ([`AdaptiveConfig::h0`]), with the work it cost; `None` (the default) lets
+    /// [`run_adaptive`] take `0.1 span tol^(1/(q+1))`. Called after [`Integrator::reset`], before
+    /// the first attempt; the result is clamped to `[controller.h_min, min(h_max, span)]`.
+    fn initial_step(
+        &mut self,
+        sys: &System,
+        state: &State,
+        span: f64,
+        cfg: &AdaptiveConfig,
+    ) -> Result<Option<(f64, StepStats)>, SolveError> {
+        let _ = (sys, state, span, cfg);
+        Ok(None)
+    }
 }
 
 impl<I: AdaptiveIntegrator + ?Sized> AdaptiveIntegrator for Box<I> {
@@ -61,6 +76,15 @@ impl<I: AdaptiveIntegrator + ?Sized> AdaptiveIntegrator for Box<I> {
     ) -> Result<StepAttempt, SolveError> {
         (**self).attempt_step(sys, state, h, ctrl)
     }
+    fn initial_step(
+        &mut self,
+        sys: &System,
+        state: &State,
+        span: f64,
+        cfg: &AdaptiveConfig,
+    ) -> Result<Option<(f64, StepStats)>, SolveError> {
+        (**self).initial_step(sys, state, span, cfg)
+    }
 }
 
 /// Settings of [`run_adaptive`].
@@ -70,15 +94,20 @@ pub struct AdaptiveConfig {
     pub t_end: f64,
     /// Tolerances, safety factor, shrink/growth limits and the smallest step.
     pub controller: StepController,
-    /// First step; `None` = `0.1 (t_end - t0) tol^(1/(q+1))` with `tol = max(atol, rtol)`
-    /// (the controller corrects it within a few steps).
+    /// First step; `None` = the integrator's estimate
+    /// ([`AdaptiveIntegrator::initial_step`]), or for integrators without one
+    /// `0.1 (t_end - t0) tol^(1/(q+1))` with `tol = max(atol, rtol)` (the controller corrects it
+    /// within a few steps).
     pub h0: Option<f64>,
     /// Largest step (default infinite).
     pub h_max: f64,
     /// Limit on accepted plus rejected steps (default `10^7`).
     pub max_steps: usize,
     /// `beta` of the PI controller (`None` = Gustafsson's `0.4/(q+1)`; `Some(0.0)` = I
-    /// controller), as in `mbd_tangent::AdaptiveSettings::pi_beta`.
+    /// controller). After an accepted step with error norm `err` (previous accepted step:
+    /// `err_prev`), `h <- h safety err^-(1/(q+1) - 0.75 beta) err_prev^beta`; Gustafsson's
+    /// PI.3.4 is 0.08 for DOPRI5, Hairer and Wanner's DOPRI5 code uses 0.04. Must lie in
+    /// `[0, 1 / (1.75 (q+1)))`: at larger values a steady error never lets the step grow.
     pub pi_beta: Option<f64>,
     /// The constraint-drift guard, checked after every accepted step (default on).
     pub drift_guard: Option<DriftGuard>,
@@ -171,12 +200,15 @@ impl AdaptiveConfig {
 /// Integrates from `state.t` to `cfg.t_end` with adaptive steps, calling `observer` with the
 /// initial state (step 0) and after every accepted step (with the accepted-step index).
 ///
-/// Step control as in `mbd_tangent::TangentRk::integrate_adaptive`: after an accepted step
+/// The first step is [`AdaptiveConfig::h0`], else the integrator's
+/// [`AdaptiveIntegrator::initial_step`], else `0.1 span tol^(1/(q+1))`. After an accepted step
 /// with error norm `err` (previous accepted: `err_prev`), `h <- h safety err^-(1/(q+1) -
 /// 0.75 beta) err_prev^beta` clamped to `[fac_min, fac_max]` (no growth right after a
 /// rejection); after a rejection `h <- h max(fac_min, safety err^-(1/(q+1) - 0.75 beta))`.
-/// A rejection with an infinite error norm and a [`StepAttempt::shrink`] factor multiplies the
-/// step by that factor instead. The last step lands exactly on `t_end`. Errors: a step below
+/// A rejection with an infinite error norm (an attempt that failed for another reason, e.g. a
+/// chart map that did not converge) multiplies the step by the solver's
+/// [`StepAttempt::shrink`] factor instead (`fac_min` without one), leaving the controller's
+/// memory alone; the solver decides when such failures become an error. The last step lands exactly on `t_end`. Errors: a step below
 /// `controller.h_min` ([`SolveError::StepSizeTooSmall`]), more than `max_steps` attempts
 /// ([`SolveError::TooManyAttempts`]), a non-finite state or error estimate
 /// ([`SolveError::NonFinite`]), constraint drift beyond the guard
@@ -222,17 +254,28 @@ where
     let ctrl = cfg.controller;
     let expo = 1.0 / k - 0.75 * beta;
     let span = cfg.t_end - t0;
-    let mut h = match cfg.h0 {
-        Some(h0) => h0,
-        None => 0.1 * span * ctrl.atol.max(ctrl.rtol).powf(1.0 / k),
-    }
-    .min(cfg.h_max)
-    .min(span)
-    .max(ctrl.h_min);
     integrator.reset();
     let mut stats = RunStats::default();
+    let h0 = match cfg.h0 {
+        Some(h0) => h0,
+        None => match integrator.initial_step(sys, state, span, &cfg)? {
+            Some((h0, work)) => {
+                stats.rhs_evals += work.rhs_evals;
+                stats.newton_iterations += work.newton_iterations;
+                h0
+            }
+            None => 0.1 * span * ctrl.atol.max(ctrl.rtol).powf(1.0 / k),
+        },
+    };
+    if !(h0 > 0.0) {
+        return Err(SolveError::NonFinite {
+            t: t0,
+            what: "initial step estimate",
+        });
+    }
+    let mut h = h0.min(cfg.h_max).min(span).max(ctrl.h_min);
     if observer.observe(sys, state, 0)? == Flow::Stop {
-        stats.stopped_early = true;
+        stats.stopped_by(observer);
         return Ok(stats);
     }
     let mut err_prev = 1e-4f64;
@@ -293,6 +336,7 @@ where
             g.check(sys, state)?;
         }
         stats.steps += 1;
+        stats.record_step(hs);
         stats.max_residual = stats.max_residual.max(a.stats.residual);
         stats.max_condition = stats.max_condition.max(a.stats.condition);
         if a.stats.condition > cfg.condition_limit {
@@ -311,7 +355,7 @@ where
         last_rejected = false;
         h = (hs * fac).min(cfg.h_max);
         if observer.observe(sys, state, stats.steps)? == Flow::Stop {
-            stats.stopped_early = true;
+            stats.stopped_by(observer);
             break;
         }
     }

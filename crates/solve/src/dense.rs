@@ -16,7 +16,7 @@
 
 use crate::accel::Accel;
 use crate::error::SolveError;
-use crate::integrator::{Flow, Observer, Recorder};
+use crate::integrator::{Flow, Observer, Recorder, StopReason};
 use crate::sparse::LinearSolver;
 use crate::state::State;
 use mbd_model::System;
@@ -221,6 +221,8 @@ pub struct DenseOutput<O> {
     vb: Vec<f64>,
     /// Crossings of the current step: (time, event index, rising).
     pending: Vec<(f64, usize, bool)>,
+    /// The terminal event that stopped the run, if one did.
+    stopped_by: Option<StopReason>,
 }
 
 impl<O> std::fmt::Debug for DenseOutput<O> {
@@ -259,6 +261,7 @@ impl<O: Observer> DenseOutput<O> {
             qb: vec![0.0; n],
             vb: vec![0.0; n],
             pending: Vec::new(),
+            stopped_by: None,
         }
     }
 
@@ -433,8 +436,17 @@ impl<O> DenseOutput<O> {
 }
 
 impl<O: Observer> Observer for DenseOutput<O> {
+    /// The terminal event that stopped the run ([`StopReason::Event`]), or the inner
+    /// observer's reason.
+    fn stop_reason(&self) -> Option<StopReason> {
+        self.stopped_by
+    }
+
     fn observe(&mut self, sys: &System, state: &State, step: usize) -> Result<Flow, SolveError> {
         let (q, v, t) = (state.q.as_slice(), state.v.as_slice(), state.t);
+        if step == 0 {
+            self.stopped_by = None;
+        }
         if q.len() != self.seg.q1.len() {
             return Err(SolveError::Dimension {
                 what: "DenseOutput state",
@@ -515,12 +527,16 @@ impl<O: Observer> Observer for DenseOutput<O> {
                 if self.events[e].terminal {
                     t_stop = tc;
                     flow = Flow::Stop;
+                    self.stopped_by = Some(StopReason::Event { event: e, t: tc });
                     break;
                 }
             }
             self.sample_upto(t0, t_stop, false, step);
         }
         let inner = self.inner.observe(sys, state, step)?;
+        if inner == Flow::Stop && self.stopped_by.is_none() {
+            self.stopped_by = self.inner.stop_reason();
+        }
         Ok(if inner == Flow::Stop {
             Flow::Stop
         } else {

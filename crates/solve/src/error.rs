@@ -5,6 +5,7 @@ use thiserror::Error;
 
 /// Everything that can go wrong while integrating.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum SolveError {
     /// The step size is not positive and finite.
     #[error("step size h = {h} is invalid: it must be positive and finite")]
@@ -57,6 +58,39 @@ pub enum SolveError {
         t: f64,
         /// Attempts made (the limit).
         attempts: usize,
+    },
+    /// Adaptive step attempts kept failing for a reason other than the error test (a chart map
+    /// that did not converge, a singular index-1 solve at a stage point) while the step shrank:
+    /// `failures` times in a row at one point, or down to the controller's `h_min`.
+    #[error(
+        "step attempts from t = {t} failed {failures} times in a row (last step h = {h:e}): \
+         {source}"
+    )]
+    RepeatedFailure {
+        /// Time of the point the attempts started from.
+        t: f64,
+        /// The last step size tried.
+        h: f64,
+        /// Failures in a row at that point.
+        failures: usize,
+        /// The last failure.
+        source: Box<SolveError>,
+    },
+    /// A solver spec string names no registered solver.
+    #[error("unknown solver '{spec}'; use one of: {known}")]
+    UnknownSolver {
+        /// The spec as given.
+        spec: String,
+        /// The registered syntaxes.
+        known: String,
+    },
+    /// A solver spec string names a registered solver with options it refuses.
+    #[error("solver '{spec}': {reason}")]
+    SolverSpec {
+        /// The spec as given.
+        spec: String,
+        /// What is wrong, with an example of what works.
+        reason: String,
     },
     /// Newton's method did not converge.
     #[error(

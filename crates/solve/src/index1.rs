@@ -119,6 +119,14 @@ impl Integrator for Index1Rk {
         Some(self.rk.tableau.order)
     }
 
+    fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {
+        if self.embedded_order().is_some() {
+            Some(self)
+        } else {
+            None
+        }
+    }
+
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
         state.check(sys)?;
         if !(h.is_finite() && h > 0.0) {

@@ -1,5 +1,6 @@
 //! The `Integrator` trait, the run loop and observers.
 
+use crate::adaptive::AdaptiveIntegrator;
 use crate::error::SolveError;
 use crate::state::State;
 use mbd_model::System;
@@ -39,6 +40,12 @@ pub trait Integrator {
     fn order(&self) -> Option<u32> {
         None
     }
+    /// This solver as an [`AdaptiveIntegrator`] (one with an embedded error estimate, driven by
+    /// [`crate::run_adaptive`]), or `None` (the default) for a fixed-step method. Lets a caller
+    /// holding a `Box<dyn Integrator>` (the solver registry's product) run it adaptively.
+    fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {
+        None
+    }
 }
 
 impl<I: Integrator + ?Sized> Integrator for Box<I> {
@@ -54,6 +61,9 @@ impl<I: Integrator + ?Sized> Integrator for Box<I> {
     fn order(&self) -> Option<u32> {
         (**self).order()
     }
+    fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {
+        (**self).as_adaptive()
+    }
 }
 
 /// Whether a run should go on after an observation.
@@ -65,10 +75,34 @@ pub enum Flow {
     Stop,
 }
 
+/// Why a run ended (without an error: errors stay errors).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub enum StopReason {
+    /// The run reached its end time.
+    #[default]
+    ReachedEnd,
+    /// An observer returned [`Flow::Stop`].
+    Observer,
+    /// A terminal event of a [`crate::DenseOutput`] fired.
+    Event {
+        /// The event's index (order of [`crate::DenseOutput::with_event`] calls).
+        event: usize,
+        /// The located time of the crossing.
+        t: f64,
+    },
+}
+
 /// Receives samples of a run: the initial state (step 0) and the state after steps.
 pub trait Observer {
     /// Called with the step index (0 = initial state) and the state.
     fn observe(&mut self, sys: &System, state: &State, step: usize) -> Result<Flow, SolveError>;
+
+    /// After this observer returned [`Flow::Stop`]: why, if more is known than "an observer
+    /// stopped the run" (a terminal event). The run loops record it in [`RunStats::stop`].
+    fn stop_reason(&self) -> Option<StopReason> {
+        None
+    }
 }
 
 impl<F> Observer for F
@@ -90,6 +124,9 @@ impl<A: Observer, B: Observer> Observer for (A, B) {
         } else {
             Flow::Continue
         })
+    }
+    fn stop_reason(&self) -> Option<StopReason> {
+        self.0.stop_reason().or_else(|| self.1.stop_reason())
     }
 }
 
@@ -206,6 +243,9 @@ impl<O: Observer> Observer for Every<O> {
         } else {
             Ok(Flow::Continue)
         }
+    }
+    fn stop_reason(&self) -> Option<StopReason> {
+        self.inner.stop_reason()
     }
 }
 
@@ -373,8 +413,10 @@ pub struct RunStats {
     pub objective_evals: usize,
     /// Largest Newton residual of a step.
     pub max_residual: f64,
-    /// Whether an observer stopped the run early.
+    /// Whether an observer stopped the run early (`stop != StopReason::ReachedEnd`).
     pub stopped_early: bool,
+    /// Why the run ended.
+    pub stop: StopReason,
     /// Steps whose index-1 condition estimate exceeded [`RunConfig::condition_limit`]: the run
     /// passed close to a singular configuration, where accelerations and multipliers lose
     /// digits (see [`RunStats::warning`]).
@@ -383,9 +425,30 @@ pub struct RunStats {
     pub first_near_singular: Option<f64>,
     /// Largest condition estimate met (0 if the solver does not estimate it).
     pub max_condition: f64,
+    /// Smallest step taken (accepted steps of an adaptive run; the shortened last step counts);
+    /// 0 before the first step.
+    pub min_step: f64,
+    /// Largest step taken (accepted steps of an adaptive run); 0 before the first step.
+    pub max_step: f64,
 }
 
 impl RunStats {
+    /// Records that `observer` stopped the run.
+    pub(crate) fn stopped_by<O: Observer + ?Sized>(&mut self, observer: &O) {
+        self.stopped_early = true;
+        self.stop = observer.stop_reason().unwrap_or(StopReason::Observer);
+    }
+
+    /// Counts a step of size `h` in [`RunStats::min_step`] and [`RunStats::max_step`].
+    pub(crate) fn record_step(&mut self, h: f64) {
+        self.min_step = if self.max_step == 0.0 {
+            h
+        } else {
+            self.min_step.min(h)
+        };
+        self.max_step = self.max_step.max(h);
+    }
+
     /// A warning to show the user when the run passed near a singular configuration, `None`
     /// otherwise.
     pub fn warning(&self) -> Option<String> {
@@ -550,7 +613,7 @@ where
     integrator.reset();
     let mut stats = RunStats::default();
     if observer.observe(sys, state, 0)? == Flow::Stop {
-        stats.stopped_early = true;
+        stats.stopped_by(observer);
         return Ok(stats);
     }
     for k in 1..=n {
@@ -571,6 +634,7 @@ where
             g.check(sys, state)?;
         }
         stats.steps = k;
+        stats.record_step(h);
         stats.newton_iterations += s.newton_iterations;
         stats.rhs_evals += s.rhs_evals;
         stats.objective_evals += s.objective_evals;
@@ -581,7 +645,7 @@ where
             stats.first_near_singular.get_or_insert(state.t);
         }
         if observer.observe(sys, state, k)? == Flow::Stop {
-            stats.stopped_early = true;
+            stats.stopped_by(observer);
             break;
         }
     }

@@ -60,6 +60,7 @@ pub mod linalg;
 mod newton;
 mod projection;
 pub mod quadrature;
+pub mod registry;
 pub mod sparse;
 mod state;
 mod tableau;
@@ -72,7 +73,7 @@ pub use error::SolveError;
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{
     observe, observer, run, step_count, DriftGuard, Every, Flow, FnObserver, Integrator,
-    NoObserver, Observer, Recorder, RunConfig, RunStats, StateFn, StepStats,
+    NoObserver, Observer, Recorder, RunConfig, RunStats, StateFn, StepStats, StopReason,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_ROUNDOFF_FACTOR};

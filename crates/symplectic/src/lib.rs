@@ -52,6 +52,7 @@ mod error;
 mod galerkin;
 mod options;
 mod preadjust;
+mod registry;
 mod tables;
 
 pub use calibrate::{calibrate_gamma, Calibration, CalibrationSettings};
@@ -59,4 +60,5 @@ pub use error::SymplecticError;
 pub use galerkin::Galerkin;
 pub use options::{kappa, phase_constant, Nodes, PreadjustMode, SymplecticOptions};
 pub use preadjust::{Preadjustment, E4_TERMS};
+pub use registry::SOLVERS;
 pub use tables::lobatto_nodes;

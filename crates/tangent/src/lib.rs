@@ -40,8 +40,8 @@
 //!
 //! ```
 //! use mbd_model::models;
-//! use mbd_solve::{run, Integrator, NoObserver, RunConfig, State};
-//! use mbd_tangent::{AdaptiveSettings, TangentRk};
+//! use mbd_solve::{run, run_adaptive, AdaptiveConfig, NoObserver, RunConfig, State};
+//! use mbd_tangent::TangentRk;
 //!
 //! let sys = models::slider_crank()?;
 //! let mut state = State::consistent(&sys, 0.0)?;
@@ -56,31 +56,23 @@
 //!
 //! // adaptive DOPRI5 5(4) to t = 2 s at tolerance 1e-9
 //! let mut dp = TangentRk::dopri5(&sys)?;
-//! let stats = dp.integrate_adaptive(
-//!     &sys,
-//!     &mut state,
-//!     2.0,
-//!     &AdaptiveSettings::with_tolerance(1e-9),
-//!     &mut NoObserver,
-//! )?;
-//! assert!(stats.accepted > 0 && (state.t - 2.0).abs() < 1e-15);
+//! let stats = run_adaptive(&mut dp, &sys, &mut state, AdaptiveConfig::new(2.0, 1e-9), &mut NoObserver)?;
+//! assert!(stats.steps > 0 && (state.t - 2.0).abs() < 1e-15);
 //! assert!(stats.max_residual <= 1e-12);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
 
 mod chart;
-mod error;
 mod integrator;
 mod kernels;
+mod registry;
 mod sparse_chart;
 
 pub use chart::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR};
-pub use error::TangentError;
-pub use integrator::{
-    AdaptiveSettings, AdaptiveStats, IterationMatrix, TangentOptions, TangentRk, TangentStats,
-};
+pub use integrator::{IterationMatrix, TangentOptions, TangentRk, TangentStats};
 pub use mbd_solve::LinearSolver;
+pub use registry::SOLVERS;
 pub use sparse_chart::SparseChart;
 
 pub use mbd_solve::{ButcherTableau, StepController};

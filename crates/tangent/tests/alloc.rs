@@ -1,10 +1,8 @@
 //! A step allocates nothing (fixed and adaptive, RK4 and DOPRI5), counted by a global allocator.
 
 use mbd_model::models;
-use mbd_solve::{Integrator, NoObserver, State};
-use mbd_tangent::{
-    AdaptiveSettings, ButcherTableau, IterationMatrix, LinearSolver, TangentOptions, TangentRk,
-};
+use mbd_solve::{run_adaptive, AdaptiveConfig, Integrator, NoObserver, State};
+use mbd_tangent::{ButcherTableau, IterationMatrix, LinearSolver, TangentOptions, TangentRk};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -49,7 +47,6 @@ fn steps_allocate_nothing() {
             ..Default::default()
         };
         let mut br = TangentRk::new(&sys, ButcherTableau::rk4(), broyden).expect("solver");
-        let settings = AdaptiveSettings::with_tolerance(1e-9);
         rk4.step(&sys, &mut s, 1e-3).expect("warm-up");
         let before = ALLOCS.with(|c| c.get());
         for _ in 0..200 {
@@ -63,8 +60,14 @@ fn steps_allocate_nothing() {
             br.step(&sys, &mut s, 0.1).expect("halved step");
         }
         let t1 = s.t + 0.5;
-        dp.integrate_adaptive(&sys, &mut s, t1, &settings, &mut NoObserver)
-            .expect("adaptive");
+        run_adaptive(
+            &mut dp,
+            &sys,
+            &mut s,
+            AdaptiveConfig::new(t1, 1e-9).without_drift_guard(),
+            &mut NoObserver,
+        )
+        .expect("adaptive");
         let after = ALLOCS.with(|c| c.get());
         assert_eq!(after - before, 0, "allocations during steps");
     }
@@ -87,7 +90,6 @@ fn sparse_steps_allocate_nothing() {
         let mut rk4 = TangentRk::new(&sys, ButcherTableau::rk4(), sparse).expect("solver");
         let mut dp = TangentRk::new(&sys, ButcherTableau::dopri5(), sparse).expect("solver");
         assert!(rk4.is_sparse() && dp.is_sparse());
-        let settings = AdaptiveSettings::with_tolerance(1e-9);
         rk4.step(&sys, &mut s, h).expect("warm-up");
         let before = ALLOCS.with(|c| c.get());
         for _ in 0..100 {
@@ -102,8 +104,14 @@ fn sparse_steps_allocate_nothing() {
             assert!(rk4.stats().halvings > h0, "the large steps were halved");
         }
         let t1 = s.t + 0.1;
-        dp.integrate_adaptive(&sys, &mut s, t1, &settings, &mut NoObserver)
-            .expect("adaptive");
+        run_adaptive(
+            &mut dp,
+            &sys,
+            &mut s,
+            AdaptiveConfig::new(t1, 1e-9).without_drift_guard(),
+            &mut NoObserver,
+        )
+        .expect("adaptive");
         let after = ALLOCS.with(|c| c.get());
         assert_eq!(after - before, 0, "allocations during sparse steps");
     }

@@ -6,10 +6,11 @@ mod common;
 
 use common::{residuals, state_error, ResidualWatch};
 use mbd_model::{models, System};
-use mbd_solve::{run, ButcherTableau, Integrator, NoObserver, RunConfig, SolveError, State};
-use mbd_tangent::{
-    AdaptiveSettings, IterationMatrix, LinearSolver, TangentError, TangentOptions, TangentRk,
+use mbd_solve::{
+    run, run_adaptive, AdaptiveConfig, ButcherTableau, Integrator, NoObserver, RunConfig,
+    SolveError, State,
 };
+use mbd_tangent::{IterationMatrix, LinearSolver, TangentOptions, TangentRk};
 use nalgebra::DVector;
 
 fn solver(sys: &System, tableau: ButcherTableau, linear_solver: LinearSolver) -> TangentRk {
@@ -67,23 +68,21 @@ fn sparse_and_dense_rk4_agree_on_a_30_link_chain() {
 fn sparse_and_dense_adaptive_dopri5_agree_on_a_30_link_chain() {
     let sys = models::n_link_chain(30).expect("model");
     let s0 = State::consistent(&sys, 0.0).expect("state");
-    let settings = AdaptiveSettings::with_tolerance(1e-8);
     let mut ends = vec![];
     let mut stats = vec![];
     for ls in [LinearSolver::Dense, LinearSolver::Sparse] {
         let mut dp = solver(&sys, ButcherTableau::dopri5(), ls);
         let mut s = s0.clone();
-        let st = dp
-            .integrate_adaptive(&sys, &mut s, 0.2, &settings, &mut NoObserver)
-            .expect("adaptive");
+        let cfg = AdaptiveConfig::new(0.2, 1e-8).without_drift_guard();
+        let st = run_adaptive(&mut dp, &sys, &mut s, cfg, &mut NoObserver).expect("adaptive");
         assert_eq!(s.t, 0.2);
         assert!(st.max_residual <= 1e-12, "{ls:?} {st:?}");
         stats.push(st);
         ends.push(s);
     }
     println!("{stats:?}");
-    assert_eq!(stats[0].accepted, stats[1].accepted);
-    assert_eq!(stats[0].rejected, stats[1].rejected);
+    assert_eq!(stats[0].steps, stats[1].steps);
+    assert_eq!(stats[0].rejected_steps, stats[1].rejected_steps);
     let d = state_error(&ends[0], ends[1].q.as_slice(), ends[1].v.as_slice());
     println!("max |dense - sparse| over q, v at t = 0.2: {d:.2e}");
     assert!(d <= 1e-10, "{d:e}");
@@ -143,19 +142,15 @@ fn sparse_singular_start_is_a_typed_error() {
     }
     assert_eq!(s, s0, "the state is left alone");
     let mut dp = solver(&sys, ButcherTableau::dopri5(), LinearSolver::Sparse);
-    let e = dp
-        .integrate_adaptive(
-            &sys,
-            &mut s,
-            1.0,
-            &AdaptiveSettings::default(),
-            &mut NoObserver,
-        )
-        .unwrap_err();
-    assert!(
-        matches!(&e, TangentError::Solve(SolveError::Singular { .. })),
-        "{e}"
-    );
+    let e = run_adaptive(
+        &mut dp,
+        &sys,
+        &mut s,
+        AdaptiveConfig::new(1.0, 1e-6),
+        &mut NoObserver,
+    )
+    .unwrap_err();
+    assert!(matches!(&e, SolveError::Singular { .. }), "{e}");
     assert_eq!(s, s0);
 }
 

@@ -15,10 +15,10 @@
 //! DOPRI5 (tol 1e-8).
 use mbd::model::models;
 use mbd::solve::{
-    reference_trajectory, run, ButcherTableau, Index1Options, Index1Rk, NoObserver,
-    ProjectionSettings, RunConfig, State,
+    reference_trajectory, run, run_adaptive, AdaptiveConfig, ButcherTableau, Index1Options,
+    Index1Rk, NoObserver, ProjectionSettings, RunConfig, State,
 };
-use mbd::tangent::{AdaptiveSettings, TangentRk};
+use mbd::tangent::TangentRk;
 
 fn env_f64(name: &str) -> Result<Option<f64>, Box<dyn std::error::Error>> {
     match std::env::var(name) {
@@ -37,7 +37,7 @@ fn adaptive() -> Result<(), Box<dyn std::error::Error>> {
     let r = reference_trajectory(&sys, &s0, 2.0, 1, 32_000, ButcherTableau::dopri5())?;
     for k in 3..=12 {
         let tol = 10f64.powi(-k);
-        let mut set = AdaptiveSettings::with_tolerance(tol);
+        let mut set = AdaptiveConfig::new(2.0, tol).without_drift_guard();
         if let Some(b) = env_f64("PI_BETA")? {
             set.pi_beta = Some(b);
         }
@@ -50,24 +50,23 @@ fn adaptive() -> Result<(), Box<dyn std::error::Error>> {
         set.h0 = env_f64("H0")?;
         let mut dp = TangentRk::dopri5(&sys)?;
         let mut s = s0.clone();
-        match dp.integrate_adaptive(&sys, &mut s, 2.0, &set, &mut NoObserver) {
+        match run_adaptive(&mut dp, &sys, &mut s, set, &mut NoObserver) {
             Ok(st) => {
+                let chart = dp.stats().chart_failures;
                 let eq = max_diff(s.q.as_slice(), &r.q[1]);
                 let err = eq.max(max_diff(s.v.as_slice(), &r.v[1]));
-                let attempts = st.accepted + st.rejected + st.chart_rejections;
+                let attempts = st.steps + st.rejected_steps;
                 println!(
                     "tol {tol:.0e}: error {err:.2e} (q {eq:.2e}), error/tol {:.1}, accepted {}, \
-                     rejected {}, chart rejections {}, rejection rate {:.3}, first step {:.2e}, \
+                     rejected {} (chart {chart}), rejection rate {:.3}, \
                      h in [{:.2e}, {:.2e}], exact maps {}, acceleration solves {}",
                     err / tol,
-                    st.accepted,
-                    st.rejected,
-                    st.chart_rejections,
-                    (st.rejected + st.chart_rejections) as f64 / attempts as f64,
-                    st.h_initial_estimate,
-                    st.h_min,
-                    st.h_max,
-                    st.exact_maps,
+                    st.steps,
+                    st.rejected_steps,
+                    st.rejected_steps as f64 / attempts as f64,
+                    st.min_step,
+                    st.max_step,
+                    dp.stats().exact_maps,
                     st.rhs_evals
                 );
             }
@@ -109,11 +108,11 @@ fn four_bar() -> Result<(), Box<dyn std::error::Error>> {
         );
         let mut d = TangentRk::dopri5(&sys)?;
         let mut s = s0.clone();
-        let r = d.integrate_adaptive(
+        let r = run_adaptive(
+            &mut d,
             &sys,
             &mut s,
-            2.0,
-            &AdaptiveSettings::with_tolerance(1e-8),
+            AdaptiveConfig::new(2.0, 1e-8),
             &mut NoObserver,
         );
         println!("  tangent DOPRI5 (tol 1e-8): {r:?}, t = {}", s.t);

@@ -1,14 +1,13 @@
 //! The tangent-space Runge-Kutta integrator: fixed steps ([`Integrator`]) and adaptive steps
-//! ([`TangentRk::integrate_adaptive`]).
+//! ([`AdaptiveIntegrator`], driven by [`mbd_solve::run_adaptive`]).
 
 use crate::chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
-use crate::error::TangentError;
 use crate::kernels::axpy;
 use crate::sparse_chart::SparseChart;
 use mbd_model::System;
 use mbd_solve::{
-    AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Integrator, Observer,
-    SolveError, SparseAccelerationSolver, State, StepAttempt, StepController, StepStats,
+    AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Integrator, SolveError,
+    SparseAccelerationSolver, State, StepAttempt, StepController, StepStats,
 };
 mod adaptive;
 mod attempt;
@@ -17,7 +16,6 @@ mod path;
 
 use path::{Path, SparseParts};
 
-pub use adaptive::{AdaptiveSettings, AdaptiveStats};
 pub use options::{IterationMatrix, TangentOptions, TangentStats};
 
 /// Why an attempted step failed.
@@ -109,6 +107,12 @@ pub struct TangentRk {
     /// Tolerance of the interior stage maps of a step that follows the last accepted one
     /// (`TangentOptions::stage_tol_ratio`).
     stage_tol: f64,
+    /// The time the chart was centred at for adaptive attempts from the current point (NaN once
+    /// the point changed): a rejected attempt retries from the same chart.
+    centred_at: f64,
+    /// Adaptive attempts in a row from the current point that failed for another reason than
+    /// the error test.
+    failures_here: usize,
 }
 
 /// Steps of `eta` history kept for the Newton starting points.
@@ -216,6 +220,8 @@ impl TangentRk {
             eta_pred: vec![0.0; 2 * m],
             eta_tmp: vec![0.0; 2 * m],
             stage_tol: options.newton.tol,
+            centred_at: f64::NAN,
+            failures_here: 0,
         })
     }
 
@@ -224,8 +230,8 @@ impl TangentRk {
         Self::new(sys, ButcherTableau::rk4(), TangentOptions::default())
     }
 
-    /// Tangent-space DOPRI5 (order 5, embedded order-4 estimate for
-    /// [`TangentRk::integrate_adaptive`]) with default options.
+    /// Tangent-space DOPRI5 (order 5, embedded order-4 estimate for adaptive steps through
+    /// [`mbd_solve::run_adaptive`]) with default options.
     pub fn dopri5(sys: &System) -> Result<Self, SolveError> {
         Self::new(sys, ButcherTableau::dopri5(), TangentOptions::default())
     }
@@ -304,6 +310,8 @@ impl TangentRk {
             return Ok(());
         }
         self.hist_len = 0;
+        self.centred_at = f64::NAN;
+        self.failures_here = 0;
         self.cur[..n].copy_from_slice(state.q.as_slice());
         self.cur[n..].copy_from_slice(state.v.as_slice());
         self.cur_t = state.t;
@@ -425,6 +433,16 @@ impl Integrator for TangentRk {
         self.stats = TangentStats::default();
         self.cur_ok = false;
         self.hist_len = 0;
+        self.centred_at = f64::NAN;
+        self.failures_here = 0;
+    }
+
+    fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {
+        if self.embedded_order().is_some() {
+            Some(self)
+        } else {
+            None
+        }
     }
 
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
@@ -433,6 +451,7 @@ impl Integrator for TangentRk {
             return Err(SolveError::InvalidStep { h });
         }
         self.load(sys, state)?;
+        self.centred_at = f64::NAN;
         let mut out = StepStats::default();
         let t = state.t;
         self.advance(sys, t, h, 0, &mut out)?;

@@ -66,6 +66,14 @@ pub struct TangentOptions {
     /// [`mbd_solve::SPARSE_THRESHOLD`] constraint equations, sparse above. Both give the same
     /// trajectory up to rounding (`docs/tangent.md` section 9).
     pub linear_solver: LinearSolver,
+    /// Adaptive steps: the factor applied to the step after an attempt whose chart map did not
+    /// converge, or whose index-1 solve at a stage point was singular (the error controller's
+    /// memory is left alone). Default 0.25; must lie in (0, 1).
+    pub chart_shrink: f64,
+    /// Adaptive steps: most such failures in a row at one point before
+    /// [`SolveError::RepeatedFailure`]. Default 8 (the step shrinks by `chart_shrink^8`,
+    /// 1.5e-5 by default); at least 1.
+    pub max_chart_failures: usize,
 }
 
 impl Default for TangentOptions {
@@ -78,6 +86,8 @@ impl Default for TangentOptions {
             consistency_tol: 1e-8,
             stage_tol_ratio: 1e-2,
             linear_solver: LinearSolver::Auto,
+            chart_shrink: 0.25,
+            max_chart_failures: 8,
         }
     }
 }
@@ -112,6 +122,20 @@ impl TangentOptions {
                 parameter: "stage_tol_ratio",
                 value: self.stage_tol_ratio,
                 reason: "must lie in [0, 1)",
+            });
+        }
+        if !(self.chart_shrink > 0.0 && self.chart_shrink < 1.0) {
+            return Err(SolveError::InvalidParameter {
+                parameter: "chart_shrink",
+                value: self.chart_shrink,
+                reason: "must lie in (0, 1)",
+            });
+        }
+        if self.max_chart_failures == 0 {
+            return Err(SolveError::InvalidParameter {
+                parameter: "max_chart_failures",
+                value: 0.0,
+                reason: "must be at least 1",
             });
         }
         Ok(())

@@ -1,0 +1,111 @@
+//! The solver registry is what every front end reads: the tables in README.md and
+//! docs/cli.md are the registry's, every registered solver runs through the front door, and
+//! spec strings round-trip.
+
+use mbd::prelude::*;
+
+/// The text between `<!-- solvers:begin -->` and `<!-- solvers:end -->` of a file.
+fn table_in(path: &str) -> String {
+    let text = std::fs::read_to_string(format!("{}/{path}", env!("CARGO_MANIFEST_DIR")))
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
+    let begin = "<!-- solvers:begin -->\n";
+    let i = text
+        .find(begin)
+        .unwrap_or_else(|| panic!("{path}: no {begin}"))
+        + begin.len();
+    let j = text[i..]
+        .find("<!-- solvers:end -->")
+        .unwrap_or_else(|| panic!("{path}: no end marker"));
+    text[i..i + j].to_string()
+}
+
+#[test]
+fn readme_and_cli_docs_carry_the_registry_table() {
+    let want = mbd::registry().markdown_table();
+    for path in ["README.md", "docs/cli.md"] {
+        assert_eq!(
+            table_in(path),
+            want,
+            "{path}: the solver table differs from the registry; regenerate it with \
+             `cargo run -p mbd-cli -- solvers --markdown`"
+        );
+    }
+}
+
+#[test]
+fn spec_strings_round_trip_and_bad_ones_say_what_to_use() {
+    for name in [
+        "rk4",
+        "rk4-projected",
+        "symplectic:2",
+        "symplectic:3:gamma=0.5",
+        "symplectic:1:modified",
+        "index1:dopri5",
+        "tangent:rk4",
+        "tangent:dopri5",
+        "firefly-gauss",
+        "firefly-gauss:polish:seed=7",
+    ] {
+        let spec = mbd::registry().parse(name).expect(name);
+        assert_eq!(spec.to_string(), name);
+        assert_eq!(mbd::registry().parse(&spec.to_string()).expect(name), spec);
+    }
+    // every listed variant parses to itself
+    for (_, v) in mbd::registry().variants() {
+        assert_eq!(mbd::registry().parse(v.spec).expect(v.spec).spec(), v.spec);
+    }
+    let bad = [
+        ("rk5", "unknown solver 'rk5'"),
+        ("symplectic:x", "S must be a whole number"),
+        ("symplectic:9", "S must be a whole number"),
+        ("symplectic:2:gamma=abc", "gamma must be a finite number"),
+        ("symplectic:2:gamma=inf", "gamma must be a finite number"),
+        ("symplectic:3:modified", "needs S = 1 or 2"),
+        ("symplectic:2:modified:gamma=1", "no gamma"),
+        ("symplectic:2:foo", "unknown option 'foo'"),
+        ("symplectic:2:gamma=1:gamma=2", "'gamma' is given twice"),
+        (
+            "symplectic:1:modified:modified",
+            "'modified' is given twice",
+        ),
+        ("rk4:fast", "takes no options"),
+        ("tangent:rk5", "tangent:rk4 or tangent:dopri5"),
+        ("index1:rk4", "index1:dopri5"),
+        ("firefly-gauss:seed=-1", "seed must be a whole number"),
+        ("firefly-gauss:polish:polish", "given twice"),
+    ];
+    for (spec, want) in bad {
+        let e = mbd::registry().parse(spec).unwrap_err().to_string();
+        assert!(e.contains(want), "{spec}: {e}");
+    }
+    // an unknown name lists every family's syntax
+    let e = mbd::registry().parse("rk5").unwrap_err().to_string();
+    for f in mbd::registry().families() {
+        assert!(e.contains(f.syntax), "{e}");
+    }
+}
+
+#[test]
+fn the_registry_lists_what_the_solvers_say() {
+    let sys = models::manipulator().expect("model");
+    for (_, v) in mbd::registry().variants() {
+        let spec = mbd::registry().parse(v.spec).expect(v.spec);
+        let mut integ = spec.build(&sys).expect(v.spec);
+        assert_eq!(integ.order(), Some(v.order), "{}", v.spec);
+        assert_eq!(integ.as_adaptive().is_some(), v.adaptive, "{}", v.spec);
+    }
+}
+
+#[test]
+fn modified_lagrangian_refusal_names_the_cause() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/models/slider_crank_spring.toml"
+    );
+    let sys = System::from_path(path).expect("model");
+    assert!(!sys.is_conservative());
+    let e = Simulation::new(sys, "symplectic:2:modified")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("conservative"), "{e}");
+}
