@@ -3,8 +3,10 @@
 use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{Integrator, State};
-mod counting;
-use counting::allocations;
+use mbd_testkit::allocations;
+
+#[global_allocator]
+static GLOBAL: mbd_testkit::CountingAlloc = mbd_testkit::CountingAlloc;
 
 fn count_step_allocations<I: Integrator>(mut integ: I, sys: &mbd::model::System) -> usize {
     let mut s = State::consistent(sys, 0.0).unwrap();

@@ -7,8 +7,10 @@ use mbd::solve::{
     NoObserver, RunConfig, State,
 };
 use mbd::tangent::{TangentOptions, TangentRk};
-mod counting;
-use counting::allocations;
+use mbd_testkit::allocations;
+
+#[global_allocator]
+static GLOBAL: mbd_testkit::CountingAlloc = mbd_testkit::CountingAlloc;
 
 fn count(f: impl FnOnce() -> usize) -> (usize, usize) {
     let before = allocations();

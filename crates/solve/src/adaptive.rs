@@ -5,9 +5,8 @@
 //! [`run`]: crate::run
 
 use crate::error::SolveError;
-use crate::integrator::{
-    DriftGuard, Flow, GuardState, Integrator, Observer, RunConfig, RunStats, StepStats,
-};
+use crate::guard::{validate_condition_limit, DriftGuard, RunChecks};
+use crate::integrator::{Flow, Integrator, Observer, RunConfig, RunStats, StepStats};
 use crate::state::State;
 use crate::tableau::StepController;
 use mbd_model::System;
@@ -186,14 +185,7 @@ impl AdaptiveConfig {
         if self.max_steps == 0 {
             return bad("max_steps", 0.0, "must be at least 1");
         }
-        if !(self.condition_limit > 0.0) {
-            return bad(
-                "condition_limit",
-                self.condition_limit,
-                "must be positive (infinity turns the count off)",
-            );
-        }
-        Ok(())
+        validate_condition_limit(self.condition_limit)
     }
 }
 
@@ -225,9 +217,9 @@ where
     I: AdaptiveIntegrator + ?Sized,
     O: Observer + ?Sized,
 {
-    state.check(sys)?;
     let t0 = state.t;
     cfg.validate(t0)?;
+    let mut checks = RunChecks::open(sys, state, cfg.drift_guard, cfg.condition_limit)?;
     let q = integrator.embedded_order().ok_or_else(|| {
         SolveError::Unsupported(format!(
             "adaptive stepping needs an embedded error estimate; '{}' has none \
@@ -244,13 +236,6 @@ where
             reason: "must lie in [0, 1 / (1.75 (q+1))) for the embedded order q",
         });
     }
-    let mut guard = match cfg.drift_guard {
-        Some(g) => {
-            g.validate()?;
-            Some(GuardState::new(sys, g))
-        }
-        None => None,
-    };
     let ctrl = cfg.controller;
     let expo = 1.0 / k - 0.75 * beta;
     let span = cfg.t_end - t0;
@@ -260,8 +245,7 @@ where
         Some(h0) => h0,
         None => match integrator.initial_step(sys, state, span, &cfg)? {
             Some((h0, work)) => {
-                stats.rhs_evals += work.rhs_evals;
-                stats.newton_iterations += work.newton_iterations;
+                stats.add_work(&work);
                 h0
             }
             None => 0.1 * span * ctrl.atol.max(ctrl.rtol).powf(1.0 / k),
@@ -301,9 +285,7 @@ where
             });
         }
         let a = integrator.attempt_step(sys, state, hs, &ctrl)?;
-        stats.newton_iterations += a.stats.newton_iterations;
-        stats.rhs_evals += a.stats.rhs_evals;
-        stats.objective_evals += a.stats.objective_evals;
+        stats.add_work(&a.stats);
         let en = a.error_norm;
         if en.is_nan() {
             return Err(SolveError::NonFinite {
@@ -326,23 +308,7 @@ where
             continue;
         }
         state.t = if last { cfg.t_end } else { t + hs };
-        if !state.is_finite() {
-            return Err(SolveError::NonFinite {
-                t: state.t,
-                what: "state after step",
-            });
-        }
-        if let Some(g) = guard.as_mut() {
-            g.check(sys, state)?;
-        }
-        stats.steps += 1;
-        stats.record_step(hs);
-        stats.max_residual = stats.max_residual.max(a.stats.residual);
-        stats.max_condition = stats.max_condition.max(a.stats.condition);
-        if a.stats.condition > cfg.condition_limit {
-            stats.near_singular_steps += 1;
-            stats.first_near_singular.get_or_insert(state.t);
-        }
+        checks.accepted(sys, state, hs, &a.stats, &mut stats)?;
         let mut fac = if en == 0.0 {
             ctrl.fac_max
         } else {

@@ -173,10 +173,7 @@ impl Integrator for Index1Rk {
 /// rejected attempt restores the start state.
 impl AdaptiveIntegrator for Index1Rk {
     fn embedded_order(&self) -> Option<u32> {
-        match (&self.rk.tableau.b_hat, self.rk.tableau.embedded_order) {
-            (Some(_), q) if q > 0 => Some(q),
-            _ => None,
-        }
+        self.rk.tableau.error_estimate_order()
     }
 
     fn attempt_step(

@@ -2,6 +2,8 @@
 
 use crate::adaptive::AdaptiveIntegrator;
 use crate::error::SolveError;
+pub use crate::guard::DriftGuard;
+use crate::guard::RunChecks;
 use crate::state::State;
 use mbd_model::System;
 
@@ -287,63 +289,6 @@ impl Observer for Recorder {
     }
 }
 
-/// The constraint-drift guard of [`run`]: after every step the constraint residuals are
-/// checked, and a run whose constraints have drifted stops with
-/// [`SolveError::ConstraintDrift`] naming the time, the equation and its joint.
-///
-/// Position residuals are compared equation by equation with `position_tol` times the
-/// equation's scale ([`System::equation_scale`]: the mechanism's length scale for equations in
-/// lengths, 1 rad for angle equations). The default, `1e-2`, stops a run whose joints have come
-/// apart by 1% of the mechanism's size (or whose angle constraints are off by 0.01 rad): a
-/// violation visible in any plot or animation, far beyond every solver's tolerance, and reached
-/// by unstabilised RK4 only when its step is too large for the run's length (plain RK4 at
-/// h = 0.02 s on the two-link manipulator drifts by 1e-3 of its size in 1.2 s). It stops a solver
-/// that has left the constraint manifold (plain RK4 past a singular configuration) before its
-/// numbers become meaningless. Velocity residuals
-/// `Phi_q v + Phi_t` are checked only if `velocity_tol` is set (absolute, in the equation's unit
-/// per second). Turn the guard off ([`RunConfig::without_drift_guard`]) to measure drift itself.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DriftGuard {
-    /// Largest accepted `|Phi_i|`, relative to the equation's scale (default `1e-2`).
-    pub position_tol: f64,
-    /// Largest accepted `|Phi_q v + Phi_t|_i` (absolute); `None` (default) = not checked.
-    pub velocity_tol: Option<f64>,
-}
-
-impl Default for DriftGuard {
-    fn default() -> Self {
-        DriftGuard {
-            position_tol: DriftGuard::DEFAULT_POSITION_TOL,
-            velocity_tol: None,
-        }
-    }
-}
-
-impl DriftGuard {
-    /// The default relative position tolerance.
-    pub const DEFAULT_POSITION_TOL: f64 = 1e-2;
-
-    pub(crate) fn validate(&self) -> Result<(), SolveError> {
-        if !(self.position_tol.is_finite() && self.position_tol > 0.0) {
-            return Err(SolveError::InvalidParameter {
-                parameter: "drift_guard.position_tol",
-                value: self.position_tol,
-                reason: "must be positive and finite",
-            });
-        }
-        if let Some(v) = self.velocity_tol {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(SolveError::InvalidParameter {
-                    parameter: "drift_guard.velocity_tol",
-                    value: v,
-                    reason: "must be positive and finite",
-                });
-            }
-        }
-        Ok(())
-    }
-}
-
 /// Time span, step size and safety settings of a fixed-step run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RunConfig {
@@ -439,14 +384,12 @@ impl RunStats {
         self.stop = observer.stop_reason().unwrap_or(StopReason::Observer);
     }
 
-    /// Counts a step of size `h` in [`RunStats::min_step`] and [`RunStats::max_step`].
-    pub(crate) fn record_step(&mut self, h: f64) {
-        self.min_step = if self.max_step == 0.0 {
-            h
-        } else {
-            self.min_step.min(h)
-        };
-        self.max_step = self.max_step.max(h);
+    /// Adds the work of one step or attempt (Newton iterations, right-hand sides, objective
+    /// evaluations).
+    pub(crate) fn add_work(&mut self, s: &StepStats) {
+        self.newton_iterations += s.newton_iterations;
+        self.rhs_evals += s.rhs_evals;
+        self.objective_evals += s.objective_evals;
     }
 
     /// A warning to show the user when the run passed near a singular configuration, `None`
@@ -504,75 +447,6 @@ pub fn step_count(t0: f64, t_end: f64, h: f64) -> Result<usize, SolveError> {
     Ok(n as usize)
 }
 
-/// The guard's workspace: one residual buffer, allocated once per run.
-pub(crate) struct GuardState {
-    guard: DriftGuard,
-    scale: Vec<f64>,
-    buf: Vec<f64>,
-}
-
-impl GuardState {
-    pub(crate) fn new(sys: &System, guard: DriftGuard) -> Self {
-        let m = sys.n_constraints();
-        GuardState {
-            guard,
-            scale: sys.equation_scales(),
-            buf: vec![0.0; m],
-        }
-    }
-
-    pub(crate) fn check(&mut self, sys: &System, state: &State) -> Result<(), SolveError> {
-        let (q, v, t) = (state.q.as_slice(), state.v.as_slice(), state.t);
-        sys.phi(q, t, &mut self.buf);
-        self.worst("position", self.guard.position_tol, true, sys, t)?;
-        if let Some(tol) = self.guard.velocity_tol {
-            sys.phi_dot(q, v, t, &mut self.buf);
-            self.worst("velocity", tol, false, sys, t)?;
-        }
-        Ok(())
-    }
-
-    /// Errors with the equation whose residual is largest relative to its limit, if that one
-    /// is over its limit (or NaN).
-    fn worst(
-        &self,
-        level: &'static str,
-        tol: f64,
-        relative: bool,
-        sys: &System,
-        t: f64,
-    ) -> Result<(), SolveError> {
-        let limit = |r: usize| if relative { tol * self.scale[r] } else { tol };
-        let mut worst = (0usize, 0.0f64);
-        for (r, &x) in self.buf.iter().enumerate() {
-            let ratio = x.abs() / limit(r);
-            if ratio.is_nan() {
-                worst = (r, f64::NAN);
-                break;
-            }
-            if ratio > worst.1 {
-                worst = (r, ratio);
-            }
-        }
-        let (row, ratio) = worst;
-        if ratio <= 1.0 {
-            return Ok(());
-        }
-        let joint = sys
-            .equation_joint(row)
-            .map(|j| sys.joints()[j.0].name.clone())
-            .unwrap_or_default();
-        Err(SolveError::ConstraintDrift {
-            t,
-            level,
-            equation: sys.equation_name(row),
-            joint,
-            residual: self.buf[row].abs(),
-            tolerance: limit(row),
-        })
-    }
-}
-
 /// Integrates from `state.t` to `cfg.t_end` with steps of `cfg.h`, calling `observer` with the
 /// initial state (step 0) and after every step.
 ///
@@ -593,21 +467,7 @@ where
     I: Integrator + ?Sized,
     O: Observer + ?Sized,
 {
-    state.check(sys)?;
-    if !(cfg.condition_limit > 0.0) {
-        return Err(SolveError::InvalidParameter {
-            parameter: "condition_limit",
-            value: cfg.condition_limit,
-            reason: "must be positive (infinity turns the count off)",
-        });
-    }
-    let mut guard = match cfg.drift_guard {
-        Some(g) => {
-            g.validate()?;
-            Some(GuardState::new(sys, g))
-        }
-        None => None,
-    };
+    let mut checks = RunChecks::open(sys, state, cfg.drift_guard, cfg.condition_limit)?;
     let t0 = state.t;
     let n = step_count(t0, cfg.t_end, cfg.h)?;
     integrator.reset();
@@ -624,26 +484,8 @@ where
         };
         let s = integrator.step(sys, state, h)?;
         state.t = t_next;
-        if !state.is_finite() {
-            return Err(SolveError::NonFinite {
-                t: state.t,
-                what: "state after step",
-            });
-        }
-        if let Some(g) = guard.as_mut() {
-            g.check(sys, state)?;
-        }
-        stats.steps = k;
-        stats.record_step(h);
-        stats.newton_iterations += s.newton_iterations;
-        stats.rhs_evals += s.rhs_evals;
-        stats.objective_evals += s.objective_evals;
-        stats.max_residual = stats.max_residual.max(s.residual);
-        stats.max_condition = stats.max_condition.max(s.condition);
-        if s.condition > cfg.condition_limit {
-            stats.near_singular_steps += 1;
-            stats.first_near_singular.get_or_insert(state.t);
-        }
+        stats.add_work(&s);
+        checks.accepted(sys, state, h, &s, &mut stats)?;
         if observer.observe(sys, state, k)? == Flow::Stop {
             stats.stopped_by(observer);
             break;

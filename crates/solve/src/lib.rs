@@ -54,6 +54,7 @@ mod adaptive;
 mod consistent;
 mod dense;
 mod error;
+mod guard;
 mod index1;
 mod integrator;
 pub mod linalg;

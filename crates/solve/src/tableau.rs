@@ -53,6 +53,15 @@ impl ButcherTableau {
         }
     }
 
+    /// The order `q` of the embedded error estimate the step-size controller uses, or `None`
+    /// for a tableau without one (no `b_hat`, or an embedded order of 0).
+    pub fn error_estimate_order(&self) -> Option<u32> {
+        match (&self.b_hat, self.embedded_order) {
+            (Some(_), q) if q > 0 => Some(q),
+            _ => None,
+        }
+    }
+
     /// `a_ij`.
     #[inline]
     pub fn a(&self, i: usize, j: usize) -> f64 {

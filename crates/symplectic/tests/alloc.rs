@@ -3,25 +3,9 @@
 use mbd_model::models;
 use mbd_solve::{Integrator, LinearSolver, State};
 use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 
-struct Counting;
-thread_local! {
-    // per thread: the test harness allocates on its own threads meanwhile
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-}
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: mbd_testkit::CountingAlloc = mbd_testkit::CountingAlloc;
 
 #[test]
 fn steps_allocate_nothing() {
@@ -31,11 +15,11 @@ fn steps_allocate_nothing() {
         let mut g = Galerkin::new(&sys, SymplecticOptions::new(s).with_gamma(gamma)).unwrap();
         let mut st = s0.clone();
         g.step(&sys, &mut st, 0.01).unwrap();
-        let before = ALLOCS.with(|c| c.get());
+        let before = mbd_testkit::allocations();
         for _ in 0..100 {
             g.step(&sys, &mut st, 0.01).unwrap();
         }
-        let n = ALLOCS.with(|c| c.get()) - before;
+        let n = mbd_testkit::allocations() - before;
         assert_eq!(n, 0, "s={s} gamma={gamma}: {n} allocations in 100 steps");
     }
     // the modified-Lagrangian preadjustment (s = 1, and s = 2, whose e4 workspace is allocated
@@ -45,11 +29,11 @@ fn steps_allocate_nothing() {
         let mut g = Galerkin::new(&sys, opts).unwrap();
         let mut st = s0.clone();
         g.step(&sys, &mut st, 0.01).unwrap();
-        let before = ALLOCS.with(|c| c.get());
+        let before = mbd_testkit::allocations();
         for _ in 0..100 {
             g.step(&sys, &mut st, 0.01).unwrap();
         }
-        let n = ALLOCS.with(|c| c.get()) - before;
+        let n = mbd_testkit::allocations() - before;
         assert_eq!(
             n, 0,
             "modified Lagrangian, s = {s}: {n} allocations in 100 steps"
@@ -87,11 +71,11 @@ fn sparse_steps_allocate_nothing() {
         for _ in 0..3 {
             g.step(&sys, &mut st, 1e-3).unwrap();
         }
-        let before = ALLOCS.with(|c| c.get());
+        let before = mbd_testkit::allocations();
         for _ in 0..100 {
             g.step(&sys, &mut st, 1e-3).unwrap();
         }
-        let n = ALLOCS.with(|c| c.get()) - before;
+        let n = mbd_testkit::allocations() - before;
         assert_eq!(
             n, 0,
             "s={s} reuse={reuse} modified={modified}: {n} allocations in 100 steps"
@@ -107,11 +91,11 @@ fn sparse_steps_allocate_nothing() {
         for _ in 0..3 {
             g.step(&sys, &mut st, 1e-3).unwrap();
         }
-        let before = ALLOCS.with(|c| c.get());
+        let before = mbd_testkit::allocations();
         for _ in 0..100 {
             g.step(&sys, &mut st, 1e-3).unwrap();
         }
-        let n = ALLOCS.with(|c| c.get()) - before;
+        let n = mbd_testkit::allocations() - before;
         assert_eq!(n, 0, "damped chain, s={s}: {n} allocations in 100 steps");
     }
 }

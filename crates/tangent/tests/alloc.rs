@@ -3,38 +3,16 @@
 use mbd_model::models;
 use mbd_solve::{run_adaptive, AdaptiveConfig, Integrator, NoObserver, State};
 use mbd_tangent::{ButcherTableau, IterationMatrix, LinearSolver, TangentOptions, TangentRk};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
-struct Counting;
-thread_local! {
-    // per thread: the test harness may allocate on its own threads meanwhile (seen under load)
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.realloc(p, l, n) }
-    }
-}
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: mbd_testkit::CountingAlloc = mbd_testkit::CountingAlloc;
 
 #[test]
 fn steps_allocate_nothing() {
     // the counter counts
-    let probe = ALLOCS.with(|c| c.get());
+    let probe = mbd_testkit::allocations();
     std::hint::black_box(vec![1u8; 16]);
-    assert!(ALLOCS.with(|c| c.get()) > probe);
+    assert!(mbd_testkit::allocations() > probe);
     for sys in [
         models::manipulator().expect("model"),
         models::slider_crank().expect("model"),
@@ -48,7 +26,7 @@ fn steps_allocate_nothing() {
         };
         let mut br = TangentRk::new(&sys, ButcherTableau::rk4(), broyden).expect("solver");
         rk4.step(&sys, &mut s, 1e-3).expect("warm-up");
-        let before = ALLOCS.with(|c| c.get());
+        let before = mbd_testkit::allocations();
         for _ in 0..200 {
             rk4.step(&sys, &mut s, 1e-3).expect("step");
             dp.step(&sys, &mut s, 1e-3).expect("step");
@@ -68,7 +46,7 @@ fn steps_allocate_nothing() {
             &mut NoObserver,
         )
         .expect("adaptive");
-        let after = ALLOCS.with(|c| c.get());
+        let after = mbd_testkit::allocations();
         assert_eq!(after - before, 0, "allocations during steps");
     }
 }
@@ -91,7 +69,7 @@ fn sparse_steps_allocate_nothing() {
         let mut dp = TangentRk::new(&sys, ButcherTableau::dopri5(), sparse).expect("solver");
         assert!(rk4.is_sparse() && dp.is_sparse());
         rk4.step(&sys, &mut s, h).expect("warm-up");
-        let before = ALLOCS.with(|c| c.get());
+        let before = mbd_testkit::allocations();
         for _ in 0..100 {
             rk4.step(&sys, &mut s, h).expect("step");
             dp.step(&sys, &mut s, h).expect("step");
@@ -112,7 +90,7 @@ fn sparse_steps_allocate_nothing() {
             &mut NoObserver,
         )
         .expect("adaptive");
-        let after = ALLOCS.with(|c| c.get());
+        let after = mbd_testkit::allocations();
         assert_eq!(after - before, 0, "allocations during sparse steps");
     }
 }

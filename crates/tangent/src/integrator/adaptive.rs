@@ -185,10 +185,7 @@ impl TangentRk {
 /// [`SolveError::Singular`] at once.
 impl AdaptiveIntegrator for TangentRk {
     fn embedded_order(&self) -> Option<u32> {
-        match (&self.rk.tableau.b_hat, self.rk.tableau.embedded_order) {
-            (Some(_), q) if q > 0 => Some(q),
-            _ => None,
-        }
+        self.rk.tableau.error_estimate_order()
     }
 
     fn attempt_step(
