@@ -1,36 +1,7 @@
-//! The solver registry is what every front end reads: the tables in README.md and
-//! docs/cli.md are the registry's, every registered solver runs through the front door, and
-//! spec strings round-trip.
+//! The solver registry is what every front end reads: spec strings round-trip, bad ones say
+//! what to use, and every variant is what its solver says it is.
 
 use mbd::prelude::*;
-
-/// The text between `<!-- solvers:begin -->` and `<!-- solvers:end -->` of a file.
-fn table_in(path: &str) -> String {
-    let text = std::fs::read_to_string(format!("{}/{path}", env!("CARGO_MANIFEST_DIR")))
-        .unwrap_or_else(|e| panic!("{path}: {e}"));
-    let begin = "<!-- solvers:begin -->\n";
-    let i = text
-        .find(begin)
-        .unwrap_or_else(|| panic!("{path}: no {begin}"))
-        + begin.len();
-    let j = text[i..]
-        .find("<!-- solvers:end -->")
-        .unwrap_or_else(|| panic!("{path}: no end marker"));
-    text[i..i + j].to_string()
-}
-
-#[test]
-fn readme_and_cli_docs_carry_the_registry_table() {
-    let want = mbd::registry().markdown_table();
-    for path in ["README.md", "docs/cli.md"] {
-        assert_eq!(
-            table_in(path),
-            want,
-            "{path}: the solver table differs from the registry; regenerate it with \
-             `cargo run -p mbd-cli -- solvers --markdown`"
-        );
-    }
-}
 
 #[test]
 fn spec_strings_round_trip_and_bad_ones_say_what_to_use() {

@@ -71,7 +71,7 @@ pub struct PaperCRow {
     pub e_phidot: Cell,
     /// e(Phiddot).
     pub e_phiddot: Cell,
-    /// Runtime [s].
+    /// Runtime in seconds.
     pub runtime: f64,
 }
 

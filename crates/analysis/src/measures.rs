@@ -1,4 +1,5 @@
-//! Energy and constraint measures (paper C, methods.md section 5), accumulated online.
+//! Energy and constraint measures (paper C's e(H), MRE(H), e(Phi), e(Phidot), e(Phiddot)),
+//! accumulated online.
 
 use crate::error::AnalysisError;
 use mbd_model::numeric::max_abs;

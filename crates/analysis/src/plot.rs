@@ -62,7 +62,7 @@ impl Series {
 pub struct Figure {
     /// Title.
     pub title: String,
-    /// x-axis label with unit, e.g. "time t [s]".
+    /// x-axis label with unit, e.g. `"time t [s]"`.
     pub x_label: String,
     /// y-axis label with unit.
     pub y_label: String,

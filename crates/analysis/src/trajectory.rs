@@ -164,8 +164,9 @@ impl Trajectory {
     }
 }
 
-/// Paper A's trajectory error measures (methods.md 2.4): means over moving bodies `i` and
-/// samples `k` of the centre-of-mass errors, and energy errors over samples.
+/// Paper A's trajectory error measures: means over moving bodies `i` and samples `k` of the
+/// centre-of-mass errors, and energy errors over samples (`d_w` is the calibration target of
+/// `docs/symplectic.md` section 6).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct TrajectoryErrors {
     /// `E|dx| = mean_{i,k} |x_i^k - x_i,ref^k|`.

@@ -1,4 +1,4 @@
-//! Model-file features of issue 12: the example models, point masses, body frames, the JSON
+//! Model-file features: the example models, point masses, body frames, the JSON
 //! Schema (up to date, accepting the examples, rejecting malformed models) and the docs.
 
 use mbd_model::{BodyKind, ModelError, ModelFile, System};

@@ -1,5 +1,5 @@
-//! The secant calibration of `gamma_opt` (paper A, methods.md 2.3-2.4): the root of the
-//! calibration target `dW(gamma) = E[dx] + E[dy]` of runs against a reference.
+//! The secant calibration of `gamma_opt` (paper A; `docs/symplectic.md` section 6): the root of
+//! the calibration target `dW(gamma) = E[dx] + E[dy]` of runs against a reference.
 //!
 //! The measure itself (running the scheme and comparing with a reference) is the caller's:
 //! paper A's averaged errors are `mbd_analysis::trajectory_errors` (its `d_w`), and the solver

@@ -1,9 +1,10 @@
 //! # mbd-symplectic
 //!
 //! Paper A's parameter-preadjusted symplectic algorithm for planar rigid multibody systems in
-//! absolute coordinates (methods.md section 2): the (s,s) constrained Galerkin variational
-//! integrator, the preadjusted Lagrangian `L_gamma = T - V - gamma kappa_s h^(2s) W_s(q)`, and
-//! the calibration of `gamma_opt`.
+//! absolute coordinates: the (s,s) constrained Galerkin variational integrator, the preadjusted
+//! Lagrangian `L_gamma = T - V - gamma kappa_s h^(2s) W_s(q)`, and the calibration of
+//! `gamma_opt` (`docs/symplectic.md` in the repository gives the stage equations in section 2,
+//! `W_s` in section 5 and the calibration in section 6).
 //!
 //! * [`Galerkin`] implements [`mbd_solve::Integrator`]: Lagrange interpolation of `q` through
 //!   `s + 1` control points, `s`-point Gauss-Legendre quadrature of the action, constraints at
@@ -14,8 +15,8 @@
 //! * [`SymplecticOptions`]: `s`, `gamma`, the control-point placement [`Nodes`] and the Newton
 //!   settings. `gamma = 0` is the plain scheme bit for bit; [`kappa`] gives `kappa_s`.
 //!   [`PreadjustMode::ModifiedLagrangian`] (s = 1 or 2) replaces `W_s` by a parameter-free
-//!   modified Lagrangian with velocity terms: order 4 and 6, symplectic (issue 13;
-//!   `docs/symplectic.md` sections 5a and 5b).
+//!   modified Lagrangian with velocity terms: order 4 and 6, symplectic
+//!   (`docs/symplectic.md` sections 5a and 5b).
 //! * [`Preadjustment`]: `W_s`, its gradient and the tangential force on any model.
 //! * [`calibrate_gamma`]: `gamma_opt` by the secant method on the averaged signed trajectory
 //!   error `dW(gamma)` against a reference, measured by the caller (paper A's `E|dx|`, `E|dy|`,

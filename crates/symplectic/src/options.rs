@@ -25,7 +25,7 @@ pub enum PreadjustMode {
     /// the plain scheme). Default.
     #[default]
     Paper,
-    /// The parameter-free modified Lagrangian of issue 13. For `s = 1`, `L~ = L + h^2 e(q, v)`
+    /// A parameter-free modified Lagrangian instead of `W_s`. For `s = 1`, `L~ = L + h^2 e(q, v)`
     /// with `e = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v - 1/8 v^T Hess V v +
     /// 1/24 gamma_c^T S^-1 gamma_c`, evaluated at the chord midpoint of each step
     /// (`docs/symplectic.md` section 5a, derivation in `docs/modified-lagrangian.md`); for

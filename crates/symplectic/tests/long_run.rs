@@ -72,7 +72,7 @@ fn no_energy_drift_over_1e5_steps() {
     assert!(r.max_phi <= 1e-12 && r.max_phid <= 1e-12);
 }
 
-/// The modified-Lagrangian (1,1) and (2,2) schemes (issue 13), 1e5 steps of h = 0.04 on paper
+/// The modified-Lagrangian (1,1) and (2,2) schemes, 1e5 steps of h = 0.04 on paper
 /// A's double pendulum (4000 s, ~1800 periods of the slow mode): the constraints on position and
 /// velocity stay at round-off at every step, and the energy error does not drift (its maximum
 /// over the last tenth is within 2x that over the first tenth). Measured max |dH|: 4.6e-6
@@ -105,7 +105,7 @@ fn modified_lagrangian_constraints_and_energy_over_1e5_steps() {
     }
 }
 
-/// The issue's long-run requirement on the paper-C manipulator (a chaotic double pendulum whose
+/// The long-run requirement on the paper-C manipulator (a chaotic double pendulum whose
 /// links spin up to hundreds of radians): over 1e5 steps of h = 0.01 s, constraints at position
 /// and velocity level <= 1e-12 at every step and no energy drift, for s = 1 and s = 2.
 #[test]

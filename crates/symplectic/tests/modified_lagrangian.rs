@@ -1,4 +1,4 @@
-//! The parameter-free modified-Lagrangian preadjustment of the (1,1) scheme (issue 13):
+//! The parameter-free modified-Lagrangian preadjustment of the (1,1) scheme:
 //! pendulum period error of order 4 at 45 and 90 degrees (plain: order 2), paper A's double
 //! pendulum against a DOPRI5 reference, constraints over a long run, typed errors.
 mod common;

@@ -1,5 +1,5 @@
 //! The modified-Lagrangian (1,1) step is a symplectic map of the constrained phase space
-//! (issue 13; its long run is in `long_run.rs`).
+//! (its long run is in `long_run.rs`).
 //!
 //! The Jacobian of one step is taken by central differences in the reduced coordinates of the
 //! double pendulum (joint angles and their conjugate momenta `p_theta = T^T M v`, a chart of the

@@ -1,4 +1,4 @@
-//! Badly scaled mechanisms (issue 10): centimetre links with 1e-7 kg m^2 inertias and 1 kg (or
+//! Badly scaled mechanisms: centimetre links with 1e-7 kg m^2 inertias and 1 kg (or
 //! 1e3 kg) masses. The stage LU's pivot test was relative to `max |J|`, so at h = 1.25e-7 the
 //! multiplier columns (`h^2 M^-1 Phi_q^T`, 1e-14 times smaller than the others) were taken for
 //! singular in the first step, while every other solver ran the model.

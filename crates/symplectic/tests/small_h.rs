@@ -1,5 +1,5 @@
 //! At small h the solution must not depend on the predictor, and the error must not grow as h
-//! falls (issue 10). The multistep predictor's residual falls below the Newton tolerance at
+//! falls. The multistep predictor's residual falls below the Newton tolerance at
 //! small h; accepted without a correction, its smooth error accumulated from step to step (at
 //! t = 2 s on the manipulator the (2,2) error rose from 5.1e-10 at h = 6.25e-4 to 2.0e-8 at
 //! h = 1.56e-4), and the end momentum computed as `D_s L_d` divided the displacements' Newton

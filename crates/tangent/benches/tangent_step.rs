@@ -1,6 +1,6 @@
 //! One tangent-space RK4 step against one plain RK4 step (`Index1Rk` with the RK4 tableau, what
 //! `mbd-rk4` wraps) on the paper-C manipulator, at h = 0.01 (paper C's step) and h = 0.002.
-//! The target is a ratio of at most 4; `docs/tangent.md` records the measured ratio.
+//! The target is a ratio of at most 4; `docs/tangent.md` records the measured ratio.
 //! Also: tangent DOPRI5, and tangent RK4 with the interpolated iteration matrix. Criterion times
 //! each function on its own; on a loaded machine `tools/src/bin/tangent_step_ratio.rs` (interleaved blocks,
 //! best of 30) gives the steadier ratio.

@@ -1,5 +1,5 @@
 //! Constraint residuals of the (1,1) and (2,2) schemes over `10^5` steps of the manipulator at
-//! `h = 0.01` (the issue's `<= 1e-12` at every step), with the Newton work per step.
+//! `h = 0.01` (the target: `<= 1e-12` at every step), with the Newton work per step.
 //!
 //! `cargo run --release -p mbd-tools --bin symplectic_long_constraints [steps]`
 use mbd::model::models;

@@ -1,4 +1,4 @@
-//! The measurements of `docs/tangent.md` sections 6 and 7 (issue 10, robustness):
+//! The measurements of `docs/tangent.md` sections 6 and 7 (robustness):
 //!
 //! ```text
 //! cargo run --release -p mbd-tools --bin tangent_robust_probe -- adaptive

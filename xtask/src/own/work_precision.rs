@@ -140,7 +140,7 @@ pub(super) fn work_precision(ctx: &Ctx) -> Result<Section, String> {
             .push(Series::points(spec.name, hs.clone(), ys.clone()));
         fig.series.push(Series::points(spec.name, xs, ys));
     }
-    // the accuracy targets for the symplectic scheme
+    // the accuracy targets for the symplectic scheme
     for (name, target) in [("symplectic (1,1)", 2e-8), ("symplectic (2,2)", 1e-11)] {
         let best = floor_rows
             .iter()

@@ -1,5 +1,5 @@
 //! The cost of a preadjusted step against the plain step of the same `s`, timed in this process
-//! (issue 13's target: at most 3x): the (1,1) and (2,2) modified-Lagrangian steps and the (2,2) step with
+//! (the target: at most 3x): the (1,1) and (2,2) modified-Lagrangian steps and the (2,2) step with
 //! paper A's `W_2` (`gamma = 1`), on paper A's double pendulum (h = 0.04) and on
 //! `n_link_chain(10)` (h = 0.01), and the modified-Lagrangian steps on `n_link_chain(100)`
 //! (h = 0.01, the sparse stage solve; `W_2` has no sparse path), through the public
@@ -12,7 +12,7 @@ use super::*;
 use mbd_symplectic::PreadjustMode;
 use std::time::Instant;
 
-/// The target of issue 13: a preadjusted step at most this many times the plain step.
+/// The cost target: a preadjusted step at most this many times the plain step.
 const COST_TARGET: f64 = 3.0;
 
 const COST_MISS: &str = "after the cost work of docs/symplectic.md sections 5b and 8 every preadjusted step measured below the target on the double pendulum and n_link_chain(10): by wall clock the (1,1) modified-Lagrangian step 2.2x to 2.5x, W_2 2.0x to 2.5x, the (2,2) modified step 1.5x to 2.6x; by instructions 2.25x / 2.28x, 2.31x / 1.69x and 2.38x / 1.39x; so a miss of these is the machine's load, not the step";

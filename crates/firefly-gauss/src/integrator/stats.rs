@@ -65,8 +65,8 @@ impl Default for StepInfo {
     }
 }
 
-/// Totals over the steps since the last [`Integrator::reset`] (the run loop resets before the
-/// first step, so these are per run).
+/// Totals over the steps since the last [`Integrator::reset`](mbd_solve::Integrator::reset) (the
+/// run loop resets before the first step, so these are per run).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FaDaeStats {
     /// Steps taken.
@@ -77,7 +77,8 @@ pub struct FaDaeStats {
     pub evaluations: u64,
     /// Box re-runs.
     pub expansions: u64,
-    /// Steps whose firefly stopped above the target (accepted under [`MissPolicy::Accept`]).
+    /// Steps whose firefly stopped above the target (accepted under
+    /// [`MissPolicy::Accept`](crate::MissPolicy::Accept)).
     pub target_misses: u64,
     /// Partition changes.
     pub repartitions: u64,

@@ -155,15 +155,12 @@ impl Galerkin {
         // v) are left out (docs/symplectic.md, section 5a); the converged solution does not
         // depend on them.
         // Both blocks are dense on the coordinates K that enter V and the constraints
-        // non-linearly (S^-1 and Pi are dense), which fills the stage LU there (chain10:
-        // ~90k instructions per factorisation against 18k plain). Sparse approximations were
-        // measured and rejected (chain10, h = 0.01, Newton iterations per step, exact blocks
-        // 2.15): A Pi A left out 2.74, its diagonal 2.47, its entries between neighbouring
-        // bodies 2.20 (no saving: E is dense on K anyway); E without the off-diagonal part
-        // 2.93, E between neighbouring bodies 2.85; both diagonal (no fill) 2.91 (paper A's
-        // pendulum 3.99 against 2.99). Only dropping both off-diagonals removes the fill, and
-        // the extra iterations cost as much as it saves here; the sparse path, where the fill
-        // would cost O(N^3), takes the diagonals (sparse.rs, docs/symplectic.md section 5a).
+        // non-linearly (S^-1 and Pi are dense), which fills the stage LU there. Sparser
+        // approximations of either block cost more Newton iterations than they save
+        // (docs/symplectic.md section 8, "Cost of the preadjusted steps"): only dropping both
+        // off-diagonals removes the fill, and the extra iterations cost as much as it saves
+        // here; the sparse path, where the fill would cost O(N^3), takes the diagonals
+        // (sparse.rs, docs/symplectic.md section 5a).
         if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
             // (s = 2: the h^4 e4 term is left out of the Newton matrix)
             // (the slice's fill is a memset; the matrix's goes entry by entry)

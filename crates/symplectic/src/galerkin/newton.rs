@@ -106,9 +106,8 @@ impl Galerkin {
             t,
             residual: res,
             iterations: it,
-            // (measured: a 500-link chain fails at h = 0.01 and runs at h = 0.008 with s = 1,
-            // where the fastest modes of a long chain under tension outgrow the step;
-            // docs/symplectic.md, "Newton")
+            // (a step can be too long for the fastest modes of the model, e.g. of a long chain
+            // under tension, with no solution near the prediction: docs/symplectic.md section 2)
             context: format!(
                 "symplectic ({s},{s}) stage equations, h = {h}; a smaller h may converge (the \
                  step may be too long for the model's fastest motion)"

@@ -155,8 +155,7 @@ fn singular_stage_matrix_is_reported() {
 /// On the manipulator and the slider-crank the static pivots of the coordinate-blocked
 /// ordering pass the pivot tests at every step, from h = 0.01 down to h = 1e-6 (the general
 /// path is a guard, not the normal path), and at the usual steps without the scale factors
-/// of the equilibration (measured: they are first needed between h = 1e-5 and 1e-6, for
-/// s = 2 and 3).
+/// of the equilibration (`docs/symplectic.md` section 2 says from which h on they are needed).
 #[test]
 fn static_pivots_are_used() {
     for sys in [

@@ -10,7 +10,7 @@
 //! * `W_1 = 1/2 f_T^T M^-1 f_T = 1/2 u^T M u`,
 //!   `W_s = 1/2 f_T^T M^-1 (P K_T M^-1)^(s-1) f_T = 1/2 u^T A (Pi A)^(s-2) u` for `s >= 2`.
 //!
-//! For `s = 1, 2` this is exactly the `W_s` of methods.md 2.2; for `s >= 3` the projector `P`
+//! For `s = 1, 2` this is exactly paper A's `W_s`; for `s >= 3` the projector `P`
 //! between the factors keeps the modal form `W_s = 1/2 sum_i omega_i^(2s+2) eta_i^2` about an
 //! equilibrium (without it the normal components of `K_T` would enter). The gradient is exact:
 //! the third derivatives of `V` and `Phi` it needs for `s >= 2` come from

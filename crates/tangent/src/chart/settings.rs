@@ -105,7 +105,7 @@ pub struct MapStats {
     /// Chord Newton iterations.
     pub iterations: usize,
     /// Final `||f||_inf`; for a map that stopped on the predicted residual
-    /// ([`TangentChart::map_predicted`]), that prediction.
+    /// ([`TangentChart::map_predicted`](crate::TangentChart::map_predicted)), that prediction.
     pub residual: f64,
     /// `||f||_inf` at the starting point, before the first iteration.
     pub initial_residual: f64,
