@@ -30,4 +30,3 @@ fn readme_and_cli_docs_carry_the_registry_table() {
         );
     }
 }
-

@@ -17,7 +17,7 @@
 //! consistent initial state projected from a guess.
 //!
 //! Joint and force equations are written once over a generic scalar and differentiated in
-//! forward mode (see [`jet`]), so Jacobians, `gamma` and Hessians are exact.
+//! forward mode (dual-number jets), so Jacobians, `gamma` and Hessians are exact.
 //!
 //! ```
 //! use mbd_model::{Body, BodyRef, Joint, SystemBuilder};

@@ -7,7 +7,7 @@ use crate::integrator::{RunStats, StepStats};
 use crate::state::State;
 use mbd_model::System;
 
-/// The constraint-drift guard of [`run`]: after every step the constraint residuals are
+/// The constraint-drift guard of [`crate::run`] and [`crate::run_adaptive`]: after every step the constraint residuals are
 /// checked, and a run whose constraints have drifted stops with
 /// [`SolveError::ConstraintDrift`] naming the time, the equation and its joint.
 ///
@@ -21,7 +21,7 @@ use mbd_model::System;
 /// that has left the constraint manifold (plain RK4 past a singular configuration) before its
 /// numbers become meaningless. Velocity residuals
 /// `Phi_q v + Phi_t` are checked only if `velocity_tol` is set (absolute, in the equation's unit
-/// per second). Turn the guard off ([`RunConfig::without_drift_guard`]) to measure drift itself.
+/// per second). Turn the guard off ([`crate::RunConfig::without_drift_guard`]) to measure drift itself.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DriftGuard {
     /// Largest accepted `|Phi_i|`, relative to the equation's scale (default `1e-2`).

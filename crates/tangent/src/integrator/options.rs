@@ -20,14 +20,14 @@ pub enum IterationMatrix {
     Interpolated,
     /// Starts each chart from the centre's `R^-T` and improves the iteration's inverse matrix
     /// by good Broyden rank-one updates after every correction, carried from one map of the
-    /// step to the next ([`TangentChart::set_broyden`]): superlinear convergence for `O(n m)`
+    /// step to the next ([`crate::TangentChart::set_broyden`]): superlinear convergence for `O(n m)`
     /// more work per iteration, no extra `Df`. On the manipulator it saves a third of the
     /// iterations at `h = 0.01` but costs more per step than the centre chord (the residual is
     /// cheap there; `docs/tangent.md`), so it is not the default.
     Broyden,
 }
 
-/// Settings of [`TangentRk`].
+/// Settings of [`TangentRk`](crate::TangentRk).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TangentOptions {
     /// The chord Newton iteration of the chart map (tolerance 1e-13 on `||(Phi, Phidot)||_inf`
@@ -142,8 +142,8 @@ impl TangentOptions {
     }
 }
 
-/// Work counters of a [`TangentRk`], cumulative since construction or the last
-/// [`Integrator::reset`].
+/// Work counters of a [`TangentRk`](crate::TangentRk), cumulative since construction or the last
+/// [`mbd_solve::Integrator::reset`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TangentStats {
     /// Accepted steps (sub-steps of halved steps count one each).
