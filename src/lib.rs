@@ -118,24 +118,58 @@ impl std::error::Error for Error {
     }
 }
 
-macro_rules! from_error {
-    ($($variant:ident($ty:ty)),* $(,)?) => {
-        $(impl From<$ty> for Error {
-            fn from(e: $ty) -> Self {
-                Error::$variant(e)
-            }
-        })*
-    };
+impl From<model::ModelError> for Error {
+    fn from(e: model::ModelError) -> Self {
+        Error::Model(e)
+    }
 }
 
-from_error!(
-    Model(model::ModelError),
-    Solve(solve::SolveError),
-    Symplectic(symplectic::SymplecticError),
-    Firefly(firefly::FireflyError),
-    FaDae(firefly_gauss::FaDaeError),
-    Analysis(analysis::AnalysisError),
-);
+/// A model error inside a solve error arrives as [`Error::Model`]: each kind of failure has one
+/// variant, whichever crate passed it on.
+impl From<solve::SolveError> for Error {
+    fn from(e: solve::SolveError) -> Self {
+        match e {
+            solve::SolveError::Model(m) => Error::Model(m),
+            e => Error::Solve(e),
+        }
+    }
+}
+
+/// A solve error inside a symplectic error arrives as [`Error::Solve`] (or [`Error::Model`]).
+impl From<symplectic::SymplecticError> for Error {
+    fn from(e: symplectic::SymplecticError) -> Self {
+        match e {
+            symplectic::SymplecticError::Solve(s) => s.into(),
+            e => Error::Symplectic(e),
+        }
+    }
+}
+
+impl From<firefly::FireflyError> for Error {
+    fn from(e: firefly::FireflyError) -> Self {
+        Error::Firefly(e)
+    }
+}
+
+/// A solve error inside an FA-DAE error arrives as [`Error::Solve`] (or [`Error::Model`]).
+impl From<firefly_gauss::FaDaeError> for Error {
+    fn from(e: firefly_gauss::FaDaeError) -> Self {
+        match e {
+            firefly_gauss::FaDaeError::Solve(s) => s.into(),
+            e => Error::FaDae(e),
+        }
+    }
+}
+
+/// A solve error inside an analysis error arrives as [`Error::Solve`] (or [`Error::Model`]).
+impl From<analysis::AnalysisError> for Error {
+    fn from(e: analysis::AnalysisError) -> Self {
+        match e {
+            analysis::AnalysisError::Solve(s) => s.into(),
+            e => Error::Analysis(e),
+        }
+    }
+}
 
 /// What a program needs for the common path: a model, a consistent state, a solver, the run
 /// loop (fixed or adaptive steps), observers (with closures whose argument types are
@@ -173,3 +207,30 @@ pub mod prelude {
 /// The README's usage example, compiled and run as a doctest.
 #[doc = include_str!("../README.md")]
 mod readme {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_failure_reaches_the_one_error_by_one_variant() {
+        let m = model::ModelError::UnknownBody {
+            element: "joint 'pin'".into(),
+            body: "arm".into(),
+        };
+        assert!(matches!(Error::from(m.clone()), Error::Model(_)));
+        let s = solve::SolveError::Model(m.clone());
+        assert!(matches!(Error::from(s.clone()), Error::Model(_)));
+        let sy = symplectic::SymplecticError::Solve(s.clone());
+        assert!(matches!(Error::from(sy), Error::Model(_)));
+        let fa = firefly_gauss::FaDaeError::Solve(s.clone());
+        assert!(matches!(Error::from(fa), Error::Model(_)));
+        let an = analysis::AnalysisError::Solve(s);
+        assert!(matches!(Error::from(an), Error::Model(_)));
+        let step = solve::SolveError::InvalidStep { h: -1.0 };
+        assert!(matches!(
+            Error::from(symplectic::SymplecticError::Solve(step)),
+            Error::Solve(solve::SolveError::InvalidStep { .. })
+        ));
+    }
+}

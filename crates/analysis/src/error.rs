@@ -3,6 +3,7 @@ use thiserror::Error;
 
 /// What can go wrong in an analysis.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum AnalysisError {
     /// Inputs have inconsistent lengths.
     #[error("{what}: expected length {expected}, got {got}")]

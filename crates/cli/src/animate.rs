@@ -100,6 +100,8 @@ fn joint_geom(sys: &System) -> Vec<JointGeom> {
                     (index(*body), Some(*point), -1, None, None)
                 }
                 JointKind::AngleDriver { a, b, .. } => (index(*a), None, index(*b), None, None),
+                // a joint kind this page does not know how to draw: listed, not drawn
+                _ => (-1, None, -1, None, None),
             };
             JointGeom {
                 name: j.name.clone(),

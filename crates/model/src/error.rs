@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Everything that can go wrong when building, loading or evaluating a model.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum ModelError {
     /// An element refers to a body that does not exist.
     #[error("{element} refers to unknown body '{body}'")]

@@ -9,6 +9,7 @@ use crate::timefn::TimeFunction;
 
 /// The kinds of force element.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum ForceKind {
     /// Linear point-to-point spring-damper: `V = k/2 (l - l0)^2`, damping force `c ldot` along
     /// the line.

@@ -25,6 +25,7 @@ pub enum Coordinate {
 /// The kinds of joint, with their parameters. Local points are in the body frame (relative to
 /// the centre of mass); on ground they are global points.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum JointKind {
     /// Pin: point `pa` on `a` coincides with point `pb` on `b` (2 equations).
     Revolute {

@@ -5,6 +5,7 @@ use thiserror::Error;
 
 /// Errors of the calibration and of the error measures (integration errors are wrapped).
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum SymplecticError {
     /// An error of the integrator or the model.
     #[error(transparent)]

@@ -59,9 +59,8 @@ pub struct SymplecticOptions {
     /// the update at least 4x (`jacobian_every = 1`: full Newton; default 6). See
     /// `docs/symplectic.md` for why the predictor is never accepted without an update.
     pub newton: NewtonOptions,
-    /// Relative step of the finite-difference checks of the preadjustment's derivatives
-    /// ([`crate::Preadjustment::fd_step`]). The integrator itself no longer differentiates
-    /// numerically: the third derivatives of `V` and `Phi` in `grad W_s` and in the
+    /// Relative step of the finite-difference checks of the preadjustment's derivatives. The
+    /// integrator itself does not differentiate numerically: the third derivatives of `V` and `Phi` in `grad W_s` and in the
     /// modified-Lagrangian gradient are exact (`mbd_model::System::potential_third`,
     /// `constraint_third`). Still validated (finite, in `(0, 1)`).
     pub fd_step: f64,

@@ -14,7 +14,7 @@
 //!   two small Householder QRs of its blocks) gives an orthonormal basis `U` of `ker Df(x_c)` (`2(n-m)` columns) and `Q1` of its
 //!   orthogonal complement;
 //! * the chart `x(xi) = x_c + U xi + Df(x_c)^T eta(xi)`, with `eta` by chord Newton on
-//!   `f(x(xi), t) = 0` ([`TangentChart`]);
+//!   `f(x(xi), t) = 0`;
 //! * the state equation `xi' = U^T F(x(xi), t)`, integrated from `xi = 0` over one step with any
 //!   [`ButcherTableau`] (RK4 by default; DOPRI5 with adaptive steps), mapped back, and the chart
 //!   re-centred at the new point ([`TangentRk`]).
@@ -30,7 +30,7 @@
 //! state. See `docs/tangent.md` for the derivation.
 //!
 //! Large mechanisms (more than [`mbd_solve::SPARSE_THRESHOLD`] constraint equations, or
-//! [`TangentOptions::linear_solver`] = [`LinearSolver::Sparse`]) run on the [`SparseChart`]:
+//! [`TangentOptions::linear_solver`] = [`LinearSolver::Sparse`]) run on a sparse chart:
 //! no basis of `ker Df` is formed; the chart is `x(y) = x_c + y + Df(x_c)^T eta(y)` in redundant
 //! coordinates `y in ker Df(x_c)`, the state equation `y' = P F` with the projector
 //! `P = I - Df^T (Df Df^T)^-1 Df`, and one sparse Cholesky factorisation of `Df Df^T` per
@@ -69,10 +69,9 @@ mod kernels;
 mod registry;
 mod sparse_chart;
 
-pub use chart::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR};
+pub use chart::{NewtonSettings, ROUNDOFF_FACTOR};
 pub use integrator::{IterationMatrix, TangentOptions, TangentRk, TangentStats};
 pub use mbd_solve::LinearSolver;
 pub use registry::SOLVERS;
-pub use sparse_chart::SparseChart;
 
 pub use mbd_solve::{ButcherTableau, StepController};

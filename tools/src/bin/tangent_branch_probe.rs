@@ -42,7 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 s.q[2],
                 st.exact_maps,
                 st.exact_maps - exact,
-                rk.chart().rcond()
+                rk.rcond()
             );
         }
         exact = st.exact_maps;

@@ -76,7 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut t = TangentRk::new(&sys, ButcherTableau::rk4(), opts)?;
             run_steps(&mut t, &sys, &mut s, h, steps, through_run)?;
             let st = t.stats();
-            let (upd, resets) = t.chart().broyden_counts();
+            let (upd, resets) = t.broyden_counts();
             println!(
                 "tangent RK4: {steps} steps of {h}, t = {}, {:.2} chord iterations/step, \
                  {:.2} Broyden updates/step, {resets} resets, \

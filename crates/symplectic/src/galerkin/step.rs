@@ -19,9 +19,14 @@ impl Integrator for Galerkin {
         name
     }
 
+    /// `2s` (Lobatto control points); `2s + 2` with the modified-Lagrangian preadjustment,
+    /// which removes the scheme's leading `h^2s` error term (`docs/symplectic.md` section 5;
+    /// the report's `own-orders` measures both).
     fn order(&self) -> Option<u32> {
         let s = self.tab.s as u32;
+        let modified = self.opts.preadjust == PreadjustMode::ModifiedLagrangian;
         Some(match self.opts.nodes {
+            Nodes::Lobatto if modified => 2 * s + 2,
             Nodes::Lobatto => 2 * s,
             Nodes::Equispaced => (2 * s).min(if s % 2 == 1 { s + 1 } else { s + 2 }),
         })

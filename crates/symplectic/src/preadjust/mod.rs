@@ -29,8 +29,6 @@ mod modified2;
 mod modified2_grad;
 mod paper;
 
-pub use modified2::E4_TERMS;
-
 /// Workspace evaluating `W_s`, its gradient and an approximate Hessian (allocation-free after
 /// [`Preadjustment::new`]).
 #[derive(Debug)]
@@ -42,7 +40,7 @@ pub struct Preadjustment {
     minv: Vec<f64>,
     /// Relative step of the finite-difference checks of the derivatives (tests); the
     /// derivatives used by the integrator are exact.
-    pub fd_step: f64,
+    pub(crate) fd_step: f64,
     g: Vec<f64>,
     gq: DMatrix<f64>,
     chol: DenseCholesky,

@@ -24,7 +24,7 @@ use mbd_solve::SolveError;
 
 /// The terms of `e4` and their coefficients, in the order of [`Preadjustment::modified_term_s2`]'s
 /// evaluation (`S` in a name stands for `S^-1`).
-pub const E4_TERMS: [(&str, f64); 23] = [
+pub(crate) const E4_TERMS: [(&str, f64); 23] = [
     ("v H_sigma Pi H_mu v", 1.0 / 720.0),
     ("v H_mu Pi H_mu v", -1.0 / 1440.0),
     ("u H_mu u", -1.0 / 960.0),

@@ -82,11 +82,6 @@ impl TangentChart {
         self.pb_active = false;
     }
 
-    /// Whether the Broyden iteration is on ([`TangentChart::set_broyden`]).
-    pub fn broyden(&self) -> bool {
-        self.broyden
-    }
-
     /// Broyden updates applied, and resets of the updated matrix to the centre's `R^-T` after
     /// an iteration without progress, since the chart was created (diagnostics).
     pub fn broyden_counts(&self) -> (usize, usize) {

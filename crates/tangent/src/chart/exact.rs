@@ -6,12 +6,6 @@ use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::System;
 
 impl TangentChart {
-    /// Maps completed by Newton's method with the exact matrix after the chord iteration failed
-    /// ([`NewtonSettings::fallback_change`]), since the chart was created.
-    pub fn exact_maps(&self) -> usize {
-        self.exact_maps
-    }
-
     /// The fallback after a failed chord iteration from `x` (its starting point): if `Df(x)`
     /// is within `fallback_change` (relative) of `Df(x_c)`, Newton's method along the normal
     /// directions with the exact matrix `J = Df(x_k) Q1` at every iterate,

@@ -151,12 +151,6 @@ impl TangentChart {
         Self::with_dims(sys, sys.n_coords(), sys.n_constraints())
     }
 
-    /// A chart of no dimension (`n = m = 0`, never centred): what
-    /// [`crate::TangentRk::chart`] returns on the sparse path, which has no dense chart.
-    pub(crate) fn empty(sys: &System) -> Self {
-        Self::with_dims(sys, 0, 0)
-    }
-
     fn with_dims(sys: &System, n: usize, m: usize) -> Self {
         let (nn, mm) = (2 * n, 2 * m);
         let mut q = vec![0.0; nn * nn];
@@ -227,11 +221,13 @@ impl TangentChart {
     }
 
     /// Dimension of the ambient space, `2n`.
+    #[cfg(test)]
     pub fn ambient_dim(&self) -> usize {
         2 * self.n
     }
 
     /// Number of constraint equations of `f`, `2m`.
+    #[cfg(test)]
     pub fn codim(&self) -> usize {
         2 * self.m
     }
@@ -239,11 +235,6 @@ impl TangentChart {
     /// The centre `x_c = (q_c, v_c)` (length `2n`).
     pub fn centre_point(&self) -> &[f64] {
         &self.xc
-    }
-
-    /// Time at which the chart was centred.
-    pub fn centre_time(&self) -> f64 {
-        self.tc
     }
 
     #[inline]
@@ -259,6 +250,7 @@ impl TangentChart {
 
     /// Column `k` of the normal basis `Q1` (`k < 2m`): an orthonormal basis of the range of
     /// `Df(x_c)^T`.
+    #[cfg(test)]
     pub fn normal(&self, k: usize) -> &[f64] {
         self.col(k)
     }
@@ -274,6 +266,7 @@ impl TangentChart {
     }
 
     /// Entry `(i, j)` of the triangular factor `R` (`2m x 2m`) of `Df(x_c)^T = Q1 R`.
+    #[cfg(test)]
     pub fn r(&self, i: usize, j: usize) -> f64 {
         if i > j {
             0.0
@@ -284,6 +277,7 @@ impl TangentChart {
 
     /// `Df(x_c) = [[Phi_q, 0], [(Phi_q v)_q, Phi_q]]` as a dense `2m x 2n` matrix (allocates; for
     /// tests and diagnostics).
+    #[cfg(test)]
     pub fn jacobian(&self) -> DMatrix<f64> {
         let (n, m) = (self.n, self.m);
         let mut d = DMatrix::zeros(2 * m, 2 * n);
@@ -455,11 +449,6 @@ impl TangentChart {
         self.rcond
     }
 
-    /// Whether [`TangentChart::centre`] succeeded since the last attempt.
-    pub fn is_centred(&self) -> bool {
-        self.centred
-    }
-
     /// `f(x, t) = (Phi(q, t), Phi_q v + Phi_t)` into `out` (length `2m`); returns its max-norm
     /// (NaN if any entry is not finite).
     pub fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
@@ -542,23 +531,6 @@ impl TangentChart {
     ) -> Result<MapStats, ChartFailure> {
         self.point(xi, zeta, x);
         self.run_chord(sys, t, zeta, x, newton, true)
-    }
-
-    /// Chord Newton along the normal directions from the point `x`: on success `x` is on the
-    /// manifold at time `t` (with the same tangent coordinates `U^T (x - x_c)`) and `zeta` is
-    /// set to its normal coordinates `Q1^T (x - x_c)`.
-    pub fn solve_normal(
-        &mut self,
-        sys: &System,
-        t: f64,
-        zeta: &mut [f64],
-        x: &mut [f64],
-        newton: &NewtonSettings,
-    ) -> Result<MapStats, ChartFailure> {
-        if self.m == 0 {
-            return Ok(MapStats::default());
-        }
-        self.run_chord(sys, t, zeta, x, newton, false)
     }
 
     /// The paper's normal coefficients `eta = R^-1 zeta` of a normal part `Q1 zeta =

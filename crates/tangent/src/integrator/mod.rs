@@ -163,7 +163,6 @@ impl TangentRk {
             Path::Sparse(Box::new(SparseParts {
                 chart,
                 acc: SparseAccelerationSolver::new(sys)?,
-                empty: TangentChart::empty(sys),
             }))
         } else {
             let mut chart = TangentChart::new(sys);
@@ -251,21 +250,19 @@ impl TangentRk {
         &self.stats
     }
 
-    /// The dense chart of the last step (centred at that step's start point). On the sparse
-    /// path ([`TangentRk::is_sparse`]) a chart of no dimension that is never centred: see
-    /// [`TangentRk::sparse_chart`].
-    pub fn chart(&self) -> &TangentChart {
-        match &self.path {
-            Path::Dense { chart, .. } => chart,
-            Path::Sparse(p) => &p.empty,
-        }
+    /// The reciprocal condition estimate of the last step's chart (the smallest over the
+    /// largest diagonal of the factor of `Df^T`, dense or sparse): about the distance to the
+    /// nearest singular configuration, relative to the mechanism's scale.
+    pub fn rcond(&self) -> f64 {
+        self.path.rcond()
     }
 
-    /// The sparse chart of the last step on the sparse path, `None` on the dense path.
-    pub fn sparse_chart(&self) -> Option<&SparseChart> {
+    /// [`IterationMatrix::Broyden`] on the dense path: the rank-one updates made and the resets
+    /// to the centre's matrix since construction; `(0, 0)` otherwise.
+    pub fn broyden_counts(&self) -> (usize, usize) {
         match &self.path {
-            Path::Dense { .. } => None,
-            Path::Sparse(p) => Some(&p.chart),
+            Path::Dense { chart, .. } => chart.broyden_counts(),
+            Path::Sparse(_) => (0, 0),
         }
     }
 

@@ -31,8 +31,6 @@ pub(super) enum Path {
 pub(super) struct SparseParts {
     pub(super) chart: SparseChart,
     pub(super) acc: SparseAccelerationSolver,
-    /// A never-centred dense chart of no dimension, returned by [`super::TangentRk::chart`].
-    pub(super) empty: TangentChart,
 }
 
 impl Path {
@@ -67,7 +65,7 @@ impl Path {
     }
 
     #[inline]
-    pub(super) fn rcond(&self) -> f64 {
+    pub(crate) fn rcond(&self) -> f64 {
         match self {
             Path::Dense { chart, .. } => chart.rcond(),
             Path::Sparse(p) => p.chart.rcond(),

@@ -11,6 +11,8 @@ use mbd_solve::sparse::{RowIncidence, SparseCholesky};
 use mbd_solve::SolveError;
 
 mod rank;
+#[cfg(test)]
+mod tests;
 
 /// One contribution of a body shared by rows `r1 >= r2` to the four entries of `G` that couple
 /// them: `o1`, `o2` are the body's offsets (0 or 3) in the rows' local gradients, and `pp`, `vp`, `pv`, `vv` the value slots of (position `r1`, position `r2`),
@@ -191,6 +193,7 @@ impl SparseChart {
     }
 
     /// Number of constraint equations of `f`, `2m`: the length of `eta`.
+    #[cfg(test)]
     pub fn codim(&self) -> usize {
         2 * self.m
     }
@@ -200,25 +203,10 @@ impl SparseChart {
         &self.xc
     }
 
-    /// Time at which the chart was centred.
-    pub fn centre_time(&self) -> f64 {
-        self.tc
-    }
-
     /// `1 / sqrt(cond(G))` of the last centre, from the sparse Cholesky's condition estimate
     /// (1 without constraints): the analogue of [`crate::TangentChart::rcond`].
     pub fn rcond(&self) -> f64 {
         self.rcond
-    }
-
-    /// Whether [`SparseChart::centre`] succeeded since the last attempt.
-    pub fn is_centred(&self) -> bool {
-        self.centred
-    }
-
-    /// Non-zeros of the lower triangle of `G`, and of its Cholesky factor (fill included).
-    pub fn nnz(&self) -> (usize, usize) {
-        (self.chol.nnz(), self.chol.factor_nnz())
     }
 
     /// Centres the chart at `(q, v)` at time `t`: evaluates `Df` in element-local form,
