@@ -4,8 +4,8 @@
 //! `cargo run --release --example four_bar`
 
 use mbd::model::{models, System};
-use mbd::rk4::{Rk4, Rk4Options};
-use mbd::solve::{run, Flow, RunConfig, State};
+use mbd::solve::{observe, RunConfig};
+use mbd::Simulation;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let built = models::four_bar()?;
@@ -17,21 +17,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sys.n_constraints(),
         sys.dof()
     );
-    let mut state = State::consistent(&sys, 0.0)?;
-    let mut rk4 = Rk4::new(&sys, Rk4Options::projected())?;
+    let mut sim = Simulation::new(sys, "rk4-projected")?;
     let rocker = 3 * 2 + 2; // theta of body 3
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut obs = |_: &System, s: &State, _: usize| {
-        lo = lo.min(s.q[rocker]);
-        hi = hi.max(s.q[rocker]);
-        Ok(Flow::Continue)
-    };
-    run(
-        &mut rk4,
-        &sys,
-        &mut state,
+    sim.run_observed(
         RunConfig::new(5.0, 1e-3),
-        &mut obs,
+        &mut observe(|s| {
+            lo = lo.min(s.q[rocker]);
+            hi = hi.max(s.q[rocker]);
+        }),
     )?;
     println!("rocker angle range over 5 s: [{:.4}, {:.4}] rad", lo, hi);
     Ok(())

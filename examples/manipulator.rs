@@ -7,8 +7,8 @@
 
 use mbd::analysis::MeasureObserver;
 use mbd::model::System;
-use mbd::rk4::{Rk4, Rk4Options};
-use mbd::solve::{run, NoObserver, RunConfig, SolveError, State};
+use mbd::solve::{RunConfig, SolveError};
+use mbd::Simulation;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = concat!(
@@ -16,17 +16,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "/examples/models/manipulator.json"
     );
     let sys = System::from_path(path)?;
-    for (label, opts) in [
-        ("plain RK4", Rk4Options::plain()),
-        ("RK4 + projection", Rk4Options::projected()),
-    ] {
-        let mut state = State::consistent(&sys, 0.0)?;
-        let mut rk4 = Rk4::new(&sys, opts)?;
+    for (label, solver) in [("plain RK4", "rk4"), ("RK4 + projection", "rk4-projected")] {
+        let mut sim = Simulation::new(sys.clone(), solver)?;
         let mut obs = MeasureObserver::new(&sys, true);
         let t = std::time::Instant::now();
         // the paper's drift measurement: no drift guard
         let cfg = RunConfig::new(20.0, 0.01).without_drift_guard();
-        run(&mut rk4, &sys, &mut state, cfg, &mut obs)?;
+        sim.run_observed(cfg, &mut obs)?;
         let m = obs.measures();
         println!(
             "{label:>18}: H0 = {:.4} J, e(H) = {:.3e}, MRE(H) = {:.3e}, e(Phi) = {:.3e}, e(Phidot) = {:.3e}, e(Phiddot) = {:.3e}, {:.2} ms",
@@ -36,16 +32,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("paper C, Table 2 (RK4): e(H) = 9.0827e-2, MRE(H) = 2.8464e-2");
 
     // with the default drift guard, plain RK4 is stopped and told why
-    let mut state = State::consistent(&sys, 0.0)?;
-    let mut rk4 = Rk4::new(&sys, Rk4Options::plain())?;
-    match run(
-        &mut rk4,
-        &sys,
-        &mut state,
-        RunConfig::new(20.0, 0.01),
-        &mut NoObserver,
-    ) {
-        Err(e @ SolveError::ConstraintDrift { .. }) => println!("default drift guard: {e}"),
+    let mut sim = Simulation::new(sys, "rk4")?;
+    match sim.run(RunConfig::new(20.0, 0.01)) {
+        Err(mbd::Error::Solve(e @ SolveError::ConstraintDrift { .. })) => {
+            println!("default drift guard: {e}")
+        }
         Err(e) => return Err(e.into()),
         Ok(_) => println!("default drift guard: plain RK4 stayed within 1% of the links' size"),
     }

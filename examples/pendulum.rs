@@ -5,15 +5,13 @@
 
 use mbd::analysis::MeasureObserver;
 use mbd::model::System;
-use mbd::rk4::{Rk4, Rk4Options};
-use mbd::solve::{run, Flow, RunConfig, State};
+use mbd::solve::{Flow, RunConfig, State};
+use mbd::Simulation;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/models/pendulum.toml");
-    let sys = System::from_path(path)?;
-    let mut state = State::consistent(&sys, 0.0)?;
-    let mut rk4 = Rk4::new(&sys, Rk4Options::projected())?;
-    let mut measures = MeasureObserver::new(&sys, true);
+    let mut sim = Simulation::from_path(path, "rk4-projected")?;
+    let mut measures = MeasureObserver::new(sim.system(), true);
     // detect upward zero crossings of the angular velocity to estimate the period
     let mut last_w = 0.0f64;
     let mut crossings: Vec<f64> = vec![];
@@ -26,13 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         last_w = w;
         Ok(Flow::Continue)
     };
-    run(
-        &mut rk4,
-        &sys,
-        &mut state,
-        RunConfig::new(10.0, 1e-3),
-        &mut obs,
-    )?;
+    sim.run_observed(RunConfig::new(10.0, 1e-3), &mut obs)?;
     let m = measures.measures();
     if crossings.len() >= 2 {
         let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;

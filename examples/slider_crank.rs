@@ -6,7 +6,8 @@
 use mbd::analysis::MeasureObserver;
 use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
-use mbd::solve::{consistent_state, run, RunConfig, State};
+use mbd::solve::{consistent_state, RunConfig};
+use mbd::Simulation;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sys = models::slider_crank()?;
@@ -20,16 +21,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("Baumgarte(10,10)", Rk4Options::baumgarte(10.0, 10.0)),
         ("projected RK4", Rk4Options::projected()),
     ] {
-        let mut state = State::consistent(&sys, 0.0)?;
-        let mut rk4 = Rk4::new(&sys, opts)?;
+        // a solver with options no spec string offers (Baumgarte) goes in as an integrator
+        let mut sim = Simulation::with_integrator(sys.clone(), Rk4::new(&sys, opts)?)?;
         let mut obs = MeasureObserver::new(&sys, false);
-        run(
-            &mut rk4,
-            &sys,
-            &mut state,
-            RunConfig::new(10.0, 2e-3),
-            &mut obs,
-        )?;
+        sim.run_observed(RunConfig::new(10.0, 2e-3), &mut obs)?;
         let m = obs.measures();
         println!(
             "{label:>17}: e(Phi) = {:.3e}, e(Phidot) = {:.3e}, e(H) = {:.3e}",
