@@ -466,3 +466,34 @@ pub fn experiments() -> Vec<Experiment> {
         },
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_registered_solver_family_is_in_the_comparisons() {
+        let compared: Vec<&str> = solvers().iter().map(|s| s.spec).collect();
+        for f in mbd::registry().families() {
+            assert!(
+                f.variants.iter().any(|v| v.compared),
+                "{} registers no variant the report compares",
+                f.crate_name
+            );
+            for v in f.variants.iter().filter(|v| v.compared) {
+                assert!(
+                    compared.contains(&v.spec),
+                    "{} missing from the report",
+                    v.spec
+                );
+            }
+        }
+        // every compared solver builds for the report's problems
+        for (name, sys) in problems().expect("problems") {
+            for s in solvers() {
+                s.make(&sys)
+                    .unwrap_or_else(|e| panic!("{} on {name}: {e}", s.spec));
+            }
+        }
+    }
+}
