@@ -183,16 +183,9 @@ impl TangentChart {
         predicted: bool,
     ) -> Result<MapStats, ChartFailure> {
         let s = self.s;
-        let tol = newton.tol;
-        // f cannot be evaluated more accurately than about eps |Phi_q| |v| (and eps |theta| in
-        // sin theta): a stall below this cap is the round-off floor, not slow convergence
-        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
-        let mut res = res0;
-        let mut prev = f64::INFINITY;
-        let mut it = 0;
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
         loop {
-            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+            if let Some(verdict) = lp.head() {
                 return verdict;
             }
             // x <- x - Q1 J^-1 f = x - P0 (I + s K)^-1 f
@@ -212,25 +205,20 @@ impl TangentChart {
                 *fk = -*fk;
             }
             gemv_cols(&self.p0, f, x);
-            it += 1;
-            if it == 1 {
+            if lp.it == 0 {
                 self.first_step = x
                     .iter()
                     .zip(&self.x0)
                     .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()));
             }
-            // predicted stop (stage points only): the residual after this correction is about
-            // theta * res with theta the contraction just observed
-            if let Some(ms) = predicted_stop(predicted, res, prev, tol, it, res0) {
+            if let Some(ms) = lp.corrected() {
                 return Ok(ms);
             }
-            prev = res;
-            res = self.residual_cached(sys, x, t, f);
-            // stall at the round-off floor (no progress, not slow convergence)
-            if let Some(ms) = stalled(res, prev, tol, stall_cap, it, res0) {
+            let res = self.residual_cached(sys, x, t, f);
+            if let Some(ms) = lp.evaluated(res) {
                 return Ok(ms);
             }
-            if let Some(e) = diverged(t, res, prev, tol, newton.divergence, it) {
+            if let Some(e) = lp.diverged() {
                 return Err(e);
             }
         }
@@ -251,15 +239,11 @@ impl TangentChart {
         predicted: bool,
     ) -> Result<MapStats, ChartFailure> {
         let tol = newton.tol;
-        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
-        let mut res = res0;
-        let mut prev = f64::INFINITY;
-        let mut it = 0;
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
         // whether `wx` holds `Q1 H f` for the current `f` and `H`
         let mut have_w = false;
         loop {
-            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+            if let Some(verdict) = lp.head() {
                 return verdict;
             }
             if !have_w {
@@ -272,36 +256,34 @@ impl TangentChart {
                 *si = -wi;
                 *xi -= wi;
             }
-            it += 1;
-            if it == 1 {
+            if lp.it == 0 {
                 self.first_step = max_abs(&self.wx);
             }
-            if let Some(ms) = predicted_stop(predicted, res, prev, tol, it, res0) {
+            if let Some(ms) = lp.corrected() {
                 return Ok(ms);
             }
-            prev = res;
             self.fprev.copy_from_slice(f);
-            res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = stalled(res, prev, tol, stall_cap, it, res0) {
+            let res = self.residual_cached(sys, x, t, f);
+            if let Some(ms) = lp.evaluated(res) {
                 return Ok(ms);
             }
-            if self.pb_active && (res.is_nan() || res >= prev) {
+            if self.pb_active && (lp.res.is_nan() || lp.res >= lp.prev) {
                 // the updated matrix made no progress: undo the step, restart from R^-T
                 for (xi, si) in x.iter_mut().zip(&self.step) {
                     *xi -= si;
                 }
                 f.copy_from_slice(&self.fprev);
-                res = prev;
-                prev = f64::INFINITY;
+                lp.res = lp.prev;
+                lp.prev = f64::INFINITY;
                 self.pb_active = false;
                 self.broyden_resets += 1;
                 have_w = false;
                 continue;
             }
-            if let Some(e) = diverged(t, res, prev, tol, newton.divergence, it) {
+            if let Some(e) = lp.diverged() {
                 return Err(e);
             }
-            if res <= tol {
+            if lp.res <= tol {
                 continue;
             }
             // w = Q1 H f_(k+1); with s = step: H y = w + s, so the good Broyden update is
@@ -339,6 +321,108 @@ pub(crate) fn fast_max(a: f64, b: f64) -> f64 {
         b
     } else {
         a
+    }
+}
+
+/// The state and stopping rules of one chord iteration, shared by the dense chart's plain and
+/// Broyden loops and the sparse chart's loop: the iteration count, the last two residuals, the
+/// tolerance and the round-off cap below which a stall is accepted.
+pub(crate) struct ChordLoop {
+    t: f64,
+    tol: f64,
+    max_iter: usize,
+    divergence: f64,
+    predicted: bool,
+    /// `f` cannot be evaluated more accurately than about `eps |Phi_q| |v|` (and `eps |theta|`
+    /// in `sin theta`): a stall below this cap is the round-off floor, not slow convergence.
+    stall_cap: f64,
+    /// The residual at the start.
+    pub(crate) res0: f64,
+    /// The current residual.
+    pub(crate) res: f64,
+    /// The residual before the last correction (infinite before the first).
+    pub(crate) prev: f64,
+    /// Corrections made.
+    pub(crate) it: usize,
+}
+
+impl ChordLoop {
+    /// An iteration at time `t` from `x` with residual `res0`; `predicted` for a stage map
+    /// ([`TangentChart::map_predicted`]).
+    pub(crate) fn new(
+        t: f64,
+        x: &[f64],
+        res0: f64,
+        newton: &NewtonSettings,
+        predicted: bool,
+    ) -> Self {
+        let tol = newton.tol;
+        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        ChordLoop {
+            t,
+            tol,
+            max_iter: newton.max_iter,
+            divergence: newton.divergence,
+            predicted,
+            stall_cap: (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax)),
+            res0,
+            res: res0,
+            prev: f64::INFINITY,
+            it: 0,
+        }
+    }
+
+    /// The verdict before a correction ([`loop_head`]).
+    pub(crate) fn head(&self) -> Option<Result<MapStats, ChartFailure>> {
+        loop_head(
+            self.t,
+            self.res,
+            self.res0,
+            self.it,
+            self.tol,
+            self.max_iter,
+        )
+    }
+
+    /// After a correction: counts it and, for a stage map, stops on the predicted residual
+    /// ([`predicted_stop`]).
+    pub(crate) fn corrected(&mut self) -> Option<MapStats> {
+        self.it += 1;
+        predicted_stop(
+            self.predicted,
+            self.res,
+            self.prev,
+            self.tol,
+            self.it,
+            self.res0,
+        )
+    }
+
+    /// Records the residual `res` of the corrected point and accepts a stall at the round-off
+    /// floor ([`stalled`]).
+    pub(crate) fn evaluated(&mut self, res: f64) -> Option<MapStats> {
+        self.prev = self.res;
+        self.res = res;
+        stalled(
+            self.res,
+            self.prev,
+            self.tol,
+            self.stall_cap,
+            self.it,
+            self.res0,
+        )
+    }
+
+    /// Divergence over the last correction ([`diverged`]).
+    pub(crate) fn diverged(&self) -> Option<ChartFailure> {
+        diverged(
+            self.t,
+            self.res,
+            self.prev,
+            self.tol,
+            self.divergence,
+            self.it,
+        )
     }
 }
 

@@ -25,7 +25,7 @@ mod settings;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use chord::{diverged, fast_max, loop_head, predicted_stop, stalled, travel_within};
+pub(crate) use chord::{fast_max, loop_head, travel_within, ChordLoop};
 pub use settings::{ChartFailure, MapStats, NewtonSettings};
 
 /// A chart of the manifold `f(x, t) = (Phi(q, t), Phi_q v + Phi_t) = 0` at a centre

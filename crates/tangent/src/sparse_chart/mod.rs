@@ -2,8 +2,8 @@
 //! the projector `P = I - Df^T G^-1 Df` and the chord iteration on `eta`, all through one sparse
 //! Cholesky factorisation of `G = Df(x_c) Df(x_c)^T` per centre (`docs/tangent.md` section 9).
 
-use crate::chart::{diverged, fast_max, predicted_stop, stalled, travel_within};
-use crate::chart::{loop_head, ChartFailure, MapStats, NewtonSettings, ROUNDOFF_FACTOR};
+use crate::chart::{fast_max, travel_within, ChordLoop};
+use crate::chart::{ChartFailure, MapStats, NewtonSettings};
 use mbd_model::numeric::max_abs;
 use mbd_model::{AngleCache, System};
 use mbd_solve::linalg::FactorError;
@@ -471,15 +471,10 @@ impl SparseChart {
         self.angles.invalidate();
         self.x0.copy_from_slice(x);
         self.first_step = 0.0;
-        let tol = newton.tol;
         let res0 = self.residual_cached(sys, x, t, f);
-        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
-        let mut res = res0;
-        let mut prev = f64::INFINITY;
-        let mut it = 0;
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
         loop {
-            if let Some(verdict) = loop_head(t, res, res0, it, tol, newton.max_iter) {
+            if let Some(verdict) = lp.head() {
                 return verdict;
             }
             for (dk, fk) in d.iter_mut().zip(f.iter()) {
@@ -490,22 +485,20 @@ impl SparseChart {
             for (e, dk) in eta.iter_mut().zip(d.iter()) {
                 *e += dk;
             }
-            it += 1;
-            if it == 1 {
+            if lp.it == 0 {
                 self.first_step = x
                     .iter()
                     .zip(&self.x0)
                     .fold(0.0f64, |s, (a, b)| fast_max(s, (a - b).abs()));
             }
-            if let Some(ms) = predicted_stop(predicted, res, prev, tol, it, res0) {
+            if let Some(ms) = lp.corrected() {
                 return Ok(ms);
             }
-            prev = res;
-            res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = stalled(res, prev, tol, stall_cap, it, res0) {
+            let res = self.residual_cached(sys, x, t, f);
+            if let Some(ms) = lp.evaluated(res) {
                 return Ok(ms);
             }
-            if let Some(e) = diverged(t, res, prev, tol, newton.divergence, it) {
+            if let Some(e) = lp.diverged() {
                 return Err(e);
             }
         }
