@@ -405,7 +405,7 @@ impl Preadjustment {
         Ok(())
     }
 
-    /// The 23 terms of `e4(q, v)` ([`E4_TERMS`], without their coefficients), at `q` with
+    /// The 23 terms of `e4(q, v)` (`E4_TERMS`, without their coefficients), at `q` with
     /// the velocity `v` (tangent, or a step's chord). Allocates its workspace on first use.
     pub fn modified_terms_s2(
         &mut self,
@@ -422,7 +422,7 @@ impl Preadjustment {
     }
 
     /// The `h^4` modified-Lagrangian term of the (2,2) scheme, `e4(q, v) = sum_i c_i T_i`
-    /// ([`E4_TERMS`], [`Preadjustment::modified_terms_s2`]).
+    /// (`E4_TERMS`, [`Preadjustment::modified_terms_s2`]).
     pub fn modified_term_s2(
         &mut self,
         sys: &System,
