@@ -1,4 +1,4 @@
-//! Settings and outcomes of the chart maps: [`NewtonSettings`], [`ChartFailure`], [`MapStats`].
+//! Settings and outcomes of the chart maps: [`NewtonSettings`], chart failure, [`MapStats`].
 
 use mbd_solve::SolveError;
 
@@ -11,10 +11,10 @@ pub struct NewtonSettings {
     /// `max(10 tol, ROUNDOFF_FACTOR eps (1 + ||x||_inf))` (fast motion, or angles wound up over
     /// long runs, raise the floor of `Phi_q v` and `sin theta`).
     pub tol: f64,
-    /// Iteration limit; reaching it is a [`ChartFailure`].
+    /// Iteration limit; reaching it is a chart failure.
     pub max_iter: usize,
     /// Divergence test: an iteration whose residual exceeds `divergence` times the previous one
-    /// ends the iteration with a [`ChartFailure`] (the point has left the chart's domain).
+    /// ends the iteration with a chart failure (the point has left the chart's domain).
     pub divergence: f64,
     /// Near-singular charts: a chord iteration that fails is retried by Newton's method with
     /// the exact matrix `Df(x) Q1` at every iterate (one `Df` and a `2m x 2m` LU per
@@ -23,7 +23,7 @@ pub struct NewtonSettings {
     /// Then the step is small for the geometry and the chord failed because `Df(x_c)` is
     /// nearly rank deficient (its smallest singular value is of the size of the change), as
     /// near a singular configuration: shorter steps would not help there. A larger change
-    /// means the step is too large for the chart, which stays a [`ChartFailure`] (halving or
+    /// means the step is too large for the chart, which stays a chart failure (halving or
     /// rejection). Default 0.1; 0 turns the fallback off.
     pub fallback_change: f64,
 }

@@ -43,7 +43,7 @@ enum Attempt {
 /// to the Newton tolerance. Allocation-free per step after [`TangentRk::new`].
 ///
 /// Above [`mbd_solve::SPARSE_THRESHOLD`] constraint equations (or as chosen by
-/// [`TangentOptions::linear_solver`]) the chart is a [`SparseChart`]: the state equation is
+/// [`TangentOptions::linear_solver`]) the chart is a sparse one: the state equation is
 /// integrated in redundant coordinates `y = U xi` in `ker Df(x_c)` (`y' = P F`), which gives
 /// the same steps up to rounding at `O(N)` cost for chains.
 #[derive(Debug)]

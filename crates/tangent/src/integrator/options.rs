@@ -20,7 +20,7 @@ pub enum IterationMatrix {
     Interpolated,
     /// Starts each chart from the centre's `R^-T` and improves the iteration's inverse matrix
     /// by good Broyden rank-one updates after every correction, carried from one map of the
-    /// step to the next ([`crate::TangentChart::set_broyden`]): superlinear convergence for `O(n m)`
+    /// step to the next (carried from map to map): superlinear convergence for `O(n m)`
     /// more work per iteration, no extra `Df`. On the manipulator it saves a third of the
     /// iterations at `h = 0.01` but costs more per step than the centre chord (the residual is
     /// cheap there; `docs/tangent.md`), so it is not the default.
@@ -59,9 +59,9 @@ pub struct TangentOptions {
     /// point). Default 1e-2; must lie in [0, 1).
     pub stage_tol_ratio: f64,
     /// Which chart: [`LinearSolver::Dense`] the QR chart with an orthonormal tangent basis
-    /// ([`crate::TangentChart`], `O(n^3)` per step), [`LinearSolver::Sparse`] the chart in
+    /// (`O(n^3)` per step), [`LinearSolver::Sparse`] the chart in
     /// redundant tangent coordinates on the sparse Cholesky factorisation of `Df Df^T`
-    /// ([`crate::SparseChart`], `O(n)` per step for chains; centre iteration matrix only, no
+    /// (`O(n)` per step for chains; centre iteration matrix only, no
     /// exact-Newton fallback), [`LinearSolver::Auto`] (default) dense up to
     /// [`mbd_solve::SPARSE_THRESHOLD`] constraint equations, sparse above. Both give the same
     /// trajectory up to rounding (`docs/tangent.md` section 9).
