@@ -170,6 +170,13 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
              (rk4-projected, symplectic:S, tangent:rk4)"
         }
         SolveError::Observer { .. } => "; check the output path and the free disk space",
+        // a refusal of the model or the setting: no step size helps
+        SolveError::Unsupported(_)
+        | SolveError::InvalidParameter { .. }
+        | SolveError::Dimension { .. }
+        | SolveError::SolverSpec { .. }
+        | SolveError::UnknownSolver { .. }
+        | SolveError::Model(_) => "; `mbd solvers` lists what each solver refuses",
         _ => "; try a smaller --h (or --tol), or another --solver",
     };
     CliError::Solve {
