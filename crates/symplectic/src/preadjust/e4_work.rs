@@ -1,19 +1,20 @@
-//! The workspace of the `s = 2` modified-Lagrangian term `e4` and its gradients
-//! (`modified2.rs`, `modified2_grad.rs`): allocated on first use, reused by every evaluation.
+//! The `s = 2` modified-Lagrangian term `e4` as a type ([`ModifiedS2`]: its workspace, the
+//! forward evaluation in `modified2.rs`, the gradients in `modified2_grad.rs`) and the adjoints'
+//! workspace.
 
+use super::metric::ProjectedMetric;
 use super::modified2::{E4Forward, Pass};
 use super::modified2_grad::BasisR;
-use super::Preadjustment;
 use mbd_model::System;
 
 /// The element-local columns of a constraint row: the first coordinate of the joint's body a
 /// (local columns 0..3) and of its body b (3..6), `None` for ground.
 pub(super) type Cols = [Option<usize>; 2];
 
-/// The workspace of `e4` and its gradients: the forward intermediates, the adjoints and the
-/// element-local columns of the constraint rows.
+/// The term `e4` and the workspace of its value and gradients: the forward intermediates, the
+/// adjoints and the element-local columns of the constraint rows.
 #[derive(Debug)]
-pub(crate) struct E4Work {
+pub(crate) struct ModifiedS2 {
     pub(super) f: E4Forward,
     pub(super) b: Adjoints,
     /// The element-local columns of each constraint row ([`Cols`]).
@@ -146,10 +147,10 @@ pub(super) fn gbar_add(gbar: &mut [[f64; 6]], cols: &[Cols], c: f64, al: &[f64],
     }
 }
 
-impl E4Work {
+impl ModifiedS2 {
     fn new(sys: &System) -> Self {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let mut w = E4Work {
+        let mut w = ModifiedS2 {
             f: E4Forward::new(n, m, sys.forces().len()),
             b: Adjoints::new(n, m),
             cols: vec![[None; 2]; m],
@@ -170,20 +171,24 @@ impl E4Work {
     }
 }
 
-impl Preadjustment {
-    /// The `e4` workspace for `sys`, taken out of `self` (give it back with
-    /// `self.e4 = Some(..)`).
-    pub(super) fn e4_work(&mut self, sys: &System) -> Box<E4Work> {
-        match self.e4.take() {
-            Some(mut w)
-                if w.f.u.len() == self.n
-                    && w.cols.len() == self.m
-                    && w.f.pa.pgrads.len() == sys.forces().len() =>
-            {
-                w.set_cols(sys);
-                w
-            }
-            _ => Box::new(E4Work::new(sys)),
-        }
+/// The `e4` workspace in `slot` for `sys` and `metric` (allocated on first use, or again when
+/// the system's sizes changed; the constraint rows' columns follow `sys`).
+pub(super) fn ensure_s2<'a>(
+    slot: &'a mut Option<Box<ModifiedS2>>,
+    metric: &ProjectedMetric,
+    sys: &System,
+) -> &'a mut ModifiedS2 {
+    let fits = slot.as_ref().is_some_and(|w| {
+        w.f.u.len() == metric.n()
+            && w.cols.len() == metric.m()
+            && w.f.pa.pgrads.len() == sys.forces().len()
+    });
+    if !fits {
+        *slot = None;
     }
+    let w = slot.get_or_insert_with(|| Box::new(ModifiedS2::new(sys)));
+    if fits {
+        w.set_cols(sys);
+    }
+    w
 }

@@ -18,11 +18,13 @@
 //! `n`, which needs pass A's `gamma`), pass C along `(v, K2, K3)`; each keeps its coefficients'
 //! gradients for the reverse pass.
 
-use super::{dot, Preadjustment};
+use super::dot;
+use super::e4_work::ModifiedS2;
+use super::metric::ProjectedMetric;
 use mbd_model::{Basis, BodyAngles, PolyWorkspace, System, MAX_DIRS};
 use mbd_solve::SolveError;
 
-/// The terms of `e4` and their coefficients, in the order of [`Preadjustment::modified_term_s2`]'s
+/// The terms of `e4` and their coefficients, in the order of [`super::Preadjustment::modified_terms_s2`]'s
 /// evaluation (`S` in a name stands for `S^-1`).
 pub(crate) const E4_TERMS: [(&str, f64); 23] = [
     ("v H_sigma Pi H_mu v", 1.0 / 720.0),
@@ -302,55 +304,23 @@ impl E4Forward {
     }
 }
 
-impl Preadjustment {
-    /// `out = -D G^T S^-1 x` (`D = M^-1`; `s` receives `S^-1 x`).
-    pub(super) fn neg_e_into(&mut self, x: &[f64], s: &mut [f64], out: &mut [f64]) {
-        s.copy_from_slice(x);
-        self.s_solve(s);
-        self.dgt_into(s, out);
-        out.iter_mut().for_each(|o| *o = -*o);
-    }
-
-    /// `out = D G^T x` (x of length m).
-    pub(super) fn dgt_into(&self, x: &[f64], out: &mut [f64]) {
-        out.fill(0.0);
-        self.add_dgt_to(x, 1.0, out);
-    }
-
-    /// `pi = Pi x` (bit for bit `apply_pi`) and `sg = S^-1 G M^-1 x` (`sgm`, the solve inside
-    /// `Pi x`), by one solve.
-    fn pi_sgm(&mut self, x: &[f64], pi: &mut [f64], sg: &mut [f64]) {
-        for ((p, xi), mi) in pi.iter_mut().zip(x).zip(&self.minv) {
-            *p = mi * xi;
-        }
-        if self.m == 0 {
-            return;
-        }
-        self.sgm(x, sg);
-        self.add_dgt_to(sg, -1.0, pi);
-    }
-
-    /// `out = S^-1 x`.
-    pub(super) fn s_inv_into(&mut self, x: &[f64], out: &mut [f64]) {
-        out.copy_from_slice(x);
-        self.s_solve(out);
-    }
-
-    /// Evaluates the intermediates of `e4` at `q` with the velocity `v` into `f` (after
-    /// `check_v`; prepares the workspace at `q`); the passes keep their coefficient gradients
-    /// for the reverse pass. Allocates nothing.
-    pub(super) fn e4_forward(
+impl ModifiedS2 {
+    /// Evaluates the intermediates of `e4` at `q` with the velocity `v` into `self.f` (after
+    /// the caller checked `v`; prepares the metric at `q`); the passes keep their coefficient
+    /// gradients for the reverse pass. Allocates nothing.
+    pub(super) fn forward(
         &mut self,
+        metric: &mut ProjectedMetric,
         sys: &System,
         q: &[f64],
         v: &[f64],
-        f: &mut E4Forward,
     ) -> Result<(), SolveError> {
-        self.prepare(sys, q)?;
-        let m = self.m;
+        metric.prepare(sys, q)?;
+        let m = metric.m();
+        let f = &mut self.f;
         f.angles.update(sys, q);
-        f.u.copy_from_slice(&self.u);
-        f.mu0.copy_from_slice(&self.mu0);
+        f.u.copy_from_slice(metric.u());
+        f.mu0.copy_from_slice(metric.mu0());
         // pass A along (v, u): gamma, beta, D^3 Phi(v^3), D^4 Phi(v^4), D^3 Phi(v, v, u), the
         // rows Hess Phi_r v and Hess Phi_r u, and of V: D^4 V(v^4), D^3 V(u, v, v), H v, H u
         f.pa.eval(sys, q, &f.angles, &[v, &f.u]);
@@ -363,8 +333,8 @@ impl Preadjustment {
         }
         f.pa.pot_grad_into(sys, A_T, &mut f.hv);
         f.pa.pot_grad_into(sys, A_E, &mut f.hu);
-        self.neg_e_into(&f.gam, &mut f.sig, &mut f.nn);
-        self.neg_e_into(&f.beta, &mut f.s_beta, &mut f.k2);
+        metric.neg_e_into(&f.gam, &mut f.sig, &mut f.nn);
+        metric.neg_e_into(&f.beta, &mut f.s_beta, &mut f.k2);
         // pass B along (v, n, u): D^2 Phi(n, v), D^3 Phi(v, v, n), D^2 Phi(n, n), D^2 Phi(n, u),
         // and of V: D^3 V(n, v, v), H n
         f.pb.eval(sys, q, &f.angles, &[v, &f.nn, &f.u]);
@@ -372,7 +342,7 @@ impl Preadjustment {
         for r in 0..m {
             f.kap3[r] = 6.0 * f.pa.vals[r][A_TTT] + 3.0 * f.pb.vals[r][B_ET];
         }
-        self.neg_e_into(&f.kap3, &mut f.s_kap3, &mut f.k3);
+        metric.neg_e_into(&f.kap3, &mut f.s_kap3, &mut f.k3);
         // pass C along (v, K2, K3): D^2 Phi(K2, v), D^2 Phi(K3, v)
         f.pc.eval(sys, q, &f.angles, &[v, &f.k2, &f.k3]);
         for r in 0..m {
@@ -390,53 +360,31 @@ impl Preadjustment {
             out.fill(0.0);
             sys.add_local_rows(rows, w, out);
         }
-        self.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
+        metric.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
         if sys.forces().is_empty() {
             // (H v = 0: gravity is linear)
             f.pi_hv.fill(0.0);
             f.sg_hv.fill(0.0);
         } else {
-            self.pi_sgm(&f.hv, &mut f.pi_hv, &mut f.sg_hv);
+            metric.pi_sgm(&f.hv, &mut f.pi_hv, &mut f.sg_hv);
         }
-        self.pi_sgm(&f.hsig_v, &mut f.pi_hsig_v, &mut f.sg_hsig_v);
+        metric.pi_sgm(&f.hsig_v, &mut f.pi_hsig_v, &mut f.sg_hsig_v);
         f.d3v_u = 2.0 * f.pa.pot[A_ETT];
         f.d3v_n = 2.0 * f.pb.pot[B_ETT];
         f.d4v = 24.0 * f.pa.pot[A_T4];
         Ok(())
     }
 
-    /// The 23 terms of `e4(q, v)` ([`E4_TERMS`], without their coefficients), at `q` with
-    /// the velocity `v` (tangent, or a step's chord). Allocates its workspace on first use.
-    pub fn modified_terms_s2(
-        &mut self,
-        sys: &System,
-        q: &[f64],
-        v: &[f64],
-    ) -> Result<[f64; 23], SolveError> {
-        self.check_v(v)?;
-        let mut w = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut w.f);
-        let terms = w.f.terms();
-        self.e4 = Some(w);
-        res.map(|()| terms)
-    }
-
-    /// The `h^4` modified-Lagrangian term of the (2,2) scheme, `e4(q, v) = sum_i c_i T_i`
-    /// ([`E4_TERMS`], [`Preadjustment::modified_terms_s2`]).
-    pub fn modified_term_s2(
-        &mut self,
-        sys: &System,
-        q: &[f64],
-        v: &[f64],
-    ) -> Result<f64, SolveError> {
-        let t = self.modified_terms_s2(sys, q, v)?;
-        Ok(t.iter().zip(E4_TERMS.iter()).map(|(x, (_, c))| c * x).sum())
+    /// The 23 terms of the last forward evaluation ([`E4_TERMS`], without their coefficients).
+    pub(super) fn terms(&self) -> [f64; 23] {
+        self.f.terms()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Preadjustment;
     use mbd_model::models;
 
     /// The positions and velocities of a revolute chain of unit rods pinned at the origin, with
@@ -488,7 +436,7 @@ mod tests {
             0.1331349285714281,
             0.05536878571428572,
         ];
-        let spring = super::super::modified::modlag_tests::rod_with_spring();
+        let spring = super::super::modified_s1::modlag_tests::rod_with_spring();
         let (qb, vb) = chain_state(&[-std::f64::consts::FRAC_PI_4], &[0.9]);
         let ref_b = [
             -3.527664921849408,

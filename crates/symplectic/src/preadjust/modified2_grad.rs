@@ -35,14 +35,13 @@
 //!   `Gb -= a (D G^T z)^T + z (D G^T a)^T` with `a = S^-1 zb`;
 //! * `u = -D g + D G^T mu0`, `mu0 = S^-1 G D g` (`g = grad V`), and `gb` to `qb` by `Hess V`.
 
-use super::e4_work::{gbar_add, Adjoints, Cols, E4Work};
+use super::e4_work::{gbar_add, Adjoints, Cols, ModifiedS2};
+use super::metric::ProjectedMetric;
 use super::modified2::{
     comb_into, BasisA, BasisB, BasisC, E4Forward, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE,
     B_ET, B_ETT, C_AT, C_BT, E4_TERMS,
 };
-use super::Preadjustment;
 use mbd_model::{Basis, BodyAngles, System, MAX_DIRS};
-use mbd_solve::SolveError;
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
     for (a, b) in y.iter_mut().zip(x) {
@@ -50,64 +49,53 @@ fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
     }
 }
 
-impl Preadjustment {
-    /// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
-    /// adjoint `yb`; `Gb` updated.
-    fn adj_neg_e(&mut self, w: &mut Adjoints, cols: &[Cols], z: &[f64], yb: &[f64]) {
-        let [dyb, dz, da, ..] = &mut w.tn;
-        for ((d, y), mi) in dyb.iter_mut().zip(yb).zip(&self.minv) {
-            *d = mi * y;
-        }
-        gbar_add(&mut w.gbar, cols, -1.0, z, dyb);
-        let a = &mut w.tm[0];
-        self.sgm(yb, a);
-        a.iter_mut().for_each(|x| *x = -*x);
-        self.dgt_into(z, dz);
-        self.dgt_into(a, da);
-        gbar_add(&mut w.gbar, cols, -1.0, a, dz);
-        gbar_add(&mut w.gbar, cols, -1.0, z, da);
+/// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
+/// adjoint `yb`; `Gb` updated.
+fn adj_neg_e(metric: &mut ProjectedMetric, w: &mut Adjoints, cols: &[Cols], z: &[f64], yb: &[f64]) {
+    let [dyb, dz, da, ..] = &mut w.tn;
+    for ((d, y), mi) in dyb.iter_mut().zip(yb).zip(metric.minv()) {
+        *d = mi * y;
     }
+    gbar_add(&mut w.gbar, cols, -1.0, z, dyb);
+    let a = &mut w.tm[0];
+    metric.sgm(yb, a);
+    a.iter_mut().for_each(|x| *x = -*x);
+    metric.dgt_into(z, dz);
+    metric.dgt_into(a, da);
+    gbar_add(&mut w.gbar, cols, -1.0, a, dz);
+    gbar_add(&mut w.gbar, cols, -1.0, z, da);
+}
 
-    /// The value of `e4(q, v)` ([`Preadjustment::modified_term_s2`]) and its exact gradients
-    /// `de4/dq` into `gq` and `de4/dv` into `gv` (both length n, overwritten), by one forward
-    /// evaluation and a reverse pass (module doc). Allocates its workspace on first use only.
-    pub fn modified_gradients_s2(
+impl ModifiedS2 {
+    /// The value of `e4(q, v)` and its exact gradients `de4/dq` into `gq` and `de4/dv` into
+    /// `gv` (both length n, checked by the caller, overwritten), by one forward evaluation
+    /// and a reverse pass (module doc).
+    pub(super) fn gradients(
         &mut self,
+        metric: &mut ProjectedMetric,
         sys: &System,
         q: &[f64],
         v: &[f64],
         gq: &mut [f64],
         gv: &mut [f64],
-    ) -> Result<f64, SolveError> {
-        self.check_v(v)?;
-        for (what, got) in [("de4/dq", gq.len()), ("de4/dv", gv.len())] {
-            if got != self.n {
-                return Err(SolveError::Dimension {
-                    what,
-                    expected: self.n,
-                    got,
-                });
-            }
-        }
-        let mut work = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut work.f);
-        let out = res.map(|()| self.e4_reverse(sys, q, v, &mut work, gq, gv));
-        self.e4 = Some(work);
-        out
+    ) -> Result<f64, mbd_solve::SolveError> {
+        self.forward(metric, sys, q, v)?;
+        Ok(self.reverse(metric, sys, q, v, gq, gv))
     }
 
-    /// The reverse pass after `e4_forward` at the same `(q, v)`; returns `e4`.
-    fn e4_reverse(
+    /// The reverse pass after [`ModifiedS2::forward`] at the same `(q, v)`; returns `e4`.
+    #[allow(clippy::too_many_arguments)]
+    fn reverse(
         &mut self,
+        metric: &mut ProjectedMetric,
         sys: &System,
         q: &[f64],
         v: &[f64],
-        work: &mut E4Work,
         gq: &mut [f64],
         gv: &mut [f64],
     ) -> f64 {
-        let m = self.m;
-        let E4Work { f, b: w, cols } = work;
+        let m = metric.m();
+        let ModifiedS2 { f, b: w, cols } = self;
         let cols = cols.as_slice();
         let terms = f.terms();
         let c: [f64; 23] = std::array::from_fn(|i| E4_TERMS[i].1);
@@ -178,7 +166,7 @@ impl Preadjustment {
 
         // 2. the Hessian-vector products: the constraint-weighted ones by pass R, those of V
         //    by polarised third-order passes over the force elements
-        self.hvp_weighted_adj(sys, q, v, f, w, gq, gv);
+        hvp_weighted_adj(metric.m(), sys, q, v, f, w, gq, gv);
         if pot {
             let zero = f.zero_m.as_slice();
             let ang = &f.angles;
@@ -215,7 +203,7 @@ impl Preadjustment {
 
         // 5. k3 = -D G^T S^-1 kappa3, kappa3 = 6 A[t^3] + 3 B[e t]
         let k3b = std::mem::take(&mut w.k3b);
-        self.adj_neg_e(w, cols, &f.s_kap3, &k3b);
+        adj_neg_e(metric, w, cols, &f.s_kap3, &k3b);
         w.k3b = k3b;
         axpy(&mut w.kap3b, 1.0, &w.tm[0]);
         for r in 0..m {
@@ -224,7 +212,7 @@ impl Preadjustment {
         }
         // 6. k2 = -D G^T S^-1 beta, beta = A[e t]
         let k2b = std::mem::take(&mut w.k2b);
-        self.adj_neg_e(w, cols, &f.s_beta, &k2b);
+        adj_neg_e(metric, w, cols, &f.s_beta, &k2b);
         w.k2b = k2b;
         axpy(&mut w.betab, 1.0, &w.tm[0]);
         for r in 0..m {
@@ -243,15 +231,15 @@ impl Preadjustment {
         {
             let [dn, dsig, da, ..] = &mut w.tn;
             let [t, a, ..] = &mut w.tm;
-            for ((d, x), mi) in dn.iter_mut().zip(&w.nnb).zip(&self.minv) {
+            for ((d, x), mi) in dn.iter_mut().zip(&w.nnb).zip(metric.minv()) {
                 *d = mi * x;
             }
-            self.g_times(dn, t);
+            metric.g_times(dn, t);
             gbar_add(&mut w.gbar, cols, -1.0, &f.sig, dn);
             axpy(&mut w.sigb, -1.0, t);
-            self.s_inv_into(&w.sigb, a);
-            self.dgt_into(&f.sig, dsig);
-            self.dgt_into(a, da);
+            metric.s_inv_into(&w.sigb, a);
+            metric.dgt_into(&f.sig, dsig);
+            metric.dgt_into(a, da);
             gbar_add(&mut w.gbar, cols, -1.0, a, dsig);
             gbar_add(&mut w.gbar, cols, -1.0, &f.sig, da);
             for r in 0..m {
@@ -270,21 +258,21 @@ impl Preadjustment {
         {
             let [dub, da, dg, dmu, t, ..] = &mut w.tn;
             let [s, a, ..] = &mut w.tm;
-            for ((d, x), mi) in dub.iter_mut().zip(&w.ub).zip(&self.minv) {
+            for ((d, x), mi) in dub.iter_mut().zip(&w.ub).zip(metric.minv()) {
                 *d = mi * x;
             }
-            self.g_times(dub, s);
+            metric.g_times(dub, s);
             axpy(&mut w.mu0b, 1.0, s);
             axpy(&mut w.gradb, -1.0, dub);
             gbar_add(&mut w.gbar, cols, 1.0, &f.mu0, dub);
-            self.s_inv_into(&w.mu0b, a);
-            self.dgt_into(a, da);
+            metric.s_inv_into(&w.mu0b, a);
+            metric.dgt_into(a, da);
             axpy(&mut w.gradb, 1.0, da);
-            for ((d, x), mi) in dg.iter_mut().zip(&self.g).zip(&self.minv) {
+            for ((d, x), mi) in dg.iter_mut().zip(metric.grad_v()).zip(metric.minv()) {
                 *d = mi * x;
             }
             gbar_add(&mut w.gbar, cols, 1.0, a, dg);
-            self.dgt_into(&f.mu0, dmu);
+            metric.dgt_into(&f.mu0, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
             sys.lagrangian_hessian_vector_at(q, &f.angles, &w.gradb, 1.0, &f.zero_m, t);
@@ -382,40 +370,38 @@ impl Basis<11> for BasisR {
 const R_Y: [usize; 4] = [3, 4, 5, 6];
 const R_XY: [usize; 4] = [7, 8, 9, 10];
 
-impl Preadjustment {
-    /// The adjoints of the four constraint-weighted Hessian-vector products `y = H_w x`
-    /// (`H_w = sum_r w_r Hess Phi_r`) for `(x, w) = (v, sigma), (v, mu0), (u, sigma), (u,
-    /// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`]): `qb += D^3 (w . Phi)(x, yb,
-    /// .)` (the `q`-gradients of `x yb`), `xb += H_w yb` (those of `yb`), `wb_r += yb^T Hess
-    /// Phi_r x` (the coefficients of `x yb`).
-    #[allow(clippy::too_many_arguments)]
-    fn hvp_weighted_adj(
-        &self,
-        sys: &System,
-        q: &[f64],
-        v: &[f64],
-        f: &E4Forward,
-        w: &mut Adjoints,
-        gq: &mut [f64],
-        gv: &mut [f64],
-    ) {
-        let dirs: [&[f64]; 6] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
-        w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
-        for r in 0..self.m {
-            let (s, mu) = (f.sig[r], f.mu0[r]);
-            let c = &w.rpass.vals[r];
-            w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
-            w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
-            // weights of q (the x yb coefficients), of v (y1, y2) and of u (y3, y4)
-            let mut x = [[0.0; 11]; 3];
-            for (i, wt) in [s, mu, s, mu].into_iter().enumerate() {
-                x[0][R_XY[i]] = wt;
-                x[1 + i / 2][R_Y[i]] = wt;
-            }
-            w.rw[r] = x;
+/// The adjoints of the four constraint-weighted Hessian-vector products `y = H_w x`
+/// (`H_w = sum_r w_r Hess Phi_r`) for `(x, w) = (v, sigma), (v, mu0), (u, sigma), (u,
+/// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`]): `qb += D^3 (w . Phi)(x, yb,
+/// .)` (the `q`-gradients of `x yb`), `xb += H_w yb` (those of `yb`), `wb_r += yb^T Hess
+/// Phi_r x` (the coefficients of `x yb`).
+#[allow(clippy::too_many_arguments)]
+fn hvp_weighted_adj(
+    m: usize,
+    sys: &System,
+    q: &[f64],
+    v: &[f64],
+    f: &E4Forward,
+    w: &mut Adjoints,
+    gq: &mut [f64],
+    gv: &mut [f64],
+) {
+    let dirs: [&[f64]; 6] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
+    w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
+    for r in 0..m {
+        let (s, mu) = (f.sig[r], f.mu0[r]);
+        let c = &w.rpass.vals[r];
+        w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
+        w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
+        // weights of q (the x yb coefficients), of v (y1, y2) and of u (y3, y4)
+        let mut x = [[0.0; 11]; 3];
+        for (i, wt) in [s, mu, s, mu].into_iter().enumerate() {
+            x[0][R_XY[i]] = wt;
+            x[1 + i / 2][R_Y[i]] = wt;
         }
-        sys.add_constraint_poly_grads_many(&w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
+        w.rw[r] = x;
     }
+    sys.add_constraint_poly_grads_many(&w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
 }
 
 /// The adjoint of a pass ([`Pass`]) with the adjoint weights `wts` of its rows' coefficients
@@ -435,7 +421,7 @@ fn contract<const K: usize, B: Basis<K>>(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::Preadjustment;
     use mbd_model::models;
 
     /// The reverse-pass gradients against fourth-order central differences of `e4`, on paper
@@ -445,7 +431,7 @@ mod tests {
     fn gradients_match_differences() {
         let systems = [
             models::paper_a_double_pendulum().unwrap(),
-            super::super::modified::modlag_tests::rod_with_spring(),
+            super::super::modified_s1::modlag_tests::rod_with_spring(),
             models::n_link_chain(3).unwrap(),
             models::elastic_pendulum().unwrap(),
         ];
