@@ -6,17 +6,15 @@ use mbd_model::System;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
-mod e4_work;
 mod metric;
-mod modified2;
-mod modified2_grad;
 mod modified_s1;
+mod modified_s2;
 mod paper;
 mod stiffness;
 
 use metric::ProjectedMetric;
-pub(crate) use modified2::E4_TERMS;
 use modified_s1::ModifiedS1;
+pub(crate) use modified_s2::E4_TERMS;
 use paper::PaperTerm;
 use stiffness::TangentStiffness;
 
@@ -37,7 +35,7 @@ pub struct Preadjustment {
     paper: PaperTerm,
     s1: ModifiedS1,
     /// The `s = 2` term (allocated on first use).
-    s2: Option<Box<e4_work::ModifiedS2>>,
+    s2: Option<Box<modified_s2::ModifiedS2>>,
     /// Relative step of the finite-difference checks of the derivatives (tests); the
     /// derivatives used by the integrator are exact.
     pub(crate) fd_step: f64,
@@ -342,7 +340,7 @@ impl Preadjustment {
         v: &[f64],
     ) -> Result<[f64; 23], SolveError> {
         self.metric.check_v(v)?;
-        let term = e4_work::ensure_s2(&mut self.s2, &self.metric, sys);
+        let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.forward(&mut self.metric, sys, q, v)?;
         Ok(term.terms())
     }
@@ -381,7 +379,7 @@ impl Preadjustment {
                 });
             }
         }
-        let term = e4_work::ensure_s2(&mut self.s2, &self.metric, sys);
+        let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.gradients(&mut self.metric, sys, q, v, gq, gv)
     }
 }

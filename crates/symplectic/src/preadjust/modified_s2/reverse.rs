@@ -1,15 +1,15 @@
-//! Exact gradients of the `h^4` modified-Lagrangian term `e4(q, v)` (`modified2.rs`): one
+//! Exact gradients of the `h^4` modified-Lagrangian term `e4(q, v)`: one
 //! forward evaluation that keeps its intermediates ([`E4Forward`]), then a reverse
 //! (adjoint) pass through them, so `de4/dq` and `de4/dv` cost a fixed number of passes over the
 //! elements, independent of `n` (central differences took `8 n` evaluations of `e4`). Both
-//! run in a workspace allocated on first use ([`E4Work`]): nothing is allocated per call. Every
+//! run in a workspace allocated on first use ([`ModifiedS2`]): nothing is allocated per call. Every
 //! element pass at `q` takes the bodies' `sin`/`cos` from one table ([`mbd_model::BodyAngles`]).
 //!
 //! The reverse pass needs, besides the linear algebra's adjoints, the adjoints of three
 //! primitives:
 //!
 //! * a pass of multivariate Taylor jets ([`mbd_model::PolyJet`]; passes A, B, C of
-//!   `modified2.rs`): the forward evaluation keeps every coefficient's element-local gradient
+//!   `forward.rs`): the forward evaluation keeps every coefficient's element-local gradient
 //!   with respect to `q`, and the reverse pass contracts them with the coefficients' adjoint
 //!   weights, which gives the gradient with respect to `q` and, through the basis' division
 //!   table, with respect to every direction of the pass
@@ -35,13 +35,22 @@
 //!   `Gb -= a (D G^T z)^T + z (D G^T a)^T` with `a = S^-1 zb`;
 //! * `u = -D g + D G^T mu0`, `mu0 = S^-1 G D g` (`g = grad V`), and `gb` to `qb` by `Hess V`.
 
-use super::e4_work::{gbar_add, Adjoints, Cols, ModifiedS2};
-use super::metric::ProjectedMetric;
-use super::modified2::{
-    comb_into, BasisA, BasisB, BasisC, E4Forward, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE,
-    B_ET, B_ETT, C_AT, C_BT, E4_TERMS,
+use super::adjoints::{gbar_add, Adjoints, Cols};
+use super::forward::E4Forward;
+use super::passes::{
+    BasisA, BasisB, BasisC, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE, B_ET, B_ETT, C_AT,
+    C_BT, R_XY, R_Y,
 };
-use mbd_model::{Basis, BodyAngles, System, MAX_DIRS};
+use super::{ModifiedS2, E4_TERMS};
+use crate::preadjust::metric::ProjectedMetric;
+use mbd_model::{Basis, BodyAngles, System};
+
+/// `out = ca a + cb b`.
+fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64]) {
+    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+        *o = ca * x + cb * y;
+    }
+}
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
     for (a, b) in y.iter_mut().zip(x) {
@@ -70,7 +79,7 @@ impl ModifiedS2 {
     /// The value of `e4(q, v)` and its exact gradients `de4/dq` into `gq` and `de4/dv` into
     /// `gv` (both length n, checked by the caller, overwritten), by one forward evaluation
     /// and a reverse pass (module doc).
-    pub(super) fn gradients(
+    pub(in crate::preadjust) fn gradients(
         &mut self,
         metric: &mut ProjectedMetric,
         sys: &System,
@@ -345,31 +354,6 @@ fn hvp_adj(
     }
 }
 
-/// Pass R's basis, directions `(v, u, y1, y2, y3, y4)` with the adjoints `y1 = (H_sigma
-/// v)b`, `y2 = (H_mu v)b`, `y3 = (H_sigma u)b`, `y4 = (H_mu u)b`: `{1, t, e, y1, y2, y3, y4,
-/// t y1, t y2, e y3, e y4}` (`t` for `v`, `e` for `u`).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BasisR;
-impl Basis<11> for BasisR {
-    const ND: usize = 6;
-    const EXP: [[u8; MAX_DIRS]; 11] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [0, 0, 1, 0, 0, 0],
-        [0, 0, 0, 1, 0, 0],
-        [0, 0, 0, 0, 1, 0],
-        [0, 0, 0, 0, 0, 1],
-        [1, 0, 1, 0, 0, 0],
-        [1, 0, 0, 1, 0, 0],
-        [0, 1, 0, 0, 1, 0],
-        [0, 1, 0, 0, 0, 1],
-    ];
-}
-/// Pass R's monomials `y1 .. y4`, then `t y1`, `t y2`, `e y3`, `e y4`.
-const R_Y: [usize; 4] = [3, 4, 5, 6];
-const R_XY: [usize; 4] = [7, 8, 9, 10];
-
 /// The adjoints of the four constraint-weighted Hessian-vector products `y = H_w x`
 /// (`H_w = sum_r w_r Hess Phi_r`) for `(x, w) = (v, sigma), (v, mu0), (u, sigma), (u,
 /// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`]): `qb += D^3 (w . Phi)(x, yb,
@@ -431,7 +415,7 @@ mod tests {
     fn gradients_match_differences() {
         let systems = [
             models::paper_a_double_pendulum().unwrap(),
-            super::super::modified_s1::modlag_tests::rod_with_spring(),
+            crate::preadjust::modified_s1::modlag_tests::rod_with_spring(),
             models::n_link_chain(3).unwrap(),
             models::elastic_pendulum().unwrap(),
         ];

@@ -1,25 +1,11 @@
-//! The `s = 2` modified-Lagrangian term `e4` as a type ([`ModifiedS2`]: its workspace, the
-//! forward evaluation in `modified2.rs`, the gradients in `modified2_grad.rs`) and the adjoints'
-//! workspace.
+//! The workspace of the reverse pass of `e4` (`reverse.rs`): the adjoints of the intermediates
+//! and of `G`.
 
-use super::metric::ProjectedMetric;
-use super::modified2::{E4Forward, Pass};
-use super::modified2_grad::BasisR;
-use mbd_model::System;
+use super::passes::{BasisR, Pass};
 
 /// The element-local columns of a constraint row: the first coordinate of the joint's body a
 /// (local columns 0..3) and of its body b (3..6), `None` for ground.
 pub(super) type Cols = [Option<usize>; 2];
-
-/// The term `e4` and the workspace of its value and gradients: the forward intermediates, the
-/// adjoints and the element-local columns of the constraint rows.
-#[derive(Debug)]
-pub(crate) struct ModifiedS2 {
-    pub(super) f: E4Forward,
-    pub(super) b: Adjoints,
-    /// The element-local columns of each constraint row ([`Cols`]).
-    pub(super) cols: Vec<Cols>,
-}
 
 /// Adjoints (suffix `b`) of the intermediates, of the passes, of `G`, and scratch.
 #[derive(Debug)]
@@ -145,50 +131,4 @@ pub(super) fn gbar_add(gbar: &mut [[f64; 6]], cols: &[Cols], c: f64, al: &[f64],
             }
         }
     }
-}
-
-impl ModifiedS2 {
-    fn new(sys: &System) -> Self {
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let mut w = ModifiedS2 {
-            f: E4Forward::new(n, m, sys.forces().len()),
-            b: Adjoints::new(n, m),
-            cols: vec![[None; 2]; m],
-        };
-        w.set_cols(sys);
-        w
-    }
-
-    /// The element-local columns of every constraint row of `sys` (in place: the workspace
-    /// follows the system it is used with, not only the one it was made for).
-    fn set_cols(&mut self, sys: &System) {
-        for (r, c) in self.cols.iter_mut().enumerate() {
-            let (a, b) = sys
-                .equation_joint(r)
-                .map_or((None, None), |j| sys.joint_bodies(j));
-            *c = [a.map(|i| 3 * i), b.map(|i| 3 * i)];
-        }
-    }
-}
-
-/// The `e4` workspace in `slot` for `sys` and `metric` (allocated on first use, or again when
-/// the system's sizes changed; the constraint rows' columns follow `sys`).
-pub(super) fn ensure_s2<'a>(
-    slot: &'a mut Option<Box<ModifiedS2>>,
-    metric: &ProjectedMetric,
-    sys: &System,
-) -> &'a mut ModifiedS2 {
-    let fits = slot.as_ref().is_some_and(|w| {
-        w.f.u.len() == metric.n()
-            && w.cols.len() == metric.m()
-            && w.f.pa.pgrads.len() == sys.forces().len()
-    });
-    if !fits {
-        *slot = None;
-    }
-    let w = slot.get_or_insert_with(|| Box::new(ModifiedS2::new(sys)));
-    if fits {
-        w.set_cols(sys);
-    }
-    w
 }

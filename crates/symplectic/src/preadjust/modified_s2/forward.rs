@@ -1,187 +1,19 @@
-//! The `h^4` modified-Lagrangian term `e4(q, v)` of the constrained (2,2) scheme
-//! (`docs/modified-lagrangian.md` section 3: 23 invariant terms, fitted exactly in a graph frame
-//! and checked against the pendulum family and under changes of coordinates and of the
-//! constraint representation). The integrator adds `h^5 e4` at the chord midpoint of a (2,2)
-//! step (`PreadjustMode::ModifiedLagrangian`); its exact gradients are in `modified2_grad.rs`.
-//!
-//! With `G = Phi_q`, `S = G M^-1 G^T`, `Pi` the tangent projector, `E = M^-1 G^T S^-1`,
-//! `mu0 = S^-1 G M^-1 grad V`, `u = -Pi grad V`, `gamma_k = Hess Phi_k(v, v)`,
-//! `sigma = S^-1 gamma`, `n = -E gamma`, `beta_k = Hess Phi_k(u, v)`, `K2 = -E beta`,
-//! `kappa3_k = D^3 Phi_k(v, v, v) + 3 Hess Phi_k(n, v)`, `K3 = -E kappa3`,
-//! `kappa3u_k = D^3 Phi_k(u, v, v) + 2 Hess Phi_k(K2, v) + Hess Phi_k(n, u)`,
-//! `kappa4_k = D^4 Phi_k(v, v, v, v) + 6 D^3 Phi_k(n, v, v) + 3 Hess Phi_k(n, n) +
-//! 4 Hess Phi_k(K3, v)`, `H = Hess V`, `H_mu = mu0 . Hess Phi`, `H_sigma = sigma . Hess Phi`,
-//! the terms and their coefficients are those of [`E4_TERMS`]. The directional derivatives of
-//! orders 2 to 4, mixed ones included, come from three passes of multivariate truncated
-//! Taylor jets ([`mbd_model::PolyJet`], [`System::constraint_poly_series`],
-//! [`System::potential_poly_series`]): pass A along `(v, u)`, pass B along `(v, n, u)` (after
-//! `n`, which needs pass A's `gamma`), pass C along `(v, K2, K3)`; each keeps its coefficients'
-//! gradients for the reverse pass.
+//! The forward evaluation of `e4(q, v)`: the intermediates of the module doc at one `(q, v)`
+//! ([`E4Forward`], kept for the reverse pass) and the 23 terms of [`super::E4_TERMS`].
 
-use super::dot;
-use super::e4_work::ModifiedS2;
-use super::metric::ProjectedMetric;
-use mbd_model::{Basis, BodyAngles, PolyWorkspace, System, MAX_DIRS};
+use super::passes::{
+    BasisA, BasisB, BasisC, Pass, A_E, A_ET, A_ETT, A_T, A_T4, A_TT, A_TTT, B_E, B_ED, B_EE, B_ET,
+    B_ETT, C_AT, C_BT,
+};
+use super::ModifiedS2;
+use crate::preadjust::dot;
+use crate::preadjust::metric::ProjectedMetric;
+use mbd_model::{BodyAngles, System};
 use mbd_solve::SolveError;
-
-/// The terms of `e4` and their coefficients, in the order of [`super::Preadjustment::modified_terms_s2`]'s
-/// evaluation (`S` in a name stands for `S^-1`).
-pub(crate) const E4_TERMS: [(&str, f64); 23] = [
-    ("v H_sigma Pi H_mu v", 1.0 / 720.0),
-    ("v H_mu Pi H_mu v", -1.0 / 1440.0),
-    ("u H_mu u", -1.0 / 960.0),
-    ("v H_mu Pi H v", 1.0 / 720.0),
-    ("beta S beta", 1.0 / 160.0),
-    ("u H_sigma u", 1.0 / 960.0),
-    ("kappa3 S beta", 1.0 / 240.0),
-    ("v H K2", 1.0 / 240.0),
-    ("mu0 . kappa3u", -1.0 / 480.0),
-    ("sigma . kappa3u", 1.0 / 480.0),
-    ("mu0 . kappa4", -1.0 / 2880.0),
-    ("u H n", -1.0 / 720.0),
-    ("u H u", -1.0 / 1440.0),
-    ("D3V(u, v, v)", -1.0 / 720.0),
-    ("n H n", -1.0 / 1440.0),
-    ("v H Pi H_sigma v", -1.0 / 720.0),
-    ("v H K3", 1.0 / 720.0),
-    ("D3V(n, v, v)", -1.0 / 720.0),
-    ("v H Pi H v", -1.0 / 1440.0),
-    ("D4V(v, v, v, v)", -1.0 / 4320.0),
-    ("v H_sigma Pi H_sigma v", -1.0 / 1440.0),
-    ("sigma . kappa4", 1.0 / 2880.0),
-    ("kappa3 S kappa3", 1.0 / 1440.0),
-];
-
-/// `out = ca a + cb b`.
-pub(super) fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64]) {
-    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
-        *o = ca * x + cb * y;
-    }
-}
-
-/// The monomial bases of the passes of `e4` ([`mbd_model::PolyJet`]; `t` stands for the
-/// velocity `v` throughout). Pass A, directions `(v, u)`: `{1, t, e, t^2, e t, t^3, e t^2,
-/// t^4}`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BasisA;
-impl Basis<8> for BasisA {
-    const ND: usize = 2;
-    const EXP: [[u8; MAX_DIRS]; 8] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [2, 0, 0, 0, 0, 0],
-        [1, 1, 0, 0, 0, 0],
-        [3, 0, 0, 0, 0, 0],
-        [2, 1, 0, 0, 0, 0],
-        [4, 0, 0, 0, 0, 0],
-    ];
-}
-/// Pass A's monomials `t`, `e` (= `u`), `t^2`, `e t`, `t^3`, `e t^2`, `t^4`.
-pub(super) const A_T: usize = 1;
-pub(super) const A_E: usize = 2;
-pub(super) const A_TT: usize = 3;
-pub(super) const A_ET: usize = 4;
-pub(super) const A_TTT: usize = 5;
-pub(super) const A_ETT: usize = 6;
-pub(super) const A_T4: usize = 7;
-
-/// Pass B, directions `(v, n, u)`: `{1, t, e, d, t^2, e t, e^2, e d, e t^2}` (`e` for `n`,
-/// `d` for `u`).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BasisB;
-impl Basis<9> for BasisB {
-    const ND: usize = 3;
-    const EXP: [[u8; MAX_DIRS]; 9] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [0, 0, 1, 0, 0, 0],
-        [2, 0, 0, 0, 0, 0],
-        [1, 1, 0, 0, 0, 0],
-        [0, 2, 0, 0, 0, 0],
-        [0, 1, 1, 0, 0, 0],
-        [2, 1, 0, 0, 0, 0],
-    ];
-}
-/// Pass B's monomials `e` (= `n`), `e t`, `e^2`, `e d` (`d` = `u`), `e t^2`.
-pub(super) const B_E: usize = 2;
-pub(super) const B_ET: usize = 5;
-pub(super) const B_EE: usize = 6;
-pub(super) const B_ED: usize = 7;
-pub(super) const B_ETT: usize = 8;
-
-/// Pass C, directions `(v, K2, K3)`: `{1, t, a, b, a t, b t}`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BasisC;
-impl Basis<6> for BasisC {
-    const ND: usize = 3;
-    const EXP: [[u8; MAX_DIRS]; 6] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [0, 0, 1, 0, 0, 0],
-        [1, 1, 0, 0, 0, 0],
-        [1, 0, 1, 0, 0, 0],
-    ];
-}
-/// Pass C's monomials `a t` (`a` = `K2`) and `b t` (`b` = `K3`).
-pub(super) const C_AT: usize = 4;
-pub(super) const C_BT: usize = 5;
-
-/// One pass's coefficients per constraint row and of the potential, with their element-local
-/// gradients (per row, and per force element), and its jets' workspace.
-#[derive(Debug)]
-pub(super) struct Pass<const K: usize, B> {
-    pub(super) vals: Vec<[f64; K]>,
-    pub(super) grads: Vec<[[f64; 6]; K]>,
-    pub(super) pot: [f64; K],
-    pub(super) pgrads: Vec<[[f64; 6]; K]>,
-    ws: Box<PolyWorkspace<K, B>>,
-}
-
-impl<const K: usize, B: Basis<K>> Pass<K, B> {
-    pub(super) fn new(m: usize, nf: usize) -> Self {
-        Pass {
-            vals: vec![[0.0; K]; m],
-            grads: vec![[[0.0; 6]; K]; m],
-            pot: [0.0; K],
-            pgrads: vec![[[0.0; 6]; K]; nf],
-            ws: PolyWorkspace::new(),
-        }
-    }
-
-    /// The pass along `dirs` at `q` (constraints and potential).
-    pub(super) fn eval(&mut self, sys: &System, q: &[f64], a: &BodyAngles, dirs: &[&[f64]]) {
-        let ws = &mut self.ws;
-        sys.constraint_poly_series(ws, q, a, dirs, &mut self.vals, &mut self.grads);
-        self.pot = sys.potential_poly_series(ws, q, a, dirs, &mut self.pgrads);
-    }
-
-    /// The pass along `dirs` at `q`, constraints only.
-    pub(super) fn eval_constraints(
-        &mut self,
-        sys: &System,
-        q: &[f64],
-        a: &BodyAngles,
-        dirs: &[&[f64]],
-    ) {
-        sys.constraint_poly_series(&mut self.ws, q, a, dirs, &mut self.vals, &mut self.grads);
-    }
-
-    /// `out = sum_f grad_q` of the potential's coefficient `k` (length n; zero without force
-    /// elements): a Hessian-vector product of `V` for a coefficient of degree 1.
-    pub(super) fn pot_grad_into(&self, sys: &System, k: usize, out: &mut [f64]) {
-        out.fill(0.0);
-        let mut w = [0.0; K];
-        w[k] = 1.0;
-        sys.add_potential_poly_adjoint::<K, B>(&self.pgrads, &w, out, &mut []);
-    }
-}
 
 /// The intermediate quantities of `e4` at one `(q, v)` (names as in the module doc; `nn` is
 /// `n`, `hmu_v` is `H_mu v`, `pi_hv` is `Pi H v`, `s_beta` is `S^-1 beta`, `d4v` is
-/// `D^4 V(v, v, v, v)`), kept for the reverse pass of the gradient (`modified2_grad.rs`): a
+/// `D^4 V(v, v, v, v)`), kept for the reverse pass of the gradient (`reverse.rs`): a
 /// workspace allocated once, filled in place by every evaluation.
 #[derive(Debug)]
 pub(super) struct E4Forward {
@@ -273,7 +105,7 @@ impl E4Forward {
         }
     }
 
-    /// The 23 terms, in the order of [`E4_TERMS`].
+    /// The 23 terms, in the order of [`super::E4_TERMS`].
     pub(super) fn terms(&self) -> [f64; 23] {
         let f = self;
         [
@@ -308,7 +140,7 @@ impl ModifiedS2 {
     /// Evaluates the intermediates of `e4` at `q` with the velocity `v` into `self.f` (after
     /// the caller checked `v`; prepares the metric at `q`); the passes keep their coefficient
     /// gradients for the reverse pass. Allocates nothing.
-    pub(super) fn forward(
+    pub(in crate::preadjust) fn forward(
         &mut self,
         metric: &mut ProjectedMetric,
         sys: &System,
@@ -375,15 +207,15 @@ impl ModifiedS2 {
         Ok(())
     }
 
-    /// The 23 terms of the last forward evaluation ([`E4_TERMS`], without their coefficients).
-    pub(super) fn terms(&self) -> [f64; 23] {
+    /// The 23 terms of the last forward evaluation ([`super::E4_TERMS`], without their coefficients).
+    pub(in crate::preadjust) fn terms(&self) -> [f64; 23] {
         self.f.terms()
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::super::E4_TERMS;
     use crate::Preadjustment;
     use mbd_model::models;
 
@@ -436,7 +268,7 @@ mod tests {
             0.1331349285714281,
             0.05536878571428572,
         ];
-        let spring = super::super::modified_s1::modlag_tests::rod_with_spring();
+        let spring = crate::preadjust::modified_s1::modlag_tests::rod_with_spring();
         let (qb, vb) = chain_state(&[-std::f64::consts::FRAC_PI_4], &[0.9]);
         let ref_b = [
             -3.527664921849408,
