@@ -17,7 +17,7 @@
 //! new point gets a new [`Stamp`], by which the terms tell whether what they keep is still of
 //! this point.
 
-use super::{add_dgt, dot, gm_times, LocalRow};
+use super::{add_dgt, dot, gm_times, LocalRow, ZERO_ROW};
 use mbd_model::System;
 use mbd_solve::linalg::DenseCholesky;
 use mbd_solve::sparse::ConstraintSchur;
@@ -79,8 +79,8 @@ impl RowsAlong {
         RowsAlong {
             v: vec![0.0; n],
             stamp: 0,
-            hess_v: vec![[0.0; 6]; m],
-            third_vv: vec![[0.0; 6]; m],
+            hess_v: vec![ZERO_ROW; m],
+            third_vv: vec![ZERO_ROW; m],
             vhv: vec![0.0; m],
         }
     }
@@ -114,7 +114,7 @@ impl ProjectedMetric {
             at_valid: false,
             stamp: 0,
             nz_rows: Vec::with_capacity(m),
-            local_grads: vec![[0.0; 6]; m],
+            local_grads: vec![ZERO_ROW; m],
             tmp_m: vec![0.0; m],
             tmp_n: vec![0.0; n],
         })

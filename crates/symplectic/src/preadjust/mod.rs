@@ -14,13 +14,16 @@ mod stiffness;
 
 use metric::ProjectedMetric;
 use modified_s1::ModifiedS1;
-pub(crate) use modified_s2::E4_TERMS;
+use modified_s2::E4_TERM_COUNT;
 use paper::PaperTerm;
 use stiffness::TangentStiffness;
 
 /// A constraint row in element-local form: its derivatives in the coordinates `(x, y, theta)`
 /// of the joint's two bodies.
 type LocalRow = [f64; 6];
+
+/// A zero [`LocalRow`].
+const ZERO_ROW: LocalRow = [0.0; 6];
 
 /// The preadjustment terms at one point, with their shared metric: paper A's `W_s` (value,
 /// gradient, Newton Hessian), the tangential force, and the modified-Lagrangian terms `e`
@@ -331,14 +334,14 @@ impl Preadjustment {
         Ok(())
     }
 
-    /// The 23 terms of `e4(q, v)` ([`E4_TERMS`], without their coefficients), at `q` with
+    /// The 23 terms of `e4(q, v)` (`E4_TERMS`, without their coefficients), at `q` with
     /// the velocity `v` (tangent, or a step's chord). Allocates its workspace on first use.
     pub fn modified_terms_s2(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
-    ) -> Result<[f64; 23], SolveError> {
+    ) -> Result<[f64; E4_TERM_COUNT], SolveError> {
         self.metric.check_v(v)?;
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.forward(&mut self.metric, sys, q, v)?;
@@ -346,7 +349,7 @@ impl Preadjustment {
     }
 
     /// The `h^4` modified-Lagrangian term of the (2,2) scheme, `e4(q, v) = sum_i c_i T_i`
-    /// ([`E4_TERMS`], [`Preadjustment::modified_terms_s2`]).
+    /// (`E4_TERMS`, [`Preadjustment::modified_terms_s2`]).
     pub fn modified_term_s2(
         &mut self,
         sys: &System,
@@ -354,7 +357,7 @@ impl Preadjustment {
         v: &[f64],
     ) -> Result<f64, SolveError> {
         let t = self.modified_terms_s2(sys, q, v)?;
-        Ok(t.iter().zip(E4_TERMS.iter()).map(|(x, (_, c))| c * x).sum())
+        Ok(modified_s2::e4_value(&t))
     }
 
     /// The value of `e4(q, v)` ([`Preadjustment::modified_term_s2`]) and its exact gradients

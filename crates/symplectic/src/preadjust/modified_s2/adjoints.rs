@@ -1,7 +1,8 @@
 //! The workspace of the reverse pass of `e4` (`reverse.rs`): the adjoints of the intermediates
 //! and of `G`.
 
-use super::passes::{BasisR, Pass};
+use super::passes::{BasisR, Pass, NA, NB, NC, NR, R_OUTPUTS};
+use crate::preadjust::{LocalRow, ZERO_ROW};
 
 /// The element-local columns of a constraint row: the first coordinate of the joint's body a
 /// (local columns 0..3) and of its body b (3..6), `None` for ground.
@@ -30,18 +31,18 @@ pub(super) struct Adjoints {
     pub(super) kap4b: Vec<f64>,
     /// Adjoint weights of the coefficients of passes A, B, C per constraint row, and of
     /// passes A and B's potential.
-    pub(super) wa: Vec<[f64; 8]>,
-    pub(super) wb: Vec<[f64; 9]>,
-    pub(super) wc: Vec<[f64; 6]>,
-    pub(super) pa: [f64; 8],
-    pub(super) pb: [f64; 9],
+    pub(super) wa: Vec<[f64; NA]>,
+    pub(super) wb: Vec<[f64; NB]>,
+    pub(super) wc: Vec<[f64; NC]>,
+    pub(super) pa: [f64; NA],
+    pub(super) pb: [f64; NB],
     /// Pass R (the weighted Hessian-vector products' adjoints): coefficients, gradients and
     /// contraction weights per row.
-    pub(super) rpass: Pass<11, BasisR>,
-    pub(super) rw: Vec<[[f64; 11]; 3]>,
+    pub(super) rpass: Pass<NR, BasisR>,
+    pub(super) rw: Vec<[[f64; NR]; R_OUTPUTS]>,
 
     /// `Gb` in element-local form.
-    pub(super) gbar: Vec<[f64; 6]>,
+    pub(super) gbar: Vec<LocalRow>,
     /// Scratch: n-vectors and m-vectors.
     pub(super) tn: [Vec<f64>; 8],
     pub(super) tm: [Vec<f64>; 4],
@@ -69,15 +70,15 @@ impl Adjoints {
             kap3b: zm(),
             kap3ub: zm(),
             kap4b: zm(),
-            wa: vec![[0.0; 8]; m],
-            wb: vec![[0.0; 9]; m],
-            wc: vec![[0.0; 6]; m],
-            pa: [0.0; 8],
-            pb: [0.0; 9],
+            wa: vec![[0.0; NA]; m],
+            wb: vec![[0.0; NB]; m],
+            wc: vec![[0.0; NC]; m],
+            pa: [0.0; NA],
+            pb: [0.0; NB],
             rpass: Pass::new(m, 0),
-            rw: vec![[[0.0; 11]; 3]; m],
+            rw: vec![[[0.0; NR]; R_OUTPUTS]; m],
 
-            gbar: vec![[0.0; 6]; m],
+            gbar: vec![ZERO_ROW; m],
             tn: std::array::from_fn(|_| zn()),
             tm: std::array::from_fn(|_| zm()),
         }
@@ -106,17 +107,17 @@ impl Adjoints {
         ] {
             x.fill(0.0);
         }
-        self.wa.fill([0.0; 8]);
-        self.wb.fill([0.0; 9]);
-        self.wc.fill([0.0; 6]);
-        self.pa = [0.0; 8];
-        self.pb = [0.0; 9];
-        self.gbar.fill([0.0; 6]);
+        self.wa.fill([0.0; NA]);
+        self.wb.fill([0.0; NB]);
+        self.wc.fill([0.0; NC]);
+        self.pa = [0.0; NA];
+        self.pb = [0.0; NB];
+        self.gbar.fill(ZERO_ROW);
     }
 }
 
 /// `Gb += c alpha beta^T` in element-local form.
-pub(super) fn gbar_add(gbar: &mut [[f64; 6]], cols: &[Cols], c: f64, al: &[f64], be: &[f64]) {
+pub(super) fn gbar_add(gbar: &mut [LocalRow], cols: &[Cols], c: f64, al: &[f64], be: &[f64]) {
     for ((g, cols), &a) in gbar.iter_mut().zip(cols).zip(al) {
         if a == 0.0 {
             continue;

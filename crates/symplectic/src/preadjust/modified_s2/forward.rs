@@ -1,13 +1,13 @@
 //! The forward evaluation of `e4(q, v)`: the intermediates of the module doc at one `(q, v)`
-//! ([`E4Forward`], kept for the reverse pass) and the 23 terms of [`super::E4_TERMS`].
+//! ([`E4Forward`], kept for the reverse pass) and the terms of [`super::E4_TERMS`].
 
 use super::passes::{
     BasisA, BasisB, BasisC, Pass, A_E, A_ET, A_ETT, A_T, A_T4, A_TT, A_TTT, B_E, B_ED, B_EE, B_ET,
-    B_ETT, C_AT, C_BT,
+    B_ETT, C_AT, C_BT, NA, NB, NC,
 };
-use super::ModifiedS2;
-use crate::preadjust::dot;
+use super::{Invariant, ModifiedS2, PerInvariant, E4_TERM_COUNT};
 use crate::preadjust::metric::ProjectedMetric;
+use crate::preadjust::{dot, LocalRow, ZERO_ROW};
 use mbd_model::{BodyAngles, System};
 use mbd_solve::SolveError;
 
@@ -49,15 +49,15 @@ pub(super) struct E4Forward {
     pub(super) d3v_n: f64,
     pub(super) d4v: f64,
     /// The passes ([`BasisA`], [`BasisB`], [`BasisC`]).
-    pub(super) pa: Pass<8, BasisA>,
-    pub(super) pb: Pass<9, BasisB>,
-    pub(super) pc: Pass<6, BasisC>,
+    pub(super) pa: Pass<NA, BasisA>,
+    pub(super) pb: Pass<NB, BasisB>,
+    pub(super) pc: Pass<NC, BasisC>,
     /// `sin`/`cos` of the body angles at `q`, shared by every pass.
     pub(super) angles: BodyAngles,
     /// Per constraint row, element-local `Hess Phi_r v` and `Hess Phi_r u` (the weighted
     /// Hessian-vector products `H_mu v`, `H_sigma v`, ...; pass A's gradients of `t` and `e`).
-    pub(super) rhv_v: Vec<[f64; 6]>,
-    pub(super) rhv_u: Vec<[f64; 6]>,
+    pub(super) rhv_v: Vec<LocalRow>,
+    pub(super) rhv_u: Vec<LocalRow>,
     /// Scratch: m zeros.
     pub(super) zero_m: Vec<f64>,
 }
@@ -99,40 +99,41 @@ impl E4Forward {
             pb: Pass::new(m, nf),
             pc: Pass::new(m, nf),
             angles: BodyAngles::default(),
-            rhv_v: vec![[0.0; 6]; m],
-            rhv_u: vec![[0.0; 6]; m],
+            rhv_v: vec![ZERO_ROW; m],
+            rhv_u: vec![ZERO_ROW; m],
             zero_m: zm(),
         }
     }
 
-    /// The 23 terms, in the order of [`super::E4_TERMS`].
-    pub(super) fn terms(&self) -> [f64; 23] {
+    /// The terms of `e4` from the intermediates.
+    pub(super) fn terms(&self) -> PerInvariant {
+        use Invariant::*;
         let f = self;
-        [
-            dot(&f.hsig_v, &f.pi_hmu_v),
-            dot(&f.hmu_v, &f.pi_hmu_v),
-            dot(&f.u, &f.hmu_u),
-            dot(&f.hmu_v, &f.pi_hv),
-            dot(&f.beta, &f.s_beta),
-            dot(&f.u, &f.hsig_u),
-            dot(&f.kap3, &f.s_beta),
-            dot(&f.hv, &f.k2),
-            dot(&f.mu0, &f.kap3u),
-            dot(&f.sig, &f.kap3u),
-            dot(&f.mu0, &f.kap4),
-            dot(&f.hu, &f.nn),
-            dot(&f.u, &f.hu),
-            f.d3v_u,
-            dot(&f.nn, &f.hn),
-            dot(&f.hv, &f.pi_hsig_v),
-            dot(&f.hv, &f.k3),
-            f.d3v_n,
-            dot(&f.hv, &f.pi_hv),
-            f.d4v,
-            dot(&f.hsig_v, &f.pi_hsig_v),
-            dot(&f.sig, &f.kap4),
-            dot(&f.kap3, &f.s_kap3),
-        ]
+        let mut t = PerInvariant([0.0; E4_TERM_COUNT]);
+        t[VHsigPiHmuV] = dot(&f.hsig_v, &f.pi_hmu_v);
+        t[VHmuPiHmuV] = dot(&f.hmu_v, &f.pi_hmu_v);
+        t[UHmuU] = dot(&f.u, &f.hmu_u);
+        t[VHmuPiHV] = dot(&f.hmu_v, &f.pi_hv);
+        t[BetaSBeta] = dot(&f.beta, &f.s_beta);
+        t[UHsigU] = dot(&f.u, &f.hsig_u);
+        t[Kappa3SBeta] = dot(&f.kap3, &f.s_beta);
+        t[VHK2] = dot(&f.hv, &f.k2);
+        t[Mu0Kappa3u] = dot(&f.mu0, &f.kap3u);
+        t[SigmaKappa3u] = dot(&f.sig, &f.kap3u);
+        t[Mu0Kappa4] = dot(&f.mu0, &f.kap4);
+        t[UHN] = dot(&f.hu, &f.nn);
+        t[UHU] = dot(&f.u, &f.hu);
+        t[D3VUVV] = f.d3v_u;
+        t[NHN] = dot(&f.nn, &f.hn);
+        t[VHPiHsigV] = dot(&f.hv, &f.pi_hsig_v);
+        t[VHK3] = dot(&f.hv, &f.k3);
+        t[D3VNVV] = f.d3v_n;
+        t[VHPiHV] = dot(&f.hv, &f.pi_hv);
+        t[D4V] = f.d4v;
+        t[VHsigPiHsigV] = dot(&f.hsig_v, &f.pi_hsig_v);
+        t[SigmaKappa4] = dot(&f.sig, &f.kap4);
+        t[Kappa3SKappa3] = dot(&f.kap3, &f.s_kap3);
+        t
     }
 }
 
@@ -207,9 +208,9 @@ impl ModifiedS2 {
         Ok(())
     }
 
-    /// The 23 terms of the last forward evaluation ([`super::E4_TERMS`], without their coefficients).
-    pub(in crate::preadjust) fn terms(&self) -> [f64; 23] {
-        self.f.terms()
+    /// The terms of the last forward evaluation ([`super::E4_TERMS`], without their coefficients).
+    pub(in crate::preadjust) fn terms(&self) -> [f64; E4_TERM_COUNT] {
+        self.f.terms().0
     }
 }
 
@@ -308,7 +309,7 @@ mod tests {
                 assert!(
                     (x - r).abs() < 1e-9 * scale,
                     "term {i} ({}): {x} vs {r}",
-                    E4_TERMS[i].0
+                    E4_TERMS[i].name
                 );
             }
             let worst = t

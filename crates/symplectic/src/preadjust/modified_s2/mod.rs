@@ -33,33 +33,155 @@ mod forward;
 mod passes;
 mod reverse;
 
-/// The terms of `e4` and their coefficients, in the order of [`crate::Preadjustment::modified_terms_s2`]'s
-/// evaluation (`S` in a name stands for `S^-1`).
-pub(crate) const E4_TERMS: [(&str, f64); 23] = [
-    ("v H_sigma Pi H_mu v", 1.0 / 720.0),
-    ("v H_mu Pi H_mu v", -1.0 / 1440.0),
-    ("u H_mu u", -1.0 / 960.0),
-    ("v H_mu Pi H v", 1.0 / 720.0),
-    ("beta S beta", 1.0 / 160.0),
-    ("u H_sigma u", 1.0 / 960.0),
-    ("kappa3 S beta", 1.0 / 240.0),
-    ("v H K2", 1.0 / 240.0),
-    ("mu0 . kappa3u", -1.0 / 480.0),
-    ("sigma . kappa3u", 1.0 / 480.0),
-    ("mu0 . kappa4", -1.0 / 2880.0),
-    ("u H n", -1.0 / 720.0),
-    ("u H u", -1.0 / 1440.0),
-    ("D3V(u, v, v)", -1.0 / 720.0),
-    ("n H n", -1.0 / 1440.0),
-    ("v H Pi H_sigma v", -1.0 / 720.0),
-    ("v H K3", 1.0 / 720.0),
-    ("D3V(n, v, v)", -1.0 / 720.0),
-    ("v H Pi H v", -1.0 / 1440.0),
-    ("D4V(v, v, v, v)", -1.0 / 4320.0),
-    ("v H_sigma Pi H_sigma v", -1.0 / 1440.0),
-    ("sigma . kappa4", 1.0 / 2880.0),
-    ("kappa3 S kappa3", 1.0 / 1440.0),
-];
+/// The invariants of `e4` (module doc for the symbols), in the order of [`E4_TERMS`]: the
+/// term values ([`PerInvariant`]) and the public arrays of
+/// [`crate::Preadjustment::modified_terms_s2`] are indexed by them.
+// (the names spell the formulas: `UHN` is `u H n`)
+#[allow(clippy::upper_case_acronyms)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Invariant {
+    /// `v H_sigma Pi H_mu v`
+    VHsigPiHmuV,
+    /// `v H_mu Pi H_mu v`
+    VHmuPiHmuV,
+    /// `u H_mu u`
+    UHmuU,
+    /// `v H_mu Pi H v`
+    VHmuPiHV,
+    /// `beta S^-1 beta`
+    BetaSBeta,
+    /// `u H_sigma u`
+    UHsigU,
+    /// `kappa3 S^-1 beta`
+    Kappa3SBeta,
+    /// `v H K2`
+    VHK2,
+    /// `mu0 . kappa3u`
+    Mu0Kappa3u,
+    /// `sigma . kappa3u`
+    SigmaKappa3u,
+    /// `mu0 . kappa4`
+    Mu0Kappa4,
+    /// `u H n`
+    UHN,
+    /// `u H u`
+    UHU,
+    /// `D^3 V(u, v, v)`
+    D3VUVV,
+    /// `n H n`
+    NHN,
+    /// `v H Pi H_sigma v`
+    VHPiHsigV,
+    /// `v H K3`
+    VHK3,
+    /// `D^3 V(n, v, v)`
+    D3VNVV,
+    /// `v H Pi H v`
+    VHPiHV,
+    /// `D^4 V(v, v, v, v)`
+    D4V,
+    /// `v H_sigma Pi H_sigma v`
+    VHsigPiHsigV,
+    /// `sigma . kappa4`
+    SigmaKappa4,
+    /// `kappa3 S^-1 kappa3`
+    Kappa3SKappa3,
+}
+
+/// The number of invariants of `e4`.
+pub(crate) const E4_TERM_COUNT: usize = Invariant::Kappa3SKappa3 as usize + 1;
+
+/// One invariant of `e4` with its name (`S` stands for `S^-1`) and its coefficient.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct E4Term {
+    pub(crate) invariant: Invariant,
+    /// (Read by the tests, which compare the terms by name.)
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) name: &'static str,
+    pub(crate) coefficient: f64,
+}
+
+const fn term(invariant: Invariant, name: &'static str, coefficient: f64) -> E4Term {
+    E4Term {
+        invariant,
+        name,
+        coefficient,
+    }
+}
+
+/// The invariants of `e4` with their names and coefficients
+/// (`e4 = sum_i coefficient_i T_i`), in the order of [`Invariant`].
+pub(crate) const E4_TERMS: [E4Term; E4_TERM_COUNT] = {
+    use Invariant::*;
+    [
+        term(VHsigPiHmuV, "v H_sigma Pi H_mu v", 1.0 / 720.0),
+        term(VHmuPiHmuV, "v H_mu Pi H_mu v", -1.0 / 1440.0),
+        term(UHmuU, "u H_mu u", -1.0 / 960.0),
+        term(VHmuPiHV, "v H_mu Pi H v", 1.0 / 720.0),
+        term(BetaSBeta, "beta S beta", 1.0 / 160.0),
+        term(UHsigU, "u H_sigma u", 1.0 / 960.0),
+        term(Kappa3SBeta, "kappa3 S beta", 1.0 / 240.0),
+        term(VHK2, "v H K2", 1.0 / 240.0),
+        term(Mu0Kappa3u, "mu0 . kappa3u", -1.0 / 480.0),
+        term(SigmaKappa3u, "sigma . kappa3u", 1.0 / 480.0),
+        term(Mu0Kappa4, "mu0 . kappa4", -1.0 / 2880.0),
+        term(UHN, "u H n", -1.0 / 720.0),
+        term(UHU, "u H u", -1.0 / 1440.0),
+        term(D3VUVV, "D3V(u, v, v)", -1.0 / 720.0),
+        term(NHN, "n H n", -1.0 / 1440.0),
+        term(VHPiHsigV, "v H Pi H_sigma v", -1.0 / 720.0),
+        term(VHK3, "v H K3", 1.0 / 720.0),
+        term(D3VNVV, "D3V(n, v, v)", -1.0 / 720.0),
+        term(VHPiHV, "v H Pi H v", -1.0 / 1440.0),
+        term(D4V, "D4V(v, v, v, v)", -1.0 / 4320.0),
+        term(VHsigPiHsigV, "v H_sigma Pi H_sigma v", -1.0 / 1440.0),
+        term(SigmaKappa4, "sigma . kappa4", 1.0 / 2880.0),
+        term(Kappa3SKappa3, "kappa3 S kappa3", 1.0 / 1440.0),
+    ]
+};
+
+// E4_TERMS lists the invariants in their order (checked at compile time).
+const _: () = {
+    let mut i = 0;
+    while i < E4_TERM_COUNT {
+        assert!(E4_TERMS[i].invariant as usize == i);
+        i += 1;
+    }
+};
+
+/// One value per invariant of `e4` (the terms, or their coefficients), indexed by
+/// [`Invariant`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PerInvariant(pub(crate) [f64; E4_TERM_COUNT]);
+
+impl PerInvariant {
+    /// The coefficients of [`E4_TERMS`].
+    pub(crate) fn coefficients() -> Self {
+        PerInvariant(std::array::from_fn(|i| E4_TERMS[i].coefficient))
+    }
+}
+
+impl std::ops::Index<Invariant> for PerInvariant {
+    type Output = f64;
+    fn index(&self, t: Invariant) -> &f64 {
+        &self.0[t as usize]
+    }
+}
+
+impl std::ops::IndexMut<Invariant> for PerInvariant {
+    fn index_mut(&mut self, t: Invariant) -> &mut f64 {
+        &mut self.0[t as usize]
+    }
+}
+
+/// `e4 = sum_i c_i T_i` from the terms `T_i` (in the order of [`E4_TERMS`]).
+pub(crate) fn e4_value(terms: &[f64; E4_TERM_COUNT]) -> f64 {
+    terms
+        .iter()
+        .zip(E4_TERMS.iter())
+        .map(|(x, t)| t.coefficient * x)
+        .sum()
+}
 
 /// The term `e4` and the workspace of its value and gradients: the forward intermediates, the
 /// adjoints and the element-local columns of the constraint rows.

@@ -39,10 +39,11 @@ use super::adjoints::{gbar_add, Adjoints, Cols};
 use super::forward::E4Forward;
 use super::passes::{
     BasisA, BasisB, BasisC, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE, B_ET, B_ETT, C_AT,
-    C_BT, R_XY, R_Y,
+    C_BT, NA, NB, NC, NR, R_DIRS, R_OUTPUTS, R_XY, R_Y,
 };
-use super::{ModifiedS2, E4_TERMS};
+use super::{e4_value, Invariant, ModifiedS2, PerInvariant};
 use crate::preadjust::metric::ProjectedMetric;
+use crate::preadjust::LocalRow;
 use mbd_model::{Basis, BodyAngles, System};
 
 /// `out = ca a + cb b`.
@@ -103,12 +104,12 @@ impl ModifiedS2 {
         gq: &mut [f64],
         gv: &mut [f64],
     ) -> f64 {
+        use Invariant::*;
         let m = metric.m();
         let ModifiedS2 { f, b: w, cols } = self;
         let cols = cols.as_slice();
-        let terms = f.terms();
-        let c: [f64; 23] = std::array::from_fn(|i| E4_TERMS[i].1);
-        let e4 = terms.iter().zip(&c).map(|(t, c)| t * c).sum();
+        let e4 = e4_value(&f.terms().0);
+        let c = PerInvariant::coefficients();
         gq.fill(0.0);
         gv.fill(0.0);
         w.clear();
@@ -120,57 +121,57 @@ impl ModifiedS2 {
         let hsig_v = (f.pi_hsig_v.as_slice(), f.sg_hsig_v.as_slice());
         let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
         let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
-        adj_pi(&mut w.gbar, cols, c[0], hsig_v, hmu_v);
-        axpy(&mut w.hsig_vb, c[0], &f.pi_hmu_v);
-        axpy(&mut w.hmu_vb, c[0], &f.pi_hsig_v);
-        adj_pi(&mut w.gbar, cols, c[1], hmu_v, hmu_v);
-        axpy(&mut w.hmu_vb, 2.0 * c[1], &f.pi_hmu_v);
-        axpy(&mut w.ub, c[2], &f.hmu_u);
-        axpy(&mut w.hmu_ub, c[2], &f.u);
+        adj_pi(&mut w.gbar, cols, c[VHsigPiHmuV], hsig_v, hmu_v);
+        axpy(&mut w.hsig_vb, c[VHsigPiHmuV], &f.pi_hmu_v);
+        axpy(&mut w.hmu_vb, c[VHsigPiHmuV], &f.pi_hsig_v);
+        adj_pi(&mut w.gbar, cols, c[VHmuPiHmuV], hmu_v, hmu_v);
+        axpy(&mut w.hmu_vb, 2.0 * c[VHmuPiHmuV], &f.pi_hmu_v);
+        axpy(&mut w.ub, c[UHmuU], &f.hmu_u);
+        axpy(&mut w.hmu_ub, c[UHmuU], &f.u);
         let beta = (f.s_beta.as_slice(), f.k2.as_slice());
         let kap3 = (f.s_kap3.as_slice(), f.k3.as_slice());
-        adj_s(&mut w.gbar, cols, c[4], beta, beta);
-        axpy(&mut w.betab, 2.0 * c[4], &f.s_beta);
-        axpy(&mut w.ub, c[5], &f.hsig_u);
-        axpy(&mut w.hsig_ub, c[5], &f.u);
-        adj_s(&mut w.gbar, cols, c[6], kap3, beta);
-        axpy(&mut w.kap3b, c[6], &f.s_beta);
-        axpy(&mut w.betab, c[6], &f.s_kap3);
-        axpy(&mut w.mu0b, c[8], &f.kap3u);
-        axpy(&mut w.kap3ub, c[8], &f.mu0);
-        axpy(&mut w.sigb, c[9], &f.kap3u);
-        axpy(&mut w.kap3ub, c[9], &f.sig);
-        axpy(&mut w.mu0b, c[10], &f.kap4);
-        axpy(&mut w.kap4b, c[10], &f.mu0);
-        adj_pi(&mut w.gbar, cols, c[20], hsig_v, hsig_v);
-        axpy(&mut w.hsig_vb, 2.0 * c[20], &f.pi_hsig_v);
-        axpy(&mut w.sigb, c[21], &f.kap4);
-        axpy(&mut w.kap4b, c[21], &f.sig);
-        adj_s(&mut w.gbar, cols, c[22], kap3, kap3);
-        axpy(&mut w.kap3b, 2.0 * c[22], &f.s_kap3);
+        adj_s(&mut w.gbar, cols, c[BetaSBeta], beta, beta);
+        axpy(&mut w.betab, 2.0 * c[BetaSBeta], &f.s_beta);
+        axpy(&mut w.ub, c[UHsigU], &f.hsig_u);
+        axpy(&mut w.hsig_ub, c[UHsigU], &f.u);
+        adj_s(&mut w.gbar, cols, c[Kappa3SBeta], kap3, beta);
+        axpy(&mut w.kap3b, c[Kappa3SBeta], &f.s_beta);
+        axpy(&mut w.betab, c[Kappa3SBeta], &f.s_kap3);
+        axpy(&mut w.mu0b, c[Mu0Kappa3u], &f.kap3u);
+        axpy(&mut w.kap3ub, c[Mu0Kappa3u], &f.mu0);
+        axpy(&mut w.sigb, c[SigmaKappa3u], &f.kap3u);
+        axpy(&mut w.kap3ub, c[SigmaKappa3u], &f.sig);
+        axpy(&mut w.mu0b, c[Mu0Kappa4], &f.kap4);
+        axpy(&mut w.kap4b, c[Mu0Kappa4], &f.mu0);
+        adj_pi(&mut w.gbar, cols, c[VHsigPiHsigV], hsig_v, hsig_v);
+        axpy(&mut w.hsig_vb, 2.0 * c[VHsigPiHsigV], &f.pi_hsig_v);
+        axpy(&mut w.sigb, c[SigmaKappa4], &f.kap4);
+        axpy(&mut w.kap4b, c[SigmaKappa4], &f.sig);
+        adj_s(&mut w.gbar, cols, c[Kappa3SKappa3], kap3, kap3);
+        axpy(&mut w.kap3b, 2.0 * c[Kappa3SKappa3], &f.s_kap3);
         if pot {
-            adj_pi(&mut w.gbar, cols, c[3], hmu_v, hv);
-            axpy(&mut w.hmu_vb, c[3], &f.pi_hv);
-            axpy(&mut w.hvb, c[3], &f.pi_hmu_v);
-            axpy(&mut w.hvb, c[7], &f.k2);
-            axpy(&mut w.k2b, c[7], &f.hv);
-            axpy(&mut w.hub, c[11], &f.nn);
-            axpy(&mut w.nnb, c[11], &f.hu);
-            axpy(&mut w.ub, c[12], &f.hu);
-            axpy(&mut w.hub, c[12], &f.u);
+            adj_pi(&mut w.gbar, cols, c[VHmuPiHV], hmu_v, hv);
+            axpy(&mut w.hmu_vb, c[VHmuPiHV], &f.pi_hv);
+            axpy(&mut w.hvb, c[VHmuPiHV], &f.pi_hmu_v);
+            axpy(&mut w.hvb, c[VHK2], &f.k2);
+            axpy(&mut w.k2b, c[VHK2], &f.hv);
+            axpy(&mut w.hub, c[UHN], &f.nn);
+            axpy(&mut w.nnb, c[UHN], &f.hu);
+            axpy(&mut w.ub, c[UHU], &f.hu);
+            axpy(&mut w.hub, c[UHU], &f.u);
             // D^3 V(u, v, v) = 2 (pass A's e t^2)
-            w.pa[A_ETT] += 2.0 * c[13];
-            axpy(&mut w.nnb, c[14], &f.hn);
-            axpy(&mut w.hnb, c[14], &f.nn);
-            adj_pi(&mut w.gbar, cols, c[15], hv, hsig_v);
-            axpy(&mut w.hvb, c[15], &f.pi_hsig_v);
-            axpy(&mut w.hsig_vb, c[15], &f.pi_hv);
-            axpy(&mut w.hvb, c[16], &f.k3);
-            axpy(&mut w.k3b, c[16], &f.hv);
-            w.pb[B_ETT] += 2.0 * c[17];
-            adj_pi(&mut w.gbar, cols, c[18], hv, hv);
-            axpy(&mut w.hvb, 2.0 * c[18], &f.pi_hv);
-            w.pa[A_T4] += 24.0 * c[19];
+            w.pa[A_ETT] += 2.0 * c[D3VUVV];
+            axpy(&mut w.nnb, c[NHN], &f.hn);
+            axpy(&mut w.hnb, c[NHN], &f.nn);
+            adj_pi(&mut w.gbar, cols, c[VHPiHsigV], hv, hsig_v);
+            axpy(&mut w.hvb, c[VHPiHsigV], &f.pi_hsig_v);
+            axpy(&mut w.hsig_vb, c[VHPiHsigV], &f.pi_hv);
+            axpy(&mut w.hvb, c[VHK3], &f.k3);
+            axpy(&mut w.k3b, c[VHK3], &f.hv);
+            w.pb[B_ETT] += 2.0 * c[D3VNVV];
+            adj_pi(&mut w.gbar, cols, c[VHPiHV], hv, hv);
+            axpy(&mut w.hvb, 2.0 * c[VHPiHV], &f.pi_hv);
+            w.pa[A_T4] += 24.0 * c[D4V];
         }
 
         // 2. the Hessian-vector products: the constraint-weighted ones by pass R, those of V
@@ -203,7 +204,7 @@ impl ModifiedS2 {
         }
 
         // 4. pass C along (v, K2, K3)
-        contract::<6, BasisC>(
+        contract::<NC, BasisC>(
             sys,
             (&f.pc, &w.wc, None),
             gq,
@@ -229,7 +230,7 @@ impl ModifiedS2 {
         }
 
         // 7. pass B along (v, n, u)
-        contract::<9, BasisB>(
+        contract::<NB, BasisB>(
             sys,
             (&f.pb, &w.wb, Some(&w.pb)),
             gq,
@@ -256,7 +257,7 @@ impl ModifiedS2 {
             }
         }
         // pass A along (v, u)
-        contract::<8, BasisA>(
+        contract::<NA, BasisA>(
             sys,
             (&f.pa, &w.wa, Some(&w.pa)),
             gq,
@@ -298,7 +299,7 @@ impl ModifiedS2 {
 /// evaluation: `Gb -= c [p_b (Pi a)^T + p_a (Pi b)^T]`; the increments of `ab` and `bb`,
 /// `c Pi b` and `c Pi a`, are the caller's.
 fn adj_pi(
-    gbar: &mut [[f64; 6]],
+    gbar: &mut [LocalRow],
     cols: &[Cols],
     c: f64,
     (pa, sa): (&[f64], &[f64]),
@@ -313,7 +314,7 @@ fn adj_pi(
 /// `Gb += c [al k_b^T + be k_a^T]`; the increments of `ab` and `bb`, `c S^-1 b` and
 /// `c S^-1 a`, are the caller's.
 fn adj_s(
-    gbar: &mut [[f64; 6]],
+    gbar: &mut [LocalRow],
     cols: &[Cols],
     c: f64,
     (al, ka): (&[f64], &[f64]),
@@ -370,7 +371,7 @@ fn hvp_weighted_adj(
     gq: &mut [f64],
     gv: &mut [f64],
 ) {
-    let dirs: [&[f64]; 6] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
+    let dirs: [&[f64]; R_DIRS] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
     w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
     for r in 0..m {
         let (s, mu) = (f.sig[r], f.mu0[r]);
@@ -378,7 +379,7 @@ fn hvp_weighted_adj(
         w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
         w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
         // weights of q (the x yb coefficients), of v (y1, y2) and of u (y3, y4)
-        let mut x = [[0.0; 11]; 3];
+        let mut x = [[0.0; NR]; R_OUTPUTS];
         for (i, wt) in [s, mu, s, mu].into_iter().enumerate() {
             x[0][R_XY[i]] = wt;
             x[1 + i / 2][R_Y[i]] = wt;
