@@ -1,6 +1,27 @@
-//! The preadjustment terms of the symplectic scheme, on a shared projected metric.
+//! The preadjustment terms of the symplectic scheme, each a type owning its workspace, on one
+//! shared projected metric.
 //!
-//! (The module map is written in a later commit.)
+//! With `g = grad V`, `G = Phi_q`, `S = G M^-1 G^T`, the `M^-1`-projector
+//! `Pi = M^-1 - M^-1 G^T S^-1 G M^-1`, the rest multipliers `mu0 = S^-1 G M^-1 g`,
+//! `u = M^-1 f_T = -Pi g` and the tangential stiffness `A = Hess V - mu0 . Hess Phi`:
+//!
+//! | term | type (file) | value (forward) | gradient (adjoint) | Newton matrix | `docs/symplectic.md` |
+//! |---|---|---|---|---|---|
+//! | paper A's `W_s(q) = 1/2 u^T A (Pi A)^(s-2) u` (`W_1 = 1/2 u^T M u`), `gamma kappa_s h^(2s) W_s` at the Gauss points | [`PaperTerm`] (`paper.rs`) | `PaperTerm::value`: the Krylov vectors `a_i = (Pi A)^i u` | `PaperTerm::gradient`: by hand through the Krylov recursion, exact third derivatives | `A (Pi A)^s` ([`TangentStiffness::a_pi_a_power`]) | section 5 |
+//! | the s = 1 modified Lagrangian `e(q, v)`, `h^3 e` at the chord midpoint of a (1,1) step | [`ModifiedS1`] (`modified_s1.rs`) | `ModifiedS1::evaluate` | `ModifiedS1::gradients`: closed form, one Hessian-vector and one third-order pass | `ModifiedS1::add_velocity_hessian` and `A Pi A` ([`TangentStiffness::a_pi_a`]); diagonals on the sparse path (`ModifiedS1::newton_diagonals`) | section 5a |
+//! | the s = 2 modified Lagrangian `e4(q, v)`, 23 invariants ([`modified_s2::E4_TERMS`]), `h^5 e4` at the chord midpoint of a (2,2) step | [`modified_s2::ModifiedS2`] (`modified_s2/`) | `modified_s2/forward.rs`: jet passes A, B, C (`modified_s2/passes.rs`) | `modified_s2/reverse.rs`: reverse pass through the forward's intermediates (workspace `modified_s2/adjoints.rs`) | none (left out of the Newton matrix) | section 5b |
+//!
+//! Shared by the terms:
+//!
+//! * [`ProjectedMetric`] (`metric.rs`): `g`, `G`, the factor of `S` (dense, or sparse for the
+//!   modified Lagrangian on large models), `mu0`, `u` at one point, kept while the point does not
+//!   change bit for bit, and the products with `Pi`, `S^-1`, `G`, `M^-1 G^T` and `A`;
+//! * [`TangentStiffness`] (`stiffness.rs`): `A` assembled at the metric's point, and its
+//!   Newton matrices on the block of coordinates where `A` is not zero (dense layout).
+//!
+//! [`Preadjustment`] is the public face: one metric, the stiffness and the three terms, with the
+//! methods the integrator (`galerkin/`) and the tests call. Every method prepares the metric at
+//! its `q` (a no-op when `q` repeats), then asks one term.
 
 use mbd_model::System;
 use mbd_solve::SolveError;

@@ -531,9 +531,9 @@ pub(crate) mod modlag_tests {
         err
     }
 
-    /// With a non-linear potential (a spring) the midpoint form of `e` restores order 4; the
-    /// trapezoid form (no `-1/8 v^T Hess V v`) gave order 1.8 to 2 here in the prototype
-    /// (`docs/modified-lagrangian.md` section 4), and the plain scheme has order 2.
+    /// With a non-linear potential (a spring) the midpoint form of `e` restores order 4 where
+    /// the plain scheme has order 2 (`docs/symplectic.md` section 5a compares the trapezoid
+    /// form).
     #[test]
     fn spring_rod_converges_with_order_four() {
         let sys = rod_with_spring();

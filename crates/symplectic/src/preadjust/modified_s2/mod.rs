@@ -11,7 +11,8 @@
 //! `kappa3u_k = D^3 Phi_k(u, v, v) + 2 Hess Phi_k(K2, v) + Hess Phi_k(n, u)`,
 //! `kappa4_k = D^4 Phi_k(v, v, v, v) + 6 D^3 Phi_k(n, v, v) + 3 Hess Phi_k(n, n) +
 //! 4 Hess Phi_k(K3, v)`, `H = Hess V`, `H_mu = mu0 . Hess Phi`, `H_sigma = sigma . Hess Phi`,
-//! the terms and their coefficients are those of [`E4_TERMS`]. The directional derivatives of
+//! the terms and their coefficients are those of [`E4_TERMS`], each named by an [`Invariant`]
+//! (the term values are a [`PerInvariant`], indexed by name). The directional derivatives of
 //! orders 2 to 4, mixed ones included, come from three passes of multivariate truncated
 //! Taylor jets ([`mbd_model::PolyJet`], [`System::constraint_poly_series`],
 //! [`System::potential_poly_series`]): pass A along `(v, u)`, pass B along `(v, n, u)` (after

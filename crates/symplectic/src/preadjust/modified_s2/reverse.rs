@@ -1,9 +1,9 @@
-//! Exact gradients of the `h^4` modified-Lagrangian term `e4(q, v)`: one
-//! forward evaluation that keeps its intermediates ([`E4Forward`]), then a reverse
-//! (adjoint) pass through them, so `de4/dq` and `de4/dv` cost a fixed number of passes over the
-//! elements, independent of `n` (central differences took `8 n` evaluations of `e4`). Both
-//! run in a workspace allocated on first use ([`ModifiedS2`]): nothing is allocated per call. Every
-//! element pass at `q` takes the bodies' `sin`/`cos` from one table ([`mbd_model::BodyAngles`]).
+//! Exact gradients of the `h^4` modified-Lagrangian term `e4(q, v)`: one forward evaluation
+//! that keeps its intermediates ([`E4Forward`]), then a reverse (adjoint) pass through them, so
+//! `de4/dq` and `de4/dv` cost a fixed number of passes over the elements, independent of `n`.
+//! Both run in a workspace allocated on first use ([`ModifiedS2`]): nothing is allocated per
+//! call. Every element pass at `q` takes the bodies' `sin`/`cos` from one table
+//! ([`mbd_model::BodyAngles`]).
 //!
 //! The reverse pass needs, besides the linear algebra's adjoints, the adjoints of three
 //! primitives:
@@ -357,7 +357,7 @@ fn hvp_adj(
 
 /// The adjoints of the four constraint-weighted Hessian-vector products `y = H_w x`
 /// (`H_w = sum_r w_r Hess Phi_r`) for `(x, w) = (v, sigma), (v, mu0), (u, sigma), (u,
-/// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`]): `qb += D^3 (w . Phi)(x, yb,
+/// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`](super::passes::BasisR)): `qb += D^3 (w . Phi)(x, yb,
 /// .)` (the `q`-gradients of `x yb`), `xb += H_w yb` (those of `yb`), `wb_r += yb^T Hess
 /// Phi_r x` (the coefficients of `x yb`).
 #[allow(clippy::too_many_arguments)]
