@@ -17,7 +17,7 @@
 //! new point gets a new [`Stamp`], by which the terms tell whether what they keep is still of
 //! this point.
 
-use super::{add_dgt, dot, gm_times, LocalRow, ZERO_ROW};
+use super::{dot, LocalRow, ZERO_ROW};
 use mbd_model::System;
 use mbd_solve::linalg::DenseCholesky;
 use mbd_solve::sparse::ConstraintSchur;
@@ -422,5 +422,33 @@ impl ProjectedMetric {
         self.at.copy_from_slice(q);
         self.at_valid = true;
         Ok(())
+    }
+}
+
+/// `out = G x` for the column-major `m x n` matrix `G`, by columns (zero entries of `x`
+/// skipped).
+fn gm_times(g: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
+    let m = g.nrows();
+    out.fill(0.0);
+    if m == 0 {
+        return;
+    }
+    for (col, &xk) in g.as_slice().chunks_exact(m).zip(x) {
+        if xk != 0.0 {
+            for (o, &gr) in out.iter_mut().zip(col) {
+                *o += gr * xk;
+            }
+        }
+    }
+}
+
+/// `out += c M^-1 G^T x` for the column-major `m x n` matrix `G` (x of length m).
+fn add_dgt(g: &DMatrix<f64>, minv: &[f64], x: &[f64], c: f64, out: &mut [f64]) {
+    let m = g.nrows();
+    if m == 0 {
+        return;
+    }
+    for ((o, col), mi) in out.iter_mut().zip(g.as_slice().chunks_exact(m)).zip(minv) {
+        *o += c * mi * dot(col, x);
     }
 }

@@ -65,50 +65,8 @@ pub struct Preadjustment {
     pub(crate) fd_step: f64,
 }
 
-#[cfg(test)]
-pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
-    let n = a.nrows();
-    out.iter_mut().for_each(|o| *o = 0.0);
-    for (j, &xj) in x.iter().enumerate() {
-        if xj == 0.0 {
-            continue;
-        }
-        let col = &a.as_slice()[j * n..(j + 1) * n];
-        for i in 0..n {
-            out[i] += col[i] * xj;
-        }
-    }
-}
-
-/// `out = G x` for the column-major `m x n` matrix `G`, by columns (zero entries of `x`
-/// skipped).
-fn gm_times(g: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
-    let m = g.nrows();
-    out.fill(0.0);
-    if m == 0 {
-        return;
-    }
-    for (col, &xk) in g.as_slice().chunks_exact(m).zip(x) {
-        if xk != 0.0 {
-            for (o, &gr) in out.iter_mut().zip(col) {
-                *o += gr * xk;
-            }
-        }
-    }
-}
-
-/// `out += c M^-1 G^T x` for the column-major `m x n` matrix `G` (x of length m).
-fn add_dgt(g: &DMatrix<f64>, minv: &[f64], x: &[f64], c: f64, out: &mut [f64]) {
-    let m = g.nrows();
-    if m == 0 {
-        return;
-    }
-    for ((o, col), mi) in out.iter_mut().zip(g.as_slice().chunks_exact(m)).zip(minv) {
-        *o += c * mi * dot(col, x);
-    }
-}
-
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+/// `a . b`.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 

@@ -391,7 +391,7 @@ pub(crate) mod modlag_tests {
             sys.add_constraint_hessian(q, p.s1.sigma(), 1.0, &mut hs);
         }
         let mut t = vec![0.0; n];
-        crate::preadjust::matvec(&hs, v, &mut t);
+        crate::preadjust::stiffness::matvec(&hs, v, &mut t);
         for k in 0..n {
             dv[k] += t[k];
         }

@@ -198,6 +198,22 @@ impl TangentStiffness {
     /// `out = A x` with the assembled `A` (tests).
     #[cfg(test)]
     pub(super) fn times(&self, x: &[f64], out: &mut [f64]) {
-        super::matvec(&self.amat, x, out);
+        matvec(&self.amat, x, out);
+    }
+}
+
+/// `out = a x` (tests).
+#[cfg(test)]
+pub(super) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
+    let n = a.nrows();
+    out.iter_mut().for_each(|o| *o = 0.0);
+    for (j, &xj) in x.iter().enumerate() {
+        if xj == 0.0 {
+            continue;
+        }
+        let col = &a.as_slice()[j * n..(j + 1) * n];
+        for i in 0..n {
+            out[i] += col[i] * xj;
+        }
     }
 }
