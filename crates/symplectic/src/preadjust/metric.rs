@@ -209,6 +209,12 @@ impl ProjectedMetric {
         Ok(())
     }
 
+    /// `(G^T x)_k`, the dot product of column `k` of `G` with `x` (dense layout).
+    pub(super) fn g_col_dot(&self, k: usize, x: &[f64]) -> f64 {
+        let m = self.m;
+        dot(&self.gq.as_slice()[k * m..(k + 1) * m], x)
+    }
+
     /// `x <- S^-1 x` with the last factorisation of `S`.
     pub(super) fn s_solve(&mut self, x: &mut [f64]) {
         match &mut self.schur {
@@ -232,6 +238,7 @@ impl ProjectedMetric {
     }
 
     /// `out += c M^-1 G^T x` (x of length m).
+    #[inline]
     pub(super) fn add_dgt_to(&self, x: &[f64], c: f64, out: &mut [f64]) {
         match &self.schur {
             Some(sc) => sc.add_weighted_transpose(c, &self.minv, x, out),
@@ -409,7 +416,7 @@ impl ProjectedMetric {
         } else {
             for k in 0..n {
                 let acc = if m > 0 {
-                    dot(&self.gq.as_slice()[k * m..(k + 1) * m], &self.mu0)
+                    self.g_col_dot(k, &self.mu0)
                 } else {
                     0.0
                 };

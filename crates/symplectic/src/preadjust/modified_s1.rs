@@ -189,7 +189,7 @@ impl ModifiedS1 {
         dq: &mut [f64],
         dv: &mut [f64],
     ) -> f64 {
-        let (n, m) = (metric.n(), metric.m());
+        let n = metric.n();
         let e = self.evaluate(metric, sys, q, v);
         for k in 0..n {
             dv[k] = self.hv[k] / 6.0;
@@ -200,9 +200,9 @@ impl ModifiedS1 {
             uw.copy_from_slice(metric.u());
             metric.add_dgt_to(&self.sigma, -1.0, uw);
         } else {
-            let (gq, minv, u) = (metric.gq(), metric.minv(), metric.u());
+            let (minv, u) = (metric.minv(), metric.u());
             for k in 0..n {
-                let acc: f64 = (0..m).map(|r| gq[(r, k)] * self.sigma[r]).sum();
+                let acc = metric.g_col_dot(k, &self.sigma);
                 uw[k] = u[k] - minv[k] * acc;
             }
         }

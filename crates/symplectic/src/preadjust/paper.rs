@@ -162,12 +162,10 @@ impl PaperTerm {
             metric.s_solve(h);
         }
         // (1)+(2b'): -A (a_{l+1} + M^-1 G^T rho)
-        {
-            let (gq, minv) = (metric.gq(), metric.minv());
-            for k in 0..n {
-                let acc: f64 = (0..m).map(|r| gq[(r, k)] * h[r]).sum();
-                self.arg[k] = self.av[l + 1][k] + minv[k] * acc;
-            }
+        let minv = metric.minv();
+        for k in 0..n {
+            let acc = metric.g_col_dot(k, h);
+            self.arg[k] = self.av[l + 1][k] + minv[k] * acc;
         }
         metric.a_times(sys, q, &self.arg, out);
         out.iter_mut().for_each(|x| *x = -*x);
