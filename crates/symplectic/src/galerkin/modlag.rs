@@ -100,7 +100,7 @@ impl Galerkin {
             return Ok(());
         }
         // s = 2: E_d = h^5 e4(qbar, v) at the chord of the end control points, its exact
-        // gradients by a reverse pass (modified2_grad.rs; docs/symplectic.md section 5b); at a
+        // gradients by a reverse pass (preadjust/modified_s2/; docs/symplectic.md section 5b); at a
         // continuing step's predictor extrapolated from the last four steps (`GradientHistory`)
         let r = &mut self.mlhist;
         r.lagged = std::mem::take(&mut r.first) && r.hist_len == 4;

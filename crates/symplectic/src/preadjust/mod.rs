@@ -1,151 +1,72 @@
-//! The preadjustment potential `W_s(q)` of paper A and its gradient.
+//! The preadjustment terms of the symplectic scheme, each a type owning its workspace, on one
+//! shared projected metric.
 //!
-//! With `g = grad V`, `G = Phi_q`, `S = G M^-1 G^T` and the symmetric `M^-1`-projector
-//! `Pi = M^-1 - M^-1 G^T S^-1 G M^-1` (so `Pi = M^-1 P` with `P = I - G^T S^-1 G M^-1`):
+//! With `g = grad V`, `G = Phi_q`, `S = G M^-1 G^T`, the `M^-1`-projector
+//! `Pi = M^-1 - M^-1 G^T S^-1 G M^-1`, the rest multipliers `mu0 = S^-1 G M^-1 g`,
+//! `u = M^-1 f_T = -Pi g` and the tangential stiffness `A = Hess V - mu0 . Hess Phi`:
 //!
-//! * tangential force `f_T = P (-g)`, its velocity-like image `u = M^-1 f_T = -Pi g`,
-//! * rest multipliers `mu0 = S^-1 G M^-1 g` (so `f_T = -g + G^T mu0`),
-//! * tangential stiffness `K_T = -d f_T / dq = P A + G^T S^-1 B` with the symmetric
-//!   `A = Hess V - sum_k mu0_k Hess Phi_k`, so `P K_T = P A`,
-//! * `W_1 = 1/2 f_T^T M^-1 f_T = 1/2 u^T M u`,
-//!   `W_s = 1/2 f_T^T M^-1 (P K_T M^-1)^(s-1) f_T = 1/2 u^T A (Pi A)^(s-2) u` for `s >= 2`.
+//! | term | type (file) | value (forward) | gradient (adjoint) | Newton matrix | `docs/symplectic.md` |
+//! |---|---|---|---|---|---|
+//! | paper A's `W_s(q) = 1/2 u^T A (Pi A)^(s-2) u` (`W_1 = 1/2 u^T M u`), `gamma kappa_s h^(2s) W_s` at the Gauss points | [`PaperTerm`] (`paper.rs`) | `PaperTerm::value`: the Krylov vectors `a_i = (Pi A)^i u` | `PaperTerm::gradient`: by hand through the Krylov recursion, exact third derivatives | `A (Pi A)^s` ([`TangentStiffness::a_pi_a_power`]) | section 5 |
+//! | the s = 1 modified Lagrangian `e(q, v)`, `h^3 e` at the chord midpoint of a (1,1) step | [`ModifiedS1`] (`modified_s1.rs`) | `ModifiedS1::evaluate` | `ModifiedS1::gradients`: closed form, one Hessian-vector and one third-order pass | `ModifiedS1::add_velocity_hessian` and `A Pi A` ([`TangentStiffness::a_pi_a`]); diagonals on the sparse path (`ModifiedS1::newton_diagonals`) | section 5a |
+//! | the s = 2 modified Lagrangian `e4(q, v)`, 23 invariants ([`modified_s2::E4_TERMS`]), `h^5 e4` at the chord midpoint of a (2,2) step | [`modified_s2::ModifiedS2`] (`modified_s2/`) | `modified_s2/forward.rs`: jet passes A, B, C (`modified_s2/passes.rs`) | `modified_s2/reverse.rs`: reverse pass through the forward's intermediates (workspace `modified_s2/adjoints.rs`) | none (left out of the Newton matrix) | section 5b |
 //!
-//! For `s = 1, 2` this is exactly paper A's `W_s`; for `s >= 3` the projector `P`
-//! between the factors keeps the modal form `W_s = 1/2 sum_i omega_i^(2s+2) eta_i^2` about an
-//! equilibrium (without it the normal components of `K_T` would enter). The gradient is exact:
-//! the third derivatives of `V` and `Phi` it needs for `s >= 2` come from
-//! [`System::potential_third`] and [`System::constraint_third`]. The Newton Jacobian uses `A (Pi A)^s`, the exact Hessian of `W_s`
-//! at an equilibrium (`f_T = 0`).
+//! Shared by the terms:
+//!
+//! * [`ProjectedMetric`] (`metric.rs`): `g`, `G`, the factor of `S` (dense, or sparse for the
+//!   modified Lagrangian on large models), `mu0`, `u` at one point, kept while the point does not
+//!   change bit for bit, and the products with `Pi`, `S^-1`, `G`, `M^-1 G^T` and `A`;
+//! * [`TangentStiffness`] (`stiffness.rs`): `A` assembled at the metric's point, and its
+//!   Newton matrices on the block of coordinates where `A` is not zero (dense layout).
+//!
+//! [`Preadjustment`] is the public face: one metric, the stiffness and the three terms, with the
+//! methods the integrator (`galerkin/`) and the tests call. Every method prepares the metric at
+//! its `q` (a no-op when `q` repeats), then asks one term.
 
 use mbd_model::System;
-use mbd_solve::linalg::DenseCholesky;
-use mbd_solve::sparse::ConstraintSchur;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
-mod e4_work;
-mod modified;
-mod modified2;
-mod modified2_grad;
+mod metric;
+mod modified_s1;
+mod modified_s2;
 mod paper;
+mod stiffness;
 
-/// Workspace evaluating `W_s`, its gradient and an approximate Hessian (allocation-free after
-/// [`Preadjustment::new`]).
+use metric::ProjectedMetric;
+use modified_s1::ModifiedS1;
+use modified_s2::E4_TERM_COUNT;
+use paper::PaperTerm;
+use stiffness::TangentStiffness;
+
+/// A constraint row in element-local form: its derivatives in the coordinates `(x, y, theta)`
+/// of the joint's two bodies.
+type LocalRow = [f64; 6];
+
+/// A zero [`LocalRow`].
+const ZERO_ROW: LocalRow = [0.0; 6];
+
+/// The preadjustment terms at one point, with their shared metric: paper A's `W_s` (value,
+/// gradient, Newton Hessian), the tangential force, and the modified-Lagrangian terms `e`
+/// (s = 1) and `e4` (s = 2) with their gradients (allocation-free after the first use).
+///
+/// Every method evaluates the shared quantities at its `q` first, and keeps them while `q`
+/// does not change bit for bit.
 #[derive(Debug)]
 pub struct Preadjustment {
-    s: usize,
-    n: usize,
-    m: usize,
-    mass: Vec<f64>,
-    minv: Vec<f64>,
+    metric: ProjectedMetric,
+    stiffness: TangentStiffness,
+    paper: PaperTerm,
+    s1: ModifiedS1,
+    /// The `s = 2` term (allocated on first use).
+    s2: Option<Box<modified_s2::ModifiedS2>>,
     /// Relative step of the finite-difference checks of the derivatives (tests); the
     /// derivatives used by the integrator are exact.
     pub(crate) fd_step: f64,
-    g: Vec<f64>,
-    gq: DMatrix<f64>,
-    chol: DenseCholesky,
-    mu0: Vec<f64>,
-    u: Vec<f64>,
-    amat: DMatrix<f64>,
-    av: Vec<Vec<f64>>,
-    bv: Vec<Vec<f64>>,
-    sig: Vec<Vec<f64>>,
-    tn: [Vec<f64>; 4],
-    tm: [Vec<f64>; 3],
-    zero: Vec<f64>,
-    gc: Vec<f64>,
-    gc0: Vec<f64>,
-    sigma: Vec<f64>,
-    cm: Vec<f64>,
-    /// The point of the last successful `prepare` (its results are reused when `q` repeats
-    /// bit for bit: the control point `q_1` of one step is `q_0` of the next, and the Newton
-    /// Jacobian is evaluated where the residual was).
-    at: Vec<f64>,
-    at_valid: bool,
-    /// Whether `amat` holds `A` at `at`.
-    a_valid: bool,
-    nmu0: Vec<f64>,
-    hv: Vec<f64>,
-    d3: Vec<f64>,
-    rheonomic: bool,
-    /// The velocity of the last `modified_prepared` at `at` (valid while `mv_valid`): its
-    /// results (`sigma`, `cm`, `hv`, `d3`) are reused by the Newton Jacobian, which is
-    /// evaluated where the residual was.
-    mv: Vec<f64>,
-    mv_valid: bool,
-    /// The coordinates where `A` has a nonzero column, and `k x k` blocks on them (column-major,
-    /// `n x n` capacity) for the Newton Hessian of `W_s`.
-    kset: Vec<usize>,
-    /// Scratch `m x n` matrices: `Phi_q` (discarded) and `(Phi_q v)_q` (rows `v^T Hess Phi_k`)
-    /// for the modified Jacobian.
-    gscr: DMatrix<f64>,
-    ct: DMatrix<f64>,
-    /// Scratch: the nonzero rows of a column of `Phi_q`.
-    rows: Vec<usize>,
-    /// Element-local constraint rows along the velocity `rv` from one third-order pass
-    /// (`System::constraint_third_local`; valid at `at` while `rv_valid`): `Phi_q`,
-    /// `Hess Phi_r v`, `D^3 Phi_r(v, v, .)`; `gc` then holds `v^T Hess Phi_r v`.
-    rg: Vec<[f64; 6]>,
-    rhv: Vec<[f64; 6]>,
-    rd3: Vec<[f64; 6]>,
-    rv: Vec<f64>,
-    rv_valid: bool,
-    kpi: Vec<f64>,
-    ka: Vec<f64>,
-    kx: Vec<f64>,
-    ky: Vec<f64>,
-    /// The workspace of the s = 2 modified-Lagrangian term (allocated on first use).
-    e4: Option<Box<e4_work::E4Work>>,
-    /// The sparse layout ([`Preadjustment::new_sparse`]): `Phi_q` in element-local rows and
-    /// the sparse Cholesky factorisation of `S` instead of `gq` and `chol` (which, with the
-    /// other `n x n` and `m x n` matrices, are then empty).
-    schur: Option<Box<ConstraintSchur>>,
 }
 
-#[cfg(test)]
-pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
-    let n = a.nrows();
-    out.iter_mut().for_each(|o| *o = 0.0);
-    for (j, &xj) in x.iter().enumerate() {
-        if xj == 0.0 {
-            continue;
-        }
-        let col = &a.as_slice()[j * n..(j + 1) * n];
-        for i in 0..n {
-            out[i] += col[i] * xj;
-        }
-    }
-}
-
-/// `out = G x` for the column-major `m x n` matrix `G`, by columns (zero entries of `x`
-/// skipped).
-fn gm_times(g: &DMatrix<f64>, x: &[f64], out: &mut [f64]) {
-    let m = g.nrows();
-    out.fill(0.0);
-    if m == 0 {
-        return;
-    }
-    for (col, &xk) in g.as_slice().chunks_exact(m).zip(x) {
-        if xk != 0.0 {
-            for (o, &gr) in out.iter_mut().zip(col) {
-                *o += gr * xk;
-            }
-        }
-    }
-}
-
-/// `out += c M^-1 G^T x` for the column-major `m x n` matrix `G` (x of length m).
-fn add_dgt(g: &DMatrix<f64>, minv: &[f64], x: &[f64], c: f64, out: &mut [f64]) {
-    let m = g.nrows();
-    if m == 0 {
-        return;
-    }
-    for ((o, col), mi) in out.iter_mut().zip(g.as_slice().chunks_exact(m)).zip(minv) {
-        *o += c * mi * dot(col, x);
-    }
-}
-
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+/// `a . b`.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -158,9 +79,10 @@ impl Preadjustment {
     /// A workspace for the modified Lagrangian alone ([`Preadjustment::modified_term`],
     /// [`Preadjustment::modified_gradients`] for `s = 1`, [`Preadjustment::modified_term_s2`],
     /// [`Preadjustment::modified_gradients_s2`] for `s = 2`) with `S = Phi_q M^-1 Phi_q^T`
-    /// held sparse ([`ConstraintSchur`]): `O(N)` storage and work per evaluation on a chain of
-    /// `N` bodies (the symplectic scheme's sparse stage solve). The `W_s` methods and the dense
-    /// Hessians need the dense matrices and return [`SolveError::Unsupported`] on it.
+    /// held sparse ([`mbd_solve::sparse::ConstraintSchur`]): `O(N)` storage and work per
+    /// evaluation on a chain of `N` bodies (the symplectic scheme's sparse stage solve). The
+    /// `W_s` methods and the dense Hessians need the dense matrices and return
+    /// [`SolveError::Unsupported`] on it.
     pub fn new_sparse(sys: &System) -> Result<Self, SolveError> {
         // (the degree is that of W_s, which the modified Lagrangian does not use)
         Self::with_layout(sys, 1, true)
@@ -175,281 +97,19 @@ impl Preadjustment {
             });
         }
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let schur = if sparse {
-            Some(Box::new(ConstraintSchur::new(sys)?))
-        } else {
-            None
-        };
-        // (the dense matrices: empty on the sparse layout)
-        let (nd, md) = if sparse { (0, 0) } else { (n, m) };
         Ok(Preadjustment {
-            s,
-            n,
-            m,
-            mass: sys.mass_diag().as_slice().to_vec(),
-            minv: sys.inv_mass_diag().as_slice().to_vec(),
+            metric: ProjectedMetric::new(sys, sparse)?,
+            stiffness: TangentStiffness::new(n, m, sparse),
+            paper: PaperTerm::new(n, m, s),
+            s1: ModifiedS1::new(n, m, sparse),
+            s2: None,
             fd_step: 2e-3,
-            g: vec![0.0; n],
-            gq: DMatrix::zeros(md, nd),
-            chol: DenseCholesky::new(md),
-            mu0: vec![0.0; m],
-            u: vec![0.0; n],
-            amat: DMatrix::zeros(nd, nd),
-            av: vec![vec![0.0; n]; s + 1],
-            bv: vec![vec![0.0; n]; s + 1],
-            sig: vec![vec![0.0; m]; s.max(1)],
-            tn: std::array::from_fn(|_| vec![0.0; n]),
-            tm: std::array::from_fn(|_| vec![0.0; m]),
-            zero: vec![0.0; n],
-            gc: vec![0.0; m],
-            gc0: vec![0.0; m],
-            sigma: vec![0.0; m],
-            cm: vec![0.0; m],
-            at: vec![0.0; n],
-            at_valid: false,
-            a_valid: false,
-            nmu0: vec![0.0; m],
-            hv: vec![0.0; n],
-            d3: vec![0.0; n],
-            rheonomic: sys.is_rheonomic(),
-            mv: vec![0.0; n],
-            mv_valid: false,
-            kset: Vec::with_capacity(n),
-            gscr: DMatrix::zeros(md, nd),
-            ct: DMatrix::zeros(md, nd),
-            rows: Vec::with_capacity(m),
-            rg: vec![[0.0; 6]; m],
-            rhv: vec![[0.0; 6]; m],
-            rd3: vec![[0.0; 6]; m],
-            rv: vec![0.0; n],
-            rv_valid: false,
-            kpi: vec![0.0; nd * nd],
-            ka: vec![0.0; nd * nd],
-            kx: vec![0.0; nd * nd],
-            ky: vec![0.0; nd * nd.max(md)],
-            e4: None,
-            schur,
         })
-    }
-
-    /// [`SolveError::Unsupported`] on the sparse layout, for the methods that need the dense
-    /// matrices (`what` names the method).
-    pub(crate) fn require_dense(&self, what: &str) -> Result<(), SolveError> {
-        if self.schur.is_some() {
-            return Err(SolveError::Unsupported(format!(
-                "{what} needs the dense layout (Preadjustment::new); this workspace was built by \
-                 Preadjustment::new_sparse for the modified Lagrangian"
-            )));
-        }
-        Ok(())
-    }
-
-    /// `x <- S^-1 x` with the last factorisation of `S`.
-    pub(crate) fn s_solve(&mut self, x: &mut [f64]) {
-        match &mut self.schur {
-            Some(sc) => sc.solve_in_place(x),
-            None => self.chol.solve_in_place(x),
-        }
-    }
-
-    /// `out = G x` (`G = Phi_q` at the prepared point).
-    pub(crate) fn g_times(&self, x: &[f64], out: &mut [f64]) {
-        match &self.schur {
-            Some(sc) => sc.apply(x, out),
-            None => gm_times(&self.gq, x, out),
-        }
-    }
-
-    /// `out += c M^-1 G^T x` (x of length m).
-    pub(crate) fn add_dgt_to(&self, x: &[f64], c: f64, out: &mut [f64]) {
-        match &self.schur {
-            Some(sc) => sc.add_weighted_transpose(c, &self.minv, x, out),
-            None => add_dgt(&self.gq, &self.minv, x, c, out),
-        }
     }
 
     /// The degree `s`.
     pub fn s(&self) -> usize {
-        self.s
-    }
-
-    /// `x -> Pi x` (`Pi = M^-1 P`); uses `tm[0]`.
-    pub(crate) fn apply_pi(&mut self, x: &[f64], out: &mut [f64]) {
-        let (n, m) = (self.n, self.m);
-        for i in 0..n {
-            out[i] = self.minv[i] * x[i];
-        }
-        if m == 0 {
-            return;
-        }
-        let mut t = std::mem::take(&mut self.tm[0]);
-        self.g_times(out, &mut t);
-        self.s_solve(&mut t);
-        self.add_dgt_to(&t, -1.0, out);
-        self.tm[0] = t;
-    }
-
-    /// `out = S^-1 G M^-1 x` (length m).
-    pub(crate) fn sgm(&mut self, x: &[f64], out: &mut [f64]) {
-        let n = self.n;
-        let mut t = std::mem::take(&mut self.tn[3]);
-        for k in 0..n {
-            t[k] = self.minv[k] * x[k];
-        }
-        self.g_times(&t, out);
-        self.s_solve(out);
-        self.tn[3] = t;
-    }
-
-    /// Whether the workspace holds the evaluation at exactly `q` (bit for bit).
-    pub(crate) fn is_prepared_at(&self, q: &[f64]) -> bool {
-        self.at_valid && self.at.as_slice() == q
-    }
-
-    /// Evaluates `g`, `G`, the Cholesky factor of `S`, `mu0` and `u` at `q` (nothing when they
-    /// are held for `q`). `A` is assembled only on demand ([`Preadjustment::ensure_a`]): the
-    /// gradients use Hessian-vector products instead.
-    fn prepare(&mut self, sys: &System, q: &[f64]) -> Result<(), SolveError> {
-        self.prepare_with(sys, q, None)
-    }
-
-    /// [`Preadjustment::prepare`]; with `Some(v)` (scleronomic models) the constraint pass is
-    /// one third-order pass along `v` (`System::constraint_third_local`) that also leaves
-    /// `v^T Hess Phi_k v` in `gc` and the local rows `Hess Phi_k v`, `D^3 Phi_k(v, v, .)` for
-    /// `modified_prepared` (one pass instead of three).
-    fn prepare_with(
-        &mut self,
-        sys: &System,
-        q: &[f64],
-        v: Option<&[f64]>,
-    ) -> Result<(), SolveError> {
-        let (n, m) = (self.n, self.m);
-        if q.len() != n {
-            return Err(SolveError::Dimension {
-                what: "q for W_s",
-                expected: n,
-                got: q.len(),
-            });
-        }
-        if self.is_prepared_at(q) {
-            return Ok(());
-        }
-        self.at_valid = false;
-        self.a_valid = false;
-        self.mv_valid = false;
-        self.rv_valid = false;
-        sys.potential_gradient(q, &mut self.g);
-        if m > 0 {
-            match v {
-                Some(v) if !self.rheonomic => {
-                    sys.constraint_third_local(
-                        q,
-                        v,
-                        &mut self.rg,
-                        &mut self.rhv,
-                        &mut self.rd3,
-                        &mut self.gc,
-                    );
-                    match &mut self.schur {
-                        Some(sc) => sc.grads_mut().copy_from_slice(&self.rg),
-                        None => sys.local_rows_dense(&self.rg, &mut self.gq),
-                    }
-                    self.rv.copy_from_slice(v);
-                    self.rv_valid = true;
-                }
-                _ => match &mut self.schur {
-                    Some(sc) => sc.update(sys, q),
-                    None => sys.phi_q(q, &mut self.gq),
-                },
-            }
-            let singular = || SolveError::Singular {
-                t: f64::NAN,
-                what: "Phi_q M^-1 Phi_q^T in W_s",
-                detail: "redundant constraints or a singular configuration".into(),
-            };
-            if let Some(sc) = &mut self.schur {
-                sc.factor(&self.minv).map_err(|_| singular())?;
-            } else {
-                let gq = &self.gq;
-                let minv = &self.minv;
-                let rows = &mut self.rows;
-                let chol = &mut self.chol;
-                chol.clear();
-                // S = sum_k minv_k G_:k G_:k^T over the few nonzero rows of each column
-                for (k, col) in gq.as_slice().chunks_exact(m).enumerate() {
-                    rows.clear();
-                    rows.extend((0..m).filter(|&r| col[r] != 0.0));
-                    for (i, &c) in rows.iter().enumerate() {
-                        let gc = minv[k] * col[c];
-                        for &r in &rows[i..] {
-                            // rows ascending: r >= c, the lower triangle
-                            chol.add(r, c, col[r] * gc);
-                        }
-                    }
-                }
-                self.chol.factor_in_place().map_err(|_| singular())?;
-            }
-            let g = std::mem::take(&mut self.g);
-            let mut mu0 = std::mem::take(&mut self.mu0);
-            self.sgm(&g, &mut mu0);
-            self.g = g;
-            self.mu0 = mu0;
-        }
-        if self.schur.is_some() {
-            // u = M^-1 (G^T mu0 - g)
-            for k in 0..n {
-                self.u[k] = -self.minv[k] * self.g[k];
-            }
-            let mut u = std::mem::take(&mut self.u);
-            self.add_dgt_to(&self.mu0, 1.0, &mut u);
-            self.u = u;
-        } else {
-            for k in 0..n {
-                let acc = if m > 0 {
-                    dot(&self.gq.as_slice()[k * m..(k + 1) * m], &self.mu0)
-                } else {
-                    0.0
-                };
-                self.u[k] = self.minv[k] * (acc - self.g[k]);
-            }
-        }
-        for r in 0..m {
-            self.nmu0[r] = -self.mu0[r];
-        }
-        self.at.copy_from_slice(q);
-        self.at_valid = true;
-        Ok(())
-    }
-
-    /// Assembles `A = Hess V - mu0 . Hess Phi` after `prepare(q)` (once per point).
-    fn ensure_a(&mut self, sys: &System, q: &[f64]) {
-        if self.a_valid {
-            return;
-        }
-        sys.potential_hessian(q, &mut self.amat);
-        if self.m > 0 {
-            sys.add_constraint_hessian(q, &self.mu0, -1.0, &mut self.amat);
-        }
-        self.a_valid = true;
-    }
-
-    /// `out = A x` without assembling `A` (one Hessian-vector pass), after `prepare(q)`.
-    fn a_times(&self, sys: &System, q: &[f64], x: &[f64], out: &mut [f64]) {
-        sys.lagrangian_hessian_vector(q, x, 1.0, &self.nmu0, out);
-    }
-
-    /// Krylov vectors `a_0 = u`, `a_{i+1} = Pi b_i` with `b_i = A a_i`, for `i < count`
-    /// (`b_i` in `bv[i]`).
-    pub(crate) fn krylov(&mut self, sys: &System, q: &[f64], count: usize) {
-        self.av[0].copy_from_slice(&self.u);
-        for i in 0..count {
-            let mut b = std::mem::take(&mut self.bv[i]);
-            self.a_times(sys, q, &self.av[i], &mut b);
-            let mut next = std::mem::take(&mut self.av[i + 1]);
-            self.apply_pi(&b, &mut next);
-            self.av[i + 1] = next;
-            self.bv[i] = b;
-        }
+        self.paper.s()
     }
 
     /// The tangential force `f_T(q) = P(q) (-grad V(q))` into `out`.
@@ -459,10 +119,249 @@ impl Preadjustment {
         q: &[f64],
         out: &mut [f64],
     ) -> Result<(), SolveError> {
-        self.prepare(sys, q)?;
-        for k in 0..self.n {
-            out[k] = self.mass[k] * self.u[k];
+        self.metric.prepare(sys, q)?;
+        let (mass, u) = (self.metric.mass(), self.metric.u());
+        for k in 0..self.metric.n() {
+            out[k] = mass[k] * u[k];
         }
         Ok(())
+    }
+
+    /// `W_s(q)`.
+    pub fn value(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
+        self.metric.require_dense("Preadjustment::value")?;
+        self.metric.prepare(sys, q)?;
+        Ok(self.paper.value(&mut self.metric, sys, q))
+    }
+
+    /// `grad W_s(q)` into `out`; returns `W_s(q)`. Matrix-free: every product with `A` or
+    /// with a weighted constraint Hessian is one Hessian-vector pass over the elements
+    /// ([`System::lagrangian_hessian_vector`]), the third derivatives are exact.
+    pub fn gradient(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        out: &mut [f64],
+    ) -> Result<f64, SolveError> {
+        self.metric.require_dense("Preadjustment::gradient")?;
+        self.metric.prepare(sys, q)?;
+        Ok(self.paper.gradient(&mut self.metric, sys, q, out))
+    }
+
+    /// A bound on the spectral radius of `M^-1 A` (Gershgorin: `max_i minv_i sum_l |A_il|`; the
+    /// eigenvalues are those of the symmetric `M^-1/2 A M^-1/2`), so the Newton Hessian
+    /// [`Preadjustment::approximate_hessian`] is at most `bound^(s+1)` in the mass metric.
+    pub fn hessian_bound(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
+        self.metric.require_dense("Preadjustment::hessian_bound")?;
+        self.metric.prepare(sys, q)?;
+        self.stiffness.ensure(&self.metric, sys, q);
+        Ok(self.stiffness.bound(&self.metric))
+    }
+
+    /// An approximate Hessian of `W_s` for Newton: `A (Pi A)^s` (exact at an equilibrium),
+    /// symmetrised, into `out` (overwritten).
+    ///
+    /// `A` is symmetric, so its zero columns (coordinates that enter `V` and the constraints
+    /// linearly, e.g. the positions of bodies with revolute joints under gravity) are zero rows
+    /// too, and `A (Pi A)^s` lives on the block `K x K` of the other coordinates:
+    /// `A_KK (Pi_KK A_KK)^s`, with `Pi_KK = M^-1_KK - (G M^-1)_K^T S^-1 (G M^-1)_K` from `|K|`
+    /// Cholesky solves. Dense products of size `|K|` only.
+    pub fn approximate_hessian(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
+        self.metric
+            .require_dense("Preadjustment::approximate_hessian")?;
+        self.metric.prepare(sys, q)?;
+        self.paper
+            .newton_hessian(&self.metric, &mut self.stiffness, sys, q, out);
+        Ok(())
+    }
+
+    /// `A Pi A` into `out` (overwritten): [`Preadjustment::approximate_hessian`] with `s = 1`
+    /// whatever the workspace's `s`, in fewer operations (the modified Lagrangian's Newton
+    /// matrix, `galerkin/dense.rs`), the same matrix up to rounding and symmetric by
+    /// construction ([`TangentStiffness::a_pi_a`]).
+    pub(crate) fn approximate_hessian_1(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
+        self.metric
+            .require_dense("Preadjustment::approximate_hessian_1")?;
+        let n = self.metric.n();
+        if out.shape() != (n, n) {
+            return Err(SolveError::Dimension {
+                what: "the approximate Hessian",
+                expected: n,
+                got: out.nrows(),
+            });
+        }
+        self.metric.prepare(sys, q)?;
+        ModifiedS1::force_newton_hessian(&self.metric, &mut self.stiffness, sys, q, out);
+        Ok(())
+    }
+
+    /// The velocity-dependent modified-Lagrangian term of the (1,1) scheme (without its `h^2`):
+    /// `e(q, v) = -1/24 f_T^T M^-1 f_T + 1/12 v^T A v - 1/8 v^T Hess V v
+    /// + 1/24 gamma_c^T S^-1 gamma_c` with `gamma_c,k = v^T Hess Phi_k v` (derivation in
+    /// `docs/modified-lagrangian.md`, use in `docs/symplectic.md` section 5a). Independent of the
+    /// `s` of the workspace.
+    pub fn modified_term(&mut self, sys: &System, q: &[f64], v: &[f64]) -> Result<f64, SolveError> {
+        self.metric.check_v(v)?;
+        self.metric.prepare(sys, q)?;
+        Ok(self.s1.evaluate(&mut self.metric, sys, q, v))
+    }
+
+    /// Gradients of [`Preadjustment::modified_term`], into `dq` and `dv`; returns `e(q, v)`.
+    /// With `sigma = S^-1 gamma_c`, `H_sigma = sum_k sigma_k Hess Phi_k`, `u = M^-1 f_T` and
+    /// `w = M^-1 Phi_q^T sigma` (derivation in `docs/symplectic.md` section 5a):
+    ///
+    /// * `d e / d v = 1/6 (A + H_sigma - 3/2 Hess V) v` (exact),
+    /// * `d e / d q = 1/12 [(A + H_sigma)(u - w) + D^3(-1/2 V + (sigma - mu0) . Phi)(v, v)]`,
+    ///   where the third-derivative term is the derivative along `v` of
+    ///   `Hess(-1/2 V + (sigma - mu0) . Phi) v` (`sigma`, `mu0` frozen), exact
+    ///   ([`System::lagrangian_third`]).
+    pub fn modified_gradients(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) -> Result<f64, SolveError> {
+        self.metric.check_v(v)?;
+        let n = self.metric.n();
+        if dq.len() != n || dv.len() != n {
+            return Err(SolveError::Dimension {
+                what: "gradient buffers of the modified-Lagrangian term",
+                expected: n,
+                got: dq.len().min(dv.len()),
+            });
+        }
+        self.s1.prepare(&mut self.metric, sys, q, v)?;
+        Ok(self.s1.gradients(&mut self.metric, sys, q, v, dq, dv))
+    }
+
+    /// `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` at `q` into `out` (overwritten), with
+    /// `B = A + H_sigma - 3/2 Hess V` (`H_sigma = sum_k sigma_k Hess Phi_k`,
+    /// `sigma = S^-1 gamma_c(q, v)`) and `C = [Hess Phi_k v]_k` (the derivative of `sigma` in
+    /// `v`), used for the Newton Jacobian.
+    pub fn modified_velocity_hessian(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
+        self.metric
+            .require_dense("Preadjustment::modified_velocity_hessian")?;
+        out.fill(0.0);
+        self.add_modified_velocity_hessian(sys, q, v, 1.0, out)
+    }
+
+    /// `out += scale * (B + 2 C S^-1 C^T)` at `(q, v)` ([`Preadjustment::modified_velocity_hessian`]),
+    /// without the overwrite, from one Hessian pass over the elements
+    /// ([`System::add_lagrangian_hessian_pair`]); the same pass assembles
+    /// `A = Hess V - mu0 . Hess Phi`, which [`Preadjustment::approximate_hessian`] at the same `q`
+    /// then reuses.
+    pub fn add_modified_velocity_hessian(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        scale: f64,
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), SolveError> {
+        self.metric
+            .require_dense("Preadjustment::add_modified_velocity_hessian")?;
+        self.metric.check_v(v)?;
+        let n = self.metric.n();
+        if out.shape() != (n, n) {
+            return Err(SolveError::Dimension {
+                what: "the modified velocity Hessian",
+                expected: n,
+                got: out.nrows(),
+            });
+        }
+        self.metric.prepare(sys, q)?;
+        self.s1
+            .add_velocity_hessian(&mut self.metric, &mut self.stiffness, sys, q, v, scale, out);
+        Ok(())
+    }
+
+    /// Diagonal approximations of the `s = 1` Newton blocks at `(q, v)`, for the sparse stage
+    /// solve (`docs/symplectic.md` section 5a): `wd = diag(B)` (the velocity Hessian
+    /// `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` without its dense part) and
+    /// `ad_i = A_ii^2 / m_i` (the diagonal of `A M^-1 A`, the sparse part of `A Pi A`, with the
+    /// off-diagonal entries of `A` left out), both `O(N)`. Overwrites `wd` and `ad`.
+    pub(crate) fn modified_newton_diagonals(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        wd: &mut [f64],
+        ad: &mut [f64],
+    ) -> Result<(), SolveError> {
+        self.metric.check_v(v)?;
+        self.s1.prepare(&mut self.metric, sys, q, v)?;
+        self.s1
+            .newton_diagonals(&mut self.metric, sys, q, v, wd, ad);
+        Ok(())
+    }
+
+    /// The 23 terms of `e4(q, v)` (`E4_TERMS`, without their coefficients), at `q` with
+    /// the velocity `v` (tangent, or a step's chord). Allocates its workspace on first use.
+    pub fn modified_terms_s2(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<[f64; E4_TERM_COUNT], SolveError> {
+        self.metric.check_v(v)?;
+        let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
+        term.forward(&mut self.metric, sys, q, v)?;
+        Ok(term.terms())
+    }
+
+    /// The `h^4` modified-Lagrangian term of the (2,2) scheme, `e4(q, v) = sum_i c_i T_i`
+    /// (`E4_TERMS`, [`Preadjustment::modified_terms_s2`]).
+    pub fn modified_term_s2(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+    ) -> Result<f64, SolveError> {
+        let t = self.modified_terms_s2(sys, q, v)?;
+        Ok(modified_s2::e4_value(&t))
+    }
+
+    /// The value of `e4(q, v)` ([`Preadjustment::modified_term_s2`]) and its exact gradients
+    /// `de4/dq` into `gq` and `de4/dv` into `gv` (both length n, overwritten), by one forward
+    /// evaluation and a reverse pass. Allocates its workspace on first use only.
+    pub fn modified_gradients_s2(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        gq: &mut [f64],
+        gv: &mut [f64],
+    ) -> Result<f64, SolveError> {
+        self.metric.check_v(v)?;
+        let n = self.metric.n();
+        for (what, got) in [("de4/dq", gq.len()), ("de4/dv", gv.len())] {
+            if got != n {
+                return Err(SolveError::Dimension {
+                    what,
+                    expected: n,
+                    got,
+                });
+            }
+        }
+        let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
+        term.gradients(&mut self.metric, sys, q, v, gq, gv)
     }
 }

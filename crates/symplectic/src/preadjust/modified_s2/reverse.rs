@@ -1,15 +1,15 @@
-//! Exact gradients of the `h^4` modified-Lagrangian term `e4(q, v)` (`modified2.rs`): one
-//! forward evaluation that keeps its intermediates ([`E4Forward`]), then a reverse
-//! (adjoint) pass through them, so `de4/dq` and `de4/dv` cost a fixed number of passes over the
-//! elements, independent of `n` (central differences took `8 n` evaluations of `e4`). Both
-//! run in a workspace allocated on first use ([`E4Work`]): nothing is allocated per call. Every
-//! element pass at `q` takes the bodies' `sin`/`cos` from one table ([`mbd_model::BodyAngles`]).
+//! Exact gradients of the `h^4` modified-Lagrangian term `e4(q, v)`: one forward evaluation
+//! that keeps its intermediates ([`E4Forward`]), then a reverse (adjoint) pass through them, so
+//! `de4/dq` and `de4/dv` cost a fixed number of passes over the elements, independent of `n`.
+//! Both run in a workspace allocated on first use ([`ModifiedS2`]): nothing is allocated per
+//! call. Every element pass at `q` takes the bodies' `sin`/`cos` from one table
+//! ([`mbd_model::BodyAngles`]).
 //!
 //! The reverse pass needs, besides the linear algebra's adjoints, the adjoints of three
 //! primitives:
 //!
 //! * a pass of multivariate Taylor jets ([`mbd_model::PolyJet`]; passes A, B, C of
-//!   `modified2.rs`): the forward evaluation keeps every coefficient's element-local gradient
+//!   `forward.rs`): the forward evaluation keeps every coefficient's element-local gradient
 //!   with respect to `q`, and the reverse pass contracts them with the coefficients' adjoint
 //!   weights, which gives the gradient with respect to `q` and, through the basis' division
 //!   table, with respect to every direction of the pass
@@ -35,14 +35,23 @@
 //!   `Gb -= a (D G^T z)^T + z (D G^T a)^T` with `a = S^-1 zb`;
 //! * `u = -D g + D G^T mu0`, `mu0 = S^-1 G D g` (`g = grad V`), and `gb` to `qb` by `Hess V`.
 
-use super::e4_work::{gbar_add, Adjoints, Cols, E4Work};
-use super::modified2::{
-    comb_into, BasisA, BasisB, BasisC, E4Forward, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE,
-    B_ET, B_ETT, C_AT, C_BT, E4_TERMS,
+use super::adjoints::{gbar_add, Adjoints, Cols};
+use super::forward::E4Forward;
+use super::passes::{
+    BasisA, BasisB, BasisC, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE, B_ET, B_ETT, C_AT,
+    C_BT, NA, NB, NC, NR, R_DIRS, R_OUTPUTS, R_XY, R_Y,
 };
-use super::Preadjustment;
-use mbd_model::{Basis, BodyAngles, System, MAX_DIRS};
-use mbd_solve::SolveError;
+use super::{e4_value, Invariant, ModifiedS2, PerInvariant};
+use crate::preadjust::metric::ProjectedMetric;
+use crate::preadjust::LocalRow;
+use mbd_model::{Basis, BodyAngles, System};
+
+/// `out = ca a + cb b`.
+fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64]) {
+    for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+        *o = ca * x + cb * y;
+    }
+}
 
 fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
     for (a, b) in y.iter_mut().zip(x) {
@@ -50,68 +59,57 @@ fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
     }
 }
 
-impl Preadjustment {
-    /// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
-    /// adjoint `yb`; `Gb` updated.
-    fn adj_neg_e(&mut self, w: &mut Adjoints, cols: &[Cols], z: &[f64], yb: &[f64]) {
-        let [dyb, dz, da, ..] = &mut w.tn;
-        for ((d, y), mi) in dyb.iter_mut().zip(yb).zip(&self.minv) {
-            *d = mi * y;
-        }
-        gbar_add(&mut w.gbar, cols, -1.0, z, dyb);
-        let a = &mut w.tm[0];
-        self.sgm(yb, a);
-        a.iter_mut().for_each(|x| *x = -*x);
-        self.dgt_into(z, dz);
-        self.dgt_into(a, da);
-        gbar_add(&mut w.gbar, cols, -1.0, a, dz);
-        gbar_add(&mut w.gbar, cols, -1.0, z, da);
+/// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
+/// adjoint `yb`; `Gb` updated.
+fn adj_neg_e(metric: &mut ProjectedMetric, w: &mut Adjoints, cols: &[Cols], z: &[f64], yb: &[f64]) {
+    let [dyb, dz, da, ..] = &mut w.tn;
+    for ((d, y), mi) in dyb.iter_mut().zip(yb).zip(metric.minv()) {
+        *d = mi * y;
     }
+    gbar_add(&mut w.gbar, cols, -1.0, z, dyb);
+    let a = &mut w.tm[0];
+    metric.sgm(yb, a);
+    a.iter_mut().for_each(|x| *x = -*x);
+    metric.dgt_into(z, dz);
+    metric.dgt_into(a, da);
+    gbar_add(&mut w.gbar, cols, -1.0, a, dz);
+    gbar_add(&mut w.gbar, cols, -1.0, z, da);
+}
 
-    /// The value of `e4(q, v)` ([`Preadjustment::modified_term_s2`]) and its exact gradients
-    /// `de4/dq` into `gq` and `de4/dv` into `gv` (both length n, overwritten), by one forward
-    /// evaluation and a reverse pass (module doc). Allocates its workspace on first use only.
-    pub fn modified_gradients_s2(
+impl ModifiedS2 {
+    /// The value of `e4(q, v)` and its exact gradients `de4/dq` into `gq` and `de4/dv` into
+    /// `gv` (both length n, checked by the caller, overwritten), by one forward evaluation
+    /// and a reverse pass (module doc).
+    pub(in crate::preadjust) fn gradients(
         &mut self,
+        metric: &mut ProjectedMetric,
         sys: &System,
         q: &[f64],
         v: &[f64],
         gq: &mut [f64],
         gv: &mut [f64],
-    ) -> Result<f64, SolveError> {
-        self.check_v(v)?;
-        for (what, got) in [("de4/dq", gq.len()), ("de4/dv", gv.len())] {
-            if got != self.n {
-                return Err(SolveError::Dimension {
-                    what,
-                    expected: self.n,
-                    got,
-                });
-            }
-        }
-        let mut work = self.e4_work(sys);
-        let res = self.e4_forward(sys, q, v, &mut work.f);
-        let out = res.map(|()| self.e4_reverse(sys, q, v, &mut work, gq, gv));
-        self.e4 = Some(work);
-        out
+    ) -> Result<f64, mbd_solve::SolveError> {
+        self.forward(metric, sys, q, v)?;
+        Ok(self.reverse(metric, sys, q, v, gq, gv))
     }
 
-    /// The reverse pass after `e4_forward` at the same `(q, v)`; returns `e4`.
-    fn e4_reverse(
+    /// The reverse pass after [`ModifiedS2::forward`] at the same `(q, v)`; returns `e4`.
+    #[allow(clippy::too_many_arguments)]
+    fn reverse(
         &mut self,
+        metric: &mut ProjectedMetric,
         sys: &System,
         q: &[f64],
         v: &[f64],
-        work: &mut E4Work,
         gq: &mut [f64],
         gv: &mut [f64],
     ) -> f64 {
-        let m = self.m;
-        let E4Work { f, b: w, cols } = work;
+        use Invariant::*;
+        let m = metric.m();
+        let ModifiedS2 { f, b: w, cols } = self;
         let cols = cols.as_slice();
-        let terms = f.terms();
-        let c: [f64; 23] = std::array::from_fn(|i| E4_TERMS[i].1);
-        let e4 = terms.iter().zip(&c).map(|(t, c)| t * c).sum();
+        let e4 = e4_value(&f.terms().0);
+        let c = PerInvariant::coefficients();
         gq.fill(0.0);
         gv.fill(0.0);
         w.clear();
@@ -123,62 +121,62 @@ impl Preadjustment {
         let hsig_v = (f.pi_hsig_v.as_slice(), f.sg_hsig_v.as_slice());
         let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
         let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
-        adj_pi(&mut w.gbar, cols, c[0], hsig_v, hmu_v);
-        axpy(&mut w.hsig_vb, c[0], &f.pi_hmu_v);
-        axpy(&mut w.hmu_vb, c[0], &f.pi_hsig_v);
-        adj_pi(&mut w.gbar, cols, c[1], hmu_v, hmu_v);
-        axpy(&mut w.hmu_vb, 2.0 * c[1], &f.pi_hmu_v);
-        axpy(&mut w.ub, c[2], &f.hmu_u);
-        axpy(&mut w.hmu_ub, c[2], &f.u);
+        adj_pi(&mut w.gbar, cols, c[VHsigPiHmuV], hsig_v, hmu_v);
+        axpy(&mut w.hsig_vb, c[VHsigPiHmuV], &f.pi_hmu_v);
+        axpy(&mut w.hmu_vb, c[VHsigPiHmuV], &f.pi_hsig_v);
+        adj_pi(&mut w.gbar, cols, c[VHmuPiHmuV], hmu_v, hmu_v);
+        axpy(&mut w.hmu_vb, 2.0 * c[VHmuPiHmuV], &f.pi_hmu_v);
+        axpy(&mut w.ub, c[UHmuU], &f.hmu_u);
+        axpy(&mut w.hmu_ub, c[UHmuU], &f.u);
         let beta = (f.s_beta.as_slice(), f.k2.as_slice());
         let kap3 = (f.s_kap3.as_slice(), f.k3.as_slice());
-        adj_s(&mut w.gbar, cols, c[4], beta, beta);
-        axpy(&mut w.betab, 2.0 * c[4], &f.s_beta);
-        axpy(&mut w.ub, c[5], &f.hsig_u);
-        axpy(&mut w.hsig_ub, c[5], &f.u);
-        adj_s(&mut w.gbar, cols, c[6], kap3, beta);
-        axpy(&mut w.kap3b, c[6], &f.s_beta);
-        axpy(&mut w.betab, c[6], &f.s_kap3);
-        axpy(&mut w.mu0b, c[8], &f.kap3u);
-        axpy(&mut w.kap3ub, c[8], &f.mu0);
-        axpy(&mut w.sigb, c[9], &f.kap3u);
-        axpy(&mut w.kap3ub, c[9], &f.sig);
-        axpy(&mut w.mu0b, c[10], &f.kap4);
-        axpy(&mut w.kap4b, c[10], &f.mu0);
-        adj_pi(&mut w.gbar, cols, c[20], hsig_v, hsig_v);
-        axpy(&mut w.hsig_vb, 2.0 * c[20], &f.pi_hsig_v);
-        axpy(&mut w.sigb, c[21], &f.kap4);
-        axpy(&mut w.kap4b, c[21], &f.sig);
-        adj_s(&mut w.gbar, cols, c[22], kap3, kap3);
-        axpy(&mut w.kap3b, 2.0 * c[22], &f.s_kap3);
+        adj_s(&mut w.gbar, cols, c[BetaSBeta], beta, beta);
+        axpy(&mut w.betab, 2.0 * c[BetaSBeta], &f.s_beta);
+        axpy(&mut w.ub, c[UHsigU], &f.hsig_u);
+        axpy(&mut w.hsig_ub, c[UHsigU], &f.u);
+        adj_s(&mut w.gbar, cols, c[Kappa3SBeta], kap3, beta);
+        axpy(&mut w.kap3b, c[Kappa3SBeta], &f.s_beta);
+        axpy(&mut w.betab, c[Kappa3SBeta], &f.s_kap3);
+        axpy(&mut w.mu0b, c[Mu0Kappa3u], &f.kap3u);
+        axpy(&mut w.kap3ub, c[Mu0Kappa3u], &f.mu0);
+        axpy(&mut w.sigb, c[SigmaKappa3u], &f.kap3u);
+        axpy(&mut w.kap3ub, c[SigmaKappa3u], &f.sig);
+        axpy(&mut w.mu0b, c[Mu0Kappa4], &f.kap4);
+        axpy(&mut w.kap4b, c[Mu0Kappa4], &f.mu0);
+        adj_pi(&mut w.gbar, cols, c[VHsigPiHsigV], hsig_v, hsig_v);
+        axpy(&mut w.hsig_vb, 2.0 * c[VHsigPiHsigV], &f.pi_hsig_v);
+        axpy(&mut w.sigb, c[SigmaKappa4], &f.kap4);
+        axpy(&mut w.kap4b, c[SigmaKappa4], &f.sig);
+        adj_s(&mut w.gbar, cols, c[Kappa3SKappa3], kap3, kap3);
+        axpy(&mut w.kap3b, 2.0 * c[Kappa3SKappa3], &f.s_kap3);
         if pot {
-            adj_pi(&mut w.gbar, cols, c[3], hmu_v, hv);
-            axpy(&mut w.hmu_vb, c[3], &f.pi_hv);
-            axpy(&mut w.hvb, c[3], &f.pi_hmu_v);
-            axpy(&mut w.hvb, c[7], &f.k2);
-            axpy(&mut w.k2b, c[7], &f.hv);
-            axpy(&mut w.hub, c[11], &f.nn);
-            axpy(&mut w.nnb, c[11], &f.hu);
-            axpy(&mut w.ub, c[12], &f.hu);
-            axpy(&mut w.hub, c[12], &f.u);
+            adj_pi(&mut w.gbar, cols, c[VHmuPiHV], hmu_v, hv);
+            axpy(&mut w.hmu_vb, c[VHmuPiHV], &f.pi_hv);
+            axpy(&mut w.hvb, c[VHmuPiHV], &f.pi_hmu_v);
+            axpy(&mut w.hvb, c[VHK2], &f.k2);
+            axpy(&mut w.k2b, c[VHK2], &f.hv);
+            axpy(&mut w.hub, c[UHN], &f.nn);
+            axpy(&mut w.nnb, c[UHN], &f.hu);
+            axpy(&mut w.ub, c[UHU], &f.hu);
+            axpy(&mut w.hub, c[UHU], &f.u);
             // D^3 V(u, v, v) = 2 (pass A's e t^2)
-            w.pa[A_ETT] += 2.0 * c[13];
-            axpy(&mut w.nnb, c[14], &f.hn);
-            axpy(&mut w.hnb, c[14], &f.nn);
-            adj_pi(&mut w.gbar, cols, c[15], hv, hsig_v);
-            axpy(&mut w.hvb, c[15], &f.pi_hsig_v);
-            axpy(&mut w.hsig_vb, c[15], &f.pi_hv);
-            axpy(&mut w.hvb, c[16], &f.k3);
-            axpy(&mut w.k3b, c[16], &f.hv);
-            w.pb[B_ETT] += 2.0 * c[17];
-            adj_pi(&mut w.gbar, cols, c[18], hv, hv);
-            axpy(&mut w.hvb, 2.0 * c[18], &f.pi_hv);
-            w.pa[A_T4] += 24.0 * c[19];
+            w.pa[A_ETT] += 2.0 * c[D3VUVV];
+            axpy(&mut w.nnb, c[NHN], &f.hn);
+            axpy(&mut w.hnb, c[NHN], &f.nn);
+            adj_pi(&mut w.gbar, cols, c[VHPiHsigV], hv, hsig_v);
+            axpy(&mut w.hvb, c[VHPiHsigV], &f.pi_hsig_v);
+            axpy(&mut w.hsig_vb, c[VHPiHsigV], &f.pi_hv);
+            axpy(&mut w.hvb, c[VHK3], &f.k3);
+            axpy(&mut w.k3b, c[VHK3], &f.hv);
+            w.pb[B_ETT] += 2.0 * c[D3VNVV];
+            adj_pi(&mut w.gbar, cols, c[VHPiHV], hv, hv);
+            axpy(&mut w.hvb, 2.0 * c[VHPiHV], &f.pi_hv);
+            w.pa[A_T4] += 24.0 * c[D4V];
         }
 
         // 2. the Hessian-vector products: the constraint-weighted ones by pass R, those of V
         //    by polarised third-order passes over the force elements
-        self.hvp_weighted_adj(sys, q, v, f, w, gq, gv);
+        hvp_weighted_adj(metric.m(), sys, q, v, f, w, gq, gv);
         if pot {
             let zero = f.zero_m.as_slice();
             let ang = &f.angles;
@@ -206,7 +204,7 @@ impl Preadjustment {
         }
 
         // 4. pass C along (v, K2, K3)
-        contract::<6, BasisC>(
+        contract::<NC, BasisC>(
             sys,
             (&f.pc, &w.wc, None),
             gq,
@@ -215,7 +213,7 @@ impl Preadjustment {
 
         // 5. k3 = -D G^T S^-1 kappa3, kappa3 = 6 A[t^3] + 3 B[e t]
         let k3b = std::mem::take(&mut w.k3b);
-        self.adj_neg_e(w, cols, &f.s_kap3, &k3b);
+        adj_neg_e(metric, w, cols, &f.s_kap3, &k3b);
         w.k3b = k3b;
         axpy(&mut w.kap3b, 1.0, &w.tm[0]);
         for r in 0..m {
@@ -224,7 +222,7 @@ impl Preadjustment {
         }
         // 6. k2 = -D G^T S^-1 beta, beta = A[e t]
         let k2b = std::mem::take(&mut w.k2b);
-        self.adj_neg_e(w, cols, &f.s_beta, &k2b);
+        adj_neg_e(metric, w, cols, &f.s_beta, &k2b);
         w.k2b = k2b;
         axpy(&mut w.betab, 1.0, &w.tm[0]);
         for r in 0..m {
@@ -232,7 +230,7 @@ impl Preadjustment {
         }
 
         // 7. pass B along (v, n, u)
-        contract::<9, BasisB>(
+        contract::<NB, BasisB>(
             sys,
             (&f.pb, &w.wb, Some(&w.pb)),
             gq,
@@ -243,15 +241,15 @@ impl Preadjustment {
         {
             let [dn, dsig, da, ..] = &mut w.tn;
             let [t, a, ..] = &mut w.tm;
-            for ((d, x), mi) in dn.iter_mut().zip(&w.nnb).zip(&self.minv) {
+            for ((d, x), mi) in dn.iter_mut().zip(&w.nnb).zip(metric.minv()) {
                 *d = mi * x;
             }
-            self.g_times(dn, t);
+            metric.g_times(dn, t);
             gbar_add(&mut w.gbar, cols, -1.0, &f.sig, dn);
             axpy(&mut w.sigb, -1.0, t);
-            self.s_inv_into(&w.sigb, a);
-            self.dgt_into(&f.sig, dsig);
-            self.dgt_into(a, da);
+            metric.s_inv_into(&w.sigb, a);
+            metric.dgt_into(&f.sig, dsig);
+            metric.dgt_into(a, da);
             gbar_add(&mut w.gbar, cols, -1.0, a, dsig);
             gbar_add(&mut w.gbar, cols, -1.0, &f.sig, da);
             for r in 0..m {
@@ -259,7 +257,7 @@ impl Preadjustment {
             }
         }
         // pass A along (v, u)
-        contract::<8, BasisA>(
+        contract::<NA, BasisA>(
             sys,
             (&f.pa, &w.wa, Some(&w.pa)),
             gq,
@@ -270,21 +268,21 @@ impl Preadjustment {
         {
             let [dub, da, dg, dmu, t, ..] = &mut w.tn;
             let [s, a, ..] = &mut w.tm;
-            for ((d, x), mi) in dub.iter_mut().zip(&w.ub).zip(&self.minv) {
+            for ((d, x), mi) in dub.iter_mut().zip(&w.ub).zip(metric.minv()) {
                 *d = mi * x;
             }
-            self.g_times(dub, s);
+            metric.g_times(dub, s);
             axpy(&mut w.mu0b, 1.0, s);
             axpy(&mut w.gradb, -1.0, dub);
             gbar_add(&mut w.gbar, cols, 1.0, &f.mu0, dub);
-            self.s_inv_into(&w.mu0b, a);
-            self.dgt_into(a, da);
+            metric.s_inv_into(&w.mu0b, a);
+            metric.dgt_into(a, da);
             axpy(&mut w.gradb, 1.0, da);
-            for ((d, x), mi) in dg.iter_mut().zip(&self.g).zip(&self.minv) {
+            for ((d, x), mi) in dg.iter_mut().zip(metric.grad_v()).zip(metric.minv()) {
                 *d = mi * x;
             }
             gbar_add(&mut w.gbar, cols, 1.0, a, dg);
-            self.dgt_into(&f.mu0, dmu);
+            metric.dgt_into(&f.mu0, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
             sys.lagrangian_hessian_vector_at(q, &f.angles, &w.gradb, 1.0, &f.zero_m, t);
@@ -301,7 +299,7 @@ impl Preadjustment {
 /// evaluation: `Gb -= c [p_b (Pi a)^T + p_a (Pi b)^T]`; the increments of `ab` and `bb`,
 /// `c Pi b` and `c Pi a`, are the caller's.
 fn adj_pi(
-    gbar: &mut [[f64; 6]],
+    gbar: &mut [LocalRow],
     cols: &[Cols],
     c: f64,
     (pa, sa): (&[f64], &[f64]),
@@ -316,7 +314,7 @@ fn adj_pi(
 /// `Gb += c [al k_b^T + be k_a^T]`; the increments of `ab` and `bb`, `c S^-1 b` and
 /// `c S^-1 a`, are the caller's.
 fn adj_s(
-    gbar: &mut [[f64; 6]],
+    gbar: &mut [LocalRow],
     cols: &[Cols],
     c: f64,
     (al, ka): (&[f64], &[f64]),
@@ -357,65 +355,38 @@ fn hvp_adj(
     }
 }
 
-/// Pass R's basis, directions `(v, u, y1, y2, y3, y4)` with the adjoints `y1 = (H_sigma
-/// v)b`, `y2 = (H_mu v)b`, `y3 = (H_sigma u)b`, `y4 = (H_mu u)b`: `{1, t, e, y1, y2, y3, y4,
-/// t y1, t y2, e y3, e y4}` (`t` for `v`, `e` for `u`).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct BasisR;
-impl Basis<11> for BasisR {
-    const ND: usize = 6;
-    const EXP: [[u8; MAX_DIRS]; 11] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [0, 0, 1, 0, 0, 0],
-        [0, 0, 0, 1, 0, 0],
-        [0, 0, 0, 0, 1, 0],
-        [0, 0, 0, 0, 0, 1],
-        [1, 0, 1, 0, 0, 0],
-        [1, 0, 0, 1, 0, 0],
-        [0, 1, 0, 0, 1, 0],
-        [0, 1, 0, 0, 0, 1],
-    ];
-}
-/// Pass R's monomials `y1 .. y4`, then `t y1`, `t y2`, `e y3`, `e y4`.
-const R_Y: [usize; 4] = [3, 4, 5, 6];
-const R_XY: [usize; 4] = [7, 8, 9, 10];
-
-impl Preadjustment {
-    /// The adjoints of the four constraint-weighted Hessian-vector products `y = H_w x`
-    /// (`H_w = sum_r w_r Hess Phi_r`) for `(x, w) = (v, sigma), (v, mu0), (u, sigma), (u,
-    /// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`]): `qb += D^3 (w . Phi)(x, yb,
-    /// .)` (the `q`-gradients of `x yb`), `xb += H_w yb` (those of `yb`), `wb_r += yb^T Hess
-    /// Phi_r x` (the coefficients of `x yb`).
-    #[allow(clippy::too_many_arguments)]
-    fn hvp_weighted_adj(
-        &self,
-        sys: &System,
-        q: &[f64],
-        v: &[f64],
-        f: &E4Forward,
-        w: &mut Adjoints,
-        gq: &mut [f64],
-        gv: &mut [f64],
-    ) {
-        let dirs: [&[f64]; 6] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
-        w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
-        for r in 0..self.m {
-            let (s, mu) = (f.sig[r], f.mu0[r]);
-            let c = &w.rpass.vals[r];
-            w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
-            w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
-            // weights of q (the x yb coefficients), of v (y1, y2) and of u (y3, y4)
-            let mut x = [[0.0; 11]; 3];
-            for (i, wt) in [s, mu, s, mu].into_iter().enumerate() {
-                x[0][R_XY[i]] = wt;
-                x[1 + i / 2][R_Y[i]] = wt;
-            }
-            w.rw[r] = x;
+/// The adjoints of the four constraint-weighted Hessian-vector products `y = H_w x`
+/// (`H_w = sum_r w_r Hess Phi_r`) for `(x, w) = (v, sigma), (v, mu0), (u, sigma), (u,
+/// mu0)` with the adjoints `yb`, from one pass R ([`BasisR`](super::passes::BasisR)): `qb += D^3 (w . Phi)(x, yb,
+/// .)` (the `q`-gradients of `x yb`), `xb += H_w yb` (those of `yb`), `wb_r += yb^T Hess
+/// Phi_r x` (the coefficients of `x yb`).
+#[allow(clippy::too_many_arguments)]
+fn hvp_weighted_adj(
+    m: usize,
+    sys: &System,
+    q: &[f64],
+    v: &[f64],
+    f: &E4Forward,
+    w: &mut Adjoints,
+    gq: &mut [f64],
+    gv: &mut [f64],
+) {
+    let dirs: [&[f64]; R_DIRS] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
+    w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
+    for r in 0..m {
+        let (s, mu) = (f.sig[r], f.mu0[r]);
+        let c = &w.rpass.vals[r];
+        w.sigb[r] += c[R_XY[0]] + c[R_XY[2]];
+        w.mu0b[r] += c[R_XY[1]] + c[R_XY[3]];
+        // weights of q (the x yb coefficients), of v (y1, y2) and of u (y3, y4)
+        let mut x = [[0.0; NR]; R_OUTPUTS];
+        for (i, wt) in [s, mu, s, mu].into_iter().enumerate() {
+            x[0][R_XY[i]] = wt;
+            x[1 + i / 2][R_Y[i]] = wt;
         }
-        sys.add_constraint_poly_grads_many(&w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
+        w.rw[r] = x;
     }
+    sys.add_constraint_poly_grads_many(&w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
 }
 
 /// The adjoint of a pass ([`Pass`]) with the adjoint weights `wts` of its rows' coefficients
@@ -435,7 +406,7 @@ fn contract<const K: usize, B: Basis<K>>(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::Preadjustment;
     use mbd_model::models;
 
     /// The reverse-pass gradients against fourth-order central differences of `e4`, on paper
@@ -445,7 +416,7 @@ mod tests {
     fn gradients_match_differences() {
         let systems = [
             models::paper_a_double_pendulum().unwrap(),
-            super::super::modified::modlag_tests::rod_with_spring(),
+            crate::preadjust::modified_s1::modlag_tests::rod_with_spring(),
             models::n_link_chain(3).unwrap(),
             models::elastic_pendulum().unwrap(),
         ];

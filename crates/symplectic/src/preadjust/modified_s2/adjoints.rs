@@ -1,24 +1,12 @@
-//! The workspace of the `s = 2` modified-Lagrangian term `e4` and its gradients
-//! (`modified2.rs`, `modified2_grad.rs`): allocated on first use, reused by every evaluation.
+//! The workspace of the reverse pass of `e4` (`reverse.rs`): the adjoints of the intermediates
+//! and of `G`.
 
-use super::modified2::{E4Forward, Pass};
-use super::modified2_grad::BasisR;
-use super::Preadjustment;
-use mbd_model::System;
+use super::passes::{BasisR, Pass, NA, NB, NC, NR, R_OUTPUTS};
+use crate::preadjust::{LocalRow, ZERO_ROW};
 
 /// The element-local columns of a constraint row: the first coordinate of the joint's body a
 /// (local columns 0..3) and of its body b (3..6), `None` for ground.
 pub(super) type Cols = [Option<usize>; 2];
-
-/// The workspace of `e4` and its gradients: the forward intermediates, the adjoints and the
-/// element-local columns of the constraint rows.
-#[derive(Debug)]
-pub(crate) struct E4Work {
-    pub(super) f: E4Forward,
-    pub(super) b: Adjoints,
-    /// The element-local columns of each constraint row ([`Cols`]).
-    pub(super) cols: Vec<Cols>,
-}
 
 /// Adjoints (suffix `b`) of the intermediates, of the passes, of `G`, and scratch.
 #[derive(Debug)]
@@ -43,18 +31,18 @@ pub(super) struct Adjoints {
     pub(super) kap4b: Vec<f64>,
     /// Adjoint weights of the coefficients of passes A, B, C per constraint row, and of
     /// passes A and B's potential.
-    pub(super) wa: Vec<[f64; 8]>,
-    pub(super) wb: Vec<[f64; 9]>,
-    pub(super) wc: Vec<[f64; 6]>,
-    pub(super) pa: [f64; 8],
-    pub(super) pb: [f64; 9],
+    pub(super) wa: Vec<[f64; NA]>,
+    pub(super) wb: Vec<[f64; NB]>,
+    pub(super) wc: Vec<[f64; NC]>,
+    pub(super) pa: [f64; NA],
+    pub(super) pb: [f64; NB],
     /// Pass R (the weighted Hessian-vector products' adjoints): coefficients, gradients and
     /// contraction weights per row.
-    pub(super) rpass: Pass<11, BasisR>,
-    pub(super) rw: Vec<[[f64; 11]; 3]>,
+    pub(super) rpass: Pass<NR, BasisR>,
+    pub(super) rw: Vec<[[f64; NR]; R_OUTPUTS]>,
 
     /// `Gb` in element-local form.
-    pub(super) gbar: Vec<[f64; 6]>,
+    pub(super) gbar: Vec<LocalRow>,
     /// Scratch: n-vectors and m-vectors.
     pub(super) tn: [Vec<f64>; 8],
     pub(super) tm: [Vec<f64>; 4],
@@ -82,15 +70,15 @@ impl Adjoints {
             kap3b: zm(),
             kap3ub: zm(),
             kap4b: zm(),
-            wa: vec![[0.0; 8]; m],
-            wb: vec![[0.0; 9]; m],
-            wc: vec![[0.0; 6]; m],
-            pa: [0.0; 8],
-            pb: [0.0; 9],
+            wa: vec![[0.0; NA]; m],
+            wb: vec![[0.0; NB]; m],
+            wc: vec![[0.0; NC]; m],
+            pa: [0.0; NA],
+            pb: [0.0; NB],
             rpass: Pass::new(m, 0),
-            rw: vec![[[0.0; 11]; 3]; m],
+            rw: vec![[[0.0; NR]; R_OUTPUTS]; m],
 
-            gbar: vec![[0.0; 6]; m],
+            gbar: vec![ZERO_ROW; m],
             tn: std::array::from_fn(|_| zn()),
             tm: std::array::from_fn(|_| zm()),
         }
@@ -119,17 +107,17 @@ impl Adjoints {
         ] {
             x.fill(0.0);
         }
-        self.wa.fill([0.0; 8]);
-        self.wb.fill([0.0; 9]);
-        self.wc.fill([0.0; 6]);
-        self.pa = [0.0; 8];
-        self.pb = [0.0; 9];
-        self.gbar.fill([0.0; 6]);
+        self.wa.fill([0.0; NA]);
+        self.wb.fill([0.0; NB]);
+        self.wc.fill([0.0; NC]);
+        self.pa = [0.0; NA];
+        self.pb = [0.0; NB];
+        self.gbar.fill(ZERO_ROW);
     }
 }
 
 /// `Gb += c alpha beta^T` in element-local form.
-pub(super) fn gbar_add(gbar: &mut [[f64; 6]], cols: &[Cols], c: f64, al: &[f64], be: &[f64]) {
+pub(super) fn gbar_add(gbar: &mut [LocalRow], cols: &[Cols], c: f64, al: &[f64], be: &[f64]) {
     for ((g, cols), &a) in gbar.iter_mut().zip(cols).zip(al) {
         if a == 0.0 {
             continue;
@@ -142,48 +130,6 @@ pub(super) fn gbar_add(gbar: &mut [[f64; 6]], cols: &[Cols], c: f64, al: &[f64],
                     g[3 * h + l] += ca * b[l];
                 }
             }
-        }
-    }
-}
-
-impl E4Work {
-    fn new(sys: &System) -> Self {
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let mut w = E4Work {
-            f: E4Forward::new(n, m, sys.forces().len()),
-            b: Adjoints::new(n, m),
-            cols: vec![[None; 2]; m],
-        };
-        w.set_cols(sys);
-        w
-    }
-
-    /// The element-local columns of every constraint row of `sys` (in place: the workspace
-    /// follows the system it is used with, not only the one it was made for).
-    fn set_cols(&mut self, sys: &System) {
-        for (r, c) in self.cols.iter_mut().enumerate() {
-            let (a, b) = sys
-                .equation_joint(r)
-                .map_or((None, None), |j| sys.joint_bodies(j));
-            *c = [a.map(|i| 3 * i), b.map(|i| 3 * i)];
-        }
-    }
-}
-
-impl Preadjustment {
-    /// The `e4` workspace for `sys`, taken out of `self` (give it back with
-    /// `self.e4 = Some(..)`).
-    pub(super) fn e4_work(&mut self, sys: &System) -> Box<E4Work> {
-        match self.e4.take() {
-            Some(mut w)
-                if w.f.u.len() == self.n
-                    && w.cols.len() == self.m
-                    && w.f.pa.pgrads.len() == sys.forces().len() =>
-            {
-                w.set_cols(sys);
-                w
-            }
-            _ => Box::new(E4Work::new(sys)),
         }
     }
 }
