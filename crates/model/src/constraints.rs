@@ -2,17 +2,21 @@
 //! their element-local forms for sparse assembly, and the constraint Hessians.
 
 use crate::cache::AngleCache;
-use crate::jet::{DirJet, Dual, Frame, HessJet, Scalar, TanJet, NV};
+use crate::hessian_pair::ElementHessian;
+use crate::jet::{Dual, Frame, Scalar, TanJet, NV};
+use crate::rows::SinCos;
 use crate::system::*;
 use nalgebra::DMatrix;
 
 impl System {
     /// `Phi(q, t)` into `out` (length m).
     pub fn phi(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        let sc = SinCos::new(self, q, None);
+        let var = |i: usize| [q[3 * i], q[3 * i + 1], q[3 * i + 2]];
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let qa = Self::frm_f64(q, at.a);
-            let qb = Self::frm_f64(q, at.b);
+            let qa = sc.frame(at.a, var);
+            let qb = sc.frame(at.b, var);
             let mut e = [0.0; 3];
             j.eval(&qa, &qb, &mut e);
             let o = self.row_offset[ji];
@@ -33,16 +37,6 @@ impl System {
     }
 
     #[inline(always)]
-    pub(crate) fn joint_dir(&self, ji: usize, q: &[f64], v: Option<&[f64]>) -> [DirJet; 3] {
-        let at = self.joint_attach[ji];
-        let qa = Self::loc_dir(q, v, at.a, 0);
-        let qb = Self::loc_dir(q, v, at.b, 3);
-        let mut e = [DirJet::cst(0.0); 3];
-        self.joints[ji].eval(&qa, &qb, &mut e);
-        e
-    }
-
-    #[inline(always)]
     pub(crate) fn scatter_row(&self, ji: usize, row: usize, g: &[f64; NV], out: &mut DMatrix<f64>) {
         let at = self.joint_attach[ji];
         if let Some(i) = at.a {
@@ -60,13 +54,10 @@ impl System {
     /// The constraint Jacobian `Phi_q` (m x n, dense) into `out` (overwritten).
     pub fn phi_q(&self, q: &[f64], out: &mut DMatrix<f64>) {
         out.as_mut_slice().fill(0.0);
-        for ji in 0..self.joints.len() {
-            let e = self.joint_dir(ji, q, None);
-            let o = self.row_offset[ji];
-            for k in 0..self.joints[ji].n_equations() {
-                self.scatter_row(ji, o + k, &e[k].g, out);
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
+            self.scatter_row(ji, r, g, out)
+        });
     }
 
     /// `Phi_q` and the acceleration right-hand side
@@ -80,14 +71,11 @@ impl System {
         gamma: &mut [f64],
     ) {
         phi_q.as_mut_slice().fill(0.0);
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                self.scatter_row(ji, o + k, &e[k].g, phi_q);
-                gamma[o + k] = -e[k].d2 + j.time_part(k, t)[2];
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, Some(v), t, &sc, |ji, r, g, gm| {
+            self.scatter_row(ji, r, g, phi_q);
+            gamma[r] = gm;
+        });
     }
 
     /// `Phi_q` and the Jacobian of the velocity constraint with respect to `q`,
@@ -152,13 +140,8 @@ impl System {
     /// `grads[r][0..3]` in the columns of the joint's first body and `grads[r][3..6]` in those
     /// of its second ([`System::joint_bodies`]).
     pub fn phi_q_local(&self, q: &[f64], grads: &mut [[f64; 6]]) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, None);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                grads[o + k] = e[k].g;
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, None, 0.0, &sc, |_, r, g, _| grads[r] = *g);
     }
 
     /// `Phi_q` in element-local form and `gamma`, for sparse assembly: row `r` of `Phi_q` is
@@ -172,34 +155,32 @@ impl System {
         grads: &mut [[f64; 6]],
         gamma: &mut [f64],
     ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                grads[o + k] = e[k].g;
-                gamma[o + k] = -e[k].d2 + j.time_part(k, t)[2];
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, Some(v), t, &sc, |_, r, g, gm| {
+            grads[r] = *g;
+            gamma[r] = gm;
+        });
     }
 
     /// `gamma(q, v, t)` alone.
     pub fn gamma(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                out[o + k] = -e[k].d2 + j.time_part(k, t)[2];
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, Some(v), t, &sc, |_, r, _, gm| out[r] = gm);
     }
 
     /// The velocity constraint `Phi_q v + Phi_t` into `out`.
     pub fn phi_dot(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        let sc = SinCos::new(self, q, None);
+        let var = |i: usize| -> [Dual; 3] {
+            std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k]))
+        };
         for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
+            let at = self.joint_attach[ji];
+            let mut e = [Dual::cst(0.0); 3];
+            j.eval(&sc.frame(at.a, var), &sc.frame(at.b, var), &mut e);
             let o = self.row_offset[ji];
             for k in 0..j.n_equations() {
-                out[o + k] = e[k].d1 - j.time_part(k, t)[1];
+                out[o + k] = e[k].d - j.time_part(k, t)[1];
             }
         }
     }
@@ -319,23 +300,20 @@ impl System {
     /// factorisations. `out` is cleared first; its capacity is reused.
     pub fn phi_q_triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
         out.clear();
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, None);
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
             let at = self.joint_attach[ji];
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                if let Some(i) = at.a {
-                    for l in 0..3 {
-                        out.push((o + k, 3 * i + l, e[k].g[l]));
-                    }
-                }
-                if let Some(i) = at.b {
-                    for l in 0..3 {
-                        out.push((o + k, 3 * i + l, e[k].g[3 + l]));
-                    }
+            if let Some(i) = at.a {
+                for l in 0..3 {
+                    out.push((r, 3 * i + l, g[l]));
                 }
             }
-        }
+            if let Some(i) = at.b {
+                for l in 0..3 {
+                    out.push((r, 3 * i + l, g[3 + l]));
+                }
+            }
+        });
     }
 
     /// The lambda-weighted constraint Hessian `sum_k lambda_k d^2 Phi_k / dq^2` (n x n) into `out`
@@ -353,24 +331,23 @@ impl System {
         scale: f64,
         out: &mut DMatrix<f64>,
     ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let qa = Self::loc_hess(q, at.a, 0);
-            let qb = Self::loc_hess(q, at.b, 3);
-            let mut e = [HessJet::cst(0.0); 3];
-            j.eval(&qa, &qb, &mut e);
+        // the joints' Hessians from the element pass (closed-form revolute rows)
+        self.element_hessians(q, false, |el| {
+            let ElementHessian::Joint(ji, at, e) = el else {
+                return;
+            };
             let o = self.row_offset[ji];
             let mut h = [[0.0; NV]; NV];
-            for k in 0..j.n_equations() {
+            for (k, ek) in e.iter().enumerate() {
                 let l = lambda[o + k] * scale;
                 for r in 0..NV {
                     for c in 0..NV {
-                        h[r][c] += l * e[k].h[r][c];
+                        h[r][c] += l * ek.h[r][c];
                     }
                 }
             }
             Self::scatter_hess(at, &h, out);
-        }
+        });
     }
 
     pub(crate) fn scatter_hess(at: Attach, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {

@@ -42,6 +42,9 @@ pub struct System {
     pub(crate) mass: DVector<f64>,
     pub(crate) inv_mass: DVector<f64>,
     pub(crate) eq_joint: Vec<usize>,
+    /// The generalized gravity forces `(m_i g_x, m_i g_y, 0)` per body: constant, evaluated
+    /// once at build instead of at every force evaluation.
+    pub(crate) gravity_forces: Vec<f64>,
 }
 
 impl System {
