@@ -12,43 +12,27 @@ use nalgebra::DMatrix;
 /// A side of a row that acts on no body (ground).
 const GROUND: usize = usize::MAX;
 
-/// One term `g_r1[o1..o1 + 3] . (W g_r2)[o2..o2 + 3]` of `S_(r1, r2)` (`r1` implied by the
-/// term's place in the plan).
-#[derive(Clone, Copy, Debug)]
-struct Term {
-    /// Index of `S_(r1, r2)` in the column-major storage.
-    idx: usize,
-    r2: usize,
-    /// The body's columns in the two rows: `false` for `0..3`, `true` for `3..6`.
-    second1: bool,
-    second2: bool,
-}
-
-/// The body's three columns of a local row.
-#[inline(always)]
-fn half(g: &[f64; 6], second: bool) -> &[f64] {
-    if second {
-        &g[3..]
-    } else {
-        &g[..3]
-    }
-}
-
 /// `Phi_q` in element-local rows and the Cholesky factorisation of `S = Phi_q W Phi_q^T`.
+///
+/// Each row has two halves, the three columns of its first and of its second body (half
+/// `2 r + s`); `S_(r1, r2)` is the sum over the bodies the two rows share of
+/// `u_h1 . (W u_h2)` for the halves `h1`, `h2` on that body.
 #[derive(Debug)]
 pub(crate) struct DenseSchur {
     m: usize,
     /// Per row: the first coordinate (`3 i`) of the body in its local columns `0..3` and
     /// `3..6`, [`GROUND`] for ground.
     cols: Vec<[usize; 2]>,
-    /// One term of `S` per pair of rows `r1 >= r2` acting on a common body, grouped by `r1`
-    /// (row `r1`'s terms at `starts[r1]..starts[r1 + 1]`): see [`Term`].
-    plan: Vec<Term>,
-    starts: Vec<usize>,
+    /// One term `(index of S_(r1, r2) in the column-major storage, h1, h2)` per pair of rows
+    /// `r1 >= r2` acting on a common body, in storage order (the terms of one entry in body
+    /// order).
+    plan: Vec<[usize; 3]>,
     /// The element-local rows of `Phi_q` (see [`System::phi_q_local`]).
     pub(crate) grads: Vec<[f64; 6]>,
-    /// `W`-weighted rows of the last [`DenseSchur::factor`].
-    weighted: Vec<[f64; 6]>,
+    /// The halves of the rows and their `W`-weighted values at the last
+    /// [`DenseSchur::factor`] (ground halves unused).
+    u: Vec<[f64; 3]>,
+    wu: Vec<[f64; 3]>,
     /// The factorisation of `S`.
     pub(crate) chol: DenseCholesky,
 }
@@ -69,35 +53,20 @@ impl DenseSchur {
             for &(r1, o1) in rows {
                 for &(r2, o2) in rows {
                     if r1 >= r2 {
-                        plan.push((
-                            r1,
-                            Term {
-                                idx: r1 + r2 * m,
-                                r2,
-                                second1: o1 == 3,
-                                second2: o2 == 3,
-                            },
-                        ));
+                        plan.push([r1 + r2 * m, 2 * r1 + o1 / 3, 2 * r2 + o2 / 3]);
                     }
                 }
             }
         }
-        // by rows, and within a row by entry (the terms of one entry stay in body order)
-        plan.sort_by_key(|&(r1, t)| (r1, t.r2));
-        let mut starts = vec![0; m + 1];
-        for &(r1, _) in &plan {
-            starts[r1 + 1] += 1;
-        }
-        for r in 0..m {
-            starts[r + 1] += starts[r];
-        }
+        // in storage order (a stable sort: the terms of one entry stay in body order)
+        plan.sort_by_key(|t| t[0]);
         DenseSchur {
             m,
             cols,
-            plan: plan.into_iter().map(|(_, t)| t).collect(),
-            starts,
+            plan,
             grads: vec![[0.0; 6]; m],
-            weighted: vec![[0.0; 6]; m],
+            u: vec![[0.0; 3]; 2 * m],
+            wu: vec![[0.0; 3]; 2 * m],
             chol: DenseCholesky::new(m),
         }
     }
@@ -126,54 +95,56 @@ impl DenseSchur {
         w: &[f64],
         mut rhs: Option<(&[f64], &[f64], &mut [f64])>,
     ) -> Result<(), FactorError> {
-        for (r, ((wr, g), c)) in self
-            .weighted
-            .iter_mut()
-            .zip(&self.grads)
+        for (r, ((g, c), (u, wu))) in self
+            .grads
+            .iter()
             .zip(&self.cols)
+            .zip(self.u.chunks_exact_mut(2).zip(self.wu.chunks_exact_mut(2)))
             .enumerate()
         {
-            *wr = [0.0; 6];
             let mut acc = 0.0;
-            for (s, &col) in c.iter().enumerate() {
-                if col != GROUND {
-                    let wb = &w[col..col + 3];
-                    for l in 0..3 {
-                        wr[3 * s + l] = wb[l] * g[3 * s + l];
-                    }
-                    if let Some((x, _, _)) = &rhs {
-                        let xb = &x[col..col + 3];
-                        for l in 0..3 {
-                            acc += g[3 * s + l] * xb[l];
-                        }
-                    }
+            for s in 0..2 {
+                let col = c[s];
+                if col == GROUND {
+                    continue;
+                }
+                let h = [g[3 * s], g[3 * s + 1], g[3 * s + 2]];
+                let wb = &w[col..col + 3];
+                u[s] = h;
+                wu[s] = [wb[0] * h[0], wb[1] * h[1], wb[2] * h[2]];
+                if let Some((x, _, _)) = &rhs {
+                    let xb = &x[col..col + 3];
+                    acc += h[0] * xb[0];
+                    acc += h[1] * xb[1];
+                    acc += h[2] * xb[2];
                 }
             }
             if let Some((_, sub, out)) = &mut rhs {
                 out[r] = acc - sub[r];
             }
         }
+        let (u, wu, plan) = (&self.u[..], &self.wu[..], &self.plan[..]);
         let s = self.chol.values_mut();
         s.fill(0.0);
-        for (g, span) in self.grads.iter().zip(self.starts.windows(2)) {
-            for t in &self.plan[span[0]..span[1]] {
-                let (a, b) = (half(g, t.second1), half(&self.weighted[t.r2], t.second2));
-                s[t.idx] += a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-            }
+        for &[idx, h1, h2] in plan {
+            let (a, b) = (&u[h1], &wu[h2]);
+            s[idx] += a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         }
         self.chol.factor_in_place()
     }
 
     /// `out -= W Phi_q^T y` with the `W` of the last [`DenseSchur::factor`].
     pub(crate) fn sub_weighted_transpose(&self, y: &[f64], out: &mut [f64]) {
-        for ((wr, c), &yr) in self.weighted.iter().zip(&self.cols).zip(y) {
-            for (s, &col) in c.iter().enumerate() {
-                if col != GROUND {
-                    let ob = &mut out[col..col + 3];
-                    for l in 0..3 {
-                        ob[l] -= yr * wr[3 * s + l];
-                    }
+        for ((c, wu), &yr) in self.cols.iter().zip(self.wu.chunks_exact(2)).zip(y) {
+            for s in 0..2 {
+                let col = c[s];
+                if col == GROUND {
+                    continue;
                 }
+                let (ob, wr) = (&mut out[col..col + 3], &wu[s]);
+                ob[0] -= yr * wr[0];
+                ob[1] -= yr * wr[1];
+                ob[2] -= yr * wr[2];
             }
         }
     }

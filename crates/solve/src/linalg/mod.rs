@@ -115,7 +115,9 @@ fn factor_fixed<const M: usize>(
     let (a, diag, inv) = (&mut a[..M * M], &mut diag[..M], &mut inv[..M]);
     for j in 0..M {
         let d = a[j + j * M];
-        if !(d > 0.0 && d < f64::INFINITY) {
+        // positive and finite (`d - d` is 0 exactly for finite `d`): two floating-point
+        // comparisons, where `d < inf` compiled to an integer classification
+        if !(d > 0.0 && d - d == 0.0) {
             return Err(FactorError::NotPositiveDefinite(j));
         }
         diag[j] = d;
