@@ -3,7 +3,8 @@
 
 use crate::cache::AngleCache;
 use crate::hessian_pair::ElementHessian;
-use crate::jet::{Dual, Frame, Scalar, TanJet, NV};
+use crate::jet::{point, sub2, Dual, Frame, Scalar, NV};
+use crate::joint::JointKind;
 use crate::rows::SinCos;
 use crate::system::*;
 use nalgebra::DMatrix;
@@ -17,9 +18,16 @@ impl System {
             let at = self.joint_attach[ji];
             let qa = sc.frame(at.a, var);
             let qb = sc.frame(at.b, var);
+            let o = self.row_offset[ji];
+            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+                // the generic evaluation's operations, no time part
+                let d = sub2(point(&qa, *pa), point(&qb, *pb));
+                let p = &mut out[o..o + 2];
+                (p[0], p[1]) = (d[0], d[1]);
+                continue;
+            }
             let mut e = [0.0; 3];
             j.eval(&qa, &qb, &mut e);
-            let o = self.row_offset[ji];
             for k in 0..j.n_equations() {
                 out[o + k] = e[k] - j.time_part(k, t)[0];
             }
@@ -92,18 +100,11 @@ impl System {
     ) {
         phi_q.as_mut_slice().fill(0.0);
         out.fill(0.0);
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let qa = Self::loc_tan(q, v, at.a, 0);
-            let qb = Self::loc_tan(q, v, at.b, 3);
-            let mut e = [TanJet::cst(0.0); 3];
-            j.eval(&qa, &qb, &mut e);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                self.scatter_row(ji, o + k, &e[k].g, phi_q);
-                self.scatter_row(ji, o + k, &e[k].dg, out);
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row_tan(q, v, &sc, |ji, r, g, dg| {
+            self.scatter_row(ji, r, g, phi_q);
+            self.scatter_row(ji, r, dg, out);
+        });
     }
 
     /// [`System::phi_q_dot_jacobian`] in element-local form (see [`System::phi_q_local`]):
@@ -116,18 +117,11 @@ impl System {
         grads: &mut [[f64; 6]],
         dgrads: &mut [[f64; 6]],
     ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let qa = Self::loc_tan(q, v, at.a, 0);
-            let qb = Self::loc_tan(q, v, at.b, 3);
-            let mut e = [TanJet::cst(0.0); 3];
-            j.eval(&qa, &qb, &mut e);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                grads[o + k] = e[k].g;
-                dgrads[o + k] = e[k].dg;
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row_tan(q, v, &sc, |_, r, g, dg| {
+            grads[r] = *g;
+            dgrads[r] = *dg;
+        });
     }
 
     /// The bodies a joint attaches, as coordinate-block indices (`None` = ground).
@@ -172,13 +166,26 @@ impl System {
     pub fn phi_dot(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         let sc = SinCos::new(self, q, None);
         let var = |i: usize| -> [Dual; 3] {
-            std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k]))
+            let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+            [
+                Dual::var(qi[0], vi[0]),
+                Dual::var(qi[1], vi[1]),
+                Dual::var(qi[2], vi[2]),
+            ]
         };
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let mut e = [Dual::cst(0.0); 3];
-            j.eval(&sc.frame(at.a, var), &sc.frame(at.b, var), &mut e);
+            let (fa, fb) = (sc.frame(at.a, var), sc.frame(at.b, var));
             let o = self.row_offset[ji];
+            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+                // the generic evaluation's operations, no time part
+                let d = sub2(point(&fa, *pa), point(&fb, *pb));
+                let p = &mut out[o..o + 2];
+                (p[0], p[1]) = (d[0].d, d[1].d);
+                continue;
+            }
+            let mut e = [Dual::cst(0.0); 3];
+            j.eval(&fa, &fb, &mut e);
             for k in 0..j.n_equations() {
                 out[o + k] = e[k].d - j.time_part(k, t)[1];
             }
@@ -197,9 +204,16 @@ impl System {
         phi_dot: &mut [f64],
     ) {
         let j = &self.joints[ji];
+        let o = self.row_offset[ji];
+        if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+            // the generic evaluation's operations, no time part
+            let d = sub2(point(fa, *pa), point(fb, *pb));
+            let (p, pd) = (&mut phi[o..o + 2], &mut phi_dot[o..o + 2]);
+            (p[0], p[1], pd[0], pd[1]) = (d[0].v, d[1].v, d[0].d, d[1].d);
+            return;
+        }
         let mut e = [Dual::cst(0.0); 3];
         j.eval(fa, fb, &mut e);
-        let o = self.row_offset[ji];
         for k in 0..j.n_equations() {
             let tp = j.time_part(k, t);
             phi[o + k] = e[k].v - tp[0];
@@ -219,9 +233,12 @@ impl System {
         phi_dot: &mut [f64],
     ) {
         let loc = |i: usize| -> Frame<Dual> {
-            Frame::new(std::array::from_fn(|k| {
-                Dual::var(q[3 * i + k], v[3 * i + k])
-            }))
+            let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+            Frame::new([
+                Dual::var(qi[0], vi[0]),
+                Dual::var(qi[1], vi[1]),
+                Dual::var(qi[2], vi[2]),
+            ])
         };
         let fixed = Frame::fixed();
         let mut eval = |ji: usize, fa: &Frame<Dual>, fb: &Frame<Dual>| {
@@ -277,9 +294,14 @@ impl System {
             match i {
                 Some(i) => {
                     let e = entries[i];
-                    let w = v[3 * i + 2];
+                    let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+                    let w = vi[2];
                     Frame {
-                        q: std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k])),
+                        q: [
+                            Dual::var(qi[0], vi[0]),
+                            Dual::var(qi[1], vi[1]),
+                            Dual::var(qi[2], vi[2]),
+                        ],
                         c: Dual {
                             v: e.c,
                             d: -e.s * w,

@@ -111,6 +111,7 @@ impl System {
     }
 
     /// All generalized applied forces `Q(q, v, t) = -grad V + Q_nc` into `out` (overwritten).
+    #[inline]
     pub fn forces_into(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         // gravity (constant), then minus the elements' potential gradients: what negating
         // `potential_gradient` gives, bit for bit

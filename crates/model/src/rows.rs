@@ -10,7 +10,7 @@
 //! gradients bit for bit).
 
 use crate::directional::BodyAngles;
-use crate::jet::{DirJet, Frame, Scalar, NV};
+use crate::jet::{DirJet, Frame, Scalar, TanJet, NV};
 use crate::joint::{JointKind, RevoluteSide};
 use crate::system::System;
 
@@ -21,11 +21,13 @@ pub(crate) const STACK_BODIES: usize = 16;
 /// `(sin, cos)` of every body's angle at one configuration, for one pass: from a
 /// [`BodyAngles`] table, from a stack table filled once, or evaluated at each use (models of
 /// more than [`STACK_BODIES`] bodies without a table). The same values whichever the source.
-pub(crate) struct SinCos<'a> {
-    q: &'a [f64],
-    table: Option<&'a BodyAngles>,
-    stack: [[f64; 2]; STACK_BODIES],
-    on_stack: bool,
+pub(crate) enum SinCos<'a> {
+    /// A table evaluated at this configuration.
+    Table(&'a BodyAngles),
+    /// `[sin, cos]` per body (the first `nb` entries).
+    Stack([[f64; 2]; STACK_BODIES]),
+    /// `q`: evaluated at each use.
+    Direct(&'a [f64]),
 }
 
 impl<'a> SinCos<'a> {
@@ -33,33 +35,33 @@ impl<'a> SinCos<'a> {
     #[inline(always)]
     pub(crate) fn new(sys: &System, q: &'a [f64], table: Option<&'a BodyAngles>) -> Self {
         let nb = sys.bodies.len();
-        let mut sc = SinCos {
-            q,
-            table,
-            stack: [[0.0, 1.0]; STACK_BODIES],
-            on_stack: false,
-        };
-        if table.is_none() && nb <= STACK_BODIES {
-            for (i, e) in sc.stack.iter_mut().enumerate().take(nb) {
-                let (s, c) = q[3 * i + 2].sin_cos();
-                *e = [s, c];
+        match table {
+            Some(t) => SinCos::Table(t),
+            None if nb <= STACK_BODIES => {
+                let mut stack = [[0.0; 2]; STACK_BODIES];
+                for (i, e) in stack.iter_mut().enumerate().take(nb) {
+                    let (s, c) = q[3 * i + 2].sin_cos();
+                    *e = [s, c];
+                }
+                SinCos::Stack(stack)
             }
-            sc.on_stack = true;
+            None => SinCos::Direct(q),
         }
-        sc
     }
 
     /// `(sin theta_i, cos theta_i)`.
     #[inline(always)]
     pub(crate) fn get(&self, i: usize) -> (f64, f64) {
-        if let Some(t) = self.table {
-            let [_, s, c] = t.sin_cos_of(i);
-            (s, c)
-        } else if self.on_stack {
-            let [s, c] = self.stack[i];
-            (s, c)
-        } else {
-            self.q[3 * i + 2].sin_cos()
+        match self {
+            SinCos::Table(t) => {
+                let [_, s, c] = t.sin_cos_of(i);
+                (s, c)
+            }
+            SinCos::Stack(st) => {
+                let [s, c] = st[i];
+                (s, c)
+            }
+            SinCos::Direct(q) => q[3 * i + 2].sin_cos(),
         }
     }
 
@@ -198,6 +200,58 @@ impl System {
             j.eval(&sc.frame(at.a, var(0)), &sc.frame(at.b, var(3)), &mut e);
             for k in 0..j.n_equations() {
                 visit(ji, o + k, &e[k].g, -e[k].d2 + j.time_part(k, t)[2]);
+            }
+        }
+    }
+
+    /// For every constraint row `r` (joint `ji`), its element-local gradient and the gradient
+    /// of its velocity constraint, `Hess(Phi_r) v` (the row of `(Phi_q v)_q`), handed to
+    /// `visit(ji, r, gradient, hess_v)`: revolute rows in closed form (one second derivative,
+    /// `-R(theta) p` in theta-theta), the other kinds through [`TanJet`] on the shared
+    /// rotations.
+    #[inline(always)]
+    pub(crate) fn for_each_row_tan(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        sc: &SinCos,
+        mut visit: impl FnMut(usize, usize, &[f64; NV], &[f64; NV]),
+    ) {
+        for (ji, j) in self.joints.iter().enumerate() {
+            let at = self.joint_attach[ji];
+            let o = self.row_offset[ji];
+            if let Some(sides) = j.revolute_sides(at) {
+                let (mut g, mut dg) = ([[0.0; NV]; 2], [[0.0; NV]; 2]);
+                for RevoluteSide {
+                    body,
+                    slot,
+                    p,
+                    sign,
+                } in sides
+                {
+                    let Some(i) = body else { continue };
+                    let r0 = sc.rotate(i, p);
+                    let r1 = perp(r0);
+                    let w = v[3 * i + 2];
+                    for c in 0..2 {
+                        g[c][slot + c] = sign;
+                        g[c][slot + 2] = sign * r1[c];
+                        dg[c][slot + 2] = -sign * r0[c] * w;
+                    }
+                }
+                visit(ji, o, &g[0], &dg[0]);
+                visit(ji, o + 1, &g[1], &dg[1]);
+                continue;
+            }
+            let var = |slot: usize| {
+                move |i: usize| -> [TanJet; 3] {
+                    std::array::from_fn(|k| TanJet::var(slot + k, q[3 * i + k], v[3 * i + k]))
+                }
+            };
+            let mut e = [TanJet::cst(0.0); 3];
+            j.eval(&sc.frame(at.a, var(0)), &sc.frame(at.b, var(3)), &mut e);
+            for k in 0..j.n_equations() {
+                visit(ji, o + k, &e[k].g, &e[k].dg);
             }
         }
     }

@@ -79,6 +79,7 @@ impl DenseSchur {
 
     /// [`DenseSchur::factor`], and `out_r = (Phi_q x)_r - sub_r` for every row `r` (`x` of
     /// length n, `sub` of length m) from the same pass over the rows.
+    #[inline(always)]
     pub(crate) fn factor_rhs(
         &mut self,
         w: &[f64],
@@ -95,13 +96,11 @@ impl DenseSchur {
         w: &[f64],
         mut rhs: Option<(&[f64], &[f64], &mut [f64])>,
     ) -> Result<(), FactorError> {
-        for (r, ((g, c), (u, wu))) in self
-            .grads
-            .iter()
-            .zip(&self.cols)
-            .zip(self.u.chunks_exact_mut(2).zip(self.wu.chunks_exact_mut(2)))
-            .enumerate()
-        {
+        let m = self.grads.len();
+        let (grads, cols) = (&self.grads[..], &self.cols[..m]);
+        let (u, wu) = (&mut self.u[..2 * m], &mut self.wu[..2 * m]);
+        for r in 0..m {
+            let (g, c) = (&grads[r], cols[r]);
             let mut acc = 0.0;
             for s in 0..2 {
                 let col = c[s];
@@ -110,8 +109,8 @@ impl DenseSchur {
                 }
                 let h = [g[3 * s], g[3 * s + 1], g[3 * s + 2]];
                 let wb = &w[col..col + 3];
-                u[s] = h;
-                wu[s] = [wb[0] * h[0], wb[1] * h[1], wb[2] * h[2]];
+                u[2 * r + s] = h;
+                wu[2 * r + s] = [wb[0] * h[0], wb[1] * h[1], wb[2] * h[2]];
                 if let Some((x, _, _)) = &rhs {
                     let xb = &x[col..col + 3];
                     acc += h[0] * xb[0];
@@ -134,14 +133,18 @@ impl DenseSchur {
     }
 
     /// `out -= W Phi_q^T y` with the `W` of the last [`DenseSchur::factor`].
+    #[inline(always)]
     pub(crate) fn sub_weighted_transpose(&self, y: &[f64], out: &mut [f64]) {
-        for ((c, wu), &yr) in self.cols.iter().zip(self.wu.chunks_exact(2)).zip(y) {
+        let m = self.cols.len();
+        let (cols, wu, y) = (&self.cols[..], &self.wu[..2 * m], &y[..m]);
+        for r in 0..m {
+            let (c, yr) = (cols[r], y[r]);
             for s in 0..2 {
                 let col = c[s];
                 if col == GROUND {
                     continue;
                 }
-                let (ob, wr) = (&mut out[col..col + 3], &wu[s]);
+                let (ob, wr) = (&mut out[col..col + 3], &wu[2 * r + s]);
                 ob[0] -= yr * wr[0];
                 ob[1] -= yr * wr[1];
                 ob[2] -= yr * wr[2];
@@ -151,12 +154,15 @@ impl DenseSchur {
 
     /// The rows into the dense `m x n` matrix `out` (overwritten).
     pub(crate) fn scatter(&self, out: &mut DMatrix<f64>) {
-        out.as_mut_slice().fill(0.0);
+        let m = self.m;
+        let data = out.as_mut_slice();
+        data.fill(0.0);
         for (r, (g, c)) in self.grads.iter().zip(&self.cols).enumerate() {
             for (s, &col) in c.iter().enumerate() {
                 if col != GROUND {
+                    // column-major: entry (r, k) at r + k m
                     for l in 0..3 {
-                        out[(r, col + l)] = g[3 * s + l];
+                        data[r + (col + l) * m] = g[3 * s + l];
                     }
                 }
             }
