@@ -122,10 +122,11 @@ fn factor_fixed<const M: usize>(
         }
         diag[j] = d;
     }
+    // (the indices are constants once unrolled: L is read from the lower triangle alone)
     for j in 0..M {
         let mut d = a[j + j * M];
         for k in 0..j {
-            let l = a[k + j * M];
+            let l = a[j + k * M];
             d -= l * l;
         }
         if !(d > 0.0) {
@@ -138,11 +139,9 @@ fn factor_fixed<const M: usize>(
         for i in j + 1..M {
             let mut y = a[i + j * M];
             for k in 0..j {
-                y -= a[k + i * M] * a[k + j * M];
+                y -= a[i + k * M] * a[j + k * M];
             }
-            let lij = y * ij;
-            a[i + j * M] = lij;
-            a[j + i * M] = lij;
+            a[i + j * M] = y * ij;
         }
     }
     let mut worst = 0.0f64;
@@ -157,14 +156,14 @@ fn factor_fixed<const M: usize>(
     Ok(worst)
 }
 
-/// `b <- L^-1 b` for a fixed dimension `M`, by rows from the upper-triangle copy.
+/// `b <- L^-1 b` for a fixed dimension `M`, by rows.
 #[inline]
 fn forward_fixed<const M: usize>(a: &[f64], inv: &[f64], b: &mut [f64]) {
     let (a, inv, b) = (&a[..M * M], &inv[..M], &mut b[..M]);
     for i in 0..M {
         let mut x = b[i];
         for k in 0..i {
-            x -= a[k + i * M] * b[k];
+            x -= a[i + k * M] * b[k];
         }
         b[i] = x * inv[i];
     }
@@ -184,10 +183,10 @@ fn backward_fixed<const M: usize>(a: &[f64], inv: &[f64], b: &mut [f64]) {
 }
 
 /// Cholesky `L L^T` of a symmetric positive definite `m x m` matrix, reusing its storage.
-/// Only the lower triangle of the matrix is read (up to [`SMALL_CHOLESKY`] the factorisation
-/// also writes `L^T` into the upper triangle, for its triangular solves: fill the matrix
-/// again, after [`DenseCholesky::clear`] for [`DenseCholesky::add_rank_one`], before the next
-/// factorisation).
+/// Only the lower triangle of the matrix is read (above [`FIXED_CHOLESKY`] and up to
+/// [`SMALL_CHOLESKY`] the factorisation also writes `L^T` into the upper triangle, for its
+/// triangular solves: fill the matrix again, after [`DenseCholesky::clear`] for
+/// [`DenseCholesky::add_rank_one`], before the next factorisation).
 #[derive(Debug)]
 pub struct DenseCholesky {
     m: usize,
