@@ -7,7 +7,8 @@
 //! the gradient `e_x` or `e_y` plus `R'(theta) p` in `theta`, and the quadratic velocity term
 //! `-omega^2 R(theta) p`); the other kinds go through the generic [`DirJet`] evaluation on the
 //! shared rotations. Both give what the generic evaluation gives, up to rounding (the
-//! gradients bit for bit).
+//! revolute gradients bit for bit). [`System::for_each_row_tan`] does the same for the
+//! gradients of the velocity constraint (`Hess(Phi_r) v`, the tangent chart's pass).
 
 use crate::directional::BodyAngles;
 use crate::jet::{DirJet, Frame, Scalar, TanJet, NV};
@@ -21,6 +22,8 @@ pub(crate) const STACK_BODIES: usize = 16;
 /// `(sin, cos)` of every body's angle at one configuration, for one pass: from a
 /// [`BodyAngles`] table, from a stack table filled once, or evaluated at each use (models of
 /// more than [`STACK_BODIES`] bodies without a table). The same values whichever the source.
+// a value on the stack of one pass: the size difference costs nothing, a box would allocate
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum SinCos<'a> {
     /// A table evaluated at this configuration.
     Table(&'a BodyAngles),

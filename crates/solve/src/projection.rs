@@ -31,6 +31,8 @@ impl Default for ProjectionSettings {
 }
 
 /// The factorisation of `S = Phi_q M^-1 Phi_q^T` a projection uses.
+// one per projector, built once: the dense arm stays unboxed (no indirection on small systems)
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 enum Kernel {
     /// `Phi_q` in element-local rows and the dense factorisation of `S`.

@@ -75,6 +75,9 @@ fn mixed() -> Result<System, Box<dyn std::error::Error>> {
     Ok(b.build()?)
 }
 
+/// A named solver set-up.
+type Solver = (&'static str, Box<dyn Integrator>);
+
 fn systems() -> Result<Vec<(String, System)>, Box<dyn std::error::Error>> {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/models/");
     Ok(vec![
@@ -95,9 +98,7 @@ fn systems() -> Result<Vec<(String, System)>, Box<dyn std::error::Error>> {
     ])
 }
 
-fn solvers(
-    sys: &System,
-) -> Result<Vec<(&'static str, Box<dyn Integrator>)>, Box<dyn std::error::Error>> {
+fn solvers(sys: &System) -> Result<Vec<Solver>, Box<dyn std::error::Error>> {
     let dense = |o: Rk4Options| Rk4Options {
         linear: LinearSolver::Dense,
         ..o
@@ -106,7 +107,7 @@ fn solvers(
         linear: LinearSolver::Sparse,
         ..o
     };
-    let mut v: Vec<(&'static str, Box<dyn Integrator>)> = vec![
+    let mut v: Vec<Solver> = vec![
         ("rk4", Box::new(Rk4::new(sys, Rk4Options::plain())?)),
         (
             "rk4-dense",

@@ -170,7 +170,8 @@ impl DenseSchur {
     }
 
     /// The rows from the dense `m x n` matrix `jac`, if it has the structure of `Phi_q` (every
-    /// entry outside a row's bodies' columns zero); `false` (rows unchanged) otherwise.
+    /// entry outside a row's bodies' columns zero); `false` otherwise (the rows are then
+    /// partly overwritten: the caller solves from `jac` itself).
     pub(crate) fn gather(&mut self, jac: &DMatrix<f64>) -> bool {
         let (m, n) = jac.shape();
         if m != self.m {

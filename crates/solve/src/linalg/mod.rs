@@ -104,6 +104,14 @@ macro_rules! by_dimension {
     };
 }
 
+/// `d > 0` and finite, in two floating-point comparisons (`d - d` is zero exactly for finite
+/// `d`), where `d.is_finite()` or `d < inf` compiled to an integer classification of the bits.
+#[inline(always)]
+#[allow(clippy::eq_op)]
+fn positive_finite(d: f64) -> bool {
+    d > 0.0 && d - d == 0.0
+}
+
 /// [`DenseCholesky::factor_in_place`] for a fixed dimension `M`: the same checks and
 /// operations in the same order as the run-time-length loops; returns the condition estimate.
 #[inline]
@@ -115,9 +123,7 @@ fn factor_fixed<const M: usize>(
     let (a, diag, inv) = (&mut a[..M * M], &mut diag[..M], &mut inv[..M]);
     for j in 0..M {
         let d = a[j + j * M];
-        // positive and finite (`d - d` is 0 exactly for finite `d`): two floating-point
-        // comparisons, where `d < inf` compiled to an integer classification
-        if !(d > 0.0 && d - d == 0.0) {
+        if !positive_finite(d) {
             return Err(FactorError::NotPositiveDefinite(j));
         }
         diag[j] = d;
@@ -351,7 +357,7 @@ impl DenseCholesky {
         }
         for (j, dj) in self.diag.iter_mut().enumerate() {
             let d = self.a[j + j * m];
-            if !(d > 0.0 && d < f64::INFINITY) {
+            if !positive_finite(d) {
                 return Err(FactorError::NotPositiveDefinite(j));
             }
             *dj = d;
