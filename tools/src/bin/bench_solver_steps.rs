@@ -1,9 +1,11 @@
-//! Runs N steps of one solver on the manipulator (for callgrind: the difference of two runs
-//! with N and 2N steps is the cost of N steps without the set-up), and prints the time per step.
+//! Runs N steps of one solver on a model (for callgrind: the difference of two runs with N and
+//! 2N steps is the cost of N steps without the set-up), and prints the time per step.
 //!
-//! `cargo run --release -p mbd-tools --bin bench_solver_steps -- SOLVER [N]` with SOLVER one of
-//! `rk4` (plain RK4), `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1 DOPRI5,
-//! fixed steps), `fadae` (firefly-Gauss, default options).
+//! `cargo run --release -p mbd-tools --bin bench_solver_steps -- SOLVER [N] [MODEL]` with SOLVER
+//! one of `rk4` (plain RK4), `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1
+//! DOPRI5, fixed steps), `fadae` (firefly-Gauss, default options), and MODEL one of
+//! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
+//! links the index-1 solve takes the sparse path).
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
@@ -15,7 +17,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let solver = args.next().unwrap_or_else(|| "rk4".into());
     let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(100_000);
-    let sys = models::manipulator()?;
+    let model = args.next().unwrap_or_else(|| "manipulator".into());
+    let sys = match model.as_str() {
+        "manipulator" => models::manipulator()?,
+        "slider_crank" => models::slider_crank()?,
+        "four_bar" => models::four_bar()?,
+        other => match other.strip_prefix("chain").and_then(|k| k.parse().ok()) {
+            Some(k) => models::n_link_chain(k)?,
+            None => return Err(format!("unknown model '{other}'").into()),
+        },
+    };
     let s0 = State::consistent(&sys, 0.0)?;
     let (mut integ, h): (Box<dyn Integrator>, f64) = match solver.as_str() {
         "rk4" => (Box::new(Rk4::new(&sys, Rk4Options::plain())?), 1e-3),
@@ -54,7 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let dt = t.elapsed().as_secs_f64();
     println!(
-        "{solver}: {n} steps, {:.1} ns/step (q0 = {:.6})",
+        "{solver} on {model}: {n} steps, {:.1} ns/step (q0 = {:.6})",
         dt / n as f64 * 1e9,
         s.q[0]
     );
