@@ -520,6 +520,11 @@ impl System {
         let mass =
             DVector::from_iterator(n, bodies.iter().flat_map(|b| [b.mass, b.mass, b.inertia]));
         let inv_mass = mass.map(|x| 1.0 / x);
+        // the negated gradient of the gravity potential, as `potential_gradient` writes it
+        let gravity_forces = bodies
+            .iter()
+            .flat_map(|b| [-(-b.mass * gravity[0]), -(-b.mass * gravity[1]), 0.0])
+            .collect();
         let sys = System {
             bodies,
             joints,
@@ -533,6 +538,7 @@ impl System {
             mass,
             inv_mass,
             eq_joint,
+            gravity_forces,
         };
         sys.check_inertia_scale()?;
         let (q0, _) = sys.initial_guess();

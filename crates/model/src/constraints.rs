@@ -2,20 +2,32 @@
 //! their element-local forms for sparse assembly, and the constraint Hessians.
 
 use crate::cache::AngleCache;
-use crate::jet::{DirJet, Dual, Frame, HessJet, Scalar, TanJet, NV};
+use crate::hessian_pair::ElementHessian;
+use crate::jet::{point, sub2, Dual, Frame, Scalar, NV};
+use crate::joint::JointKind;
+use crate::rows::SinCos;
 use crate::system::*;
 use nalgebra::DMatrix;
 
 impl System {
     /// `Phi(q, t)` into `out` (length m).
     pub fn phi(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        let sc = SinCos::new(self, q, None);
+        let var = |i: usize| [q[3 * i], q[3 * i + 1], q[3 * i + 2]];
         for (ji, j) in self.joints.iter().enumerate() {
             let at = self.joint_attach[ji];
-            let qa = Self::frm_f64(q, at.a);
-            let qb = Self::frm_f64(q, at.b);
+            let qa = sc.frame(at.a, var);
+            let qb = sc.frame(at.b, var);
+            let o = self.row_offset[ji];
+            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+                // the generic evaluation's operations, no time part
+                let d = sub2(point(&qa, *pa), point(&qb, *pb));
+                let p = &mut out[o..o + 2];
+                (p[0], p[1]) = (d[0], d[1]);
+                continue;
+            }
             let mut e = [0.0; 3];
             j.eval(&qa, &qb, &mut e);
-            let o = self.row_offset[ji];
             for k in 0..j.n_equations() {
                 out[o + k] = e[k] - j.time_part(k, t)[0];
             }
@@ -30,16 +42,6 @@ impl System {
                 out[o + k] = -j.time_part(k, t)[1];
             }
         }
-    }
-
-    #[inline(always)]
-    pub(crate) fn joint_dir(&self, ji: usize, q: &[f64], v: Option<&[f64]>) -> [DirJet; 3] {
-        let at = self.joint_attach[ji];
-        let qa = Self::loc_dir(q, v, at.a, 0);
-        let qb = Self::loc_dir(q, v, at.b, 3);
-        let mut e = [DirJet::cst(0.0); 3];
-        self.joints[ji].eval(&qa, &qb, &mut e);
-        e
     }
 
     #[inline(always)]
@@ -60,13 +62,10 @@ impl System {
     /// The constraint Jacobian `Phi_q` (m x n, dense) into `out` (overwritten).
     pub fn phi_q(&self, q: &[f64], out: &mut DMatrix<f64>) {
         out.as_mut_slice().fill(0.0);
-        for ji in 0..self.joints.len() {
-            let e = self.joint_dir(ji, q, None);
-            let o = self.row_offset[ji];
-            for k in 0..self.joints[ji].n_equations() {
-                self.scatter_row(ji, o + k, &e[k].g, out);
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
+            self.scatter_row(ji, r, g, out)
+        });
     }
 
     /// `Phi_q` and the acceleration right-hand side
@@ -80,14 +79,11 @@ impl System {
         gamma: &mut [f64],
     ) {
         phi_q.as_mut_slice().fill(0.0);
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                self.scatter_row(ji, o + k, &e[k].g, phi_q);
-                gamma[o + k] = -e[k].d2 + j.time_part(k, t)[2];
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, Some(v), t, &sc, |ji, r, g, gm| {
+            self.scatter_row(ji, r, g, phi_q);
+            gamma[r] = gm;
+        });
     }
 
     /// `Phi_q` and the Jacobian of the velocity constraint with respect to `q`,
@@ -104,18 +100,11 @@ impl System {
     ) {
         phi_q.as_mut_slice().fill(0.0);
         out.fill(0.0);
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let qa = Self::loc_tan(q, v, at.a, 0);
-            let qb = Self::loc_tan(q, v, at.b, 3);
-            let mut e = [TanJet::cst(0.0); 3];
-            j.eval(&qa, &qb, &mut e);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                self.scatter_row(ji, o + k, &e[k].g, phi_q);
-                self.scatter_row(ji, o + k, &e[k].dg, out);
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row_tan(q, v, &sc, |ji, r, g, dg| {
+            self.scatter_row(ji, r, g, phi_q);
+            self.scatter_row(ji, r, dg, out);
+        });
     }
 
     /// [`System::phi_q_dot_jacobian`] in element-local form (see [`System::phi_q_local`]):
@@ -128,18 +117,11 @@ impl System {
         grads: &mut [[f64; 6]],
         dgrads: &mut [[f64; 6]],
     ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let qa = Self::loc_tan(q, v, at.a, 0);
-            let qb = Self::loc_tan(q, v, at.b, 3);
-            let mut e = [TanJet::cst(0.0); 3];
-            j.eval(&qa, &qb, &mut e);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                grads[o + k] = e[k].g;
-                dgrads[o + k] = e[k].dg;
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row_tan(q, v, &sc, |_, r, g, dg| {
+            grads[r] = *g;
+            dgrads[r] = *dg;
+        });
     }
 
     /// The bodies a joint attaches, as coordinate-block indices (`None` = ground).
@@ -152,13 +134,8 @@ impl System {
     /// `grads[r][0..3]` in the columns of the joint's first body and `grads[r][3..6]` in those
     /// of its second ([`System::joint_bodies`]).
     pub fn phi_q_local(&self, q: &[f64], grads: &mut [[f64; 6]]) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, None);
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                grads[o + k] = e[k].g;
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, None, 0.0, &sc, |_, r, g, _| grads[r] = *g);
     }
 
     /// `Phi_q` in element-local form and `gamma`, for sparse assembly: row `r` of `Phi_q` is
@@ -172,34 +149,45 @@ impl System {
         grads: &mut [[f64; 6]],
         gamma: &mut [f64],
     ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                grads[o + k] = e[k].g;
-                gamma[o + k] = -e[k].d2 + j.time_part(k, t)[2];
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, Some(v), t, &sc, |_, r, g, gm| {
+            grads[r] = *g;
+            gamma[r] = gm;
+        });
     }
 
     /// `gamma(q, v, t)` alone.
     pub fn gamma(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                out[o + k] = -e[k].d2 + j.time_part(k, t)[2];
-            }
-        }
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, Some(v), t, &sc, |_, r, _, gm| out[r] = gm);
     }
 
     /// The velocity constraint `Phi_q v + Phi_t` into `out`.
     pub fn phi_dot(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        let sc = SinCos::new(self, q, None);
+        let var = |i: usize| -> [Dual; 3] {
+            let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+            [
+                Dual::var(qi[0], vi[0]),
+                Dual::var(qi[1], vi[1]),
+                Dual::var(qi[2], vi[2]),
+            ]
+        };
         for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, Some(v));
+            let at = self.joint_attach[ji];
+            let (fa, fb) = (sc.frame(at.a, var), sc.frame(at.b, var));
             let o = self.row_offset[ji];
+            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+                // the generic evaluation's operations, no time part
+                let d = sub2(point(&fa, *pa), point(&fb, *pb));
+                let p = &mut out[o..o + 2];
+                (p[0], p[1]) = (d[0].d, d[1].d);
+                continue;
+            }
+            let mut e = [Dual::cst(0.0); 3];
+            j.eval(&fa, &fb, &mut e);
             for k in 0..j.n_equations() {
-                out[o + k] = e[k].d1 - j.time_part(k, t)[1];
+                out[o + k] = e[k].d - j.time_part(k, t)[1];
             }
         }
     }
@@ -216,9 +204,16 @@ impl System {
         phi_dot: &mut [f64],
     ) {
         let j = &self.joints[ji];
+        let o = self.row_offset[ji];
+        if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+            // the generic evaluation's operations, no time part
+            let d = sub2(point(fa, *pa), point(fb, *pb));
+            let (p, pd) = (&mut phi[o..o + 2], &mut phi_dot[o..o + 2]);
+            (p[0], p[1], pd[0], pd[1]) = (d[0].v, d[1].v, d[0].d, d[1].d);
+            return;
+        }
         let mut e = [Dual::cst(0.0); 3];
         j.eval(fa, fb, &mut e);
-        let o = self.row_offset[ji];
         for k in 0..j.n_equations() {
             let tp = j.time_part(k, t);
             phi[o + k] = e[k].v - tp[0];
@@ -238,9 +233,12 @@ impl System {
         phi_dot: &mut [f64],
     ) {
         let loc = |i: usize| -> Frame<Dual> {
-            Frame::new(std::array::from_fn(|k| {
-                Dual::var(q[3 * i + k], v[3 * i + k])
-            }))
+            let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+            Frame::new([
+                Dual::var(qi[0], vi[0]),
+                Dual::var(qi[1], vi[1]),
+                Dual::var(qi[2], vi[2]),
+            ])
         };
         let fixed = Frame::fixed();
         let mut eval = |ji: usize, fa: &Frame<Dual>, fb: &Frame<Dual>| {
@@ -296,9 +294,14 @@ impl System {
             match i {
                 Some(i) => {
                     let e = entries[i];
-                    let w = v[3 * i + 2];
+                    let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+                    let w = vi[2];
                     Frame {
-                        q: std::array::from_fn(|k| Dual::var(q[3 * i + k], v[3 * i + k])),
+                        q: [
+                            Dual::var(qi[0], vi[0]),
+                            Dual::var(qi[1], vi[1]),
+                            Dual::var(qi[2], vi[2]),
+                        ],
                         c: Dual {
                             v: e.c,
                             d: -e.s * w,
@@ -319,23 +322,20 @@ impl System {
     /// factorisations. `out` is cleared first; its capacity is reused.
     pub fn phi_q_triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
         out.clear();
-        for (ji, j) in self.joints.iter().enumerate() {
-            let e = self.joint_dir(ji, q, None);
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
             let at = self.joint_attach[ji];
-            let o = self.row_offset[ji];
-            for k in 0..j.n_equations() {
-                if let Some(i) = at.a {
-                    for l in 0..3 {
-                        out.push((o + k, 3 * i + l, e[k].g[l]));
-                    }
-                }
-                if let Some(i) = at.b {
-                    for l in 0..3 {
-                        out.push((o + k, 3 * i + l, e[k].g[3 + l]));
-                    }
+            if let Some(i) = at.a {
+                for l in 0..3 {
+                    out.push((r, 3 * i + l, g[l]));
                 }
             }
-        }
+            if let Some(i) = at.b {
+                for l in 0..3 {
+                    out.push((r, 3 * i + l, g[3 + l]));
+                }
+            }
+        });
     }
 
     /// The lambda-weighted constraint Hessian `sum_k lambda_k d^2 Phi_k / dq^2` (n x n) into `out`
@@ -353,24 +353,23 @@ impl System {
         scale: f64,
         out: &mut DMatrix<f64>,
     ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let qa = Self::loc_hess(q, at.a, 0);
-            let qb = Self::loc_hess(q, at.b, 3);
-            let mut e = [HessJet::cst(0.0); 3];
-            j.eval(&qa, &qb, &mut e);
+        // the joints' Hessians from the element pass (closed-form revolute rows)
+        self.element_hessians(q, false, |el| {
+            let ElementHessian::Joint(ji, at, e) = el else {
+                return;
+            };
             let o = self.row_offset[ji];
             let mut h = [[0.0; NV]; NV];
-            for k in 0..j.n_equations() {
+            for (k, ek) in e.iter().enumerate() {
                 let l = lambda[o + k] * scale;
                 for r in 0..NV {
                     for c in 0..NV {
-                        h[r][c] += l * e[k].h[r][c];
+                        h[r][c] += l * ek.h[r][c];
                     }
                 }
             }
             Self::scatter_hess(at, &h, out);
-        }
+        });
     }
 
     pub(crate) fn scatter_hess(at: Attach, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {

@@ -111,10 +111,27 @@ impl System {
     }
 
     /// All generalized applied forces `Q(q, v, t) = -grad V + Q_nc` into `out` (overwritten).
+    #[inline]
     pub fn forces_into(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.potential_gradient(q, out);
-        for x in out.iter_mut() {
-            *x = -*x;
+        // gravity (constant), then minus the elements' potential gradients: what negating
+        // `potential_gradient` gives, bit for bit
+        out.copy_from_slice(&self.gravity_forces);
+        for (fi, f) in self.forces.iter().enumerate() {
+            let at = self.force_attach[fi];
+            let e = f.potential(
+                &Self::loc_dir(q, None, at.a, 0),
+                &Self::loc_dir(q, None, at.b, 3),
+            );
+            if let Some(i) = at.a {
+                for l in 0..3 {
+                    out[3 * i + l] -= e.g[l];
+                }
+            }
+            if let Some(i) = at.b {
+                for l in 0..3 {
+                    out[3 * i + l] -= e.g[3 + l];
+                }
+            }
         }
         for (fi, f) in self.forces.iter().enumerate() {
             if !f.is_nonconservative() {

@@ -3,9 +3,9 @@
 //! two sets of multipliers (e.g. a preadjusted step's `A = Hess V - mu0 . Hess Phi` and
 //! `B = p Hess V + w . Hess Phi`), at the cost of one assembly instead of three passes.
 
-use crate::directional::BodyAngles;
 use crate::jet::{HessJet, Scalar, NV};
 use crate::joint::RevoluteSide;
+use crate::rows::SinCos;
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 
@@ -20,7 +20,7 @@ pub struct LagrangianWeights<'a> {
 }
 
 /// One element's local Hessians in [`System::element_hessians`]'s pass.
-enum ElementHessian<'e> {
+pub(crate) enum ElementHessian<'e> {
     /// A force element's potential.
     Force(Attach, &'e [[f64; NV]; NV]),
     /// A joint (its index) and its equations.
@@ -30,7 +30,19 @@ enum ElementHessian<'e> {
 impl System {
     /// The Hessian pass over the elements at `q`: every force element's potential (when
     /// `forces`), then every joint's equations, handed to `visit` one element at a time.
-    fn element_hessians(&self, q: &[f64], forces: bool, mut visit: impl FnMut(ElementHessian)) {
+    pub(crate) fn element_hessians(
+        &self,
+        q: &[f64],
+        forces: bool,
+        mut visit: impl FnMut(ElementHessian),
+    ) {
+        // each body's sin/cos once for the joints (the forces' own frames evaluate theirs)
+        let sc = SinCos::new(self, q, None);
+        let hess_var = |slot: usize| {
+            move |i: usize| -> [HessJet; 3] {
+                std::array::from_fn(|k| HessJet::var(slot + k, q[3 * i + k]))
+            }
+        };
         if forces {
             for (fi, f) in self.forces.iter().enumerate() {
                 let at = self.force_attach[fi];
@@ -58,7 +70,7 @@ impl System {
                         }
                         continue;
                     };
-                    let r0 = BodyAngles::rotate(None, q, i, p);
+                    let r0 = sc.rotate(i, p);
                     let r1 = [-r0[1], r0[0]];
                     for c in 0..2 {
                         e[c].v += sign * (q[3 * i + c] + r0[c]);
@@ -71,8 +83,8 @@ impl System {
                 continue;
             }
             j.eval(
-                &Self::loc_hess(q, at.a, 0),
-                &Self::loc_hess(q, at.b, 3),
+                &sc.frame(at.a, hess_var(0)),
+                &sc.frame(at.b, hess_var(3)),
                 &mut e,
             );
             visit(ElementHessian::Joint(ji, at, &e[..j.n_equations()]));

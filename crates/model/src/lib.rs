@@ -62,6 +62,7 @@ mod joint;
 mod kinematics;
 pub mod models;
 pub mod numeric;
+mod rows;
 mod scale;
 mod system;
 mod third;

@@ -5,7 +5,7 @@
 use crate::body::{Body, BodyHandle};
 use crate::error::ModelError;
 use crate::force::Force;
-use crate::jet::{DirJet, Frame, HessJet, TanJet};
+use crate::jet::{DirJet, Frame, HessJet};
 use crate::joint::Joint;
 use nalgebra::{DMatrix, DVector};
 
@@ -42,6 +42,9 @@ pub struct System {
     pub(crate) mass: DVector<f64>,
     pub(crate) inv_mass: DVector<f64>,
     pub(crate) eq_joint: Vec<usize>,
+    /// The generalized gravity forces `(m_i g_x, m_i g_y, 0)` per body: constant, evaluated
+    /// once at build instead of at every force evaluation.
+    pub(crate) gravity_forces: Vec<f64>,
 }
 
 impl System {
@@ -201,15 +204,6 @@ impl System {
         match i {
             Some(i) => Frame::new(std::array::from_fn(|k| {
                 DirJet::var(slot + k, q[3 * i + k], v.map_or(0.0, |v| v[3 * i + k]))
-            })),
-            None => Frame::fixed(),
-        }
-    }
-    #[inline(always)]
-    pub(crate) fn loc_tan(q: &[f64], v: &[f64], i: Option<usize>, slot: usize) -> Frame<TanJet> {
-        match i {
-            Some(i) => Frame::new(std::array::from_fn(|k| {
-                TanJet::var(slot + k, q[3 * i + k], v[3 * i + k])
             })),
             None => Frame::fixed(),
         }

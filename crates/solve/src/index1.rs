@@ -34,7 +34,8 @@ pub struct Index1Rk {
     projector: Option<Projector>,
     options: Index1Options,
     y: Vec<f64>,
-    a: Vec<f64>,
+    /// Stage of the last acceleration evaluated (its slope `k_i = (v_i, a_i)` holds it).
+    last: usize,
     lambda: Vec<f64>,
     phi: Vec<f64>,
     phid: Vec<f64>,
@@ -78,7 +79,7 @@ impl Index1Rk {
             },
             options,
             y: vec![0.0; 2 * n],
-            a: vec![0.0; n],
+            last: 0,
             lambda: vec![0.0; m],
             phi: vec![0.0; m],
             phid: vec![0.0; m],
@@ -99,7 +100,7 @@ impl Index1Rk {
 
     /// The accelerations and multipliers of the last right-hand-side evaluation.
     pub fn last_acceleration(&self) -> (&[f64], &[f64]) {
-        (&self.a, &self.lambda)
+        (&self.rk.slope(self.last)[self.n..], &self.lambda)
     }
 }
 
@@ -136,20 +137,23 @@ impl Integrator for Index1Rk {
         self.y[..n].copy_from_slice(state.q.as_slice());
         self.y[n..].copy_from_slice(state.v.as_slice());
         let acc = &mut self.acc;
-        let (a, lambda, phi, phid) = (&mut self.a, &mut self.lambda, &mut self.phi, &mut self.phid);
+        let (lambda, phi, phid) = (&mut self.lambda, &mut self.phi, &mut self.phid);
         let baum = self.options.baumgarte;
-        let mut evals = 0;
+        let mut evals = 0usize;
         let mut condition = 0.0f64;
+        // the stage slope k_i = (v_i, a_i): the accelerations are solved into it directly
         let mut f = |t: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
             let (q, v) = y.split_at(n);
-            acc.stage(sys, q, v, t, baum, phi, phid, a, lambda)?;
+            let (dq, dv) = dy.split_at_mut(n);
+            acc.stage(sys, q, v, t, baum, phi, phid, dv, lambda)?;
             condition = condition.max(acc.condition());
-            dy[..n].copy_from_slice(v);
-            dy[n..].copy_from_slice(a);
+            dq.copy_from_slice(v);
             evals += 1;
             Ok(())
         };
-        self.rk.step(&mut f, state.t, &mut self.y, h)?;
+        let stepped = self.rk.step(&mut f, state.t, &mut self.y, h);
+        self.last = evals.saturating_sub(1);
+        stepped?;
         state.q.as_mut_slice().copy_from_slice(&self.y[..n]);
         state.v.as_mut_slice().copy_from_slice(&self.y[n..]);
         state.t += h;
@@ -285,4 +289,54 @@ pub fn reference_trajectory(
         out.v.push(s.v.as_slice().to_vec());
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::AccelerationSolver;
+    use crate::tableau::ExplicitRk;
+
+    /// A step is the generic explicit Runge-Kutta stepper on `y = (q, v)`, `y' = (v, a)` with
+    /// the public acceleration solve, bit for bit (end points, embedded error estimates), and
+    /// `last_acceleration` holds the last stage's accelerations (solved into the stage slope),
+    /// for tableaus with and without embedded weights and with zero entries in `a` and `b`.
+    #[test]
+    fn stages_equal_the_generic_stepper_bit_for_bit() {
+        let sys = mbd_model::models::slider_crank().unwrap();
+        let n = sys.n_coords();
+        let s0 = State::consistent(&sys, 0.0).unwrap();
+        for tb in [
+            ButcherTableau::rk4(),
+            ButcherTableau::rk38(),
+            ButcherTableau::dopri5(),
+            ButcherTableau::bogacki_shampine(),
+            ButcherTableau::midpoint(),
+        ] {
+            let mut rk = Index1Rk::new(&sys, tb.clone(), Index1Options::default()).unwrap();
+            let mut generic = ExplicitRk::new(tb.clone(), 2 * n).unwrap();
+            let mut acc = AccelerationSolver::new(&sys);
+            let (mut a, mut l) = (vec![0.0; n], vec![0.0; sys.n_constraints()]);
+            let mut s = s0.clone();
+            let mut y: Vec<f64> = s0.q.iter().chain(s0.v.iter()).copied().collect();
+            let mut t = s0.t;
+            for _ in 0..20 {
+                rk.step(&sys, &mut s, 1e-3).unwrap();
+                let mut f = |t: f64, y: &[f64], dy: &mut [f64]| {
+                    acc.solve(&sys, &y[..n], &y[n..], t, &mut a, &mut l)?;
+                    dy[..n].copy_from_slice(&y[n..]);
+                    dy[n..].copy_from_slice(&a);
+                    Ok(())
+                };
+                generic.step(&mut f, t, &mut y, 1e-3).unwrap();
+                t += 1e-3;
+                let mine: Vec<f64> = s.q.iter().chain(s.v.iter()).copied().collect();
+                assert_eq!(mine, y, "{}", tb.name);
+                if tb.b_hat.is_some() {
+                    assert_eq!(rk.rk.err, generic.err, "{}", tb.name);
+                }
+                assert_eq!(rk.last_acceleration().0, &a[..], "{}", tb.name);
+            }
+        }
+    }
 }

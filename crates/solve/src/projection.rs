@@ -4,10 +4,9 @@
 //! [`crate::SPARSE_THRESHOLD`] constraints.
 
 use crate::error::SolveError;
-use crate::linalg::{max_abs, DenseCholesky, FactorError};
+use crate::linalg::{max_abs, DenseSchur, FactorError};
 use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;
-use nalgebra::DMatrix;
 
 /// The position projection stops at `max(tol, PROJECTION_ROUNDOFF_FACTOR eps max(1, |q|_inf))`: the
 /// round-off floor of evaluating `Phi` at coordinates of size `|q|`.
@@ -32,12 +31,12 @@ impl Default for ProjectionSettings {
 }
 
 /// The factorisation of `S = Phi_q M^-1 Phi_q^T` a projection uses.
+// one per projector, built once: the dense arm stays unboxed (no indirection on small systems)
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 enum Kernel {
-    Dense {
-        jac: DMatrix<f64>,
-        chol: DenseCholesky,
-    },
+    /// `Phi_q` in element-local rows and the dense factorisation of `S`.
+    Dense(DenseSchur),
     Sparse(Box<ConstraintSchur>),
 }
 
@@ -73,14 +72,11 @@ impl Projector {
         settings: ProjectionSettings,
         linear: LinearSolver,
     ) -> Result<Self, SolveError> {
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let m = sys.n_constraints();
         let kernel = if linear.use_sparse(m) {
             Kernel::Sparse(Box::new(ConstraintSchur::new(sys)?))
         } else {
-            Kernel::Dense {
-                jac: DMatrix::zeros(m, n),
-                chol: DenseCholesky::new(m),
-            }
+            Kernel::Dense(DenseSchur::new(sys))
         };
         Ok(Projector {
             settings,
@@ -97,20 +93,9 @@ impl Projector {
     fn factor(&mut self, sys: &System, q: &[f64], t: f64) -> Result<(), SolveError> {
         let minv = sys.inv_mass_diag().as_slice();
         let res = match &mut self.kernel {
-            Kernel::Dense { jac, chol } => {
-                sys.phi_q(q, jac);
-                let (n, m) = (sys.n_coords(), sys.n_constraints());
-                let mut s = chol.matrix_mut();
-                for c in 0..m {
-                    for r in c..m {
-                        let mut acc = 0.0;
-                        for k in 0..n {
-                            acc += jac[(r, k)] * minv[k] * jac[(c, k)];
-                        }
-                        s[(r, c)] = acc;
-                    }
-                }
-                chol.factor_in_place()
+            Kernel::Dense(schur) => {
+                sys.phi_q_local(q, &mut schur.grads);
+                schur.factor(minv)
             }
             Kernel::Sparse(schur) => {
                 schur.update(sys, q);
@@ -133,16 +118,9 @@ impl Projector {
     fn correct(&mut self, sys: &System, x: &mut [f64]) {
         let minv = sys.inv_mass_diag().as_slice();
         match &mut self.kernel {
-            Kernel::Dense { jac, chol } => {
-                let (n, m) = (sys.n_coords(), sys.n_constraints());
-                chol.solve_in_place(&mut self.r);
-                for k in 0..n {
-                    let mut acc = 0.0;
-                    for r in 0..m {
-                        acc += jac[(r, k)] * self.r[r];
-                    }
-                    x[k] -= minv[k] * acc;
-                }
+            Kernel::Dense(schur) => {
+                schur.chol.solve_in_place(&mut self.r);
+                schur.sub_weighted_transpose(&self.r, x);
             }
             Kernel::Sparse(schur) => {
                 schur.solve_in_place(&mut self.r);

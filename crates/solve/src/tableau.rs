@@ -273,6 +273,11 @@ impl ExplicitRk {
         })
     }
 
+    /// The slope `k_i` of stage `i` of the last step.
+    pub(crate) fn slope(&self, i: usize) -> &[f64] {
+        &self.k[i]
+    }
+
     /// One step of size `h` from `(t, y)`; `y` is overwritten with `y(t + h)`. `f(t, y, dy)`
     /// writes the derivative and may fail. If the tableau has embedded weights, the error
     /// estimate goes to [`ExplicitRk::err`].

@@ -8,8 +8,10 @@ use faer::{MatMut, Par};
 
 pub use mbd_model::numeric::{max_abs, max_abs_diff};
 
+mod local;
 mod lu;
 
+pub(crate) use local::DenseSchur;
 pub use lu::{DenseLu, PIVOT_THRESHOLD, PIVOT_TOL};
 
 /// faer's scratch memory (wrapped for `Debug`).
@@ -79,8 +81,118 @@ pub const SMALL_CHOLESKY: usize = 16;
 /// per faer solve against about 1,000 for the loops).
 pub const SMALL_CHOLESKY_SOLVE: usize = 64;
 
+/// Up to this dimension [`DenseCholesky`] factors and solves with one kernel per dimension
+/// (loops of known length, which the compiler unrolls): at these sizes the loops of run-time
+/// length spent more on loop control than on arithmetic (callgrind, the manipulator's m = 4:
+/// about 650 instructions per factorisation and 430 per solve with run-time lengths).
+pub const FIXED_CHOLESKY: usize = 8;
+
+/// Calls `$f::<m>(args)` for `m = $m` up to [`FIXED_CHOLESKY`], else evaluates `$other`.
+macro_rules! by_dimension {
+    ($m:expr, $f:ident($($arg:expr),*), $other:expr) => {
+        match $m {
+            1 => $f::<1>($($arg),*),
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            5 => $f::<5>($($arg),*),
+            6 => $f::<6>($($arg),*),
+            7 => $f::<7>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            _ => $other,
+        }
+    };
+}
+
+/// `d > 0` and finite, in two floating-point comparisons (`d - d` is zero exactly for finite
+/// `d`), where `d.is_finite()` or `d < inf` compiled to an integer classification of the bits.
+#[inline(always)]
+#[allow(clippy::eq_op)]
+fn positive_finite(d: f64) -> bool {
+    d > 0.0 && d - d == 0.0
+}
+
+/// [`DenseCholesky::factor_in_place`] for a fixed dimension `M`: the same checks and
+/// operations in the same order as the run-time-length loops; returns the condition estimate.
+#[inline]
+fn factor_fixed<const M: usize>(
+    a: &mut [f64],
+    diag: &mut [f64],
+    inv: &mut [f64],
+) -> Result<f64, FactorError> {
+    let (a, diag, inv) = (&mut a[..M * M], &mut diag[..M], &mut inv[..M]);
+    for j in 0..M {
+        let d = a[j + j * M];
+        if !positive_finite(d) {
+            return Err(FactorError::NotPositiveDefinite(j));
+        }
+        diag[j] = d;
+    }
+    // (the indices are constants once unrolled: L is read from the lower triangle alone)
+    for j in 0..M {
+        let mut d = a[j + j * M];
+        for k in 0..j {
+            let l = a[j + k * M];
+            d -= l * l;
+        }
+        if !(d > 0.0) {
+            return Err(FactorError::NotPositiveDefinite(j));
+        }
+        let ljj = d.sqrt();
+        a[j + j * M] = ljj;
+        let ij = 1.0 / ljj;
+        inv[j] = ij;
+        for i in j + 1..M {
+            let mut y = a[i + j * M];
+            for k in 0..j {
+                y -= a[i + k * M] * a[j + k * M];
+            }
+            a[i + j * M] = y * ij;
+        }
+    }
+    let mut worst = 0.0f64;
+    for i in 0..M {
+        let l = a[i + i * M];
+        let ratio = diag[i] / (l * l);
+        if !(ratio * CHOLESKY_PIVOT_TOL <= 1.0) {
+            return Err(FactorError::NotPositiveDefinite(i));
+        }
+        worst = worst.max(ratio);
+    }
+    Ok(worst)
+}
+
+/// `b <- L^-1 b` for a fixed dimension `M`, by rows.
+#[inline]
+fn forward_fixed<const M: usize>(a: &[f64], inv: &[f64], b: &mut [f64]) {
+    let (a, inv, b) = (&a[..M * M], &inv[..M], &mut b[..M]);
+    for i in 0..M {
+        let mut x = b[i];
+        for k in 0..i {
+            x -= a[i + k * M] * b[k];
+        }
+        b[i] = x * inv[i];
+    }
+}
+
+/// `b <- L^-T b` for a fixed dimension `M` (column i of L below the diagonal is row i of L^T).
+#[inline]
+fn backward_fixed<const M: usize>(a: &[f64], inv: &[f64], b: &mut [f64]) {
+    let (a, inv, b) = (&a[..M * M], &inv[..M], &mut b[..M]);
+    for i in (0..M).rev() {
+        let mut acc = 0.0;
+        for k in i + 1..M {
+            acc += a[k + i * M] * b[k];
+        }
+        b[i] = (b[i] - acc) * inv[i];
+    }
+}
+
 /// Cholesky `L L^T` of a symmetric positive definite `m x m` matrix, reusing its storage.
-/// Only the lower triangle of the matrix is read.
+/// Only the lower triangle of the matrix is read (above [`FIXED_CHOLESKY`] and up to
+/// [`SMALL_CHOLESKY`] the factorisation also writes `L^T` into the upper triangle, for its
+/// triangular solves: fill the matrix again, after [`DenseCholesky::clear`] for
+/// [`DenseCholesky::add_rank_one`], before the next factorisation).
 #[derive(Debug)]
 pub struct DenseCholesky {
     m: usize,
@@ -160,6 +272,14 @@ impl DenseCholesky {
         }
     }
 
+    /// The column-major `m x m` storage of the matrix to be factored (the lower triangle is
+    /// read), for assembly in place.
+    #[inline]
+    pub(crate) fn values_mut(&mut self) -> &mut [f64] {
+        self.factored = false;
+        &mut self.a
+    }
+
     /// `A_rc += v` for `r >= c` (the lower triangle; entry by entry, e.g. summing a sparse
     /// product into it after [`DenseCholesky::clear`]).
     #[inline]
@@ -177,8 +297,25 @@ impl DenseCholesky {
         if m == 0 || !self.factored {
             return;
         }
-        // both factorisation paths leave L in the lower triangle of `a`; by columns (contiguous)
         let a = &self.a;
+        by_dimension!(m, forward_fixed(a, &self.inv, b), ());
+        if m <= FIXED_CHOLESKY {
+            return;
+        }
+        if m <= SMALL_CHOLESKY {
+            // by rows, from the copy of L's rows in the upper triangle (the small
+            // factorisation's): the same operations in the same order as by columns
+            for i in 0..m {
+                let row = &a[i * m..i * m + i];
+                let mut x = b[i];
+                for (&l, &y) in row.iter().zip(&b[..i]) {
+                    x -= l * y;
+                }
+                b[i] = x * self.inv[i];
+            }
+            return;
+        }
+        // both factorisation paths leave L in the lower triangle of `a`; by columns (contiguous)
         for k in 0..m {
             let col = &a[k * m..(k + 1) * m];
             let x = b[k] * self.inv[k];
@@ -212,33 +349,50 @@ impl DenseCholesky {
             return Ok(());
         }
         self.condition = f64::INFINITY;
-        for j in 0..m {
+        if m <= FIXED_CHOLESKY {
+            let (a, diag, inv) = (&mut self.a, &mut self.diag, &mut self.inv);
+            self.condition = by_dimension!(m, factor_fixed(a, diag, inv), unreachable!())?;
+            self.factored = true;
+            return Ok(());
+        }
+        for (j, dj) in self.diag.iter_mut().enumerate() {
             let d = self.a[j + j * m];
-            if !(d > 0.0 && d.is_finite()) {
+            if !positive_finite(d) {
                 return Err(FactorError::NotPositiveDefinite(j));
             }
-            self.diag[j] = d;
+            *dj = d;
         }
         if m <= SMALL_CHOLESKY {
-            let a = &mut self.a;
+            // The textbook dot-product form, `L_ij = (A_ij - sum_k<j L_ik L_jk) / L_jj`, with
+            // every row of L also kept in the (otherwise unused) upper triangle: row i of L
+            // before column j is then the contiguous `a[i m..i m + j]`, so each sum is a short
+            // scalar loop over two contiguous slices.
+            let a = &mut self.a[..m * m];
             for j in 0..m {
-                let mut d = a[j + j * m];
-                for k in 0..j {
-                    let l = a[j + k * m];
+                let (_, from_j) = a.split_at_mut(j * m);
+                let (colj, after) = from_j.split_at_mut(m);
+                // row j of L (columns k < j), then A_jj and the column below it
+                let (lj, low) = colj.split_at_mut(j);
+                let mut d = low[0];
+                for &l in lj.iter() {
                     d -= l * l;
                 }
                 if !(d > 0.0) {
                     return Err(FactorError::NotPositiveDefinite(j));
                 }
                 let ljj = d.sqrt();
-                a[j + j * m] = ljj;
+                low[0] = ljj;
                 let inv = 1.0 / ljj;
-                for i in j + 1..m {
-                    let mut x = a[i + j * m];
-                    for k in 0..j {
-                        x -= a[i + k * m] * a[j + k * m];
+                for (r, x) in low[1..].iter_mut().enumerate() {
+                    // row i = j + 1 + r: its L_ik, k < j, at the top of column i
+                    let coli = &mut after[r * m..r * m + j + 1];
+                    let mut y = *x;
+                    for (&lik, &ljk) in coli.iter().zip(lj.iter()) {
+                        y -= lik * ljk;
                     }
-                    a[i + j * m] = x * inv;
+                    let lij = y * inv;
+                    *x = lij;
+                    coli[j] = lij;
                 }
             }
         } else {
@@ -277,18 +431,23 @@ impl DenseCholesky {
         if m == 0 || !self.factored {
             return;
         }
+        if m <= FIXED_CHOLESKY {
+            let (a, inv) = (&self.a, &self.inv);
+            by_dimension!(m, forward_fixed(a, inv, b), ());
+            by_dimension!(m, backward_fixed(a, inv, b), ());
+            return;
+        }
         if m <= SMALL_CHOLESKY_SOLVE {
             // L y = b, then L^T x = y (row i of L^T is column i of L: contiguous)
             self.forward_in_place(b);
             let a = &self.a;
             for i in (0..m).rev() {
-                let col = &a[i * m..(i + 1) * m];
-                let acc: f64 = col[i + 1..]
-                    .iter()
-                    .zip(&b[i + 1..m])
-                    .map(|(l, x)| l * x)
-                    .sum();
-                b[i] = (b[i] - acc) * self.inv[i];
+                let (head, tail) = b.split_at_mut(i + 1);
+                let mut acc = 0.0;
+                for (&l, &x) in a[i * m + i + 1..(i + 1) * m].iter().zip(tail.iter()) {
+                    acc += l * x;
+                }
+                head[i] = (head[i] - acc) * self.inv[i];
             }
             return;
         }
@@ -369,7 +528,12 @@ mod tests {
     #[test]
     fn small_and_blocked_cholesky_agree() {
         for m in [
-            3usize,
+            1usize,
+            2,
+            3,
+            4,
+            FIXED_CHOLESKY,
+            FIXED_CHOLESKY + 1,
             SMALL_CHOLESKY,
             SMALL_CHOLESKY + 5,
             SMALL_CHOLESKY_SOLVE,
@@ -432,6 +596,75 @@ mod tests {
                 for r in cidx..m {
                     assert_eq!(d.a[r + cidx * m], s[r + cidx * m]);
                 }
+            }
+        }
+    }
+
+    /// The fixed-dimension kernels and the run-time-length small path are the textbook
+    /// dot-product Cholesky and triangular solves, operation for operation (bit for bit).
+    #[test]
+    fn small_kernels_are_the_textbook_factorisation_bit_for_bit() {
+        for m in 1..=SMALL_CHOLESKY {
+            // a well-conditioned SPD matrix with distinct entries
+            let s: Vec<f64> = (0..m * m)
+                .map(|k| {
+                    let (i, j) = (k % m, k / m);
+                    let x = 0.3 * ((i * 7 + j * 7 + i * j) as f64 * 0.61).sin();
+                    if i == j {
+                        2.0 + m as f64 * 0.5 + x
+                    } else {
+                        x
+                    }
+                })
+                .collect();
+            // textbook L (lower, column-major) and 1 / L_jj
+            let mut l = vec![0.0; m * m];
+            for j in 0..m {
+                let mut d = s[j + j * m];
+                for k in 0..j {
+                    d -= l[j + k * m] * l[j + k * m];
+                }
+                l[j + j * m] = d.sqrt();
+                let inv = 1.0 / l[j + j * m];
+                for i in j + 1..m {
+                    let mut y = s[i + j * m];
+                    for k in 0..j {
+                        y -= l[i + k * m] * l[j + k * m];
+                    }
+                    l[i + j * m] = y * inv;
+                }
+            }
+            let mut c = DenseCholesky::new(m);
+            c.values_mut().copy_from_slice(&s);
+            c.factor_in_place().unwrap();
+            for j in 0..m {
+                for i in j..m {
+                    assert_eq!(c.a[i + j * m].to_bits(), l[i + j * m].to_bits(), "m = {m}");
+                }
+            }
+            let b: Vec<f64> = (0..m).map(|i| (i as f64 * 0.37 + 0.1).cos()).collect();
+            let mut y = b.clone();
+            for i in 0..m {
+                for k in 0..i {
+                    y[i] -= l[i + k * m] * y[k];
+                }
+                y[i] *= 1.0 / l[i + i * m];
+            }
+            let mut fwd = b.clone();
+            c.forward_in_place(&mut fwd);
+            let mut x = y.clone();
+            for i in (0..m).rev() {
+                let mut acc = 0.0;
+                for k in i + 1..m {
+                    acc += l[k + i * m] * x[k];
+                }
+                x[i] = (x[i] - acc) * (1.0 / l[i + i * m]);
+            }
+            let mut sol = b.clone();
+            c.solve_in_place(&mut sol);
+            for i in 0..m {
+                assert_eq!(fwd[i].to_bits(), y[i].to_bits(), "forward, m = {m}");
+                assert_eq!(sol[i].to_bits(), x[i].to_bits(), "solve, m = {m}");
             }
         }
     }

@@ -9,7 +9,7 @@
 use super::schur::ConstraintSchur;
 use crate::error::SolveError;
 use crate::linalg::FactorError;
-use mbd_model::System;
+use mbd_model::{BodyAngles, System};
 
 /// Sparse index-1 solver (see the module documentation).
 #[derive(Debug)]
@@ -22,6 +22,8 @@ pub struct SparseAccelerationSolver {
     /// Applied forces `Q` at the last solve.
     pub forces: Vec<f64>,
     w: Vec<f64>,
+    /// The bodies' `sin`/`cos` at the last `q` (one evaluation per body and solve).
+    angles: BodyAngles,
 }
 
 impl SparseAccelerationSolver {
@@ -35,6 +37,7 @@ impl SparseAccelerationSolver {
             gamma: vec![0.0; m],
             forces: vec![0.0; n],
             w: vec![0.0; n],
+            angles: BodyAngles::new(sys, sys.initial_guess().0.as_slice()),
         })
     }
 
@@ -81,7 +84,15 @@ impl SparseAccelerationSolver {
     /// [`SparseAccelerationSolver::finish`].
     pub fn prepare(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) {
         sys.forces_into(q, v, t, &mut self.forces);
-        sys.phi_q_local_gamma(q, v, t, self.schur.grads_mut(), &mut self.gamma);
+        self.angles.update(sys, q);
+        sys.phi_q_local_gamma_at(
+            q,
+            &self.angles,
+            v,
+            t,
+            self.schur.grads_mut(),
+            &mut self.gamma,
+        );
     }
 
     /// Completes the solve from `Phi_q`, `gamma` and `forces` already set.

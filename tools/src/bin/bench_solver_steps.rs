@@ -1,0 +1,73 @@
+//! Runs N steps of one solver on a model (for callgrind: the difference of two runs with N and
+//! 2N steps is the cost of N steps without the set-up), and prints the time per step.
+//!
+//! `cargo run --release -p mbd-tools --bin bench_solver_steps -- SOLVER [N] [MODEL]` with SOLVER
+//! one of `rk4` (plain RK4), `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1
+//! DOPRI5, fixed steps), `fadae` (firefly-Gauss, default options), and MODEL one of
+//! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
+//! links the index-1 solve takes the sparse path).
+use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
+use mbd::model::models;
+use mbd::rk4::{Rk4, Rk4Options};
+use mbd::solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, State};
+use mbd::symplectic::{Galerkin, SymplecticOptions};
+use mbd::tangent::TangentRk;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let solver = args.next().unwrap_or_else(|| "rk4".into());
+    let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(100_000);
+    let model = args.next().unwrap_or_else(|| "manipulator".into());
+    let sys = match model.as_str() {
+        "manipulator" => models::manipulator()?,
+        "slider_crank" => models::slider_crank()?,
+        "four_bar" => models::four_bar()?,
+        other => match other.strip_prefix("chain").and_then(|k| k.parse().ok()) {
+            Some(k) => models::n_link_chain(k)?,
+            None => return Err(format!("unknown model '{other}'").into()),
+        },
+    };
+    let s0 = State::consistent(&sys, 0.0)?;
+    let (mut integ, h): (Box<dyn Integrator>, f64) = match solver.as_str() {
+        "rk4" => (Box::new(Rk4::new(&sys, Rk4Options::plain())?), 1e-3),
+        "tangent-rk4" => (Box::new(TangentRk::rk4(&sys)?), 1e-3),
+        "symplectic2" => (
+            Box::new(Galerkin::new(&sys, SymplecticOptions::new(2))?),
+            1e-2,
+        ),
+        "dopri5" => (
+            Box::new(Index1Rk::new(
+                &sys,
+                ButcherTableau::dopri5(),
+                Index1Options::default(),
+            )?),
+            1e-3,
+        ),
+        "fadae" => (
+            Box::new(FireflyGauss::new(&sys, FaDaeOptions::default())?),
+            1e-3,
+        ),
+        other => {
+            return Err(format!(
+                "unknown solver '{other}': rk4, tangent-rk4, symplectic2, dopri5, fadae"
+            )
+            .into())
+        }
+    };
+    let mut s = s0.clone();
+    let t = std::time::Instant::now();
+    for _ in 0..n {
+        // restart every 10 s of model time so that long runs stay in the same regime
+        if s.t > 10.0 {
+            s = s0.clone();
+        }
+        integ.step(&sys, &mut s, h)?;
+    }
+    let dt = t.elapsed().as_secs_f64();
+    println!(
+        "{solver} on {model}: {n} steps, {:.1} ns/step (q0 = {:.6})",
+        dt / n as f64 * 1e9,
+        s.q[0]
+    );
+    Ok(())
+}
