@@ -79,6 +79,8 @@ impl State {
     }
 
     /// Whether every entry is finite.
+    // `x - x` on purpose: 0 for finite x, NaN otherwise
+    #[allow(clippy::eq_op)]
     pub fn is_finite(&self) -> bool {
         // x - x is 0 for finite x and NaN for an infinity or NaN, so the sum is 0 exactly when
         // every entry is finite: one branch-free pass instead of a test per entry
