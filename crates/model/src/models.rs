@@ -76,6 +76,39 @@ pub fn pendulum(m: f64, l: f64, angle0: f64, g: f64) -> Result<System, ModelErro
     })
 }
 
+/// A uniform rod (1 kg, 1 m, g = 9.81) pinned at one end to the origin, released at rest 45
+/// degrees from the downward vertical, with a spring (30 N/m, rest length 0.5 m, no damping)
+/// from its tip to the ground point `(0.6, -1.6)`: a conservative model with a constraint and a
+/// non-linear potential (`Hess V != 0`, which gravity alone does not give).
+pub fn rod_with_spring() -> Result<System, ModelError> {
+    let th = std::f64::consts::FRAC_PI_4;
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, -9.81]);
+    let rod = b.add_body(Body::new("rod").rod(1.0, 1.0).position(
+        0.5 * th.sin(),
+        -0.5 * th.cos(),
+        th - FRAC_PI_2,
+    ));
+    b.add_joint(Joint::revolute(
+        "pin",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        rod,
+        [-0.5, 0.0],
+    ));
+    b.add_force(crate::force::Force::spring_damper(
+        "spring",
+        rod,
+        [0.5, 0.0],
+        BodyRef::Ground,
+        [0.6, -1.6],
+        30.0,
+        0.0,
+        0.5,
+    ));
+    b.build()
+}
+
 /// An elastic pendulum without constraints: one uniform rod (1 kg, 1 m, g = 9.81) hanging from
 /// the ground origin by a spring (50 N/m, rest length 1 m, no damping) attached at its end, at
 /// rest at `(0.9, -1.0)` with angle `-0.8` rad. A conservative model with `m = 0`.

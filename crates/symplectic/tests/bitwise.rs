@@ -4,49 +4,18 @@
 //! before the preadjustment was restructured into terms. A refactoring of the preadjustment
 //! must leave these unchanged; a deliberate change of the numerics must capture them again
 //! (`cargo test -p mbd-symplectic --test bitwise -- --ignored --nocapture` prints the table).
-use mbd_model::{models, Body, BodyRef, Force, Joint, System, SystemBuilder};
+use mbd_model::{models, System};
 use mbd_solve::{Integrator, State};
 use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
 
 const STEPS: usize = 100;
 const H: f64 = 0.01;
 
-/// A uniform rod pinned at the origin with a spring from its tip to a ground point: a
-/// non-linear potential with constraints (the terms with `Hess V` and `D^k V`).
-fn rod_with_spring() -> System {
-    let th = std::f64::consts::FRAC_PI_4;
-    let mut b = SystemBuilder::new();
-    b.set_gravity([0.0, -9.81]);
-    let rod = b.add_body(Body::new("rod").rod(1.0, 1.0).position(
-        0.5 * th.sin(),
-        -0.5 * th.cos(),
-        th - std::f64::consts::FRAC_PI_2,
-    ));
-    b.add_joint(Joint::revolute(
-        "pin",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        rod,
-        [-0.5, 0.0],
-    ));
-    b.add_force(Force::spring_damper(
-        "spring",
-        rod,
-        [0.5, 0.0],
-        BodyRef::Ground,
-        [0.6, -1.6],
-        30.0,
-        0.0,
-        0.5,
-    ));
-    b.build().unwrap()
-}
-
 fn model(name: &str) -> System {
     match name {
         "pendulum" => models::paper_a_double_pendulum().unwrap(),
         "chain30" => models::n_link_chain(30).unwrap(),
-        "rod_spring" => rod_with_spring(),
+        "rod_spring" => models::rod_with_spring().unwrap(),
         "elastic" => models::elastic_pendulum().unwrap(),
         other => panic!("unknown model {other}"),
     }

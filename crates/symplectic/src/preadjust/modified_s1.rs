@@ -399,37 +399,9 @@ pub(crate) mod modlag_tests {
         Ok(e)
     }
 
-    /// A uniform rod (1 kg, 1 m) pinned at one end to the origin, released 45 degrees from the
-    /// downward vertical, with a spring (30 N/m, rest length 0.5 m) from its tip to the ground
-    /// point (0.6, -1.6): a non-linear potential, so `Hess V != 0` (gravity alone has none).
+    /// The rod with a spring of the models (`Hess V != 0`).
     pub(crate) fn rod_with_spring() -> System {
-        use mbd_model::{Body, BodyRef, Force, Joint, SystemBuilder};
-        let th = std::f64::consts::FRAC_PI_4;
-        let mut b = SystemBuilder::new();
-        b.set_gravity([0.0, -9.81]);
-        let rod = b.add_body(Body::new("rod").rod(1.0, 1.0).position(
-            0.5 * th.sin(),
-            -0.5 * th.cos(),
-            th - std::f64::consts::FRAC_PI_2,
-        ));
-        b.add_joint(Joint::revolute(
-            "pin",
-            BodyRef::Ground,
-            [0.0, 0.0],
-            rod,
-            [-0.5, 0.0],
-        ));
-        b.add_force(Force::spring_damper(
-            "spring",
-            rod,
-            [0.5, 0.0],
-            BodyRef::Ground,
-            [0.6, -1.6],
-            30.0,
-            0.0,
-            0.5,
-        ));
-        b.build().unwrap()
+        mbd_model::models::rod_with_spring().unwrap()
     }
 
     /// The analytic gradients of the modified-Lagrangian term against central differences of
