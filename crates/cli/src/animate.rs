@@ -12,7 +12,7 @@
 use crate::args::AnimateArgs;
 use crate::error::CliError;
 use crate::table::Table;
-use mbd_model::{BodyRef, ForceKind, JointKind, System};
+use mbd_model::{BodyRef, System};
 use serde::Serialize;
 
 /// Width of the drawing in SVG units (pixels at 100 % zoom).
@@ -83,26 +83,8 @@ fn joint_geom(sys: &System) -> Vec<JointGeom> {
     sys.joints()
         .iter()
         .map(|j| {
-            let (a, pa, b, pb, axis) = match &j.kind {
-                JointKind::Revolute { a, pa, b, pb }
-                | JointKind::Weld { a, pa, b, pb, .. }
-                | JointKind::Distance { a, pa, b, pb, .. } => {
-                    (index(*a), Some(*pa), index(*b), Some(*pb), None)
-                }
-                JointKind::Prismatic {
-                    a, pa, b, pb, axis, ..
-                } => {
-                    let n = axis[0].hypot(axis[1]);
-                    let axis = (n > 0.0).then(|| [axis[0] / n, axis[1] / n]);
-                    (index(*a), Some(*pa), index(*b), Some(*pb), axis)
-                }
-                JointKind::Absolute { body, point, .. } => {
-                    (index(*body), Some(*point), -1, None, None)
-                }
-                JointKind::AngleDriver { a, b, .. } => (index(*a), None, index(*b), None, None),
-                // a joint kind this page does not know how to draw: listed, not drawn
-                _ => (-1, None, -1, None, None),
-            };
+            let sk = j.sketch();
+            let (a, pa, b, pb, axis) = (index(sk.a), sk.point_a, index(sk.b), sk.point_b, sk.axis);
             JointGeom {
                 name: j.name.clone(),
                 kind: j.kind_name(),
@@ -119,15 +101,15 @@ fn joint_geom(sys: &System) -> Vec<JointGeom> {
 fn spring_geom(sys: &System) -> Vec<SpringGeom> {
     sys.forces()
         .iter()
-        .filter_map(|f| match &f.kind {
-            ForceKind::SpringDamper { a, pa, b, pb, .. } => Some(SpringGeom {
+        .filter_map(|f| {
+            let sk = f.sketch()?;
+            Some(SpringGeom {
                 name: f.name.clone(),
-                a: index(*a),
-                pa: *pa,
-                b: index(*b),
-                pb: *pb,
-            }),
-            _ => None,
+                a: index(sk.a),
+                pa: sk.point_a?,
+                b: index(sk.b),
+                pb: sk.point_b?,
+            })
         })
         .collect()
 }

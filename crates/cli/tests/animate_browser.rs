@@ -181,7 +181,9 @@ fn page_draws_the_trajectory_at_the_requested_time() {
         }
         // joints: where the model's attachment point on the second body is
         for j in sys.joints() {
-            let mbd_model::JointKind::Revolute { a, pa, b, pb } = &j.kind else {
+            let mbd_model::JointKind::Revolute(mbd_model::joints::Revolute { a, pa, b, pb }) =
+                &j.kind
+            else {
                 continue;
             };
             let w = match (b.index(), a.index()) {

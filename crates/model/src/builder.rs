@@ -1,9 +1,11 @@
 //! The builder of a [`System`] and the validation that turns bodies, joints and forces into one.
 
 use crate::body::{Body, BodyHandle, BodyRef};
+use crate::check::{self, invalid};
+use crate::element::norm;
 use crate::error::ModelError;
-use crate::force::{Force, ForceKind};
-use crate::joint::{Coordinate, Joint, JointKind};
+use crate::forces::Force;
+use crate::joints::{Coordinate, Joint};
 use crate::system::*;
 use nalgebra::DVector;
 
@@ -176,49 +178,22 @@ impl SystemBuilder {
         let nominal = self.nominal_length();
         for j in &mut self.joints {
             let element = format!("joint '{}'", j.name);
-            match &mut j.kind {
-                JointKind::Revolute { a, pa, b, pb } | JointKind::Distance { a, pa, b, pb, .. } => {
-                    local(&element, "point_a", *a, pa)?;
-                    local(&element, "point_b", *b, pb)?;
-                }
-                JointKind::Prismatic { a, pa, b, pb, .. } => {
-                    no_rotation(&element, "prismatic joint", &[*a, *b])?;
-                    local(&element, "point_a", *a, pa)?;
-                    local(&element, "point_b", *b, pb)?;
-                }
-                JointKind::Weld { a, pa, b, pb, .. } => {
-                    no_rotation(&element, "weld joint", &[*a, *b])?;
-                    local(&element, "point_a", *a, pa)?;
-                    local(&element, "point_b", *b, pb)?;
-                }
-                JointKind::Absolute {
-                    body,
-                    point,
-                    coordinate,
-                    ..
-                } => {
-                    if *coordinate == Coordinate::Angle {
-                        no_rotation(&element, "absolute angle joint", &[*body])?;
-                    }
-                    local(&element, "point", *body, point)?;
-                }
-                JointKind::AngleDriver { a, b, .. } => {
-                    no_rotation(&element, "angle driver", &[*a, *b])?;
-                }
+            if let Some(kind) = j.rotation_use() {
+                let (a, b) = j.bodies();
+                no_rotation(&element, kind, &[a, b])?;
+            }
+            for anchor in j.anchors().into_iter().flatten() {
+                local(&element, anchor.field, anchor.body, anchor.point)?;
             }
         }
         for f in &mut self.forces {
             let element = format!("force '{}'", f.name);
-            match &mut f.kind {
-                ForceKind::SpringDamper { a, pa, b, pb, .. } => {
-                    local(&element, "point_a", *a, pa)?;
-                    local(&element, "point_b", *b, pb)?;
-                }
-                ForceKind::RotarySpringDamper { a, b, .. } => {
-                    no_rotation(&element, "rotary spring-damper", &[*a, *b])?;
-                }
-                ForceKind::Force { body, point, .. } => local(&element, "point", *body, point)?,
-                ForceKind::Torque { body, .. } => no_rotation(&element, "torque", &[*body])?,
+            if let Some(kind) = f.rotation_use() {
+                let (a, b) = f.bodies();
+                no_rotation(&element, kind, &[a, b])?;
+            }
+            for anchor in f.anchors().into_iter().flatten() {
+                local(&element, anchor.field, anchor.body, anchor.point)?;
             }
         }
         for (i, f) in frames.iter().enumerate() {
@@ -241,96 +216,22 @@ impl SystemBuilder {
     /// length, spring rest length or attachment-point distance from a frame origin, 1 m if
     /// none. So a point mass neither changes [`System::length_scale`] nor trips the
     /// inertia-scale check.
-    fn nominal_length(&self) -> f64 {
+    fn nominal_length(&mut self) -> f64 {
         let mut l = 0.0f64;
-        let n = |p: &[f64; 2]| p[0].hypot(p[1]);
-        for j in &self.joints {
-            match &j.kind {
-                JointKind::Distance { pa, pb, length, .. } => {
-                    l = l.max(*length).max(n(pa)).max(n(pb))
-                }
-                JointKind::Revolute { pa, pb, .. }
-                | JointKind::Prismatic { pa, pb, .. }
-                | JointKind::Weld { pa, pb, .. } => l = l.max(n(pa)).max(n(pb)),
-                JointKind::Absolute { point, .. } => l = l.max(n(point)),
-                JointKind::AngleDriver { .. } => {}
+        for j in &mut self.joints {
+            l = l.max(j.length().unwrap_or(0.0));
+            for anchor in j.anchors().into_iter().flatten() {
+                l = l.max(norm(*anchor.point));
             }
         }
         for f in &self.forces {
-            if let ForceKind::SpringDamper { rest_length, .. } = &f.kind {
-                l = l.max(*rest_length);
-            }
+            l = l.max(f.length().unwrap_or(0.0));
         }
         if l.is_finite() && l > 0.0 {
             l
         } else {
             1.0
         }
-    }
-}
-
-fn invalid(element: String, message: String) -> ModelError {
-    ModelError::InvalidElement { element, message }
-}
-
-fn check_finite(element: &str, parameter: &'static str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(ModelError::InvalidParameter {
-            element: element.to_string(),
-            parameter,
-            value,
-            reason: "must be finite",
-        })
-    }
-}
-
-fn check_positive(element: &str, parameter: &'static str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(ModelError::InvalidParameter {
-            element: element.to_string(),
-            parameter,
-            value,
-            reason: "must be positive and finite",
-        })
-    }
-}
-
-fn check_nonneg(element: &str, parameter: &'static str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(ModelError::InvalidParameter {
-            element: element.to_string(),
-            parameter,
-            value,
-            reason: "must be non-negative and finite",
-        })
-    }
-}
-
-fn check_point(element: &str, parameter: &'static str, p: [f64; 2]) -> Result<(), ModelError> {
-    check_finite(element, parameter, p[0])?;
-    check_finite(element, parameter, p[1])
-}
-
-fn check_timefn(
-    element: &str,
-    parameter: &'static str,
-    f: &crate::TimeFunction,
-) -> Result<(), ModelError> {
-    if f.is_finite() {
-        Ok(())
-    } else {
-        Err(ModelError::InvalidParameter {
-            element: element.to_string(),
-            parameter,
-            value: f64::NAN,
-            reason: "time function coefficients must be finite",
-        })
     }
 }
 
@@ -347,8 +248,8 @@ impl System {
         if bodies.is_empty() {
             return Err(ModelError::Empty);
         }
-        check_finite("gravity", "gravity", gravity[0])?;
-        check_finite("gravity", "gravity", gravity[1])?;
+        check::finite("gravity", "gravity", gravity[0])?;
+        check::finite("gravity", "gravity", gravity[1])?;
         let mut names = std::collections::HashSet::new();
         for body in &bodies {
             if body.name.eq_ignore_ascii_case("ground") {
@@ -363,13 +264,13 @@ impl System {
                     name: body.name.clone(),
                 });
             }
-            check_positive(&body.name, "mass", body.mass)?;
-            check_positive(&body.name, "inertia", body.inertia)?;
+            check::positive(&body.name, "mass", body.mass)?;
+            check::positive(&body.name, "inertia", body.inertia)?;
             for &p in &body.position {
-                check_finite(&body.name, "position", p)?;
+                check::finite(&body.name, "position", p)?;
             }
             for &v in &body.velocity {
-                check_finite(&body.name, "velocity", v)?;
+                check::finite(&body.name, "velocity", v)?;
             }
         }
         let nb = bodies.len();
@@ -399,50 +300,14 @@ impl System {
             let (ra, rb) = j.bodies();
             let a = resolve(&j.name, ra)?;
             let bb = resolve(&j.name, rb)?;
-            let single = matches!(j.kind, JointKind::Absolute { .. });
+            let single = j.is_single_body();
             if a == bb && !(single && a.is_some()) {
                 return Err(ModelError::SameBody {
                     joint: j.name.clone(),
                     body: body_name(a),
                 });
             }
-            let name = j.name.clone();
-            match &mut j.kind {
-                JointKind::Revolute { pa, pb, .. } => {
-                    check_point(&name, "point_a", *pa)?;
-                    check_point(&name, "point_b", *pb)?;
-                }
-                JointKind::Weld { pa, pb, angle, .. } => {
-                    check_point(&name, "point_a", *pa)?;
-                    check_point(&name, "point_b", *pb)?;
-                    check_finite(&name, "angle", *angle)?;
-                }
-                JointKind::Prismatic {
-                    pa,
-                    pb,
-                    axis,
-                    angle,
-                    ..
-                } => {
-                    check_point(&name, "point_a", *pa)?;
-                    check_point(&name, "point_b", *pb)?;
-                    check_point(&name, "axis", *axis)?;
-                    check_finite(&name, "angle", *angle)?;
-                    let len = (axis[0] * axis[0] + axis[1] * axis[1]).sqrt();
-                    check_positive(&name, "axis length", len)?;
-                    *axis = [axis[0] / len, axis[1] / len];
-                }
-                JointKind::Distance { pa, pb, length, .. } => {
-                    check_point(&name, "point_a", *pa)?;
-                    check_point(&name, "point_b", *pb)?;
-                    check_positive(&name, "length", *length)?;
-                }
-                JointKind::Absolute { point, value, .. } => {
-                    check_point(&name, "point", *point)?;
-                    check_finite(&name, "value", *value)?;
-                }
-                JointKind::AngleDriver { f, .. } => check_timefn(&name, "f", f)?,
-            }
+            j.validate()?;
             joint_attach.push(Attach { a, b: bb });
         }
 
@@ -458,7 +323,7 @@ impl System {
             let (ra, rb) = f.bodies();
             let a = resolve(&f.name, ra)?;
             let bb = resolve(&f.name, rb)?;
-            let single = matches!(f.kind, ForceKind::Force { .. } | ForceKind::Torque { .. });
+            let single = f.is_single_body();
             if single && a.is_none() {
                 return Err(ModelError::SameBody {
                     joint: f.name.clone(),
@@ -471,38 +336,7 @@ impl System {
                     body: body_name(a),
                 });
             }
-            match &f.kind {
-                ForceKind::SpringDamper {
-                    pa,
-                    pb,
-                    stiffness,
-                    damping,
-                    rest_length,
-                    ..
-                } => {
-                    check_point(&f.name, "point_a", *pa)?;
-                    check_point(&f.name, "point_b", *pb)?;
-                    check_nonneg(&f.name, "stiffness", *stiffness)?;
-                    check_nonneg(&f.name, "damping", *damping)?;
-                    check_nonneg(&f.name, "rest_length", *rest_length)?;
-                }
-                ForceKind::RotarySpringDamper {
-                    stiffness,
-                    damping,
-                    rest_angle,
-                    ..
-                } => {
-                    check_nonneg(&f.name, "stiffness", *stiffness)?;
-                    check_nonneg(&f.name, "damping", *damping)?;
-                    check_finite(&f.name, "rest_angle", *rest_angle)?;
-                }
-                ForceKind::Force { point, fx, fy, .. } => {
-                    check_point(&f.name, "point", *point)?;
-                    check_timefn(&f.name, "fx", fx)?;
-                    check_timefn(&f.name, "fy", fy)?;
-                }
-                ForceKind::Torque { torque, .. } => check_timefn(&f.name, "torque", torque)?,
-            }
+            f.validate()?;
             force_attach.push(Attach { a, b: bb });
         }
 

@@ -4,7 +4,7 @@
 use crate::cache::AngleCache;
 use crate::hessian_pair::ElementHessian;
 use crate::jet::{point, sub2, Dual, Frame, Scalar, NV};
-use crate::joint::JointKind;
+use crate::joints::{JointKind, Revolute};
 use crate::rows::SinCos;
 use crate::system::*;
 use nalgebra::DMatrix;
@@ -19,7 +19,7 @@ impl System {
             let qa = sc.frame(at.a, var);
             let qb = sc.frame(at.b, var);
             let o = self.row_offset[ji];
-            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+            if let JointKind::Revolute(Revolute { pa, pb, .. }) = &j.kind {
                 // the generic evaluation's operations, no time part
                 let d = sub2(point(&qa, *pa), point(&qb, *pb));
                 let p = &mut out[o..o + 2];
@@ -177,7 +177,7 @@ impl System {
             let at = self.joint_attach[ji];
             let (fa, fb) = (sc.frame(at.a, var), sc.frame(at.b, var));
             let o = self.row_offset[ji];
-            if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+            if let JointKind::Revolute(Revolute { pa, pb, .. }) = &j.kind {
                 // the generic evaluation's operations, no time part
                 let d = sub2(point(&fa, *pa), point(&fb, *pb));
                 let p = &mut out[o..o + 2];
@@ -205,7 +205,7 @@ impl System {
     ) {
         let j = &self.joints[ji];
         let o = self.row_offset[ji];
-        if let JointKind::Revolute { pa, pb, .. } = &j.kind {
+        if let JointKind::Revolute(Revolute { pa, pb, .. }) = &j.kind {
             // the generic evaluation's operations, no time part
             let d = sub2(point(fa, *pa), point(fb, *pb));
             let (p, pd) = (&mut phi[o..o + 2], &mut phi_dot[o..o + 2]);

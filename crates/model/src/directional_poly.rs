@@ -6,7 +6,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
-use crate::joint::RevoluteSide;
+use crate::joints::RevoluteSide;
 use crate::system::{Attach, System};
 
 /// The workspace of the [`PolyJet`] passes of one basis: the frames of an element's bodies,
@@ -349,7 +349,7 @@ impl System {
 mod tests {
     use super::*;
     use crate::fixtures::{derivative_test_systems, generic_point, TwoDirections};
-    use crate::joint::JointKind;
+    use crate::joints::JointKind;
 
     /// The closed-form revolute rows equal the generic evaluation's (to rounding), on systems
     /// with revolute joints between bodies and to ground.
@@ -362,7 +362,7 @@ mod tests {
             revolute += sys
                 .joints
                 .iter()
-                .filter(|j| matches!(j.kind, JointKind::Revolute { .. }))
+                .filter(|j| matches!(j.kind, JointKind::Revolute(_)))
                 .count();
             let (n, m) = (sys.n_coords(), sys.n_constraints());
             let (q, v) = generic_point(n);

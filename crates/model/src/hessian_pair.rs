@@ -4,7 +4,7 @@
 //! `B = p Hess V + w . Hess Phi`), at the cost of one assembly instead of three passes.
 
 use crate::jet::{HessJet, Scalar, NV};
-use crate::joint::RevoluteSide;
+use crate::joints::RevoluteSide;
 use crate::rows::SinCos;
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;

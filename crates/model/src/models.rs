@@ -7,7 +7,7 @@
 use crate::body::{Body, BodyRef};
 use crate::builder::SystemBuilder;
 use crate::error::ModelError;
-use crate::joint::Joint;
+use crate::joints::Joint;
 use crate::system::System;
 use crate::timefn::TimeFunction;
 use std::f64::consts::FRAC_PI_2;
@@ -96,7 +96,7 @@ pub fn rod_with_spring() -> Result<System, ModelError> {
         rod,
         [-0.5, 0.0],
     ));
-    b.add_force(crate::force::Force::spring_damper(
+    b.add_force(crate::forces::Force::spring_damper(
         "spring",
         rod,
         [0.5, 0.0],
@@ -116,7 +116,7 @@ pub fn elastic_pendulum() -> Result<System, ModelError> {
     let mut b = SystemBuilder::new();
     b.set_gravity([0.0, -9.81]);
     let r = b.add_body(Body::new("rod").rod(1.0, 1.0).position(0.9, -1.0, -0.8));
-    b.add_force(crate::force::Force::spring_damper(
+    b.add_force(crate::forces::Force::spring_damper(
         "spring",
         BodyRef::Ground,
         [0.0, 0.0],

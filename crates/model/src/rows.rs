@@ -12,7 +12,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{DirJet, Frame, Scalar, TanJet, NV};
-use crate::joint::{JointKind, RevoluteSide};
+use crate::joints::{JointKind, Prismatic, RevoluteSide};
 use crate::system::System;
 
 /// Up to this many bodies a pass without a [`BodyAngles`] table keeps every body's `sin`/`cos`
@@ -146,7 +146,7 @@ impl System {
                 visit(ji, o + 1, &g[1], gamma[1]);
                 continue;
             }
-            if let JointKind::Prismatic { pa, pb, axis, .. } = &j.kind {
+            if let JointKind::Prismatic(Prismatic { pa, pb, axis, .. }) = &j.kind {
                 // n . d with the normal n = R_a (-axis_y, axis_x) and d = P_b - P_a; the
                 // relative angle theta_b - theta_a
                 let u = [-axis[1], axis[0]];

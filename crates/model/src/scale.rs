@@ -1,8 +1,8 @@
 //! Scales of a mechanism: its characteristic length, the natural unit of each constraint
 //! equation, and the build-time check that no body's inertia is negligible against its mass.
 
+use crate::element::norm;
 use crate::error::ModelError;
-use crate::joint::JointKind;
 use crate::system::System;
 
 /// `m r^2 / J` above which a body's rotational inertia counts as negligible (see
@@ -11,27 +11,16 @@ use crate::system::System;
 /// most four significant digits, and near `1e14` every solver reports a singular matrix.
 pub const MAX_INERTIA_RATIO: f64 = 1e12;
 
-fn norm(p: [f64; 2]) -> f64 {
-    p[0].hypot(p[1])
-}
-
 impl System {
     /// Body points of joint `j` as `(body index, lever arm from the centre of mass)` pairs.
     fn joint_lever_arms(&self, ji: usize) -> [(Option<usize>, f64); 2] {
         let at = self.joint_attach[ji];
-        match &self.joints[ji].kind {
-            JointKind::Revolute { pa, pb, .. }
-            | JointKind::Prismatic { pa, pb, .. }
-            | JointKind::Weld { pa, pb, .. }
-            | JointKind::Distance { pa, pb, .. } => [(at.a, norm(*pa)), (at.b, norm(*pb))],
-            JointKind::Absolute {
-                point, coordinate, ..
-            } => match coordinate {
-                crate::Coordinate::Angle => [(None, 0.0), (None, 0.0)],
-                _ => [(at.a, norm(*point)), (None, 0.0)],
-            },
-            JointKind::AngleDriver { .. } => [(None, 0.0), (None, 0.0)],
-        }
+        let [pa, pb] = self.joints[ji].lever_arms();
+        let side = |body: Option<usize>, p: Option<[f64; 2]>| match p {
+            Some(p) => (body, norm(p)),
+            None => (None, 0.0),
+        };
+        [side(at.a, pa), side(at.b, pb)]
     }
 
     /// The mechanism's characteristic length: the largest lever arm of a joint point on a body
@@ -46,7 +35,7 @@ impl System {
                     l = l.max(r);
                 }
             }
-            if let JointKind::Distance { length, .. } = self.joints[ji].kind {
+            if let Some(length) = self.joints[ji].length() {
                 l = l.max(length);
             }
         }

@@ -4,9 +4,9 @@
 
 use crate::body::{Body, BodyHandle};
 use crate::error::ModelError;
-use crate::force::Force;
+use crate::forces::Force;
 use crate::jet::{DirJet, Frame, HessJet};
-use crate::joint::Joint;
+use crate::joints::Joint;
 use nalgebra::{DMatrix, DVector};
 
 /// Handle of a joint inside a [`System`] (its index, in insertion order).

@@ -8,7 +8,7 @@
 
 use crate::directional::BodyAngles;
 use crate::jet::{Frame, Scalar, TanJet, ThirdJet, NV};
-use crate::joint::RevoluteSide;
+use crate::joints::RevoluteSide;
 use crate::system::{Attach, System};
 use nalgebra::DMatrix;
 

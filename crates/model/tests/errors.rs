@@ -4,6 +4,7 @@ mod common;
 
 use common::PENDULUM_TOML;
 
+use mbd_model::joints::RevoluteSpec;
 use mbd_model::models::{self, four_bar, pendulum};
 use mbd_model::{
     Body, BodyHandle, BodyRef, Force, Joint, ModelError, ModelFile, System, SystemBuilder,
@@ -76,11 +77,13 @@ fn unknown_body_name_in_file() {
     }
     // and in a force, from JSON
     let mut mf = ModelFile::from_toml(PENDULUM_TOML).unwrap();
-    mf.forces.push(mbd_model::ForceSpec::Torque {
-        name: "motor".into(),
-        body: "link2".into(),
-        torque: TimeFunction::constant(1.0),
-    });
+    mf.forces.push(mbd_model::ForceSpec::Torque(
+        mbd_model::forces::TorqueSpec {
+            name: "motor".into(),
+            body: "link2".into(),
+            torque: TimeFunction::constant(1.0),
+        },
+    ));
     match System::from_json(&mf.to_json().unwrap()).unwrap_err() {
         ModelError::UnknownBody { element, body } => {
             assert!(element.contains("motor"), "{element}");
@@ -329,13 +332,15 @@ fn ground_to_ground_joint() {
 fn redundant_four_bar() {
     // A fifth pin between the crank tip and the coupler duplicates pin "A".
     let mut mf = four_bar().unwrap().to_model_file();
-    mf.joints.push(mbd_model::JointSpec::Revolute {
-        name: "A_again".into(),
-        body_a: "crank".into(),
-        point_a: [0.2, 0.0],
-        body_b: "coupler".into(),
-        point_b: [-0.6, 0.0],
-    });
+    mf.joints.push(mbd_model::JointSpec::Revolute(
+        mbd_model::joints::RevoluteSpec {
+            name: "A_again".into(),
+            body_a: "crank".into(),
+            point_a: [0.2, 0.0],
+            body_b: "coupler".into(),
+            point_b: [-0.6, 0.0],
+        },
+    ));
     match mf.build().unwrap_err() {
         ModelError::Redundant { equation, joints } => {
             assert!(equation.starts_with("A_again."), "{equation}");
@@ -350,19 +355,10 @@ fn redundant_four_bar() {
 fn redundant_double_pin() {
     let mut mf = pendulum(1.0, 1.0, 0.2, 9.81).unwrap().to_model_file();
     let extra = match &mf.joints[0] {
-        mbd_model::JointSpec::Revolute {
-            body_a,
-            point_a,
-            body_b,
-            point_b,
-            ..
-        } => mbd_model::JointSpec::Revolute {
+        mbd_model::JointSpec::Revolute(r) => mbd_model::JointSpec::Revolute(RevoluteSpec {
             name: "pin_again".into(),
-            body_a: body_a.clone(),
-            point_a: *point_a,
-            body_b: body_b.clone(),
-            point_b: *point_b,
-        },
+            ..r.clone()
+        }),
         _ => unreachable!(),
     };
     mf.joints.push(extra);

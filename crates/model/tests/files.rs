@@ -155,7 +155,7 @@ fn hand_written_json_slider_with_forces() {
     assert!(!sys.is_conservative());
     // the axis is normalised at build
     match &sys.joints()[0].kind {
-        mbd_model::JointKind::Prismatic { axis, pa, .. } => {
+        mbd_model::JointKind::Prismatic(mbd_model::joints::Prismatic { axis, pa, .. }) => {
             assert_eq!(*axis, [1.0, 0.0]);
             assert_eq!(*pa, [0.0, 0.0]);
         }

@@ -78,7 +78,13 @@ fn check_potential(sys: &System, r: &mut ChaCha8Rng) -> (f64, f64) {
 /// formulas; such random configurations are skipped.
 fn springs_stretched(sys: &System, q: &[f64]) -> bool {
     sys.forces().iter().all(|f| match f.kind {
-        mbd_model::ForceKind::SpringDamper { a, pa, b, pb, .. } => length(q, a, pa, b, pb) >= 0.3,
+        mbd_model::ForceKind::SpringDamper(mbd_model::forces::SpringDamper {
+            a,
+            pa,
+            b,
+            pb,
+            ..
+        }) => length(q, a, pa, b, pb) >= 0.3,
         _ => true,
     })
 }
@@ -169,11 +175,13 @@ fn rotary_spring_potential_matches_finite_differences() {
         let f = sys.forces();
         let mut expect = 0.0;
         for (fi, (a, b)) in [(q[2], q[5]), (0.0, q[5])].into_iter().enumerate() {
-            if let mbd_model::ForceKind::RotarySpringDamper {
-                stiffness,
-                rest_angle,
-                ..
-            } = f[fi].kind
+            if let mbd_model::ForceKind::RotarySpringDamper(
+                mbd_model::forces::RotarySpringDamper {
+                    stiffness,
+                    rest_angle,
+                    ..
+                },
+            ) = f[fi].kind
             {
                 expect += 0.5 * stiffness * (b - a - rest_angle).powi(2);
             } else {

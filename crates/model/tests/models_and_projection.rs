@@ -193,17 +193,19 @@ fn velocity_projection_is_m_orthogonal() {
 /// Manipulator with the first link driven: theta1 = pi/3 + 0.2 sin(2 t).
 fn driven_manipulator() -> System {
     let mut mf = models::manipulator().unwrap().to_model_file();
-    mf.joints.push(mbd_model::JointSpec::AngleDriver {
-        name: "motor".into(),
-        body_a: "ground".into(),
-        body_b: "link1".into(),
-        f: TimeFunction::Harmonic {
-            offset: std::f64::consts::FRAC_PI_3,
-            amplitude: 0.2,
-            omega: 2.0,
-            phase: 0.0,
+    mf.joints.push(mbd_model::JointSpec::AngleDriver(
+        mbd_model::joints::AngleDriverSpec {
+            name: "motor".into(),
+            body_a: "ground".into(),
+            body_b: "link1".into(),
+            f: TimeFunction::Harmonic {
+                offset: std::f64::consts::FRAC_PI_3,
+                amplitude: 0.2,
+                omega: 2.0,
+                phase: 0.0,
+            },
         },
-    });
+    ));
     mf.build().unwrap()
 }
 

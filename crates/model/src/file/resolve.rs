@@ -3,13 +3,12 @@
 //! [`SystemBuilder::add_point_mass`]), which lowers them to centres of mass and constrained
 //! bodies: one implementation for files and Rust models.
 
-use super::spec::{BodyKind, BodySpec, ForceSpec, JointSpec};
+use super::spec::{BodyKind, BodySpec};
 use super::ModelFile;
 use crate::body::{Body, BodyHandle, BodyRef};
 use crate::builder::SystemBuilder;
+use crate::check::invalid;
 use crate::error::ModelError;
-use crate::force::{Force, ForceKind};
-use crate::joint::{Joint, JointKind};
 use crate::system::System;
 
 /// Body names resolved, with each body's frame offset and kind.
@@ -18,10 +17,6 @@ struct Resolver<'a> {
     /// The bodies as the file gives them (frame-origin poses; a point mass's inertia is set by
     /// the builder).
     bodies: Vec<Body>,
-}
-
-fn invalid(element: String, message: String) -> ModelError {
-    ModelError::InvalidElement { element, message }
 }
 
 impl<'a> Resolver<'a> {
@@ -123,151 +118,12 @@ impl ModelFile {
                 b.set_body_frame(h, c);
             }
         }
+        let find = |element: &str, body: &str| r.find(element, body);
         for j in &self.joints {
-            let joint = match j {
-                JointSpec::Revolute {
-                    name,
-                    body_a,
-                    point_a,
-                    body_b,
-                    point_b,
-                } => Joint::revolute(
-                    name.clone(),
-                    r.find(&format!("joint '{name}'"), body_a)?,
-                    *point_a,
-                    r.find(&format!("joint '{name}'"), body_b)?,
-                    *point_b,
-                ),
-                JointSpec::Prismatic {
-                    name,
-                    body_a,
-                    point_a,
-                    body_b,
-                    point_b,
-                    axis,
-                    angle,
-                } => Joint::prismatic(
-                    name.clone(),
-                    r.find(&format!("joint '{name}'"), body_a)?,
-                    *point_a,
-                    r.find(&format!("joint '{name}'"), body_b)?,
-                    *point_b,
-                    *axis,
-                    *angle,
-                ),
-                JointSpec::Weld {
-                    name,
-                    body_a,
-                    point_a,
-                    body_b,
-                    point_b,
-                    angle,
-                } => Joint::weld(
-                    name.clone(),
-                    r.find(&format!("joint '{name}'"), body_a)?,
-                    *point_a,
-                    r.find(&format!("joint '{name}'"), body_b)?,
-                    *point_b,
-                    *angle,
-                ),
-                JointSpec::Distance {
-                    name,
-                    body_a,
-                    point_a,
-                    body_b,
-                    point_b,
-                    length,
-                } => Joint::distance(
-                    name.clone(),
-                    r.find(&format!("joint '{name}'"), body_a)?,
-                    *point_a,
-                    r.find(&format!("joint '{name}'"), body_b)?,
-                    *point_b,
-                    *length,
-                ),
-                JointSpec::Absolute {
-                    name,
-                    body,
-                    point,
-                    coordinate,
-                    value,
-                } => Joint::absolute(
-                    name.clone(),
-                    r.find(&format!("joint '{name}'"), body)?,
-                    *point,
-                    *coordinate,
-                    *value,
-                ),
-                JointSpec::AngleDriver {
-                    name,
-                    body_a,
-                    body_b,
-                    f,
-                } => Joint::angle_driver(
-                    name.clone(),
-                    r.find(&format!("joint '{name}'"), body_a)?,
-                    r.find(&format!("joint '{name}'"), body_b)?,
-                    f.clone(),
-                ),
-            };
-            b.add_joint(joint);
+            b.add_joint(j.to_joint(&find)?);
         }
         for f in &self.forces {
-            let force = match f {
-                ForceSpec::SpringDamper {
-                    name,
-                    body_a,
-                    point_a,
-                    body_b,
-                    point_b,
-                    stiffness,
-                    damping,
-                    rest_length,
-                } => Force::spring_damper(
-                    name.clone(),
-                    r.find(&format!("force '{name}'"), body_a)?,
-                    *point_a,
-                    r.find(&format!("force '{name}'"), body_b)?,
-                    *point_b,
-                    *stiffness,
-                    *damping,
-                    *rest_length,
-                ),
-                ForceSpec::RotarySpringDamper {
-                    name,
-                    body_a,
-                    body_b,
-                    stiffness,
-                    damping,
-                    rest_angle,
-                } => Force::rotary_spring_damper(
-                    name.clone(),
-                    r.find(&format!("force '{name}'"), body_a)?,
-                    r.find(&format!("force '{name}'"), body_b)?,
-                    *stiffness,
-                    *damping,
-                    *rest_angle,
-                ),
-                ForceSpec::Force {
-                    name,
-                    body,
-                    point,
-                    fx,
-                    fy,
-                } => Force::force(
-                    name.clone(),
-                    r.find(&format!("force '{name}'"), body)?,
-                    *point,
-                    fx.clone(),
-                    fy.clone(),
-                ),
-                ForceSpec::Torque { name, body, torque } => Force::torque(
-                    name.clone(),
-                    r.find(&format!("force '{name}'"), body)?,
-                    torque.clone(),
-                ),
-            };
-            b.add_force(force);
+            b.add_force(f.to_force(&find)?);
         }
         Ok(b)
     }
@@ -282,142 +138,8 @@ impl System {
                 BodyRef::Body(h) => self.bodies[h.0].name.clone(),
             }
         };
-        let joints = self
-            .joints
-            .iter()
-            .map(|j| {
-                let n = j.name.clone();
-                match &j.kind {
-                    JointKind::Revolute { a, pa, b, pb } => JointSpec::Revolute {
-                        name: n,
-                        body_a: name(*a),
-                        point_a: *pa,
-                        body_b: name(*b),
-                        point_b: *pb,
-                    },
-                    JointKind::Prismatic {
-                        a,
-                        pa,
-                        b,
-                        pb,
-                        axis,
-                        angle,
-                    } => JointSpec::Prismatic {
-                        name: n,
-                        body_a: name(*a),
-                        point_a: *pa,
-                        body_b: name(*b),
-                        point_b: *pb,
-                        axis: *axis,
-                        angle: *angle,
-                    },
-                    JointKind::Weld {
-                        a,
-                        pa,
-                        b,
-                        pb,
-                        angle,
-                    } => JointSpec::Weld {
-                        name: n,
-                        body_a: name(*a),
-                        point_a: *pa,
-                        body_b: name(*b),
-                        point_b: *pb,
-                        angle: *angle,
-                    },
-                    JointKind::Distance {
-                        a,
-                        pa,
-                        b,
-                        pb,
-                        length,
-                    } => JointSpec::Distance {
-                        name: n,
-                        body_a: name(*a),
-                        point_a: *pa,
-                        body_b: name(*b),
-                        point_b: *pb,
-                        length: *length,
-                    },
-                    JointKind::Absolute {
-                        body,
-                        point,
-                        coordinate,
-                        value,
-                    } => JointSpec::Absolute {
-                        name: n,
-                        body: name(*body),
-                        point: *point,
-                        coordinate: *coordinate,
-                        value: *value,
-                    },
-                    JointKind::AngleDriver { a, b, f } => JointSpec::AngleDriver {
-                        name: n,
-                        body_a: name(*a),
-                        body_b: name(*b),
-                        f: f.clone(),
-                    },
-                }
-            })
-            .collect();
-        let forces = self
-            .forces
-            .iter()
-            .map(|f| {
-                let n = f.name.clone();
-                match &f.kind {
-                    ForceKind::SpringDamper {
-                        a,
-                        pa,
-                        b,
-                        pb,
-                        stiffness,
-                        damping,
-                        rest_length,
-                    } => ForceSpec::SpringDamper {
-                        name: n,
-                        body_a: name(*a),
-                        point_a: *pa,
-                        body_b: name(*b),
-                        point_b: *pb,
-                        stiffness: *stiffness,
-                        damping: *damping,
-                        rest_length: *rest_length,
-                    },
-                    ForceKind::RotarySpringDamper {
-                        a,
-                        b,
-                        stiffness,
-                        damping,
-                        rest_angle,
-                    } => ForceSpec::RotarySpringDamper {
-                        name: n,
-                        body_a: name(*a),
-                        body_b: name(*b),
-                        stiffness: *stiffness,
-                        damping: *damping,
-                        rest_angle: *rest_angle,
-                    },
-                    ForceKind::Force {
-                        body,
-                        point,
-                        fx,
-                        fy,
-                    } => ForceSpec::Force {
-                        name: n,
-                        body: name(*body),
-                        point: *point,
-                        fx: fx.clone(),
-                        fy: fy.clone(),
-                    },
-                    ForceKind::Torque { body, torque } => ForceSpec::Torque {
-                        name: n,
-                        body: name(*body),
-                        torque: torque.clone(),
-                    },
-                }
-            })
-            .collect();
+        let joints = self.joints.iter().map(|j| j.to_spec(&name)).collect();
+        let forces = self.forces.iter().map(|f| f.to_spec(&name)).collect();
         ModelFile {
             gravity: self.gravity,
             bodies: self

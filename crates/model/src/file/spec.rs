@@ -1,7 +1,9 @@
 //! The types of a model file, one per element; their JSON Schema is derived from them.
 
-use crate::joint::Coordinate;
-use crate::timefn::TimeFunction;
+use crate::forces::{PointForceSpec, RotarySpringDamperSpec, SpringDamperSpec, TorqueSpec};
+use crate::joints::{
+    AbsoluteSpec, AngleDriverSpec, DistanceSpec, PrismaticSpec, RevoluteSpec, WeldSpec,
+};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -54,118 +56,35 @@ pub struct BodySpec {
     pub com: Option<[f64; 2]>,
 }
 
-/// A joint in a model file (bodies by name).
+/// A joint in a model file (bodies by name), tagged by `type`. Each variant's fields are
+/// documented on its spec struct, beside the joint it describes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-#[allow(missing_docs)]
+#[serde(tag = "type", rename_all = "snake_case")]
 pub enum JointSpec {
-    /// See [`JointKind::Revolute`](crate::JointKind::Revolute).
-    Revolute {
-        name: String,
-        body_a: String,
-        #[serde(default)]
-        point_a: [f64; 2],
-        body_b: String,
-        #[serde(default)]
-        point_b: [f64; 2],
-    },
-    /// See [`JointKind::Prismatic`](crate::JointKind::Prismatic).
-    Prismatic {
-        name: String,
-        body_a: String,
-        #[serde(default)]
-        point_a: [f64; 2],
-        body_b: String,
-        #[serde(default)]
-        point_b: [f64; 2],
-        axis: [f64; 2],
-        #[serde(default)]
-        angle: f64,
-    },
-    /// See [`JointKind::Weld`](crate::JointKind::Weld).
-    Weld {
-        name: String,
-        body_a: String,
-        #[serde(default)]
-        point_a: [f64; 2],
-        body_b: String,
-        #[serde(default)]
-        point_b: [f64; 2],
-        #[serde(default)]
-        angle: f64,
-    },
-    /// See [`JointKind::Distance`](crate::JointKind::Distance).
-    Distance {
-        name: String,
-        body_a: String,
-        #[serde(default)]
-        point_a: [f64; 2],
-        body_b: String,
-        #[serde(default)]
-        point_b: [f64; 2],
-        length: f64,
-    },
-    /// See [`JointKind::Absolute`](crate::JointKind::Absolute).
-    Absolute {
-        name: String,
-        body: String,
-        #[serde(default)]
-        point: [f64; 2],
-        coordinate: Coordinate,
-        value: f64,
-    },
-    /// See [`JointKind::AngleDriver`](crate::JointKind::AngleDriver).
-    AngleDriver {
-        name: String,
-        body_a: String,
-        body_b: String,
-        f: TimeFunction,
-    },
+    /// A [`Revolute`](crate::joints::Revolute) joint.
+    Revolute(RevoluteSpec),
+    /// A [`Prismatic`](crate::joints::Prismatic) joint.
+    Prismatic(PrismaticSpec),
+    /// A [`Weld`](crate::joints::Weld) joint.
+    Weld(WeldSpec),
+    /// A [`Distance`](crate::joints::Distance) joint.
+    Distance(DistanceSpec),
+    /// An [`Absolute`](crate::joints::Absolute) joint.
+    Absolute(AbsoluteSpec),
+    /// An [`AngleDriver`](crate::joints::AngleDriver).
+    AngleDriver(AngleDriverSpec),
 }
 
-/// A force element in a model file (bodies by name).
+/// A force element in a model file (bodies by name), tagged by `type`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
-#[allow(missing_docs)]
+#[serde(tag = "type", rename_all = "snake_case")]
 pub enum ForceSpec {
-    /// See [`ForceKind::SpringDamper`](crate::ForceKind::SpringDamper).
-    SpringDamper {
-        name: String,
-        body_a: String,
-        #[serde(default)]
-        point_a: [f64; 2],
-        body_b: String,
-        #[serde(default)]
-        point_b: [f64; 2],
-        stiffness: f64,
-        #[serde(default)]
-        damping: f64,
-        rest_length: f64,
-    },
-    /// See [`ForceKind::RotarySpringDamper`](crate::ForceKind::RotarySpringDamper).
-    RotarySpringDamper {
-        name: String,
-        body_a: String,
-        body_b: String,
-        stiffness: f64,
-        #[serde(default)]
-        damping: f64,
-        #[serde(default)]
-        rest_angle: f64,
-    },
-    /// See [`ForceKind::Force`](crate::ForceKind::Force).
-    Force {
-        name: String,
-        body: String,
-        #[serde(default)]
-        point: [f64; 2],
-        fx: TimeFunction,
-        fy: TimeFunction,
-    },
-    /// See [`ForceKind::Torque`](crate::ForceKind::Torque).
-    Torque {
-        name: String,
-        body: String,
-        torque: TimeFunction,
-    },
+    /// A [`SpringDamper`](crate::forces::SpringDamper).
+    SpringDamper(SpringDamperSpec),
+    /// A [`RotarySpringDamper`](crate::forces::RotarySpringDamper).
+    RotarySpringDamper(RotarySpringDamperSpec),
+    /// A [`PointForce`](crate::forces::PointForce).
+    Force(PointForceSpec),
+    /// A [`Torque`](crate::forces::Torque).
+    Torque(TorqueSpec),
 }

@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyRef};
 use crate::builder::SystemBuilder;
 use crate::error::ModelError;
-use crate::joint::Joint;
+use crate::joints::Joint;
 use crate::system::System;
 use crate::timefn::TimeFunction;
 
@@ -61,7 +61,7 @@ use crate::timefn::TimeFunction;
 /// `epsilon = 1.23054744454982119249735015568` rad; the absolute coordinates are computed from
 /// them with the local points above (they satisfy `Phi = 0` to rounding).
 pub fn andrews_squeezer() -> Result<System, ModelError> {
-    use crate::force::Force;
+    use crate::forces::Force;
     // masses and centroidal inertias
     let m = [
         0.04325, 0.00365, 0.02373, 0.00706, 0.07050, 0.00706, 0.05498,

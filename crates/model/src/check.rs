@@ -1,0 +1,80 @@
+//! Parameter checks shared by the builder, the joints and the forces: each error names the
+//! element and the parameter at fault.
+
+use crate::error::ModelError;
+use crate::timefn::TimeFunction;
+
+/// An element-level error with a free-form message.
+pub(crate) fn invalid(element: String, message: String) -> ModelError {
+    ModelError::InvalidElement { element, message }
+}
+
+/// `value` must be finite.
+pub(crate) fn finite(element: &str, parameter: &'static str, value: f64) -> Result<(), ModelError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ModelError::InvalidParameter {
+            element: element.to_string(),
+            parameter,
+            value,
+            reason: "must be finite",
+        })
+    }
+}
+
+/// `value` must be positive and finite.
+pub(crate) fn positive(
+    element: &str,
+    parameter: &'static str,
+    value: f64,
+) -> Result<(), ModelError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(ModelError::InvalidParameter {
+            element: element.to_string(),
+            parameter,
+            value,
+            reason: "must be positive and finite",
+        })
+    }
+}
+
+/// `value` must be non-negative and finite.
+pub(crate) fn nonneg(element: &str, parameter: &'static str, value: f64) -> Result<(), ModelError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(ModelError::InvalidParameter {
+            element: element.to_string(),
+            parameter,
+            value,
+            reason: "must be non-negative and finite",
+        })
+    }
+}
+
+/// Both coordinates of a point must be finite.
+pub(crate) fn point(element: &str, parameter: &'static str, p: [f64; 2]) -> Result<(), ModelError> {
+    finite(element, parameter, p[0])?;
+    finite(element, parameter, p[1])
+}
+
+/// Every coefficient of a time function must be finite.
+pub(crate) fn time_function(
+    element: &str,
+    parameter: &'static str,
+    f: &TimeFunction,
+) -> Result<(), ModelError> {
+    if f.is_finite() {
+        Ok(())
+    } else {
+        Err(ModelError::InvalidParameter {
+            element: element.to_string(),
+            parameter,
+            value: f64::NAN,
+            reason: "time function coefficients must be finite",
+        })
+    }
+}
