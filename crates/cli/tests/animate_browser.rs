@@ -186,10 +186,10 @@ fn page_draws_the_trajectory_at_the_requested_time() {
             else {
                 continue;
             };
-            let w = match (b.index(), a.index()) {
-                (Some(bi), _) => sys.point_position(mbd_model::BodyHandle(bi), *pb, &q),
-                (None, Some(ai)) => sys.point_position(mbd_model::BodyHandle(ai), *pa, &q),
-                (None, None) => continue,
+            let w = match (b, a) {
+                (mbd_model::BodyRef::Body(hb), _) => sys.point_position(*hb, *pb, &q),
+                (_, mbd_model::BodyRef::Body(ha)) => sys.point_position(*ha, *pa, &q),
+                _ => continue,
             };
             let c = circles
                 .iter()

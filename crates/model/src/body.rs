@@ -2,9 +2,20 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Handle of a body inside a [`crate::System`] (its index, in insertion order).
+/// Handle of a body inside a [`crate::System`], given by [`crate::SystemBuilder::add_body`],
+/// [`crate::System::body_handle`] or [`crate::System::body_handles`]. Opaque: it cannot be
+/// made from a number, so a handle always comes from a model (one of another model with more
+/// bodies is an error of `build`, naming the element).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub struct BodyHandle(pub usize);
+pub struct BodyHandle(pub(crate) usize);
+
+impl BodyHandle {
+    /// The body's position in [`crate::System::bodies`] (insertion order); its coordinates
+    /// are `q[3 * index..3 * index + 3]`.
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
 
 /// What a joint or force attaches to: the fixed ground frame or a body.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -9,13 +9,29 @@ use crate::jet::{DirJet, Frame, HessJet};
 use crate::joints::Joint;
 use nalgebra::{DMatrix, DVector};
 
-/// Handle of a joint inside a [`System`] (its index, in insertion order).
+/// Handle of a joint inside a [`System`], given by [`crate::SystemBuilder::add_joint`],
+/// [`System::joint_handle`] or [`System::joint_handles`] (opaque, like [`BodyHandle`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct JointHandle(pub usize);
+pub struct JointHandle(pub(crate) usize);
 
-/// Handle of a force element inside a [`System`].
+impl JointHandle {
+    /// The joint's position in [`System::joints`] (insertion order).
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
+/// Handle of a force element inside a [`System`], given by [`crate::SystemBuilder::add_force`],
+/// [`System::force_handle`] or [`System::force_handles`] (opaque, like [`BodyHandle`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ForceHandle(pub usize);
+pub struct ForceHandle(pub(crate) usize);
+
+impl ForceHandle {
+    /// The element's position in [`System::forces`] (insertion order).
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
 
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Attach {
@@ -89,6 +105,25 @@ impl System {
             .iter()
             .position(|j| j.name == name)
             .map(JointHandle)
+    }
+    /// The handle of the force element called `name`.
+    pub fn force_handle(&self, name: &str) -> Option<ForceHandle> {
+        self.forces
+            .iter()
+            .position(|f| f.name == name)
+            .map(ForceHandle)
+    }
+    /// The handles of every body, in the order of [`System::bodies`].
+    pub fn body_handles(&self) -> impl ExactSizeIterator<Item = BodyHandle> {
+        (0..self.bodies.len()).map(BodyHandle)
+    }
+    /// The handles of every joint, in the order of [`System::joints`].
+    pub fn joint_handles(&self) -> impl ExactSizeIterator<Item = JointHandle> {
+        (0..self.joints.len()).map(JointHandle)
+    }
+    /// The handles of every force element, in the order of [`System::forces`].
+    pub fn force_handles(&self) -> impl ExactSizeIterator<Item = ForceHandle> {
+        (0..self.forces.len()).map(ForceHandle)
     }
     /// Names of the coordinates: `body.x`, `body.y`, `body.theta`.
     pub fn coordinate_names(&self) -> Vec<String> {

@@ -172,7 +172,13 @@ fn point_mass_and_frame_misuse_are_errors_naming_the_element() {
         "{e}"
     );
     let e = build(&|b, _| {
-        b.set_body_frame(mbd_model::BodyHandle(7), [0.0, 0.0]);
+        // a handle of another model with eight bodies
+        let mut other = SystemBuilder::new();
+        let eighth = (0..8)
+            .map(|i| other.add_body(Body::new(format!("b{i}"))))
+            .last()
+            .expect("eight bodies");
+        b.set_body_frame(eighth, [0.0, 0.0]);
     });
     assert!(e.contains("#7") && e.contains("set_body_frame"), "{e}");
     let e = build(&|b, bob| {

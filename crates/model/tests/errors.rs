@@ -40,12 +40,18 @@ fn valid_reference_file_builds() {
 
 #[test]
 fn unknown_body_handle() {
+    // a handle of another model with four bodies
+    let mut other = SystemBuilder::new();
+    let fourth = (0..4)
+        .map(|i| other.add_body(Body::new(format!("b{i}")).mass(1.0).inertia(1.0)))
+        .last()
+        .unwrap();
     let (mut b, _) = one_body();
     b.add_joint(Joint::revolute(
         "pin",
         BodyRef::Ground,
         [0.0, 0.0],
-        BodyHandle(3),
+        fourth,
         [0.0, 0.0],
     ));
     match err(b) {
@@ -57,11 +63,7 @@ fn unknown_body_handle() {
     }
     // in a force too
     let (mut b, _) = one_body();
-    b.add_force(Force::torque(
-        "tq",
-        BodyHandle(1),
-        TimeFunction::constant(1.0),
-    ));
+    b.add_force(Force::torque("tq", fourth, TimeFunction::constant(1.0)));
     assert!(matches!(err(b), ModelError::UnknownBody { element, .. } if element == "tq"));
 }
 

@@ -267,7 +267,7 @@ fn constant_loads_are_conservative() {
             let q = rconfig(&mut r, 6);
             let mut g = vec![0.0; 6];
             sys.potential_gradient(&q, &mut g);
-            let jp = point_jacobian(&sys, BodyHandle(1), s, &q);
+            let jp = point_jacobian(&sys, body(&sys, 1), s, &q);
             let qf = jp.tr_mul(&mbd_model::nalgebra::DVector::from_column_slice(&[fx, fy]));
             let mut expect = qf.as_slice().to_vec();
             expect[2] += tau;
@@ -300,9 +300,9 @@ fn spring_damping_force_is_minus_c_ldot_grad_l() {
         let a = if ground {
             BodyRef::Ground
         } else {
-            BodyRef::Body(BodyHandle(0))
+            BodyRef::Body(body(&sys, 0))
         };
-        let b = BodyRef::Body(BodyHandle(1));
+        let b = BodyRef::Body(body(&sys, 1));
         // away from the l = 0 singularity of grad l (see `springs_stretched`)
         let q = loop {
             let q = rconfig(&mut r, 6);
@@ -399,8 +399,8 @@ fn time_dependent_loads_are_generalized_by_the_point_jacobian() {
         let t = uni(&mut r, 0.0, 3.0);
         let mut qnc = vec![0.0; 6];
         sys.nonconservative_forces(&q, &v, t, &mut qnc);
-        let j1 = point_jacobian(&sys, BodyHandle(0), s, &q);
-        let j2 = point_jacobian(&sys, BodyHandle(1), s, &q);
+        let j1 = point_jacobian(&sys, body(&sys, 0), s, &q);
+        let j2 = point_jacobian(&sys, body(&sys, 1), s, &q);
         let f1 = mbd_model::nalgebra::DVector::from_column_slice(&[fx.eval(t)[0], fy.eval(t)[0]]);
         // a force with one time-dependent component is non-conservative as a whole
         let f2 = mbd_model::nalgebra::DVector::from_column_slice(&[1.0, t]);
@@ -506,7 +506,7 @@ fn kinetic_energy_and_point_kinematics() {
         assert!(rel(sys.energy(&q, &v), t + sys.potential(&q)) < 1e-14);
         for i in 0..sys.bodies().len() {
             let s = rpoint(&mut r, 1.0);
-            let h = BodyHandle(i);
+            let h = body(&sys, i);
             let p = sys.point_position(h, s, &q);
             let e = body_point(&q[3 * i..3 * i + 3], s);
             assert!((p[0] - e[0]).abs() < 1e-14 && (p[1] - e[1]).abs() < 1e-14);

@@ -406,8 +406,7 @@ fn local_jacobians_scatter_to_the_dense_ones() {
         nalgebra::DMatrix::zeros(m, n),
         nalgebra::DMatrix::zeros(m, n),
     );
-    for j in 0..sys.joints().len() {
-        let jh = mbd_model::JointHandle(j);
+    for jh in sys.joint_handles() {
         let (a, b) = sys.joint_bodies(jh);
         for r in sys.joint_rows(jh) {
             assert_eq!(g[r], g2[r]);

@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use mbd_model::models::{self, chain, ChainParams};
 use mbd_model::nalgebra::DMatrix;
-use mbd_model::{Body, BodyHandle, BodyRef, Joint, System, SystemBuilder, TimeFunction};
+use mbd_model::{Body, BodyRef, Joint, System, SystemBuilder, TimeFunction};
 
 fn named_models() -> Vec<(&'static str, System)> {
     vec![
@@ -233,7 +233,12 @@ fn rheonomic_projection_includes_phi_t() {
     let jv = &jac * &x.v;
     assert!((jv[m - 1] + pt[m - 1]).abs() < 1e-12 && pt[m - 1].abs() > 0.2);
     // a pin velocity consistent with the motion: pin2 tip of link 1 moves at omega * L1
-    let tip = sys.point_velocity(BodyHandle(0), [0.5, 0.0], x.q.as_slice(), x.v.as_slice());
+    let tip = sys.point_velocity(
+        sys.body_handles().next().unwrap(),
+        [0.5, 0.0],
+        x.q.as_slice(),
+        x.v.as_slice(),
+    );
     assert!((tip.norm() - omega.abs()).abs() < 1e-12);
     perturb_and_project(&sys, t, 7);
 }

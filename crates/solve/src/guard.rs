@@ -120,7 +120,7 @@ impl GuardState {
         }
         let joint = sys
             .equation_joint(row)
-            .map(|j| sys.joints()[j.0].name.clone())
+            .map(|j| sys.joints()[j.index()].name.clone())
             .unwrap_or_default();
         Err(SolveError::ConstraintDrift {
             t,

@@ -14,7 +14,7 @@ use mbd_analysis::plot::{Figure, Series};
 use mbd_analysis::{fit_order, MeasureObserver, RunMeasures};
 use mbd_firefly_gauss::{FaDaeOptions, FaDaeStats, FireflyGauss, RefinedAcceleration};
 use mbd_model::numeric::{max_abs, max_abs_diff};
-use mbd_model::{models, BodyHandle, System};
+use mbd_model::{models, System};
 use mbd_rk4::{Rk4, Rk4Options};
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Flow, Integrator, Observer, RunConfig, SolveError,
@@ -102,7 +102,11 @@ impl Observer for PcObserver {
         let r = self.acc.residual();
         self.e_phiddot = self.e_phiddot.max(r);
         if self.stride > 0 && step.is_multiple_of(self.stride) {
-            let tip = sys.point_position(BodyHandle(1), [0.5, 0.0], q);
+            let tip = sys.point_position(
+                sys.body_handles().nth(1).expect("the model has two bodies"),
+                [0.5, 0.0],
+                q,
+            );
             sys.phi(q, s.t, &mut self.phi);
             let ep = max_abs(&self.phi);
             sys.phi_dot(q, v, s.t, &mut self.phi);

@@ -134,7 +134,10 @@ pub fn body_point(qi: &[f64], s: [f64; 2]) -> [f64; 2] {
 pub fn ref_point(q: &[f64], r: BodyRef, s: [f64; 2]) -> [f64; 2] {
     match r {
         BodyRef::Ground => s,
-        BodyRef::Body(BodyHandle(i)) => body_point(&q[3 * i..3 * i + 3], s),
+        BodyRef::Body(h) => {
+            let i = h.index();
+            body_point(&q[3 * i..3 * i + 3], s)
+        }
     }
 }
 
@@ -286,3 +289,10 @@ point_a = [0.0, 0.0]
 body_b = "link1"
 point_b = [-0.5, 0.0]
 "#;
+
+/// The handle of body `i` of `sys` (panics when out of range: a test set-up error).
+pub fn body(sys: &System, i: usize) -> BodyHandle {
+    sys.body_handles()
+        .nth(i)
+        .unwrap_or_else(|| panic!("the model has no body #{i}"))
+}

@@ -4,7 +4,7 @@
 use super::cholesky::SparseCholesky;
 use crate::error::SolveError;
 use crate::linalg::FactorError;
-use mbd_model::{JointHandle, System};
+use mbd_model::System;
 
 /// One contribution to an entry of `S`: rows `r1 >= r2` both act on `body`; `o1`, `o2` are the
 /// offsets (0 or 3) of that body in the rows' local gradients; `idx` is the value slot.
@@ -33,9 +33,9 @@ impl RowIncidence {
     /// The incidence of `sys` (allocates; once per pattern).
     pub fn new(sys: &System) -> Self {
         let mut row_bodies = vec![(None, None); sys.n_constraints()];
-        for j in 0..sys.joints().len() {
-            let jb = sys.joint_bodies(JointHandle(j));
-            for r in sys.joint_rows(JointHandle(j)) {
+        for j in sys.joint_handles() {
+            let jb = sys.joint_bodies(j);
+            for r in sys.joint_rows(j) {
                 row_bodies[r] = jb;
             }
         }

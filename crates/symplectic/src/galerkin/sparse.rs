@@ -137,7 +137,7 @@ impl SparseStage {
         let mut fnbr: Vec<Vec<usize>> = vec![Vec::new(); nb];
         for f in sys.forces() {
             let idx = |r: BodyRef| match r {
-                BodyRef::Body(h) if h.0 < nb => Some(h.0),
+                BodyRef::Body(h) if h.index() < nb => Some(h.index()),
                 _ => None,
             };
             let (a, b) = f.bodies();

@@ -130,7 +130,7 @@ impl TangentChart {
             rows.sort_unstable();
             for r in rows {
                 if let Some(h) = sys.equation_joint(r) {
-                    let name = sys.joints()[h.0].name.clone();
+                    let name = sys.joints()[h.index()].name.clone();
                     if !joints.contains(&name) {
                         joints.push(name);
                     }

@@ -64,7 +64,7 @@ impl SparseChart {
             Err(FactorError::Singular(i) | FactorError::NotPositiveDefinite(i)) => {
                 let joint = sys
                     .equation_joint(i)
-                    .and_then(|h| sys.joints().get(h.0))
+                    .and_then(|h| sys.joints().get(h.index()))
                     .map(|j| j.name.clone())
                     .unwrap_or_default();
                 Some(SolveError::Singular {
