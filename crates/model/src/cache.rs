@@ -1,70 +1,157 @@
-//! The angle cache of repeated constraint evaluations at nearby configurations.
+//! The one angle cache: `sin` and `cos` of every body's angle at a configuration, evaluated
+//! once and shared by the element passes there, or brought to a nearby configuration by
+//! rotation.
 
-use crate::system::*;
+use crate::jet::{Frame, Scalar};
+use crate::system::System;
 
-/// `sin` and `cos` of every body's angle from the last evaluation, for repeated evaluations
-/// at nearby configurations (Newton iterations): [`System::phi_and_phi_dot_cached`] rotates
-/// the cached values by the angle increment `delta` (`|delta| <= 1e-3`, with `cos delta` and
-/// `sin delta` from their Taylor series, exact to rounding there) instead of calling `sin_cos`,
-/// and recomputes them exactly after [`AngleCache::MAX_ROTATIONS`] rotations, for a larger
-/// increment, or after [`AngleCache::invalidate`]. The rotated values differ from exact ones by
-/// a few units in the last place.
-#[derive(Clone, Debug)]
-pub struct AngleCache {
-    /// Per body: the angle, its sine and cosine, and the rotations since the exact evaluation.
-    pub(crate) entries: Vec<AngleEntry>,
-    pub(crate) valid: bool,
+/// The sine and cosine of every body's angle at one configuration `q`, evaluated once
+/// ([`BodyAngles::update`]) and shared by all the element passes at that `q` (the `_at`
+/// variants such as [`System::lagrangian_third_at`], and [`System::constraint_poly_series`]):
+/// they give bit for bit the results of the plain passes without one `sin_cos` per element
+/// and body. Allocated once ([`BodyAngles::new`]); updating allocates nothing unless the
+/// number of bodies changed.
+///
+/// The same table serves repeated evaluations at nearby configurations (Newton iterations):
+/// [`BodyAngles::update_near`] rotates the stored values by each angle's increment `delta`
+/// (`|delta| <= 1e-3`, with `cos delta` and `sin delta` from their Taylor series, exact to
+/// rounding there) instead of calling `sin_cos`, and evaluates exactly after
+/// [`BodyAngles::MAX_ROTATIONS`] rotations, for a larger increment, or after
+/// [`BodyAngles::invalidate`]. Rotated values differ from exact ones by a few units in the last
+/// place; [`System::phi_and_phi_dot_cached`] uses them.
+#[derive(Clone, Debug, Default)]
+pub struct BodyAngles {
+    /// Per body: `[theta, sin theta, cos theta]`.
+    sc: Vec<[f64; 3]>,
+    /// Per body: rotations since the last exact evaluation (used by `update_near` only).
+    rotations: Vec<u32>,
+    /// Whether the table holds values `update_near` may rotate from.
+    valid: bool,
 }
 
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct AngleEntry {
-    pub(crate) theta: f64,
-    pub(crate) s: f64,
-    pub(crate) c: f64,
-    pub(crate) rotations: u32,
-}
+impl BodyAngles {
+    /// The table for the bodies of `sys` at the configuration `q` (length `sys.n_coords()`).
+    pub fn new(sys: &System, q: &[f64]) -> Self {
+        let mut a = BodyAngles::default();
+        a.update(sys, q);
+        a
+    }
 
-impl AngleCache {
-    /// Rotations allowed between two exact evaluations of one body's `sin_cos`.
-    pub const MAX_ROTATIONS: u32 = 8;
+    /// Evaluates `sin` and `cos` of every body angle of `sys` at `q` (length
+    /// `sys.n_coords()`), in place.
+    pub fn update(&mut self, sys: &System, q: &[f64]) {
+        let nb = sys.bodies.len();
+        debug_assert_eq!(q.len(), 3 * nb);
+        self.resize(nb);
+        for (i, e) in self.sc.iter_mut().enumerate() {
+            let th = q[3 * i + 2];
+            let (s, c) = th.sin_cos();
+            *e = [th, s, c];
+        }
+        self.rotations.fill(0);
+        self.valid = true;
+    }
 
-    /// A cache for the bodies of `sys` (empty: the first evaluation is exact).
-    pub fn new(sys: &System) -> Self {
-        AngleCache {
-            entries: vec![AngleEntry::default(); sys.bodies.len()],
+    /// An empty table sized for the bodies of `sys` (allocated here, so later updates allocate
+    /// nothing); the first [`BodyAngles::update_near`] evaluates exactly.
+    pub fn sized(sys: &System) -> Self {
+        let nb = sys.bodies.len();
+        BodyAngles {
+            sc: vec![[0.0; 3]; nb],
+            rotations: vec![0; nb],
             valid: false,
         }
     }
 
-    /// Forgets the cached values: the next evaluation computes `sin_cos` exactly.
+    /// Rotations allowed between two exact evaluations of one body's `sin_cos` in
+    /// [`BodyAngles::update_near`].
+    pub const MAX_ROTATIONS: u32 = 8;
+
+    /// Brings the table to the configuration `q` from the one it holds: each angle that moved
+    /// by at most 1e-3 has its `sin`/`cos` rotated by the increment (at most
+    /// [`BodyAngles::MAX_ROTATIONS`] times in a row), the others are evaluated exactly. For
+    /// `|d| <= 1e-3` the truncated series `cos d = 1 - d^2/2 + d^4/24`,
+    /// `sin d = d - d^3/6 + d^5/120` are exact to rounding (the next terms are below 1.4e-21).
+    pub fn update_near(&mut self, sys: &System, q: &[f64]) {
+        let nb = sys.bodies.len();
+        debug_assert_eq!(q.len(), 3 * nb);
+        if self.sc.len() != nb {
+            self.resize(nb);
+            self.valid = false;
+        }
+        let valid = self.valid;
+        for (i, (e, r)) in self.sc.iter_mut().zip(&mut self.rotations).enumerate() {
+            let theta = q[3 * i + 2];
+            let d = theta - e[0];
+            if valid && d.abs() <= 1e-3 && *r < Self::MAX_ROTATIONS {
+                if d != 0.0 {
+                    let d2 = d * d;
+                    let cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+                    let sd = d * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0)));
+                    let (s, c) = (e[1], e[2]);
+                    *e = [theta, s * cd + c * sd, c * cd - s * sd];
+                    *r += 1;
+                }
+            } else {
+                let (s, c) = theta.sin_cos();
+                *e = [theta, s, c];
+                *r = 0;
+            }
+        }
+        self.valid = true;
+    }
+
+    /// Forgets the stored values: the next [`BodyAngles::update_near`] evaluates `sin_cos`
+    /// exactly.
     pub fn invalidate(&mut self) {
         self.valid = false;
     }
 
-    /// `(sin, cos)` of body `i`'s angle `theta`, updating the cache. For `|d| <= 1e-3` the
-    /// truncated series `cos d = 1 - d^2/2 + d^4/24`, `sin d = d - d^3/6 + d^5/120` are exact to
-    /// rounding (the next terms are below 1.4e-21).
-    #[inline]
-    pub(crate) fn sin_cos(&mut self, i: usize, theta: f64) -> (f64, f64) {
-        let valid = self.valid;
-        let e = &mut self.entries[i];
-        let d = theta - e.theta;
-        if valid && d.abs() <= 1e-3 && e.rotations < Self::MAX_ROTATIONS {
-            if d != 0.0 {
-                let d2 = d * d;
-                let cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
-                let sd = d * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0)));
-                let (s, c) = (e.s, e.c);
-                e.s = s * cd + c * sd;
-                e.c = c * cd - s * sd;
-                e.theta = theta;
-                e.rotations += 1;
-            }
-        } else {
-            (e.s, e.c) = theta.sin_cos();
-            e.theta = theta;
-            e.rotations = 0;
+    fn resize(&mut self, nb: usize) {
+        if self.sc.len() != nb {
+            self.sc.resize(nb, [0.0; 3]);
+            self.rotations.resize(nb, 0);
         }
-        (e.s, e.c)
+    }
+
+    /// Whether the table holds the angles of `q` (the `_at` passes check it in debug builds).
+    pub fn matches(&self, q: &[f64]) -> bool {
+        q.len() == 3 * self.sc.len()
+            && self
+                .sc
+                .iter()
+                .enumerate()
+                .all(|(i, e)| e[0].to_bits() == q[3 * i + 2].to_bits())
+    }
+
+    /// `R(theta_i) p`: the body-fixed vector `p` of body `i` in global axes, with `sin`/`cos`
+    /// of its angle from the table or, without one, evaluated (the closed-form revolute rows of
+    /// the derivative passes start from it; `R'(theta) p` is its quarter turn `(-y, x)`).
+    #[inline(always)]
+    pub(crate) fn rotate(angles: Option<&Self>, q: &[f64], i: usize, p: [f64; 2]) -> [f64; 2] {
+        let (sn, cs) = match angles {
+            Some(a) => (a.sc[i][1], a.sc[i][2]),
+            None => q[3 * i + 2].sin_cos(),
+        };
+        [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]]
+    }
+
+    /// `[theta, sin theta, cos theta]` of body `i`.
+    #[inline(always)]
+    pub(crate) fn sin_cos_of(&self, i: usize) -> [f64; 3] {
+        self.sc[i]
+    }
+
+    /// The frame of body `i` with the jet coordinates `vars` (whose angle has the value of
+    /// body `i`'s angle in the table), or with `sin_cos` evaluated when there is no table.
+    #[inline(always)]
+    pub(crate) fn frame<T: Scalar>(angles: Option<&Self>, i: usize, vars: [T; 3]) -> Frame<T> {
+        match angles {
+            Some(a) => {
+                let [_, s, c] = a.sc[i];
+                Frame::with_sin_cos(vars, s, c)
+            }
+            None => Frame::new(vars),
+        }
     }
 }

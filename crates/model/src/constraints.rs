@@ -1,7 +1,7 @@
 //! Evaluation of the constraints and their derivatives: `Phi`, `Phi_q`, `gamma`, `Phi_q v`,
 //! their element-local forms for sparse assembly, and the constraint Hessians.
 
-use crate::cache::AngleCache;
+use crate::cache::BodyAngles;
 use crate::hessian_pair::ElementHessian;
 use crate::jet::{point, sub2, Dual, Frame, Scalar, NV};
 use crate::joints::{JointKind, Revolute};
@@ -268,9 +268,10 @@ impl System {
         }
     }
 
-    /// [`System::phi_and_phi_dot`] with the bodies' `sin`/`cos` from `cache` (see
-    /// [`AngleCache`]): the same values to a few units in the last place, cheaper when called
-    /// repeatedly at nearby configurations.
+    /// [`System::phi_and_phi_dot`] with the bodies' `sin`/`cos` brought to `q` by
+    /// [`BodyAngles::update_near`] (rotation from the configuration `angles` held): the same
+    /// values to a few units in the last place, cheaper when called repeatedly at nearby
+    /// configurations (the Newton iterations of a chart or a projection).
     pub fn phi_and_phi_dot_cached(
         &self,
         q: &[f64],
@@ -278,22 +279,14 @@ impl System {
         t: f64,
         phi: &mut [f64],
         phi_dot: &mut [f64],
-        cache: &mut AngleCache,
+        angles: &mut BodyAngles,
     ) {
-        let nb = self.bodies.len();
-        if cache.entries.len() != nb {
-            self.phi_and_phi_dot(q, v, t, phi, phi_dot);
-            return;
-        }
-        for i in 0..nb {
-            cache.sin_cos(i, q[3 * i + 2]);
-        }
-        cache.valid = true;
-        let entries = &cache.entries;
+        angles.update_near(self, q);
+        let angles = &*angles;
         let frame = |i: Option<usize>| -> Frame<Dual> {
             match i {
                 Some(i) => {
-                    let e = entries[i];
+                    let [_, s, c] = angles.sin_cos_of(i);
                     let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
                     let w = vi[2];
                     Frame {
@@ -302,11 +295,8 @@ impl System {
                             Dual::var(qi[1], vi[1]),
                             Dual::var(qi[2], vi[2]),
                         ],
-                        c: Dual {
-                            v: e.c,
-                            d: -e.s * w,
-                        },
-                        s: Dual { v: e.s, d: e.c * w },
+                        c: Dual { v: c, d: -s * w },
+                        s: Dual { v: s, d: c * w },
                     }
                 }
                 None => Frame::fixed(),
@@ -461,7 +451,7 @@ mod phi_q_dot_jacobian_tests {
             models::manipulator().unwrap(),
         ] {
             let (n, m) = (sys.n_coords(), sys.n_constraints());
-            let mut cache = crate::AngleCache::new(&sys);
+            let mut cache = crate::BodyAngles::sized(&sys);
             let mut q: Vec<f64> = (0..n).map(|i| 0.3 + 0.17 * i as f64).collect();
             // a wound-up angle
             q[2] += 300.0;

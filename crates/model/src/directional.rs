@@ -4,85 +4,9 @@
 //! `D^2 f(a, b) = [D^2 f(a + b)^2 - D^2 f(a - b)^2] / 4` and
 //! `D^3 f(a, a, b) = [D^3 f(a + b)^3 - D^3 f(a - b)^3 - 2 D^3 f(b)^3] / 6`).
 
+use crate::cache::BodyAngles;
 use crate::jet::{Frame, Scalar, Taylor4};
 use crate::system::System;
-
-/// The sine and cosine of every body's angle at one configuration `q`, evaluated once
-/// ([`BodyAngles::update`]) and shared by all the element passes at that `q` (the `_at`
-/// variants such as [`System::lagrangian_third_at`], and [`System::constraint_poly_series`]):
-/// they give bit for bit the results of the plain passes without one `sin_cos` per element
-/// and body. Allocated once ([`BodyAngles::new`]); updating allocates nothing unless the
-/// number of bodies changed.
-#[derive(Clone, Debug, Default)]
-pub struct BodyAngles {
-    /// Per body: `[theta, sin theta, cos theta]`.
-    sc: Vec<[f64; 3]>,
-}
-
-impl BodyAngles {
-    /// The table for the bodies of `sys` at the configuration `q` (length `sys.n_coords()`).
-    pub fn new(sys: &System, q: &[f64]) -> Self {
-        let mut a = BodyAngles::default();
-        a.update(sys, q);
-        a
-    }
-
-    /// Evaluates `sin` and `cos` of every body angle of `sys` at `q` (length
-    /// `sys.n_coords()`), in place.
-    pub fn update(&mut self, sys: &System, q: &[f64]) {
-        let nb = sys.bodies.len();
-        debug_assert_eq!(q.len(), 3 * nb);
-        if self.sc.len() != nb {
-            self.sc.resize(nb, [0.0; 3]);
-        }
-        for (i, e) in self.sc.iter_mut().enumerate() {
-            let th = q[3 * i + 2];
-            let (s, c) = th.sin_cos();
-            *e = [th, s, c];
-        }
-    }
-
-    /// Whether the table holds the angles of `q` (the `_at` passes check it in debug builds).
-    pub fn matches(&self, q: &[f64]) -> bool {
-        q.len() == 3 * self.sc.len()
-            && self
-                .sc
-                .iter()
-                .enumerate()
-                .all(|(i, e)| e[0].to_bits() == q[3 * i + 2].to_bits())
-    }
-
-    /// `R(theta_i) p`: the body-fixed vector `p` of body `i` in global axes, with `sin`/`cos`
-    /// of its angle from the table or, without one, evaluated (the closed-form revolute rows of
-    /// the derivative passes start from it; `R'(theta) p` is its quarter turn `(-y, x)`).
-    #[inline(always)]
-    pub(crate) fn rotate(angles: Option<&Self>, q: &[f64], i: usize, p: [f64; 2]) -> [f64; 2] {
-        let (sn, cs) = match angles {
-            Some(a) => (a.sc[i][1], a.sc[i][2]),
-            None => q[3 * i + 2].sin_cos(),
-        };
-        [cs * p[0] - sn * p[1], sn * p[0] + cs * p[1]]
-    }
-
-    /// `[theta, sin theta, cos theta]` of body `i`.
-    #[inline(always)]
-    pub(crate) fn sin_cos_of(&self, i: usize) -> [f64; 3] {
-        self.sc[i]
-    }
-
-    /// The frame of body `i` with the jet coordinates `vars` (whose angle has the value of
-    /// body `i`'s angle in the table), or with `sin_cos` evaluated when there is no table.
-    #[inline(always)]
-    pub(crate) fn frame<T: Scalar>(angles: Option<&Self>, i: usize, vars: [T; 3]) -> Frame<T> {
-        match angles {
-            Some(a) => {
-                let [_, s, c] = a.sc[i];
-                Frame::with_sin_cos(vars, s, c)
-            }
-            None => Frame::new(vars),
-        }
-    }
-}
 
 impl System {
     #[inline(always)]
@@ -235,7 +159,7 @@ mod tests {
     /// joint kind, the manipulator and the spring model; and the table knows its `q`.
     #[test]
     fn passes_at_precomputed_angles_are_bitwise_the_plain_ones() {
-        use super::BodyAngles;
+        use crate::cache::BodyAngles;
         let same = |a: &[f64], b: &[f64], what: &str| {
             assert_eq!(a.len(), b.len());
             for (i, (x, y)) in a.iter().zip(b).enumerate() {

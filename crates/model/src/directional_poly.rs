@@ -4,7 +4,7 @@
 //! their gradients with respect to `q` and to every direction), without the polarisations of
 //! single-direction passes.
 
-use crate::directional::BodyAngles;
+use crate::cache::BodyAngles;
 use crate::jet::{Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
 use crate::joints::RevoluteSide;
 use crate::system::{Attach, System};

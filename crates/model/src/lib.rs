@@ -72,8 +72,7 @@ mod timefn;
 
 pub use body::{Body, BodyHandle, BodyRef};
 pub use builder::SystemBuilder;
-pub use cache::AngleCache;
-pub use directional::BodyAngles;
+pub use cache::BodyAngles;
 pub use directional_poly::PolyWorkspace;
 pub use element::Sketch;
 pub use error::ModelError;

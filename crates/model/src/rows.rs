@@ -10,7 +10,7 @@
 //! revolute gradients bit for bit). [`System::for_each_row_tan`] does the same for the
 //! gradients of the velocity constraint (`Hess(Phi_r) v`, the tangent chart's pass).
 
-use crate::directional::BodyAngles;
+use crate::cache::BodyAngles;
 use crate::jet::{DirJet, Frame, Scalar, TanJet, NV};
 use crate::joints::{JointKind, Prismatic, RevoluteSide};
 use crate::system::System;

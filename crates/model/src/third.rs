@@ -6,7 +6,7 @@
 //! `D^3 f(a, b, .)` follow by polarisation:
 //! `D^3 f(a, b, .) = 1/4 [D^3 f(a + b, a + b, .) - D^3 f(a - b, a - b, .)]`.
 
-use crate::directional::BodyAngles;
+use crate::cache::BodyAngles;
 use crate::jet::{Frame, Scalar, TanJet, ThirdJet, NV};
 use crate::joints::RevoluteSide;
 use crate::system::{Attach, System};

@@ -2,7 +2,7 @@
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
 use crate::kernels::{axpy, form_q, gemv_cols, gemv_t_cols, householder_qr};
-use mbd_model::{AngleCache, System};
+use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
@@ -117,7 +117,7 @@ pub struct TangentChart {
     /// The interpolation parameter of the active iteration matrix (0: the centre's).
     s: f64,
     /// `sin`/`cos` of the body angles of the last residual evaluation of a map.
-    angles: AngleCache,
+    angles: BodyAngles,
     /// The starting point of the map in progress (`2n`), for the exact Newton fallback.
     x0: Vec<f64>,
     /// `||x_1 - x_0||_inf`: the first correction of the iteration in progress (chord or exact
@@ -178,7 +178,7 @@ impl TangentChart {
             dphi_e: DMatrix::zeros(m, n),
             e: vec![0.0; mm * mm],
             has_e: false,
-            angles: AngleCache::new(sys),
+            angles: BodyAngles::sized(sys),
             rinv: vec![0.0; mm * mm],
             p0: vec![0.0; nn * mm],
             dx: vec![0.0; nn],
@@ -467,7 +467,7 @@ impl TangentChart {
     }
 
     /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous
-    /// evaluation ([`AngleCache`]: a few ulps from the exact values; the chord's iterates move
+    /// evaluation ([`BodyAngles::update_near`]: a few ulps from the exact values; the chord's iterates move
     /// by small angles).
     fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
         let (n, m) = (self.n, self.m);

@@ -5,7 +5,7 @@
 use crate::chart::{fast_max, travel_within, ChordLoop};
 use crate::chart::{ChartFailure, MapStats, NewtonSettings};
 use mbd_model::numeric::max_abs;
-use mbd_model::{AngleCache, System};
+use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::FactorError;
 use mbd_solve::sparse::{RowIncidence, SparseCholesky};
 use mbd_solve::SolveError;
@@ -90,7 +90,7 @@ pub struct SparseChart {
     /// The starting point of the map in progress (`2n`), for the travel bound.
     x0: Vec<f64>,
     first_step: f64,
-    angles: AngleCache,
+    angles: BodyAngles,
     rcond: f64,
     centred: bool,
     /// Relative threshold: the centre is singular when `1 / sqrt(cond(G))` (the estimate of
@@ -174,7 +174,7 @@ impl SparseChart {
             d: vec![0.0; 2 * m],
             x0: vec![0.0; 2 * n],
             first_step: 0.0,
-            angles: AngleCache::new(sys),
+            angles: BodyAngles::sized(sys),
             rcond: 1.0,
             centred: false,
             singular_tol: 1e-8,
@@ -386,7 +386,7 @@ impl SparseChart {
         max_abs(&out[..2 * m])
     }
 
-    /// [`SparseChart::residual`] with rotated `sin`/`cos` ([`AngleCache`]).
+    /// [`SparseChart::residual`] with rotated `sin`/`cos` ([`BodyAngles::update_near`]).
     fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
