@@ -42,8 +42,8 @@ pub use settings::{ChartFailure, MapStats, NewtonSettings};
 /// `x <- x - Q1 J^-1 f`. With `J = R^T = Df(x_c) Q1` this is the paper's
 /// `eta <- eta - (Df Df^T)^-1 f` (since `Df Df^T = R^T R`), written without forming
 /// `Df Df^T`; [`TangentChart::select_iteration_matrix`] offers a better `J` for points away from
-/// the centre. The correction matrices (`Q1 R^-T`, `2n x 2m`) are formed once per chart, so an
-/// iteration costs one residual evaluation and one or two `2n x 2m` products.
+/// the centre. With `R^T` an iteration costs one residual evaluation, one triangular solve and
+/// one `2n x 2m` product; the other matrices use `Q1 R^-T`, formed once per chart when needed.
 ///
 /// The QR factorisation uses the block structure `Df = [[Phi_q, 0], [X, Phi_q]]`
 /// (`X = (Phi_q v)_q`): `Phi_q^T = Qa [Ra; 0]` (`Qa = [Qa1 Na]`), then
