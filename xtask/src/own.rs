@@ -123,7 +123,7 @@ fn solve_to(
 /// to 9,300 instructions), while the tangent chart's own work (the QR of `Df^T`, the chord
 /// maps, the eta history) did not change (about 40,800 of its 56,100 instructions); even at no
 /// cost for the shared passes the ratio would be 4.4x. The chart's own code is the next step.
-const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300) while the tangent chart's own work (about 40,800 of its 56,100 instructions per step: QR of Df^T, chord maps) did not change; see docs/report.md, expected misses";
+const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step, the centre's QR of Df^T 19,500 -> 9,900), 4.55x in instructions, still above 4x; see docs/report.md, expected misses";
 
 /// Errors of the order study within this of zero are at the reference's / round-off floor.
 const FLOOR: f64 = 1e-11;

@@ -8,6 +8,7 @@
 /// `a = H_0 H_1 ... H_{cols-1} [R; 0]`. The first `short` columns must vanish below row `half`
 /// (true of `Df^T`: its first `m` columns are `(Phi_q^T, 0)`); their reflectors then act on rows
 /// `k..half` only and the others never refill those zeros.
+#[cfg(test)]
 pub(crate) fn householder_qr(
     a: &mut [f64],
     tau: &mut [f64],
@@ -48,6 +49,7 @@ pub(crate) fn householder_qr(
 
 /// `q = H_0 H_1 ... H_{cols-1}` (`rows x rows`, column-major) by backward accumulation, for the
 /// factors of [`householder_qr`] with the same `short` and `half`.
+#[cfg(test)]
 pub(crate) fn form_q(
     a: &[f64],
     tau: &[f64],
@@ -81,14 +83,57 @@ pub(crate) fn form_q(
     }
 }
 
+/// Calls `$f::<r>(args)` for the column lengths `r` of the planar mechanisms' small charts
+/// (`n` and `2n` for up to four bodies, `m` and `2m` for their constraints), else evaluates
+/// `$other`: with the length known the compiler unrolls the column loops and keeps the
+/// accumulators in registers, where loops of run-time length spent most of their
+/// instructions on loop control and bounds at these sizes.
+macro_rules! by_length {
+    ($r:expr, $f:ident($($arg:expr),*), $other:expr) => {
+        match $r {
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            6 => $f::<6>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            9 => $f::<9>($($arg),*),
+            12 => $f::<12>($($arg),*),
+            16 => $f::<16>($($arg),*),
+            18 => $f::<18>($($arg),*),
+            24 => $f::<24>($($arg),*),
+            _ => $other,
+        }
+    };
+}
+
 /// `y += sum_k a_k c_k` for the column-major matrix `cols` whose columns `c_k` have the length
-/// of `y` (`a.len()` of them), four columns per pass over `y`.
+/// of `y` (`a.len()` of them).
 #[inline]
 pub(crate) fn gemv_cols(cols: &[f64], a: &[f64], y: &mut [f64]) {
     let r = y.len();
     if r == 0 {
         return;
     }
+    by_length!(r, gemv_cols_fixed(cols, a, y), gemv_cols_any(cols, a, y))
+}
+
+/// [`gemv_cols`] for columns of the fixed length `R`: `y` stays in registers.
+#[inline]
+fn gemv_cols_fixed<const R: usize>(cols: &[f64], a: &[f64], y: &mut [f64]) {
+    let y: &mut [f64; R] = (&mut y[..R]).try_into().unwrap();
+    let mut acc = *y;
+    for (c, &ak) in cols.chunks_exact(R).zip(a) {
+        let c: &[f64; R] = c.try_into().unwrap();
+        for i in 0..R {
+            acc[i] += ak * c[i];
+        }
+    }
+    *y = acc;
+}
+
+/// [`gemv_cols`] for any length: four columns per pass over `y`.
+fn gemv_cols_any(cols: &[f64], a: &[f64], y: &mut [f64]) {
+    let r = y.len();
     let cols = &cols[..a.len() * r];
     let mut blocks = cols.chunks_exact(4 * r);
     let mut coef = a.chunks_exact(4);
@@ -107,7 +152,7 @@ pub(crate) fn gemv_cols(cols: &[f64], a: &[f64], y: &mut [f64]) {
 }
 
 /// `out_k = c_k . y` for the columns `c_k` (of the length of `y`, `out.len()` of them) of the
-/// column-major matrix `cols`, four columns per pass over `y`.
+/// column-major matrix `cols`.
 #[inline]
 pub(crate) fn gemv_t_cols(cols: &[f64], y: &[f64], out: &mut [f64]) {
     let r = y.len();
@@ -115,6 +160,37 @@ pub(crate) fn gemv_t_cols(cols: &[f64], y: &[f64], out: &mut [f64]) {
         out.fill(0.0);
         return;
     }
+    by_length!(
+        r,
+        gemv_t_cols_fixed(cols, y, out),
+        gemv_t_cols_any(cols, y, out)
+    )
+}
+
+/// [`gemv_t_cols`] for columns of the fixed length `R`: `y` in registers, two partial sums
+/// per column (pairs of lanes).
+#[inline]
+fn gemv_t_cols_fixed<const R: usize>(cols: &[f64], y: &[f64], out: &mut [f64]) {
+    let y: &[f64; R] = (&y[..R]).try_into().unwrap();
+    for (c, o) in cols.chunks_exact(R).zip(out.iter_mut()) {
+        let c: &[f64; R] = c.try_into().unwrap();
+        *o = dot_fixed(c, y);
+    }
+}
+
+/// `a . b` for arrays of the fixed length `R`, in two interleaved partial sums.
+#[inline(always)]
+pub(crate) fn dot_fixed<const R: usize>(a: &[f64; R], b: &[f64; R]) -> f64 {
+    let mut s = [0.0f64; 2];
+    for i in 0..R {
+        s[i % 2] += a[i] * b[i];
+    }
+    s[0] + s[1]
+}
+
+/// [`gemv_t_cols`] for any length: four columns per pass over `y`.
+fn gemv_t_cols_any(cols: &[f64], y: &[f64], out: &mut [f64]) {
+    let r = y.len();
     let cols = &cols[..out.len() * r];
     let mut blocks = cols.chunks_exact(4 * r);
     let mut outs = out.chunks_exact_mut(4);
@@ -196,3 +272,162 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     }
     t
 }
+
+/// Calls `$f(args, len)` with `len` a literal for the coordinate counts of planar mechanisms
+/// of one to four bodies (3, 6, 9, 12), else with `$n` itself: `$f` is `#[inline(always)]`,
+/// so each arm is compiled with the length known (loops unrolled, no bounds checks).
+macro_rules! with_len {
+    ($n:expr, $f:ident($($arg:expr),*)) => {
+        match $n {
+            3 => $f($($arg,)* 3),
+            6 => $f($($arg,)* 6),
+            9 => $f($($arg,)* 9),
+            12 => $f($($arg,)* 12),
+            n => $f($($arg,)* n),
+        }
+    };
+}
+pub(crate) use with_len;
+
+/// Householder QR of the first `kcols` columns of the `n x tcols` column-major matrix `a`
+/// (`n >= kcols`), applying each reflector also to the columns `kcols..tcols`. Afterwards the
+/// first `kcols` columns hold `R` on and above the diagonal and zeros below, the others
+/// `H_(kcols-1) ... H_0` times their input; the reflectors `H_k = I - tau_k v_k v_k^T` are
+/// stored full length in `v` (`n x kcols`: `v_k[i] = 0` for `i < k`, `v_k[k] = 1`), so that
+/// applying one is a product over all `n` rows (see [`reflect`]). The reflector of a column is
+/// LAPACK `dgeqr2`'s (`beta = -sign(x_0) |x|`, `tau = (beta - x_0) / beta`).
+#[inline(always)]
+pub(crate) fn qr_padded(
+    a: &mut [f64],
+    kcols: usize,
+    tcols: usize,
+    v: &mut [f64],
+    tau: &mut [f64],
+    n: usize,
+) {
+    for k in 0..kcols {
+        let (head, tail) = a[..tcols * n].split_at_mut((k + 1) * n);
+        let col = &mut head[k * n..];
+        let vk = &mut v[k * n..(k + 1) * n];
+        let x0 = col[k];
+        let mut sigma = 0.0;
+        for &x in &col[k + 1..] {
+            sigma += x * x;
+        }
+        vk.fill(0.0);
+        vk[k] = 1.0;
+        if sigma == 0.0 {
+            tau[k] = 0.0;
+            continue;
+        }
+        let norm = (x0 * x0 + sigma).sqrt();
+        let beta = if x0 >= 0.0 { -norm } else { norm };
+        let tk = (beta - x0) / beta;
+        tau[k] = tk;
+        let scale = 1.0 / (x0 - beta);
+        for (vi, ci) in vk[k + 1..].iter_mut().zip(col[k + 1..].iter_mut()) {
+            *vi = *ci * scale;
+            *ci = 0.0;
+        }
+        col[k] = beta;
+        let vk = &v[k * n..(k + 1) * n];
+        for cj in tail[..(tcols - k - 1) * n].chunks_exact_mut(n) {
+            reflect(vk, tk, cj, n);
+        }
+    }
+}
+
+/// `y <- (I - tau v v^T) y` for vectors of length `n`.
+#[inline(always)]
+pub(crate) fn reflect(v: &[f64], tau: f64, y: &mut [f64], n: usize) {
+    let (v, y) = (&v[..n], &mut y[..n]);
+    let mut s = [0.0f64; 2];
+    for i in 0..n {
+        s[i % 2] += v[i] * y[i];
+    }
+    let w = tau * (s[0] + s[1]);
+    if w != 0.0 {
+        for i in 0..n {
+            y[i] -= w * v[i];
+        }
+    }
+}
+
+/// The explicit orthogonal factor `Q = H_0 ... H_(k-1)` (`n x n`, column-major) of the
+/// reflectors `v`, `tau` of [`qr_padded`] (`k = tau.len()`): `Q e_j` for every column.
+#[inline(always)]
+pub(crate) fn form_q_padded(v: &[f64], tau: &[f64], q: &mut [f64], n: usize) {
+    let k = tau.len();
+    for (j, col) in q[..n * n].chunks_exact_mut(n).enumerate() {
+        col.fill(0.0);
+        col[j] = 1.0;
+        // H_l e_j = e_j for l > j (v_l vanishes above row l)
+        for l in (0..k.min(j + 1)).rev() {
+            reflect(&v[l * n..(l + 1) * n], tau[l], col, n);
+        }
+    }
+}
+
+/// `u = R^-T f` for the upper triangular `R` (`mm x mm`, column `i` at `r[i * stride..]`)
+/// with the reciprocals of its diagonal in `dinv`: forward substitution, row `i` of `R^T` being
+/// column `i` of `R` above the diagonal.
+#[inline(always)]
+pub(crate) fn solve_rt(
+    r: &[f64],
+    stride: usize,
+    dinv: &[f64],
+    f: &[f64],
+    u: &mut [f64],
+    mm: usize,
+) {
+    let (f, u, dinv) = (&f[..mm], &mut u[..mm], &dinv[..mm]);
+    for i in 0..mm {
+        let col = &r[i * stride..i * stride + i];
+        let mut acc = f[i];
+        for k in 0..i {
+            acc -= col[k] * u[k];
+        }
+        u[i] = acc * dinv[i];
+    }
+}
+
+/// `eta = R^-1 zeta` for the upper triangular `R` of [`solve_rt`]: back substitution by
+/// columns of `R` (contiguous).
+#[inline(always)]
+pub(crate) fn solve_r(
+    r: &[f64],
+    stride: usize,
+    dinv: &[f64],
+    zeta: &[f64],
+    eta: &mut [f64],
+    mm: usize,
+) {
+    let (eta, dinv) = (&mut eta[..mm], &dinv[..mm]);
+    eta.copy_from_slice(&zeta[..mm]);
+    for i in (0..mm).rev() {
+        let e = eta[i] * dinv[i];
+        eta[i] = e;
+        let col = &r[i * stride..i * stride + i];
+        for k in 0..i {
+            eta[k] -= col[k] * e;
+        }
+    }
+}
+
+/// Calls `$f(args, len)` with `len` a literal for the constraint counts `2m` of small planar
+/// mechanisms (2 to 16), else with `$mm` itself (see [`with_len`]).
+macro_rules! with_codim {
+    ($mm:expr, $f:ident($($arg:expr),*)) => {
+        match $mm {
+            2 => $f($($arg,)* 2),
+            4 => $f($($arg,)* 4),
+            6 => $f($($arg,)* 6),
+            8 => $f($($arg,)* 8),
+            10 => $f($($arg,)* 10),
+            12 => $f($($arg,)* 12),
+            16 => $f($($arg,)* 16),
+            mm => $f($($arg,)* mm),
+        }
+    };
+}
+pub(crate) use with_codim;

@@ -2,7 +2,7 @@
 //! Broyden), the plain and Broyden iterations, and the travel bound.
 
 use super::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR, TRAVEL_FACTOR};
-use crate::kernels::{dot, gemv_cols, gemv_t_cols, rank_one_update};
+use crate::kernels::{dot, gemv_cols, gemv_t_cols, rank_one_update, solve_rt, with_codim};
 use mbd_model::numeric::max_abs;
 use mbd_model::System;
 
@@ -19,6 +19,7 @@ impl TangentChart {
         if m == 0 || x_e.len() != nn || !self.centred {
             return;
         }
+        self.form_p0();
         sys.phi_q_dot_jacobian(&x_e[..n], &x_e[n..], &mut self.pq_e, &mut self.dphi_e);
         // Delta Df = [[dP, 0], [dX, dP]] with dP = Phi_q(e) - Phi_q(c), dX likewise
         self.pq_e -= &self.phi_q;
@@ -109,8 +110,14 @@ impl TangentChart {
         let res = self.residual_cached(sys, x, t, &mut f);
         let res_start = res;
         self.first_step = 0.0;
+        // the plain chord iteration updates zeta along with x; the others leave it to the
+        // projection below
+        let mut zeta_done = false;
         let mut out = if self.broyden && self.s == 0.0 {
             self.chord_broyden(sys, t, x, newton, &mut f, res, predicted)
+        } else if self.s == 0.0 {
+            zeta_done = true;
+            self.chord_centre(sys, t, x, zeta, newton, &mut f, res, predicted)
         } else {
             self.chord(sys, t, x, newton, &mut f, res, predicted)
         };
@@ -127,6 +134,7 @@ impl TangentChart {
             }
         }
         if let Err(failure) = out {
+            zeta_done = false;
             // whatever the failure taught the matrix is suspect
             self.pb_active = false;
             if newton.fallback_change > 0.0 {
@@ -147,7 +155,7 @@ impl TangentChart {
             }
         }
         self.f = f;
-        if out.is_ok() {
+        if out.is_ok() && !zeta_done {
             for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
                 *d = xv - xc;
             }
@@ -168,6 +176,54 @@ impl TangentChart {
             return true;
         }
         travel_within(x, start, self.first_step)
+    }
+
+    /// The chord iteration with the centre's matrix, `x <- x - Q1 R^-T f`, on `x` from its
+    /// residual `f`: each correction solves `R^T u = f` (forward substitution, `1 / R_ii`
+    /// stored) and moves `x` by `-Q1 u` and the normal coordinates `zeta` by `-u`, so that
+    /// `zeta` stays `Q1^T (x - x_c)` without a projection at the end and `Q1 R^-T` need not be
+    /// formed per chart.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn chord_centre(
+        &mut self,
+        sys: &System,
+        t: f64,
+        x: &mut [f64],
+        zeta: &mut [f64],
+        newton: &NewtonSettings,
+        f: &mut [f64],
+        res0: f64,
+        predicted: bool,
+    ) -> Result<MapStats, ChartFailure> {
+        let (nn, mm) = (2 * self.n, 2 * self.m);
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
+        loop {
+            if let Some(verdict) = lp.head() {
+                return verdict;
+            }
+            with_codim!(mm, solve_rt(&self.a, nn, &self.rdinv, f, &mut self.u));
+            for (w, (z, u)) in self.w.iter_mut().zip(zeta.iter_mut().zip(&self.u)) {
+                *w = -u;
+                *z -= u;
+            }
+            gemv_cols(&self.q[..mm * nn], &self.w, x);
+            if lp.it == 0 {
+                self.first_step = x
+                    .iter()
+                    .zip(&self.x0)
+                    .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()));
+            }
+            if let Some(ms) = lp.corrected() {
+                return Ok(ms);
+            }
+            let res = self.residual_cached(sys, x, t, f);
+            if let Some(ms) = lp.evaluated(res) {
+                return Ok(ms);
+            }
+            if let Some(e) = lp.diverged() {
+                return Err(e);
+            }
+        }
     }
 
     /// The chord iteration on `x` from its residual `f`.
@@ -239,6 +295,7 @@ impl TangentChart {
         predicted: bool,
     ) -> Result<MapStats, ChartFailure> {
         let tol = newton.tol;
+        self.form_p0();
         let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
         // whether `wx` holds `Q1 H f` for the current `f` and `H`
         let mut have_w = false;

@@ -1,7 +1,9 @@
 //! The local chart of the constraint manifold at an accepted point (paper B's "local
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
-use crate::kernels::{axpy, form_q, gemv_cols, gemv_t_cols, householder_qr};
+use crate::kernels::{
+    axpy, form_q_padded, gemv_cols, gemv_t_cols, qr_padded, solve_r, with_codim, with_len,
+};
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
 use mbd_solve::SolveError;
@@ -40,8 +42,8 @@ pub use settings::{ChartFailure, MapStats, NewtonSettings};
 /// `x <- x - Q1 J^-1 f`. With `J = R^T = Df(x_c) Q1` this is the paper's
 /// `eta <- eta - (Df Df^T)^-1 f` (since `Df Df^T = R^T R`), written without forming
 /// `Df Df^T`; [`TangentChart::select_iteration_matrix`] offers a better `J` for points away from
-/// the centre. The correction matrices (`Q1 R^-T`, `2n x 2m`) are formed once per chart, so an
-/// iteration costs one residual evaluation and one or two `2n x 2m` products.
+/// the centre. With `R^T` an iteration costs one residual evaluation, one triangular solve and
+/// one `2n x 2m` product; the other matrices use `Q1 R^-T`, formed once per chart when needed.
 ///
 /// The QR factorisation uses the block structure `Df = [[Phi_q, 0], [X, Phi_q]]`
 /// (`X = (Phi_q v)_q`): `Phi_q^T = Qa [Ra; 0]` (`Qa = [Qa1 Na]`), then
@@ -64,16 +66,22 @@ pub struct TangentChart {
     a: Vec<f64>,
     /// Householder coefficients of the two small QR factorisations.
     tau: Vec<f64>,
-    /// `Phi_q^T` (`n x m`) overwritten by its QR factors (`Ra` and reflectors).
+    tau_b: Vec<f64>,
+    /// `[Phi_q^T | X^T]` (`n x 2m`) overwritten by `[Ra; 0]` and `Qa^T X^T`.
     aq: Vec<f64>,
-    /// `B = [D; Ra]` (`n x m`) overwritten by its QR factors (`Rb` and reflectors).
+    /// `B = [D; Ra]` (`n x m`) overwritten by `[Rb; 0]`.
     bq: Vec<f64>,
+    /// The full-length Householder vectors of the two QRs (`n x m` each, see
+    /// [`qr_padded`]).
+    va: Vec<f64>,
+    vb: Vec<f64>,
+    /// `1 / R_ii` (`2m`).
+    rdinv: Vec<f64>,
+    /// Whether `rinv` and `p0` belong to the current centre ([`TangentChart::form_p0`]).
+    p0_ready: bool,
     /// The orthogonal factors `Qa` of `Phi_q^T` and `Qb` of `B` (`n x n`, column-major).
     qa: Vec<f64>,
     qb: Vec<f64>,
-    /// A row of `(Phi_q v)_q`, and `Qa^T` times it (`n`), work vectors.
-    xt: Vec<f64>,
-    g: Vec<f64>,
     /// `Q = [Q1 U]` (`2n x 2n`, column-major).
     q: Vec<f64>,
     /// The centre `(q_c, v_c)`.
@@ -164,12 +172,15 @@ impl TangentChart {
             dphi: DMatrix::zeros(m, n),
             a: vec![0.0; nn * mm],
             tau: vec![0.0; m],
-            aq: vec![0.0; n * m],
+            tau_b: vec![0.0; m],
+            aq: vec![0.0; 2 * n * m],
+            va: vec![0.0; n * m],
+            vb: vec![0.0; n * m],
+            rdinv: vec![0.0; mm],
+            p0_ready: false,
             bq: vec![0.0; n * m],
             qa: vec![0.0; n * n],
             qb: vec![0.0; n * n],
-            xt: vec![0.0; n],
-            g: vec![0.0; n],
             q,
             xc: vec![0.0; nn],
             tc: 0.0,
@@ -340,37 +351,37 @@ impl TangentChart {
             });
         }
         let nm = n - m;
-        // 1. Phi_q^T = Qa [Ra; 0] (n x m), Qa = [Qa1 Na] explicit (n x n)
-        let pq = self.phi_q.as_slice(); // column-major m x n: (r, c) at c m + r
+        // 1. [Phi_q^T | X^T] (n x 2m), X = (Phi_q v)_q: the QR of its first m columns,
+        //    Phi_q^T = Qa [Ra; 0] (Qa = [Qa1 Na]), leaves Qa^T X^T in the last m columns: its
+        //    first m rows are the block C of R, the other n - m rows (D = Na^T X^T) stacked
+        //    on Ra form B = [D; Ra] (n x m)
+        let (pq, xs) = (self.phi_q.as_slice(), self.dphi.as_slice()); // (r, c) at c m + r
         for k in 0..m {
             for c in 0..n {
                 self.aq[k * n + c] = pq[c * m + k];
+                self.aq[(m + k) * n + c] = xs[c * m + k];
             }
         }
-        householder_qr(&mut self.aq, &mut self.tau, n, m, 0, n);
-        form_q(&self.aq, &self.tau, n, m, 0, n, &mut self.qa);
-        // 2. Qa^T X^T with X = (Phi_q v)_q: its first m rows are the block C of R, the other
-        //    n - m rows (D = Na^T X^T) stacked on Ra form B = [D; Ra] (n x m)
-        let xs = self.dphi.as_slice();
+        with_len!(
+            n,
+            qr_padded(&mut self.aq, m, mm, &mut self.va, &mut self.tau)
+        );
         for j in 0..m {
-            for c in 0..n {
-                self.xt[c] = xs[c * m + j];
-            }
-            gemv_t_cols(&self.qa, &self.xt, &mut self.g);
-            self.a[(m + j) * nn..(m + j) * nn + m].copy_from_slice(&self.g[..m]);
-            self.bq[j * n..j * n + nm].copy_from_slice(&self.g[m..]);
-            for i in 0..m {
-                self.bq[j * n + nm + i] = if i <= j { self.aq[j * n + i] } else { 0.0 };
-                // R's leading block: Ra
-                self.a[j * nn + i] = if i <= j { self.aq[j * n + i] } else { 0.0 };
-            }
+            let (ra, g) = (&self.aq[j * n..], &self.aq[(m + j) * n..(m + j + 1) * n]);
+            self.a[(m + j) * nn..(m + j) * nn + m].copy_from_slice(&g[..m]);
+            self.bq[j * n..j * n + nm].copy_from_slice(&g[m..]);
+            // R's leading block: Ra (zero below its diagonal)
+            self.bq[j * n + nm..(j + 1) * n].copy_from_slice(&ra[..m]);
+            self.a[j * nn..j * nn + m].copy_from_slice(&ra[..m]);
         }
-        // 3. B = Qb [Rb; 0], Qb explicit (n x n)
-        householder_qr(&mut self.bq, &mut self.tau, n, m, 0, n);
+        // 2. B = Qb [Rb; 0]
+        with_len!(
+            n,
+            qr_padded(&mut self.bq, m, m, &mut self.vb, &mut self.tau_b)
+        );
         for j in 0..m {
-            for i in 0..=j {
-                self.a[(m + j) * nn + m + i] = self.bq[j * n + i];
-            }
+            self.a[(m + j) * nn + m..(m + j) * nn + m + j + 1]
+                .copy_from_slice(&self.bq[j * n..j * n + j + 1]);
         }
         let dmax = (0..mm).fold(0.0f64, |d, i| d.max(self.a[i * nn + i].abs()));
         let dmin = (0..mm).fold(f64::INFINITY, |d, i| d.min(self.a[i * nn + i].abs()));
@@ -392,8 +403,11 @@ impl TangentChart {
                     }
                 }));
             }
+            self.rdinv[i] = 1.0 / self.a[i * nn + i];
         }
-        form_q(&self.bq, &self.tau, n, m, 0, n, &mut self.qb);
+        // 3. Qa and Qb explicit (n x n)
+        with_len!(n, form_q_padded(&self.va, &self.tau[..m], &mut self.qa));
+        with_len!(n, form_q_padded(&self.vb, &self.tau_b[..m], &mut self.qb));
         // 4. Q = [[Qa1, W Qb, 0], [0, ., Na]] with W y = (Na y[..n-m], Qa1 y[n-m..]): columns
         //    0..m = (Qa1, 0), m..m+n = W Qb (the last n - m of them tangent), m+n..2n = (0, Na)
         for k in 0..m {
@@ -415,10 +429,27 @@ impl TangentChart {
             col[..n].fill(0.0);
             col[n..].copy_from_slice(&self.qa[(m + l) * n..(m + l + 1) * n]);
         }
+        // P0 = Q1 R^-T only for the Broyden and interpolated matrices (the plain chord solves
+        // with R^T per iteration)
+        self.p0_ready = false;
+        if self.broyden {
+            self.form_p0();
+        }
+        self.centred = true;
+        Ok(())
+    }
+
+    /// Forms `R^-1` and `P0 = Q1 R^-T` (the correction matrix of the Broyden and interpolated
+    /// iterations) for the current centre, once.
+    pub(crate) fn form_p0(&mut self) {
+        if self.p0_ready {
+            return;
+        }
+        let (nn, mm) = (2 * self.n, 2 * self.m);
         // R^-1 by back substitution, column by column (diagonal first: 1 / R_ii)
         self.rinv.fill(0.0);
         for i in 0..mm {
-            self.rinv[i * mm + i] = 1.0 / self.a[i * nn + i];
+            self.rinv[i * mm + i] = self.rdinv[i];
         }
         for j in 0..mm {
             for i in (0..j).rev() {
@@ -438,8 +469,7 @@ impl TangentChart {
             let col = &mut self.p0[k * nn..(k + 1) * nn];
             gemv_cols(&self.q[k * nn..mm * nn], &self.u[k..mm], col);
         }
-        self.centred = true;
-        Ok(())
+        self.p0_ready = true;
     }
 
     /// `min_i |R_ii| / max_i |R_ii|` of the last [`TangentChart::centre`] (1 without
@@ -538,12 +568,8 @@ impl TangentChart {
     /// choice of the orthonormal basis `Q1` (`eta = (Df Df^T)^-1 Df (x - x_c)`), so it varies
     /// smoothly from one chart to the next along a trajectory.
     pub fn eta_from_zeta(&self, zeta: &[f64], eta: &mut [f64]) {
-        let mm = 2 * self.m;
-        let eta = &mut eta[..mm];
-        eta.fill(0.0);
-        for (j, &zj) in zeta.iter().enumerate().take(mm) {
-            axpy(zj, &self.rinv[j * mm..j * mm + j + 1], &mut eta[..j + 1]);
-        }
+        let (nn, mm) = (2 * self.n, 2 * self.m);
+        with_codim!(mm, solve_r(&self.a, nn, &self.rdinv, zeta, eta));
     }
 
     /// `zeta = R eta`: the normal coordinates in the basis `Q1` of the paper's `Df(x_c)^T eta`
