@@ -84,7 +84,7 @@ fn problems() -> Result<Vec<(&'static str, System)>, String> {
     ])
 }
 
-use mbd_model::numeric::max_abs_diff as max_diff;
+use mbd_solve::linalg::max_abs_diff as max_diff;
 
 /// Reference at `t_end` from DOPRI5 + projection with a small step (independent of every solver
 /// compared).

@@ -2,8 +2,8 @@
 //! accumulated online.
 
 use crate::error::AnalysisError;
-use mbd_model::numeric::max_abs;
 use mbd_model::System;
+use mbd_solve::linalg::max_abs;
 use mbd_solve::{AccelerationSolver, Flow, Observer, SolveError, State};
 use serde::Serialize;
 

@@ -170,9 +170,9 @@ impl<W: Write> CsvObserver<W> {
         if self.residuals {
             self.phi.resize(sys.n_constraints(), 0.0);
             sys.phi(s.q.as_slice(), s.t, &mut self.phi);
-            let a = mbd_model::numeric::max_abs(&self.phi);
+            let a = mbd_solve::linalg::max_abs(&self.phi);
             sys.phi_dot(s.q.as_slice(), s.v.as_slice(), s.t, &mut self.phi);
-            let b = mbd_model::numeric::max_abs(&self.phi);
+            let b = mbd_solve::linalg::max_abs(&self.phi);
             self.row.push(a);
             self.row.push(b);
         }
@@ -308,7 +308,7 @@ mod tests {
         // the residuals are those of the states: RK4 on the index-1 form drifts a little
         let mut phi = vec![0.0; sys.n_constraints()];
         sys.phi(s.q.as_slice(), s.t, &mut phi);
-        let want_phi = mbd_model::numeric::max_abs(&phi);
+        let want_phi = mbd_solve::linalg::max_abs(&phi);
         let last = rows.last().unwrap();
         assert_eq!(last[last.len() - 2], want_phi);
         assert!(rows[0][head.len() - 2] < 1e-12);

@@ -8,8 +8,8 @@
 //! predictor's), so the serial and the parallel optimiser see identical values.
 
 use crate::partition::Partition;
-use mbd_model::numeric::max_abs;
 use mbd_model::System;
+use mbd_solve::linalg::max_abs;
 use mbd_solve::linalg::DenseLu;
 use nalgebra::DMatrix;
 

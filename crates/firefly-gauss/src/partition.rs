@@ -2,8 +2,8 @@
 //! which are dependent (completed by Newton on `Phi = 0`).
 
 use crate::error::FaDaeError;
-use mbd_model::numeric::max_abs;
 use mbd_model::System;
+use mbd_solve::linalg::max_abs;
 use nalgebra::DMatrix;
 
 /// A split of the `n` coordinates into `dof` independent and `m` dependent ones, such that the

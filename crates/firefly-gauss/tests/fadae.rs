@@ -4,8 +4,8 @@ use mbd_analysis::{fit_order, MeasureObserver};
 use mbd_firefly_gauss::{
     FaDaeError, FaDaeOptions, FireflyGauss, MissPolicy, PartitionChoice, Predictor,
 };
-use mbd_model::numeric::max_abs_diff;
 use mbd_model::{models, System};
+use mbd_solve::linalg::max_abs_diff;
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Integrator, NoObserver, Recorder, RunConfig,
     SolveError, State,

@@ -8,8 +8,8 @@
 //! throughout) is the yardstick of accuracy.
 
 use mbd_firefly_gauss::{FaDaeOptions, FireflyGauss};
-use mbd_model::numeric::max_abs;
 use mbd_model::{models, Body, BodyRef, Joint, System, SystemBuilder};
+use mbd_solve::linalg::max_abs;
 use mbd_solve::{Integrator, State};
 use std::f64::consts::{FRAC_PI_2, PI};
 

@@ -5,7 +5,7 @@
 //! single-direction passes.
 
 use crate::cache::BodyAngles;
-use crate::jet::{Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
+use crate::jet::{set_var_frame, Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
 use crate::joints::RevoluteSide;
 use crate::system::{Attach, System};
 
@@ -46,7 +46,7 @@ impl<const K: usize, B: Basis<K>> PolyWorkspace<K, B> {
             *wd = [d[3 * i], d[3 * i + 1], d[3 * i + 2]];
         }
         let [_, s, c] = ang.sin_cos_of(i);
-        PolyJet::set_var_frame(f, slot, qi, &w[..B::ND], s, c);
+        set_var_frame(f, slot, qi, &w[..B::ND], s, c);
     }
 
     /// Sets the frames of the bodies `at` and returns them with the equations' buffer.

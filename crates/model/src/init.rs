@@ -4,9 +4,8 @@
 use crate::error::ModelError;
 use crate::system::System;
 use faer::{Mat, Side};
+use mbd_linalg::max_abs;
 use nalgebra::{DMatrix, DVector};
-
-use crate::numeric::max_abs;
 
 impl System {
     /// Checks that `Phi_q(q)` has full row rank. On failure returns

@@ -1,4 +1,6 @@
-//! Forward-mode differentiation for joint and force equations.
+//! Forward-mode differentiation for joint and force equations: the jets of [`mbd_jet`] and the
+//! planar helpers the equations are written with ([`Frame`], [`point`], [`direction`], [`dot`],
+//! [`sub2`]).
 //!
 //! Every joint and force element is written once, generically over [`Scalar`], as a function of
 //! the six absolute coordinates of the (at most two) bodies it connects. Evaluating it with
@@ -27,99 +29,9 @@
 //! so the Jacobian, `gamma`, the Hessians and the third derivatives are exact (to round-off) and consistent with the
 //! equation by construction. Finite-difference tests check them all.
 
-use std::ops::{Add, Mul, Neg, Sub};
+pub use mbd_jet::{Basis, PolyJet, MAX_DIRS};
+pub(crate) use mbd_jet::{DirJet, Dual, HessJet, Scalar, TanJet, Taylor4, ThirdJet, NV};
 
-/// `-x` (as `x * -1.0`, bit-identical to negating every component), `x + c` and `x - c` (the
-/// value shifts, the derivatives do not) for a jet type with a `v` field and `Mul<f64>`.
-macro_rules! scalar_shift_ops {
-    ($t:ty) => {
-        impl std::ops::Neg for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn neg(self) -> Self {
-                self * -1.0
-            }
-        }
-        impl std::ops::Add<f64> for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn add(mut self, c: f64) -> Self {
-                self.v += c;
-                self
-            }
-        }
-        impl std::ops::Sub<f64> for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn sub(mut self, c: f64) -> Self {
-                self.v -= c;
-                self
-            }
-        }
-    };
-}
-use scalar_shift_ops;
-
-mod dir;
-mod dual;
-mod hess;
-mod poly;
-mod tan;
-mod taylor;
-mod third;
-
-pub use dir::DirJet;
-pub use dual::Dual;
-pub use hess::HessJet;
-pub use poly::{Basis, PolyJet, MAX_DIRS};
-pub use tan::TanJet;
-pub use taylor::Taylor4;
-pub use third::ThirdJet;
-
-/// Number of local variables of one element: `(x, y, theta)` of body a, then of body b.
-pub const NV: usize = 6;
-
-/// The arithmetic an element equation needs.
-pub trait Scalar:
-    Copy
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Neg<Output = Self>
-    + Add<f64, Output = Self>
-    + Sub<f64, Output = Self>
-    + Mul<f64, Output = Self>
-{
-    /// A constant (zero derivatives).
-    fn cst(v: f64) -> Self;
-    /// `(sin x, cos x)`.
-    fn sin_cos(self) -> (Self, Self);
-    /// `(sin x, cos x)` given `s = sin` and `c = cos` of the value of `x` (evaluated once and
-    /// shared by several jets at the same point): bit for bit [`Scalar::sin_cos`] when `(s, c)`
-    /// is `value.sin_cos()`.
-    fn sin_cos_with(self, s: f64, c: f64) -> (Self, Self);
-    /// Square root (the caller keeps the argument positive).
-    fn sqrt(self) -> Self;
-}
-
-impl Scalar for f64 {
-    #[inline(always)]
-    fn cst(v: f64) -> Self {
-        v
-    }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        f64::sin_cos(self)
-    }
-    #[inline(always)]
-    fn sin_cos_with(self, s: f64, c: f64) -> (Self, Self) {
-        (s, c)
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-}
 /// A body's coordinates `(x, y, theta)` with `cos theta` and `sin theta` evaluated once, so the
 /// points and directions of one element share them (and ground costs no trigonometry).
 #[derive(Clone, Copy, Debug)]
@@ -192,33 +104,67 @@ pub fn sub2<T: Scalar>(b: [T; 2], a: [T; 2]) -> [T; 2] {
     [b[0] - a[0], b[1] - a[1]]
 }
 
+/// Writes into `f` the frame of a body whose coordinates are the jet variables `slot ..
+/// slot + 3` with the values `q`, the components `w[j]` (this body's three) along direction
+/// `j`, and `(sin, cos)` of its angle `(sn, cs)`. Only the entries that can be non-zero are
+/// written, so every other entry of `f` must be zero already: `f` starts as [`Frame::fixed`]
+/// and is only ever set with the same `slot`.
+#[inline(always)]
+pub(crate) fn set_var_frame<const K: usize, B: Basis<K>>(
+    f: &mut Frame<PolyJet<K, B>>,
+    slot: usize,
+    q: [f64; 3],
+    w: &[[f64; 3]],
+    sn: f64,
+    cs: f64,
+) {
+    let mut wa = [0.0; MAX_DIRS];
+    for k in 0..3 {
+        let x = &mut f.q[k];
+        x.c[0] = q[k];
+        x.g[0][slot + k] = 1.0;
+        for (d, wd) in w.iter().enumerate().take(B::ND) {
+            x.c[B::LIN[d] as usize] = wd[k];
+        }
+    }
+    for (d, wd) in w.iter().enumerate().take(B::ND) {
+        wa[d] = wd[2];
+    }
+    // the angle's gradient is e_(slot + 2): only that column is written
+    let [sv, sd, cv, cd] = PolyJet::<K, B>::angle_series(&wa, sn, cs);
+    let l = slot + 2;
+    for k in 0..K {
+        (f.s.c[k], f.s.g[k][l]) = (sv[k], sd[k]);
+        (f.c.c[k], f.c.g[k][l]) = (cv[k], cd[k]);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fixtures::TwoDirections;
 
+    /// A distance between two points of two bodies, times an angle, plus a product.
     fn f<T: Scalar>(x: [T; 6]) -> T {
         let p = point(&Frame::new([x[0], x[1], x[2]]), [0.3, -0.2]);
         let q = point(&Frame::new([x[3], x[4], x[5]]), [-0.1, 0.4]);
+        let u = direction(&Frame::new([x[3], x[4], x[5]]), [0.6, 0.8]);
         let d = sub2(q, p);
-        dot(d, d).sqrt() * x[2] + x[0] * x[4]
+        dot(d, d).sqrt() * x[2] + x[0] * x[4] + dot(d, u)
     }
 
+    /// The planar helpers on jets: gradient and Hessian against finite differences.
     #[test]
-    fn jets_match_finite_differences() {
+    fn planar_helpers_on_jets_match_finite_differences() {
         let x0 = [0.1, -0.3, 0.7, 1.2, 0.4, -0.5];
-        let dir = [0.3, -0.1, 0.9, 0.2, -0.6, 0.5];
-        let dj: [DirJet; 6] = std::array::from_fn(|i| DirJet::var(i, x0[i], dir[i]));
-        let hj: [HessJet; 6] = std::array::from_fn(|i| HessJet::var(i, x0[i]));
-        let d = f(dj);
-        let h = f(hj);
+        let h = f(std::array::from_fn(|i| HessJet::var(i, x0[i])));
+        assert_eq!(h.v, f(x0));
         let e = 1e-5;
         for i in 0..6 {
-            let mut xp = x0;
-            let mut xm = x0;
+            let (mut xp, mut xm) = (x0, x0);
             xp[i] += e;
             xm[i] -= e;
             let fd = (f(xp) - f(xm)) / (2.0 * e);
-            assert!((fd - d.g[i]).abs() < 1e-8, "grad {i}");
             assert!((fd - h.g[i]).abs() < 1e-8, "grad {i}");
             let gp = f(std::array::from_fn(|k| HessJet::var(k, xp[k]))).g;
             let gm = f(std::array::from_fn(|k| HessJet::var(k, xm[k]))).g;
@@ -227,51 +173,33 @@ mod tests {
                 assert!((fd2 - h.h[i][j]).abs() < 1e-7, "hess {i} {j}");
             }
         }
-        let mut vhv = 0.0;
-        for i in 0..6 {
-            for j in 0..6 {
-                vhv += dir[i] * h.h[i][j] * dir[j];
+    }
+
+    /// The frames built in place by [`set_var_frame`] equal the frames of variables.
+    #[test]
+    fn var_frames_match() {
+        let x0 = [0.1, -0.3, 0.7, 1.2, 0.4, -0.5];
+        let dirs = [
+            [0.3, -0.1, 0.9, 0.2, -0.6, 0.5],
+            [-0.4, 0.2, 0.6, -0.3, 0.1, 0.8],
+        ];
+        for slot in [0, 3] {
+            let q = [x0[slot], x0[slot + 1], x0[slot + 2]];
+            let w: Vec<[f64; 3]> = dirs
+                .iter()
+                .map(|d| [d[slot], d[slot + 1], d[slot + 2]])
+                .collect();
+            let (sn, cs) = q[2].sin_cos();
+            let mut g: Frame<PolyJet<8, TwoDirections>> = Frame::fixed();
+            set_var_frame(&mut g, slot, q, &w, sn, cs);
+            let r = Frame::new(std::array::from_fn(|k| {
+                let wk: Vec<f64> = w.iter().map(|d| d[k]).collect();
+                PolyJet::<8, TwoDirections>::var(slot + k, q[k], &wk)
+            }));
+            for (a, b) in [(g.s, r.s), (g.c, r.c), (g.q[0], r.q[0]), (g.q[2], r.q[2])] {
+                assert_eq!(a.c, b.c);
+                assert_eq!(a.g, b.g);
             }
         }
-        assert!((vhv - d.d2).abs() < 1e-12);
-        let gd: f64 = (0..6).map(|i| d.g[i] * dir[i]).sum();
-        assert!((gd - d.d1).abs() < 1e-14);
-        // TanJet: H w and the directional derivative, against the HessJet
-        let tj = f(std::array::from_fn(|i| TanJet::var(i, x0[i], dir[i])));
-        assert!((tj.v - h.v).abs() < 1e-15);
-        assert!((tj.d - d.d1).abs() < 1e-14);
-        for i in 0..6 {
-            assert!((tj.g[i] - h.g[i]).abs() < 1e-14, "TanJet grad {i}");
-            let hw: f64 = (0..6).map(|j| h.h[i][j] * dir[j]).sum();
-            assert!((tj.dg[i] - hw).abs() < 1e-13, "TanJet H w {i}");
-        }
-        // ThirdJet: H w, w^T H w and grad(w^T H w) against differences of the HessJet
-        let t3 = f(std::array::from_fn(|i| ThirdJet::var(i, x0[i], dir[i])));
-        assert!((t3.v - h.v).abs() < 1e-15);
-        assert!((t3.d1 - d.d1).abs() < 1e-14);
-        assert!((t3.d2 - vhv).abs() < 1e-12);
-        let quad = |x: [f64; 6]| -> f64 {
-            let hh = f(std::array::from_fn(|k| HessJet::var(k, x[k]))).h;
-            (0..6)
-                .map(|i| (0..6).map(|j| dir[i] * hh[i][j] * dir[j]).sum::<f64>())
-                .sum()
-        };
-        for i in 0..6 {
-            assert!((t3.g[i] - h.g[i]).abs() < 1e-14, "ThirdJet grad {i}");
-            let hw: f64 = (0..6).map(|j| h.h[i][j] * dir[j]).sum();
-            assert!((t3.g1[i] - hw).abs() < 1e-13, "ThirdJet H w {i}");
-            let (mut xp, mut xm) = (x0, x0);
-            xp[i] += e;
-            xm[i] -= e;
-            let fd3 = (quad(xp) - quad(xm)) / (2.0 * e);
-            assert!(
-                (t3.g2[i] - fd3).abs() < 1e-7,
-                "ThirdJet D3 {i}: {} vs {fd3}",
-                t3.g2[i]
-            );
-        }
-        let du = f(std::array::from_fn(|i| Dual::var(x0[i], dir[i])));
-        assert!((du.v - d.v).abs() < 1e-15);
-        assert!((du.d - d.d1).abs() < 1e-14);
     }
 }

@@ -3,10 +3,9 @@
 //! sparse above [`crate::SPARSE_THRESHOLD`] constraints), with a report of how far it moved.
 
 use crate::error::SolveError;
-use crate::linalg::max_abs;
+use crate::linalg::{max_abs, max_abs_diff};
 use crate::projection::{ProjectionSettings, Projector};
 use crate::sparse::LinearSolver;
-use mbd_model::numeric::max_abs_diff;
 use mbd_model::System;
 use nalgebra::DVector;
 

@@ -1,5 +1,6 @@
 //! The one error type of `mbd-solve` (and the error solver crates return).
 
+use mbd_linalg::LinalgError;
 use mbd_model::ModelError;
 use thiserror::Error;
 
@@ -169,4 +170,27 @@ pub enum SolveError {
     /// An error from the model.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// A factorisation failed, or its workspace could not be set up, where no time or
+    /// equation is known to name (see [`SolveError::from`]).
+    #[error("linear algebra: {0}")]
+    LinearAlgebra(LinalgError),
+}
+
+/// The one conversion of the linear algebra's errors: a pattern entry out of range becomes
+/// [`SolveError::Dimension`], a failed symbolic analysis [`SolveError::Unsupported`] (the
+/// analysis refuses the model's structure), anything else [`SolveError::LinearAlgebra`]. The
+/// solvers turn a failed factorisation at a time `t` into [`SolveError::Singular`] themselves,
+/// with the equation at fault.
+impl From<LinalgError> for SolveError {
+    fn from(e: LinalgError) -> Self {
+        match e {
+            LinalgError::PatternEntry { what, dim, index } => SolveError::Dimension {
+                what,
+                expected: dim,
+                got: index,
+            },
+            LinalgError::Analysis(reason) => SolveError::Unsupported(reason),
+            e => SolveError::LinearAlgebra(e),
+        }
+    }
 }

@@ -329,7 +329,7 @@ fn sparse_and_dense_projections_agree_and_stop_at_the_roundoff_floor() {
         assert!(mbd_solve::linalg::max_abs(&phid) < 1e-12);
         results.push((q, v));
     }
-    let dq = mbd_model::numeric::max_abs_diff(&results[0].0, &results[1].0);
-    let dv = mbd_model::numeric::max_abs_diff(&results[0].1, &results[1].1);
+    let dq = mbd_solve::linalg::max_abs_diff(&results[0].0, &results[1].0);
+    let dv = mbd_solve::linalg::max_abs_diff(&results[0].1, &results[1].1);
     assert!(dq < 1e-12 && dv < 1e-12, "dense vs sparse: {dq:e} {dv:e}");
 }

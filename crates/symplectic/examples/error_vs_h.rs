@@ -9,8 +9,8 @@
 //! steps and to the (4,4) and (3,3) schemes at h = 2/1024 .. 2/8192, and theirs to each other
 //! (together they bound what the reference resolves: about 2e-13).
 use mbd_model::models;
-use mbd_model::numeric::max_abs_diff;
 use mbd_model::System;
+use mbd_solve::linalg::max_abs_diff;
 use mbd_solve::{reference_trajectory, ButcherTableau, Integrator, State};
 use mbd_symplectic::{Galerkin, SymplecticOptions};
 

@@ -2,8 +2,8 @@
 //! 1e3 kg) masses. The stage LU's pivot test was relative to `max |J|`, so at h = 1.25e-7 the
 //! multiplier columns (`h^2 M^-1 Phi_q^T`, 1e-14 times smaller than the others) were taken for
 //! singular in the first step, while every other solver ran the model.
-use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::{Body, BodyRef, Joint, System, SystemBuilder};
+use mbd_solve::linalg::{max_abs, max_abs_diff};
 use mbd_solve::{reference_trajectory, ButcherTableau, Integrator, SolveError, State};
 use mbd_symplectic::{Galerkin, SymplecticOptions};
 

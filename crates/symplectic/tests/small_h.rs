@@ -7,8 +7,8 @@
 //! h = 9.8e-6 even when at least two Newton updates per step were forced).
 mod common;
 use mbd_model::models;
-use mbd_model::numeric::max_abs_diff;
 use mbd_model::{Body, System, SystemBuilder};
+use mbd_solve::linalg::max_abs_diff;
 use mbd_solve::{reference_trajectory, ButcherTableau, Integrator, State};
 use mbd_symplectic::{Galerkin, SymplecticOptions};
 

@@ -28,7 +28,7 @@ fn env_f64(name: &str) -> Result<Option<f64>, Box<dyn std::error::Error>> {
 }
 
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    mbd::model::numeric::max_abs_diff(a, b)
+    mbd::solve::linalg::max_abs_diff(a, b)
 }
 
 fn adaptive() -> Result<(), Box<dyn std::error::Error>> {

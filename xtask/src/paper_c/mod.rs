@@ -13,9 +13,9 @@ use crate::report::{
 use mbd_analysis::plot::{Figure, Series};
 use mbd_analysis::{fit_order, MeasureObserver, RunMeasures};
 use mbd_firefly_gauss::{FaDaeOptions, FaDaeStats, FireflyGauss, RefinedAcceleration};
-use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::{models, System};
 use mbd_rk4::{Rk4, Rk4Options};
+use mbd_solve::linalg::{max_abs, max_abs_diff};
 use mbd_solve::{
     reference_trajectory, run, ButcherTableau, Flow, Integrator, Observer, RunConfig, SolveError,
     State,

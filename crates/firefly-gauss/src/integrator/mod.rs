@@ -7,9 +7,9 @@ use crate::objective::{StepProblem, Workspace};
 use crate::options::{FaDaeOptions, MissPolicy, PartitionChoice, Predictor};
 use crate::partition::{Partition, Pivoting};
 use mbd_firefly::{Bounds, Firefly, Objective, SyncObjective};
-use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::System;
 use mbd_solve::linalg::DenseLu;
+use mbd_solve::linalg::{max_abs, max_abs_diff};
 use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
 use std::sync::Mutex;
 

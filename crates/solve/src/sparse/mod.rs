@@ -1,13 +1,13 @@
 //! The sparse numerics kernel: what every solver uses above the dense threshold.
 //!
-//! * [`SparseCholesky`]: a symmetric positive definite matrix on a fixed pattern, analysed once
-//!   (fill-reducing ordering, elimination tree) and refactored into preallocated storage, with
-//!   the same scale-invariant pivot test and condition estimate as the dense
-//!   [`crate::linalg::DenseCholesky`];
+//! * [`SparseCholesky`] (from [`mbd_linalg`]): a symmetric positive definite matrix on a fixed
+//!   pattern, analysed once (fill-reducing ordering, elimination tree) and refactored into
+//!   preallocated storage, with the same scale-invariant pivot test and condition estimate as
+//!   the dense [`crate::linalg::DenseCholesky`];
 //! * [`ConstraintSchur`]: the constraint Jacobian `Phi_q` in element-local form (each equation
 //!   acts on at most two bodies) and the matrix `S = Phi_q W Phi_q^T` for a diagonal weight `W`
 //!   (the index-1 solve and the projections use `W = M^-1`);
-//! * [`SparseLu`]: a general square matrix on a fixed pattern (the symplectic stage
+//! * [`SparseLu`] (from [`mbd_linalg`]): a general square matrix on a fixed pattern (the symplectic stage
 //!   equations), analysed once and refactored into reused storage, with a scale-invariant
 //!   pivot test by power-of-two equilibration;
 //! * [`SparseAccelerationSolver`]: the index-1 acceleration solve on top of both.
@@ -15,13 +15,10 @@
 //! For a chain of `N` bodies every one of them costs `O(N)` per call.
 
 mod accel;
-mod cholesky;
-mod lu;
 mod schur;
 
 pub use accel::SparseAccelerationSolver;
-pub use cholesky::SparseCholesky;
-pub use lu::{SparseLu, SPARSE_PIVOT_TOL};
+pub use mbd_linalg::{SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};
 pub use schur::{ConstraintSchur, RowIncidence};
 
 /// Constraint count above which [`LinearSolver::Auto`] picks the sparse path (index-1 solve,

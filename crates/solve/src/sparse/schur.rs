@@ -1,7 +1,7 @@
 //! The constraint Jacobian in element-local form and the weighted Schur complement
 //! `S = Phi_q W Phi_q^T` on its sparse pattern.
 
-use super::cholesky::SparseCholesky;
+use super::SparseCholesky;
 use crate::error::SolveError;
 use crate::linalg::FactorError;
 use mbd_model::System;

@@ -24,6 +24,7 @@
 //! its `q` (a no-op when `q` repeats), then asks one term.
 
 use mbd_model::System;
+use mbd_solve::linalg::dot;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -63,11 +64,6 @@ pub struct Preadjustment {
     /// Relative step of the finite-difference checks of the derivatives (tests); the
     /// derivatives used by the integrator are exact.
     pub(crate) fd_step: f64,
-}
-
-/// `a . b`.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 impl Preadjustment {

@@ -45,17 +45,12 @@ use super::{e4_value, Invariant, ModifiedS2, PerInvariant};
 use crate::preadjust::metric::ProjectedMetric;
 use crate::preadjust::LocalRow;
 use mbd_model::{Basis, BodyAngles, System};
+use mbd_solve::linalg::axpy;
 
 /// `out = ca a + cb b`.
 fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64]) {
     for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
         *o = ca * x + cb * y;
-    }
-}
-
-fn axpy(y: &mut [f64], c: f64, x: &[f64]) {
-    for (a, b) in y.iter_mut().zip(x) {
-        *a += c * b;
     }
 }
 
@@ -122,55 +117,55 @@ impl ModifiedS2 {
         let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
         let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
         adj_pi(&mut w.gbar, cols, c[VHsigPiHmuV], hsig_v, hmu_v);
-        axpy(&mut w.hsig_vb, c[VHsigPiHmuV], &f.pi_hmu_v);
-        axpy(&mut w.hmu_vb, c[VHsigPiHmuV], &f.pi_hsig_v);
+        axpy(c[VHsigPiHmuV], &f.pi_hmu_v, &mut w.hsig_vb);
+        axpy(c[VHsigPiHmuV], &f.pi_hsig_v, &mut w.hmu_vb);
         adj_pi(&mut w.gbar, cols, c[VHmuPiHmuV], hmu_v, hmu_v);
-        axpy(&mut w.hmu_vb, 2.0 * c[VHmuPiHmuV], &f.pi_hmu_v);
-        axpy(&mut w.ub, c[UHmuU], &f.hmu_u);
-        axpy(&mut w.hmu_ub, c[UHmuU], &f.u);
+        axpy(2.0 * c[VHmuPiHmuV], &f.pi_hmu_v, &mut w.hmu_vb);
+        axpy(c[UHmuU], &f.hmu_u, &mut w.ub);
+        axpy(c[UHmuU], &f.u, &mut w.hmu_ub);
         let beta = (f.s_beta.as_slice(), f.k2.as_slice());
         let kap3 = (f.s_kap3.as_slice(), f.k3.as_slice());
         adj_s(&mut w.gbar, cols, c[BetaSBeta], beta, beta);
-        axpy(&mut w.betab, 2.0 * c[BetaSBeta], &f.s_beta);
-        axpy(&mut w.ub, c[UHsigU], &f.hsig_u);
-        axpy(&mut w.hsig_ub, c[UHsigU], &f.u);
+        axpy(2.0 * c[BetaSBeta], &f.s_beta, &mut w.betab);
+        axpy(c[UHsigU], &f.hsig_u, &mut w.ub);
+        axpy(c[UHsigU], &f.u, &mut w.hsig_ub);
         adj_s(&mut w.gbar, cols, c[Kappa3SBeta], kap3, beta);
-        axpy(&mut w.kap3b, c[Kappa3SBeta], &f.s_beta);
-        axpy(&mut w.betab, c[Kappa3SBeta], &f.s_kap3);
-        axpy(&mut w.mu0b, c[Mu0Kappa3u], &f.kap3u);
-        axpy(&mut w.kap3ub, c[Mu0Kappa3u], &f.mu0);
-        axpy(&mut w.sigb, c[SigmaKappa3u], &f.kap3u);
-        axpy(&mut w.kap3ub, c[SigmaKappa3u], &f.sig);
-        axpy(&mut w.mu0b, c[Mu0Kappa4], &f.kap4);
-        axpy(&mut w.kap4b, c[Mu0Kappa4], &f.mu0);
+        axpy(c[Kappa3SBeta], &f.s_beta, &mut w.kap3b);
+        axpy(c[Kappa3SBeta], &f.s_kap3, &mut w.betab);
+        axpy(c[Mu0Kappa3u], &f.kap3u, &mut w.mu0b);
+        axpy(c[Mu0Kappa3u], &f.mu0, &mut w.kap3ub);
+        axpy(c[SigmaKappa3u], &f.kap3u, &mut w.sigb);
+        axpy(c[SigmaKappa3u], &f.sig, &mut w.kap3ub);
+        axpy(c[Mu0Kappa4], &f.kap4, &mut w.mu0b);
+        axpy(c[Mu0Kappa4], &f.mu0, &mut w.kap4b);
         adj_pi(&mut w.gbar, cols, c[VHsigPiHsigV], hsig_v, hsig_v);
-        axpy(&mut w.hsig_vb, 2.0 * c[VHsigPiHsigV], &f.pi_hsig_v);
-        axpy(&mut w.sigb, c[SigmaKappa4], &f.kap4);
-        axpy(&mut w.kap4b, c[SigmaKappa4], &f.sig);
+        axpy(2.0 * c[VHsigPiHsigV], &f.pi_hsig_v, &mut w.hsig_vb);
+        axpy(c[SigmaKappa4], &f.kap4, &mut w.sigb);
+        axpy(c[SigmaKappa4], &f.sig, &mut w.kap4b);
         adj_s(&mut w.gbar, cols, c[Kappa3SKappa3], kap3, kap3);
-        axpy(&mut w.kap3b, 2.0 * c[Kappa3SKappa3], &f.s_kap3);
+        axpy(2.0 * c[Kappa3SKappa3], &f.s_kap3, &mut w.kap3b);
         if pot {
             adj_pi(&mut w.gbar, cols, c[VHmuPiHV], hmu_v, hv);
-            axpy(&mut w.hmu_vb, c[VHmuPiHV], &f.pi_hv);
-            axpy(&mut w.hvb, c[VHmuPiHV], &f.pi_hmu_v);
-            axpy(&mut w.hvb, c[VHK2], &f.k2);
-            axpy(&mut w.k2b, c[VHK2], &f.hv);
-            axpy(&mut w.hub, c[UHN], &f.nn);
-            axpy(&mut w.nnb, c[UHN], &f.hu);
-            axpy(&mut w.ub, c[UHU], &f.hu);
-            axpy(&mut w.hub, c[UHU], &f.u);
+            axpy(c[VHmuPiHV], &f.pi_hv, &mut w.hmu_vb);
+            axpy(c[VHmuPiHV], &f.pi_hmu_v, &mut w.hvb);
+            axpy(c[VHK2], &f.k2, &mut w.hvb);
+            axpy(c[VHK2], &f.hv, &mut w.k2b);
+            axpy(c[UHN], &f.nn, &mut w.hub);
+            axpy(c[UHN], &f.hu, &mut w.nnb);
+            axpy(c[UHU], &f.hu, &mut w.ub);
+            axpy(c[UHU], &f.u, &mut w.hub);
             // D^3 V(u, v, v) = 2 (pass A's e t^2)
             w.pa[A_ETT] += 2.0 * c[D3VUVV];
-            axpy(&mut w.nnb, c[NHN], &f.hn);
-            axpy(&mut w.hnb, c[NHN], &f.nn);
+            axpy(c[NHN], &f.hn, &mut w.nnb);
+            axpy(c[NHN], &f.nn, &mut w.hnb);
             adj_pi(&mut w.gbar, cols, c[VHPiHsigV], hv, hsig_v);
-            axpy(&mut w.hvb, c[VHPiHsigV], &f.pi_hsig_v);
-            axpy(&mut w.hsig_vb, c[VHPiHsigV], &f.pi_hv);
-            axpy(&mut w.hvb, c[VHK3], &f.k3);
-            axpy(&mut w.k3b, c[VHK3], &f.hv);
+            axpy(c[VHPiHsigV], &f.pi_hsig_v, &mut w.hvb);
+            axpy(c[VHPiHsigV], &f.pi_hv, &mut w.hsig_vb);
+            axpy(c[VHK3], &f.k3, &mut w.hvb);
+            axpy(c[VHK3], &f.hv, &mut w.k3b);
             w.pb[B_ETT] += 2.0 * c[D3VNVV];
             adj_pi(&mut w.gbar, cols, c[VHPiHV], hv, hv);
-            axpy(&mut w.hvb, 2.0 * c[VHPiHV], &f.pi_hv);
+            axpy(2.0 * c[VHPiHV], &f.pi_hv, &mut w.hvb);
             w.pa[A_T4] += 24.0 * c[D4V];
         }
 
@@ -215,7 +210,7 @@ impl ModifiedS2 {
         let k3b = std::mem::take(&mut w.k3b);
         adj_neg_e(metric, w, cols, &f.s_kap3, &k3b);
         w.k3b = k3b;
-        axpy(&mut w.kap3b, 1.0, &w.tm[0]);
+        axpy(1.0, &w.tm[0], &mut w.kap3b);
         for r in 0..m {
             w.wa[r][A_TTT] += 6.0 * w.kap3b[r];
             w.wb[r][B_ET] += 3.0 * w.kap3b[r];
@@ -224,7 +219,7 @@ impl ModifiedS2 {
         let k2b = std::mem::take(&mut w.k2b);
         adj_neg_e(metric, w, cols, &f.s_beta, &k2b);
         w.k2b = k2b;
-        axpy(&mut w.betab, 1.0, &w.tm[0]);
+        axpy(1.0, &w.tm[0], &mut w.betab);
         for r in 0..m {
             w.wa[r][A_ET] += w.betab[r];
         }
@@ -246,7 +241,7 @@ impl ModifiedS2 {
             }
             metric.g_times(dn, t);
             gbar_add(&mut w.gbar, cols, -1.0, &f.sig, dn);
-            axpy(&mut w.sigb, -1.0, t);
+            axpy(-1.0, t, &mut w.sigb);
             metric.s_inv_into(&w.sigb, a);
             metric.dgt_into(&f.sig, dsig);
             metric.dgt_into(a, da);
@@ -272,12 +267,12 @@ impl ModifiedS2 {
                 *d = mi * x;
             }
             metric.g_times(dub, s);
-            axpy(&mut w.mu0b, 1.0, s);
-            axpy(&mut w.gradb, -1.0, dub);
+            axpy(1.0, s, &mut w.mu0b);
+            axpy(-1.0, dub, &mut w.gradb);
             gbar_add(&mut w.gbar, cols, 1.0, &f.mu0, dub);
             metric.s_inv_into(&w.mu0b, a);
             metric.dgt_into(a, da);
-            axpy(&mut w.gradb, 1.0, da);
+            axpy(1.0, da, &mut w.gradb);
             for ((d, x), mi) in dg.iter_mut().zip(metric.grad_v()).zip(metric.minv()) {
                 *d = mi * x;
             }
@@ -286,7 +281,7 @@ impl ModifiedS2 {
             gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
             sys.lagrangian_hessian_vector_at(q, &f.angles, &w.gradb, 1.0, &f.zero_m, t);
-            axpy(gq, 1.0, t);
+            axpy(1.0, t, gq);
         }
 
         // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r

@@ -2,9 +2,7 @@
 //! pivoting, columns in a COLAMD order), with power-of-two equilibration and a scale-invariant
 //! pivot test.
 
-use super::cholesky::Scratch;
-use crate::error::SolveError;
-use crate::linalg::{pow2_inverse, LuError};
+use crate::{pow2_inverse, LinalgError, LuError, Scratch};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
 use faer::sparse::linalg::lu::simplicial::{
@@ -45,7 +43,7 @@ const EQUILIBRATION_SWEEPS: usize = 1;
 /// `D_r A D_c y = D_r b`).
 ///
 /// ```
-/// use mbd_solve::sparse::SparseLu;
+/// use mbd_linalg::SparseLu;
 /// // [[0, 2, 0], [1, 0, 3], [0, 4, 5]]
 /// let entries = [(0, 1, 2.0), (1, 0, 1.0), (1, 2, 3.0), (2, 1, 4.0), (2, 2, 5.0)];
 /// let pattern: Vec<(usize, usize)> = entries.iter().map(|&(r, c, _)| (r, c)).collect();
@@ -87,14 +85,14 @@ pub struct SparseLu {
 impl SparseLu {
     /// Analyses the pattern: `n` unknowns, entries `(row, col)` (repeats are merged). Allocates;
     /// done once per pattern.
-    pub fn new(n: usize, entries: &[(usize, usize)]) -> Result<Self, SolveError> {
+    pub fn new(n: usize, entries: &[(usize, usize)]) -> Result<Self, LinalgError> {
         let mut e: Vec<(usize, usize)> = Vec::with_capacity(entries.len());
         for &(r, c) in entries {
             if r >= n || c >= n {
-                return Err(SolveError::Dimension {
+                return Err(LinalgError::PatternEntry {
                     what: "sparse LU pattern entry",
-                    expected: n,
-                    got: r.max(c),
+                    dim: n,
+                    index: r.max(c),
                 });
             }
             e.push((c, r));
@@ -125,7 +123,7 @@ impl SparseLu {
                 ..Default::default()
             };
             let symbolic = factorize_symbolic_lu(sym.as_ref(), params).map_err(|e| {
-                SolveError::Unsupported(format!("sparse LU symbolic analysis failed: {e:?}"))
+                LinalgError::Analysis(format!("sparse LU symbolic analysis failed: {e:?}"))
             })?;
             let (f, i) = symbolic.col_perm().arrays();
             (f.to_vec(), i.to_vec())

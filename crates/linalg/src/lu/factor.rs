@@ -2,7 +2,7 @@
 //! equilibration's scale factors, and the general path (threshold partial pivoting).
 
 use super::{DenseLu, PIVOT_THRESHOLD};
-use crate::linalg::{pow2_inverse, LuError};
+use crate::{pow2_inverse, LuError};
 
 impl DenseLu {
     /// Factors the matrix in place (singularity tests on the equilibrated matrix, see the

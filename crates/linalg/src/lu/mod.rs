@@ -57,7 +57,7 @@ mod factor;
 mod solve;
 mod symbolic;
 
-use super::{FactorError, LuError};
+use crate::{FactorError, LuError};
 use faer::MatMut;
 use nalgebra::DMatrix;
 use symbolic::Pattern;

@@ -20,7 +20,7 @@
 //! be closed under division (every divisor of a member is a member), so products truncate
 //! consistently; the tables are built, and these rules checked, at compile time.
 
-use super::{Frame, Scalar, NV};
+use super::{Scalar, NV};
 use std::marker::PhantomData;
 use std::ops::{Add, Mul, Neg, Sub};
 
@@ -230,7 +230,7 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
     /// `prod_j w_j^(e_j) / e_j!` for every monomial, from the components `w` of a linear
     /// polynomial along the directions (monomials of degree 1).
     #[inline(always)]
-    pub(crate) fn powers(w: &[f64; MAX_DIRS]) -> [f64; K] {
+    pub fn powers(w: &[f64; MAX_DIRS]) -> [f64; K] {
         let mut p = [0.0; K];
         p[0] = 1.0;
         for k in 1..K {
@@ -247,9 +247,11 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
     /// `sin` and `cos` of `theta + sum_j w_j x_j` with `(sin theta, cos theta) = (sn, cs)`:
     /// coefficient `k` is `sin^(p)(theta) prod_j w_j^(e_j) / e_j!` (`p` its degree), and its
     /// derivative with respect to `theta` is `sin^(p+1)(theta)` times the same. Returns the
-    /// coefficients and those derivatives, `[sin, d sin, cos, d cos]`.
+    /// coefficients and those derivatives, `[sin, d sin, cos, d cos]` (what a caller that seeds
+    /// a linear argument itself, e.g. an angle variable, writes into the coefficients and the
+    /// angle's gradient column).
     #[inline(always)]
-    fn angle_series(w: &[f64; MAX_DIRS], sn: f64, cs: f64) -> [[f64; K]; 4] {
+    pub fn angle_series(w: &[f64; MAX_DIRS], sn: f64, cs: f64) -> [[f64; K]; 4] {
         let ds = [sn, cs, -sn, -cs];
         let dc = [cs, -sn, -cs, sn];
         let p = Self::powers(w);
@@ -262,41 +264,6 @@ impl<const K: usize, B: Basis<K>> PolyJet<K, B> {
             out[3][k] = dc[(d + 1) % 4] * p[k];
         }
         out
-    }
-
-    /// Writes into `f` the frame of a body whose coordinates are the variables `slot ..
-    /// slot + 3` with the values `q`, the components `w[j]` (this body's three) along
-    /// direction `j`, and `(sin, cos)` of its angle `(sn, cs)`. Only the entries that can be
-    /// non-zero are written, so every other entry of `f` must be zero already: `f` starts as
-    /// [`Frame::fixed`] and is only ever set with the same `slot`.
-    #[inline(always)]
-    pub(crate) fn set_var_frame(
-        f: &mut Frame<Self>,
-        slot: usize,
-        q: [f64; 3],
-        w: &[[f64; 3]],
-        sn: f64,
-        cs: f64,
-    ) {
-        let mut wa = [0.0; MAX_DIRS];
-        for k in 0..3 {
-            let x = &mut f.q[k];
-            x.c[0] = q[k];
-            x.g[0][slot + k] = 1.0;
-            for (d, wd) in w.iter().enumerate().take(B::ND) {
-                x.c[B::LIN[d] as usize] = wd[k];
-            }
-        }
-        for (d, wd) in w.iter().enumerate().take(B::ND) {
-            wa[d] = wd[2];
-        }
-        // the angle's gradient is e_(slot + 2): only that column is written
-        let [sv, sd, cv, cd] = Self::angle_series(&wa, sn, cs);
-        let l = slot + 2;
-        for k in 0..K {
-            (f.s.c[k], f.s.g[k][l]) = (sv[k], sd[k]);
-            (f.c.c[k], f.c.g[k][l]) = (cv[k], cd[k]);
-        }
     }
 
     /// `f(self)` for a function with the scaled derivatives `a[k] = f^(k)(x0) / k!` at the
@@ -425,8 +392,8 @@ impl<const K: usize, B: Basis<K>> Scalar for PolyJet<K, B> {
         self.sin_cos_with(sn, cs)
     }
     fn sin_cos_with(self, sn: f64, cs: f64) -> (Self, Self) {
-        // a linear argument theta + sum_j w_j x_j whose coefficients carry no gradient (a
-        // body angle): the closed form of `angle_series` times the value's gradient
+        // a linear argument theta + sum_j w_j x_j whose coefficients carry no gradient (an
+        // angle variable): the closed form of `angle_series` times the value's gradient
         let linear = (1..K).all(|k| (B::DEG[k] == 1 || self.c[k] == 0.0) && self.g[k] == [0.0; NV]);
         if linear {
             let mut w = [0.0; MAX_DIRS];

@@ -5,7 +5,7 @@ use std::ops::{Add, Mul, Sub};
 
 /// Value, gradient, derivative along a direction `w` and the gradient of that derivative, with
 /// respect to the 6 local variables: `H w` (for the velocity constraint's Jacobian
-/// `(Phi_q w)_q`) at about a fifth of the cost of a [`HessJet`].
+/// `(Phi_q w)_q`) at about a fifth of the cost of a [`HessJet`](crate::HessJet).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TanJet {
     /// Value.

@@ -1,8 +1,7 @@
 //! Sparse Cholesky factorisation on a fixed pattern (faer, simplicial), with diagonal
 //! equilibration and the scale-invariant pivot test of the dense path.
 
-use crate::error::SolveError;
-use crate::linalg::{FactorError, CHOLESKY_PIVOT_TOL};
+use crate::{FactorError, LinalgError, Scratch, CHOLESKY_PIVOT_TOL};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
@@ -12,13 +11,6 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
-
-pub(crate) struct Scratch(pub(crate) MemBuffer);
-impl std::fmt::Debug for Scratch {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("Scratch")
-    }
-}
 
 /// A symmetric positive definite `m x m` matrix on a fixed sparsity pattern, and its Cholesky
 /// factorisation.
@@ -37,7 +29,7 @@ impl std::fmt::Debug for Scratch {
 /// one; both grow like the inverse square distance to a singular configuration.)
 ///
 /// ```
-/// use mbd_solve::sparse::SparseCholesky;
+/// use mbd_linalg::SparseCholesky;
 /// // the 1D Laplacian [[2, -1, 0], [-1, 2, -1], [0, -1, 2]]
 /// let mut chol = SparseCholesky::new(3, &[(1, 0), (2, 1)])?;
 /// for (r, c, v) in [(0, 0, 2.0), (1, 1, 2.0), (2, 2, 2.0), (1, 0, -1.0), (2, 1, -1.0)] {
@@ -74,14 +66,14 @@ impl SparseCholesky {
     /// Analyses the pattern: `m` unknowns, off-diagonal entries `(row, col)` of the lower
     /// triangle (`row > col`; an entry given as `row < col` is mirrored, repeats are merged, the
     /// diagonal is added). Allocates; done once per pattern.
-    pub fn new(m: usize, lower: &[(usize, usize)]) -> Result<Self, SolveError> {
+    pub fn new(m: usize, lower: &[(usize, usize)]) -> Result<Self, LinalgError> {
         let mut entries: Vec<(usize, usize)> = (0..m).map(|r| (r, r)).collect();
         for &(r, c) in lower {
             if r >= m || c >= m {
-                return Err(SolveError::Dimension {
+                return Err(LinalgError::PatternEntry {
                     what: "sparse Cholesky pattern entry",
-                    expected: m,
-                    got: r.max(c),
+                    dim: m,
+                    index: r.max(c),
                 });
             }
             let (r, c) = if r >= c { (r, c) } else { (c, r) };
@@ -114,7 +106,7 @@ impl SparseCholesky {
         let symbolic =
             factorize_symbolic_cholesky(sym.as_ref(), Side::Lower, Default::default(), params)
                 .map_err(|e| {
-                    SolveError::Unsupported(format!("sparse symbolic analysis failed: {e:?}"))
+                    LinalgError::Analysis(format!("sparse symbolic analysis failed: {e:?}"))
                 })?;
         let l_diag = match symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(s) => {
@@ -125,7 +117,7 @@ impl SparseCholesky {
                     match col.iter().position(|&r| r == j) {
                         Some(p) => d.push(cp[j] + p),
                         None => {
-                            return Err(SolveError::Unsupported(format!(
+                            return Err(LinalgError::Analysis(format!(
                                 "sparse Cholesky: column {j} of L has no diagonal entry"
                             )))
                         }
@@ -134,7 +126,7 @@ impl SparseCholesky {
                 d
             }
             SymbolicCholeskyRaw::Supernodal(_) => {
-                return Err(SolveError::Unsupported(
+                return Err(LinalgError::Analysis(
                     "sparse Cholesky: expected a simplicial factorisation".into(),
                 ))
             }
@@ -301,7 +293,7 @@ impl SparseCholesky {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::DenseCholesky;
+    use crate::DenseCholesky;
 
     /// A random symmetric positive definite banded matrix (bandwidth 2) with a wide diagonal
     /// scale spread.

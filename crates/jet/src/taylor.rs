@@ -144,7 +144,7 @@ impl Scalar for Taylor4 {
     fn sin_cos_with(self, sn: f64, cs: f64) -> (Self, Self) {
         let x = self.coefs();
         if x[2..].iter().all(|&a| a == 0.0) {
-            // a variable theta + t w (a body angle): coefficients sin^(k)(theta) w^k / k!
+            // a variable theta + t w (an angle variable): coefficients sin^(k)(theta) w^k / k!
             let ds = [sn, cs, -sn, -cs];
             let dc = [cs, -sn, -cs, sn];
             let (mut s, mut c) = ([0.0; TAYLOR_DEGREE + 1], [0.0; TAYLOR_DEGREE + 1]);
@@ -223,7 +223,7 @@ mod tests {
         }
     }
 
-    /// The closed form for a variable `theta + t w` (body angles) against the general
+    /// The closed form for a variable `theta + t w` (an angle variable) against the general
     /// recurrence.
     #[test]
     fn sin_cos_of_a_variable_matches_the_recurrence() {
