@@ -7,7 +7,7 @@ use crate::system::System;
 
 /// The sine and cosine of every body's angle at one configuration `q`, evaluated once
 /// ([`BodyAngles::update`]) and shared by all the element passes at that `q` (the `_at`
-/// variants such as [`System::lagrangian_third_at`], and [`System::constraint_poly_series`]):
+/// variants of the derivative passes of mbd-symplectic, and its `constraint_poly_series`):
 /// they give bit for bit the results of the plain passes without one `sin_cos` per element
 /// and body. Allocated once ([`BodyAngles::new`]); updating allocates nothing unless the
 /// number of bodies changed.
@@ -128,7 +128,7 @@ impl BodyAngles {
     /// of its angle from the table or, without one, evaluated (the closed-form revolute rows of
     /// the derivative passes start from it; `R'(theta) p` is its quarter turn `(-y, x)`).
     #[inline(always)]
-    pub(crate) fn rotate(angles: Option<&Self>, q: &[f64], i: usize, p: [f64; 2]) -> [f64; 2] {
+    pub fn rotate(angles: Option<&Self>, q: &[f64], i: usize, p: [f64; 2]) -> [f64; 2] {
         let (sn, cs) = match angles {
             Some(a) => (a.sc[i][1], a.sc[i][2]),
             None => q[3 * i + 2].sin_cos(),
@@ -138,14 +138,14 @@ impl BodyAngles {
 
     /// `[theta, sin theta, cos theta]` of body `i`.
     #[inline(always)]
-    pub(crate) fn sin_cos_of(&self, i: usize) -> [f64; 3] {
+    pub fn sin_cos_of(&self, i: usize) -> [f64; 3] {
         self.sc[i]
     }
 
     /// The frame of body `i` with the jet coordinates `vars` (whose angle has the value of
     /// body `i`'s angle in the table), or with `sin_cos` evaluated when there is no table.
     #[inline(always)]
-    pub(crate) fn frame<T: Scalar>(angles: Option<&Self>, i: usize, vars: [T; 3]) -> Frame<T> {
+    pub fn frame<T: Scalar>(angles: Option<&Self>, i: usize, vars: [T; 3]) -> Frame<T> {
         match angles {
             Some(a) => {
                 let [_, s, c] = a.sc[i];

@@ -1,4 +1,5 @@
-//! Test fixtures shared by the unit tests of several modules.
+//! Test fixtures: the systems and points the derivative tests of this crate and of the
+//! solver crates above it (feature `fixtures`, for their tests only) compare passes on.
 
 use crate::jet::{Basis, MAX_DIRS};
 use crate::{Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, TimeFunction};
@@ -6,7 +7,7 @@ use crate::{Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, Time
 /// Every joint kind (revolute, prismatic, weld, distance, absolute x / y / angle, angle
 /// driver) on five bodies: the fixture of the unit tests that check derivatives element by
 /// element.
-pub(crate) fn every_joint_kind() -> System {
+pub fn every_joint_kind() -> System {
     let mut b = SystemBuilder::new();
     let b1 = b.add_body(Body::new("b1").rod(1.0, 1.0).position(0.3, -0.2, 0.4));
     let b2 = b.add_body(Body::new("b2").rod(2.0, 0.7).position(1.1, 0.5, -0.9));
@@ -52,7 +53,7 @@ pub(crate) fn every_joint_kind() -> System {
 /// Two free bodies (no joints), a spring between them and one to the ground, under gravity: a
 /// potential with non-zero Hessian and higher derivatives, for the unit tests of the potential's
 /// derivatives.
-pub(crate) fn two_springs() -> System {
+pub fn two_springs() -> System {
     let mut b = SystemBuilder::new();
     b.set_gravity([0.0, -9.81]);
     let r = b.add_body(Body::new("r").rod(1.0, 1.0).position(0.4, -0.3, 0.7));
@@ -82,7 +83,7 @@ pub(crate) fn two_springs() -> System {
 
 /// The fixtures of the unit tests that compare derivative passes with each other: every joint
 /// kind, the manipulator and [`two_springs`].
-pub(crate) fn derivative_test_systems() -> [System; 3] {
+pub fn derivative_test_systems() -> [System; 3] {
     [
         every_joint_kind(),
         crate::models::manipulator().expect("the manipulator model is valid"),
@@ -91,7 +92,7 @@ pub(crate) fn derivative_test_systems() -> [System; 3] {
 }
 
 /// A generic configuration and direction for `n` coordinates (no symmetry, no zero entries).
-pub(crate) fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
+pub fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
     let q = (0..n).map(|i| 0.3 + 0.2 * (i as f64 * 0.9).sin()).collect();
     let v = (0..n).map(|i| 0.5 * (i as f64 * 1.7 + 0.3).cos()).collect();
     (q, v)
@@ -100,7 +101,7 @@ pub(crate) fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
 /// A [`crate::PolyJet`] basis in two directions (`t`, `e`): `{1, t, e, t^2, e t, t^3, e t^2,
 /// t^4}`, the shape of the preadjustment's first pass.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct TwoDirections;
+pub struct TwoDirections;
 impl Basis<8> for TwoDirections {
     const ND: usize = 2;
     const EXP: [[u8; MAX_DIRS]; 8] = [

@@ -30,7 +30,7 @@
 //! equation by construction. Finite-difference tests check them all.
 
 pub use mbd_jet::{Basis, PolyJet, MAX_DIRS};
-pub(crate) use mbd_jet::{DirJet, Dual, HessJet, Scalar, TanJet, Taylor4, ThirdJet, NV};
+pub use mbd_jet::{DirJet, Dual, HessJet, Scalar, TanJet, Taylor4, ThirdJet, NV};
 
 /// A body's coordinates `(x, y, theta)` with `cos theta` and `sin theta` evaluated once, so the
 /// points and directions of one element share them (and ground costs no trigonometry).
@@ -110,7 +110,7 @@ pub fn sub2<T: Scalar>(b: [T; 2], a: [T; 2]) -> [T; 2] {
 /// written, so every other entry of `f` must be zero already: `f` starts as [`Frame::fixed`]
 /// and is only ever set with the same `slot`.
 #[inline(always)]
-pub(crate) fn set_var_frame<const K: usize, B: Basis<K>>(
+pub fn set_var_frame<const K: usize, B: Basis<K>>(
     f: &mut Frame<PolyJet<K, B>>,
     slot: usize,
     q: [f64; 3],

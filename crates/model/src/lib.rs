@@ -48,41 +48,39 @@ mod builder;
 mod cache;
 mod check;
 mod constraints;
-mod directional;
-mod directional_poly;
 mod dynamics;
 mod element;
 mod error;
 mod file;
-#[cfg(test)]
-mod fixtures;
+#[cfg(any(test, feature = "fixtures"))]
+pub mod fixtures;
 pub mod forces;
 mod hessian_pair;
 mod init;
-mod jet;
+pub mod jet;
 pub mod joints;
 mod kinematics;
+mod local_rows;
 pub mod models;
 pub mod numeric;
 mod rows;
 mod scale;
 mod system;
-mod third;
 mod timefn;
 
 pub use body::{Body, BodyHandle, BodyRef};
 pub use builder::SystemBuilder;
 pub use cache::BodyAngles;
-pub use directional_poly::PolyWorkspace;
 pub use element::Sketch;
 pub use error::ModelError;
 pub use file::{BodyKind, BodySpec, ForceSpec, JointSpec, ModelFile};
 pub use forces::{Force, ForceKind};
 pub use hessian_pair::LagrangianWeights;
 pub use jet::{Basis, PolyJet, MAX_DIRS};
+pub use joints::RevoluteSide;
 pub use joints::{Coordinate, Joint, JointKind};
 pub use scale::MAX_INERTIA_RATIO;
-pub use system::{ForceHandle, JointHandle, System};
+pub use system::{Attach, ForceHandle, JointElement, JointHandle, System};
 pub use timefn::TimeFunction;
 
 pub use nalgebra;

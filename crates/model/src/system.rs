@@ -33,10 +33,25 @@ impl ForceHandle {
     }
 }
 
+/// The bodies an element attaches, as body indices (`None`: ground): the local coordinates of
+/// an element are side `a`'s three followed by side `b`'s.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Attach {
-    pub(crate) a: Option<usize>,
-    pub(crate) b: Option<usize>,
+pub struct Attach {
+    /// Body index of side `a` (local slots 0..3), `None` for ground.
+    pub a: Option<usize>,
+    /// Body index of side `b` (local slots 3..6), `None` for ground.
+    pub b: Option<usize>,
+}
+
+/// A joint as [`System::joint_elements`] hands it out.
+#[derive(Clone, Copy, Debug)]
+pub struct JointElement<'a> {
+    /// The joint (evaluate it with [`Joint::eval`]).
+    pub joint: &'a Joint,
+    /// The bodies it attaches.
+    pub attach: Attach,
+    /// Its first equation row (it has [`Joint::n_equations`] rows).
+    pub row: usize,
 }
 
 /// A validated planar multibody system in absolute coordinates `q = (x_i, y_i, theta_i)_i`.
@@ -112,6 +127,23 @@ impl System {
             .iter()
             .position(|f| f.name == name)
             .map(ForceHandle)
+    }
+    /// Every joint with its attachment and its first equation row, in the order of
+    /// [`System::joints`]: with [`Joint::eval`] (generic over the scalar) the one hook through
+    /// which derivative passes outside this crate (the symplectic preadjustment's higher
+    /// derivatives) evaluate the constraints with their own jet types.
+    pub fn joint_elements(&self) -> impl ExactSizeIterator<Item = JointElement<'_>> + '_ {
+        self.joints
+            .iter()
+            .zip(&self.joint_attach)
+            .zip(&self.row_offset)
+            .map(|((joint, &attach), &row)| JointElement { joint, attach, row })
+    }
+    /// Every force element with its attachment, in the order of [`System::forces`]: with
+    /// [`Force::potential`] the hook of the potential's derivative passes (gravity, linear in
+    /// `q`, is not an element).
+    pub fn force_elements(&self) -> impl ExactSizeIterator<Item = (&Force, Attach)> + '_ {
+        self.forces.iter().zip(self.force_attach.iter().copied())
     }
     /// The handles of every body, in the order of [`System::bodies`].
     pub fn body_handles(&self) -> impl ExactSizeIterator<Item = BodyHandle> {

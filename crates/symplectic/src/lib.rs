@@ -52,6 +52,7 @@ mod calibrate;
 mod error;
 mod galerkin;
 mod options;
+mod passes;
 mod preadjust;
 mod registry;
 mod tables;

@@ -61,7 +61,7 @@ pub struct SymplecticOptions {
     pub newton: NewtonOptions,
     /// Relative step of the finite-difference checks of the preadjustment's derivatives. The
     /// integrator itself does not differentiate numerically: the third derivatives of `V` and `Phi` in `grad W_s` and in the
-    /// modified-Lagrangian gradient are exact (`mbd_model::System::potential_third`,
+    /// modified-Lagrangian gradient are exact (`passes::potential_third`,
     /// `constraint_third`). Still validated (finite, in `(0, 1)`).
     pub fd_step: f64,
     /// Start a step with the factored Jacobian of the previous step (same `h`) instead of a new

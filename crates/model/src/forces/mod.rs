@@ -216,9 +216,12 @@ impl Force {
         each_force!(&self.kind, f => single(f))
     }
 
-    /// Potential energy of the conservative part, generic over the scalar type.
+    /// Potential energy of the conservative part, generic over the scalar type: the hook
+    /// through which every derivative pass of the potential evaluates the element (with the
+    /// bodies' frames from [`crate::jet::Frame`] and the attachments from
+    /// [`crate::System::force_elements`]).
     #[inline]
-    pub(crate) fn potential<T: Scalar>(&self, qa: &Frame<T>, qb: &Frame<T>) -> T {
+    pub fn potential<T: Scalar>(&self, qa: &Frame<T>, qb: &Frame<T>) -> T {
         each_force!(&self.kind, f => f.potential(qa, qb))
     }
 

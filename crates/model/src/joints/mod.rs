@@ -115,14 +115,18 @@ pub struct Joint {
     pub kind: JointKind,
 }
 
-/// One side of a revolute joint's equations `point_a(pa) - point_b(pb)`: the body (`None`:
-/// ground), its local slot (0 for body a, 3 for body b), the body-fixed point and the sign.
+/// One side of a revolute joint's equations `point_a(pa) - point_b(pb)`: what closed-form
+/// revolute rows iterate over (see [`Joint::revolute_sides`]).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct RevoluteSide {
-    pub(crate) body: Option<usize>,
-    pub(crate) slot: usize,
-    pub(crate) p: [f64; 2],
-    pub(crate) sign: f64,
+pub struct RevoluteSide {
+    /// The body (`None`: ground).
+    pub body: Option<usize>,
+    /// Its local slot: 0 for side a, 3 for side b.
+    pub slot: usize,
+    /// The body-fixed point.
+    pub p: [f64; 2],
+    /// The sign of the side in the equations: `+1` for a, `-1` for b.
+    pub sign: f64,
 }
 
 impl Joint {
@@ -293,9 +297,14 @@ impl Joint {
         }
     }
 
-    /// The time-free part `g(q_a, q_b)` of the equations, written once for every scalar type.
+    /// The time-free part `g(q_a, q_b)` of the equations (the first [`Joint::n_equations`]
+    /// entries of `out`), written once for every scalar type: the generic hook through which
+    /// every derivative pass evaluates the joint, in this crate and above it (with the bodies'
+    /// frames from [`crate::jet::Frame`] and the attachments from [`System::joint_elements`]).
+    ///
+    /// [`System::joint_elements`]: crate::System::joint_elements
     #[inline]
-    pub(crate) fn eval<T: Scalar>(&self, qa: &Frame<T>, qb: &Frame<T>, out: &mut [T; 3]) {
+    pub fn eval<T: Scalar>(&self, qa: &Frame<T>, qb: &Frame<T>, out: &mut [T; 3]) {
         each_joint!(&self.kind, j => j.eval(qa, qb, out))
     }
 
@@ -333,7 +342,7 @@ impl Joint {
     /// The two sides of a revolute joint attached at `at`, `None` for any other kind: what
     /// the closed-form revolute rows of the derivative passes iterate over (a body point
     /// `r + R(theta) p` has the derivatives `R^(k)(theta) p` in `theta`, a quarter turn each).
-    pub(crate) fn revolute_sides(&self, at: Attach) -> Option<[RevoluteSide; 2]> {
+    pub fn revolute_sides(&self, at: Attach) -> Option<[RevoluteSide; 2]> {
         match &self.kind {
             JointKind::Revolute(r) => Some([
                 RevoluteSide {

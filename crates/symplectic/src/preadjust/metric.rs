@@ -18,6 +18,7 @@
 //! this point.
 
 use super::{dot, LocalRow, ZERO_ROW};
+use crate::passes;
 use mbd_model::System;
 use mbd_solve::linalg::DenseCholesky;
 use mbd_solve::sparse::ConstraintSchur;
@@ -303,7 +304,7 @@ impl ProjectedMetric {
 
     /// `out = A x` without assembling `A` (one Hessian-vector pass), after `prepare(q)`.
     pub(super) fn a_times(&self, sys: &System, q: &[f64], x: &[f64], out: &mut [f64]) {
-        sys.lagrangian_hessian_vector(q, x, 1.0, &self.nmu0, out);
+        passes::lagrangian_hessian_vector(sys, q, x, 1.0, &self.nmu0, out);
     }
 
     /// Whether the workspace holds the evaluation at exactly `q` (bit for bit).
@@ -352,7 +353,8 @@ impl ProjectedMetric {
         if m > 0 {
             match along {
                 Some((v, rows)) if !self.rheonomic => {
-                    sys.constraint_third_local(
+                    passes::constraint_third_local(
+                        sys,
                         q,
                         v,
                         &mut self.local_grads,

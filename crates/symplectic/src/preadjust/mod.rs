@@ -132,7 +132,7 @@ impl Preadjustment {
 
     /// `grad W_s(q)` into `out`; returns `W_s(q)`. Matrix-free: every product with `A` or
     /// with a weighted constraint Hessian is one Hessian-vector pass over the elements
-    /// ([`System::lagrangian_hessian_vector`]), the third derivatives are exact.
+    /// (`passes::lagrangian_hessian_vector`), the third derivatives are exact.
     pub fn gradient(
         &mut self,
         sys: &System,
@@ -220,7 +220,7 @@ impl Preadjustment {
     /// * `d e / d q = 1/12 [(A + H_sigma)(u - w) + D^3(-1/2 V + (sigma - mu0) . Phi)(v, v)]`,
     ///   where the third-derivative term is the derivative along `v` of
     ///   `Hess(-1/2 V + (sigma - mu0) . Phi) v` (`sigma`, `mu0` frozen), exact
-    ///   ([`System::lagrangian_third`]).
+    ///   (`passes::lagrangian_third`).
     pub fn modified_gradients(
         &mut self,
         sys: &System,

@@ -14,6 +14,7 @@
 use super::dot;
 use super::metric::{ProjectedMetric, RowsAlong, Stamp};
 use super::stiffness::TangentStiffness;
+use crate::passes;
 use mbd_model::{LagrangianWeights, System};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
@@ -136,7 +137,8 @@ impl ModifiedS1 {
         if rows {
             // the potential's part by a pass over the forces (the zero weights skip the
             // joints), the constraints' from the rows
-            sys.lagrangian_third(
+            passes::lagrangian_third(
+                sys,
                 q,
                 v,
                 POTENTIAL_WEIGHT,
@@ -144,10 +146,18 @@ impl ModifiedS1 {
                 &mut self.hv,
                 &mut self.d3,
             );
-            sys.add_local_rows(&along.hess_v, &self.cm, &mut self.hv);
-            sys.add_local_rows(&along.third_vv, &self.cm, &mut self.d3);
+            passes::add_local_rows(sys, &along.hess_v, &self.cm, &mut self.hv);
+            passes::add_local_rows(sys, &along.third_vv, &self.cm, &mut self.d3);
         } else {
-            sys.lagrangian_third(q, v, POTENTIAL_WEIGHT, &self.cm, &mut self.hv, &mut self.d3);
+            passes::lagrangian_third(
+                sys,
+                q,
+                v,
+                POTENTIAL_WEIGHT,
+                &self.cm,
+                &mut self.hv,
+                &mut self.d3,
+            );
         }
         self.mv.copy_from_slice(v);
         self.mv_stamp = metric.stamp();
@@ -179,7 +189,7 @@ impl ModifiedS1 {
     /// * `d e / d q = 1/12 [(A + H_sigma)(u - w) + D^3(-1/2 V + (sigma - mu0) . Phi)(v, v)]`,
     ///   where the third-derivative term is the derivative along `v` of
     ///   `Hess(-1/2 V + (sigma - mu0) . Phi) v` (`sigma`, `mu0` frozen), exact
-    ///   ([`System::lagrangian_third`]).
+    ///   ([`passes::lagrangian_third`](crate::passes::lagrangian_third)).
     pub(super) fn gradients(
         &mut self,
         metric: &mut ProjectedMetric,
@@ -206,7 +216,7 @@ impl ModifiedS1 {
                 uw[k] = u[k] - minv[k] * acc;
             }
         }
-        sys.lagrangian_hessian_vector(q, uw, 1.0, &self.cm, dq);
+        passes::lagrangian_hessian_vector(sys, q, uw, 1.0, &self.cm, dq);
         // third derivatives along v (exact, from evaluate)
         for k in 0..n {
             dq[k] += self.d3[k];

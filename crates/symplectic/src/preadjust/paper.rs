@@ -11,13 +11,14 @@
 //! For `s = 1, 2` this is exactly paper A's `W_s`; for `s >= 3` the projector `P` between the
 //! factors keeps the modal form `W_s = 1/2 sum_i omega_i^(2s+2) eta_i^2` about an equilibrium
 //! (without it the normal components of `K_T` would enter). The gradient is exact: the third
-//! derivatives of `V` and `Phi` it needs for `s >= 2` come from [`System::potential_third`] and
-//! [`System::constraint_third`]. The Newton Hessian is `A (Pi A)^s`, the exact Hessian of `W_s`
+//! derivatives of `V` and `Phi` it needs for `s >= 2` come from [`passes::potential_third`](crate::passes::potential_third) and
+//! [`passes::constraint_third`](crate::passes::constraint_third). The Newton Hessian is `A (Pi A)^s`, the exact Hessian of `W_s`
 //! at an equilibrium (`f_T = 0`; [`TangentStiffness::a_pi_a_power`]).
 
 use super::dot;
 use super::metric::ProjectedMetric;
 use super::stiffness::TangentStiffness;
+use crate::passes;
 use mbd_model::System;
 use nalgebra::DMatrix;
 
@@ -91,7 +92,7 @@ impl PaperTerm {
 
     /// `grad W_s(q)` into `out` at the metric's prepared point `q` (dense layout); returns
     /// `W_s(q)`. Matrix-free: every product with `A` or with a weighted constraint Hessian is
-    /// one Hessian-vector pass over the elements ([`System::lagrangian_hessian_vector`]).
+    /// one Hessian-vector pass over the elements ([`passes::lagrangian_hessian_vector`](crate::passes::lagrangian_hessian_vector)).
     pub(super) fn gradient(
         &mut self,
         metric: &mut ProjectedMetric,
@@ -110,11 +111,11 @@ impl PaperTerm {
         // a_0..a_{l+1}, b_k = A a_k (k = 0..=l); sigma_k = S^-1 G M^-1 b_k
         if l == 0 {
             // s = 2: b_0 = A u and the third-derivative term D^3 (V - mu0 . Phi)(u, u, .) from
-            // one third-order pass (System::lagrangian_third) instead of a Hessian-vector pass
+            // one third-order pass (passes::lagrangian_third) instead of a Hessian-vector pass
             // and two third-order passes
             self.av[0].copy_from_slice(metric.u());
             let (u, nmu0) = (metric.u(), metric.neg_mu0());
-            sys.lagrangian_third(q, u, 1.0, nmu0, &mut self.bv[0], &mut self.d3);
+            passes::lagrangian_third(sys, q, u, 1.0, nmu0, &mut self.bv[0], &mut self.d3);
             let (a, b) = (&mut self.av[1], &self.bv[0]);
             metric.apply_pi(b, a);
         } else {
@@ -176,7 +177,7 @@ impl PaperTerm {
                 for r in 0..m {
                     wts[r] = self.sig[l - j][r] - if j == 0 { h[r] } else { 0.0 };
                 }
-                sys.lagrangian_hessian_vector(q, &self.av[j], 0.0, wts, t);
+                passes::lagrangian_hessian_vector(sys, q, &self.av[j], 0.0, wts, t);
                 for i in 0..n {
                     out[i] -= t[i];
                 }
@@ -202,7 +203,7 @@ impl PaperTerm {
     }
 
     /// `out += factor * (D_{a_i} A~) a_j = factor * D^3 (V - mu0 . Phi)(a_i, a_j, .)` (`mu0`
-    /// frozen), exact: [`System::potential_third`] and [`System::constraint_third`] along
+    /// frozen), exact: [`passes::potential_third`](crate::passes::potential_third) and [`passes::constraint_third`](crate::passes::constraint_third) along
     /// `a_i` when `i = j`, by polarisation along `a_i +- a_j` otherwise.
     #[allow(clippy::too_many_arguments)]
     fn third_derivative(
@@ -223,9 +224,9 @@ impl PaperTerm {
                 dir[k] = self.av[i][k] + if i == j { 0.0 } else { sg * self.av[j][k] };
             }
             let c = if i == j { factor } else { 0.25 * sg * factor };
-            sys.add_potential_third(q, dir, c, out);
+            passes::add_potential_third(sys, q, dir, c, out);
             if metric.m() > 0 {
-                sys.add_constraint_third(q, dir, metric.mu0(), -c, out);
+                passes::add_constraint_third(sys, q, dir, metric.mu0(), -c, out);
             }
         }
     }

@@ -6,6 +6,7 @@ use super::passes::{
     B_ETT, C_AT, C_BT, NA, NB, NC,
 };
 use super::{Invariant, ModifiedS2, PerInvariant, E4_TERM_COUNT};
+use crate::passes;
 use crate::preadjust::metric::ProjectedMetric;
 use crate::preadjust::{dot, LocalRow, ZERO_ROW};
 use mbd_model::{BodyAngles, System};
@@ -191,7 +192,7 @@ impl ModifiedS2 {
             (&mut f.hsig_u, &f.rhv_u, &f.sig),
         ] {
             out.fill(0.0);
-            sys.add_local_rows(rows, w, out);
+            passes::add_local_rows(sys, rows, w, out);
         }
         metric.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
         if sys.forces().is_empty() {

@@ -14,8 +14,8 @@
 //! the terms and their coefficients are those of [`E4_TERMS`], each named by an [`Invariant`]
 //! (the term values are a [`PerInvariant`], indexed by name). The directional derivatives of
 //! orders 2 to 4, mixed ones included, come from three passes of multivariate truncated
-//! Taylor jets ([`mbd_model::PolyJet`], [`System::constraint_poly_series`],
-//! [`System::potential_poly_series`]): pass A along `(v, u)`, pass B along `(v, n, u)` (after
+//! Taylor jets ([`mbd_model::PolyJet`], [`passes::constraint_poly_series`](crate::passes::constraint_poly_series),
+//! [`passes::potential_poly_series`](crate::passes::potential_poly_series)): pass A along `(v, u)`, pass B along `(v, n, u)` (after
 //! `n`, which needs pass A's `gamma`), pass C along `(v, K2, K3)`; each keeps its coefficients'
 //! gradients for the reverse pass.
 //!

@@ -6,8 +6,10 @@
 //! exponents; `t` stands for the velocity `v` throughout. Its size, its number of directions
 //! and the positions of the monomials the term reads are derived from the list.
 
+use crate::passes;
+use crate::passes::PolyWorkspace;
 use crate::preadjust::{LocalRow, ZERO_ROW};
-use mbd_model::{Basis, BodyAngles, PolyWorkspace, System, MAX_DIRS};
+use mbd_model::{Basis, BodyAngles, System, MAX_DIRS};
 
 /// A monomial by its exponents in the first directions of a pass (the others zero).
 const fn mono<const D: usize>(e: [u8; D]) -> [u8; MAX_DIRS] {
@@ -214,8 +216,8 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
     /// The pass along `dirs` at `q` (constraints and potential).
     pub(super) fn eval(&mut self, sys: &System, q: &[f64], a: &BodyAngles, dirs: &[&[f64]]) {
         let ws = &mut self.ws;
-        sys.constraint_poly_series(ws, q, a, dirs, &mut self.vals, &mut self.grads);
-        self.pot = sys.potential_poly_series(ws, q, a, dirs, &mut self.pgrads);
+        passes::constraint_poly_series(sys, ws, q, a, dirs, &mut self.vals, &mut self.grads);
+        self.pot = passes::potential_poly_series(sys, ws, q, a, dirs, &mut self.pgrads);
     }
 
     /// The pass along `dirs` at `q`, constraints only.
@@ -226,7 +228,15 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         a: &BodyAngles,
         dirs: &[&[f64]],
     ) {
-        sys.constraint_poly_series(&mut self.ws, q, a, dirs, &mut self.vals, &mut self.grads);
+        passes::constraint_poly_series(
+            sys,
+            &mut self.ws,
+            q,
+            a,
+            dirs,
+            &mut self.vals,
+            &mut self.grads,
+        );
     }
 
     /// `out = sum_f grad_q` of the potential's coefficient `k` (length n; zero without force
@@ -235,6 +245,6 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         out.fill(0.0);
         let mut w = [0.0; K];
         w[k] = 1.0;
-        sys.add_potential_poly_adjoint::<K, B>(&self.pgrads, &w, out, &mut []);
+        passes::add_potential_poly_adjoint::<K, B>(sys, &self.pgrads, &w, out, &mut []);
     }
 }

@@ -13,7 +13,7 @@
 //!   with respect to `q`, and the reverse pass contracts them with the coefficients' adjoint
 //!   weights, which gives the gradient with respect to `q` and, through the basis' division
 //!   table, with respect to every direction of the pass
-//!   ([`System::add_constraint_poly_adjoint`], [`System::add_potential_poly_adjoint`]: one
+//!   ([`passes::add_constraint_poly_adjoint`](crate::passes::add_constraint_poly_adjoint), [`passes::add_potential_poly_adjoint`](crate::passes::add_potential_poly_adjoint): one
 //!   sweep, no element evaluated again);
 //! * the four constraint-weighted Hessian-vector products `y = H_w x` (`H_w = sum_r w_r Hess
 //!   Phi_r`, `(x, w)` = `(v, sigma)`, `(v, mu0)`, `(u, sigma)`, `(u, mu0)`): with the adjoints
@@ -23,7 +23,7 @@
 //!   each, `D^3 L(x, y, .) = [D^3 L(x + y, x + y, .) - D^3 L(x - y, x - y, .)] / 4`;
 //! * `G = Phi_q` itself: every linear-algebra adjoint leaves `Gb` as a sum of outer products
 //!   `alpha beta^T`, collected in element-local form, and `qb += sum_r Hess Phi_r Gb_r`
-//!   ([`System::add_constraint_hessian_rows`]).
+//!   ([`passes::add_constraint_hessian_rows`](crate::passes::add_constraint_hessian_rows)).
 //!
 //! The linear-algebra adjoints (`D = M^-1`, `S = G D G^T`, `Pi = D - D G^T S^-1 G D`):
 //!
@@ -42,6 +42,7 @@ use super::passes::{
     C_BT, NA, NB, NC, NR, R_DIRS, R_OUTPUTS, R_XY, R_Y,
 };
 use super::{e4_value, Invariant, ModifiedS2, PerInvariant};
+use crate::passes;
 use crate::preadjust::metric::ProjectedMetric;
 use crate::preadjust::LocalRow;
 use mbd_model::{Basis, BodyAngles, System};
@@ -280,12 +281,12 @@ impl ModifiedS2 {
             metric.dgt_into(&f.mu0, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
             gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
-            sys.lagrangian_hessian_vector_at(q, &f.angles, &w.gradb, 1.0, &f.zero_m, t);
+            passes::lagrangian_hessian_vector_at(sys, q, &f.angles, &w.gradb, 1.0, &f.zero_m, t);
             axpy(1.0, t, gq);
         }
 
         // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r
-        sys.add_constraint_hessian_rows_at(q, &f.angles, &w.gbar, gq);
+        passes::add_constraint_hessian_rows_at(sys, q, &f.angles, &w.gbar, gq);
         e4
     }
 }
@@ -342,8 +343,8 @@ fn hvp_adj(
     };
     comb_into(x, 1.0, yb, 1.0, xp);
     comb_into(x, 1.0, yb, -1.0, xm);
-    sys.lagrangian_third_at(q, ang, xp, pot, wts, hp, dp);
-    sys.lagrangian_third_at(q, ang, xm, pot, wts, hm, dm);
+    passes::lagrangian_third_at(sys, q, ang, xp, pot, wts, hp, dp);
+    passes::lagrangian_third_at(sys, q, ang, xm, pot, wts, hm, dm);
     for i in 0..x.len() {
         xb[i] += 0.5 * (hp[i] - hm[i]);
         qb[i] += 0.25 * (dp[i] - dm[i]);
@@ -381,7 +382,7 @@ fn hvp_weighted_adj(
         }
         w.rw[r] = x;
     }
-    sys.add_constraint_poly_grads_many(&w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
+    passes::add_constraint_poly_grads_many(sys, &w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
 }
 
 /// The adjoint of a pass ([`Pass`]) with the adjoint weights `wts` of its rows' coefficients
@@ -393,9 +394,9 @@ fn contract<const K: usize, B: Basis<K>>(
     qb: &mut [f64],
     dirs: &mut [&mut [f64]],
 ) {
-    sys.add_constraint_poly_adjoint::<K, B>(&p.grads, wts, qb, dirs);
+    passes::add_constraint_poly_adjoint::<K, B>(sys, &p.grads, wts, qb, dirs);
     if let Some(pw) = pot {
-        sys.add_potential_poly_adjoint::<K, B>(&p.pgrads, pw, qb, dirs);
+        passes::add_potential_poly_adjoint::<K, B>(sys, &p.pgrads, pw, qb, dirs);
     }
 }
 

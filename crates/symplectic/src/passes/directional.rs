@@ -4,106 +4,99 @@
 //! `D^2 f(a, b) = [D^2 f(a + b)^2 - D^2 f(a - b)^2] / 4` and
 //! `D^3 f(a, a, b) = [D^3 f(a + b)^3 - D^3 f(a - b)^3 - 2 D^3 f(b)^3] / 6`).
 
-use crate::cache::BodyAngles;
-use crate::jet::{Frame, Scalar, Taylor4};
-use crate::system::System;
+use mbd_model::jet::{Frame, Scalar, Taylor4};
+use mbd_model::{BodyAngles, JointElement, System};
 
-impl System {
-    #[inline(always)]
-    fn loc_taylor(
-        q: &[f64],
-        ang: Option<&BodyAngles>,
-        w: &[f64],
-        i: Option<usize>,
-    ) -> Frame<Taylor4> {
-        match i {
-            Some(i) => BodyAngles::frame(
-                ang,
-                i,
-                std::array::from_fn(|k| Taylor4::var(q[3 * i + k], w[3 * i + k])),
-            ),
-            None => Frame::fixed(),
+#[inline(always)]
+fn loc_taylor(q: &[f64], ang: Option<&BodyAngles>, w: &[f64], i: Option<usize>) -> Frame<Taylor4> {
+    match i {
+        Some(i) => BodyAngles::frame(
+            ang,
+            i,
+            std::array::from_fn(|k| Taylor4::var(q[3 * i + k], w[3 * i + k])),
+        ),
+        None => Frame::fixed(),
+    }
+}
+
+/// `out[r] = [D^2 Phi_r(w, w), D^3 Phi_r(w, w, w), D^4 Phi_r(w, w, w, w)]` at `q` for every
+/// constraint row `r` (the configuration part: time enters the joint equations only
+/// additively).
+pub(crate) fn constraint_directional(sys: &System, q: &[f64], w: &[f64], out: &mut [[f64; 3]]) {
+    constraint_directional_impl(sys, q, None, w, out);
+}
+
+#[inline(always)]
+fn constraint_directional_impl(
+    sys: &System,
+    q: &[f64],
+    ang: Option<&BodyAngles>,
+    w: &[f64],
+    out: &mut [[f64; 3]],
+) {
+    for JointElement {
+        joint: j,
+        attach: at,
+        row: o,
+    } in sys.joint_elements()
+    {
+        let mut e = [Taylor4::cst(0.0); 3];
+        j.eval(
+            &loc_taylor(q, ang, w, at.a),
+            &loc_taylor(q, ang, w, at.b),
+            &mut e,
+        );
+        for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+            out[o + k] = [ek.derivative(2), ek.derivative(3), ek.derivative(4)];
         }
     }
+}
 
-    /// `out[r] = [D^2 Phi_r(w, w), D^3 Phi_r(w, w, w), D^4 Phi_r(w, w, w, w)]` at `q` for every
-    /// constraint row `r` (the configuration part: time enters the joint equations only
-    /// additively).
-    pub fn constraint_directional(&self, q: &[f64], w: &[f64], out: &mut [[f64; 3]]) {
-        self.constraint_directional_impl(q, None, w, out);
-    }
+/// `[D^2 V(w, w), D^3 V(w, w, w), D^4 V(w, w, w, w)]` at `q` (gravity is linear and
+/// contributes nothing; non-conservative elements have no potential).
+pub(crate) fn potential_directional(sys: &System, q: &[f64], w: &[f64]) -> [f64; 3] {
+    potential_directional_impl(sys, q, None, w)
+}
 
-    #[inline(always)]
-    fn constraint_directional_impl(
-        &self,
-        q: &[f64],
-        ang: Option<&BodyAngles>,
-        w: &[f64],
-        out: &mut [[f64; 3]],
-    ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let mut e = [Taylor4::cst(0.0); 3];
-            j.eval(
-                &Self::loc_taylor(q, ang, w, at.a),
-                &Self::loc_taylor(q, ang, w, at.b),
-                &mut e,
-            );
-            let o = self.row_offset[ji];
-            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
-                out[o + k] = [ek.derivative(2), ek.derivative(3), ek.derivative(4)];
-            }
+#[inline(always)]
+fn potential_directional_impl(
+    sys: &System,
+    q: &[f64],
+    ang: Option<&BodyAngles>,
+    w: &[f64],
+) -> [f64; 3] {
+    let mut d = [0.0; 3];
+    for (f, at) in sys.force_elements() {
+        let e = f.potential(&loc_taylor(q, ang, w, at.a), &loc_taylor(q, ang, w, at.b));
+        for (k, dk) in d.iter_mut().enumerate() {
+            *dk += e.derivative(k + 2);
         }
     }
-
-    /// `[D^2 V(w, w), D^3 V(w, w, w), D^4 V(w, w, w, w)]` at `q` (gravity is linear and
-    /// contributes nothing; non-conservative elements have no potential).
-    pub fn potential_directional(&self, q: &[f64], w: &[f64]) -> [f64; 3] {
-        self.potential_directional_impl(q, None, w)
-    }
-
-    #[inline(always)]
-    fn potential_directional_impl(
-        &self,
-        q: &[f64],
-        ang: Option<&BodyAngles>,
-        w: &[f64],
-    ) -> [f64; 3] {
-        let mut d = [0.0; 3];
-        for (fi, f) in self.forces.iter().enumerate() {
-            let at = self.force_attach[fi];
-            let e = f.potential(
-                &Self::loc_taylor(q, ang, w, at.a),
-                &Self::loc_taylor(q, ang, w, at.b),
-            );
-            for (k, dk) in d.iter_mut().enumerate() {
-                *dk += e.derivative(k + 2);
-            }
-        }
-        d
-    }
+    d
 }
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::passes::*;
 
     /// Orders 2 and 3 against the exact jets (`v^T Hess v` from `gamma`, `D^3(v, v, v)` from
     /// the third-order rows and `potential_third`), order 4 against central differences of
     /// order 3 along `w`; on every joint kind, the manipulator and a model with springs.
     #[test]
     fn directional_derivatives_match_the_jets() {
-        for sys in crate::fixtures::derivative_test_systems() {
+        for sys in mbd_model::fixtures::derivative_test_systems() {
             let (n, m) = (sys.n_coords(), sys.n_constraints());
-            let (q, w) = crate::fixtures::generic_point(n);
+            let (q, w) = mbd_model::fixtures::generic_point(n);
             let mut rows = vec![[0.0; 3]; m];
-            sys.constraint_directional(&q, &w, &mut rows);
+            constraint_directional(&sys, &q, &w, &mut rows);
             let (mut g, mut hv, mut d3, mut vhv) = (
                 vec![[0.0; 6]; m],
                 vec![[0.0; 6]; m],
                 vec![[0.0; 6]; m],
                 vec![0.0; m],
             );
-            sys.constraint_third_local(&q, &w, &mut g, &mut hv, &mut d3, &mut vhv);
+            constraint_third_local(&sys, &q, &w, &mut g, &mut hv, &mut d3, &mut vhv);
             let (ba, bb): (Vec<_>, Vec<_>) = (0..m)
                 .map(|r| sys.joint_bodies(sys.equation_joint(r).unwrap()))
                 .unzip();
@@ -123,7 +116,7 @@ mod tests {
                 for i in 0..n {
                     qp[i] = q[i] + t * w[i];
                 }
-                sys.constraint_directional(&qp, &w, rows_out);
+                constraint_directional(&sys, &qp, &w, rows_out);
             };
             let (mut p1, mut m1) = (vec![[0.0; 3]; m], vec![[0.0; 3]; m]);
             d3_at(step, &mut p1);
@@ -141,9 +134,9 @@ mod tests {
                     rows[r][2]
                 );
             }
-            let pd = sys.potential_directional(&q, &w);
+            let pd = potential_directional(&sys, &q, &w);
             let mut p3 = vec![0.0; n];
-            sys.potential_third(&q, &w, &mut p3);
+            potential_third(&sys, &q, &w, &mut p3);
             let t3: f64 = p3.iter().zip(&w).map(|(a, b)| a * b).sum();
             assert!((pd[1] - t3).abs() < 1e-12 * (1.0 + t3.abs()), "D3 V");
             let mut hm = nalgebra::DMatrix::zeros(n, n);
@@ -159,16 +152,16 @@ mod tests {
     /// joint kind, the manipulator and the spring model; and the table knows its `q`.
     #[test]
     fn passes_at_precomputed_angles_are_bitwise_the_plain_ones() {
-        use crate::cache::BodyAngles;
+        use mbd_model::BodyAngles;
         let same = |a: &[f64], b: &[f64], what: &str| {
             assert_eq!(a.len(), b.len());
             for (i, (x, y)) in a.iter().zip(b).enumerate() {
                 assert_eq!(x.to_bits(), y.to_bits(), "{what} [{i}]: {x} vs {y}");
             }
         };
-        for sys in crate::fixtures::derivative_test_systems() {
+        for sys in mbd_model::fixtures::derivative_test_systems() {
             let (n, m) = (sys.n_coords(), sys.n_constraints());
-            let (q, w) = crate::fixtures::generic_point(n);
+            let (q, w) = mbd_model::fixtures::generic_point(n);
             let ang = BodyAngles::new(&sys, &q);
             assert!(ang.matches(&q));
             let mut q2 = q.clone();
@@ -178,12 +171,12 @@ mod tests {
             let wts: Vec<f64> = (0..m).map(|r| 0.3 - 0.11 * r as f64).collect();
             for pot in [0.0, 1.0] {
                 let (mut h1, mut h2) = (vec![0.0; n], vec![0.0; n]);
-                sys.lagrangian_hessian_vector(&q, &w, pot, &wts, &mut h1);
-                sys.lagrangian_hessian_vector_at(&q, &ang, &w, pot, &wts, &mut h2);
+                lagrangian_hessian_vector(&sys, &q, &w, pot, &wts, &mut h1);
+                lagrangian_hessian_vector_at(&sys, &q, &ang, &w, pot, &wts, &mut h2);
                 same(&h1, &h2, "lagrangian_hessian_vector");
                 let (mut d1, mut d2) = (vec![0.0; n], vec![0.0; n]);
-                sys.lagrangian_third(&q, &w, pot, &wts, &mut h1, &mut d1);
-                sys.lagrangian_third_at(&q, &ang, &w, pot, &wts, &mut h2, &mut d2);
+                lagrangian_third(&sys, &q, &w, pot, &wts, &mut h1, &mut d1);
+                lagrangian_third_at(&sys, &q, &ang, &w, pot, &wts, &mut h2, &mut d2);
                 same(&h1, &h2, "lagrangian_third H w");
                 same(&d1, &d2, "lagrangian_third D3");
             }
@@ -191,8 +184,8 @@ mod tests {
                 .map(|r| std::array::from_fn(|l| 0.2 * ((r * 6 + l) as f64 * 0.37).sin()))
                 .collect();
             let (mut o1, mut o2) = (vec![0.5; n], vec![0.5; n]);
-            sys.add_constraint_hessian_rows(&q, &dirs, &mut o1);
-            sys.add_constraint_hessian_rows_at(&q, &ang, &dirs, &mut o2);
+            add_constraint_hessian_rows(&sys, &q, &dirs, &mut o1);
+            add_constraint_hessian_rows_at(&sys, &q, &ang, &dirs, &mut o2);
             same(&o1, &o2, "add_constraint_hessian_rows");
         }
     }

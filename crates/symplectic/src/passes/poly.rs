@@ -4,17 +4,16 @@
 //! their gradients with respect to `q` and to every direction), without the polarisations of
 //! single-direction passes.
 
-use crate::cache::BodyAngles;
-use crate::jet::{set_var_frame, Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
-use crate::joints::RevoluteSide;
-use crate::system::{Attach, System};
+use super::scatter_grad;
+use mbd_model::jet::{set_var_frame, Basis, Frame, PolyJet, Scalar, MAX_DIRS, NV};
+use mbd_model::{Attach, BodyAngles, JointElement, RevoluteSide, System};
 
 /// The workspace of the [`PolyJet`] passes of one basis: the frames of an element's bodies,
 /// built in place and reused from element to element and from pass to pass (every
 /// entry that can be non-zero is written: body a in slots `0..3`, body b in `3..6`, ground constant), and
 /// the element's equations. Make it once (it is large: boxed) and hand it to every pass.
 #[derive(Debug)]
-pub struct PolyWorkspace<const K: usize, B> {
+pub(crate) struct PolyWorkspace<const K: usize, B> {
     a: Frame<PolyJet<K, B>>,
     b: Frame<PolyJet<K, B>>,
     ground: Frame<PolyJet<K, B>>,
@@ -139,206 +138,211 @@ fn revolute_rows<const K: usize, B: Basis<K>>(
     }
 }
 
-impl System {
-    /// Per constraint row `r`, the coefficients `vals[r]` of the [`PolyJet`] of `Phi_r(q +
-    /// sum_j x_j dirs[j])` in the basis `B` (`dirs.len() == B::ND`, each of length n) and their
-    /// element-local gradients `grads[r]` with respect to `q` (the six columns of the joint's
-    /// two bodies, as in [`System::phi_q_local`]). The time part of rheonomic constraints is
-    /// left out (it does not depend on `q`). One pass per joint; no allocation.
-    pub fn constraint_poly_series<const K: usize, B: Basis<K>>(
-        &self,
-        ws: &mut PolyWorkspace<K, B>,
-        q: &[f64],
-        angles: &BodyAngles,
-        dirs: &[&[f64]],
-        vals: &mut [[f64; K]],
-        grads: &mut [[[f64; NV]; K]],
-    ) {
-        debug_assert!(angles.matches(q) && dirs.len() == B::ND);
-        debug_assert!(vals.len() == self.n_constraints() && grads.len() == vals.len());
-        self.constraint_poly_series_impl(ws, q, angles, dirs, vals, grads, true);
-    }
+/// Per constraint row `r`, the coefficients `vals[r]` of the [`PolyJet`] of `Phi_r(q +
+/// sum_j x_j dirs[j])` in the basis `B` (`dirs.len() == B::ND`, each of length n) and their
+/// element-local gradients `grads[r]` with respect to `q` (the six columns of the joint's
+/// two bodies, as in [`System::phi_q_local`]). The time part of rheonomic constraints is
+/// left out (it does not depend on `q`). One pass per joint; no allocation.
+pub(crate) fn constraint_poly_series<const K: usize, B: Basis<K>>(
+    sys: &System,
+    ws: &mut PolyWorkspace<K, B>,
+    q: &[f64],
+    angles: &BodyAngles,
+    dirs: &[&[f64]],
+    vals: &mut [[f64; K]],
+    grads: &mut [[[f64; NV]; K]],
+) {
+    debug_assert!(angles.matches(q) && dirs.len() == B::ND);
+    debug_assert!(vals.len() == sys.n_constraints() && grads.len() == vals.len());
+    constraint_poly_series_impl(sys, ws, q, angles, dirs, vals, grads, true);
+}
 
-    /// [`System::constraint_poly_series`]; `closed_form`: revolute joints by
-    /// [`revolute_rows`] (otherwise every joint by its generic equations, the oracle of the
-    /// tests).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn constraint_poly_series_impl<const K: usize, B: Basis<K>>(
-        &self,
-        ws: &mut PolyWorkspace<K, B>,
-        q: &[f64],
-        angles: &BodyAngles,
-        dirs: &[&[f64]],
-        vals: &mut [[f64; K]],
-        grads: &mut [[[f64; NV]; K]],
-        closed_form: bool,
-    ) {
-        for (ji, j) in self.joints.iter().enumerate() {
-            let at = self.joint_attach[ji];
-            let o = self.row_offset[ji];
-            if let Some(sides) = j.revolute_sides(at).filter(|_| closed_form) {
-                let (v, g) = (&mut vals[o..o + 2], &mut grads[o..o + 2]);
-                revolute_rows::<K, B>(q, angles, dirs, sides, v, g);
-                continue;
-            }
-            let (fa, fb, e) = ws.get(q, angles, dirs, at);
-            j.eval(fa, fb, e);
-            for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
-                vals[o + k] = ek.c;
-                grads[o + k] = ek.g;
-            }
+/// [`constraint_poly_series`]; `closed_form`: revolute joints by
+/// [`revolute_rows`] (otherwise every joint by its generic equations, the oracle of the
+/// tests).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn constraint_poly_series_impl<const K: usize, B: Basis<K>>(
+    sys: &System,
+    ws: &mut PolyWorkspace<K, B>,
+    q: &[f64],
+    angles: &BodyAngles,
+    dirs: &[&[f64]],
+    vals: &mut [[f64; K]],
+    grads: &mut [[[f64; NV]; K]],
+    closed_form: bool,
+) {
+    for JointElement {
+        joint: j,
+        attach: at,
+        row: o,
+    } in sys.joint_elements()
+    {
+        if let Some(sides) = j.revolute_sides(at).filter(|_| closed_form) {
+            let (v, g) = (&mut vals[o..o + 2], &mut grads[o..o + 2]);
+            revolute_rows::<K, B>(q, angles, dirs, sides, v, g);
+            continue;
+        }
+        let (fa, fb, e) = ws.get(q, angles, dirs, at);
+        j.eval(fa, fb, e);
+        for (k, ek) in e.iter().enumerate().take(j.n_equations()) {
+            vals[o + k] = ek.c;
+            grads[o + k] = ek.g;
         }
     }
+}
 
-    /// The coefficients of the [`PolyJet`] of the potential `V(q + sum_j x_j dirs[j])` in the
-    /// basis `B` (force elements only: gravity is linear, and only its value and first
-    /// coefficients would change, which no caller reads; non-conservative elements have no
-    /// potential), and per force element (in the order of [`System::forces`]) their
-    /// element-local gradients. One pass per force element; no allocation.
-    pub fn potential_poly_series<const K: usize, B: Basis<K>>(
-        &self,
-        ws: &mut PolyWorkspace<K, B>,
-        q: &[f64],
-        angles: &BodyAngles,
-        dirs: &[&[f64]],
-        grads: &mut [[[f64; NV]; K]],
-    ) -> [f64; K] {
-        debug_assert!(angles.matches(q) && dirs.len() == B::ND);
-        debug_assert_eq!(grads.len(), self.forces.len());
-        let mut sum = [0.0; K];
-        if self.forces.is_empty() {
-            return sum;
-        }
-        for (fi, f) in self.forces.iter().enumerate() {
-            let at = self.force_attach[fi];
-            let (fa, fb, _) = ws.get(q, angles, dirs, at);
-            let e = f.potential(fa, fb);
-            for k in 0..K {
-                sum[k] += e.c[k];
-            }
-            grads[fi] = e.g;
-        }
-        sum
+/// The coefficients of the [`PolyJet`] of the potential `V(q + sum_j x_j dirs[j])` in the
+/// basis `B` (force elements only: gravity is linear, and only its value and first
+/// coefficients would change, which no caller reads; non-conservative elements have no
+/// potential), and per force element (in the order of [`System::forces`]) their
+/// element-local gradients. One pass per force element; no allocation.
+pub(crate) fn potential_poly_series<const K: usize, B: Basis<K>>(
+    sys: &System,
+    ws: &mut PolyWorkspace<K, B>,
+    q: &[f64],
+    angles: &BodyAngles,
+    dirs: &[&[f64]],
+    grads: &mut [[[f64; NV]; K]],
+) -> [f64; K] {
+    debug_assert!(angles.matches(q) && dirs.len() == B::ND);
+    debug_assert_eq!(grads.len(), sys.forces().len());
+    let mut sum = [0.0; K];
+    if sys.forces().is_empty() {
+        return sum;
     }
+    for (fi, (f, at)) in sys.force_elements().enumerate() {
+        let (fa, fb, _) = ws.get(q, angles, dirs, at);
+        let e = f.potential(fa, fb);
+        for k in 0..K {
+            sum[k] += e.c[k];
+        }
+        grads[fi] = e.g;
+    }
+    sum
+}
 
-    /// `outs[p] += sum_r sum_k w[r][p][k] grads[r][k]` (length n each) for the element-local
-    /// coefficient gradients of [`System::constraint_poly_series`] and `P` weight sets, in one
-    /// sweep over the rows: gradients with respect to `q` of weighted coefficients.
-    pub fn add_constraint_poly_grads_many<const K: usize, const P: usize>(
-        &self,
-        grads: &[[[f64; NV]; K]],
-        w: &[[[f64; K]; P]],
-        outs: [&mut [f64]; P],
-    ) {
-        debug_assert!(w.len() == self.n_constraints() && grads.len() == w.len());
-        let mut outs = outs;
-        for (ji, j) in self.joints.iter().enumerate() {
-            let o = self.row_offset[ji];
-            let ne = j.n_equations();
-            let mut g = [[0.0; NV]; P];
-            for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
-                for (gp, wp) in g.iter_mut().zip(wr) {
-                    for k in 0..K {
-                        if wp[k] != 0.0 {
-                            for l in 0..NV {
-                                gp[l] += wp[k] * gr[k][l];
-                            }
+/// `outs[p] += sum_r sum_k w[r][p][k] grads[r][k]` (length n each) for the element-local
+/// coefficient gradients of [`constraint_poly_series`] and `P` weight sets, in one
+/// sweep over the rows: gradients with respect to `q` of weighted coefficients.
+pub(crate) fn add_constraint_poly_grads_many<const K: usize, const P: usize>(
+    sys: &System,
+    grads: &[[[f64; NV]; K]],
+    w: &[[[f64; K]; P]],
+    outs: [&mut [f64]; P],
+) {
+    debug_assert!(w.len() == sys.n_constraints() && grads.len() == w.len());
+    let mut outs = outs;
+    for JointElement {
+        joint: j,
+        attach: at,
+        row: o,
+    } in sys.joint_elements()
+    {
+        let ne = j.n_equations();
+        let mut g = [[0.0; NV]; P];
+        for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
+            for (gp, wp) in g.iter_mut().zip(wr) {
+                for k in 0..K {
+                    if wp[k] != 0.0 {
+                        for l in 0..NV {
+                            gp[l] += wp[k] * gr[k][l];
                         }
                     }
                 }
             }
-            let at = self.joint_attach[ji];
-            for (gp, out) in g.iter().zip(outs.iter_mut()) {
-                Self::scatter_grad(at, gp, 1.0, out);
+        }
+        for (gp, out) in g.iter().zip(outs.iter_mut()) {
+            scatter_grad(at, gp, 1.0, out);
+        }
+    }
+}
+
+/// The adjoint of a [`constraint_poly_series`] pass with the adjoint weights `w`
+/// of its rows' coefficients, in one sweep over the rows: `qb += sum_r sum_k w[r][k]
+/// grads[r][k]` (the gradient with respect to `q`) and, for every direction `j <
+/// dirs.len()`, `dirs[j] += sum_r sum_k w[r][k] grads[r][DIV[k][j]]` (the gradient with
+/// respect to direction `j`, [`Basis::DIV`]). Rows whose weights are all zero are skipped.
+pub(crate) fn add_constraint_poly_adjoint<const K: usize, B: Basis<K>>(
+    sys: &System,
+    grads: &[[[f64; NV]; K]],
+    w: &[[f64; K]],
+    qb: &mut [f64],
+    dirs: &mut [&mut [f64]],
+) {
+    debug_assert!(w.len() == sys.n_constraints() && grads.len() == w.len());
+    debug_assert!(dirs.len() <= B::ND);
+    for JointElement {
+        joint: j,
+        attach: at,
+        row: o,
+    } in sys.joint_elements()
+    {
+        let ne = j.n_equations();
+        let mut gq = [0.0; NV];
+        let mut gd = [[0.0; NV]; MAX_DIRS];
+        let mut any = false;
+        for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
+            poly_local_adjoint::<K, B>(gr, wr, dirs.len(), &mut gq, &mut gd, &mut any);
+        }
+        if any {
+            scatter_grad(at, &gq, 1.0, qb);
+            for (d, out) in dirs.iter_mut().enumerate() {
+                scatter_grad(at, &gd[d], 1.0, out);
             }
         }
     }
+}
 
-    /// The adjoint of a [`System::constraint_poly_series`] pass with the adjoint weights `w`
-    /// of its rows' coefficients, in one sweep over the rows: `qb += sum_r sum_k w[r][k]
-    /// grads[r][k]` (the gradient with respect to `q`) and, for every direction `j <
-    /// dirs.len()`, `dirs[j] += sum_r sum_k w[r][k] grads[r][DIV[k][j]]` (the gradient with
-    /// respect to direction `j`, [`Basis::DIV`]). Rows whose weights are all zero are skipped.
-    pub fn add_constraint_poly_adjoint<const K: usize, B: Basis<K>>(
-        &self,
-        grads: &[[[f64; NV]; K]],
-        w: &[[f64; K]],
-        qb: &mut [f64],
-        dirs: &mut [&mut [f64]],
-    ) {
-        debug_assert!(w.len() == self.n_constraints() && grads.len() == w.len());
-        debug_assert!(dirs.len() <= B::ND);
-        for (ji, j) in self.joints.iter().enumerate() {
-            let o = self.row_offset[ji];
-            let ne = j.n_equations();
-            let mut gq = [0.0; NV];
-            let mut gd = [[0.0; NV]; MAX_DIRS];
-            let mut any = false;
-            for (gr, wr) in grads[o..o + ne].iter().zip(&w[o..o + ne]) {
-                Self::poly_local_adjoint::<K, B>(gr, wr, dirs.len(), &mut gq, &mut gd, &mut any);
-            }
-            if any {
-                let at = self.joint_attach[ji];
-                Self::scatter_grad(at, &gq, 1.0, qb);
-                for (d, out) in dirs.iter_mut().enumerate() {
-                    Self::scatter_grad(at, &gd[d], 1.0, out);
-                }
+/// [`add_constraint_poly_adjoint`] for a [`potential_poly_series`] pass
+/// (one weight vector for every force element).
+pub(crate) fn add_potential_poly_adjoint<const K: usize, B: Basis<K>>(
+    sys: &System,
+    grads: &[[[f64; NV]; K]],
+    w: &[f64; K],
+    qb: &mut [f64],
+    dirs: &mut [&mut [f64]],
+) {
+    debug_assert_eq!(grads.len(), sys.forces().len());
+    debug_assert!(dirs.len() <= B::ND);
+    for (gr, (_, at)) in grads.iter().zip(sys.force_elements()) {
+        let mut gq = [0.0; NV];
+        let mut gd = [[0.0; NV]; MAX_DIRS];
+        let mut any = false;
+        poly_local_adjoint::<K, B>(gr, w, dirs.len(), &mut gq, &mut gd, &mut any);
+        if any {
+            scatter_grad(at, &gq, 1.0, qb);
+            for (d, out) in dirs.iter_mut().enumerate() {
+                scatter_grad(at, &gd[d], 1.0, out);
             }
         }
     }
+}
 
-    /// [`System::add_constraint_poly_adjoint`] for a [`System::potential_poly_series`] pass
-    /// (one weight vector for every force element).
-    pub fn add_potential_poly_adjoint<const K: usize, B: Basis<K>>(
-        &self,
-        grads: &[[[f64; NV]; K]],
-        w: &[f64; K],
-        qb: &mut [f64],
-        dirs: &mut [&mut [f64]],
-    ) {
-        debug_assert_eq!(grads.len(), self.forces.len());
-        debug_assert!(dirs.len() <= B::ND);
-        for (fi, gr) in grads.iter().enumerate() {
-            let mut gq = [0.0; NV];
-            let mut gd = [[0.0; NV]; MAX_DIRS];
-            let mut any = false;
-            Self::poly_local_adjoint::<K, B>(gr, w, dirs.len(), &mut gq, &mut gd, &mut any);
-            if any {
-                let at = self.force_attach[fi];
-                Self::scatter_grad(at, &gq, 1.0, qb);
-                for (d, out) in dirs.iter_mut().enumerate() {
-                    Self::scatter_grad(at, &gd[d], 1.0, out);
-                }
-            }
+/// One element row's share of the adjoints: `gq += sum_k w[k] g[k]`, `gd[j] += sum_k w[k]
+/// g[DIV[k][j]]` for `j < nd`.
+#[inline(always)]
+fn poly_local_adjoint<const K: usize, B: Basis<K>>(
+    g: &[[f64; NV]; K],
+    w: &[f64; K],
+    nd: usize,
+    gq: &mut [f64; NV],
+    gd: &mut [[f64; NV]; MAX_DIRS],
+    any: &mut bool,
+) {
+    for k in 0..K {
+        let wk = w[k];
+        if wk == 0.0 {
+            continue;
         }
-    }
-
-    /// One element row's share of the adjoints: `gq += sum_k w[k] g[k]`, `gd[j] += sum_k w[k]
-    /// g[DIV[k][j]]` for `j < nd`.
-    #[inline(always)]
-    fn poly_local_adjoint<const K: usize, B: Basis<K>>(
-        g: &[[f64; NV]; K],
-        w: &[f64; K],
-        nd: usize,
-        gq: &mut [f64; NV],
-        gd: &mut [[f64; NV]; MAX_DIRS],
-        any: &mut bool,
-    ) {
-        for k in 0..K {
-            let wk = w[k];
-            if wk == 0.0 {
-                continue;
-            }
-            *any = true;
-            for l in 0..NV {
-                gq[l] += wk * g[k][l];
-            }
-            for (j, gdj) in gd.iter_mut().enumerate().take(nd) {
-                let d = B::DIV[k][j];
-                if d != u8::MAX {
-                    for l in 0..NV {
-                        gdj[l] += wk * g[d as usize][l];
-                    }
+        *any = true;
+        for l in 0..NV {
+            gq[l] += wk * g[k][l];
+        }
+        for (j, gdj) in gd.iter_mut().enumerate().take(nd) {
+            let d = B::DIV[k][j];
+            if d != u8::MAX {
+                for l in 0..NV {
+                    gdj[l] += wk * g[d as usize][l];
                 }
             }
         }
@@ -347,20 +351,21 @@ impl System {
 
 #[cfg(test)]
 mod tests {
+    use super::super::directional::{constraint_directional, potential_directional};
     use super::*;
-    use crate::fixtures::{derivative_test_systems, generic_point, TwoDirections};
-    use crate::joints::JointKind;
+    use mbd_model::fixtures::{derivative_test_systems, generic_point, TwoDirections};
+    use mbd_model::JointKind;
 
     /// The closed-form revolute rows equal the generic evaluation's (to rounding), on systems
     /// with revolute joints between bodies and to ground.
     #[test]
     fn revolute_closed_form_matches_the_generic_rows() {
         let mut systems = derivative_test_systems().to_vec();
-        systems.push(crate::models::n_link_chain(4).expect("chain"));
+        systems.push(mbd_model::models::n_link_chain(4).expect("chain"));
         let mut revolute = 0;
         for sys in &systems {
             revolute += sys
-                .joints
+                .joints()
                 .iter()
                 .filter(|j| matches!(j.kind, JointKind::Revolute(_)))
                 .count();
@@ -373,7 +378,8 @@ mod tests {
             for closed in [true, false] {
                 let (mut vals, mut grads) = (vec![[0.0; 8]; m], vec![[[0.0; NV]; 8]; m]);
                 let mut ws = PolyWorkspace::<8, TwoDirections>::new();
-                sys.constraint_poly_series_impl(
+                constraint_poly_series_impl(
+                    sys,
                     &mut ws,
                     &q,
                     &ang,
@@ -416,17 +422,17 @@ mod tests {
                 ang.update(&sys, q);
                 let (mut vals, mut grads) = (vec![[0.0; 8]; m], vec![[[0.0; NV]; 8]; m]);
                 let mut ws = PolyWorkspace::<8, TwoDirections>::new();
-                sys.constraint_poly_series(&mut ws, q, &ang, &[v, u], &mut vals, &mut grads);
+                constraint_poly_series(&sys, &mut ws, q, &ang, &[v, u], &mut vals, &mut grads);
                 let mut pg = vec![[[0.0; NV]; 8]; nf];
-                let pot = sys.potential_poly_series(&mut ws, q, &ang, &[v, u], &mut pg);
+                let pot = potential_poly_series(&sys, &mut ws, q, &ang, &[v, u], &mut pg);
                 (vals, grads, pot, pg)
             };
             let (vals, grads, pot, pg) = series(&q, &v, &u);
             ang.update(&sys, &q);
             let dir = |w: &[f64]| {
                 let mut rows = vec![[0.0; 3]; m];
-                sys.constraint_directional(&q, w, &mut rows);
-                (rows, sys.potential_directional(&q, w))
+                constraint_directional(&sys, &q, w, &mut rows);
+                (rows, potential_directional(&sys, &q, w))
             };
             let (dv, pv) = dir(&v);
             let upv: Vec<f64> = u.iter().zip(&v).map(|(a, b)| a + b).collect();
@@ -463,8 +469,8 @@ mod tests {
             let mut gq = vec![0.0; n];
             let (mut gdv, mut gdu) = (vec![0.0; n], vec![0.0; n]);
             let mut gd = [gdv.as_mut_slice(), gdu.as_mut_slice()];
-            sys.add_constraint_poly_adjoint::<8, TwoDirections>(&grads, &w, &mut gq, &mut gd);
-            sys.add_potential_poly_adjoint::<8, TwoDirections>(&pg, &wp, &mut gq, &mut gd);
+            add_constraint_poly_adjoint::<8, TwoDirections>(&sys, &grads, &w, &mut gq, &mut gd);
+            add_potential_poly_adjoint::<8, TwoDirections>(&sys, &pg, &wp, &mut gq, &mut gd);
             let gd = [gdv, gdu];
             let h = 1e-4;
             for i in 0..n {

@@ -1,6 +1,7 @@
 //! Tests of the third-derivative passes against differences of assembled Hessians.
 
-use crate::{models, Body, BodyRef, Force, Joint, System, SystemBuilder, TimeFunction};
+use super::*;
+use mbd_model::{models, Body, BodyRef, Force, Joint, System, SystemBuilder, TimeFunction};
 use nalgebra::DMatrix;
 
 /// Every conservative force kind (springs with and without rest length, rotary spring,
@@ -121,7 +122,7 @@ fn point(n: usize) -> (Vec<f64>, Vec<f64>) {
 #[test]
 fn constraint_third_matches_hessian_differences() {
     let systems = [
-        crate::fixtures::every_joint_kind(),
+        mbd_model::fixtures::every_joint_kind(),
         forces_system(),
         models::slider_crank().unwrap(),
         models::manipulator().unwrap(),
@@ -137,7 +138,7 @@ fn constraint_third_matches_hessian_differences() {
         weights.push((0..m).map(|r| 0.7 - 0.3 * r as f64).collect());
         let mut out = vec![0.0; n];
         for w in &weights {
-            sys.constraint_third(&q, &v, w, &mut out);
+            constraint_third(sys, &q, &v, w, &mut out);
             let fd = fd_third(&|qq, hm| sys.constraint_hessian(qq, w, hm), &q, &v);
             check(&out, &fd, "constraint_third");
         }
@@ -153,14 +154,14 @@ fn potential_third_matches_hessian_differences() {
         let n = sys.n_coords();
         let (q, v) = point(n);
         let mut out = vec![0.0; n];
-        sys.potential_third(&q, &v, &mut out);
+        potential_third(sys, &q, &v, &mut out);
         // (the springs make it non-zero; the manipulator's potential may be linear)
         assert!(k > 0 || out.iter().any(|&x| x != 0.0));
         let fd = fd_third(&|qq, hm| sys.potential_hessian(qq, hm), &q, &v);
         check(&out, &fd, "potential_third");
         // add_ with a scale accumulates
         let mut acc = vec![1.0; n];
-        sys.add_potential_third(&q, &v, -2.0, &mut acc);
+        add_potential_third(sys, &q, &v, -2.0, &mut acc);
         for i in 0..n {
             assert!((acc[i] - (1.0 - 2.0 * out[i])).abs() < 1e-12 * (1.0 + out[i].abs()));
         }
@@ -170,7 +171,7 @@ fn potential_third_matches_hessian_differences() {
 fn lagrangian_products_match_assembled_hessians() {
     for sys in [
         forces_system(),
-        crate::fixtures::every_joint_kind(),
+        mbd_model::fixtures::every_joint_kind(),
         models::manipulator().unwrap(),
     ] {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
@@ -182,11 +183,11 @@ fn lagrangian_products_match_assembled_hessians() {
         sys.add_constraint_hessian(&q, &w, 1.0, &mut hm);
         let dense = &hm * nalgebra::DVector::from_column_slice(&v);
         let (mut hv, mut hv2, mut d3) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        sys.lagrangian_hessian_vector(&q, &v, 0.5, &w, &mut hv);
-        sys.lagrangian_third(&q, &v, 0.5, &w, &mut hv2, &mut d3);
+        lagrangian_hessian_vector(&sys, &q, &v, 0.5, &w, &mut hv);
+        lagrangian_third(&sys, &q, &v, 0.5, &w, &mut hv2, &mut d3);
         let (mut p3, mut c3) = (vec![0.0; n], vec![0.0; n]);
-        sys.potential_third(&q, &v, &mut p3);
-        sys.constraint_third(&q, &v, &w, &mut c3);
+        potential_third(&sys, &q, &v, &mut p3);
+        constraint_third(&sys, &q, &v, &w, &mut c3);
         for i in 0..n {
             let tol = 1e-12 * (1.0 + dense[i].abs());
             assert!((hv[i] - dense[i]).abs() < tol, "Hess L v [{i}]");
@@ -199,11 +200,11 @@ fn lagrangian_products_match_assembled_hessians() {
 
 /// The local third-order rows equal the dense passes: `Phi_q` and `gamma`
 /// ([`System::phi_q_gamma`]), and, weighted, `Hess(w . Phi) v` and `D^3(w . Phi)(v, v, .)`
-/// ([`System::lagrangian_third`]).
+/// ([`lagrangian_third`]).
 #[test]
 fn local_third_rows_match_the_dense_passes() {
     for sys in [
-        crate::fixtures::every_joint_kind(),
+        mbd_model::fixtures::every_joint_kind(),
         models::manipulator().unwrap(),
     ] {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
@@ -215,7 +216,7 @@ fn local_third_rows_match_the_dense_passes() {
             vec![[0.0; 6]; m],
             vec![0.0; m],
         );
-        sys.constraint_third_local(&q, &v, &mut g, &mut hv, &mut d3, &mut vhv);
+        constraint_third_local(&sys, &q, &v, &mut g, &mut hv, &mut d3, &mut vhv);
         let mut gq = DMatrix::from_element(m, n, 3.0);
         sys.local_rows_dense(&g, &mut gq);
         let (mut gq2, mut gamma) = (DMatrix::zeros(m, n), vec![0.0; m]);
@@ -228,10 +229,10 @@ fn local_third_rows_match_the_dense_passes() {
             );
         }
         let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-        sys.add_local_rows(&hv, &w, &mut a);
-        sys.add_local_rows(&d3, &w, &mut b);
+        add_local_rows(&sys, &hv, &w, &mut a);
+        add_local_rows(&sys, &d3, &w, &mut b);
         let (mut ea, mut eb) = (vec![0.0; n], vec![0.0; n]);
-        sys.lagrangian_third(&q, &v, 0.0, &w, &mut ea, &mut eb);
+        lagrangian_third(&sys, &q, &v, 0.0, &w, &mut ea, &mut eb);
         for i in 0..n {
             assert!(
                 (a[i] - ea[i]).abs() < 1e-13 * (1.0 + ea[i].abs()),
@@ -249,14 +250,14 @@ fn local_third_rows_match_the_dense_passes() {
 /// each row (`constraint_hessian` with a unit multiplier) times the row's direction.
 #[test]
 fn hessian_rows_match_assembled_hessians() {
-    for sys in crate::fixtures::derivative_test_systems() {
+    for sys in mbd_model::fixtures::derivative_test_systems() {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let (q, _) = crate::fixtures::generic_point(n);
+        let (q, _) = mbd_model::fixtures::generic_point(n);
         let dirs: Vec<[f64; 6]> = (0..m)
             .map(|r| std::array::from_fn(|l| 0.3 + 0.1 * r as f64 - 0.07 * (l * l) as f64))
             .collect();
         let mut got = vec![0.0; n];
-        sys.add_constraint_hessian_rows(&q, &dirs, &mut got);
+        add_constraint_hessian_rows(&sys, &q, &dirs, &mut got);
         let mut want = vec![0.0; n];
         let mut h = DMatrix::zeros(n, n);
         for (r, d) in dirs.iter().enumerate() {
