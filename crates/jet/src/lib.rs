@@ -87,6 +87,8 @@ macro_rules! scalar_shift_ops {
 use scalar_shift_ops;
 
 mod dir;
+#[cfg(any(test, feature = "fixtures"))]
+pub mod fixtures;
 mod dual;
 mod hess;
 mod poly;

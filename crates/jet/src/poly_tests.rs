@@ -4,22 +4,7 @@
 use super::*;
 use crate::Taylor4;
 
-/// `{1, t, e, t^2, e t, t^3, e t^2, t^4}` in two directions (`t`, `e`).
-#[derive(Clone, Copy, Debug)]
-struct TwoDirections;
-impl Basis<8> for TwoDirections {
-    const ND: usize = 2;
-    const EXP: [[u8; MAX_DIRS]; 8] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [2, 0, 0, 0, 0, 0],
-        [1, 1, 0, 0, 0, 0],
-        [3, 0, 0, 0, 0, 0],
-        [2, 1, 0, 0, 0, 0],
-        [4, 0, 0, 0, 0, 0],
-    ];
-}
+use crate::fixtures::TwoDirections;
 
 /// `{1, t, e, d, t^2, e t, e^2, e d, e t^2}`.
 #[derive(Clone, Copy, Debug)]

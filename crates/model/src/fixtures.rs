@@ -1,7 +1,6 @@
 //! Test fixtures: the systems and points the derivative tests of this crate and of the
 //! solver crates above it (feature `fixtures`, for their tests only) compare passes on.
 
-use crate::jet::{Basis, MAX_DIRS};
 use crate::{Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, TimeFunction};
 
 /// Every joint kind (revolute, prismatic, weld, distance, absolute x / y / angle, angle
@@ -98,20 +97,4 @@ pub fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
     (q, v)
 }
 
-/// A [`crate::PolyJet`] basis in two directions (`t`, `e`): `{1, t, e, t^2, e t, t^3, e t^2,
-/// t^4}`, the shape of the preadjustment's first pass.
-#[derive(Clone, Copy, Debug)]
-pub struct TwoDirections;
-impl Basis<8> for TwoDirections {
-    const ND: usize = 2;
-    const EXP: [[u8; MAX_DIRS]; 8] = [
-        [0, 0, 0, 0, 0, 0],
-        [1, 0, 0, 0, 0, 0],
-        [0, 1, 0, 0, 0, 0],
-        [2, 0, 0, 0, 0, 0],
-        [1, 1, 0, 0, 0, 0],
-        [3, 0, 0, 0, 0, 0],
-        [2, 1, 0, 0, 0, 0],
-        [4, 0, 0, 0, 0, 0],
-    ];
-}
+pub use mbd_jet::fixtures::TwoDirections;
