@@ -245,6 +245,23 @@ pub(crate) fn rank_one_update(p: &mut [f64], s: &[f64], w: &[f64], c: f64) {
     }
 }
 
+/// `||x||_inf`, or NaN if an entry is not finite: one pass without branches (`e - e` is 0
+/// for a finite `e` and NaN otherwise).
+#[inline]
+pub(crate) fn max_abs_finite(x: &[f64]) -> f64 {
+    let (mut r, mut bad) = (0.0f64, 0.0f64);
+    for &e in x {
+        let a = e.abs();
+        r = if a > r { a } else { r };
+        bad += e - e;
+    }
+    if bad == 0.0 {
+        r
+    } else {
+        f64::NAN
+    }
+}
+
 #[inline]
 pub(crate) fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
     for (yi, xi) in y.iter_mut().zip(x) {

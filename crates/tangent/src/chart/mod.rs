@@ -2,7 +2,8 @@
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
 use crate::kernels::{
-    axpy, form_q_padded, gemv_cols, gemv_t_cols, qr_padded, solve_r, with_codim, with_len,
+    axpy, form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, qr_padded, solve_r, with_codim,
+    with_len,
 };
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
@@ -503,15 +504,8 @@ impl TangentChart {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
-        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
-        let mut r = 0.0f64;
-        for &e in out[..2 * m].iter() {
-            if !e.is_finite() {
-                return f64::NAN;
-            }
-            r = r.max(e.abs());
-        }
-        r
+        sys.phi_and_phi_dot_near(q, v, t, p, pd, &mut self.angles);
+        max_abs_finite(&out[..2 * m])
     }
 
     /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
@@ -583,9 +577,11 @@ impl TangentChart {
         }
     }
 
-    /// `out = [Q1 U]^T y`: the normal components (first `2m`) and the tangent components (last
-    /// `2(n - m)`) of a vector `y` of length `2n`.
-    pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
-        gemv_t_cols(&self.q, y, out);
+    /// `[Q1 U]^T y` for a vector `y` of length `2n`, in two parts: its normal components
+    /// `normal = Q1^T y` (`2m`) and its tangent components `tangent = U^T y` (`2(n - m)`).
+    pub fn split_coordinates(&self, y: &[f64], normal: &mut [f64], tangent: &mut [f64]) {
+        let (nn, mm) = (2 * self.n, 2 * self.m);
+        gemv_t_cols(&self.q[..mm * nn], y, &mut normal[..mm]);
+        gemv_t_cols(&self.q[mm * nn..], y, tangent);
     }
 }

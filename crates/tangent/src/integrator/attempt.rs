@@ -69,13 +69,7 @@ impl TangentRk {
         {
             let chart = &mut self.path;
             let zlast = &mut self.zeta;
-            let (zplain, x, g, fx, proj) = (
-                &mut self.zplain,
-                &mut self.x,
-                &mut self.g,
-                &mut self.fx,
-                &mut self.proj,
-            );
+            let (zplain, x, g, fx) = (&mut self.zplain, &mut self.x, &mut self.g, &mut self.fx);
             let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
             let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
             let fsal = self.fsal;
@@ -177,7 +171,7 @@ impl TangentRk {
                 work.rhs_evals += 1;
                 fx[..n].copy_from_slice(v);
                 fx[n..].copy_from_slice(acc_a);
-                chart.split(fx, proj, &mut g[i * mm..(i + 1) * mm], dy);
+                chart.split(fx, &mut g[i * mm..(i + 1) * mm], dy);
                 stage += 1;
                 Ok(())
             };

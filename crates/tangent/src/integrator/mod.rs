@@ -81,7 +81,7 @@ pub struct TangentRk {
     g: Vec<f64>,
     /// `F = (v, a)`.
     fx: Vec<f64>,
-    /// `Q^T F` (dense path); work space.
+    /// Work space (`2n`).
     proj: Vec<f64>,
     /// Residual buffer.
     res: Vec<f64>,
