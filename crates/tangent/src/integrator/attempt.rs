@@ -73,11 +73,11 @@ impl TangentRk {
             let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
             let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
             let fsal = self.fsal;
-            let (eta_now, eta_hist, eta_pred, eta_tmp) = (
+            let (eta_now, eta_hist, eta_pred, eta_raw) = (
                 &mut self.eta_now,
                 &self.eta_hist,
                 &mut self.eta_pred,
-                &mut self.eta_tmp,
+                &mut self.eta_raw,
             );
             let work = &mut work;
             let failure = &mut failure;
@@ -102,14 +102,18 @@ impl TangentRk {
                 chart.select_iteration_matrix(c_coef[i]);
                 let ysq: f64 = y.iter().map(|v| v * v).sum();
                 if npts > 0 {
-                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, eta_pred);
+                    // the plain extrapolation of this stage, kept for the later stages'
+                    // corrections
+                    let raw = &mut eta_raw[i * mm..(i + 1) * mm];
+                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, raw);
+                    eta_pred.copy_from_slice(raw);
                     if jlast > 0 {
                         // correct by the extrapolation error of the latest mapped stage j,
                         // scaled like the normal offset (|Y_i|^2 / |Y_j|^2)
                         let r = ysq / ylast_sq;
-                        extrapolate(eta_hist, npts, (s + 1) * mm, jlast * mm, eta_tmp);
+                        let raw_j = &eta_raw[jlast * mm..(jlast + 1) * mm];
                         let now = &eta_now[jlast * mm..(jlast + 1) * mm];
-                        for ((p, e), x) in eta_pred.iter_mut().zip(now).zip(eta_tmp.iter()) {
+                        for ((p, e), x) in eta_pred.iter_mut().zip(now).zip(raw_j) {
                             *p += r * (e - x);
                         }
                     }
