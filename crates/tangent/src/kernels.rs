@@ -306,6 +306,21 @@ macro_rules! with_len {
 }
 pub(crate) use with_len;
 
+/// Calls `$f(args, m)` with `m` a literal for the constraint counts of the planar mechanisms'
+/// small charts (4: two revolute joints; 6; 8: a four-bar or slider-crank), else with `$m`
+/// itself; for the loops over the constraints of the chart's centre (see [`with_len`]).
+macro_rules! with_rows {
+    ($m:expr, $f:ident($($arg:expr),*)) => {
+        match $m {
+            4 => $f($($arg,)* 4),
+            6 => $f($($arg,)* 6),
+            8 => $f($($arg,)* 8),
+            m => $f($($arg,)* m),
+        }
+    };
+}
+pub(crate) use with_rows;
+
 /// Householder QR of the first `kcols` columns of the `n x tcols` column-major matrix `a`
 /// (`n >= kcols`), applying each reflector also to the columns `kcols..tcols`. Afterwards the
 /// first `kcols` columns hold `R` on and above the diagonal and zeros below, the others

@@ -3,7 +3,7 @@
 
 use crate::kernels::{
     axpy, form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, qr_padded, solve_r, with_codim,
-    with_len,
+    with_len, with_rows,
 };
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
@@ -543,7 +543,13 @@ impl TangentChart {
 /// 2. `B = Qb [Rb; 0]`.
 #[inline(always)]
 fn factor_blocks(ch: &mut TangentChart, n: usize) {
-    let m = ch.m;
+    with_rows!(ch.m, factor_blocks_mn(ch, n));
+}
+
+/// [`factor_blocks`] for `m` constraints (a literal for the common counts through
+/// `with_rows!`).
+#[inline(always)]
+fn factor_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
     let (nn, mm, nm) = (2 * n, 2 * m, n - m);
     let (pq, xs) = (ch.phi_q.as_slice(), ch.dphi.as_slice()); // (r, c) at c m + r
     for k in 0..m {
@@ -585,7 +591,13 @@ fn factor_blocks(ch: &mut TangentChart, n: usize) {
 /// [`gemv_cols`] does.
 #[inline(always)]
 fn form_q_blocks(ch: &mut TangentChart, n: usize) {
-    let m = ch.m;
+    with_rows!(ch.m, form_q_blocks_mn(ch, n));
+}
+
+/// [`form_q_blocks`] for `m` constraints (a literal for the common counts through
+/// `with_rows!`).
+#[inline(always)]
+fn form_q_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
     let (nn, nm) = (2 * n, n - m);
     form_q_padded(&ch.va, &ch.tau[..m], &mut ch.qa, n);
     form_q_padded(&ch.vb, &ch.tau_b[..m], &mut ch.qb, n);
