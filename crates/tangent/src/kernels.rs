@@ -117,9 +117,54 @@ pub(crate) fn gemv_cols(cols: &[f64], a: &[f64], y: &mut [f64]) {
     by_length!(r, gemv_cols_fixed(cols, a, y), gemv_cols_any(cols, a, y))
 }
 
-/// [`gemv_cols`] for columns of the fixed length `R`: `y` stays in registers.
+/// Calls `$f::<R, C>(args)` for the column counts `C` of the small charts (`2m` and
+/// `2(n - m)` of the planar mechanisms: 2, 4, 6, 8, 12, 16), else evaluates `$other`.
+macro_rules! by_count {
+    ($c:expr, $r:ident, $f:ident($($arg:expr),*), $other:expr) => {
+        match $c {
+            2 => $f::<$r, 2>($($arg),*),
+            4 => $f::<$r, 4>($($arg),*),
+            6 => $f::<$r, 6>($($arg),*),
+            8 => $f::<$r, 8>($($arg),*),
+            12 => $f::<$r, 12>($($arg),*),
+            16 => $f::<$r, 16>($($arg),*),
+            _ => $other,
+        }
+    };
+}
+
+/// [`gemv_cols`] for columns of the fixed length `R`: `y` stays in registers; the column
+/// count fixed too where it is a common one ([`gemv_cols_rc`]).
 #[inline]
 fn gemv_cols_fixed<const R: usize>(cols: &[f64], a: &[f64], y: &mut [f64]) {
+    by_count!(
+        a.len(),
+        R,
+        gemv_cols_rc(cols, a, y),
+        gemv_cols_r::<R>(cols, a, y)
+    )
+}
+
+/// [`gemv_cols`] for `C` columns of the fixed length `R` (the loops unroll), in the
+/// order of [`gemv_cols_r`] (the same sums).
+#[inline]
+fn gemv_cols_rc<const R: usize, const C: usize>(cols: &[f64], a: &[f64], y: &mut [f64]) {
+    let y: &mut [f64; R] = (&mut y[..R]).try_into().unwrap();
+    let cols: &[f64] = &cols[..R * C];
+    let a: &[f64; C] = (&a[..C]).try_into().unwrap();
+    let mut acc = *y;
+    for k in 0..C {
+        let ak = a[k];
+        for i in 0..R {
+            acc[i] += ak * cols[k * R + i];
+        }
+    }
+    *y = acc;
+}
+
+/// [`gemv_cols`] for columns of the fixed length `R` and any count.
+#[inline]
+fn gemv_cols_r<const R: usize>(cols: &[f64], a: &[f64], y: &mut [f64]) {
     let y: &mut [f64; R] = (&mut y[..R]).try_into().unwrap();
     let mut acc = *y;
     for (c, &ak) in cols.chunks_exact(R).zip(a) {
@@ -171,6 +216,30 @@ pub(crate) fn gemv_t_cols(cols: &[f64], y: &[f64], out: &mut [f64]) {
 /// per column (pairs of lanes).
 #[inline]
 fn gemv_t_cols_fixed<const R: usize>(cols: &[f64], y: &[f64], out: &mut [f64]) {
+    by_count!(
+        out.len(),
+        R,
+        gemv_t_cols_rc(cols, y, out),
+        gemv_t_cols_r::<R>(cols, y, out)
+    )
+}
+
+/// [`gemv_t_cols`] for `C` columns of the fixed length `R` (the same sums as
+/// [`gemv_t_cols_r`]).
+#[inline]
+fn gemv_t_cols_rc<const R: usize, const C: usize>(cols: &[f64], y: &[f64], out: &mut [f64]) {
+    let y: &[f64; R] = (&y[..R]).try_into().unwrap();
+    let cols: &[f64] = &cols[..R * C];
+    let out: &mut [f64; C] = (&mut out[..C]).try_into().unwrap();
+    for k in 0..C {
+        let c: &[f64; R] = (&cols[k * R..(k + 1) * R]).try_into().unwrap();
+        out[k] = dot_fixed(c, y);
+    }
+}
+
+/// [`gemv_t_cols`] for columns of the fixed length `R` and any count.
+#[inline]
+fn gemv_t_cols_r<const R: usize>(cols: &[f64], y: &[f64], out: &mut [f64]) {
     let y: &[f64; R] = (&y[..R]).try_into().unwrap();
     for (c, o) in cols.chunks_exact(R).zip(out.iter_mut()) {
         let c: &[f64; R] = c.try_into().unwrap();
