@@ -492,6 +492,20 @@ pub(crate) fn solve_rt(
     }
 }
 
+/// `zeta = R eta` for the upper triangular `R` of [`solve_rt`] (`mm x mm`, column `j` at
+/// `r[j * stride..]`): column by column, `zeta[..=j] += eta_j R[..=j, j]`.
+#[inline(always)]
+pub(crate) fn mul_r(r: &[f64], stride: usize, eta: &[f64], zeta: &mut [f64], mm: usize) {
+    let (eta, zeta) = (&eta[..mm], &mut zeta[..mm]);
+    zeta.fill(0.0);
+    for j in 0..mm {
+        let (e, col) = (eta[j], &r[j * stride..j * stride + j + 1]);
+        for i in 0..=j {
+            zeta[i] += e * col[i];
+        }
+    }
+}
+
 /// `eta = R^-1 zeta` for the upper triangular `R` of [`solve_rt`]: back substitution by
 /// columns of `R` (contiguous).
 #[inline(always)]

@@ -2,7 +2,7 @@
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
 use crate::kernels::{
-    axpy, form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, qr_padded, solve_r, with_codim,
+    form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, mul_r, qr_padded, solve_r, with_codim,
     with_len, with_rows,
 };
 use mbd_model::{BodyAngles, System};
@@ -517,11 +517,7 @@ impl TangentChart {
     /// (the inverse of [`TangentChart::eta_from_zeta`]).
     pub fn zeta_from_eta(&self, eta: &[f64], zeta: &mut [f64]) {
         let (nn, mm) = (2 * self.n, 2 * self.m);
-        let zeta = &mut zeta[..mm];
-        zeta.fill(0.0);
-        for (j, &ej) in eta.iter().enumerate().take(mm) {
-            axpy(ej, &self.a[j * nn..j * nn + j + 1], &mut zeta[..j + 1]);
-        }
+        with_codim!(mm, mul_r(&self.a, nn, eta, zeta));
     }
 
     /// `[Q1 U]^T y` for a vector `y` of length `2n`, in two parts: its normal components

@@ -2,6 +2,7 @@
 //! the end-point map, and the `eta` history the starting points are extrapolated from.
 
 use super::*;
+use crate::kernels::with_codim;
 
 impl TangentRk {
     /// One attempted step of size `h` from the chart centre (at time `t`) into `xnew`; the
@@ -289,13 +290,23 @@ impl TangentRk {
 /// Polynomial extrapolation to the next step of the `eta` of one map (offset `off` within a
 /// step's record of length `len`) from the last `npts` (1 to 3) steps, most recent first.
 pub(super) fn extrapolate(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64]) {
+    with_codim!(out.len(), extrapolate_mm(hist, npts, len, off, out));
+}
+
+/// [`extrapolate`] for `eta` of length `mm` (a literal for the common lengths).
+#[inline(always)]
+fn extrapolate_mm(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64], mm: usize) {
     let w: &[f64] = match npts {
         1 => &[1.0],
         2 => &[2.0, -1.0],
         _ => &[3.0, -3.0, 1.0],
     };
+    let out = &mut out[..mm];
     out.fill(0.0);
     for (k, &wk) in w.iter().enumerate() {
-        axpy(wk, &hist[k * len + off..k * len + off + out.len()], out);
+        let h = &hist[k * len + off..k * len + off + mm];
+        for i in 0..mm {
+            out[i] += wk * h[i];
+        }
     }
 }
