@@ -314,7 +314,7 @@ pub(crate) fn rank_one_update(p: &mut [f64], s: &[f64], w: &[f64], c: f64) {
     }
 }
 
-/// `||x||_inf`, or NaN if an entry is not finite: one pass without branches (`e - e` is 0
+/// `||x||_inf`, or NaN if an entry is not finite: one pass without branches (`e * 0` is 0
 /// for a finite `e` and NaN otherwise).
 #[inline]
 pub(crate) fn max_abs_finite(x: &[f64]) -> f64 {
@@ -322,7 +322,7 @@ pub(crate) fn max_abs_finite(x: &[f64]) -> f64 {
     for &e in x {
         let a = e.abs();
         r = if a > r { a } else { r };
-        bad += e - e;
+        bad += e * 0.0;
     }
     if bad == 0.0 {
         r

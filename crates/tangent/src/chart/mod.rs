@@ -565,11 +565,9 @@ fn factor_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
         // column j of R's leading block Ra (zero below its diagonal), column m + j of C
         let (left, right) = ch.a.split_at_mut((m + j) * nn);
         let (ar, ac) = (&mut left[j * nn..], right);
-        for i in 0..m {
-            ac[i] = g[i];
-            ar[i] = ra[i];
-            bj[nm + i] = ra[i];
-        }
+        ac[..m].copy_from_slice(&g[..m]);
+        ar[..m].copy_from_slice(&ra[..m]);
+        bj[nm..].copy_from_slice(&ra[..m]);
         bj[..nm].copy_from_slice(&g[m..]);
     }
     qr_padded(&mut ch.bq, m, m, &mut ch.vb, &mut ch.tau_b, n);
