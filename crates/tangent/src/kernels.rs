@@ -314,12 +314,12 @@ pub(crate) fn rank_one_update(p: &mut [f64], s: &[f64], w: &[f64], c: f64) {
     }
 }
 
-/// `||x||_inf`, or NaN if an entry is not finite: one pass without branches (`e * 0` is 0
-/// for a finite `e` and NaN otherwise).
-#[inline]
-pub(crate) fn max_abs_finite(x: &[f64]) -> f64 {
+/// `||x[..len]||_inf`, or NaN if an entry is not finite: one pass without branches (`e * 0`
+/// is 0 for a finite `e` and NaN otherwise); `len` a literal through `with_codim!`.
+#[inline(always)]
+pub(crate) fn max_abs_finite(x: &[f64], len: usize) -> f64 {
     let (mut r, mut bad) = (0.0f64, 0.0f64);
-    for &e in x {
+    for &e in &x[..len] {
         let a = e.abs();
         r = if a > r { a } else { r };
         bad += e * 0.0;
@@ -329,6 +329,12 @@ pub(crate) fn max_abs_finite(x: &[f64]) -> f64 {
     } else {
         f64::NAN
     }
+}
+
+/// Whether every entry of `x` is finite (one pass without branches, as [`max_abs_finite`]).
+#[inline]
+pub(crate) fn all_finite(x: &[f64]) -> bool {
+    x.iter().fold(0.0f64, |bad, &e| bad + e * 0.0) == 0.0
 }
 
 #[inline]

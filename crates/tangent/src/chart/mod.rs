@@ -2,8 +2,8 @@
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
 use crate::kernels::{
-    form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, mul_r, qr_padded, solve_r, with_codim,
-    with_len, with_rows,
+    all_finite, form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, mul_r, qr_padded, solve_r,
+    with_codim, with_len, with_rows,
 };
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
@@ -331,13 +331,7 @@ impl TangentChart {
             return Ok(());
         }
         sys.phi_q_dot_jacobian(q, v, &mut self.phi_q, &mut self.dphi);
-        if self
-            .phi_q
-            .as_slice()
-            .iter()
-            .chain(self.dphi.as_slice())
-            .any(|x| !x.is_finite())
-        {
+        if !all_finite(self.phi_q.as_slice()) || !all_finite(self.dphi.as_slice()) {
             return Err(SolveError::NonFinite {
                 t,
                 what: "constraint Jacobian at the chart centre",
@@ -452,7 +446,7 @@ impl TangentChart {
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
         sys.phi_and_phi_dot_near(q, v, t, p, pd, &mut self.angles);
-        max_abs_finite(&out[..2 * m])
+        with_codim!(2 * m, max_abs_finite(out))
     }
 
     /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
