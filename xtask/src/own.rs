@@ -121,9 +121,11 @@ fn solve_to(
 /// Why the tangent RK4 step is more than 4x a plain RK4 step: the everyday passes and the
 /// index-1 solve they share became about 2x cheaper (plain RK4 on the manipulator from 22,200
 /// to 9,300 instructions), while the tangent chart's own work (the QR of `Df^T`, the chord
-/// maps, the eta history) did not change (about 40,800 of its 56,100 instructions); even at no
-/// cost for the shared passes the ratio would be 4.4x. The chart's own code is the next step.
-const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step, the centre's QR of Df^T 19,500 -> 9,900), 4.55x in instructions, still above 4x; see docs/report.md, expected misses";
+/// maps, the eta history) did not change (about 40,800 of its 56,100 instructions). Two rounds
+/// on the chart's own code (tangent-perf, tangent-perf2) brought it to 37,100 instructions,
+/// 3.93x in instructions but about 4.3x by wall clock (latency-bound trigonometry, divisions and
+/// triangular solves).
+const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step; tangent-perf2: 42,600 -> 37,100), 3.93x plain RK4 in instructions but about 4.3x by wall clock (the remaining work is latency-bound: trigonometry, divisions, triangular solves); see docs/report.md, expected misses";
 
 /// Errors of the order study within this of zero are at the reference's / round-off floor.
 const FLOOR: f64 = 1e-11;

@@ -308,6 +308,59 @@ impl System {
         }
     }
 
+    /// [`System::phi_and_phi_dot_cached`] with the revolute rows written out in closed form
+    /// (no dual-number frames): a body point `r + R(theta) p` and its velocity
+    /// `v_r + omega R'(theta) p` from the cached `sin`/`cos`, in the same operations as the
+    /// dual-number evaluation, so the values are bit for bit those of
+    /// [`System::phi_and_phi_dot_cached`]; the other joint kinds go through that evaluation.
+    /// Allocation-free; the cheapest residual of the first-order constraints at a sequence of
+    /// nearby configurations (the chord iterations of a tangent chart).
+    pub fn phi_and_phi_dot_near(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+        angles: &mut BodyAngles,
+    ) {
+        angles.update_near(self, q);
+        let angles = &*angles;
+        for ji in 0..self.joints.len() {
+            let at = self.joint_attach[ji];
+            let j = &self.joints[ji];
+            if let JointKind::Revolute(Revolute { pa, pb, .. }) = &j.kind {
+                let (xa, va) = revolute_point(angles, q, v, at.a, *pa);
+                let (xb, vb) = revolute_point(angles, q, v, at.b, *pb);
+                let o = self.row_offset[ji];
+                let (p, pd) = (&mut phi[o..o + 2], &mut phi_dot[o..o + 2]);
+                (p[0], p[1]) = (xa[0] - xb[0], xa[1] - xb[1]);
+                (pd[0], pd[1]) = (va[0] - vb[0], va[1] - vb[1]);
+                continue;
+            }
+            let frame = |i: Option<usize>| -> Frame<Dual> {
+                match i {
+                    Some(i) => {
+                        let [_, s, c] = angles.sin_cos_of(i);
+                        let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+                        let w = vi[2];
+                        Frame {
+                            q: [
+                                Dual::var(qi[0], vi[0]),
+                                Dual::var(qi[1], vi[1]),
+                                Dual::var(qi[2], vi[2]),
+                            ],
+                            c: Dual { v: c, d: -s * w },
+                            s: Dual { v: s, d: c * w },
+                        }
+                    }
+                    None => Frame::fixed(),
+                }
+            };
+            self.eval_phi_phi_dot(ji, &frame(at.a), &frame(at.b), t, phi, phi_dot);
+        }
+    }
+
     /// `Phi_q` as (row, column, value) triplets of its structural non-zeros, for sparse
     /// factorisations. `out` is cleared first; its capacity is reused.
     pub fn phi_q_triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
@@ -382,6 +435,37 @@ impl System {
     // ---------------------------------------------------------------- forces and energy
 }
 
+/// The point `r + R(theta) p` of body `i` (ground for `None`) and its velocity
+/// `v_r + omega R'(theta) p`, from the cached `sin`/`cos`, written as the dual-number
+/// evaluation ([`point`] on a [`Frame`] of [`Dual`]s) computes them: the same operations in
+/// the same order, so the same bits.
+#[inline(always)]
+fn revolute_point(
+    angles: &BodyAngles,
+    q: &[f64],
+    v: &[f64],
+    i: Option<usize>,
+    p: [f64; 2],
+) -> ([f64; 2], [f64; 2]) {
+    match i {
+        Some(i) => {
+            let [_, s, c] = angles.sin_cos_of(i);
+            let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+            // the derivatives of cos and sin along the velocity
+            let (dc, ds) = (-s * vi[2], c * vi[2]);
+            (
+                [qi[0] + c * p[0] - s * p[1], qi[1] + s * p[0] + c * p[1]],
+                [vi[0] + dc * p[0] - ds * p[1], vi[1] + ds * p[0] + dc * p[1]],
+            )
+        }
+        // the ground frame: identity rotation, constant
+        None => (
+            [0.0 + 1.0 * p[0] - 0.0 * p[1], 0.0 + 0.0 * p[0] + 1.0 * p[1]],
+            [0.0 + 0.0 * p[0] - 0.0 * p[1], 0.0 + 0.0 * p[0] + 0.0 * p[1]],
+        ),
+    }
+}
+
 #[cfg(test)]
 mod phi_q_dot_jacobian_tests {
     use crate::models;
@@ -439,6 +523,52 @@ mod phi_q_dot_jacobian_tests {
                     );
                 }
             }
+        }
+    }
+
+    /// The closed-form revolute rows of `phi_and_phi_dot_near` give bit for bit what
+    /// `phi_and_phi_dot_cached` gives (and so the generic evaluation to a few ulps), on every
+    /// joint kind, the manipulator and a chain longer than the stack of frames.
+    #[test]
+    fn near_residual_matches_cached_bit_for_bit() {
+        for sys in [
+            crate::fixtures::every_joint_kind(),
+            models::manipulator().unwrap(),
+            models::n_link_chain(20).unwrap(),
+        ] {
+            let (n, m) = (sys.n_coords(), sys.n_constraints());
+            let mut c1 = crate::BodyAngles::sized(&sys);
+            let mut c2 = crate::BodyAngles::sized(&sys);
+            let mut q: Vec<f64> = (0..n).map(|i| 0.3 + 0.17 * i as f64).collect();
+            q[2] += 300.0;
+            let v: Vec<f64> = (0..n).map(|i| 1.3 - 0.41 * i as f64).collect();
+            let (mut p1, mut p2, mut d1, mut d2) =
+                (vec![0.0; m], vec![1.0; m], vec![0.0; m], vec![1.0; m]);
+            let (mut p0, mut d0) = (vec![0.0; m], vec![0.0; m]);
+            let mut worst = 0.0f64;
+            for k in 0..30 {
+                let step = if k % 11 == 10 {
+                    0.1
+                } else {
+                    1e-4 / (1 + k) as f64
+                };
+                for (i, qi) in q.iter_mut().enumerate() {
+                    *qi += step * ((i + k) as f64 * 0.7).sin();
+                }
+                if k == 20 {
+                    c1.invalidate();
+                    c2.invalidate();
+                }
+                sys.phi_and_phi_dot_cached(&q, &v, 0.3, &mut p1, &mut d1, &mut c1);
+                sys.phi_and_phi_dot_near(&q, &v, 0.3, &mut p2, &mut d2, &mut c2);
+                sys.phi_and_phi_dot(&q, &v, 0.3, &mut p0, &mut d0);
+                for r in 0..m {
+                    assert_eq!(p1[r].to_bits(), p2[r].to_bits(), "phi row {r}");
+                    assert_eq!(d1[r].to_bits(), d2[r].to_bits(), "phi_dot row {r}");
+                    worst = worst.max((p0[r] - p2[r]).abs()).max((d0[r] - d2[r]).abs());
+                }
+            }
+            assert!(worst < 1e-13, "near vs exact: {worst:e}");
         }
     }
 

@@ -117,9 +117,54 @@ pub(crate) fn gemv_cols(cols: &[f64], a: &[f64], y: &mut [f64]) {
     by_length!(r, gemv_cols_fixed(cols, a, y), gemv_cols_any(cols, a, y))
 }
 
-/// [`gemv_cols`] for columns of the fixed length `R`: `y` stays in registers.
+/// Calls `$f::<R, C>(args)` for the column counts `C` of the small charts (`2m` and
+/// `2(n - m)` of the planar mechanisms: 2, 4, 6, 8, 12, 16), else evaluates `$other`.
+macro_rules! by_count {
+    ($c:expr, $r:ident, $f:ident($($arg:expr),*), $other:expr) => {
+        match $c {
+            2 => $f::<$r, 2>($($arg),*),
+            4 => $f::<$r, 4>($($arg),*),
+            6 => $f::<$r, 6>($($arg),*),
+            8 => $f::<$r, 8>($($arg),*),
+            12 => $f::<$r, 12>($($arg),*),
+            16 => $f::<$r, 16>($($arg),*),
+            _ => $other,
+        }
+    };
+}
+
+/// [`gemv_cols`] for columns of the fixed length `R`: `y` stays in registers; the column
+/// count fixed too where it is a common one ([`gemv_cols_rc`]).
 #[inline]
 fn gemv_cols_fixed<const R: usize>(cols: &[f64], a: &[f64], y: &mut [f64]) {
+    by_count!(
+        a.len(),
+        R,
+        gemv_cols_rc(cols, a, y),
+        gemv_cols_r::<R>(cols, a, y)
+    )
+}
+
+/// [`gemv_cols`] for `C` columns of the fixed length `R` (the loops unroll), in the
+/// order of [`gemv_cols_r`] (the same sums).
+#[inline]
+fn gemv_cols_rc<const R: usize, const C: usize>(cols: &[f64], a: &[f64], y: &mut [f64]) {
+    let y: &mut [f64; R] = (&mut y[..R]).try_into().unwrap();
+    let cols: &[f64] = &cols[..R * C];
+    let a: &[f64; C] = (&a[..C]).try_into().unwrap();
+    let mut acc = *y;
+    for k in 0..C {
+        let ak = a[k];
+        for i in 0..R {
+            acc[i] += ak * cols[k * R + i];
+        }
+    }
+    *y = acc;
+}
+
+/// [`gemv_cols`] for columns of the fixed length `R` and any count.
+#[inline]
+fn gemv_cols_r<const R: usize>(cols: &[f64], a: &[f64], y: &mut [f64]) {
     let y: &mut [f64; R] = (&mut y[..R]).try_into().unwrap();
     let mut acc = *y;
     for (c, &ak) in cols.chunks_exact(R).zip(a) {
@@ -171,6 +216,30 @@ pub(crate) fn gemv_t_cols(cols: &[f64], y: &[f64], out: &mut [f64]) {
 /// per column (pairs of lanes).
 #[inline]
 fn gemv_t_cols_fixed<const R: usize>(cols: &[f64], y: &[f64], out: &mut [f64]) {
+    by_count!(
+        out.len(),
+        R,
+        gemv_t_cols_rc(cols, y, out),
+        gemv_t_cols_r::<R>(cols, y, out)
+    )
+}
+
+/// [`gemv_t_cols`] for `C` columns of the fixed length `R` (the same sums as
+/// [`gemv_t_cols_r`]).
+#[inline]
+fn gemv_t_cols_rc<const R: usize, const C: usize>(cols: &[f64], y: &[f64], out: &mut [f64]) {
+    let y: &[f64; R] = (&y[..R]).try_into().unwrap();
+    let cols: &[f64] = &cols[..R * C];
+    let out: &mut [f64; C] = (&mut out[..C]).try_into().unwrap();
+    for k in 0..C {
+        let c: &[f64; R] = (&cols[k * R..(k + 1) * R]).try_into().unwrap();
+        out[k] = dot_fixed(c, y);
+    }
+}
+
+/// [`gemv_t_cols`] for columns of the fixed length `R` and any count.
+#[inline]
+fn gemv_t_cols_r<const R: usize>(cols: &[f64], y: &[f64], out: &mut [f64]) {
     let y: &[f64; R] = (&y[..R]).try_into().unwrap();
     for (c, o) in cols.chunks_exact(R).zip(out.iter_mut()) {
         let c: &[f64; R] = c.try_into().unwrap();
@@ -245,6 +314,29 @@ pub(crate) fn rank_one_update(p: &mut [f64], s: &[f64], w: &[f64], c: f64) {
     }
 }
 
+/// `||x[..len]||_inf`, or NaN if an entry is not finite: one pass without branches (`e * 0`
+/// is 0 for a finite `e` and NaN otherwise); `len` a literal through `with_codim!`.
+#[inline(always)]
+pub(crate) fn max_abs_finite(x: &[f64], len: usize) -> f64 {
+    let (mut r, mut bad) = (0.0f64, 0.0f64);
+    for &e in &x[..len] {
+        let a = e.abs();
+        r = if a > r { a } else { r };
+        bad += e * 0.0;
+    }
+    if bad == 0.0 {
+        r
+    } else {
+        f64::NAN
+    }
+}
+
+/// Whether every entry of `x` is finite (one pass without branches, as [`max_abs_finite`]).
+#[inline]
+pub(crate) fn all_finite(x: &[f64]) -> bool {
+    x.iter().fold(0.0f64, |bad, &e| bad + e * 0.0) == 0.0
+}
+
 #[inline]
 pub(crate) fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
     for (yi, xi) in y.iter_mut().zip(x) {
@@ -288,6 +380,21 @@ macro_rules! with_len {
     };
 }
 pub(crate) use with_len;
+
+/// Calls `$f(args, m)` with `m` a literal for the constraint counts of the planar mechanisms'
+/// small charts (4: two revolute joints; 6; 8: a four-bar or slider-crank), else with `$m`
+/// itself; for the loops over the constraints of the chart's centre (see [`with_len`]).
+macro_rules! with_rows {
+    ($m:expr, $f:ident($($arg:expr),*)) => {
+        match $m {
+            4 => $f($($arg,)* 4),
+            6 => $f($($arg,)* 6),
+            8 => $f($($arg,)* 8),
+            m => $f($($arg,)* m),
+        }
+    };
+}
+pub(crate) use with_rows;
 
 /// Householder QR of the first `kcols` columns of the `n x tcols` column-major matrix `a`
 /// (`n >= kcols`), applying each reflector also to the columns `kcols..tcols`. Afterwards the
@@ -388,6 +495,20 @@ pub(crate) fn solve_rt(
             acc -= col[k] * u[k];
         }
         u[i] = acc * dinv[i];
+    }
+}
+
+/// `zeta = R eta` for the upper triangular `R` of [`solve_rt`] (`mm x mm`, column `j` at
+/// `r[j * stride..]`): column by column, `zeta[..=j] += eta_j R[..=j, j]`.
+#[inline(always)]
+pub(crate) fn mul_r(r: &[f64], stride: usize, eta: &[f64], zeta: &mut [f64], mm: usize) {
+    let (eta, zeta) = (&eta[..mm], &mut zeta[..mm]);
+    zeta.fill(0.0);
+    for j in 0..mm {
+        let (e, col) = (eta[j], &r[j * stride..j * stride + j + 1]);
+        for i in 0..=j {
+            zeta[i] += e * col[i];
+        }
     }
 }
 

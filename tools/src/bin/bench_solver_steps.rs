@@ -5,7 +5,8 @@
 //! one of `rk4` (plain RK4), `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1
 //! DOPRI5, fixed steps), `fadae` (firefly-Gauss, default options), and MODEL one of
 //! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
-//! links the index-1 solve takes the sparse path).
+//! links the index-1 solve takes the sparse path). A fourth argument `state` prints the final
+//! state in full (for comparing trajectories between builds).
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::models;
 use mbd::rk4::{Rk4, Rk4Options};
@@ -18,6 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let solver = args.next().unwrap_or_else(|| "rk4".into());
     let n: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(100_000);
     let model = args.next().unwrap_or_else(|| "manipulator".into());
+    let print_state = args.next().is_some_and(|a| a == "state");
     let sys = match model.as_str() {
         "manipulator" => models::manipulator()?,
         "slider_crank" => models::slider_crank()?,
@@ -69,5 +71,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         dt / n as f64 * 1e9,
         s.q[0]
     );
+    if print_state {
+        for (i, x) in s.q.iter().chain(s.v.iter()).enumerate() {
+            println!("x[{i}] = {x:?}");
+        }
+    }
     Ok(())
 }

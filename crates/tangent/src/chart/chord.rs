@@ -414,7 +414,8 @@ impl ChordLoop {
         predicted: bool,
     ) -> Self {
         let tol = newton.tol;
-        let xmax = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        // (a NaN entry is skipped, as by f64::max)
+        let xmax = x.iter().fold(0.0f64, |m, v| fast_max(m, v.abs()));
         ChordLoop {
             t,
             tol,

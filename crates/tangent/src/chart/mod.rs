@@ -2,7 +2,8 @@
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
 use crate::kernels::{
-    axpy, form_q_padded, gemv_cols, gemv_t_cols, qr_padded, solve_r, with_codim, with_len,
+    all_finite, form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, mul_r, qr_padded, solve_r,
+    with_codim, with_len, with_rows,
 };
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
@@ -330,13 +331,7 @@ impl TangentChart {
             return Ok(());
         }
         sys.phi_q_dot_jacobian(q, v, &mut self.phi_q, &mut self.dphi);
-        if self
-            .phi_q
-            .as_slice()
-            .iter()
-            .chain(self.dphi.as_slice())
-            .any(|x| !x.is_finite())
-        {
+        if !all_finite(self.phi_q.as_slice()) || !all_finite(self.dphi.as_slice()) {
             return Err(SolveError::NonFinite {
                 t,
                 what: "constraint Jacobian at the chart centre",
@@ -350,39 +345,8 @@ impl TangentChart {
                 detail: format!("position constraint {}", sys.equation_name(n)),
             });
         }
-        let nm = n - m;
-        // 1. [Phi_q^T | X^T] (n x 2m), X = (Phi_q v)_q: the QR of its first m columns,
-        //    Phi_q^T = Qa [Ra; 0] (Qa = [Qa1 Na]), leaves Qa^T X^T in the last m columns: its
-        //    first m rows are the block C of R, the other n - m rows (D = Na^T X^T) stacked
-        //    on Ra form B = [D; Ra] (n x m)
-        let (pq, xs) = (self.phi_q.as_slice(), self.dphi.as_slice()); // (r, c) at c m + r
-        for k in 0..m {
-            for c in 0..n {
-                self.aq[k * n + c] = pq[c * m + k];
-                self.aq[(m + k) * n + c] = xs[c * m + k];
-            }
-        }
-        with_len!(
-            n,
-            qr_padded(&mut self.aq, m, mm, &mut self.va, &mut self.tau)
-        );
-        for j in 0..m {
-            let (ra, g) = (&self.aq[j * n..], &self.aq[(m + j) * n..(m + j + 1) * n]);
-            self.a[(m + j) * nn..(m + j) * nn + m].copy_from_slice(&g[..m]);
-            self.bq[j * n..j * n + nm].copy_from_slice(&g[m..]);
-            // R's leading block: Ra (zero below its diagonal)
-            self.bq[j * n + nm..(j + 1) * n].copy_from_slice(&ra[..m]);
-            self.a[j * nn..j * nn + m].copy_from_slice(&ra[..m]);
-        }
-        // 2. B = Qb [Rb; 0]
-        with_len!(
-            n,
-            qr_padded(&mut self.bq, m, m, &mut self.vb, &mut self.tau_b)
-        );
-        for j in 0..m {
-            self.a[(m + j) * nn + m..(m + j) * nn + m + j + 1]
-                .copy_from_slice(&self.bq[j * n..j * n + j + 1]);
-        }
+        // 1. and 2.: the two QRs (see `factor_blocks`)
+        with_len!(n, factor_blocks(self));
         let dmax = (0..mm).fold(0.0f64, |d, i| d.max(self.a[i * nn + i].abs()));
         let dmin = (0..mm).fold(f64::INFINITY, |d, i| d.min(self.a[i * nn + i].abs()));
         self.rcond = dmin / dmax;
@@ -405,30 +369,8 @@ impl TangentChart {
             }
             self.rdinv[i] = 1.0 / self.a[i * nn + i];
         }
-        // 3. Qa and Qb explicit (n x n)
-        with_len!(n, form_q_padded(&self.va, &self.tau[..m], &mut self.qa));
-        with_len!(n, form_q_padded(&self.vb, &self.tau_b[..m], &mut self.qb));
-        // 4. Q = [[Qa1, W Qb, 0], [0, ., Na]] with W y = (Na y[..n-m], Qa1 y[n-m..]): columns
-        //    0..m = (Qa1, 0), m..m+n = W Qb (the last n - m of them tangent), m+n..2n = (0, Na)
-        for k in 0..m {
-            let col = &mut self.q[k * nn..(k + 1) * nn];
-            col[..n].copy_from_slice(&self.qa[k * n..(k + 1) * n]);
-            col[n..].fill(0.0);
-        }
-        for j in 0..n {
-            let y = &self.qb[j * n..(j + 1) * n];
-            let col = &mut self.q[(m + j) * nn..(m + j + 1) * nn];
-            let (cq, cv) = col.split_at_mut(n);
-            cq.fill(0.0);
-            cv.fill(0.0);
-            gemv_cols(&self.qa[m * n..], &y[..nm], cq);
-            gemv_cols(&self.qa[..m * n], &y[nm..], cv);
-        }
-        for l in 0..nm {
-            let col = &mut self.q[(m + n + l) * nn..(m + n + l + 1) * nn];
-            col[..n].fill(0.0);
-            col[n..].copy_from_slice(&self.qa[(m + l) * n..(m + l + 1) * n]);
-        }
+        // 3. and 4.: Qa, Qb and Q (see `form_q_blocks`)
+        with_len!(n, form_q_blocks(self));
         // P0 = Q1 R^-T only for the Broyden and interpolated matrices (the plain chord solves
         // with R^T per iteration)
         self.p0_ready = false;
@@ -503,15 +445,8 @@ impl TangentChart {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
-        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
-        let mut r = 0.0f64;
-        for &e in out[..2 * m].iter() {
-            if !e.is_finite() {
-                return f64::NAN;
-            }
-            r = r.max(e.abs());
-        }
-        r
+        sys.phi_and_phi_dot_near(q, v, t, p, pd, &mut self.angles);
+        with_codim!(2 * m, max_abs_finite(out))
     }
 
     /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
@@ -576,16 +511,112 @@ impl TangentChart {
     /// (the inverse of [`TangentChart::eta_from_zeta`]).
     pub fn zeta_from_eta(&self, eta: &[f64], zeta: &mut [f64]) {
         let (nn, mm) = (2 * self.n, 2 * self.m);
-        let zeta = &mut zeta[..mm];
-        zeta.fill(0.0);
-        for (j, &ej) in eta.iter().enumerate().take(mm) {
-            axpy(ej, &self.a[j * nn..j * nn + j + 1], &mut zeta[..j + 1]);
-        }
+        with_codim!(mm, mul_r(&self.a, nn, eta, zeta));
     }
 
-    /// `out = [Q1 U]^T y`: the normal components (first `2m`) and the tangent components (last
-    /// `2(n - m)`) of a vector `y` of length `2n`.
-    pub fn coordinates(&self, y: &[f64], out: &mut [f64]) {
-        gemv_t_cols(&self.q, y, out);
+    /// `[Q1 U]^T y` for a vector `y` of length `2n`, in two parts: its normal components
+    /// `normal = Q1^T y` (`2m`) and its tangent components `tangent = U^T y` (`2(n - m)`).
+    pub fn split_coordinates(&self, y: &[f64], normal: &mut [f64], tangent: &mut [f64]) {
+        let (nn, mm) = (2 * self.n, 2 * self.m);
+        gemv_t_cols(&self.q[..mm * nn], y, &mut normal[..mm]);
+        gemv_t_cols(&self.q[mm * nn..], y, tangent);
+    }
+}
+
+/// Steps 1 and 2 of [`TangentChart::centre`] for `n` coordinates (`with_len!` passes the
+/// planar mechanisms' `n` as a literal, so the copies and loops over `n` are unrolled).
+///
+/// 1. `[Phi_q^T | X^T]` (`n x 2m`), `X = (Phi_q v)_q`: the QR of its first `m` columns,
+///    `Phi_q^T = Qa [Ra; 0]` (`Qa = [Qa1 Na]`), leaves `Qa^T X^T` in the last `m` columns: its
+///    first `m` rows are the block `C` of `R`, the other `n - m` rows (`D = Na^T X^T`) stacked
+///    on `Ra` form `B = [D; Ra]` (`n x m`).
+/// 2. `B = Qb [Rb; 0]`.
+#[inline(always)]
+fn factor_blocks(ch: &mut TangentChart, n: usize) {
+    with_rows!(ch.m, factor_blocks_mn(ch, n));
+}
+
+/// [`factor_blocks`] for `m` constraints (a literal for the common counts through
+/// `with_rows!`).
+#[inline(always)]
+fn factor_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
+    let (nn, mm, nm) = (2 * n, 2 * m, n - m);
+    let (pq, xs) = (ch.phi_q.as_slice(), ch.dphi.as_slice()); // (r, c) at c m + r
+    for k in 0..m {
+        let (ca, cx) = ch.aq[k * n..].split_at_mut(m * n);
+        for c in 0..n {
+            ca[c] = pq[c * m + k];
+            cx[c] = xs[c * m + k];
+        }
+    }
+    qr_padded(&mut ch.aq, m, mm, &mut ch.va, &mut ch.tau, n);
+    for j in 0..m {
+        let (ra, g) = (
+            &ch.aq[j * n..(j + 1) * n],
+            &ch.aq[(m + j) * n..(m + j + 1) * n],
+        );
+        let bj = &mut ch.bq[j * n..(j + 1) * n];
+        // column j of R's leading block Ra (zero below its diagonal), column m + j of C
+        let (left, right) = ch.a.split_at_mut((m + j) * nn);
+        let (ar, ac) = (&mut left[j * nn..], right);
+        ac[..m].copy_from_slice(&g[..m]);
+        ar[..m].copy_from_slice(&ra[..m]);
+        bj[nm..].copy_from_slice(&ra[..m]);
+        bj[..nm].copy_from_slice(&g[m..]);
+    }
+    qr_padded(&mut ch.bq, m, m, &mut ch.vb, &mut ch.tau_b, n);
+    for j in 0..m {
+        let (col, b) = (&mut ch.a[(m + j) * nn + m..], &ch.bq[j * n..]);
+        col[..=j].copy_from_slice(&b[..=j]);
+    }
+}
+
+/// Steps 3 and 4 of [`TangentChart::centre`] for `n` coordinates (literal through
+/// `with_len!`): `Qa` and `Qb` explicit (`n x n`), then
+/// `Q = [[Qa1, W Qb, 0], [0, ., Na]]` with `W y = (Na y[..n-m], Qa1 y[n-m..])`: columns
+/// `0..m` are `(Qa1, 0)`, `m..m+n` are `W Qb` (the last `n - m` of them tangent), `m+n..2n`
+/// are `(0, Na)`. The products `W Qb_j` accumulate column by column from zero, as
+/// [`gemv_cols`] does.
+#[inline(always)]
+fn form_q_blocks(ch: &mut TangentChart, n: usize) {
+    with_rows!(ch.m, form_q_blocks_mn(ch, n));
+}
+
+/// [`form_q_blocks`] for `m` constraints (a literal for the common counts through
+/// `with_rows!`).
+#[inline(always)]
+fn form_q_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
+    let (nn, nm) = (2 * n, n - m);
+    form_q_padded(&ch.va, &ch.tau[..m], &mut ch.qa, n);
+    form_q_padded(&ch.vb, &ch.tau_b[..m], &mut ch.qb, n);
+    let (qa, qb) = (&ch.qa[..n * n], &ch.qb[..n * n]);
+    for k in 0..m {
+        let col = &mut ch.q[k * nn..(k + 1) * nn];
+        col[..n].copy_from_slice(&qa[k * n..(k + 1) * n]);
+        col[n..].fill(0.0);
+    }
+    for j in 0..n {
+        let y = &qb[j * n..(j + 1) * n];
+        let col = &mut ch.q[(m + j) * nn..(m + j + 1) * nn];
+        let (cq, cv) = col.split_at_mut(n);
+        cq.fill(0.0);
+        cv.fill(0.0);
+        for (k, &yk) in y[..nm].iter().enumerate() {
+            let c = &qa[(m + k) * n..(m + k + 1) * n];
+            for i in 0..n {
+                cq[i] += yk * c[i];
+            }
+        }
+        for (k, &yk) in y[nm..].iter().enumerate() {
+            let c = &qa[k * n..(k + 1) * n];
+            for i in 0..n {
+                cv[i] += yk * c[i];
+            }
+        }
+    }
+    for l in 0..nm {
+        let col = &mut ch.q[(m + n + l) * nn..(m + n + l + 1) * nn];
+        col[..n].fill(0.0);
+        col[n..].copy_from_slice(&qa[(m + l) * n..(m + l + 1) * n]);
     }
 }

@@ -2,6 +2,7 @@
 //! the end-point map, and the `eta` history the starting points are extrapolated from.
 
 use super::*;
+use crate::kernels::with_codim;
 
 impl TangentRk {
     /// One attempted step of size `h` from the chart centre (at time `t`) into `xnew`; the
@@ -69,21 +70,15 @@ impl TangentRk {
         {
             let chart = &mut self.path;
             let zlast = &mut self.zeta;
-            let (zplain, x, g, fx, proj) = (
-                &mut self.zplain,
-                &mut self.x,
-                &mut self.g,
-                &mut self.fx,
-                &mut self.proj,
-            );
+            let (zplain, x, g, fx) = (&mut self.zplain, &mut self.x, &mut self.g, &mut self.fx);
             let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
             let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
             let fsal = self.fsal;
-            let (eta_now, eta_hist, eta_pred, eta_tmp) = (
+            let (eta_now, eta_hist, eta_pred, eta_raw) = (
                 &mut self.eta_now,
                 &self.eta_hist,
                 &mut self.eta_pred,
-                &mut self.eta_tmp,
+                &mut self.eta_raw,
             );
             let work = &mut work;
             let failure = &mut failure;
@@ -108,14 +103,18 @@ impl TangentRk {
                 chart.select_iteration_matrix(c_coef[i]);
                 let ysq: f64 = y.iter().map(|v| v * v).sum();
                 if npts > 0 {
-                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, eta_pred);
+                    // the plain extrapolation of this stage, kept for the later stages'
+                    // corrections
+                    let raw = &mut eta_raw[i * mm..(i + 1) * mm];
+                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, raw);
+                    eta_pred.copy_from_slice(raw);
                     if jlast > 0 {
                         // correct by the extrapolation error of the latest mapped stage j,
                         // scaled like the normal offset (|Y_i|^2 / |Y_j|^2)
                         let r = ysq / ylast_sq;
-                        extrapolate(eta_hist, npts, (s + 1) * mm, jlast * mm, eta_tmp);
+                        let raw_j = &eta_raw[jlast * mm..(jlast + 1) * mm];
                         let now = &eta_now[jlast * mm..(jlast + 1) * mm];
-                        for ((p, e), x) in eta_pred.iter_mut().zip(now).zip(eta_tmp.iter()) {
+                        for ((p, e), x) in eta_pred.iter_mut().zip(now).zip(raw_j) {
                             *p += r * (e - x);
                         }
                     }
@@ -177,7 +176,7 @@ impl TangentRk {
                 work.rhs_evals += 1;
                 fx[..n].copy_from_slice(v);
                 fx[n..].copy_from_slice(acc_a);
-                chart.split(fx, proj, &mut g[i * mm..(i + 1) * mm], dy);
+                chart.split(fx, &mut g[i * mm..(i + 1) * mm], dy);
                 stage += 1;
                 Ok(())
             };
@@ -291,13 +290,23 @@ impl TangentRk {
 /// Polynomial extrapolation to the next step of the `eta` of one map (offset `off` within a
 /// step's record of length `len`) from the last `npts` (1 to 3) steps, most recent first.
 pub(super) fn extrapolate(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64]) {
+    with_codim!(out.len(), extrapolate_mm(hist, npts, len, off, out));
+}
+
+/// [`extrapolate`] for `eta` of length `mm` (a literal for the common lengths).
+#[inline(always)]
+fn extrapolate_mm(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64], mm: usize) {
     let w: &[f64] = match npts {
         1 => &[1.0],
         2 => &[2.0, -1.0],
         _ => &[3.0, -3.0, 1.0],
     };
+    let out = &mut out[..mm];
     out.fill(0.0);
     for (k, &wk) in w.iter().enumerate() {
-        axpy(wk, &hist[k * len + off..k * len + off + out.len()], out);
+        let h = &hist[k * len + off..k * len + off + mm];
+        for i in 0..mm {
+            out[i] += wk * h[i];
+        }
     }
 }

@@ -81,7 +81,7 @@ pub struct TangentRk {
     g: Vec<f64>,
     /// `F = (v, a)`.
     fx: Vec<f64>,
-    /// `Q^T F` (dense path); work space.
+    /// Work space (`2n`).
     proj: Vec<f64>,
     /// Residual buffer.
     res: Vec<f64>,
@@ -101,9 +101,10 @@ pub struct TangentRk {
     hist_rcond: [f64; HISTORY],
     hist_h: f64,
     hist_t: f64,
-    /// Extrapolated `eta` of the map in progress, and of an earlier stage.
+    /// Extrapolated and corrected `eta` of the map in progress; the plain extrapolations of
+    /// the attempt's stages (stage `i` at `i * 2m`).
     eta_pred: Vec<f64>,
-    eta_tmp: Vec<f64>,
+    eta_raw: Vec<f64>,
     /// Tolerance of the interior stage maps of a step that follows the last accepted one
     /// (`TangentOptions::stage_tol_ratio`).
     stage_tol: f64,
@@ -217,7 +218,7 @@ impl TangentRk {
             hist_h: f64::NAN,
             hist_t: f64::NAN,
             eta_pred: vec![0.0; 2 * m],
-            eta_tmp: vec![0.0; 2 * m],
+            eta_raw: vec![0.0; s * 2 * m],
             stage_tol: options.newton.tol,
             centred_at: f64::NAN,
             failures_here: 0,

@@ -184,16 +184,11 @@ impl Path {
     }
 
     /// Splits `F` into its normal coordinates `g` (`2m`) and the state equation's right-hand
-    /// side `dy` (dense: `U^T F`; sparse: `P F`); `proj` is work space of length `2n`.
+    /// side `dy` (dense: `U^T F`; sparse: `P F`).
     #[inline]
-    pub(super) fn split(&mut self, fx: &[f64], proj: &mut [f64], g: &mut [f64], dy: &mut [f64]) {
+    pub(super) fn split(&mut self, fx: &[f64], g: &mut [f64], dy: &mut [f64]) {
         match self {
-            Path::Dense { chart, .. } => {
-                let mm = g.len();
-                chart.coordinates(fx, proj);
-                g.copy_from_slice(&proj[..mm]);
-                dy.copy_from_slice(&proj[mm..]);
-            }
+            Path::Dense { chart, .. } => chart.split_coordinates(fx, g, dy),
             Path::Sparse(p) => p.chart.split(fx, g, dy),
         }
     }
