@@ -87,9 +87,9 @@ macro_rules! scalar_shift_ops {
 use scalar_shift_ops;
 
 mod dir;
+mod dual;
 #[cfg(any(test, feature = "fixtures"))]
 pub mod fixtures;
-mod dual;
 mod hess;
 mod poly;
 mod tan;

@@ -49,6 +49,7 @@
 
 mod cholesky;
 mod error;
+mod householder;
 mod lu;
 mod sparse;
 
@@ -56,6 +57,7 @@ pub use cholesky::{
     DenseCholesky, CHOLESKY_PIVOT_TOL, FIXED_CHOLESKY, SMALL_CHOLESKY, SMALL_CHOLESKY_SOLVE,
 };
 pub use error::{FactorError, LinalgError, LuError};
+pub use householder::{form_q_padded, mul_r, qr_padded, reflect, solve_r, solve_rt};
 pub use lu::{DenseLu, PIVOT_THRESHOLD, PIVOT_TOL};
 pub use sparse::{SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};
 

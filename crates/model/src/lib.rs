@@ -62,7 +62,6 @@ pub mod joints;
 mod kinematics;
 mod local_rows;
 pub mod models;
-pub mod numeric;
 mod rows;
 mod scale;
 mod system;

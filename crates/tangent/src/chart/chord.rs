@@ -2,9 +2,9 @@
 //! Broyden), the plain and Broyden iterations, and the travel bound.
 
 use super::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR, TRAVEL_FACTOR};
-use crate::kernels::{dot, gemv_cols, gemv_t_cols, rank_one_update, solve_rt, with_codim};
-use mbd_model::numeric::max_abs;
+use crate::kernels::{dot, gemv_cols, gemv_t_cols, rank_one_update, with_codim};
 use mbd_model::System;
+use mbd_solve::linalg::{max_abs, solve_rt};
 
 impl TangentChart {
     /// Evaluates `Df` at a second point `x_e` (typically the Euler prediction `x_c + h F(x_c)` of

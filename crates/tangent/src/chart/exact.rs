@@ -2,8 +2,8 @@
 
 use super::{loop_head, ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR};
 use crate::kernels::{gemv_cols, gemv_t_cols};
-use mbd_model::numeric::{max_abs, max_abs_diff};
 use mbd_model::System;
+use mbd_solve::linalg::{max_abs, max_abs_diff};
 
 impl TangentChart {
     /// The fallback after a failed chord iteration from `x` (its starting point): if `Df(x)`

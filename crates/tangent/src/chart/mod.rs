@@ -2,11 +2,11 @@
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
 use crate::kernels::{
-    all_finite, form_q_padded, gemv_cols, gemv_t_cols, max_abs_finite, mul_r, qr_padded, solve_r,
-    with_codim, with_len, with_rows,
+    all_finite, gemv_cols, gemv_t_cols, max_abs_finite, with_codim, with_len, with_rows,
 };
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
+use mbd_solve::linalg::{form_q_padded, mul_r, qr_padded, solve_r};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 

@@ -2,9 +2,9 @@
 //! equations and the joints of the dependency (an error path; allocates).
 
 use super::TangentChart;
-use crate::kernels::{axpy, dot};
-use mbd_model::numeric::max_abs;
+use crate::kernels::dot;
 use mbd_model::System;
+use mbd_solve::linalg::{axpy, max_abs};
 use mbd_solve::SolveError;
 
 impl TangentChart {

@@ -1,7 +1,7 @@
 //! Unit tests of the dense chart and its kernels.
 
 use super::*;
-use crate::kernels::{dot, form_q, form_q_padded, householder_qr, qr_padded, with_len};
+use crate::kernels::dot;
 
 /// The block-structured chart: `[Q1 U]` orthonormal, `Q1 R = Df^T`, `Df U = 0`.
 #[test]
@@ -98,75 +98,4 @@ fn broyden_reaches_the_chord_point_in_fewer_iterations() {
     }
     assert!(updates > 0);
     assert!(iters[1] < iters[0], "{iters:?}");
-}
-
-#[test]
-fn householder_qr_reconstructs_and_q_is_orthogonal() {
-    // 8 x 4 with the first 2 columns zero below row 4 (the structure of Df^T)
-    let (rows, cols, short, half) = (8, 4, 2, 4);
-    let mut a0: Vec<f64> = (0..rows * cols)
-        .map(|i| ((i * 37 % 11) as f64 - 5.0) * 0.3 + if i % 9 == 0 { 2.0 } else { 0.0 })
-        .collect();
-    for k in 0..short {
-        for r in half..rows {
-            a0[k * rows + r] = 0.0;
-        }
-    }
-    for (short, half) in [(0, rows), (short, half)] {
-        let mut a = a0.clone();
-        let mut tau = vec![0.0; cols];
-        householder_qr(&mut a, &mut tau, rows, cols, short, half);
-        let mut q = vec![0.0; rows * rows];
-        form_q(&a, &tau, rows, cols, short, half, &mut q);
-        for i in 0..rows {
-            for j in 0..rows {
-                let d = dot(&q[i * rows..(i + 1) * rows], &q[j * rows..(j + 1) * rows]);
-                let e = if i == j { 1.0 } else { 0.0 };
-                assert!((d - e).abs() < 1e-14, "({i},{j}) {d}");
-            }
-        }
-        for j in 0..cols {
-            for i in 0..rows {
-                let mut s = 0.0;
-                for k in 0..=j {
-                    s += q[k * rows + i] * a[j * rows + k];
-                }
-                assert!((s - a0[j * rows + i]).abs() < 1e-13, "({i},{j})");
-            }
-        }
-    }
-}
-
-#[test]
-fn padded_householder_qr_reconstructs_and_q_is_orthogonal() {
-    // 6 x 4 QR of the first 3 columns of a 6 x 5 matrix (the last two get Q^T applied), at a
-    // length with a fixed-size arm (6) and one without (7: the same code with a run-time length)
-    for rows in [6usize, 7] {
-        let (kcols, tcols) = (3, 5);
-        let a0: Vec<f64> = (0..rows * tcols)
-            .map(|i| ((i * 37 % 11) as f64 - 5.0) * 0.3 + if i % 9 == 0 { 2.0 } else { 0.0 })
-            .collect();
-        let mut a = a0.clone();
-        let (mut v, mut tau) = (vec![0.0; rows * kcols], vec![0.0; kcols]);
-        with_len!(rows, qr_padded(&mut a, kcols, tcols, &mut v, &mut tau));
-        let mut q = vec![0.0; rows * rows];
-        with_len!(rows, form_q_padded(&v, &tau, &mut q));
-        for i in 0..rows {
-            for j in 0..rows {
-                let d = dot(&q[i * rows..(i + 1) * rows], &q[j * rows..(j + 1) * rows]);
-                let e = if i == j { 1.0 } else { 0.0 };
-                assert!((d - e).abs() < 1e-14, "({i},{j}) {d}");
-            }
-        }
-        // Q [R | Q^T B] = [A | B], R upper triangular
-        for j in 0..tcols {
-            for i in 0..rows {
-                if j < kcols && i > j {
-                    assert_eq!(a[j * rows + i], 0.0);
-                }
-                let s: f64 = (0..rows).map(|k| q[k * rows + i] * a[j * rows + k]).sum();
-                assert!((s - a0[j * rows + i]).abs() < 1e-13, "({i},{j})");
-            }
-        }
-    }
 }

@@ -2,9 +2,9 @@
 //! ([`AdaptiveIntegrator`], driven by [`mbd_solve::run_adaptive`]).
 
 use crate::chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
-use crate::kernels::axpy;
 use crate::sparse_chart::SparseChart;
 use mbd_model::System;
+use mbd_solve::linalg::axpy;
 use mbd_solve::{
     AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Integrator, SolveError,
     SparseAccelerationSolver, State, StepAttempt, StepController, StepStats,

@@ -4,8 +4,8 @@
 
 use crate::chart::{fast_max, travel_within, ChordLoop};
 use crate::chart::{ChartFailure, MapStats, NewtonSettings};
-use mbd_model::numeric::max_abs;
 use mbd_model::{BodyAngles, System};
+use mbd_solve::linalg::max_abs;
 use mbd_solve::linalg::FactorError;
 use mbd_solve::sparse::{RowIncidence, SparseCholesky};
 use mbd_solve::SolveError;
