@@ -120,6 +120,16 @@ impl SystemBuilder {
                 ),
             });
         }
+        // the initial state must be finite before the frame lowering mixes its entries (an
+        // infinite angular velocity times a zero offset would be reported as NaN)
+        for body in &self.bodies {
+            for &p in &body.position {
+                check::finite(&body.name, "position", p)?;
+            }
+            for &v in &body.velocity {
+                check::finite(&body.name, "velocity", v)?;
+            }
+        }
         let frames = std::mem::take(&mut self.frames);
         let frame = |r: BodyRef| r.index().and_then(|i| frames.get(i).copied());
         let names: Vec<String> = self.bodies.iter().map(|b| b.name.clone()).collect();
@@ -265,12 +275,34 @@ impl System {
                 });
             }
             check::positive(&body.name, "mass", body.mass)?;
-            check::positive(&body.name, "inertia", body.inertia)?;
+            if !(body.inertia.is_finite() && body.inertia > 0.0) {
+                return Err(ModelError::InvalidParameter {
+                    element: body.name.clone(),
+                    parameter: "inertia",
+                    value: body.inertia,
+                    reason: "must be positive and finite (a particle without rotation is a \
+                             point mass: `kind = \"point_mass\"` in a model file, \
+                             `SystemBuilder::add_point_mass` in code)",
+                });
+            }
             for &p in &body.position {
                 check::finite(&body.name, "position", p)?;
             }
             for &v in &body.velocity {
                 check::finite(&body.name, "velocity", v)?;
+            }
+            // finite entries whose kinetic energy overflows (|v| near 1e308) would make every
+            // energy and residual infinite later, blamed on the solver
+            let [vx, vy, w] = body.velocity;
+            let kinetic = 0.5 * (body.mass * (vx * vx + vy * vy) + body.inertia * w * w);
+            if !kinetic.is_finite() {
+                let value = vx.abs().max(vy.abs()).max(w.abs());
+                return Err(ModelError::InvalidParameter {
+                    element: body.name.clone(),
+                    parameter: "velocity",
+                    value,
+                    reason: "gives a kinetic energy that overflows f64",
+                });
             }
         }
         let nb = bodies.len();

@@ -48,7 +48,8 @@ impl BodyAngles {
             let (s, c) = th.sin_cos();
             *e = [th, s, c];
         }
-        self.rotations.fill(0);
+        // (the rotation counts are left as they are: after an exact evaluation they can only
+        // make `update_near` evaluate exactly sooner)
         self.valid = true;
     }
 

@@ -46,7 +46,7 @@ pub enum ModelError {
         name: String,
     },
     /// A parameter is out of range or not finite.
-    #[error("{element}: parameter '{parameter}' = {value} is invalid: {reason}")]
+    #[error("{element}: parameter '{parameter}' = {} is invalid: {reason}", num(*value))]
     InvalidParameter {
         /// The body, joint or force at fault.
         element: String,
@@ -103,4 +103,14 @@ pub enum ModelError {
         /// The parser's message.
         message: String,
     },
+}
+
+/// `x` as a reader wants it in a message: plain decimal between 1e-4 and 1e16 (and 0), else in
+/// scientific notation (never 300 digits for `1e300`).
+pub(crate) fn num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }

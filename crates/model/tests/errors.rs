@@ -38,6 +38,46 @@ fn valid_reference_file_builds() {
     System::from_toml(PENDULUM_TOML).unwrap();
 }
 
+/// An infinite initial velocity is reported as infinite (not as the NaN that frame lowering
+/// would make of it), a finite one whose kinetic energy overflows is rejected, and a rigid
+/// body without inertia is pointed at the point mass.
+#[test]
+fn initial_state_and_inertia_errors_say_what_is_wrong() {
+    for (velocity, value) in [
+        ([0.0, 0.0, f64::INFINITY], f64::INFINITY),
+        ([0.0, 1e308, 0.0], 1e308),
+    ] {
+        let mut b = SystemBuilder::new();
+        let h = b.add_body(Body::new("link").position(0.5, 0.0, 0.0).velocity(
+            velocity[0],
+            velocity[1],
+            velocity[2],
+        ));
+        b.set_body_frame(h, [0.1, 0.0]);
+        let e = err(b);
+        invalid(&e, "link", "velocity");
+        match &e {
+            ModelError::InvalidParameter { value: v, .. } => assert_eq!(*v, value, "{e}"),
+            _ => unreachable!(),
+        }
+        // the value as a reader wants it: `inf`, `1e308`, not 309 digits
+        let shown = if value.is_finite() {
+            "= 1e308 "
+        } else {
+            "= inf "
+        };
+        assert!(e.to_string().contains(shown), "{e}");
+    }
+    let mut b = SystemBuilder::new();
+    b.add_body(Body::new("bob").mass(1.0).inertia(0.0));
+    let e = err(b);
+    invalid(&e, "bob", "inertia");
+    assert!(
+        e.to_string().contains("point_mass") && e.to_string().contains("add_point_mass"),
+        "{e}"
+    );
+}
+
 #[test]
 fn unknown_body_handle() {
     // a handle of another model with four bodies

@@ -13,8 +13,9 @@ use nalgebra::DVector;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConsistentOptions {
     /// Target max-norm of `Phi`, floored at the round-off level of the coordinates
-    /// (`8 eps max(1, |q|_inf)`, see [`crate::PROJECTION_ROUNDOFF_FACTOR`]), which no iteration
-    /// can beat (so a model placed far from the origin still projects). Default `1e-13`.
+    /// (`8 eps max(1, |x, y|, |theta_guess|)`, see [`crate::PROJECTION_ROUNDOFF_FACTOR`]),
+    /// which no iteration can beat (so a model placed far from the origin still projects).
+    /// Default `1e-13`.
     pub tol: f64,
     /// Newton iteration limit. Default 50.
     pub max_iter: usize,
@@ -182,6 +183,20 @@ mod tests {
         }
         assert!(max_abs_diff(out[0].q.as_slice(), out[1].q.as_slice()) < 1e-12);
         assert!(max_abs_diff(out[0].v.as_slice(), out[1].v.as_slice()) < 1e-12);
+    }
+
+    /// A guess far from the origin (x = 1e20) must not lend its round-off floor to the
+    /// configuration Newton brings back: the projection either converges to the requested
+    /// tolerance or fails, never reports a residual of 0.5 as converged.
+    #[test]
+    fn a_far_guess_converges_or_fails() {
+        let sys = mbd_model::models::pendulum(1.0, 1.0, 0.2, 9.81).unwrap();
+        let (mut q, v) = sys.initial_guess();
+        q[0] = 1e20;
+        match project_state(&sys, q.as_slice(), v.as_slice(), 0.0, Default::default()) {
+            Ok(x) => assert!(x.residual <= 1e-13, "{x:?}"),
+            Err(e) => assert!(matches!(e, SolveError::Newton { .. }), "{e}"),
+        }
     }
 
     #[test]

@@ -8,8 +8,10 @@ use crate::linalg::{max_abs, DenseSchur, FactorError};
 use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;
 
-/// The position projection stops at `max(tol, PROJECTION_ROUNDOFF_FACTOR eps max(1, |q|_inf))`: the
-/// round-off floor of evaluating `Phi` at coordinates of size `|q|`.
+/// The position projection stops at `max(tol, PROJECTION_ROUNDOFF_FACTOR eps max(1, |x, y|,
+/// |theta_guess|))`: the round-off floor of evaluating `Phi` at positions of the current iterate
+/// (`|x, y|`: the largest centre-of-mass coordinate) and at the angles of the guess (an angle
+/// Newton inflates does not raise the floor).
 pub const PROJECTION_ROUNDOFF_FACTOR: f64 = 8.0;
 
 /// Settings of [`Projector`].
@@ -155,12 +157,18 @@ impl Projector {
         let mut stats = ProjectionStats::default();
         // The residual of `Phi` cannot fall below the round-off of evaluating it at coordinates
         // of size |q|: a far-out or long mechanism (a 100-link chain reaches 100 m) has a floor
-        // above a fixed 1e-14, and Newton would otherwise iterate to `max_iter` there.
-        let tol = self
-            .settings
-            .tol
-            .max(PROJECTION_ROUNDOFF_FACTOR * f64::EPSILON * max_abs(q).max(1.0));
+        // above a fixed 1e-14, and Newton would otherwise iterate to `max_iter` there. The floor
+        // takes the positions of the current iterate (a guess far out, x = 1e20, must not lend
+        // its floor to the configuration Newton brings back) and the angles of the guess (a
+        // wound-up angle is legitimate, an angle Newton inflates is not).
+        let angles = (0..q.len() / 3).fold(0.0f64, |a, i| a.max(q[3 * i + 2].abs()));
+        let floor = |q: &[f64]| {
+            let pos =
+                (0..q.len() / 3).fold(0.0f64, |a, i| a.max(q[3 * i].abs()).max(q[3 * i + 1].abs()));
+            PROJECTION_ROUNDOFF_FACTOR * f64::EPSILON * pos.max(angles).max(1.0)
+        };
         for it in 0..=self.settings.max_iter {
+            let tol = self.settings.tol.max(floor(q));
             sys.phi(q, t, &mut self.r);
             let res = max_abs(&self.r);
             stats.residual = res;
@@ -181,7 +189,7 @@ impl Projector {
             stats.iterations += 1;
         }
         // accept a residual at the round-off floor of the configuration
-        if stats.residual <= 1e3 * tol {
+        if stats.residual <= 1e3 * self.settings.tol.max(floor(q)) {
             return Ok(stats);
         }
         let worst = (0..self.r.len())
