@@ -4,18 +4,31 @@
 use crate::error::ModelError;
 use crate::system::System;
 use faer::{Mat, Side};
-use mbd_linalg::max_abs;
+use mbd_linalg::{max_abs, SparseCholesky};
 use nalgebra::{DMatrix, DVector};
+
+/// Above this many constraint equations [`System::check_rank`] factors the Schur complement
+/// `Phi_q M^-1 Phi_q^T` as a sparse matrix (memory and time linear in the size of a chain)
+/// instead of forming `Phi_q` densely.
+pub const SPARSE_RANK_THRESHOLD: usize = 200;
 
 impl System {
     /// Checks that `Phi_q(q)` has full row rank. On failure returns
     /// [`ModelError::Redundant`] naming the first dependent equation and the joints whose
     /// equations it combines.
+    ///
+    /// Above [`SPARSE_RANK_THRESHOLD`] equations the test is a sparse Cholesky factorisation of
+    /// `Phi_q M^-1 Phi_q^T` (equilibrated pivots above `mbd_linalg::CHOLESKY_PIVOT_TOL`); a
+    /// failure names the equation whose pivot vanished and the joints that share a body with
+    /// it.
     pub fn check_rank(&self, q: &[f64], _t: f64) -> Result<(), ModelError> {
         self.check_len("q", q, self.n)?;
         let (n, m) = (self.n, self.m);
         if m == 0 {
             return Ok(());
+        }
+        if m > SPARSE_RANK_THRESHOLD {
+            return self.check_rank_sparse(q);
         }
         let mut jac = DMatrix::zeros(m, n);
         self.phi_q(q, &mut jac);
@@ -76,6 +89,82 @@ impl System {
             combo.push(c / norm);
         }
         Ok(())
+    }
+
+    /// The sparse rank test of [`System::check_rank`]: `S = Phi_q M^-1 Phi_q^T` from the
+    /// element-local rows, its pattern from the bodies the rows share (O(m) entries for a
+    /// chain), factored by [`SparseCholesky`].
+    fn check_rank_sparse(&self, q: &[f64]) -> Result<(), ModelError> {
+        let m = self.m;
+        let mut grads = vec![[0.0; 6]; m];
+        self.phi_q_local(q, &mut grads);
+        // per body, the rows that touch it and the slot of the body in each row
+        let mut touching: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.bodies.len()];
+        for (ji, at) in self.joint_attach.iter().enumerate() {
+            let o = self.row_offset[ji];
+            for r in o..o + self.joints[ji].n_equations() {
+                for (slot, body) in [(0, at.a), (3, at.b)] {
+                    if let Some(i) = body {
+                        touching[i].push((r, slot));
+                    }
+                }
+            }
+        }
+        let mut pattern = Vec::new();
+        for rows in &touching {
+            for (a, &(r, _)) in rows.iter().enumerate() {
+                for &(s, _) in &rows[..a] {
+                    if r != s {
+                        pattern.push((r.max(s), r.min(s)));
+                    }
+                }
+            }
+        }
+        let mut chol =
+            SparseCholesky::new(m, &pattern).map_err(|e| ModelError::InvalidElement {
+                element: "constraint Jacobian".into(),
+                message: format!("the sparse rank check could not analyse its pattern: {e}"),
+            })?;
+        for (i, rows) in touching.iter().enumerate() {
+            let w = [
+                self.inv_mass[3 * i],
+                self.inv_mass[3 * i + 1],
+                self.inv_mass[3 * i + 2],
+            ];
+            for (a, &(r, sr)) in rows.iter().enumerate() {
+                for &(s, ss) in &rows[..=a] {
+                    let v: f64 = (0..3)
+                        .map(|l| w[l] * grads[r][sr + l] * grads[s][ss + l])
+                        .sum();
+                    let (hi, lo) = (r.max(s), r.min(s));
+                    if let Some(k) = chol.slot(hi, lo) {
+                        chol.values_mut()[k] += v;
+                    }
+                }
+            }
+        }
+        let Err(e) = chol.factor() else {
+            return Ok(());
+        };
+        let r = match e {
+            mbd_linalg::FactorError::NotPositiveDefinite(r)
+            | mbd_linalg::FactorError::Singular(r) => r,
+        };
+        let mut joints: Vec<String> = Vec::new();
+        let ji = self.eq_joint[r];
+        let at = self.joint_attach[ji];
+        for body in [at.a, at.b].into_iter().flatten() {
+            for &(s, _) in &touching[body] {
+                let name = &self.joints[self.eq_joint[s]].name;
+                if !joints.contains(name) {
+                    joints.push(name.clone());
+                }
+            }
+        }
+        Err(ModelError::Redundant {
+            equation: self.equation_name(r),
+            joints,
+        })
     }
 
     /// `S = Phi_q M^-1 Phi_q^T` (dense), accumulated column by column over the few non-zeros of

@@ -393,6 +393,40 @@ fn redundant_four_bar() {
     }
 }
 
+/// Above `SPARSE_RANK_THRESHOLD` equations the rank check is sparse: a long chain builds, and
+/// a duplicated pin at its far end is found and named, as the dense check does on a short one.
+#[test]
+fn sparse_rank_check_accepts_chains_and_names_a_duplicate_pin() {
+    let links = mbd_model::SPARSE_RANK_THRESHOLD / 2 + 20;
+    for n in [10, links] {
+        let sys = models::n_link_chain(n).unwrap();
+        assert_eq!(sys.n_constraints(), 2 * n);
+        let mut mf = sys.to_model_file();
+        let last = mf.joints.last().cloned().unwrap();
+        let mbd_model::JointSpec::Revolute(r) = last else {
+            panic!("the chain ends with a revolute joint")
+        };
+        mf.joints.push(mbd_model::JointSpec::Revolute(RevoluteSpec {
+            name: "pin_again".into(),
+            ..r.clone()
+        }));
+        match mf.build().unwrap_err() {
+            ModelError::Redundant { equation, joints } => {
+                assert!(
+                    equation.starts_with("pin_again.") || equation.starts_with(&r.name),
+                    "{n} links: {equation}"
+                );
+                assert!(
+                    joints.contains(&"pin_again".to_string()),
+                    "{n} links: {joints:?}"
+                );
+                assert!(joints.contains(&r.name), "{n} links: {joints:?}");
+            }
+            e => panic!("{n} links: {e:?}"),
+        }
+    }
+}
+
 #[test]
 fn redundant_double_pin() {
     let mut mf = pendulum(1.0, 1.0, 0.2, 9.81).unwrap().to_model_file();

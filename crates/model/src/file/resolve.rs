@@ -13,7 +13,8 @@ use crate::system::System;
 
 /// Body names resolved, with each body's frame offset and kind.
 struct Resolver<'a> {
-    file: &'a ModelFile,
+    /// Body name to index (the first body of a name: duplicates are an error of the build).
+    index: std::collections::HashMap<&'a str, usize>,
     /// The bodies as the file gives them (frame-origin poses; a point mass's inertia is set by
     /// the builder).
     bodies: Vec<Body>,
@@ -74,26 +75,20 @@ impl<'a> Resolver<'a> {
                 velocity: s.velocity,
             });
         }
-        Ok(Resolver { file, bodies })
-    }
-
-    fn spec(&self, name: &str) -> Option<(usize, &BodySpec)> {
-        if name.eq_ignore_ascii_case("ground") {
-            return None;
+        let mut index = std::collections::HashMap::with_capacity(file.bodies.len());
+        for (i, b) in file.bodies.iter().enumerate() {
+            index.entry(b.name.as_str()).or_insert(i);
         }
-        self.file
-            .bodies
-            .iter()
-            .enumerate()
-            .find(|(_, b)| b.name == name)
+        Ok(Resolver { index, bodies })
     }
 
     fn find(&self, element: &str, name: &str) -> Result<BodyRef, ModelError> {
         if name.eq_ignore_ascii_case("ground") {
             return Ok(BodyRef::Ground);
         }
-        self.spec(name)
-            .map(|(i, _)| BodyRef::Body(BodyHandle(i)))
+        self.index
+            .get(name)
+            .map(|&i| BodyRef::Body(BodyHandle(i)))
             .ok_or_else(|| ModelError::UnknownBody {
                 element: element.to_string(),
                 body: name.to_string(),
