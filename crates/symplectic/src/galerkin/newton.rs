@@ -106,12 +106,25 @@ impl Galerkin {
             t,
             residual: res,
             iterations: it,
-            // (a step can be too long for the fastest modes of the model, e.g. of a long chain
-            // under tension, with no solution near the prediction: docs/symplectic.md section 2)
-            context: format!(
-                "symplectic ({s},{s}) stage equations, h = {h}; a smaller h may converge (the \
-                 step may be too long for the model's fastest motion)"
-            ),
+            context: if res.is_finite() && res <= 1e3 * tol {
+                // stalled a few digits above the tolerance: the iteration cannot contract, as
+                // where the stage Jacobian is near-singular (a singular configuration), and a
+                // smaller h does not change that
+                format!(
+                    "symplectic ({s},{s}) stage equations, h = {h}: the iteration stalled near \
+                     round-off (tolerance {tol:.1e}); the stage Jacobian is near-singular, as at \
+                     a singular configuration of the mechanism, where a smaller h does not help \
+                     (`mbd solvers` lists the other solvers)"
+                )
+            } else {
+                // a step can be too long for the fastest modes of the model, e.g. of a long
+                // chain under tension, with no solution near the prediction
+                // (docs/symplectic.md section 2)
+                format!(
+                    "symplectic ({s},{s}) stage equations, h = {h}; a smaller h may converge \
+                     (the step may be too long for the model's fastest motion)"
+                )
+            },
         };
         if !res.is_finite() {
             return Err(fail(res, 0, self.tab.s));
