@@ -271,51 +271,11 @@ impl System {
     /// [`System::phi_and_phi_dot`] with the bodies' `sin`/`cos` brought to `q` by
     /// [`BodyAngles::update_near`] (rotation from the configuration `angles` held): the same
     /// values to a few units in the last place, cheaper when called repeatedly at nearby
-    /// configurations (the Newton iterations of a chart or a projection).
+    /// configurations (the chord iterations of a tangent chart, a projection). Revolute rows
+    /// are written out in closed form (a body point `r + R(theta) p` and its velocity
+    /// `v_r + omega R'(theta) p`, in the operations of the dual-number evaluation, so bit for
+    /// bit its values); the other joint kinds go through that evaluation. Allocation-free.
     pub fn phi_and_phi_dot_cached(
-        &self,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        phi: &mut [f64],
-        phi_dot: &mut [f64],
-        angles: &mut BodyAngles,
-    ) {
-        angles.update_near(self, q);
-        let angles = &*angles;
-        let frame = |i: Option<usize>| -> Frame<Dual> {
-            match i {
-                Some(i) => {
-                    let [_, s, c] = angles.sin_cos_of(i);
-                    let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
-                    let w = vi[2];
-                    Frame {
-                        q: [
-                            Dual::var(qi[0], vi[0]),
-                            Dual::var(qi[1], vi[1]),
-                            Dual::var(qi[2], vi[2]),
-                        ],
-                        c: Dual { v: c, d: -s * w },
-                        s: Dual { v: s, d: c * w },
-                    }
-                }
-                None => Frame::fixed(),
-            }
-        };
-        for ji in 0..self.joints.len() {
-            let at = self.joint_attach[ji];
-            self.eval_phi_phi_dot(ji, &frame(at.a), &frame(at.b), t, phi, phi_dot);
-        }
-    }
-
-    /// [`System::phi_and_phi_dot_cached`] with the revolute rows written out in closed form
-    /// (no dual-number frames): a body point `r + R(theta) p` and its velocity
-    /// `v_r + omega R'(theta) p` from the cached `sin`/`cos`, in the same operations as the
-    /// dual-number evaluation, so the values are bit for bit those of
-    /// [`System::phi_and_phi_dot_cached`]; the other joint kinds go through that evaluation.
-    /// Allocation-free; the cheapest residual of the first-order constraints at a sequence of
-    /// nearby configurations (the chord iterations of a tangent chart).
-    pub fn phi_and_phi_dot_near(
         &self,
         q: &[f64],
         v: &[f64],
@@ -338,26 +298,11 @@ impl System {
                 (pd[0], pd[1]) = (va[0] - vb[0], va[1] - vb[1]);
                 continue;
             }
-            let frame = |i: Option<usize>| -> Frame<Dual> {
-                match i {
-                    Some(i) => {
-                        let [_, s, c] = angles.sin_cos_of(i);
-                        let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
-                        let w = vi[2];
-                        Frame {
-                            q: [
-                                Dual::var(qi[0], vi[0]),
-                                Dual::var(qi[1], vi[1]),
-                                Dual::var(qi[2], vi[2]),
-                            ],
-                            c: Dual { v: c, d: -s * w },
-                            s: Dual { v: s, d: c * w },
-                        }
-                    }
-                    None => Frame::fixed(),
-                }
-            };
-            self.eval_phi_phi_dot(ji, &frame(at.a), &frame(at.b), t, phi, phi_dot);
+            let (fa, fb) = (
+                dual_frame(angles, q, v, at.a),
+                dual_frame(angles, q, v, at.b),
+            );
+            self.eval_phi_phi_dot(ji, &fa, &fb, t, phi, phi_dot);
         }
     }
 
@@ -466,6 +411,29 @@ fn revolute_point(
     }
 }
 
+/// Body `i`'s dual-number frame (value and derivative along `v`) with `sin`/`cos` from
+/// `angles`; ground is fixed.
+#[inline(always)]
+fn dual_frame(angles: &BodyAngles, q: &[f64], v: &[f64], i: Option<usize>) -> Frame<Dual> {
+    match i {
+        Some(i) => {
+            let [_, s, c] = angles.sin_cos_of(i);
+            let (qi, vi) = (&q[3 * i..3 * i + 3], &v[3 * i..3 * i + 3]);
+            let w = vi[2];
+            Frame {
+                q: [
+                    Dual::var(qi[0], vi[0]),
+                    Dual::var(qi[1], vi[1]),
+                    Dual::var(qi[2], vi[2]),
+                ],
+                c: Dual { v: c, d: -s * w },
+                s: Dual { v: s, d: c * w },
+            }
+        }
+        None => Frame::fixed(),
+    }
+}
+
 #[cfg(test)]
 mod phi_q_dot_jacobian_tests {
     use crate::models;
@@ -526,11 +494,12 @@ mod phi_q_dot_jacobian_tests {
         }
     }
 
-    /// The closed-form revolute rows of `phi_and_phi_dot_near` give bit for bit what
-    /// `phi_and_phi_dot_cached` gives (and so the generic evaluation to a few ulps), on every
-    /// joint kind, the manipulator and a chain longer than the stack of frames.
+    /// The closed-form revolute rows of `phi_and_phi_dot_cached` give bit for bit what the
+    /// dual-number evaluation at the same cached angles gives (and so the generic evaluation
+    /// to a few ulps), on every joint kind, the manipulator and a chain longer than the stack
+    /// of frames.
     #[test]
-    fn near_residual_matches_cached_bit_for_bit() {
+    fn closed_form_cached_residual_matches_the_dual_evaluation_bit_for_bit() {
         for sys in [
             crate::fixtures::every_joint_kind(),
             models::manipulator().unwrap(),
@@ -559,8 +528,14 @@ mod phi_q_dot_jacobian_tests {
                     c1.invalidate();
                     c2.invalidate();
                 }
-                sys.phi_and_phi_dot_cached(&q, &v, 0.3, &mut p1, &mut d1, &mut c1);
-                sys.phi_and_phi_dot_near(&q, &v, 0.3, &mut p2, &mut d2, &mut c2);
+                c1.update_near(&sys, &q);
+                for ji in 0..sys.joints.len() {
+                    let at = sys.joint_attach[ji];
+                    let fa = super::dual_frame(&c1, &q, &v, at.a);
+                    let fb = super::dual_frame(&c1, &q, &v, at.b);
+                    sys.eval_phi_phi_dot(ji, &fa, &fb, 0.3, &mut p1, &mut d1);
+                }
+                sys.phi_and_phi_dot_cached(&q, &v, 0.3, &mut p2, &mut d2, &mut c2);
                 sys.phi_and_phi_dot(&q, &v, 0.3, &mut p0, &mut d0);
                 for r in 0..m {
                     assert_eq!(p1[r].to_bits(), p2[r].to_bits(), "phi row {r}");

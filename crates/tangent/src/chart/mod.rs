@@ -445,7 +445,7 @@ impl TangentChart {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
-        sys.phi_and_phi_dot_near(q, v, t, p, pd, &mut self.angles);
+        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
         with_codim!(2 * m, max_abs_finite(out))
     }
 

@@ -391,7 +391,7 @@ impl SparseChart {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
-        sys.phi_and_phi_dot_near(q, v, t, p, pd, &mut self.angles);
+        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
         max_abs(&out[..2 * m])
     }
 
