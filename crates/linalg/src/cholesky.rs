@@ -2,7 +2,7 @@
 //! fixed dimension up to [`FIXED_CHOLESKY`], plain loops up to [`SMALL_CHOLESKY`], faer's
 //! blocked factorisation above; a scale-invariant pivot test and a condition estimate.
 
-use crate::{FactorError, LinalgError, Scratch};
+use crate::{semidefinite, FactorError, LinalgError, Scratch};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
 use faer::{MatMut, Par};
@@ -146,6 +146,10 @@ pub struct DenseCholesky {
     condition: f64,
     mem: Scratch,
     factored: bool,
+    /// How many dependent rows a factorisation may drop (0: the matrix must be definite).
+    max_dependent: usize,
+    /// The rows dropped by the last factorisation (capacity `m`).
+    dependent: Vec<usize>,
 }
 
 /// Smallest accepted pivot of [`DenseCholesky`], relative to the matrix's own diagonal entry:
@@ -173,6 +177,8 @@ impl DenseCholesky {
             condition: 0.0,
             mem: Scratch(MemBuffer::new(req)),
             factored: false,
+            max_dependent: 0,
+            dependent: Vec::new(),
         }
     }
 
@@ -214,7 +220,47 @@ impl DenseCholesky {
             condition: 0.0,
             mem: Scratch(mem),
             factored: false,
+            max_dependent: 0,
+            dependent: Vec::new(),
         })
+    }
+
+    /// Lets each factorisation drop up to `k` rows that depend on the earlier ones (a
+    /// positive *semi*definite matrix of rank `m - k`, as `Phi_q M^-1 Phi_q^T` is for a
+    /// mechanism with `k` redundant constraint equations): a dropped row's unknown is zero in
+    /// every solve (see the module `semidefinite`: the basic solution). `k = 0` (the default)
+    /// is the definite factorisation, unchanged. With `k > 0` every factorisation and solve
+    /// runs the plain loops. Allocates the list of dropped rows (once).
+    ///
+    /// ```
+    /// use mbd_linalg::DenseCholesky;
+    /// // rows 0 and 2 equal: rank 2
+    /// let a = [[1.0, 0.5, 1.0], [0.5, 2.0, 0.5], [1.0, 0.5, 1.0]];
+    /// let mut c = DenseCholesky::new(3);
+    /// c.set_max_dependent(1);
+    /// for (r, row) in a.iter().enumerate() {
+    ///     for (k, v) in row.iter().enumerate() {
+    ///         c.matrix_mut()[(r, k)] = *v;
+    ///     }
+    /// }
+    /// c.factor_in_place()?;
+    /// assert_eq!(c.dependent(), &[2]);
+    /// // a right-hand side in the range of the matrix: A x = b with x_2 = 0
+    /// let mut x = [1.5, 2.5, 1.5];
+    /// c.solve_in_place(&mut x);
+    /// assert!((x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15 && x[2] == 0.0);
+    /// # Ok::<(), mbd_linalg::FactorError>(())
+    /// ```
+    pub fn set_max_dependent(&mut self, k: usize) {
+        self.max_dependent = k.min(self.m);
+        self.dependent = Vec::with_capacity(self.m);
+        self.factored = false;
+    }
+
+    /// The rows dropped as dependent by the last factorisation, in increasing order (empty
+    /// unless [`DenseCholesky::set_max_dependent`] allowed some).
+    pub fn dependent(&self) -> &[usize] {
+        &self.dependent
     }
 
     /// A cheap condition estimate of the last factored matrix after symmetric diagonal
@@ -330,6 +376,13 @@ impl DenseCholesky {
             return Ok(());
         }
         self.condition = f64::INFINITY;
+        if self.max_dependent > 0 {
+            let (a, diag, inv) = (&mut self.a, &mut self.diag, &mut self.inv);
+            self.condition =
+                semidefinite::factor(a, diag, inv, m, self.max_dependent, &mut self.dependent)?;
+            self.factored = true;
+            return Ok(());
+        }
         if m <= FIXED_CHOLESKY {
             let (a, diag, inv) = (&mut self.a, &mut self.diag, &mut self.inv);
             self.condition = by_dimension!(m, factor_fixed(a, diag, inv), unreachable!())?;
@@ -418,7 +471,7 @@ impl DenseCholesky {
             by_dimension!(m, backward_fixed(a, inv, b), ());
             return;
         }
-        if m <= SMALL_CHOLESKY_SOLVE {
+        if m <= SMALL_CHOLESKY_SOLVE || self.max_dependent > 0 {
             // L y = b, then L^T x = y (row i of L^T is column i of L: contiguous)
             self.forward_in_place(b);
             let a = &self.a;

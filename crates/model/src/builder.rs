@@ -5,6 +5,7 @@ use crate::check::{self, invalid};
 use crate::element::norm;
 use crate::error::ModelError;
 use crate::forces::Force;
+use crate::init::RedundantConstraints;
 use crate::joints::{Coordinate, Joint};
 use crate::system::*;
 use nalgebra::DVector;
@@ -20,6 +21,8 @@ pub struct SystemBuilder {
     pub(crate) frames: Vec<BodyFrame>,
     /// The first handle given to [`SystemBuilder::set_body_frame`] without a body.
     unknown_frame: Option<usize>,
+    /// What `build` does with redundant equations.
+    pub(crate) redundant: RedundantConstraints,
 }
 
 /// How a body was added (builder side only: the [`System`] keeps centre-of-mass poses).
@@ -96,9 +99,21 @@ impl SystemBuilder {
         self.forces.push(force);
         ForceHandle(self.forces.len() - 1)
     }
+    /// What [`SystemBuilder::build`] does with constraint equations that depend on others at
+    /// the initial configuration: [`RedundantConstraints::Allow`] (the default) builds the
+    /// system and lists them in [`System::redundant_equations`];
+    /// [`RedundantConstraints::Reject`] makes them an error.
+    pub fn redundant_constraints(&mut self, policy: RedundantConstraints) -> &mut Self {
+        self.redundant = policy;
+        self
+    }
     /// Validates the model and assembles it. Checks names, parameters, attachments, and the rank
-    /// of `Phi_q` at the bodies' initial positions (redundant constraints are an error naming the
-    /// joints involved).
+    /// of `Phi_q` at the bodies' initial positions: equations that depend on earlier ones are
+    /// listed in [`System::redundant_equations`] (or, with [`RedundantConstraints::Reject`], an
+    /// error naming the first and the joints involved). Give positions that satisfy the
+    /// constraints (to about `1e-9` relative) for the dependency to be seen: at a configuration
+    /// off the constraints the rows are independent in floating point and the redundancy shows
+    /// only when the consistent state is projected (as a rank error).
     pub fn build(mut self) -> Result<System, ModelError> {
         self.lower_frames()?;
         System::new(self)
@@ -254,6 +269,7 @@ impl System {
             gravity,
             frames: _,
             unknown_frame: _,
+            redundant: policy,
         } = b;
         if bodies.is_empty() {
             return Err(ModelError::Empty);
@@ -391,7 +407,7 @@ impl System {
             .iter()
             .flat_map(|b| [-(-b.mass * gravity[0]), -(-b.mass * gravity[1]), 0.0])
             .collect();
-        let sys = System {
+        let mut sys = System {
             bodies,
             joints,
             forces,
@@ -405,10 +421,21 @@ impl System {
             inv_mass,
             eq_joint,
             gravity_forces,
+            redundant: Vec::new(),
         };
         sys.check_inertia_scale()?;
         let (q0, _) = sys.initial_guess();
-        sys.check_rank(q0.as_slice(), 0.0)?;
+        let redundant = sys.redundant_at(q0.as_slice())?;
+        if policy == RedundantConstraints::Reject {
+            if let Some(e) = redundant.into_iter().next() {
+                return Err(ModelError::Redundant {
+                    equation: e.equation,
+                    joints: e.joints,
+                });
+            }
+        } else {
+            sys.redundant = redundant;
+        }
         Ok(sys)
     }
 

@@ -1,4 +1,4 @@
-//! The rank check of the constraint Jacobian (consistent initial states are
+//! Redundant equations and the rank check of the constraint Jacobian (consistent initial states are
 //! `mbd_solve::consistent_state`, on the solver core's projection).
 
 use crate::error::ModelError;
@@ -6,38 +6,111 @@ use crate::system::System;
 use faer::{Mat, Side};
 use mbd_linalg::{max_abs, SparseCholesky};
 use nalgebra::{DMatrix, DVector};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// Above this many constraint equations [`System::check_rank`] factors the Schur complement
 /// `Phi_q M^-1 Phi_q^T` as a sparse matrix (memory and time linear in the size of a chain)
 /// instead of forming `Phi_q` densely.
 pub const SPARSE_RANK_THRESHOLD: usize = 200;
 
-impl System {
-    /// Checks that `Phi_q(q)` has full row rank. On failure returns
-    /// [`ModelError::Redundant`] naming the first dependent equation and the joints whose
-    /// equations it combines.
-    ///
-    /// Above [`SPARSE_RANK_THRESHOLD`] equations the test is a sparse Cholesky factorisation of
-    /// `Phi_q M^-1 Phi_q^T` (equilibrated pivots above `mbd_linalg::CHOLESKY_PIVOT_TOL`); a
-    /// failure names the equation whose pivot vanished and the joints that share a body with
+/// What [`crate::SystemBuilder::build`] does with constraint equations that are combinations
+/// of others at the initial configuration (a double parallelogram's third crank, a
+/// pantograph's extra bar: the mechanism moves, but `Phi_q` has fewer independent rows than
+/// equations).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum RedundantConstraints {
+    /// Build the system and report the dependent equations
+    /// ([`System::redundant_equations`]); every solver then drops, at each factorisation, the
+    /// equations that depend on earlier ones (their multipliers are zero).
+    #[default]
+    Allow,
+    /// Refuse the model with [`ModelError::Redundant`] naming the first dependent equation.
+    Reject,
+}
+
+/// A constraint equation that is a combination of the equations before it (at the
+/// configuration where [`System::redundant_at`] looked).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RedundantEquation {
+    /// Its row in `Phi`.
+    pub row: usize,
+    /// Its name (`joint.label`, see [`System::equation_name`]).
+    pub equation: String,
+    /// The joints whose equations it combines (its own first): with the dense test those
+    /// whose equations enter the combination, with the sparse test those sharing a body with
     /// it.
-    pub fn check_rank(&self, q: &[f64], _t: f64) -> Result<(), ModelError> {
+    pub joints: Vec<String>,
+}
+
+impl RedundantEquation {
+    fn into_error(self) -> ModelError {
+        ModelError::Redundant {
+            equation: self.equation,
+            joints: self.joints,
+        }
+    }
+}
+
+impl System {
+    /// The equations found dependent at build time, in row order (empty for a mechanism whose
+    /// equations are independent). The solvers allow this many dependent rows in each
+    /// factorisation of `Phi_q M^-1 Phi_q^T` (or of their own systems with `Phi_q`) and no
+    /// more: a configuration where the rank falls further is singular.
+    pub fn redundant_equations(&self) -> &[RedundantEquation] {
+        &self.redundant
+    }
+
+    /// The number of redundant equations, `m - rank(Phi_q)` at build time.
+    pub fn n_redundant(&self) -> usize {
+        self.redundant.len()
+    }
+
+    /// The equations of `Phi_q(q)` that depend on the ones before them, in row order (the rows
+    /// a factorisation in the natural order drops). Below [`SPARSE_RANK_THRESHOLD`] equations
+    /// a Gram-Schmidt pass over the rows (a row is dependent when its part outside the span of
+    /// the earlier rows is below `1e-9` of the largest row norm); above, a semidefinite sparse
+    /// Cholesky factorisation of `Phi_q M^-1 Phi_q^T` (pivot ratios below
+    /// [`mbd_linalg::DEPENDENT_PIVOT_TOL`]), linear in the size of a chain.
+    pub fn redundant_at(&self, q: &[f64]) -> Result<Vec<RedundantEquation>, ModelError> {
         self.check_len("q", q, self.n)?;
-        let (n, m) = (self.n, self.m);
-        if m == 0 {
-            return Ok(());
+        if self.m == 0 {
+            return Ok(Vec::new());
         }
-        if m > SPARSE_RANK_THRESHOLD {
-            return self.check_rank_sparse(q);
+        if self.m > SPARSE_RANK_THRESHOLD {
+            return self.redundant_sparse(q);
         }
-        let mut jac = DMatrix::zeros(m, n);
+        let mut jac = DMatrix::zeros(self.m, self.n);
         self.phi_q(q, &mut jac);
         // Fast path: a well-conditioned Cholesky factor of Phi_q M^-1 Phi_q^T proves full rank.
         if self.schur_well_conditioned(&jac) {
+            return Ok(Vec::new());
+        }
+        Ok(self.redundant_dense(&jac))
+    }
+
+    /// Checks that `Phi_q(q)` has no more dependent rows than the mechanism's redundant
+    /// equations ([`System::n_redundant`]): full row rank for a mechanism without redundancy.
+    /// On failure returns [`ModelError::Redundant`] naming a dependent equation (the first one
+    /// not found at build time) and the joints whose equations it combines.
+    pub fn check_rank(&self, q: &[f64], _t: f64) -> Result<(), ModelError> {
+        let found = self.redundant_at(q)?;
+        if found.len() <= self.redundant.len() {
             return Ok(());
         }
-        // Gram-Schmidt on the rows (twice for stability), tracking each basis vector as a
-        // combination of the original rows so a dependency can be traced to its joints.
+        let known = |r: usize| self.redundant.iter().any(|e| e.row == r);
+        let pick = found.iter().position(|e| !known(e.row)).unwrap_or(0);
+        match found.into_iter().nth(pick) {
+            Some(e) => Err(e.into_error()),
+            None => Ok(()),
+        }
+    }
+
+    /// Gram-Schmidt on the rows (twice for stability), tracking each basis vector as a
+    /// combination of the original rows so a dependency can be traced to its joints.
+    fn redundant_dense(&self, jac: &DMatrix<f64>) -> Vec<RedundantEquation> {
+        let m = self.m;
         let scale = (0..m)
             .map(|r| jac.row(r).norm())
             .fold(0.0, f64::max)
@@ -45,6 +118,7 @@ impl System {
         let tol = 1e-9 * scale;
         let mut basis: Vec<DVector<f64>> = Vec::new();
         let mut combo: Vec<DVector<f64>> = Vec::new();
+        let mut found = Vec::new();
         for r in 0..m {
             let row: DVector<f64> = jac.row(r).transpose();
             let mut w = row.clone();
@@ -67,34 +141,30 @@ impl System {
                     coef += &combo[k] * *p;
                 }
                 let cmax = max_abs(coef.as_slice()).max(1e-300);
-                let mut joints: Vec<String> = Vec::new();
-                let mut push = |ji: usize| {
-                    let name = self.joints[ji].name.clone();
-                    if !joints.contains(&name) {
-                        joints.push(name);
-                    }
-                };
+                let mut joints: Vec<String> = vec![self.joints[self.eq_joint[r]].name.clone()];
                 for j in 0..m {
-                    if coef[j].abs() > 1e-8 * cmax {
-                        push(self.eq_joint[j]);
+                    let name = &self.joints[self.eq_joint[j]].name;
+                    if coef[j].abs() > 1e-8 * cmax && !joints.contains(name) {
+                        joints.push(name.clone());
                     }
                 }
-                push(self.eq_joint[r]);
-                return Err(ModelError::Redundant {
+                found.push(RedundantEquation {
+                    row: r,
                     equation: self.equation_name(r),
                     joints,
                 });
+                continue;
             }
             basis.push(w / norm);
             combo.push(c / norm);
         }
-        Ok(())
+        found
     }
 
-    /// The sparse rank test of [`System::check_rank`]: `S = Phi_q M^-1 Phi_q^T` from the
+    /// The sparse test of [`System::redundant_at`]: `S = Phi_q M^-1 Phi_q^T` from the
     /// element-local rows, its pattern from the bodies the rows share (O(m) entries for a
-    /// chain), factored by [`SparseCholesky`].
-    fn check_rank_sparse(&self, q: &[f64]) -> Result<(), ModelError> {
+    /// chain), factored by [`SparseCholesky`] allowing every row to be dropped.
+    fn redundant_sparse(&self, q: &[f64]) -> Result<Vec<RedundantEquation>, ModelError> {
         let m = self.m;
         let mut grads = vec![[0.0; 6]; m];
         self.phi_q_local(q, &mut grads);
@@ -125,6 +195,7 @@ impl System {
                 element: "constraint Jacobian".into(),
                 message: format!("the sparse rank check could not analyse its pattern: {e}"),
             })?;
+        chol.set_max_dependent(m);
         for (i, rows) in touching.iter().enumerate() {
             let w = [
                 self.inv_mass[3 * i],
@@ -143,28 +214,35 @@ impl System {
                 }
             }
         }
-        let Err(e) = chol.factor() else {
-            return Ok(());
+        let dependent: Vec<usize> = match chol.factor() {
+            Ok(()) => chol.dependent().to_vec(),
+            // (a non-finite or zero entry on the diagonal: that row)
+            Err(mbd_linalg::FactorError::NotPositiveDefinite(r))
+            | Err(mbd_linalg::FactorError::Singular(r)) => vec![r],
         };
-        let r = match e {
-            mbd_linalg::FactorError::NotPositiveDefinite(r)
-            | mbd_linalg::FactorError::Singular(r) => r,
-        };
-        let mut joints: Vec<String> = Vec::new();
-        let ji = self.eq_joint[r];
-        let at = self.joint_attach[ji];
-        for body in [at.a, at.b].into_iter().flatten() {
-            for &(s, _) in &touching[body] {
-                let name = &self.joints[self.eq_joint[s]].name;
-                if !joints.contains(name) {
-                    joints.push(name.clone());
+        let mut found: Vec<RedundantEquation> = dependent
+            .into_iter()
+            .map(|r| {
+                let ji = self.eq_joint[r];
+                let at = self.joint_attach[ji];
+                let mut joints: Vec<String> = vec![self.joints[ji].name.clone()];
+                for body in [at.a, at.b].into_iter().flatten() {
+                    for &(s, _) in &touching[body] {
+                        let name = &self.joints[self.eq_joint[s]].name;
+                        if !joints.contains(name) {
+                            joints.push(name.clone());
+                        }
+                    }
                 }
-            }
-        }
-        Err(ModelError::Redundant {
-            equation: self.equation_name(r),
-            joints,
-        })
+                RedundantEquation {
+                    row: r,
+                    equation: self.equation_name(r),
+                    joints,
+                }
+            })
+            .collect();
+        found.sort_by_key(|e| e.row);
+        Ok(found)
     }
 
     /// `S = Phi_q M^-1 Phi_q^T` (dense), accumulated column by column over the few non-zeros of

@@ -75,7 +75,7 @@ pub use error::ModelError;
 pub use file::{BodyKind, BodySpec, ForceSpec, JointSpec, ModelFile};
 pub use forces::{Force, ForceKind};
 pub use hessian_pair::LagrangianWeights;
-pub use init::SPARSE_RANK_THRESHOLD;
+pub use init::{RedundantConstraints, RedundantEquation, SPARSE_RANK_THRESHOLD};
 pub use jet::{Basis, PolyJet, MAX_DIRS};
 pub use joints::RevoluteSide;
 pub use joints::{Coordinate, Joint, JointKind};

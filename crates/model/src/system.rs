@@ -5,6 +5,7 @@
 use crate::body::{Body, BodyHandle};
 use crate::error::ModelError;
 use crate::forces::Force;
+use crate::init::RedundantEquation;
 use crate::jet::{DirJet, Frame, HessJet};
 use crate::joints::Joint;
 use nalgebra::{DMatrix, DVector};
@@ -76,6 +77,8 @@ pub struct System {
     /// The generalized gravity forces `(m_i g_x, m_i g_y, 0)` per body: constant, evaluated
     /// once at build instead of at every force evaluation.
     pub(crate) gravity_forces: Vec<f64>,
+    /// The equations found dependent on earlier ones at build time.
+    pub(crate) redundant: Vec<RedundantEquation>,
 }
 
 impl System {
@@ -87,9 +90,10 @@ impl System {
     pub fn n_constraints(&self) -> usize {
         self.m
     }
-    /// Degrees of freedom `n - m` (the rank check at build guarantees independent equations).
+    /// Degrees of freedom `n - rank(Phi_q) = n - m + ` [`System::n_redundant`] (the rank at
+    /// the build configuration).
     pub fn dof(&self) -> usize {
-        self.n - self.m
+        self.n - self.m + self.redundant.len()
     }
     /// The bodies, in handle order.
     pub fn bodies(&self) -> &[Body] {

@@ -60,7 +60,16 @@ pub struct SparseCholesky {
     mem: Scratch,
     factored: bool,
     condition: f64,
+    /// How many dependent rows a factorisation may drop (0: the matrix must be definite).
+    max_dependent: usize,
+    /// The rows (original indices) dropped by the last factorisation.
+    dependent: Vec<usize>,
 }
+
+/// The pivot a semidefinite factorisation puts in place of a dependent row's (in the
+/// equilibrated matrix, whose genuine pivots are at most 1 plus rounding): `L_jj = 2` exactly
+/// marks the row as dropped.
+const DROPPED_PIVOT: f64 = 4.0;
 
 impl SparseCholesky {
     /// Analyses the pattern: `m` unknowns, off-diagonal entries `(row, col)` of the lower
@@ -156,7 +165,29 @@ impl SparseCholesky {
             mem: Scratch(MemBuffer::new(req)),
             factored: false,
             condition: 0.0,
+            max_dependent: 0,
+            dependent: Vec::new(),
         })
+    }
+
+    /// Lets each factorisation drop up to `k` rows that depend on the earlier ones in the
+    /// elimination order (a positive *semi*definite matrix, as `Phi_q M^-1 Phi_q^T` is for a
+    /// mechanism with `k` redundant constraint equations), as
+    /// [`crate::DenseCholesky::set_max_dependent`] does: a pivot of the equilibrated matrix at
+    /// most [`crate::DEPENDENT_PIVOT_TOL`] is replaced by a positive one (faer's dynamic
+    /// regularisation) and the row's unknown is then set to zero in every solve. `k = 0` (the
+    /// default) is the definite factorisation, unchanged. Allocates the list of dropped rows
+    /// (once).
+    pub fn set_max_dependent(&mut self, k: usize) {
+        self.max_dependent = k.min(self.m);
+        self.dependent = Vec::with_capacity(self.m);
+        self.factored = false;
+    }
+
+    /// The rows (original indices) dropped as dependent by the last factorisation, in the
+    /// elimination order (empty unless [`SparseCholesky::set_max_dependent`] allowed some).
+    pub fn dependent(&self) -> &[usize] {
+        &self.dependent
     }
 
     /// Dimension `m`.
@@ -224,11 +255,20 @@ impl SparseCholesky {
         let sym = SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx);
         let mat = SparseColMatRef::new(sym, &self.scaled);
         let stack = MemStack::new(&mut self.mem.0);
+        let regularization = if self.max_dependent > 0 {
+            LltRegularization {
+                dynamic_regularization_delta: DROPPED_PIVOT,
+                dynamic_regularization_epsilon: crate::DEPENDENT_PIVOT_TOL,
+            }
+        } else {
+            LltRegularization::default()
+        };
+        self.dependent.clear();
         let res = self.symbolic.factorize_numeric_llt(
             &mut self.l_values,
             mat,
             Side::Lower,
-            LltRegularization::default(),
+            regularization,
             Par::Seq,
             stack,
             Default::default(),
@@ -244,6 +284,17 @@ impl SparseCholesky {
         let mut worst = 1.0f64;
         for (j, &p) in self.l_diag.iter().enumerate() {
             let l = self.l_values[p];
+            if self.max_dependent > 0 && l == DROPPED_PIVOT.sqrt() {
+                if self.dependent.len() == self.max_dependent {
+                    return Err(FactorError::NotPositiveDefinite(self.perm[j]));
+                }
+                self.dependent.push(self.perm[j]);
+                // the solves divide by L_jj: an infinite one gives the dropped row's unknown
+                // zero and leaves the others alone (its column below the diagonal is rounding
+                // noise, multiplied by that zero)
+                self.l_values[p] = f64::INFINITY;
+                continue;
+            }
             let piv = l * l;
             if !(piv >= CHOLESKY_PIVOT_TOL) {
                 return Err(FactorError::NotPositiveDefinite(self.perm[j]));
@@ -367,6 +418,104 @@ mod tests {
             sp.factor(),
             Err(FactorError::NotPositiveDefinite(6))
         ));
+    }
+
+    /// `G G^T` for a 40 x 60 banded `G` whose rows 17 and 33 are combinations of others (a
+    /// positive semidefinite matrix of rank 38), in the sparse and the dense semidefinite
+    /// factorisations: both drop two rows, one more dependent row is an error, and for a
+    /// right-hand side in the range the solutions agree and solve the system.
+    #[test]
+    fn semidefinite_factorisations_drop_dependent_rows_and_agree() {
+        let (m, n) = (40, 60);
+        let mut g = vec![vec![0.0; n]; m];
+        for (i, row) in g.iter_mut().enumerate() {
+            for k in 0..3 {
+                row[(i + k) % n] = 1.0 + ((i * 7 + k * 3) % 5) as f64;
+            }
+        }
+        g[17] = g[16]
+            .iter()
+            .zip(&g[18])
+            .map(|(a, b)| 2.0 * a - 0.5 * b)
+            .collect();
+        g[33] = g[32].iter().zip(&g[31]).map(|(a, b)| a + b).collect();
+        let s = |r: usize, c: usize| -> f64 { g[r].iter().zip(&g[c]).map(|(a, b)| a * b).sum() };
+        let mut pattern = Vec::new();
+        for r in 0..m {
+            for c in 0..r {
+                if s(r, c) != 0.0 {
+                    pattern.push((r, c));
+                }
+            }
+        }
+        let fill = |sp: &mut SparseCholesky, de: &mut DenseCholesky| {
+            for r in 0..m {
+                for c in 0..=r {
+                    let v = s(r, c);
+                    if v != 0.0 {
+                        let k = sp.slot(r, c).unwrap();
+                        sp.values_mut()[k] = v;
+                    }
+                    de.matrix_mut()[(r, c)] = v;
+                }
+            }
+        };
+        let mut sp = SparseCholesky::new(m, &pattern).unwrap();
+        let mut de = DenseCholesky::new(m);
+        // definite factorisations refuse it
+        fill(&mut sp, &mut de);
+        assert!(sp.factor().is_err());
+        assert!(de.factor_in_place().is_err());
+        // one dropped row allowed: not enough
+        sp.set_max_dependent(1);
+        de.set_max_dependent(1);
+        fill(&mut sp, &mut de);
+        assert!(sp.factor().is_err());
+        assert!(de.factor_in_place().is_err());
+        sp.set_max_dependent(2);
+        de.set_max_dependent(3);
+        fill(&mut sp, &mut de);
+        sp.factor().unwrap();
+        de.factor_in_place().unwrap();
+        // in the natural order the last row of each dependent set goes: 18 (= (2 g16 - g17) / 0.5)
+        // and 33
+        assert_eq!(de.dependent(), &[18, 33]);
+        assert_eq!(sp.dependent().len(), 2);
+        // b = S x0 is in the range; both solutions solve S x = b
+        let x0: Vec<f64> = (0..m).map(|i| (i as f64 * 0.37).cos()).collect();
+        let b: Vec<f64> = (0..m)
+            .map(|r| (0..m).map(|c| s(r, c) * x0[c]).sum())
+            .collect();
+        let bmax = b.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        for x in [
+            {
+                let mut x = b.clone();
+                sp.solve_in_place(&mut x);
+                x
+            },
+            {
+                let mut x = b.clone();
+                de.solve_in_place(&mut x);
+                x
+            },
+        ] {
+            for r in 0..m {
+                let sx: f64 = (0..m).map(|c| s(r, c) * x[c]).sum();
+                assert!(
+                    (sx - b[r]).abs() <= 1e-10 * bmax,
+                    "row {r}: {sx} vs {}",
+                    b[r]
+                );
+            }
+        }
+        let mut x = b.clone();
+        de.solve_in_place(&mut x);
+        assert_eq!((x[18], x[33]), (0.0, 0.0));
+        let mut y = b.clone();
+        sp.solve_in_place(&mut y);
+        for &d in sp.dependent() {
+            assert_eq!(y[d], 0.0, "dropped row {d}");
+        }
     }
 
     #[test]

@@ -26,6 +26,7 @@ pub use spec::{BodyKind, BodySpec, ForceSpec, JointSpec};
 
 use crate::builder::SystemBuilder;
 use crate::error::ModelError;
+use crate::init::RedundantConstraints;
 use crate::system::System;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -45,6 +46,15 @@ pub struct ModelFile {
     /// The force elements.
     #[serde(default)]
     pub forces: Vec<ForceSpec>,
+    /// What to do with constraint equations that are combinations of others at the initial
+    /// configuration: `"allow"` (default: the model runs, `mbd check` names them) or
+    /// `"reject"` (an error).
+    #[serde(default, skip_serializing_if = "is_allow")]
+    pub redundant_constraints: RedundantConstraints,
+}
+
+fn is_allow(r: &RedundantConstraints) -> bool {
+    *r == RedundantConstraints::Allow
 }
 
 impl ModelFile {

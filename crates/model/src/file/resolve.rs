@@ -9,6 +9,7 @@ use crate::body::{Body, BodyHandle, BodyRef};
 use crate::builder::SystemBuilder;
 use crate::check::invalid;
 use crate::error::ModelError;
+use crate::init::RedundantConstraints;
 use crate::system::System;
 
 /// Body names resolved, with each body's frame offset and kind.
@@ -102,6 +103,7 @@ impl ModelFile {
         let r = Resolver::new(self)?;
         let mut b = SystemBuilder::new();
         b.set_gravity(self.gravity);
+        b.redundant_constraints(self.redundant_constraints);
         for (body, spec) in r.bodies.iter().zip(&self.bodies) {
             let h = if spec.kind == BodyKind::PointMass {
                 let (p, v) = (body.position, body.velocity);
@@ -137,6 +139,7 @@ impl System {
         let forces = self.forces.iter().map(|f| f.to_spec(&name)).collect();
         ModelFile {
             gravity: self.gravity,
+            redundant_constraints: RedundantConstraints::Allow,
             bodies: self
                 .bodies
                 .iter()

@@ -60,6 +60,10 @@ impl DenseSchur {
         }
         // in storage order (a stable sort: the terms of one entry stay in body order)
         plan.sort_by_key(|t| t[0]);
+        let mut chol = DenseCholesky::new(m);
+        // a mechanism with redundant equations: each factorisation drops that many dependent
+        // rows (their multipliers zero), and no more
+        chol.set_max_dependent(sys.n_redundant());
         DenseSchur {
             m,
             cols,
@@ -67,7 +71,7 @@ impl DenseSchur {
             grads: vec![[0.0; 6]; m],
             u: vec![[0.0; 3]; 2 * m],
             wu: vec![[0.0; 3]; 2 * m],
-            chol: DenseCholesky::new(m),
+            chol,
         }
     }
 

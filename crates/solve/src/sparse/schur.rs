@@ -91,7 +91,10 @@ impl ConstraintSchur {
                 }
             }
         }
-        let chol = SparseCholesky::new(m, &pattern)?;
+        let mut chol = SparseCholesky::new(m, &pattern)?;
+        // a mechanism with redundant equations: each factorisation drops that many dependent
+        // rows (their multipliers zero), and no more
+        chol.set_max_dependent(sys.n_redundant());
         let mut contributions = Vec::new();
         for (body, rows) in by_body.iter().enumerate() {
             for &(r1, o1) in rows {
