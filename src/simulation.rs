@@ -97,7 +97,9 @@ impl Simulation {
 
     /// `system` with a parsed solver spec.
     pub fn with_spec(system: System, spec: &SolverSpec) -> Result<Self, Error> {
-        let integrator = spec.build(&system)?;
+        let integrator = spec
+            .build(&system)
+            .map_err(|e| registry().with_advice(&system, e))?;
         let state = State::consistent(&system, 0.0)?;
         Ok(Simulation {
             system,

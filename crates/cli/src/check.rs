@@ -69,6 +69,18 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
         sys.n_constraints(),
         sys.dof()
     );
+    let red = sys.redundant_equations();
+    if !red.is_empty() {
+        let _ = writeln!(
+            s,
+            "redundant equations ({}; combinations of the others at the initial configuration, \
+             carrying no multiplier; redundant_constraints = \"reject\" refuses them):",
+            red.len()
+        );
+        for e in red {
+            let _ = writeln!(s, "  {:<16} joints {}", e.equation, e.joints.join(", "));
+        }
+    }
     let _ = writeln!(s, "consistent initial state at t = 0:");
     let _ = writeln!(s, "  {:<24} {:>14} {:>14}", "coordinate", "q", "v");
     for (k, name) in sys.coordinate_names().iter().enumerate() {

@@ -202,6 +202,20 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         )));
     }
     let sys = crate::model::load(&args.model)?;
+    if sys.n_redundant() > 0 {
+        let names: Vec<&str> = sys
+            .redundant_equations()
+            .iter()
+            .map(|e| e.equation.as_str())
+            .collect();
+        eprintln!(
+            "warning: {} redundant constraint equation(s) ({}): combinations of the others, \
+             carrying no multiplier (`mbd check` lists them; redundant_constraints = \"reject\" \
+             in the model file refuses them)",
+            names.len(),
+            names.join(", ")
+        );
+    }
     let state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {
         path: args.model.display().to_string(),
         source: Box::new(source),
@@ -218,7 +232,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     let integrator = args
         .solver
         .build(&sys)
-        .map_err(|e| solve_error(&args.solver, e))?;
+        .map_err(|e| solve_error(&args.solver, mbd::registry().with_advice(&sys, e)))?;
     let every = usize::try_from(args.every).unwrap_or(usize::MAX);
     let sink = open_sink(args, every)?;
     let measures = MeasureObserver::new(&sys, false);

@@ -6,6 +6,14 @@ use mbd_model::System;
 use mbd_solve::linalg::max_abs;
 use nalgebra::DMatrix;
 
+/// The dependent block is square (`m x m`): the equations must be independent.
+fn refuse_redundant(sys: &System) -> Result<(), FaDaeError> {
+    mbd_solve::refuse_redundant(sys, "the firefly-algorithm DAE solver").map_err(|e| match e {
+        mbd_solve::SolveError::Unsupported(s) => FaDaeError::Unsupported(s),
+        other => FaDaeError::Unsupported(other.to_string()),
+    })
+}
+
 /// A split of the `n` coordinates into `dof` independent and `m` dependent ones, such that the
 /// dependent block `Phi_q[:, dependent]` is invertible.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -26,6 +34,7 @@ impl Partition {
     /// [`FaDaeError::Unsupported`] if `Phi_q` is rank deficient (redundant constraints or a
     /// singular configuration) or the system has no degree of freedom.
     pub fn auto(sys: &System, q: &[f64]) -> Result<Partition, FaDaeError> {
+        refuse_redundant(sys)?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         if m >= n {
             return Err(FaDaeError::Unsupported(format!(
@@ -52,6 +61,7 @@ impl Partition {
     /// [`FaDaeError::InvalidPartition`] for a wrong count (must equal the degrees of freedom
     /// `n - m`), an index out of range, a duplicate, or a singular dependent block at `q`.
     pub fn given(sys: &System, q: &[f64], independent: &[usize]) -> Result<Partition, FaDaeError> {
+        refuse_redundant(sys)?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let bad = |reason: String| FaDaeError::InvalidPartition {
             given: independent.to_vec(),

@@ -93,7 +93,7 @@ impl System {
     /// Degrees of freedom `n - rank(Phi_q) = n - m + ` [`System::n_redundant`] (the rank at
     /// the build configuration).
     pub fn dof(&self) -> usize {
-        self.n - self.m + self.redundant.len()
+        (self.n + self.redundant.len()).saturating_sub(self.m)
     }
     /// The bodies, in handle order.
     pub fn bodies(&self) -> &[Body] {

@@ -7,8 +7,8 @@ use common::PENDULUM_TOML;
 use mbd_model::joints::RevoluteSpec;
 use mbd_model::models::{self, four_bar, pendulum};
 use mbd_model::{
-    Body, BodyHandle, BodyRef, Force, Joint, ModelError, ModelFile, System, SystemBuilder,
-    TimeFunction,
+    Body, BodyHandle, BodyRef, Force, Joint, ModelError, ModelFile, RedundantConstraints, System,
+    SystemBuilder, TimeFunction,
 };
 
 fn one_body() -> (SystemBuilder, BodyHandle) {
@@ -383,6 +383,17 @@ fn redundant_four_bar() {
             point_b: [-0.6, 0.0],
         },
     ));
+    // accepted by default, the two dependent rows listed with the joints they combine
+    let sys = mf.build().unwrap();
+    let red = sys.redundant_equations();
+    assert_eq!(red.len(), 2, "{red:?}");
+    assert_eq!(sys.dof(), 1);
+    for e in red {
+        assert!(e.equation.starts_with("A_again."), "{e:?}");
+        assert!(e.joints.contains(&"A".to_string()), "{e:?}");
+    }
+    // refused on request
+    mf.redundant_constraints = RedundantConstraints::Reject;
     match mf.build().unwrap_err() {
         ModelError::Redundant { equation, joints } => {
             assert!(equation.starts_with("A_again."), "{equation}");
@@ -394,7 +405,8 @@ fn redundant_four_bar() {
 }
 
 /// Above `SPARSE_RANK_THRESHOLD` equations the rank check is sparse: a long chain builds, and
-/// a duplicated pin at its far end is found and named, as the dense check does on a short one.
+/// a duplicated pin at its far end is found and named, as the dense check does on a short one
+/// (listed by default, an error on request).
 #[test]
 fn sparse_rank_check_accepts_chains_and_names_a_duplicate_pin() {
     let links = mbd_model::SPARSE_RANK_THRESHOLD / 2 + 20;
@@ -410,6 +422,18 @@ fn sparse_rank_check_accepts_chains_and_names_a_duplicate_pin() {
             name: "pin_again".into(),
             ..r.clone()
         }));
+        let sys = mf.build().unwrap();
+        let red = sys.redundant_equations();
+        assert_eq!(red.len(), 2, "{n} links: {red:?}");
+        assert_eq!(sys.dof(), n, "{n} links");
+        for e in red {
+            assert!(
+                e.joints.contains(&"pin_again".to_string()),
+                "{n} links: {e:?}"
+            );
+            assert!(e.joints.contains(&r.name), "{n} links: {e:?}");
+        }
+        mf.redundant_constraints = RedundantConstraints::Reject;
         match mf.build().unwrap_err() {
             ModelError::Redundant { equation, joints } => {
                 assert!(
@@ -438,11 +462,20 @@ fn redundant_double_pin() {
         _ => unreachable!(),
     };
     mf.joints.push(extra);
+    let sys = mf.build().unwrap();
+    let names: Vec<&str> = sys
+        .redundant_equations()
+        .iter()
+        .map(|e| e.equation.as_str())
+        .collect();
+    assert_eq!(names, ["pin_again.x", "pin_again.y"]);
+    assert_eq!(sys.redundant_equations()[0].joints, ["pin_again", "pin1"]);
+    mf.redundant_constraints = RedundantConstraints::Reject;
     assert_eq!(
         mf.build().unwrap_err(),
         ModelError::Redundant {
             equation: "pin_again.x".into(),
-            joints: vec!["pin1".into(), "pin_again".into()],
+            joints: vec!["pin_again".into(), "pin1".into()],
         }
     );
 }

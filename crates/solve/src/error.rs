@@ -194,3 +194,21 @@ impl From<LinalgError> for SolveError {
         }
     }
 }
+
+/// The refusal of a solver that cannot run a mechanism with redundant constraint equations
+/// ([`mbd_model::System::redundant_equations`]): `Ok` for a mechanism without them, else
+/// [`SolveError::Unsupported`] naming `solver` and the redundant equations with their joints.
+pub fn refuse_redundant(sys: &mbd_model::System, solver: &str) -> Result<(), SolveError> {
+    let red = sys.redundant_equations();
+    if red.is_empty() {
+        return Ok(());
+    }
+    let list: Vec<String> = red
+        .iter()
+        .map(|e| format!("{} (joints {})", e.equation, e.joints.join(", ")))
+        .collect();
+    Err(SolveError::Unsupported(format!(
+        "{solver} does not run mechanisms with redundant constraint equations: {}",
+        list.join("; ")
+    )))
+}

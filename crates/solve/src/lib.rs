@@ -70,7 +70,7 @@ pub use accel::AccelerationSolver;
 pub use adaptive::{run_adaptive, AdaptiveConfig, AdaptiveIntegrator, StepAttempt};
 pub use consistent::{consistent_state, project_state, ConsistentOptions, ConsistentState};
 pub use dense::{Crossing, DenseOutput, Event, EventFn, EventHit};
-pub use error::SolveError;
+pub use error::{refuse_redundant, SolveError};
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{
     observe, observer, run, step_count, DriftGuard, Every, Flow, FnObserver, Integrator,

@@ -320,6 +320,28 @@ impl Registry {
         &self.families
     }
 
+    /// `e`, an error of building a solver for `sys`, completed with what the registry knows:
+    /// a refusal of redundant constraint equations ([`crate::refuse_redundant`]) gets the
+    /// list of the registered solvers that run them. Other errors are returned unchanged.
+    pub fn with_advice(&self, sys: &mbd_model::System, e: SolveError) -> SolveError {
+        match e {
+            SolveError::Unsupported(msg)
+                if sys.n_redundant() > 0 && msg.contains("redundant constraint") =>
+            {
+                let ok: Vec<&str> = self
+                    .variants()
+                    .filter(|(_, v)| !v.refuses.contains("redundant"))
+                    .map(|(_, v)| v.spec)
+                    .collect();
+                SolveError::Unsupported(format!(
+                    "{msg}; the solvers that run them: {}",
+                    ok.join(", ")
+                ))
+            }
+            other => other,
+        }
+    }
+
     /// Every registered variant with its family, in registration order.
     pub fn variants(
         &self,

@@ -127,6 +127,17 @@ impl Galerkin {
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
         let sparse_ok = options.gamma == 0.0;
         let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
+        if use_sparse {
+            // the sparse LU keeps every multiplier: redundant equations only on the dense path
+            mbd_solve::refuse_redundant(sys, "the sparse symplectic stage solve").map_err(|e| {
+                match e {
+                    SolveError::Unsupported(s) => {
+                        SolveError::Unsupported(format!("{s}; use LinearSolver::Dense"))
+                    }
+                    other => other,
+                }
+            })?;
+        }
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
                 "the sparse symplectic stage solve needs gamma = 0 (the Hessian of the paper's \
@@ -193,7 +204,7 @@ impl Galerkin {
             lu: if use_sparse {
                 DenseLu::with_ordering(Vec::new(), Vec::new())
             } else {
-                stage_lu(n, m, s)
+                stage_lu(n, m, s, sys.n_redundant())
             },
             qk: vec![0.0; n],
             hvk: vec![0.0; n],
@@ -220,7 +231,11 @@ impl Galerkin {
             wh: DMatrix::zeros(nd, nd),
             pre,
             tn: std::array::from_fn(|_| vec![0.0; n]),
-            proj: DenseCholesky::new(md),
+            proj: {
+                let mut c = DenseCholesky::new(md);
+                c.set_max_dependent(sys.n_redundant());
+                c
+            },
             vm: vec![0.0; n],
             mu: vec![0.0; m],
             acc: if use_sparse {

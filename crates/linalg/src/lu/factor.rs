@@ -60,6 +60,7 @@ impl DenseLu {
             return Ok(());
         }
         self.fallbacks += 1;
+        self.dropped.clear();
         self.f.fill(0.0);
         for (&b, &k) in self.backup.iter().zip(&self.nz[..self.n_nz]) {
             self.f[k] = b;
@@ -131,11 +132,28 @@ impl DenseLu {
     fn factor_static(&mut self, tol: f64, gmax: f64) -> Result<bool, LuError> {
         let n = self.n;
         let sure = 4.0 * tol * gmax;
+        let dep_tol = crate::DEPENDENT_PIVOT_TOL * n as f64;
+        self.dropped.clear();
         for k in 0..n {
             let piv = self.f[k * n + k];
             let pa = piv.abs();
             if pa.is_nan() {
                 return Ok(false);
+            }
+            if k >= self.drop_from
+                && self.dropped.len() < self.drop_max
+                && pa <= 4.0 * dep_tol * gmax
+            {
+                self.equilibrate()?;
+                if pa * self.rscale[k] * self.cscale[k] <= dep_tol {
+                    // a dependent row: its unknown is zero and nothing is eliminated with it
+                    self.dropped.push(k);
+                    self.dinv[k] = 0.0;
+                    let p = &self.symbolic;
+                    self.l_val[p.l_start[k]..p.l_start[k + 1]].fill(0.0);
+                    self.u_val[p.u_start[k]..p.u_start[k + 1]].fill(0.0);
+                    continue;
+                }
             }
             if pa <= sure {
                 self.equilibrate()?;

@@ -137,6 +137,11 @@ pub struct DenseLu {
     /// A pivot of the equilibrated matrix at most `pivot_tol n` counts as zero (default
     /// [`PIVOT_TOL`]; 0: only exact zeros).
     pub pivot_tol: f64,
+    /// Ordered positions from which a negligible pivot may be dropped, and how many.
+    drop_from: usize,
+    drop_max: usize,
+    /// The ordered positions dropped by the last factorisation (capacity `drop_max`).
+    dropped: Vec<usize>,
 }
 
 impl DenseLu {
@@ -192,7 +197,31 @@ impl DenseLu {
             raw: false,
             factored: false,
             pivot_tol: PIVOT_TOL,
+            drop_from: n,
+            drop_max: 0,
+            dropped: Vec::new(),
         }
+    }
+
+    /// Lets each factorisation drop up to `max` pivots at ordered positions `from..n` whose
+    /// equilibrated value is at most [`crate::DEPENDENT_PIVOT_TOL`] `n`: the unknown of a
+    /// dropped pivot is zero in every solve and its equation is left out. For a saddle-point
+    /// matrix whose multipliers are ordered last (`from` = the first multiplier) and whose
+    /// constraint rows are dependent (redundant constraints), that is the basic solution: the
+    /// dependent equations carry zero multipliers, as with
+    /// [`crate::DenseCholesky::set_max_dependent`]. Only the static elimination order drops
+    /// pivots (a factorisation that needs the pivoting fallback drops none). Allocates once.
+    pub fn set_droppable(&mut self, from: usize, max: usize) {
+        self.drop_from = from.min(self.n);
+        self.drop_max = max.min(self.n - self.drop_from);
+        self.dropped = Vec::with_capacity(self.drop_max);
+        self.factored = false;
+    }
+
+    /// The caller's unknowns (columns) whose pivots the last factorisation dropped (see
+    /// [`DenseLu::set_droppable`]).
+    pub fn dropped(&self) -> impl Iterator<Item = usize> + '_ {
+        self.dropped.iter().map(|&k| self.cols[k])
     }
 
     /// Dimension.

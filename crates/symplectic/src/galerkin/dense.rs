@@ -9,8 +9,10 @@ use mbd_solve::SolveError;
 /// The LU of the stage Jacobian with the elimination order that keeps it sparse: for each
 /// coordinate `i`, the momentum rows `(nu, i)`, `nu = 0..s-1`, paired with the displacement
 /// unknowns `Z_(nu+1), i` (their `s x s` block is the stiffness matrix `K` when the Hessians
-/// are sparse); then the constraint rows with the multipliers (their Schur complement).
-pub(super) fn stage_lu(n: usize, m: usize, s: usize) -> DenseLu {
+/// are sparse); then the constraint rows with the multipliers (their Schur complement), of
+/// which `redundant` per control point (the model's redundant equations) may be dropped: their
+/// multipliers are zero (the basic solution, as in the index-1 solve).
+pub(super) fn stage_lu(n: usize, m: usize, s: usize, redundant: usize) -> DenseLu {
     let mut order: Vec<usize> = Vec::with_capacity(s * (n + m));
     for i in 0..n {
         for nu in 0..s {
@@ -18,7 +20,9 @@ pub(super) fn stage_lu(n: usize, m: usize, s: usize) -> DenseLu {
         }
     }
     order.extend(s * n..s * (n + m));
-    DenseLu::with_ordering(order.clone(), order)
+    let mut lu = DenseLu::with_ordering(order.clone(), order);
+    lu.set_droppable(s * n, s * redundant);
+    lu
 }
 
 /// Relative size below which the `W_s` term is left out of the Newton Jacobian (see

@@ -98,6 +98,8 @@ impl ProjectedMetric {
             None
         };
         let (nd, md) = if sparse { (0, 0) } else { (n, m) };
+        let mut chol = DenseCholesky::new(md);
+        chol.set_max_dependent(sys.n_redundant());
         Ok(ProjectedMetric {
             n,
             m,
@@ -106,7 +108,7 @@ impl ProjectedMetric {
             rheonomic: sys.is_rheonomic(),
             g: vec![0.0; n],
             gq: DMatrix::zeros(md, nd),
-            chol: DenseCholesky::new(md),
+            chol,
             schur,
             mu0: vec![0.0; m],
             nmu0: vec![0.0; m],

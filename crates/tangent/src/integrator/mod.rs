@@ -150,6 +150,8 @@ impl TangentRk {
         options: TangentOptions,
     ) -> Result<Self, SolveError> {
         options.validate()?;
+        // the chart's dimension is n - m: it needs independent equations
+        mbd_solve::refuse_redundant(sys, "the tangent-space solver")?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let path = if options.linear_solver.use_sparse(m) {
             if options.iteration_matrix != IterationMatrix::Centre {

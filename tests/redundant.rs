@@ -1,0 +1,217 @@
+//! Mechanisms with redundant constraint equations (dependent at every configuration) run with
+//! every solver of the registry.
+
+use mbd::model::{Body, BodyRef, Joint, RedundantConstraints, SystemBuilder};
+use mbd::prelude::*;
+
+/// Three equal cranks (length `l`, ground pivots `d` apart) carrying one coupler of length
+/// `2 d` pinned at its ends and its middle; released from `angle` at rest.
+fn double_parallelogram(angle: f64, reject: bool) -> Result<System, mbd::model::ModelError> {
+    let (l, d) = (0.5, 1.0);
+    let (s, c) = angle.sin_cos();
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, -9.81]);
+    if reject {
+        b.redundant_constraints(RedundantConstraints::Reject);
+    }
+    let mut cranks = Vec::new();
+    for k in 0..3 {
+        let x0 = k as f64 * d;
+        cranks.push(
+            b.add_body(Body::new(format!("crank{k}")).rod(1.0, l).position(
+                x0 + 0.5 * l * c,
+                0.5 * l * s,
+                angle,
+            )),
+        );
+    }
+    let coupler = b.add_body(Body::new("coupler").rod(2.0, 2.0 * d).position(
+        l * c + d,
+        l * s,
+        0.0,
+    ));
+    for (k, &cr) in cranks.iter().enumerate() {
+        let x0 = k as f64 * d;
+        b.add_joint(Joint::revolute(
+            format!("G{k}"),
+            BodyRef::Ground,
+            [x0, 0.0],
+            cr,
+            [-0.5 * l, 0.0],
+        ));
+    }
+    for (k, &cr) in cranks.iter().enumerate() {
+        b.add_joint(Joint::revolute(
+            format!("C{k}"),
+            cr,
+            [0.5 * l, 0.0],
+            coupler,
+            [(k as f64 - 1.0) * d, 0.0],
+        ));
+    }
+    b.build()
+}
+
+/// The exact crank angle of the swinging double parallelogram: on its branch the three cranks
+/// share the angle `theta` and the coupler translates, so `T = I theta'^2 / 2` with
+/// `I = 3 (m l^2 / 3) + m_c l^2 = 3 l^2` and `V = g (3 m l / 2 + m_c l) sin(theta) = 3.5 g l
+/// sin(theta)` (`m = 1`, `m_c = 2`, `l = 0.5`): `theta'' = -(3.5 g / (3 l)) cos(theta)`,
+/// integrated here by RK4 at 1e-5 s (error below 1e-15 over 2 s).
+fn exact_angle(angle: f64, t_end: f64) -> f64 {
+    let k = 3.5 * 9.81 / (3.0 * 0.5);
+    let f = |x: [f64; 2]| [x[1], -k * x[0].cos()];
+    let steps = (t_end / 1e-5).round() as usize;
+    let h = t_end / steps as f64;
+    let mut x = [angle, 0.0];
+    for _ in 0..steps {
+        let k1 = f(x);
+        let k2 = f([x[0] + 0.5 * h * k1[0], x[1] + 0.5 * h * k1[1]]);
+        let k3 = f([x[0] + 0.5 * h * k2[0], x[1] + 0.5 * h * k2[1]]);
+        let k4 = f([x[0] + h * k3[0], x[1] + h * k3[1]]);
+        for i in 0..2 {
+            x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+    x[0]
+}
+
+/// The registry's solvers that do not refuse redundant equations.
+fn accepting() -> Vec<&'static str> {
+    mbd::registry()
+        .variants()
+        .filter(|(_, v)| !v.refuses.contains("redundant"))
+        .map(|(_, v)| v.spec)
+        .collect()
+}
+
+/// Crank angle error at t = 1 s and max |Phi| (all twelve equations, the redundant one too)
+/// over the run.
+fn run(solver: &str, h: f64) -> (f64, f64) {
+    let sys = double_parallelogram(-0.5, false).expect("model");
+    let mut sim = Simulation::new(sys.clone(), solver).expect(solver);
+    let mut rec = Recorder::new();
+    let plan: Plan = if solver.starts_with("index1") {
+        AdaptiveConfig::new(1.0, h).into()
+    } else {
+        RunConfig::new(1.0, h).into()
+    };
+    sim.run_observed(plan, &mut rec).expect(solver);
+    let mut phi = vec![0.0; sys.n_constraints()];
+    let mut worst = 0.0f64;
+    for (q, &t) in rec.q.iter().zip(&rec.t) {
+        sys.phi(q, t, &mut phi);
+        worst = phi.iter().fold(worst, |w, p| w.max(p.abs()));
+    }
+    let q = &sim.state().q;
+    // the three cranks keep one angle and the coupler translates
+    assert!(
+        (q[2] - q[5]).abs() < 1e-8 && (q[2] - q[8]).abs() < 1e-8,
+        "{solver}"
+    );
+    assert!(q[11].abs() < 1e-8, "{solver}: coupler angle {}", q[11]);
+    ((q[2] - exact_angle(-0.5, 1.0)).abs(), worst)
+}
+
+#[test]
+fn the_redundant_equation_is_found_named_and_refusable() {
+    let sys = double_parallelogram(-0.5, false).expect("model");
+    let red = sys.redundant_equations();
+    assert_eq!(red.len(), 1);
+    // the last equation of the dependent set in row order: the third pin's y row
+    assert_eq!(red[0].equation, "C2.y");
+    assert_eq!(red[0].joints[0], "C2");
+    assert_eq!((sys.n_constraints(), sys.dof()), (12, 1));
+    match double_parallelogram(-0.5, true) {
+        Err(mbd::model::ModelError::Redundant { equation, joints }) => {
+            assert_eq!(equation, "C2.y");
+            assert!(joints.contains(&"C0".to_string()), "{joints:?}");
+        }
+        other => panic!("expected a Redundant error, got {other:?}"),
+    }
+}
+
+#[test]
+fn every_accepting_solver_follows_the_exact_motion_at_its_order() {
+    let solvers = accepting();
+    assert!(solvers.len() >= 5, "{solvers:?}");
+    for solver in solvers {
+        let order = mbd::registry()
+            .variants()
+            .find(|(_, v)| v.spec == solver)
+            .map(|(_, v)| v.order)
+            .expect("variant");
+        let (hs, want) = if solver.starts_with("index1") {
+            // tolerances a decade apart: the error falls with them
+            ([1e-6, 1e-8], 10.0)
+        } else if order > 4 {
+            // (at 4e-3 the (2,2) modified scheme's error is at the reference's 1e-14 floor)
+            ([2e-2, 1e-2], 0.7 * 2f64.powi(order as i32))
+        } else {
+            ([4e-3, 2e-3], 0.7 * 2f64.powi(order as i32))
+        };
+        let (e1, c1) = run(solver, hs[0]);
+        let (e2, c2) = run(solver, hs[1]);
+        eprintln!(
+            "{solver}: errors {e1:.3e} {e2:.3e} (ratio {:.2}), max|Phi| {c1:.1e} {c2:.1e}",
+            e1 / e2
+        );
+        assert!(
+            e1 / e2 > want,
+            "{solver}: {e1:e} -> {e2:e}, want a ratio above {want}"
+        );
+        assert!(e2 < 10f64.powi(-(order as i32) - 1), "{solver}: {e2:e}");
+        // (plain RK4 and index-1 DOPRI5 do not project: their drift is the integration error)
+        let drift = if solver == "rk4" || solver.starts_with("index1") {
+            1e-8
+        } else {
+            1e-10
+        };
+        assert!(c2 < drift, "{solver}: max|Phi| = {c2:e}");
+    }
+}
+
+#[test]
+fn refusing_solvers_say_which_equations_and_which_solvers_run_them() {
+    let ok = accepting();
+    for (_, v) in mbd::registry().variants() {
+        if !v.refuses.contains("redundant") {
+            continue;
+        }
+        let sys = double_parallelogram(-0.5, false).expect("model");
+        let e = Simulation::new(sys, v.spec).expect_err(v.spec).to_string();
+        assert!(
+            e.contains("redundant constraint equations: C2.y"),
+            "{}: {e}",
+            v.spec
+        );
+        for s in &ok {
+            assert!(e.contains(s), "{}: {e} lacks {s}", v.spec);
+        }
+    }
+}
+
+/// The sparse and the dense Schur complement drop the same equation and give the same motion.
+#[test]
+fn dense_and_sparse_index1_solves_agree() {
+    use mbd::rk4::{Rk4, Rk4Options};
+    use mbd::solve::{run, LinearSolver, NoObserver};
+    let sys = double_parallelogram(-0.5, false).expect("model");
+    let mut ends = Vec::new();
+    for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
+        let mut opts = Rk4Options::projected();
+        opts.linear = linear;
+        let mut rk = Rk4::new(&sys, opts).expect("rk4");
+        let mut s = State::consistent(&sys, 0.0).expect("state");
+        run(
+            &mut rk,
+            &sys,
+            &mut s,
+            RunConfig::new(1.0, 1e-3),
+            &mut NoObserver,
+        )
+        .expect("run");
+        ends.push(s.q.clone());
+    }
+    let d = (&ends[0] - &ends[1]).amax();
+    assert!(d < 1e-12, "dense vs sparse: {d:e}");
+}
