@@ -87,7 +87,23 @@ impl System {
         if self.schur_well_conditioned(&jac) {
             return Ok(Vec::new());
         }
-        Ok(self.redundant_dense(&jac))
+        Ok(self.redundant_dense(&jac, 1e-9))
+    }
+
+    /// The equations of `Phi_q(q)` nearest to dependence, for a report at a near-singular
+    /// configuration: those whose part outside the span of the earlier rows is below `rel_tol`
+    /// of the largest row norm (Gram-Schmidt, as [`System::redundant_at`]), without the ones
+    /// found redundant at build time. Empty above [`SPARSE_RANK_THRESHOLD`] equations (the
+    /// sparse factorisation reports exact dependence only).
+    pub fn nearly_dependent_at(&self, q: &[f64], rel_tol: f64) -> Vec<RedundantEquation> {
+        if q.len() != self.n || self.m == 0 || self.m > SPARSE_RANK_THRESHOLD {
+            return Vec::new();
+        }
+        let mut jac = DMatrix::zeros(self.m, self.n);
+        self.phi_q(q, &mut jac);
+        let mut found = self.redundant_dense(&jac, rel_tol);
+        found.retain(|e| !self.redundant.iter().any(|r| r.row == e.row));
+        found
     }
 
     /// Checks that `Phi_q(q)` has no more dependent rows than the mechanism's redundant
@@ -109,13 +125,13 @@ impl System {
 
     /// Gram-Schmidt on the rows (twice for stability), tracking each basis vector as a
     /// combination of the original rows so a dependency can be traced to its joints.
-    fn redundant_dense(&self, jac: &DMatrix<f64>) -> Vec<RedundantEquation> {
+    fn redundant_dense(&self, jac: &DMatrix<f64>, rel_tol: f64) -> Vec<RedundantEquation> {
         let m = self.m;
         let scale = (0..m)
             .map(|r| jac.row(r).norm())
             .fold(0.0, f64::max)
             .max(1e-300);
-        let tol = 1e-9 * scale;
+        let tol = rel_tol * scale;
         let mut basis: Vec<DVector<f64>> = Vec::new();
         let mut combo: Vec<DVector<f64>> = Vec::new();
         let mut found = Vec::new();

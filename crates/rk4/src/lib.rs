@@ -99,6 +99,9 @@ impl Integrator for Rk4 {
     fn order(&self) -> Option<u32> {
         Some(4)
     }
+    fn keeps_constraints(&self) -> bool {
+        self.inner.keeps_constraints()
+    }
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
         self.inner.step(sys, state, h)
     }

@@ -219,7 +219,13 @@ where
 {
     let t0 = state.t;
     cfg.validate(t0)?;
-    let mut checks = RunChecks::open(sys, state, cfg.drift_guard, cfg.condition_limit)?;
+    let mut checks = RunChecks::open(
+        sys,
+        state,
+        cfg.drift_guard,
+        cfg.condition_limit,
+        integrator.keeps_constraints(),
+    )?;
     let q = integrator.embedded_order().ok_or_else(|| {
         SolveError::Unsupported(format!(
             "adaptive stepping needs an embedded error estimate; '{}' has none \

@@ -28,6 +28,13 @@ pub struct DriftGuard {
     pub position_tol: f64,
     /// Largest accepted `|Phi_q v + Phi_t|_i` (absolute); `None` (default) = not checked.
     pub velocity_tol: Option<f64>,
+    /// The branch check: on a step whose condition estimate is above
+    /// [`BRANCH_WATCH_CONDITION`] (near a singular configuration), the mismatch between the
+    /// step's displacement and the mean of its end velocities, relative to the distance
+    /// travelled, must stay below this (default [`BRANCH_JUMP_TOL`]); a step beyond it left
+    /// the branch of the motion it was on and stops the run with [`SolveError::Singular`].
+    /// `None` = not checked.
+    pub branch_tol: Option<f64>,
 }
 
 impl Default for DriftGuard {
@@ -35,6 +42,7 @@ impl Default for DriftGuard {
         DriftGuard {
             position_tol: DriftGuard::DEFAULT_POSITION_TOL,
             velocity_tol: None,
+            branch_tol: Some(BRANCH_JUMP_TOL),
         }
     }
 }
@@ -60,6 +68,15 @@ impl DriftGuard {
                 });
             }
         }
+        if let Some(b) = self.branch_tol {
+            if !(b.is_finite() && b > 0.0) {
+                return Err(SolveError::InvalidParameter {
+                    parameter: "drift_guard.branch_tol",
+                    value: b,
+                    reason: "must be positive and finite",
+                });
+            }
+        }
         Ok(())
     }
 }
@@ -69,16 +86,54 @@ pub(crate) struct GuardState {
     guard: DriftGuard,
     scale: Vec<f64>,
     buf: Vec<f64>,
+    /// The state before the step (time, positions, velocities) and the mass weights of the
+    /// branch check.
+    prev_t: f64,
+    prev_q: Vec<f64>,
+    prev_v: Vec<f64>,
+    weight: Vec<f64>,
 }
 
 impl GuardState {
-    pub(crate) fn new(sys: &System, guard: DriftGuard) -> Self {
+    pub(crate) fn new(sys: &System, guard: DriftGuard, state: &State) -> Self {
         let m = sys.n_constraints();
         GuardState {
             guard,
             scale: sys.equation_scales(),
             buf: vec![0.0; m],
+            prev_t: state.t,
+            prev_q: state.q.as_slice().to_vec(),
+            prev_v: state.v.as_slice().to_vec(),
+            weight: sys.mass_diag().as_slice().to_vec(),
         }
+    }
+
+    /// The branch check after an accepted step of size `h` with condition estimate
+    /// `condition` (see [`DriftGuard::branch_tol`]); remembers the state for the next one.
+    fn branch(&mut self, state: &State, h: f64, condition: f64) -> Result<(), SolveError> {
+        if let Some(tol) = self.guard.branch_tol {
+            if condition > BRANCH_WATCH_CONDITION {
+                let dev = self.branch_deviation(state, h);
+                if !(dev <= tol) {
+                    return Err(SolveError::Singular {
+                        t: state.t,
+                        what: "configuration passed onto another branch",
+                        detail: format!(
+                            "between t = {} and t = {} (condition estimate {condition:.1e}), \
+                             the end velocity disagrees with the step's displacement by {dev:.2} \
+                             of the distance travelled (a smooth step: about (omega h)^2 / 12): \
+                             the solver went on along another branch of the motion; take a \
+                             smaller h, or a solver that keeps the constraints",
+                            self.prev_t, state.t
+                        ),
+                    });
+                }
+            }
+            self.prev_t = state.t;
+            self.prev_q.copy_from_slice(state.q.as_slice());
+            self.prev_v.copy_from_slice(state.v.as_slice());
+        }
+        Ok(())
     }
 
     pub(crate) fn check(&mut self, sys: &System, state: &State) -> Result<(), SolveError> {
@@ -133,10 +188,25 @@ impl GuardState {
     }
 }
 
+/// The default of [`DriftGuard::branch_tol`]: a step whose end velocity breaks the
+/// trapezoidal relation with its displacement by more than this fraction of the distance
+/// travelled jumped to another branch of the motion. A smooth step reaches it only at
+/// `omega h` above about 1 rad (`omega`: the motion's angular rate).
+pub const BRANCH_JUMP_TOL: f64 = 0.1;
+
+/// Steps whose condition estimate is above this (constraint gradients within about 0.03 rad
+/// of linear dependence) get the branch check of [`DriftGuard::branch_tol`]: a motion can
+/// change branch only where `Phi_q` nearly loses rank, and away from there a large step on a
+/// fast motion must not be taken for a jump.
+pub const BRANCH_WATCH_CONDITION: f64 = 1e3;
+
 /// The checks of one run: opened before the first step, applied after every accepted one.
 pub(crate) struct RunChecks {
     guard: Option<GuardState>,
     condition_limit: f64,
+    /// Whether the integrator keeps the constraints itself (else a near-singular step stops
+    /// the run).
+    keeps_constraints: bool,
 }
 
 impl RunChecks {
@@ -147,22 +217,50 @@ impl RunChecks {
         state: &State,
         drift_guard: Option<DriftGuard>,
         condition_limit: f64,
+        keeps_constraints: bool,
     ) -> Result<Self, SolveError> {
         state.check(sys)?;
         validate_condition_limit(condition_limit)?;
         let guard = match drift_guard {
             Some(g) => {
                 g.validate()?;
-                Some(GuardState::new(sys, g))
+                Some(GuardState::new(sys, g, state))
             }
             None => None,
         };
         Ok(RunChecks {
             guard,
             condition_limit,
+            keeps_constraints,
         })
     }
+}
 
+impl GuardState {
+    /// The branch check of one step: on a smooth motion the displacement of a step and the
+    /// mean of its end velocities agree to second order, `q1 - q0 - h (v0 + v1) / 2 =
+    /// -h^3 q''' / 12 + ...`, a fraction `(omega h)^2 / 12` of the distance travelled
+    /// `h |v|` (`omega`: the motion's angular rate; 3e-4 at 6 rad/s and h = 1e-2). A step
+    /// that leaves its branch at a singular configuration ends with the velocity of the other
+    /// branch (a four-bar's rocker turning the other way): the relation then fails by a
+    /// fraction of order one. Mass-weighted norms (scale-free), with a floor at the
+    /// positions' round-off for a mechanism at rest. Returns the fraction.
+    fn branch_deviation(&self, state: &State, h: f64) -> f64 {
+        let (q, v) = (state.q.as_slice(), state.v.as_slice());
+        let (mut r2, mut v0, mut v1, mut q2) = (0.0, 0.0, 0.0, 0.0);
+        for i in 0..q.len() {
+            let w = self.weight[i];
+            let r = q[i] - self.prev_q[i] - 0.5 * h * (self.prev_v[i] + v[i]);
+            r2 += w * r * r;
+            v0 += w * self.prev_v[i] * self.prev_v[i];
+            v1 += w * v[i] * v[i];
+            q2 += w * q[i] * q[i];
+        }
+        r2.sqrt() / (h * v0.max(v1).sqrt() + 1e3 * f64::EPSILON * q2.sqrt()).max(f64::MIN_POSITIVE)
+    }
+}
+
+impl RunChecks {
     /// After an accepted step of size `h` with work `s` (the state's time already advanced):
     /// a non-finite state and constraint drift are errors; the step is counted in `stats`.
     pub(crate) fn accepted(
@@ -182,6 +280,12 @@ impl RunChecks {
         if let Some(g) = self.guard.as_mut() {
             g.check(sys, state)?;
         }
+        if s.condition > self.condition_limit && !self.keeps_constraints {
+            return Err(self.singular_stop(sys, state, s.condition));
+        }
+        if let Some(g) = self.guard.as_mut() {
+            g.branch(state, h, s.condition)?;
+        }
         stats.steps += 1;
         stats.min_step = if stats.max_step == 0.0 {
             h
@@ -196,6 +300,35 @@ impl RunChecks {
             stats.first_near_singular.get_or_insert(state.t);
         }
         Ok(())
+    }
+}
+
+impl RunChecks {
+    /// The stop of an integrator that does not keep the constraints at a near-singular step:
+    /// the equations nearest to dependence and their joints (allocates: an error path).
+    fn singular_stop(&self, sys: &System, state: &State, condition: f64) -> SolveError {
+        let near = sys.nearly_dependent_at(state.q.as_slice(), 1e-2);
+        let named = if near.is_empty() {
+            String::new()
+        } else {
+            let list: Vec<String> = near
+                .iter()
+                .map(|e| format!("{} (joints {})", e.equation, e.joints.join(", ")))
+                .collect();
+            format!("; equations near dependence: {}", list.join("; "))
+        };
+        SolveError::Singular {
+            t: state.t,
+            what: "configuration (Phi_q near rank loss)",
+            detail: format!(
+                "condition estimate {condition:.2e} above the run's limit {:.0e}{named}; this \
+                 solver integrates the index-1 equations without keeping the constraints, so past \
+                 the singular configuration it may go on along another branch: use a solver that \
+                 keeps them (a projection, symplectic or tangent: `mbd solvers`), or raise \
+                 condition_limit to go on unchecked",
+                self.condition_limit
+            ),
+        }
     }
 }
 

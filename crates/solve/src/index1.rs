@@ -120,6 +120,10 @@ impl Integrator for Index1Rk {
         Some(self.rk.tableau.order)
     }
 
+    fn keeps_constraints(&self) -> bool {
+        self.options.projection.is_some()
+    }
+
     fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {
         if self.embedded_order().is_some() {
             Some(self)

@@ -2,8 +2,8 @@
 
 use crate::adaptive::AdaptiveIntegrator;
 use crate::error::SolveError;
-pub use crate::guard::DriftGuard;
 use crate::guard::RunChecks;
+pub use crate::guard::{DriftGuard, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION};
 use crate::state::State;
 use mbd_model::System;
 
@@ -38,6 +38,15 @@ pub trait Integrator {
     /// Forgets any history (predictors, cached momenta) so the next step starts afresh. Called
     /// by [`run`] before the first step.
     fn reset(&mut self) {}
+    /// Whether every step ends on the position constraints by the method's own means (a
+    /// projection, constrained stage equations, a chart), so that it follows the branch it is
+    /// on through a singular configuration. `false` (the default) for a method that
+    /// integrates the index-1 equations as they are: past a singular configuration it may go
+    /// on along another branch, so the run loops stop it with [`SolveError::Singular`] at the
+    /// first step whose condition estimate exceeds the run's `condition_limit`.
+    fn keeps_constraints(&self) -> bool {
+        false
+    }
     /// The method's convergence order in the step size, if known.
     fn order(&self) -> Option<u32> {
         None
@@ -59,6 +68,9 @@ impl<I: Integrator + ?Sized> Integrator for Box<I> {
     }
     fn reset(&mut self) {
         (**self).reset()
+    }
+    fn keeps_constraints(&self) -> bool {
+        (**self).keeps_constraints()
     }
     fn order(&self) -> Option<u32> {
         (**self).order()
@@ -467,7 +479,13 @@ where
     I: Integrator + ?Sized,
     O: Observer + ?Sized,
 {
-    let mut checks = RunChecks::open(sys, state, cfg.drift_guard, cfg.condition_limit)?;
+    let mut checks = RunChecks::open(
+        sys,
+        state,
+        cfg.drift_guard,
+        cfg.condition_limit,
+        integrator.keeps_constraints(),
+    )?;
     let t0 = state.t;
     let n = step_count(t0, cfg.t_end, cfg.h)?;
     integrator.reset();

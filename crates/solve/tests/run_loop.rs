@@ -120,6 +120,7 @@ fn drift_guard_stops_at_the_predicted_step_naming_the_joint() {
     let g = DriftGuard {
         position_tol: 1e-1,
         velocity_tol: None,
+        ..Default::default()
     };
     let cfg = RunConfig::new(10.0, 0.01).with_drift_guard(g);
     match run(&mut Drifter(1e-2), &sys, &mut s, cfg, &mut NoObserver) {
@@ -131,6 +132,7 @@ fn drift_guard_stops_at_the_predicted_step_naming_the_joint() {
     let g = DriftGuard {
         position_tol: 1.0,
         velocity_tol: Some(1e-4),
+        ..Default::default()
     };
     let cfg = RunConfig::new(10.0, 0.01).with_drift_guard(g);
     match run(&mut Drifter(0.0), &sys, &mut s, cfg, &mut NoObserver) {
@@ -150,6 +152,7 @@ fn bad_guard_settings_are_errors() {
             DriftGuard {
                 position_tol: 0.0,
                 velocity_tol: None,
+                ..Default::default()
             },
             "drift_guard.position_tol",
         ),
@@ -157,8 +160,16 @@ fn bad_guard_settings_are_errors() {
             DriftGuard {
                 position_tol: 1e-3,
                 velocity_tol: Some(f64::NAN),
+                ..Default::default()
             },
             "drift_guard.velocity_tol",
+        ),
+        (
+            DriftGuard {
+                branch_tol: Some(-1.0),
+                ..Default::default()
+            },
+            "drift_guard.branch_tol",
         ),
     ] {
         let mut s = State::consistent(&sys, 0.0).unwrap();
@@ -184,6 +195,10 @@ struct Scripted(Vec<f64>, usize);
 impl Integrator for Scripted {
     fn name(&self) -> String {
         "scripted".into()
+    }
+    // (counted, not stopped: a solver that keeps the constraints)
+    fn keeps_constraints(&self) -> bool {
+        true
     }
     fn step(&mut self, _: &System, s: &mut State, h: f64) -> Result<StepStats, SolveError> {
         let c = self.0[self.1 % self.0.len()];
@@ -225,6 +240,112 @@ fn near_singular_steps_are_counted_with_the_first_time() {
     .unwrap();
     assert_eq!(stats.near_singular_steps, 0);
     assert!(stats.warning().is_none());
+}
+
+/// Moves body 0 along x at unit speed, reversing its velocity at the step `flip` (a jump to
+/// the other branch of a motion, in the velocity only), and reports `condition` every step.
+struct Flipper {
+    flip: usize,
+    k: usize,
+    condition: f64,
+    keeps: bool,
+}
+impl Integrator for Flipper {
+    fn name(&self) -> String {
+        "flipper".into()
+    }
+    fn keeps_constraints(&self) -> bool {
+        self.keeps
+    }
+    fn step(&mut self, _: &System, s: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        self.k += 1;
+        s.q[0] += s.v[0] * h;
+        if self.k == self.flip {
+            s.v[0] = -s.v[0];
+        }
+        s.t += h;
+        Ok(StepStats {
+            condition: self.condition,
+            ..Default::default()
+        })
+    }
+}
+
+/// A solver that does not keep the constraints stops at its first near-singular step, naming
+/// the time; one that does is counted and goes on.
+#[test]
+fn a_solver_without_projection_stops_at_the_first_near_singular_step() {
+    let sys = two_link();
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    s.v.fill(0.0);
+    s.v[0] = 1.0;
+    let cfg = RunConfig::new(0.1, 0.01).without_drift_guard();
+    for (keeps, condition) in [(false, 1e7), (true, 1e7), (false, 1e5)] {
+        let mut st = s.clone();
+        let mut f = Flipper {
+            flip: 0,
+            k: 0,
+            condition,
+            keeps,
+        };
+        let r = run(&mut f, &sys, &mut st, cfg, &mut NoObserver);
+        match (keeps || condition < RunConfig::DEFAULT_CONDITION_LIMIT, r) {
+            (true, Ok(stats)) => assert_eq!(stats.steps, 10),
+            (false, Err(SolveError::Singular { t, what, detail })) => {
+                assert!((t - 0.01).abs() < 1e-15, "{t}");
+                assert!(what.contains("near rank loss"), "{what}");
+                assert!(detail.contains("condition estimate 1.00e7"), "{detail}");
+            }
+            (_, other) => panic!("keeps {keeps}, condition {condition}: {other:?}"),
+        }
+    }
+}
+
+/// The branch check: a velocity that reverses within a step near a singular configuration
+/// (condition above BRANCH_WATCH_CONDITION) stops the run at that step; the same reversal at a
+/// well-conditioned step, or with the check off, does not.
+#[test]
+fn a_velocity_jump_near_a_singular_configuration_is_a_branch_error() {
+    let sys = two_link();
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    s.v.fill(0.0);
+    s.v[0] = 1.0;
+    let guard = DriftGuard {
+        position_tol: 1e3,
+        ..Default::default()
+    };
+    for (condition, guard, stops) in [
+        (1e4, Some(guard), true),
+        (10.0, Some(guard), false),
+        (
+            1e4,
+            Some(DriftGuard {
+                branch_tol: None,
+                ..guard
+            }),
+            false,
+        ),
+    ] {
+        let mut st = s.clone();
+        let mut f = Flipper {
+            flip: 4,
+            k: 0,
+            condition,
+            keeps: true,
+        };
+        let mut cfg = RunConfig::new(0.1, 0.01).without_drift_guard();
+        cfg.drift_guard = guard;
+        match (stops, run(&mut f, &sys, &mut st, cfg, &mut NoObserver)) {
+            (false, Ok(stats)) => assert_eq!(stats.steps, 10),
+            (true, Err(SolveError::Singular { t, what, detail })) => {
+                assert!((t - 0.04).abs() < 1e-15, "{t}");
+                assert!(what.contains("another branch"), "{what}");
+                // |q1 - q0 - h (v0 + v1) / 2| = h against h |v|: a fraction 1
+                assert!(detail.contains("by 1.00 of the distance"), "{detail}");
+            }
+            (_, other) => panic!("condition {condition}: {other:?}"),
+        }
+    }
 }
 
 /// A body held by two distance joints from ground points (-1, 0) and (1, 0), at height `y`:

@@ -482,6 +482,9 @@ impl Integrator for FireflyGauss {
         self.try_step(sys, state, h).map_err(SolveError::from)
     }
 
+    fn keeps_constraints(&self) -> bool {
+        true
+    }
     fn reset(&mut self) {
         self.step_index = 0;
         self.n_corr = 0;

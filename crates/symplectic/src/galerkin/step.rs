@@ -4,6 +4,9 @@
 use super::*;
 
 impl Integrator for Galerkin {
+    fn keeps_constraints(&self) -> bool {
+        true
+    }
     fn name(&self) -> String {
         let s = self.tab.s;
         let mut name = format!("symplectic ({s},{s})");

@@ -429,6 +429,9 @@ impl Integrator for TangentRk {
         Some(self.rk.tableau.order)
     }
 
+    fn keeps_constraints(&self) -> bool {
+        true
+    }
     fn reset(&mut self) {
         self.stats = TangentStats::default();
         self.cur_ok = false;
