@@ -483,3 +483,7 @@ pub fn parallelogram_four_bar(
 
 mod andrews;
 pub use andrews::andrews_squeezer;
+mod loops;
+pub use loops::{
+    double_parallelogram, n_four_bar, pantograph, ClosedLoop, LOOP_GRAVITY, MAX_LOOPS,
+};
