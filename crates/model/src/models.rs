@@ -487,3 +487,5 @@ mod loops;
 pub use loops::{
     double_parallelogram, n_four_bar, pantograph, ClosedLoop, LOOP_GRAVITY, MAX_LOOPS,
 };
+mod exact;
+pub use exact::{CrankMotion, Regime};
