@@ -355,6 +355,20 @@ fn n_four_bar_branch_energies_rank_and_counts() {
 }
 
 #[test]
+fn a_long_row_of_loops_builds_through_the_sparse_rank_check() {
+    let loops = 2000;
+    let sys = n_four_bar(loops, 1.0, 0.5, 2.0, -1.0, false).unwrap();
+    assert_eq!(sys.n_constraints(), 2 * (3 * loops + 1));
+    assert_eq!((sys.n_redundant(), sys.dof()), (0, 1));
+    let (q, v) = sys.initial_guess();
+    let mut phi = vec![0.0; sys.n_constraints()];
+    sys.phi(q.as_slice(), 0.0, &mut phi);
+    assert!(max_abs(&phi) <= 4.0 * f64::EPSILON * max_abs(q.as_slice()));
+    sys.phi_dot(q.as_slice(), v.as_slice(), 0.0, &mut phi);
+    assert!(max_abs(&phi) <= 4.0 * f64::EPSILON);
+}
+
+#[test]
 fn redundant_models_branch_energies_rank_and_counts() {
     for lp in redundant() {
         check_branch(&lp);
