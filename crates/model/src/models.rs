@@ -483,3 +483,9 @@ pub fn parallelogram_four_bar(
 
 mod andrews;
 pub use andrews::andrews_squeezer;
+mod loops;
+pub use loops::{
+    double_parallelogram, n_four_bar, pantograph, ClosedLoop, LOOP_GRAVITY, MAX_LOOPS,
+};
+mod exact;
+pub use exact::{CrankMotion, Regime};
