@@ -81,3 +81,66 @@ fn plain_rk4_through_the_flat_configuration_stops_loudly_or_stays_on_the_manifol
         }
     }
 }
+
+/// Every solver of the registry on a 2-loop N-four-bar driven through five flat configurations
+/// (3 s), at two step sizes (tolerances): a run that reaches the end has the last crank's tip
+/// on the exact motion; a run that stops, stops with the typed singular error (or the model is
+/// refused at construction). This fails if any solver reaches the end on another branch.
+#[test]
+fn no_solver_reaches_the_end_on_another_branch() {
+    use mbd::model::models::{ClosedLoop, CrankMotion};
+    use mbd::prelude::*;
+    let cl = ClosedLoop::n_four_bar(2, 0.4, 1.0).unwrap();
+    let (angle, speed, t_end) = (1.0, 6.0, 3.0);
+    let want = cl.tracked_point(CrankMotion::driven(angle, speed).unwrap().at(t_end)[0]);
+    let mut reached = 0;
+    for (_, v) in mbd::registry().variants() {
+        let hs = if v.spec.starts_with("index1") {
+            [1e-6, 1e-8]
+        } else {
+            [1e-2, 1e-3]
+        };
+        for h in hs {
+            let sys = cl.system(angle, speed, true).unwrap();
+            let body = sys.body_handle(&cl.tracked_body()).unwrap().index();
+            let mut sim = match Simulation::new(sys, v.spec) {
+                Ok(s) => s,
+                Err(e) => {
+                    // only the structural refusal of the optimisation-based solver
+                    assert!(
+                        e.to_string().contains("no degree of freedom"),
+                        "{}: {e}",
+                        v.spec
+                    );
+                    continue;
+                }
+            };
+            let plan: Plan = if v.spec.starts_with("index1") {
+                AdaptiveConfig::new(t_end, h).into()
+            } else {
+                RunConfig::new(t_end, h).into()
+            };
+            match sim.run(plan) {
+                Ok(_) => {
+                    let q = &sim.state().q;
+                    let (x, y, a) = (q[3 * body], q[3 * body + 1], q[3 * body + 2]);
+                    let tip = [x + 0.2 * a.cos(), y + 0.2 * a.sin()];
+                    let err = (tip[0] - want[0]).hypot(tip[1] - want[1]);
+                    assert!(
+                        err < 1e-9,
+                        "{} h = {h:e}: reached the end {err:e} off",
+                        v.spec
+                    );
+                    reached += 1;
+                }
+                Err(mbd::Error::Solve(SolveError::Singular { .. })) => {}
+                Err(e) => panic!(
+                    "{} h = {h:e}: stopped with a non-singular error: {e}",
+                    v.spec
+                ),
+            }
+        }
+    }
+    // the projecting and symplectic solvers pass
+    assert!(reached >= 8, "{reached} runs reached the end");
+}

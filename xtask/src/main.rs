@@ -8,6 +8,7 @@
 
 mod own;
 mod own_scaling;
+mod own_singular;
 mod paper_a;
 mod paper_b;
 mod paper_c;

@@ -460,6 +460,12 @@ pub fn experiments() -> Vec<Experiment> {
             run: crate::own_scaling::scaling,
         },
         Experiment {
+            id: "own-singular",
+            part: Part::Own,
+            title: "Singular configurations and redundant constraints, every solver",
+            run: crate::own_singular::singular,
+        },
+        Experiment {
             id: "own-orders",
             part: Part::Own,
             title: "Convergence orders of every solver",

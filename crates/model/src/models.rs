@@ -383,7 +383,7 @@ pub fn four_bar() -> Result<System, ModelError> {
 /// `pi` all links are collinear (the *flat* configurations): `Phi_q` loses rank there (the
 /// closing loop's equations become dependent) and the parallelogram branch crosses the crossed
 /// (anti-parallelogram) branch. Free, released at `speed`, the crank turns through them if its
-/// kinetic energy `(2/3 crank^2 + 1/2 crank^2) speed^2 / 2` exceeds the potential rise
+/// kinetic energy `(2/3 + 1) crank^2 speed^2 / 2` exceeds the potential rise
 /// `2 g crank (1 - sin(angle))` to the top.
 pub fn parallelogram_four_bar(
     crank: f64,

@@ -278,7 +278,22 @@ impl RunChecks {
             });
         }
         if let Some(g) = self.guard.as_mut() {
-            g.check(sys, state)?;
+            if let Err(e) = g.check(sys, state) {
+                // drift that appears on a step near a singular configuration: the solver left
+                // the branch there (a solver on the constraints does not drift by 1%)
+                if s.condition > BRANCH_WATCH_CONDITION && g.guard.branch_tol.is_some() {
+                    return Err(SolveError::Singular {
+                        t: state.t,
+                        what: "configuration passed onto another branch",
+                        detail: format!(
+                            "the step ending at t = {} (condition estimate {:.1e}) left the \
+                             constraints: {e}",
+                            state.t, s.condition
+                        ),
+                    });
+                }
+                return Err(e);
+            }
         }
         if s.condition > self.condition_limit && !self.keeps_constraints {
             return Err(self.singular_stop(sys, state, s.condition));

@@ -123,9 +123,9 @@ fn sparse_path_matches_the_dense_path() {
 }
 
 /// Through the flat configurations of a parallelogram four-bar (free and driven), the (2,2)
-/// modified-Lagrangian scheme either passes or stops with a Newton error that says why: a
-/// stall near round-off at a near-singular stage Jacobian, not "a smaller h may converge"
-/// (which does not help there). Measured: it stops at every h tried, at residuals 3e-12 to
+/// modified-Lagrangian scheme either passes or stops with the typed singular-configuration
+/// error that says why: a stall near round-off at a near-singular stage Jacobian, not "a
+/// smaller h may converge" (which does not help there). Measured: it stops at every h tried, at residuals 3e-12 to
 /// 3e-11.
 #[test]
 fn a_stall_at_a_singular_configuration_does_not_advise_a_smaller_h() {
@@ -142,7 +142,7 @@ fn a_stall_at_a_singular_configuration_does_not_advise_a_smaller_h() {
                 };
                 let msg = e.to_string();
                 assert!(
-                    matches!(e, mbd_solve::SolveError::Newton { .. }),
+                    matches!(e, mbd_solve::SolveError::Singular { .. }),
                     "driven {driven}, h {h}: {msg}"
                 );
                 assert!(

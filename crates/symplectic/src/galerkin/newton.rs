@@ -102,32 +102,58 @@ impl Galerkin {
             evals += 1;
         }
         let mut it = 0;
-        let fail = |res: f64, it: usize, s: usize| SolveError::Newton {
-            t,
-            residual: res,
-            iterations: it,
-            context: if res.is_finite() && res <= 1e3 * tol {
+        let fail = |res: f64, it: usize, s: usize, qk: &[f64]| {
+            // (an error path: the rank report allocates)
+            let near = if res.is_finite() && res <= 1e3 * tol {
+                Vec::new()
+            } else {
+                sys.nearly_dependent_at(qk, 1e-2)
+            };
+            if res.is_finite() && res <= 1e3 * tol {
                 // stalled a few digits above the tolerance: the iteration cannot contract, as
                 // where the stage Jacobian is near-singular (a singular configuration), and a
                 // smaller h does not change that
-                format!(
-                    "symplectic ({s},{s}) stage equations, h = {h}: the iteration stalled near \
-                     round-off (tolerance {tol:.1e}); the stage Jacobian is near-singular, as at \
-                     a singular configuration of the mechanism, where a smaller h does not help \
-                     (`mbd solvers` lists the other solvers)"
-                )
+                SolveError::Singular {
+                    t,
+                    what: "configuration (the stage Jacobian near-singular)",
+                    detail: format!(
+                        "symplectic ({s},{s}) stage equations, h = {h}: Newton stalled near \
+                         round-off, residual {res:.2e} after {it} iterations (tolerance \
+                         {tol:.1e}), as at a singular configuration of the mechanism, where a \
+                         smaller h does not help (`mbd solvers` lists the other solvers)"
+                    ),
+                }
+            } else if let Some(near) = near.first() {
+                // no convergence at a step that starts within 1e-2 of rank loss: the singular
+                // configuration, not the step length, is the cause
+                SolveError::Singular {
+                    t,
+                    what: "configuration (Phi_q near rank loss: the stage equations failed there)",
+                    detail: format!(
+                        "symplectic ({s},{s}) stage equations, h = {h}: Newton residual {res:.2e} \
+                         after {it} iterations; equation {} (joints {}) within 1e-2 of \
+                         dependence (`mbd solvers` lists the other solvers)",
+                        near.equation,
+                        near.joints.join(", ")
+                    ),
+                }
             } else {
                 // a step can be too long for the fastest modes of the model, e.g. of a long
                 // chain under tension, with no solution near the prediction
                 // (docs/symplectic.md section 2)
-                format!(
-                    "symplectic ({s},{s}) stage equations, h = {h}; a smaller h may converge \
-                     (the step may be too long for the model's fastest motion)"
-                )
-            },
+                SolveError::Newton {
+                    t,
+                    residual: res,
+                    iterations: it,
+                    context: format!(
+                        "symplectic ({s},{s}) stage equations, h = {h}; a smaller h may \
+                         converge (the step may be too long for the model's fastest motion)"
+                    ),
+                }
+            }
         };
         if !res.is_finite() {
-            return Err(fail(res, 0, self.tab.s));
+            return Err(fail(res, 0, self.tab.s, &self.qk));
         }
         // simplified Newton: one Jacobian per step (or the last step's, if reuse is on), kept
         // while it contracts by 4x per iteration, recomputed every `jacobian_every` iterations
@@ -145,7 +171,7 @@ impl Galerkin {
         let mut last_dz = f64::INFINITY;
         while !(res <= tol && last_dz <= tol) {
             if it >= o.max_iter {
-                return Err(fail(res, it, self.tab.s));
+                return Err(fail(res, it, self.tab.s, &self.qk));
             }
             if need_jacobian || since_jacobian >= o.jacobian_every {
                 self.jacobian(sys, t, h)?;
@@ -262,14 +288,14 @@ impl Galerkin {
             prev_step = step;
             last_dz = step;
             if !res.is_finite() {
-                return Err(fail(res, it, self.tab.s));
+                return Err(fail(res, it, self.tab.s, &self.qk));
             }
             if step <= o.step_tol * qscale {
                 // stagnated at round-off: accept if the residual is sane
                 if res <= 1e-8 * qscale {
                     break;
                 }
-                return Err(fail(res, it, self.tab.s));
+                return Err(fail(res, it, self.tab.s, &self.qk));
             }
         }
         Ok(StepStats {

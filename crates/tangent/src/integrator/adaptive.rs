@@ -60,7 +60,7 @@ impl TangentRk {
             Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_) | Attempt::SingularEnd(_))) => {
                 self.stats.chart_failures += 1;
                 Ok(Err(match fail {
-                    Attempt::Chart(f) => f.into_error(),
+                    Attempt::Chart(f) => self.near_singular(sys, t, f.into_error()),
                     Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
                 }))
             }

@@ -387,7 +387,7 @@ impl TangentRk {
                     self.advance(sys, t + h2, h2, depth + 1, out)
                 } else {
                     Err(match fail {
-                        Attempt::Chart(f) => f.into_error(),
+                        Attempt::Chart(f) => self.near_singular(sys, t, f.into_error()),
                         Attempt::Stage(e) | Attempt::SingularEnd(e) | Attempt::Hard(e) => e,
                     })
                 }
@@ -396,6 +396,28 @@ impl TangentRk {
         }
     }
 }
+
+impl TangentRk {
+    /// A chart map that failed at every halving, at a centre `t` within
+    /// [`NEAR_SINGULAR_TOL`] of rank loss, is reported as the singular configuration it is
+    /// (with the numerical rank at that tolerance, the dependent equations and their joints)
+    /// rather than as a Newton failure; elsewhere `e` is returned.
+    pub(super) fn near_singular(&mut self, sys: &System, t: f64, e: SolveError) -> SolveError {
+        match self.path.singular_error(sys, t, NEAR_SINGULAR_TOL) {
+            Some(SolveError::Singular { detail, .. }) => SolveError::Singular {
+                t,
+                what: "configuration (Phi_q near rank loss: the chart's map failed there)",
+                detail: format!("{detail} (pivots below {NEAR_SINGULAR_TOL:.0e}); {e}"),
+            },
+            _ => e,
+        }
+    }
+}
+
+/// A centre where a column-pivoted QR of `Phi_q^T` has a pivot below this fraction of the
+/// largest (constraint gradients within about 0.6 degrees of dependence) is near a singular
+/// configuration, for the report of a chart map that failed there.
+const NEAR_SINGULAR_TOL: f64 = 1e-2;
 
 /// Relative tolerance to which two step sizes, or two times, count as the same
 /// ([`same_step`], [`same_time`]).

@@ -1,0 +1,350 @@
+//! `own-singular`: singular configurations and redundant constraints with every solver of the
+//! registry. The N-four-bar (N parallelogram loops in a row) driven through its flat
+//! configurations, where `Phi_q` loses N ranks, at three step sizes (tolerances) a decade
+//! apart: each run either reaches the end with the tracked point on the exact motion, or stops
+//! with the typed singular-configuration error. The double parallelogram and the pantograph
+//! (one redundant equation each, everywhere) swinging freely: the crank angle against the
+//! exact elliptic-function motion (docs/closed-loops.md) at two step sizes.
+
+use crate::report::{fmt_e, num, Claim, Ctx, Section, Table};
+use mbd::model::models::{ClosedLoop, CrankMotion};
+use mbd::prelude::*;
+use mbd::solve::registry::SolverVariant;
+use serde_json::json;
+
+/// Crank and ground lengths of every model (m), initial crank angle (rad) and speed (rad/s).
+const CRANK: f64 = 0.4;
+const GROUND: f64 = 1.0;
+const ANGLE: f64 = 1.0;
+const SPEED: f64 = 6.0;
+/// An error below this is at the floor of double precision for these runs.
+const FLOOR: f64 = 1e-9;
+
+/// How a run ended.
+enum Outcome {
+    /// Reached the end; the error of the tracked quantity there.
+    Reached(f64),
+    /// Stopped with `SolveError::Singular` at this time.
+    Singular(f64),
+    /// Refused the model when built (the message).
+    Refused(String),
+    /// Any other error (the message): a defect for this experiment.
+    Other(String),
+}
+
+impl Outcome {
+    fn cell(&self) -> (String, String) {
+        match self {
+            Outcome::Reached(e) => ("reached the end".into(), fmt_e(*e)),
+            Outcome::Singular(t) => (format!("singular error at t = {t:.4}"), "-".into()),
+            Outcome::Refused(m) => (format!("refused: {}", short(m)), "-".into()),
+            Outcome::Other(m) => (format!("OTHER ERROR: {}", short(m)), "-".into()),
+        }
+    }
+}
+
+fn short(m: &str) -> String {
+    m.chars().take(90).collect()
+}
+
+/// The step sizes (or tolerances, for the adaptive index-1 solver) of a solver.
+fn steps(v: &SolverVariant, quick: bool) -> Vec<f64> {
+    let all = if v.spec.starts_with("index1") {
+        vec![1e-6, 1e-8, 1e-10]
+    } else {
+        vec![1e-2, 1e-3, 1e-4]
+    };
+    // the swarm-based solver costs about 100 plain steps a step: its smallest h is left out
+    let n = if quick || v.relative_cost > 20.0 {
+        2
+    } else {
+        3
+    };
+    all.into_iter().take(n).collect()
+}
+
+/// Runs `sys` with `v` to `t_end` at step (tolerance) `h`; `measure` gives the error of the
+/// final state.
+fn run_one(
+    sys: System,
+    v: &SolverVariant,
+    t_end: f64,
+    h: f64,
+    measure: impl Fn(&State) -> f64,
+) -> Outcome {
+    let mut sim = match Simulation::new(sys, v.spec) {
+        Ok(s) => s,
+        Err(e) => return Outcome::Refused(e.to_string()),
+    };
+    let plan: Plan = if v.spec.starts_with("index1") {
+        AdaptiveConfig::new(t_end, h).into()
+    } else {
+        RunConfig::new(t_end, h).into()
+    };
+    match sim.run(plan) {
+        Ok(_) => Outcome::Reached(measure(sim.state())),
+        Err(mbd::Error::Solve(SolveError::Singular { t, .. })) => Outcome::Singular(t),
+        Err(e) => Outcome::Other(e.to_string()),
+    }
+}
+
+/// The tip of crank `body` (its point `[crank / 2, 0]`) in the state.
+fn tip(s: &State, body: usize) -> [f64; 2] {
+    let q = s.q.as_slice();
+    let (x, y, a) = (q[3 * body], q[3 * body + 1], q[3 * body + 2]);
+    [x + 0.5 * CRANK * a.cos(), y + 0.5 * CRANK * a.sin()]
+}
+
+/// Whether a solver's runs (in the order of decreasing h) pass the N-four-bar target: every
+/// run reaches the end on the exact motion or stops with the singular error (or the model is
+/// refused), and among the runs that reach the end each decade of h cuts the error at least
+/// tenfold until it is below the floor.
+fn passes(outcomes: &[Outcome]) -> bool {
+    let mut last: Option<f64> = None;
+    for o in outcomes {
+        match o {
+            Outcome::Other(_) => return false,
+            Outcome::Reached(e) => {
+                if e.is_nan() || *e >= 1e-3 {
+                    return false;
+                }
+                if let Some(p) = last {
+                    if !(*e <= p / 10.0 || *e < FLOOR) {
+                        return false;
+                    }
+                }
+                last = Some(*e);
+            }
+            Outcome::Singular(_) | Outcome::Refused(_) => {}
+        }
+    }
+    true
+}
+
+/// The experiment.
+pub fn singular(ctx: &Ctx) -> Result<Section, String> {
+    let mut sec = Section::default();
+    let loops: Vec<usize> = if ctx.quick { vec![2] } else { vec![2, 10] };
+    let t_end = if ctx.quick { 3.0 } else { 10.0 };
+    sec.setting(
+        "N-four-bar",
+        format!(
+            "N = {loops:?} loops, cranks {CRANK} m, ground and couplers {GROUND} m, 1 kg rods, \
+             driven at {SPEED} rad/s from {ANGLE} rad over {t_end} s (a flat configuration every \
+             {:.3} s)",
+            std::f64::consts::PI / SPEED
+        ),
+    );
+    sec.setting(
+        "step sizes",
+        "1e-2, 1e-3, 1e-4 s (index-1 DOPRI5: tolerances 1e-6, 1e-8, 1e-10; FA-DAE: the first two)",
+    );
+    let mut table = Table::new(
+        "N-four-bar driven through its flat configurations: outcome and tracked-point error at the end",
+        &["N", "solver", "h (tol)", "outcome", "error [m]"],
+    );
+    let mut rows = Vec::new();
+    let mut stopped_other = Vec::new();
+    let mut wrong_branch = Vec::new();
+    for &n in &loops {
+        let cl = ClosedLoop::n_four_bar(n, CRANK, GROUND).map_err(|e| e.to_string())?;
+        let exact = CrankMotion::driven(ANGLE, SPEED).map_err(|e| e.to_string())?;
+        let want = cl.tracked_point(exact.at(t_end)[0]);
+        for (_, v) in mbd::registry().variants() {
+            let mut outcomes = Vec::new();
+            for h in steps(v, ctx.quick) {
+                let sys = cl.system(ANGLE, SPEED, true).map_err(|e| e.to_string())?;
+                let body = sys
+                    .body_handle(&cl.tracked_body())
+                    .ok_or("the tracked body is missing")?
+                    .index();
+                let o = run_one(sys, v, t_end, h, |s| {
+                    let p = tip(s, body);
+                    ((p[0] - want[0]).powi(2) + (p[1] - want[1]).powi(2)).sqrt()
+                });
+                let (what, err) = o.cell();
+                table.row(vec![
+                    n.to_string(),
+                    v.spec.into(),
+                    format!("{h:e}"),
+                    what.clone(),
+                    err,
+                ]);
+                rows.push(json!({
+                    "loops": n, "solver": v.spec, "h": h, "outcome": what,
+                    "error": match &o { Outcome::Reached(e) => json!(num(*e)), _ => json!(null) },
+                }));
+                match &o {
+                    Outcome::Reached(e) if e.is_nan() || *e >= 1e-3 => {
+                        wrong_branch.push(format!("{} N = {n} h = {h:e}: {e:.2e}", v.spec))
+                    }
+                    Outcome::Other(m) => {
+                        stopped_other.push(format!("{} N = {n} h = {h:e}: {}", v.spec, short(m)))
+                    }
+                    _ => {}
+                }
+                outcomes.push(o);
+            }
+            let ok = passes(&outcomes);
+            let reached: Vec<String> = outcomes
+                .iter()
+                .filter_map(|o| match o {
+                    Outcome::Reached(e) => Some(fmt_e(*e)),
+                    _ => None,
+                })
+                .collect();
+            sec.claims.push(Claim::check(
+                format!(
+                    "N-four-bar N = {n}, {}: every run reaches t = {t_end} with the tracked point's \
+                     error falling tenfold per decade of h (to below {FLOOR:e}) or stops with the \
+                     typed singular error (or refuses the model)",
+                    v.spec
+                ),
+                ok,
+                format!(
+                    "errors of the runs that reached the end: [{}]",
+                    reached.join(", ")
+                ),
+            ));
+        }
+    }
+    sec.claims.push(Claim::check(
+        "no solver reaches the end of an N-four-bar run on another branch (tracked point off by 1e-3 m or more)",
+        wrong_branch.is_empty(),
+        if wrong_branch.is_empty() {
+            "none".to_string()
+        } else {
+            wrong_branch.join("; ")
+        },
+    ));
+    sec.claims.push(Claim::check(
+        "every N-four-bar run that stops, stops with the typed singular-configuration error (or a refusal at construction)",
+        stopped_other.is_empty(),
+        if stopped_other.is_empty() {
+            "none stopped otherwise".to_string()
+        } else {
+            stopped_other.join("; ")
+        },
+    ));
+    sec.tables.push(table);
+    redundant(ctx, &mut sec)?;
+    sec.summary = json!({ "singular": rows });
+    Ok(sec)
+}
+
+/// The redundant mechanisms: every solver on the double parallelogram and the pantograph.
+fn redundant(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
+    let t_end = if ctx.quick { 0.5 } else { 2.0 };
+    let angle = -0.5;
+    let mut table = Table::new(
+        "Redundant constraints: crank angle error against the exact motion at the end of a free swing",
+        &["model", "redundant equation", "solver", "h (tol)", "outcome", "error [rad]", "observed order"],
+    );
+    for (name, cl) in [
+        (
+            "double parallelogram",
+            ClosedLoop::double_parallelogram(CRANK, GROUND).map_err(|e| e.to_string())?,
+        ),
+        (
+            "pantograph",
+            ClosedLoop::pantograph(CRANK, GROUND, 0.5).map_err(|e| e.to_string())?,
+        ),
+    ] {
+        let exact = cl.motion(angle, 0.0).map_err(|e| e.to_string())?;
+        let want = exact.at(t_end)[0];
+        let probe = cl.system(angle, 0.0, false).map_err(|e| e.to_string())?;
+        let named: Vec<String> = probe
+            .redundant_equations()
+            .iter()
+            .map(|e| format!("{} ({})", e.equation, e.joints.join(", ")))
+            .collect();
+        sec.claims.push(Claim::check(
+            format!("{name}: build() finds and names exactly one redundant equation"),
+            named.len() == 1,
+            named.join("; "),
+        ));
+        for (_, v) in mbd::registry().variants() {
+            let hs: Vec<f64> = if v.spec.starts_with("index1") {
+                vec![1e-6, 1e-8]
+            } else if v.order > 4 {
+                vec![2e-2, 1e-2]
+            } else {
+                vec![4e-3, 2e-3]
+            };
+            let mut errs = Vec::new();
+            let mut refused = None;
+            for &h in &hs {
+                let sys = cl.system(angle, 0.0, false).map_err(|e| e.to_string())?;
+                let body = sys
+                    .body_handle(&cl.tracked_body())
+                    .ok_or("the tracked body is missing")?
+                    .index();
+                let o = run_one(sys, v, t_end, h, |s| (s.q[3 * body + 2] - want).abs());
+                let (what, err) = o.cell();
+                match &o {
+                    Outcome::Reached(e) => errs.push(*e),
+                    Outcome::Refused(m) => refused = Some(m.clone()),
+                    _ => {}
+                }
+                table.row(vec![
+                    name.into(),
+                    named.first().cloned().unwrap_or_default(),
+                    v.spec.into(),
+                    format!("{h:e}"),
+                    what,
+                    err,
+                    String::new(),
+                ]);
+            }
+            if let Some(m) = refused {
+                sec.claims.push(Claim::check(
+                    format!(
+                        "{name}, {}: the refusal names the redundant equation",
+                        v.spec
+                    ),
+                    m.contains("redundant constraint equations"),
+                    short(&m),
+                ));
+                continue;
+            }
+            let observed = if errs.len() == 2 && errs[1] > 0.0 {
+                let ratio = hs[0] / hs[1];
+                Some((errs[0] / errs[1]).ln() / ratio.ln())
+            } else {
+                None
+            };
+            if let (Some(o), Some(last)) = (observed, table.rows.last_mut()) {
+                last[6] = format!("{o:.2}");
+            }
+            let order = v.order as f64;
+            let ok = errs.len() == 2
+                && (errs[1] < 1e-11
+                    || if v.spec.starts_with("index1") {
+                        errs[0] / errs[1] >= 10.0
+                    } else {
+                        observed.is_some_and(|o| o >= order - 0.5)
+                    });
+            sec.claims.push(Claim::check(
+                format!(
+                    "{name}, {}: follows the exact motion at its order ({})",
+                    v.spec,
+                    if v.spec.starts_with("index1") {
+                        "error tenfold smaller per hundredfold tolerance".to_string()
+                    } else {
+                        format!("observed at least {:.1}", order - 0.5)
+                    }
+                ),
+                ok,
+                format!(
+                    "errors [{}]",
+                    errs.iter()
+                        .map(|e| fmt_e(*e))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+    }
+    sec.tables.push(table);
+    Ok(())
+}
