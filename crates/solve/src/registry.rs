@@ -322,7 +322,8 @@ impl Registry {
 
     /// `e`, an error of building a solver for `sys`, completed with what the registry knows:
     /// a refusal of redundant constraint equations ([`crate::refuse_redundant`]) gets the
-    /// list of the registered solvers that run them. Other errors are returned unchanged.
+    /// list of the registered solvers that build for `sys` (tried one by one: an error path).
+    /// Other errors are returned unchanged.
     pub fn with_advice(&self, sys: &mbd_model::System, e: SolveError) -> SolveError {
         match e {
             SolveError::Unsupported(msg)
@@ -330,11 +331,11 @@ impl Registry {
             {
                 let ok: Vec<&str> = self
                     .variants()
-                    .filter(|(_, v)| !v.refuses.contains("redundant"))
+                    .filter(|(_, v)| self.parse(v.spec).and_then(|spec| spec.build(sys)).is_ok())
                     .map(|(_, v)| v.spec)
                     .collect();
                 SolveError::Unsupported(format!(
-                    "{msg}; the solvers that run them: {}",
+                    "{msg}; the solvers that run this model: {}",
                     ok.join(", ")
                 ))
             }

@@ -20,7 +20,14 @@ impl TangentChart {
             return;
         }
         self.form_p0();
-        sys.phi_q_dot_jacobian(&x_e[..n], &x_e[n..], &mut self.pq_e, &mut self.dphi_e);
+        self.sel.jacobian(
+            sys,
+            &x_e[..n],
+            &x_e[n..],
+            &mut self.pq_e,
+            &mut self.dphi_e,
+            false,
+        );
         // Delta Df = [[dP, 0], [dX, dP]] with dP = Phi_q(e) - Phi_q(c), dX likewise
         self.pq_e -= &self.phi_q;
         self.dphi_e -= &self.dphi;

@@ -40,13 +40,24 @@ impl TangentChart {
             }
             self.step.copy_from_slice(x);
             gemv_cols(&self.q[..mm * nn], &self.w, &mut self.step);
-            if self.residual(sys, &self.step, t, f).is_finite() {
-                x.copy_from_slice(&self.step);
+            // (the residual borrows the chart mutably: the point is moved out for the call,
+            // which does not allocate)
+            let step = std::mem::take(&mut self.step);
+            if self.residual(sys, &step, t, f).is_finite() {
+                x.copy_from_slice(&step);
             }
+            self.step = step;
         }
         self.wx.copy_from_slice(x);
         self.first_step = 0.0;
-        sys.phi_q_dot_jacobian(&x[..n], &x[n..], &mut self.pq_x, &mut self.dphi_x);
+        self.sel.jacobian(
+            sys,
+            &x[..n],
+            &x[n..],
+            &mut self.pq_x,
+            &mut self.dphi_x,
+            false,
+        );
         let scale = max_abs(self.phi_q.as_slice()).max(max_abs(self.dphi.as_slice()));
         let change = max_abs_diff(self.pq_x.as_slice(), self.phi_q.as_slice())
             .max(max_abs_diff(self.dphi_x.as_slice(), self.dphi.as_slice()));
@@ -75,7 +86,14 @@ impl TangentChart {
                 return verdict.map(|_| done(it, res));
             }
             if !first {
-                sys.phi_q_dot_jacobian(&x[..n], &x[n..], &mut self.pq_x, &mut self.dphi_x);
+                self.sel.jacobian(
+                    sys,
+                    &x[..n],
+                    &x[n..],
+                    &mut self.pq_x,
+                    &mut self.dphi_x,
+                    false,
+                );
             }
             first = false;
             // J = Df(x) Q1: column k = (Phi_q cq, X cq + Phi_q cv) for Q1_k = (cq, cv)

@@ -24,6 +24,7 @@ pub const TRAVEL_FACTOR: f64 = 4.0;
 mod chord;
 mod exact;
 mod rank;
+mod rows;
 mod settings;
 #[cfg(test)]
 mod tests;
@@ -152,12 +153,15 @@ pub struct TangentChart {
     /// Relative threshold on the diagonal of `R` below which `Df(x_c)` counts as rank deficient.
     pub singular_tol: f64,
     centred: bool,
+    /// The constraint rows the chart works with (all of them without redundant equations).
+    sel: rows::RowSelection,
 }
 
 impl TangentChart {
     /// A chart workspace for `sys` (allocates once).
     pub fn new(sys: &System) -> Self {
-        Self::with_dims(sys, sys.n_coords(), sys.n_constraints())
+        // a model with k redundant equations: m - k independent rows, chosen at each centre
+        Self::with_dims(sys, sys.n_coords(), sys.n_constraints() - sys.n_redundant())
     }
 
     fn with_dims(sys: &System, n: usize, m: usize) -> Self {
@@ -224,7 +228,14 @@ impl TangentChart {
             hv: vec![0.0; n],
             singular_tol: 1e-8,
             centred: false,
+            sel: rows::RowSelection::new(sys),
         }
+    }
+
+    /// Whether the chart drops rows of `Phi` (the model's redundant equations): its `Phi_q` is
+    /// then not the model's.
+    pub(crate) fn drops_rows(&self) -> bool {
+        self.sel.drops_rows()
     }
 
     /// Dimension of the chart, `2 (n - m)`: twice the degrees of freedom.
@@ -330,12 +341,27 @@ impl TangentChart {
             self.centred = true;
             return Ok(());
         }
-        sys.phi_q_dot_jacobian(q, v, &mut self.phi_q, &mut self.dphi);
+        let selected = self
+            .sel
+            .jacobian(sys, q, v, &mut self.phi_q, &mut self.dphi, true);
         if !all_finite(self.phi_q.as_slice()) || !all_finite(self.dphi.as_slice()) {
             return Err(SolveError::NonFinite {
                 t,
                 what: "constraint Jacobian at the chart centre",
             });
+        }
+        if !selected {
+            // the model's redundant equations are not the only dependent ones here
+            let tol = self.singular_tol.max(1e-6);
+            return Err(self
+                .singular_error(sys, t, tol)
+                .unwrap_or(SolveError::Singular {
+                    t,
+                    what: "constraint Jacobian Df of the tangent chart",
+                    detail: "the rows dependent at this centre are not the model's redundant \
+                         equations alone"
+                        .into(),
+                }));
         }
         if m > n {
             // more constraint equations than coordinates: necessarily dependent
@@ -356,9 +382,15 @@ impl TangentChart {
                 let tol = self.singular_tol;
                 return Err(self.singular_error(sys, t, tol).unwrap_or_else(|| {
                     let detail = if i < m {
-                        format!("position constraint {}", sys.equation_name(i))
+                        format!(
+                            "position constraint {}",
+                            sys.equation_name(self.sel.full_row(i))
+                        )
                     } else {
-                        format!("velocity constraint {}", sys.equation_name(i - m))
+                        format!(
+                            "velocity constraint {}",
+                            sys.equation_name(self.sel.full_row(i - m))
+                        )
                     };
                     SolveError::Singular {
                         t,
@@ -423,11 +455,11 @@ impl TangentChart {
 
     /// `f(x, t) = (Phi(q, t), Phi_q v + Phi_t)` into `out` (length `2m`); returns its max-norm
     /// (NaN if any entry is not finite).
-    pub fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+    pub fn residual(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
-        sys.phi_and_phi_dot(q, v, t, p, pd);
+        self.sel.residual(sys, q, v, t, p, pd, None);
         let mut r = 0.0f64;
         for &e in out[..2 * m].iter() {
             if !e.is_finite() {
@@ -445,7 +477,8 @@ impl TangentChart {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
-        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
+        self.sel
+            .residual(sys, q, v, t, p, pd, Some(&mut self.angles));
         with_codim!(2 * m, max_abs_finite(out))
     }
 

@@ -40,7 +40,7 @@ impl TangentChart {
         if m == 0 || m > n || q.len() != n {
             return None;
         }
-        sys.phi_q(q, &mut self.pq_x);
+        self.sel.phi_q(sys, q, &mut self.pq_x);
         self.rank_report(sys, t, rel_tol)
     }
 
@@ -120,12 +120,12 @@ impl TangentChart {
                 y[i] = acc / a[i * n + i];
             }
             let wmax = max_abs(&y).max(1.0);
-            dependent.push(sys.equation_name(perm[j]));
-            let mut rows: Vec<usize> = vec![perm[j]];
+            dependent.push(sys.equation_name(self.sel.full_row(perm[j])));
+            let mut rows: Vec<usize> = vec![self.sel.full_row(perm[j])];
             rows.extend(
                 (0..rank)
                     .filter(|&i| y[i].abs() > 1e-6 * wmax)
-                    .map(|i| perm[i]),
+                    .map(|i| self.sel.full_row(perm[i])),
             );
             rows.sort_unstable();
             for r in rows {

@@ -55,6 +55,8 @@ pub struct TangentRk {
     stats: TangentStats,
     n: usize,
     m: usize,
+    /// The model's constraint equations (`m` plus its redundant ones).
+    m_full: usize,
     stages: usize,
     a_coef: Vec<f64>,
     b_coef: Vec<f64>,
@@ -150,10 +152,18 @@ impl TangentRk {
         options: TangentOptions,
     ) -> Result<Self, SolveError> {
         options.validate()?;
-        // the chart's dimension is n - m: it needs independent equations
-        mbd_solve::refuse_redundant(sys, "the tangent-space solver")?;
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let path = if options.linear_solver.use_sparse(m) {
+        let (n, m_full) = (sys.n_coords(), sys.n_constraints());
+        // the chart works with the m - k independent rows (chosen at each centre)
+        let m = m_full - sys.n_redundant();
+        let path = if options.linear_solver.use_sparse(m_full) {
+            // the sparse chart's dimension is n - m: it needs independent equations
+            mbd_solve::refuse_redundant(sys, "the sparse tangent chart (above the dense size)")
+                .map_err(|e| match e {
+                    SolveError::Unsupported(s) => {
+                        SolveError::Unsupported(format!("{s}; use LinearSolver::Dense"))
+                    }
+                    other => other,
+                })?;
             if options.iteration_matrix != IterationMatrix::Centre {
                 return Err(SolveError::Unsupported(format!(
                     "the sparse tangent chart iterates with the centre's matrix only \
@@ -192,6 +202,7 @@ impl TangentRk {
             stats: TangentStats::default(),
             n,
             m,
+            m_full,
             stages: s,
             a_coef,
             b_coef,
@@ -210,7 +221,7 @@ impl TangentRk {
             proj: vec![0.0; 2 * n],
             res: vec![0.0; 2 * m],
             acc_a: vec![0.0; n],
-            lambda: vec![0.0; m],
+            lambda: vec![0.0; m_full],
             ex: vec![0.0; 2 * n],
             scale: vec![0.0; 2 * n],
             eta_now: vec![0.0; (s + 1) * 2 * m],
@@ -281,7 +292,7 @@ impl TangentRk {
     }
 
     fn check_sizes(&self, sys: &System, state: &State) -> Result<(), SolveError> {
-        if sys.n_coords() != self.n || sys.n_constraints() != self.m {
+        if sys.n_coords() != self.n || sys.n_constraints() != self.m_full {
             return Err(SolveError::Dimension {
                 what: "system (not the one the solver was built for: coordinates)",
                 expected: self.n,

@@ -154,7 +154,8 @@ impl Path {
     ) -> Result<(), SolveError> {
         match self {
             Path::Dense { chart, acc } => {
-                if at_centre {
+                // (with redundant equations the chart keeps only its rows of Phi_q)
+                if at_centre && !chart.drops_rows() {
                     sys.forces_into(q, v, t, &mut acc.forces);
                     acc.phi_q.copy_from(chart.centre_phi_q());
                     let dphi = chart.centre_phi_q_dot_jacobian().as_slice();
@@ -210,7 +211,7 @@ impl Path {
     }
 
     /// `||f(x, t)||_inf` with `f` into `out`.
-    pub(super) fn residual(&self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
+    pub(super) fn residual(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
         match self {
             Path::Dense { chart, .. } => chart.residual(sys, x, t, out),
             Path::Sparse(p) => p.chart.residual(sys, x, t, out),
