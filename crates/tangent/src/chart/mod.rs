@@ -456,10 +456,8 @@ impl TangentChart {
     /// `f(x, t) = (Phi(q, t), Phi_q v + Phi_t)` into `out` (length `2m`); returns its max-norm
     /// (NaN if any entry is not finite).
     pub fn residual(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
-        let (n, m) = (self.n, self.m);
-        let (q, v) = x.split_at(n);
-        let (p, pd) = out[..2 * m].split_at_mut(m);
-        self.sel.residual(sys, q, v, t, p, pd, None);
+        let m = self.m;
+        self.sel.residual(sys, x, t, &mut out[..2 * m], None);
         let mut r = 0.0f64;
         for &e in out[..2 * m].iter() {
             if !e.is_finite() {
@@ -474,11 +472,9 @@ impl TangentChart {
     /// evaluation ([`BodyAngles::update_near`]: a few ulps from the exact values; the chord's iterates move
     /// by small angles).
     fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
-        let (n, m) = (self.n, self.m);
-        let (q, v) = x.split_at(n);
-        let (p, pd) = out[..2 * m].split_at_mut(m);
+        let m = self.m;
         self.sel
-            .residual(sys, q, v, t, p, pd, Some(&mut self.angles));
+            .residual(sys, x, t, &mut out[..2 * m], Some(&mut self.angles));
         with_codim!(2 * m, max_abs_finite(out))
     }
 

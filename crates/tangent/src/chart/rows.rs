@@ -126,18 +126,18 @@ impl RowSelection {
         true
     }
 
-    /// `Phi` and `Phi_q v + Phi_t` at `(q, v, t)`, kept rows, into `p` and `pd` (the rotations
-    /// from `angles` near the previous evaluation when given).
+    /// `Phi` and `Phi_q v + Phi_t` at `x = (q, v)` and `t`, kept rows, into the two halves of
+    /// `out` (the rotations from `angles` near the previous evaluation when given).
     pub(crate) fn residual(
         &mut self,
         sys: &System,
-        q: &[f64],
-        v: &[f64],
+        x: &[f64],
         t: f64,
-        p: &mut [f64],
-        pd: &mut [f64],
+        out: &mut [f64],
         angles: Option<&mut BodyAngles>,
     ) {
+        let (q, v) = x.split_at(x.len() / 2);
+        let (p, pd) = out.split_at_mut(out.len() / 2);
         if self.k == 0 {
             match angles {
                 Some(a) => sys.phi_and_phi_dot_cached(q, v, t, p, pd, a),
