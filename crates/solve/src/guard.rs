@@ -111,27 +111,35 @@ impl GuardState {
     /// The branch check after an accepted step of size `h` with condition estimate
     /// `condition` (see [`DriftGuard::branch_tol`]); remembers the state for the next one.
     fn branch(&mut self, state: &State, h: f64, condition: f64) -> Result<(), SolveError> {
-        if let Some(tol) = self.guard.branch_tol {
-            if condition > BRANCH_WATCH_CONDITION {
-                let dev = self.branch_deviation(state, h);
-                if !(dev <= tol) {
-                    return Err(SolveError::Singular {
-                        t: state.t,
-                        what: "configuration passed onto another branch",
-                        detail: format!(
-                            "between t = {} and t = {} (condition estimate {condition:.1e}), \
-                             the end velocity disagrees with the step's displacement by {dev:.2} \
-                             of the distance travelled (a smooth step: about (omega h)^2 / 12): \
-                             the solver went on along another branch of the motion; take a \
-                             smaller h, or a solver that keeps the constraints",
-                            self.prev_t, state.t
-                        ),
-                    });
-                }
+        let Some(tol) = self.guard.branch_tol else {
+            return Ok(());
+        };
+        // the state before this step is at hand only if the last step was remembered
+        let fresh = (state.t - h - self.prev_t).abs() <= 1e-12 * state.t.abs().max(h);
+        if condition > BRANCH_WATCH_CONDITION && fresh {
+            let dev = self.branch_deviation(state, h);
+            if !(dev <= tol) {
+                return Err(SolveError::Singular {
+                    t: state.t,
+                    what: "configuration passed onto another branch",
+                    detail: format!(
+                        "between t = {} and t = {} (condition estimate {condition:.1e}), the \
+                         end velocity disagrees with the step's displacement by {dev:.2} of the \
+                         distance travelled (a smooth step: about (omega h)^2 / 12): the solver \
+                         went on along another branch of the motion; take a smaller h, or a \
+                         solver that keeps the constraints",
+                        self.prev_t, state.t
+                    ),
+                });
             }
+        }
+        // remembered only near a singular configuration (a well-conditioned step copies nothing)
+        if condition > BRANCH_ARM_CONDITION {
             self.prev_t = state.t;
             self.prev_q.copy_from_slice(state.q.as_slice());
             self.prev_v.copy_from_slice(state.v.as_slice());
+        } else {
+            self.prev_t = f64::NAN;
         }
         Ok(())
     }
@@ -199,6 +207,12 @@ pub const BRANCH_JUMP_TOL: f64 = 0.1;
 /// change branch only where `Phi_q` nearly loses rank, and away from there a large step on a
 /// fast motion must not be taken for a jump.
 pub const BRANCH_WATCH_CONDITION: f64 = 1e3;
+
+/// A step with a condition estimate above this remembers its end state for the branch check of
+/// the next step; below it nothing is copied (well-posed mechanisms stay below it), so the
+/// check costs nothing away from singular configurations. A step that goes from below this
+/// straight above [`BRANCH_WATCH_CONDITION`] is not checked.
+pub const BRANCH_ARM_CONDITION: f64 = 1e2;
 
 /// The checks of one run: opened before the first step, applied after every accepted one.
 pub(crate) struct RunChecks {
@@ -279,20 +293,7 @@ impl RunChecks {
         }
         if let Some(g) = self.guard.as_mut() {
             if let Err(e) = g.check(sys, state) {
-                // drift that appears on a step near a singular configuration: the solver left
-                // the branch there (a solver on the constraints does not drift by 1%)
-                if s.condition > BRANCH_WATCH_CONDITION && g.guard.branch_tol.is_some() {
-                    return Err(SolveError::Singular {
-                        t: state.t,
-                        what: "configuration passed onto another branch",
-                        detail: format!(
-                            "the step ending at t = {} (condition estimate {:.1e}) left the \
-                             constraints: {e}",
-                            state.t, s.condition
-                        ),
-                    });
-                }
-                return Err(e);
+                return Err(drift_error(e, state.t, s.condition, g.guard.branch_tol.is_some()));
             }
         }
         if s.condition > self.condition_limit && !self.keeps_constraints {
@@ -319,6 +320,8 @@ impl RunChecks {
 }
 
 impl RunChecks {
+    #[cold]
+    #[inline(never)]
     /// The stop of an integrator that does not keep the constraints at a near-singular step:
     /// the equations nearest to dependence and their joints (allocates: an error path).
     fn singular_stop(&self, sys: &System, state: &State, condition: f64) -> SolveError {
@@ -344,6 +347,27 @@ impl RunChecks {
                 self.condition_limit
             ),
         }
+    }
+}
+
+/// The drift guard's error `e` after a step ending at `t` with condition estimate
+/// `condition`: drift that appears on a step near a singular configuration means the solver
+/// left the branch there (a solver on the constraints does not drift by 1%), reported as such
+/// while the branch check is on.
+#[cold]
+#[inline(never)]
+fn drift_error(e: SolveError, t: f64, condition: f64, branch_check: bool) -> SolveError {
+    if condition > BRANCH_WATCH_CONDITION && branch_check {
+        SolveError::Singular {
+            t,
+            what: "configuration passed onto another branch",
+            detail: format!(
+                "the step ending at t = {t} (condition estimate {condition:.1e}) left the \
+                 constraints: {e}"
+            ),
+        }
+    } else {
+        e
     }
 }
 

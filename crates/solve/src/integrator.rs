@@ -3,7 +3,7 @@
 use crate::adaptive::AdaptiveIntegrator;
 use crate::error::SolveError;
 use crate::guard::RunChecks;
-pub use crate::guard::{DriftGuard, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION};
+pub use crate::guard::{DriftGuard, BRANCH_ARM_CONDITION, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION};
 use crate::state::State;
 use mbd_model::System;
 
