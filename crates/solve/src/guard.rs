@@ -293,7 +293,12 @@ impl RunChecks {
         }
         if let Some(g) = self.guard.as_mut() {
             if let Err(e) = g.check(sys, state) {
-                return Err(drift_error(e, state.t, s.condition, g.guard.branch_tol.is_some()));
+                return Err(drift_error(
+                    e,
+                    state.t,
+                    s.condition,
+                    g.guard.branch_tol.is_some(),
+                ));
             }
         }
         if s.condition > self.condition_limit && !self.keeps_constraints {
