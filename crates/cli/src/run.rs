@@ -170,6 +170,12 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
              (rk4-projected, symplectic:S, tangent:rk4)"
         }
         SolveError::Observer { .. } => "; check the output path and the free disk space",
+        // a singular configuration: a smaller step does not help a solver that cannot pass
+        SolveError::Singular { .. } => {
+            "; the mechanism is at or near a singular configuration: the solvers that keep the \
+             constraints pass such configurations on their branch (rk4-projected, symplectic:1, \
+             symplectic:2; see the report's own-singular experiment), the others stop there"
+        }
         // a refusal of the model or the setting: no step size helps
         SolveError::Unsupported(_)
         | SolveError::InvalidParameter { .. }
@@ -337,4 +343,29 @@ fn write_json(path: &Path, file: std::fs::File, doc: &serde_json::Value) -> Resu
     writeln!(w)
         .and_then(|()| w.flush())
         .map_err(|e| CliError::write(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A singular configuration names the solvers that pass it, never "a smaller --h".
+    #[test]
+    fn a_singular_stop_names_the_solvers_that_pass() {
+        let spec = mbd::registry().parse("rk4").expect("spec");
+        let e = solve_error(
+            &spec,
+            SolveError::Singular {
+                t: 0.357,
+                what: "configuration (Phi_q near rank loss)",
+                detail: "condition estimate 2e7".into(),
+            },
+        )
+        .to_string();
+        assert!(
+            e.contains("rk4-projected") && e.contains("symplectic:2"),
+            "{e}"
+        );
+        assert!(!e.contains("smaller --h"), "{e}");
+    }
 }
