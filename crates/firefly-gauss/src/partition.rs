@@ -46,8 +46,8 @@ fn rank_error(sys: &System, piv: &Pivoting, e: RankError) -> FaDaeError {
                 .collect();
             FaDaeError::Unsupported(format!(
                 "the redundancy found at build is gone: Phi_q has rank above {} = {m} \
-                 constraints - {k} redundant ({}) at this configuration; equation {} is \
-                 independent of the others",
+                 constraints - {k} redundant at this configuration (redundant at build: {}); \
+                 equation {} is independent of the others",
                 m - k,
                 names.join(", "),
                 sys.equation_name(row)

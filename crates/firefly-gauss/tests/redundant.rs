@@ -190,3 +190,28 @@ fn given_partition_checks_the_count_against_the_dof_and_runs() {
     assert!(e < 2e-7, "{e:e}");
     assert!(p <= 1.0 && v <= 10.0, "{p:e} {v:e}");
 }
+
+#[test]
+fn a_rank_other_than_m_minus_k_is_an_error_naming_it() {
+    let (sys, cl) = double_parallelogram();
+    // flat (all links on the x-axis): rank 10 < 11, a singular configuration
+    let (flat, _) = cl.branch_state(0.0, 0.0);
+    match Partition::auto(&sys, &flat) {
+        Err(FaDaeError::Unsupported(msg)) => {
+            assert!(msg.contains("rank deficient"), "{msg}");
+            assert!(msg.contains("1 redundant"), "{msg}");
+        }
+        other => panic!("expected a rank-deficiency error, got {other:?}"),
+    }
+    // off the branch (the middle crank turned): the twelve rows are independent, the
+    // redundancy found at build is gone
+    let (mut q, _) = cl.branch_state(ANGLE, 0.0);
+    q[5] += 0.3;
+    match Partition::auto(&sys, &q) {
+        Err(FaDaeError::Unsupported(msg)) => {
+            assert!(msg.contains("redundancy found at build is gone"), "{msg}");
+            assert!(msg.contains("M.y") || msg.contains("M.x"), "{msg}");
+        }
+        other => panic!("expected the redundancy to be gone, got {other:?}"),
+    }
+}
