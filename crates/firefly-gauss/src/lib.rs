@@ -16,7 +16,10 @@
 //!    pivoting of `Phi_q` ([`Partition::auto`]) and re-chosen during the run when the
 //!    dependent block becomes much worse than the best available one
 //!    ([`FaDaeOptions::repartition_threshold`]), or given by the user
-//!    ([`PartitionChoice::Given`]).
+//!    ([`PartitionChoice::Given`]). With `k` redundant constraint equations
+//!    ([`mbd_model::System::n_redundant`]) `Phi_q` has rank `m - k`: the partition also picks
+//!    the `m - k` equations that complete the dependent coordinates ([`Partition::equations`]),
+//!    and `dof = n - m + k`.
 //! 2. **Completion**: the dependent coordinates follow from `Phi(q, t_{k+1}) = 0` (chord Newton
 //!    from the predictor, to `1e-14`), the dependent velocities from
 //!    `Phi_q v + Phi_t = 0`, so every accepted state satisfies the position and velocity

@@ -6,6 +6,11 @@
 //! evaluation. An evaluation is a pure function of the candidate and the step problem: the
 //! Newton iteration for the dependent coordinates always starts from the same point (the
 //! predictor's), so the serial and the parallel optimiser see identical values.
+//!
+//! Only the partition's `r` equations enter (`r = m - k` with `k` redundant equations): the
+//! full `Phi` and `Phi_q` are evaluated into scratch and their rows gathered, so the dependent
+//! block is square (`r x r`). Without redundant equations the rows are `0..m` and the gathered
+//! values are the evaluated ones.
 
 use crate::partition::Partition;
 use mbd_model::System;
@@ -53,10 +58,13 @@ pub(crate) fn gauss_nodes() -> [GaussNode; 2] {
 #[derive(Debug)]
 pub(crate) struct StepProblem {
     pub n: usize,
-    pub m: usize,
+    /// Number of equations in use (the rank of `Phi_q`), `dep.len() == rows.len()`.
+    pub r: usize,
     pub dof: usize,
     pub ind: Vec<usize>,
     pub dep: Vec<usize>,
+    /// The equations in use (rows of `Phi`, ascending).
+    pub rows: Vec<usize>,
     pub t0: f64,
     pub t1: f64,
     pub h: f64,
@@ -66,7 +74,7 @@ pub(crate) struct StepProblem {
     pub q_start: Vec<f64>,
     /// LU of the dependent block of `Phi_q(q_start)` (chord Newton).
     pub chord: DenseLu,
-    /// `Phi_t(t1)`.
+    /// `Phi_t(t1)` (all `m` equations).
     pub phi_t1: Vec<f64>,
     /// LU of `G0 = N0^T M N0` at `q0` (the tangent metric that turns the projected residual
     /// into independent-coordinate accelerations).
@@ -81,20 +89,22 @@ pub(crate) struct StepProblem {
 impl StepProblem {
     pub fn new(sys: &System, part: &Partition) -> Self {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let dof = n - m;
+        let r = part.dependent.len();
+        let dof = n - r;
         StepProblem {
             n,
-            m,
+            r,
             dof,
             ind: part.independent.clone(),
             dep: part.dependent.clone(),
+            rows: part.equations.clone(),
             t0: 0.0,
             t1: 0.0,
             h: 0.0,
             q0: vec![0.0; n],
             v0: vec![0.0; n],
             q_start: vec![0.0; n],
-            chord: crate::objective::small_lu(m),
+            chord: crate::objective::small_lu(r),
             phi_t1: vec![0.0; m],
             metric: crate::objective::small_lu(dof),
             mass: sys.mass_diag().iter().copied().collect(),
@@ -104,10 +114,11 @@ impl StepProblem {
         }
     }
 
-    /// Re-targets the problem to another partition (same sizes).
+    /// Re-targets the problem to another partition (same sizes: no allocation).
     pub fn set_partition(&mut self, part: &Partition) {
         self.ind.clone_from(&part.independent);
         self.dep.clone_from(&part.dependent);
+        self.rows.clone_from(&part.equations);
     }
 
     /// Number of decision variables `2 dof`.
@@ -134,20 +145,20 @@ impl StepProblem {
         sys.phi_t(self.t1, &mut self.phi_t1);
         // chord Jacobian at the predicted positions
         sys.phi_q(&self.q_start, &mut ws.jac);
-        fill_block(&ws.jac, &self.dep, self.m, self.chord.rows_mut());
+        fill_block(&ws.jac, &self.rows, &self.dep, self.chord.rows_mut());
         self.chord
             .factor_lu()
             .map_err(|_| "dependent block of Phi_q at the predicted state")?;
         // metric G0 = M_z + X^T M_d X with X = Phi_d^-1 Phi_z at q0
         sys.phi_q(q0, &mut ws.jac);
-        fill_block(&ws.jac, &self.dep, self.m, ws.lu.rows_mut());
+        fill_block(&ws.jac, &self.rows, &self.dep, ws.lu.rows_mut());
         ws.lu
             .factor_lu()
             .map_err(|_| "dependent block of Phi_q at the step's start")?;
-        let (m, dof) = (self.m, self.dof);
+        let (m, dof) = (self.r, self.dof);
         for (c, &zc) in self.ind.iter().enumerate() {
-            for r in 0..m {
-                ws.x[c * m + r] = ws.jac[(r, zc)];
+            for (r, &row) in self.rows.iter().enumerate() {
+                ws.x[c * m + r] = ws.jac[(row, zc)];
             }
             ws.lu.solve_in_place(&mut ws.x[c * m..(c + 1) * m]);
         }
@@ -172,7 +183,7 @@ impl StepProblem {
     /// constraint with the Jacobian at the converged positions. Returns the Newton iterations,
     /// or `None` if Newton did not reach the tolerance (or met a singular block).
     pub fn complete(&self, sys: &System, ws: &mut Workspace, x: &[f64]) -> Option<usize> {
-        let (m, dof) = (self.m, self.dof);
+        let dof = self.dof;
         ws.q1.copy_from_slice(&self.q_start);
         for (k, &i) in self.ind.iter().enumerate() {
             ws.q1[i] = x[k];
@@ -180,6 +191,8 @@ impl StepProblem {
         let mut iters = 0;
         loop {
             sys.phi(&ws.q1, self.t1, &mut ws.phi);
+            // the test covers every equation: a redundant one is a combination of the rows in
+            // use, with coefficients that grow as their block loses conditioning
             let res = max_abs(&ws.phi);
             if !res.is_finite() {
                 return None;
@@ -192,20 +205,23 @@ impl StepProblem {
             if iters >= self.newton_max_iter {
                 return None;
             }
-            self.chord.solve_with(&mut ws.phi, &mut ws.ly, &mut ws.lx);
+            for (k, &row) in self.rows.iter().enumerate() {
+                ws.phi_r[k] = ws.phi[row];
+            }
+            self.chord.solve_with(&mut ws.phi_r, &mut ws.ly, &mut ws.lx);
             for (r, &d) in self.dep.iter().enumerate() {
-                ws.q1[d] -= ws.phi[r];
+                ws.q1[d] -= ws.phi_r[r];
             }
             iters += 1;
         }
         // velocities: Phi_d v_d = -Phi_t - Phi_z zdot at the converged q1
         sys.phi_q(&ws.q1, &mut ws.jac);
-        fill_block(&ws.jac, &self.dep, m, ws.lu.rows_mut());
+        fill_block(&ws.jac, &self.rows, &self.dep, ws.lu.rows_mut());
         ws.lu.factor_lu().ok()?;
-        for r in 0..m {
-            let mut s = -self.phi_t1[r];
+        for (r, &row) in self.rows.iter().enumerate() {
+            let mut s = -self.phi_t1[row];
             for (k, &i) in self.ind.iter().enumerate() {
-                s -= ws.jac[(r, i)] * x[dof + k];
+                s -= ws.jac[(row, i)] * x[dof + k];
             }
             ws.rhs[r] = s;
         }
@@ -224,7 +240,7 @@ impl StepProblem {
     /// projected residual of the equations of motion at Gauss node `g` in independent-coordinate
     /// accelerations. The objective is `||out||^2`.
     pub fn gauss_residuals(&self, sys: &System, ws: &mut Workspace, out: &mut [f64]) -> bool {
-        let (n, m, dof, h) = (self.n, self.m, self.dof, self.h);
+        let (n, dof, h) = (self.n, self.dof, self.h);
         let scale = std::f64::consts::FRAC_1_SQRT_2 * h * h;
         for i in 0..n {
             ws.dq[i] = ws.q1[i] - self.q0[i];
@@ -244,7 +260,7 @@ impl StepProblem {
             }
             // eliminate lambda: rho = N^T r = r_z - Phi_z^T mu,  Phi_d^T mu = r_d
             sys.phi_q(&ws.qg, &mut ws.jac);
-            fill_block(&ws.jac, &self.dep, m, ws.lu.rows_mut());
+            fill_block(&ws.jac, &self.rows, &self.dep, ws.lu.rows_mut());
             if ws.lu.factor_lu().is_err() {
                 return false;
             }
@@ -255,8 +271,8 @@ impl StepProblem {
             let rho = &mut out[g * dof..(g + 1) * dof];
             for (k, &i) in self.ind.iter().enumerate() {
                 let mut s = ws.r[i];
-                for r in 0..m {
-                    s -= ws.jac[(r, i)] * ws.mu[r];
+                for (r, &row) in self.rows.iter().enumerate() {
+                    s -= ws.jac[(row, i)] * ws.mu[r];
                 }
                 rho[k] = s;
             }
@@ -296,12 +312,13 @@ impl StepProblem {
     }
 }
 
-/// Copies `Phi_q[:, dep]` row-major into `out`.
+/// Copies the square block `Phi_q[rows, dep]` row-major into `out` (`rows.len() == dep.len()`).
 #[inline]
-fn fill_block(j: &DMatrix<f64>, dep: &[usize], m: usize, out: &mut [f64]) {
-    for r in 0..m {
+pub(crate) fn fill_block(j: &DMatrix<f64>, rows: &[usize], dep: &[usize], out: &mut [f64]) {
+    let r = dep.len();
+    for (k, &row) in rows.iter().enumerate() {
         for (c, &col) in dep.iter().enumerate() {
-            out[r * m + c] = j[(r, col)];
+            out[k * r + c] = j[(row, col)];
         }
     }
 }
@@ -311,7 +328,10 @@ fn fill_block(j: &DMatrix<f64>, dep: &[usize], m: usize, out: &mut [f64]) {
 pub(crate) struct Workspace {
     pub q1: Vec<f64>,
     pub v1: Vec<f64>,
+    /// `Phi` (all `m` equations).
     pub phi: Vec<f64>,
+    /// The `r` equations in use, gathered from `phi`.
+    pub phi_r: Vec<f64>,
     pub rhs: Vec<f64>,
     pub mu: Vec<f64>,
     pub jac: DMatrix<f64>,
@@ -323,32 +343,35 @@ pub(crate) struct Workspace {
     pub force: Vec<f64>,
     pub x: Vec<f64>,
     pub res: Vec<f64>,
-    /// Workspace of the solves with the shared LUs (`max(m, dof)` each).
+    /// Workspace of the solves with the shared LUs (`max(r, dof)` each).
     pub ly: Vec<f64>,
     pub lx: Vec<f64>,
 }
 
 impl Workspace {
+    /// Buffers for `sys`: `r = m - k` equations in use (`k` redundant), `dof = n - r`.
     pub fn new(sys: &System) -> Self {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let dof = n.saturating_sub(m);
+        let r = m - sys.n_redundant().min(m);
+        let dof = n.saturating_sub(r);
         Workspace {
             q1: vec![0.0; n],
             v1: vec![0.0; n],
             phi: vec![0.0; m],
-            rhs: vec![0.0; m],
-            mu: vec![0.0; m],
+            phi_r: vec![0.0; r],
+            rhs: vec![0.0; r],
+            mu: vec![0.0; r],
             jac: DMatrix::zeros(m, n),
-            lu: crate::objective::small_lu(m),
+            lu: crate::objective::small_lu(r),
             dq: vec![0.0; n],
             qg: vec![0.0; n],
             vg: vec![0.0; n],
             r: vec![0.0; n],
             force: vec![0.0; n],
-            x: vec![0.0; m * dof],
+            x: vec![0.0; r * dof],
             res: vec![0.0; 2 * dof],
-            ly: vec![0.0; m.max(dof)],
-            lx: vec![0.0; m.max(dof)],
+            ly: vec![0.0; r.max(dof)],
+            lx: vec![0.0; r.max(dof)],
         }
     }
 }

@@ -13,9 +13,10 @@ pub enum PartitionChoice {
     /// [`FaDaeOptions::repartition_threshold`]).
     #[default]
     Auto,
-    /// These coordinate indices are independent (exactly `n - m` distinct indices whose
-    /// dependent block of `Phi_q` is invertible). Never re-chosen: a singular dependent block
-    /// during the run is an error.
+    /// These coordinate indices are independent (exactly [`mbd_model::System::dof`] `=
+    /// n - m + k` distinct indices, `k` redundant equations, whose dependent block of `Phi_q`
+    /// is invertible). Never re-chosen (with redundant equations only the `m - k` equations
+    /// that complete them are): a singular dependent block during the run is an error.
     Given(Vec<usize>),
 }
 

@@ -6,77 +6,130 @@ use mbd_model::System;
 use mbd_solve::linalg::max_abs;
 use nalgebra::DMatrix;
 
-/// The dependent block is square (`m x m`): the equations must be independent.
-fn refuse_redundant(sys: &System) -> Result<(), FaDaeError> {
-    mbd_solve::refuse_redundant(sys, "the firefly-algorithm DAE solver").map_err(|e| match e {
-        mbd_solve::SolveError::Unsupported(s) => FaDaeError::Unsupported(s),
-        other => FaDaeError::Unsupported(other.to_string()),
-    })
+/// `Partition::auto` and `Partition::given` need at least one degree of freedom.
+fn no_dof(sys: &System) -> FaDaeError {
+    let (n, m, k) = (sys.n_coords(), sys.n_constraints(), sys.n_redundant());
+    if k == 0 {
+        FaDaeError::Unsupported(format!(
+            "{m} constraints on {n} coordinates leave no degree of freedom to optimise"
+        ))
+    } else {
+        FaDaeError::Unsupported(format!(
+            "{m} constraints ({k} of them redundant) on {n} coordinates leave no degree of \
+             freedom to optimise"
+        ))
+    }
 }
 
-/// A split of the `n` coordinates into `dof` independent and `m` dependent ones, such that the
-/// dependent block `Phi_q[:, dependent]` is invertible.
+/// The error of [`Partition::auto`] (or of a check of [`Partition::given`]) when `Phi_q(q)`
+/// does not have the rank `m - k` that the build found (`k` redundant equations).
+fn rank_error(sys: &System, piv: &Pivoting, e: RankError) -> FaDaeError {
+    let (m, k) = (sys.n_constraints(), sys.n_redundant());
+    match e {
+        RankError::Deficient(i) if k == 0 => FaDaeError::Unsupported(format!(
+            "Phi_q is rank deficient (rank {i} < {m} constraints): redundant constraints \
+             or a singular configuration; equation {}",
+            sys.equation_name(piv.rows[i])
+        )),
+        RankError::Deficient(i) => FaDaeError::Unsupported(format!(
+            "Phi_q is rank deficient (rank {i} < {} = {m} constraints - {k} redundant): a \
+             singular configuration or more redundant constraints than the build found; \
+             equation {}",
+            m - k,
+            sys.equation_name(piv.rows[i])
+        )),
+        RankError::Excess(row) => {
+            let names: Vec<&str> = sys
+                .redundant_equations()
+                .iter()
+                .map(|e| e.equation.as_str())
+                .collect();
+            FaDaeError::Unsupported(format!(
+                "the redundancy found at build is gone: Phi_q has rank above {} = {m} \
+                 constraints - {k} redundant at this configuration (redundant at build: {}); \
+                 equation {} is independent of the others",
+                m - k,
+                names.join(", "),
+                sys.equation_name(row)
+            ))
+        }
+    }
+}
+
+/// A split of the `n` coordinates into `dof` independent and `r` dependent ones, and a choice
+/// of `r` equations (rows of `Phi`) such that the dependent block
+/// `Phi_q[equations, dependent]` is invertible. `r = m - k` is the rank of `Phi_q`: `m`
+/// without redundant equations (then `equations` is every row), `m - k` for a mechanism with
+/// `k` redundant equations ([`System::n_redundant`]), whose other rows are combinations of
+/// these and hold wherever these do.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Partition {
     /// Independent coordinates (ascending).
     pub independent: Vec<usize>,
     /// Dependent coordinates (ascending).
     pub dependent: Vec<usize>,
+    /// The equations (rows of `Phi`, ascending) that complete the dependent coordinates, as
+    /// many as dependent coordinates.
+    pub equations: Vec<usize>,
 }
 
 impl Partition {
-    /// Partition by Gaussian elimination with complete pivoting of `Phi_q(q)`: the `m` pivot
-    /// columns (largest remaining entry first) become the dependent coordinates, the rest are
-    /// independent. For the two-link manipulator this picks the four centre-of-mass
-    /// coordinates as dependent and the two link angles as independent, as the paper does.
+    /// Partition by Gaussian elimination with complete pivoting of `Phi_q(q)`: the `r = m - k`
+    /// pivot columns (largest remaining entry first) become the dependent coordinates, the
+    /// rest are independent, and the `r` pivot rows are the equations that complete them
+    /// (`k` = [`System::n_redundant`]). For the two-link manipulator this picks the four
+    /// centre-of-mass coordinates as dependent and the two link angles as independent, as
+    /// the paper does.
     ///
     /// # Errors
-    /// [`FaDaeError::Unsupported`] if `Phi_q` is rank deficient (redundant constraints or a
-    /// singular configuration) or the system has no degree of freedom.
+    /// [`FaDaeError::Unsupported`] if the system has no degree of freedom, if `Phi_q(q)` has
+    /// rank below `m - k` (a singular configuration: a pivot at most `1e-10` of the largest
+    /// entry) or above it (the redundancy found at build is gone: a row left after `m - k`
+    /// pivots has an entry above that tolerance); the message names the equation.
     pub fn auto(sys: &System, q: &[f64]) -> Result<Partition, FaDaeError> {
-        refuse_redundant(sys)?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        if m >= n {
-            return Err(FaDaeError::Unsupported(format!(
-                "{m} constraints on {n} coordinates leave no degree of freedom to optimise"
-            )));
+        if sys.dof() == 0 {
+            return Err(no_dof(sys));
         }
         let mut j = DMatrix::zeros(m, n);
         sys.phi_q(q, &mut j);
-        let mut piv = Pivoting::new(m, n);
+        let mut piv = Pivoting::new(m, n, sys.n_redundant());
         match piv.eliminate(&j) {
             Ok(_) => Ok(piv.partition()),
-            Err(k) => Err(FaDaeError::Unsupported(format!(
-                "Phi_q is rank deficient (rank {k} < {m} constraints): redundant constraints \
-                 or a singular configuration; equation {}",
-                sys.equation_name(piv.rows[k])
-            ))),
+            Err(e) => Err(rank_error(sys, &piv, e)),
         }
     }
 
     /// A partition with the given independent coordinates; checks the indices and that the
-    /// dependent block of `Phi_q(q)` is invertible.
+    /// dependent block of `Phi_q(q)` is invertible. With `k > 0` redundant equations the `r`
+    /// equations are chosen by Gaussian elimination with complete pivoting of `Phi_q(q)` with
+    /// the pivot columns restricted to the dependent coordinates.
     ///
     /// # Errors
     /// [`FaDaeError::InvalidPartition`] for a wrong count (must equal the degrees of freedom
-    /// `n - m`), an index out of range, a duplicate, or a singular dependent block at `q`.
+    /// [`System::dof`], `n - m + k`), an index out of range, a duplicate, or a singular
+    /// dependent block at `q`; [`FaDaeError::Unsupported`] for a system without degrees of
+    /// freedom or (with redundant equations) a `Phi_q(q)` whose rank is not `m - k`.
     pub fn given(sys: &System, q: &[f64], independent: &[usize]) -> Result<Partition, FaDaeError> {
-        refuse_redundant(sys)?;
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let (n, m, k) = (sys.n_coords(), sys.n_constraints(), sys.n_redundant());
         let bad = |reason: String| FaDaeError::InvalidPartition {
             given: independent.to_vec(),
             reason,
         };
-        if m >= n {
-            return Err(FaDaeError::Unsupported(format!(
-                "{m} constraints on {n} coordinates leave no degree of freedom to optimise"
-            )));
+        let dof = sys.dof();
+        if dof == 0 {
+            return Err(no_dof(sys));
         }
-        if independent.len() != n - m {
+        if independent.len() != dof {
+            let redundant = if k == 0 {
+                String::new()
+            } else {
+                format!(", {k} of them redundant")
+            };
             return Err(bad(format!(
-                "{} indices given, but the system has {} degrees of freedom ({n} coordinates, {m} constraints)",
+                "{} indices given, but the system has {dof} degrees of freedom ({n} \
+                 coordinates, {m} constraints{redundant})",
                 independent.len(),
-                n - m
             )));
         }
         let mut seen = vec![false; n];
@@ -92,21 +145,36 @@ impl Partition {
         let mut ind = independent.to_vec();
         ind.sort_unstable();
         let dep: Vec<usize> = (0..n).filter(|i| !seen[*i]).collect();
-        let p = Partition {
-            independent: ind,
-            dependent: dep,
-        };
-        let mut j = DMatrix::zeros(m, n);
-        sys.phi_q(q, &mut j);
-        let mut lu = crate::objective::small_lu(m);
-        p.fill_dependent_block(&j, lu.rows_mut());
-        match lu.factor_lu().map(|()| lu.pivot_range()) {
-            Ok((pmin, pmax)) if pmin > 1e-10 * pmax => Ok(p),
-            _ => Err(bad(
+        let singular = || {
+            bad(
                 "the dependent block of Phi_q is singular at the initial state: these \
                  coordinates cannot be chosen freely"
                     .into(),
-            )),
+            )
+        };
+        let mut j = DMatrix::zeros(m, n);
+        sys.phi_q(q, &mut j);
+        let equations = if k == 0 {
+            (0..m).collect()
+        } else {
+            let mut piv = Pivoting::new(m, n, k);
+            match piv.eliminate_with_dependent(&j, &dep) {
+                Ok(_) => piv.partition().equations,
+                Err(RankError::Deficient(_)) => return Err(singular()),
+                Err(e) => return Err(rank_error(sys, &piv, e)),
+            }
+        };
+        let p = Partition {
+            independent: ind,
+            dependent: dep,
+            equations,
+        };
+        let r = p.dependent.len();
+        let mut lu = crate::objective::small_lu(r);
+        p.fill_dependent_block(&j, lu.rows_mut());
+        match lu.factor_lu().map(|()| lu.pivot_range()) {
+            Ok((pmin, pmax)) if pmin > 1e-10 * pmax => Ok(p),
+            _ => Err(singular()),
         }
     }
 
@@ -115,57 +183,99 @@ impl Partition {
         self.independent.len()
     }
 
-    /// Copies `Phi_q[:, dependent]` into a row-major `m x m` buffer.
+    /// Copies `Phi_q[equations, dependent]` into a row-major `r x r` buffer.
     pub(crate) fn fill_dependent_block(&self, j: &DMatrix<f64>, out: &mut [f64]) {
-        let m = self.dependent.len();
-        for r in 0..m {
-            for (c, &col) in self.dependent.iter().enumerate() {
-                out[r * m + c] = j[(r, col)];
-            }
-        }
+        crate::objective::fill_block(j, &self.equations, &self.dependent, out);
     }
 }
 
-/// Gaussian elimination with complete pivoting of an `m x n` Jacobian `Phi_q`, with its own
-/// buffers (allocation-free after construction): the choice of [`Partition::auto`], and the
-/// yardstick of the repartitioning test (the best available dependent block).
+/// Why [`Pivoting`] found no partition: `Phi_q` does not have the expected rank `m - k`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum RankError {
+    /// Pivot `i` (counting from 0, `i < m - k`) is at most the tolerance (or NaN): rank
+    /// deficient, a singular configuration.
+    Deficient(usize),
+    /// After `m - k` pivots this row of `Phi_q` still has an entry above the tolerance: fewer
+    /// than `k` equations are dependent.
+    Excess(usize),
+}
+
+/// Gaussian elimination with complete pivoting of an `m x n` Jacobian `Phi_q` of rank
+/// `r = m - k` (`k` redundant equations), with its own buffers (allocation-free after
+/// construction): the choice of [`Partition::auto`], and the yardstick of the repartitioning
+/// test (the best available dependent block).
 #[derive(Clone, Debug)]
 pub(crate) struct Pivoting {
     j: DMatrix<f64>,
     rows: Vec<usize>,
     cols: Vec<usize>,
+    /// The number `k` of rows expected to be dependent.
+    redundant: usize,
 }
 
 impl Pivoting {
-    pub(crate) fn new(m: usize, n: usize) -> Self {
+    /// Buffers for `m x n` Jacobians with `redundant <= m` dependent rows.
+    pub(crate) fn new(m: usize, n: usize, redundant: usize) -> Self {
         Pivoting {
             j: DMatrix::zeros(m, n),
             rows: (0..m).collect(),
             cols: (0..n).collect(),
+            redundant: redundant.min(m),
         }
     }
 
-    /// Eliminates a copy of `jac`: the `m` pivot columns (largest remaining entry first, lowest
-    /// index on ties) are the chosen dependent coordinates. Returns `ln |det|` of the chosen
-    /// block (the sum of the logarithms of the pivot magnitudes), or `Err(k)` if the `k`-th
-    /// pivot is at most `1e-10` of the largest entry (or NaN): `Phi_q` is rank deficient.
-    pub(crate) fn eliminate(&mut self, jac: &DMatrix<f64>) -> Result<f64, usize> {
-        let (m, n) = (self.rows.len(), self.cols.len());
-        let j = &mut self.j;
-        j.copy_from(jac);
-        for (i, r) in self.rows.iter_mut().enumerate() {
-            *r = i;
-        }
+    /// Eliminates a copy of `jac`: the `r = m - k` pivot columns (largest remaining entry
+    /// first, lowest index on ties) are the chosen dependent coordinates, the pivot rows the
+    /// equations. Returns `ln |det|` of the chosen `r x r` block (the sum of the logarithms of
+    /// the pivot magnitudes), or the [`RankError`] (tolerance: `1e-10` of the largest entry).
+    pub(crate) fn eliminate(&mut self, jac: &DMatrix<f64>) -> Result<f64, RankError> {
         for (i, c) in self.cols.iter_mut().enumerate() {
             *c = i;
         }
+        let n = self.cols.len();
+        self.reduce(jac, n)
+    }
+
+    /// As [`Pivoting::eliminate`] with the pivot columns restricted to `dep` (`r` columns):
+    /// the `r` equations for given dependent coordinates.
+    pub(crate) fn eliminate_with_dependent(
+        &mut self,
+        jac: &DMatrix<f64>,
+        dep: &[usize],
+    ) -> Result<f64, RankError> {
+        let n = self.cols.len();
+        let mut k = 0;
+        for &c in dep {
+            self.cols[k] = c;
+            k += 1;
+        }
+        for c in 0..n {
+            if !dep.contains(&c) {
+                self.cols[k] = c;
+                k += 1;
+            }
+        }
+        self.reduce(jac, dep.len())
+    }
+
+    /// The elimination, with pivot columns searched among the first `ncand` of `self.cols`
+    /// (every remaining column is reduced).
+    fn reduce(&mut self, jac: &DMatrix<f64>, ncand: usize) -> Result<f64, RankError> {
+        let m = self.rows.len();
+        let r = m - self.redundant;
+        let j = &mut self.j;
+        j.copy_from(jac);
+        for (i, row) in self.rows.iter_mut().enumerate() {
+            *row = i;
+        }
         let scale = max_abs(j.as_slice());
+        let tol = 1e-10 * scale.max(f64::MIN_POSITIVE);
         let mut log_det = 0.0;
-        for k in 0..m {
+        for k in 0..r {
             // complete pivoting over the remaining block
             let (mut pr, mut pc, mut best) = (k, k, -1.0f64);
             for ri in k..m {
-                for ci in k..n {
+                for ci in k..ncand {
                     let v = j[(self.rows[ri], self.cols[ci])].abs();
                     // strict `>` keeps the lowest index on ties: deterministic
                     if v > best {
@@ -175,37 +285,52 @@ impl Pivoting {
                     }
                 }
             }
-            if best.is_nan() || best <= 1e-10 * scale.max(f64::MIN_POSITIVE) {
-                return Err(k);
+            if best.is_nan() || best <= tol {
+                return Err(RankError::Deficient(k));
             }
             self.rows.swap(k, pr);
             self.cols.swap(k, pc);
             log_det += best.ln();
             let (r0, c0) = (self.rows[k], self.cols[k]);
             let p = j[(r0, c0)];
-            for &r in &self.rows[k + 1..] {
-                let l = j[(r, c0)] / p;
+            for &row in &self.rows[k + 1..] {
+                let l = j[(row, c0)] / p;
                 if l != 0.0 {
                     for &c in &self.cols[k..] {
                         let v = j[(r0, c)];
-                        j[(r, c)] -= l * v;
+                        j[(row, c)] -= l * v;
                     }
+                }
+            }
+        }
+        // the k rows left are combinations of the pivot rows: reduced to round-off
+        for &row in &self.rows[r..] {
+            for &c in &self.cols[r..] {
+                let v = j[(row, c)].abs();
+                if v.is_nan() {
+                    return Err(RankError::Deficient(r));
+                }
+                if v > tol {
+                    return Err(RankError::Excess(row));
                 }
             }
         }
         Ok(log_det)
     }
 
-    /// The partition chosen by the last successful [`Pivoting::eliminate`].
+    /// The partition chosen by the last successful elimination.
     pub(crate) fn partition(&self) -> Partition {
-        let m = self.rows.len();
-        let mut dependent = self.cols[..m].to_vec();
-        let mut independent = self.cols[m..].to_vec();
+        let r = self.rows.len() - self.redundant;
+        let mut dependent = self.cols[..r].to_vec();
+        let mut independent = self.cols[r..].to_vec();
+        let mut equations = self.rows[..r].to_vec();
         dependent.sort_unstable();
         independent.sort_unstable();
+        equations.sort_unstable();
         Partition {
             independent,
             dependent,
+            equations,
         }
     }
 }

@@ -127,7 +127,8 @@ impl FireflyGauss {
     /// # Errors
     /// Invalid options ([`FaDaeError::InvalidOption`], [`FaDaeError::Firefly`]), invalid
     /// independent coordinates ([`FaDaeError::InvalidPartition`]), a system without degrees of
-    /// freedom or with redundant constraints ([`FaDaeError::Unsupported`]).
+    /// freedom or whose `Phi_q` at the initial guess does not have the rank `m - k` the build
+    /// found (`k` redundant equations; [`FaDaeError::Unsupported`]).
     pub fn new(sys: &System, options: FaDaeOptions) -> Result<Self, FaDaeError> {
         options.validate()?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
@@ -153,7 +154,7 @@ impl FireflyGauss {
             n,
             m,
             partition,
-            pivoting: Pivoting::new(m, n),
+            pivoting: Pivoting::new(m, n, sys.n_redundant()),
             prob,
             ws: Workspace::new(sys),
             pool,

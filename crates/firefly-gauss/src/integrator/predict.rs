@@ -3,11 +3,13 @@
 use super::*;
 
 impl FireflyGauss {
-    /// Auto partitioning: re-choose when the dependent block at the step's start has become
-    /// much worse than the best available one (see [`FaDaeOptions::repartition_threshold`]).
-    /// Given partitioning: error when it is singular. Returns whether the partition changed and
-    /// the quality of the dependent block before any change (`|det Phi_d| / |det Phi_best|`;
-    /// NaN for a given partition).
+    /// Auto partitioning: re-choose the dependent coordinates and the equations when the
+    /// dependent block at the step's start has become much worse than the best available one
+    /// (see [`FaDaeOptions::repartition_threshold`]). Given partitioning: error when it is
+    /// singular; with redundant equations the equations are re-chosen for the given
+    /// coordinates first, in the same way. Returns whether the partition changed and the
+    /// quality of the dependent block before any change (`|det Phi_d| / |det Phi_best|`; NaN
+    /// for a given partition).
     pub(super) fn check_partition(
         &mut self,
         sys: &System,
@@ -19,6 +21,9 @@ impl FireflyGauss {
             .fill_dependent_block(&self.ws.jac, self.ws.lu.rows_mut());
         let factored = self.ws.lu.factor_lu().map(|()| self.ws.lu.pivot_range());
         if let PartitionChoice::Given(_) = self.opts.partition {
+            if self.prob.r < self.m {
+                return self.check_given_rows(state, factored.is_ok());
+            }
             let ratio = match factored {
                 Ok((pmin, pmax)) => pmin / pmax,
                 Err(_) => 0.0,
@@ -37,8 +42,9 @@ impl FireflyGauss {
             Ok(_) => self.ws.lu.log_abs_det(),
             Err(_) => f64::NEG_INFINITY,
         };
-        // Phi_q rank deficient (a singular configuration): no block is better, keep this one
-        // (the step fails in `prepare` if it is exactly singular)
+        // Phi_q rank deficient (a singular configuration) or, with redundant equations, of
+        // higher rank than at build: no block is better, keep this one (the step fails in
+        // `prepare` if it is exactly singular)
         let Ok(best) = self.pivoting.eliminate(&self.ws.jac) else {
             return Ok((false, 1.0));
         };
@@ -54,6 +60,57 @@ impl FireflyGauss {
             self.n_corr = 0;
         }
         Ok((changed, quality))
+    }
+
+    /// A given partition of a mechanism with redundant equations: the coordinates are the
+    /// user's, the equations are not. When the block of the equations in use is worse than
+    /// `repartition_threshold` times the best block for these coordinates (complete pivoting
+    /// restricted to the dependent columns), the equations are re-chosen; a block that stays
+    /// singular is an error as without redundant equations. `factored`: the LU of the block in
+    /// use (in `self.ws.lu`) succeeded.
+    fn check_given_rows(
+        &mut self,
+        state: &State,
+        factored: bool,
+    ) -> Result<(bool, f64), FaDaeError> {
+        let current = if factored {
+            self.ws.lu.log_abs_det()
+        } else {
+            f64::NEG_INFINITY
+        };
+        let mut changed = false;
+        if let Ok(best) = self
+            .pivoting
+            .eliminate_with_dependent(&self.ws.jac, &self.partition.dependent)
+        {
+            if (current - best).exp() < self.opts.repartition_threshold.max(1e-12) {
+                let p = self.pivoting.partition();
+                changed = p.equations != self.partition.equations;
+                if changed {
+                    self.partition.equations.clone_from(&p.equations);
+                    self.prob.set_partition(&self.partition);
+                    self.n_corr = 0;
+                }
+            }
+        }
+        self.partition
+            .fill_dependent_block(&self.ws.jac, self.ws.lu.rows_mut());
+        let ratio = match self.ws.lu.factor_lu().map(|()| self.ws.lu.pivot_range()) {
+            Ok((pmin, pmax)) => pmin / pmax,
+            Err(_) => 0.0,
+        };
+        if ratio.is_nan() || ratio <= 1e-12 {
+            return Err(SolveError::Singular {
+                t: state.t,
+                what: "dependent block of Phi_q (user-given partition)",
+                detail: format!(
+                    "independent coordinates {:?}, equations {:?}",
+                    self.partition.independent, self.partition.equations
+                ),
+            }
+            .into());
+        }
+        Ok((changed, f64::NAN))
     }
 
     /// RK4 on the index-1 form from the state (the predictor) and, without a correction
