@@ -57,11 +57,13 @@ impl RowSelection {
     }
 
     /// Whether rows are dropped (the model has redundant equations).
+    #[inline]
     pub(crate) fn drops_rows(&self) -> bool {
         self.k > 0
     }
 
     /// The model's row of kept row `i`.
+    #[inline]
     pub(crate) fn full_row(&self, i: usize) -> usize {
         self.rows.get(i).copied().unwrap_or(i)
     }
@@ -70,6 +72,7 @@ impl RowSelection {
     /// `select`, the rows are chosen afresh at this point first (a centre). `false` if the
     /// selection failed: `Phi_q` has more than `k` dependent rows here (a singular
     /// configuration), or fewer (the redundancy found at build time is gone).
+    #[inline]
     pub(crate) fn jacobian(
         &mut self,
         sys: &System,
@@ -128,6 +131,7 @@ impl RowSelection {
 
     /// `Phi` and `Phi_q v + Phi_t` at `x = (q, v)` and `t`, kept rows, into the two halves of
     /// `out` (the rotations from `angles` near the previous evaluation when given).
+    #[inline]
     pub(crate) fn residual(
         &mut self,
         sys: &System,
