@@ -224,3 +224,37 @@ fn dense_and_sparse_index1_solves_agree() {
     let d = (&ends[0] - &ends[1]).amax();
     assert!(d < 1e-12, "dense vs sparse: {d:e}");
 }
+
+/// The tangent-space chart forced onto its sparse path (all rows, the dependent ones dropped in
+/// each factorisation of `Df Df^T`) and its dense path (the independent rows chosen at each
+/// centre) follow the same motion.
+#[test]
+fn dense_and_sparse_tangent_charts_agree() {
+    use mbd::solve::{run, ButcherTableau, LinearSolver, NoObserver};
+    use mbd::tangent::{TangentOptions, TangentRk};
+    let sys = double_parallelogram(-0.5, false).expect("model");
+    let mut ends = Vec::new();
+    for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
+        let opts = TangentOptions {
+            linear_solver: linear,
+            ..Default::default()
+        };
+        let mut rk = TangentRk::new(&sys, ButcherTableau::rk4(), opts).expect("tangent");
+        let mut s = State::consistent(&sys, 0.0).expect("state");
+        run(
+            &mut rk,
+            &sys,
+            &mut s,
+            RunConfig::new(1.0, 1e-3),
+            &mut NoObserver,
+        )
+        .expect("run");
+        let mut phi = vec![0.0; sys.n_constraints()];
+        sys.phi(s.q.as_slice(), s.t, &mut phi);
+        let worst = phi.iter().fold(0.0f64, |w, p| w.max(p.abs()));
+        assert!(worst < 1e-12, "{linear:?}: max|Phi| = {worst:e}");
+        ends.push(s.q.clone());
+    }
+    let d = (&ends[0] - &ends[1]).amax();
+    assert!(d < 1e-11, "dense vs sparse tangent: {d:e}");
+}

@@ -153,17 +153,15 @@ impl TangentRk {
     ) -> Result<Self, SolveError> {
         options.validate()?;
         let (n, m_full) = (sys.n_coords(), sys.n_constraints());
-        // the chart works with the m - k independent rows (chosen at each centre)
-        let m = m_full - sys.n_redundant();
-        let path = if options.linear_solver.use_sparse(m_full) {
-            // the sparse chart's dimension is n - m: it needs independent equations
-            mbd_solve::refuse_redundant(sys, "the sparse tangent chart (above the dense size)")
-                .map_err(|e| match e {
-                    SolveError::Unsupported(s) => {
-                        SolveError::Unsupported(format!("{s}; use LinearSolver::Dense"))
-                    }
-                    other => other,
-                })?;
+        let sparse = options.linear_solver.use_sparse(m_full);
+        // the dense chart works with the m - k independent rows (chosen at each centre); the
+        // sparse chart with all m, its factorisations dropping the dependent ones
+        let m = if sparse {
+            m_full
+        } else {
+            m_full - sys.n_redundant()
+        };
+        let path = if sparse {
             if options.iteration_matrix != IterationMatrix::Centre {
                 return Err(SolveError::Unsupported(format!(
                     "the sparse tangent chart iterates with the centre's matrix only \

@@ -123,8 +123,14 @@ impl SparseChart {
                 }
             }
         }
-        let chol = SparseCholesky::new(2 * m, &pattern)?;
-        let pos_chol = SparseCholesky::new(m, &pos_pattern)?;
+        let mut chol = SparseCholesky::new(2 * m, &pattern)?;
+        let mut pos_chol = SparseCholesky::new(m, &pos_pattern)?;
+        // k redundant equations: k dependent position rows and k velocity rows, dropped at
+        // each factorisation (the projector and the chord then work with the independent
+        // rows, whose span is the same: docs/architecture.md, "Redundant constraints")
+        let k = sys.n_redundant();
+        chol.set_max_dependent(2 * k);
+        pos_chol.set_max_dependent(k);
         let missing = |r: usize, c: usize| {
             SolveError::Unsupported(format!("sparse chart: pattern lacks entry ({r}, {c})"))
         };
