@@ -127,17 +127,6 @@ impl Galerkin {
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
         let sparse_ok = options.gamma == 0.0;
         let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
-        if use_sparse {
-            // the sparse LU keeps every multiplier: redundant equations only on the dense path
-            mbd_solve::refuse_redundant(sys, "the sparse symplectic stage solve").map_err(|e| {
-                match e {
-                    SolveError::Unsupported(s) => {
-                        SolveError::Unsupported(format!("{s}; use LinearSolver::Dense"))
-                    }
-                    other => other,
-                }
-            })?;
-        }
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
                 "the sparse symplectic stage solve needs gamma = 0 (the Hessian of the paper's \

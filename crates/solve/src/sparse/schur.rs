@@ -180,6 +180,12 @@ impl ConstraintSchur {
         self.chol.factor()
     }
 
+    /// The rows (equations) the last factorisation dropped as dependent on earlier ones
+    /// (empty for a model without redundant equations).
+    pub fn dependent(&self) -> &[usize] {
+        self.chol.dependent()
+    }
+
     /// Solves `S x = b` in place with the last factorisation.
     pub fn solve_in_place(&mut self, b: &mut [f64]) {
         self.chol.solve_in_place(b);

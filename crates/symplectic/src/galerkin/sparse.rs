@@ -28,6 +28,9 @@ pub(super) struct SparseStage {
     k_slot: Vec<usize>,
     /// `lam_slot[nu m + r][a]`: entry (momentum row `(nu, coord(a))`, multiplier `(nu, r)`).
     lam_slot: Vec<[usize; 6]>,
+    /// `diag_slot[(nu - 1) m + r]`: entry (constraint `(nu, r)`, multiplier `(nu - 1, r)`),
+    /// only for a model with redundant equations (else empty).
+    diag_slot: Vec<usize>,
     /// `con_slot[(nu - 1) m + r][c]`: entry (constraint `(nu, r)`, `Z_nu,coord(c)`).
     con_slot: Vec<[usize; 6]>,
     /// `curv_slot[(nu - 1) m + r][a][c]` (`nu = 1..s-1`): entry (momentum row
@@ -170,6 +173,17 @@ impl SparseStage {
                 }
             }
         }
+        // a model with redundant equations: each constraint row (nu, r) pairs with its
+        // multiplier (nu - 1, r) on a diagonal entry, which a dropped row sets to 1
+        let redundant = sys.n_redundant() > 0;
+        if redundant {
+            for nu in 1..=s {
+                for r in 0..m {
+                    let k = s * n + (nu - 1) * m + r;
+                    entries.push((k, k));
+                }
+            }
+        }
         let lu = SparseLu::new(dim, &entries)?;
         let slot = |r: usize, c: usize| lu.slot(r, c).unwrap_or(NONE);
         let mut k_slot = vec![NONE; s * s * n];
@@ -265,7 +279,13 @@ impl SparseStage {
             fseed[3 * fcolor[l / 3] + l % 3].push(e);
         }
         let ne = fent.len();
+        let diag_slot = if redundant {
+            (0..s * m).map(|k| slot(s * n + k, s * n + k)).collect()
+        } else {
+            Vec::new()
+        };
         Ok(SparseStage {
+            diag_slot,
             lu,
             row_bodies,
             schur: ConstraintSchur::new(sys)?,
@@ -483,6 +503,35 @@ impl Galerkin {
             let vals = sp.lu.values_mut();
             for i in 0..n {
                 vals[sp.k_slot[i]] += minv[i] * (cw * 2.0 * wd[i] + ch * ad[i]);
+            }
+        }
+        if !sp.diag_slot.is_empty() {
+            // the equations dependent at the step's end configuration are left out: their
+            // rows become the identity on their multipliers, which then stay put (Newton
+            // moves them by the residual of an equation the others imply)
+            sp.schur.update(sys, &self.qn[s * n..(s + 1) * n]);
+            sp.schur
+                .factor(&self.minv)
+                .map_err(|_| SolveError::Singular {
+                    t: t + h,
+                    what: "constraint matrix Phi_q M^-1 Phi_q^T of the stage equations",
+                    detail: "more dependent equations than the model's redundant ones".into(),
+                })?;
+            let vals = sp.lu.values_mut();
+            for &r in sp.schur.dependent() {
+                for nu in 1..=s {
+                    for &k in &sp.con_slot[(nu - 1) * m + r] {
+                        if k != NONE {
+                            vals[k] = 0.0;
+                        }
+                    }
+                    for &k in &sp.lam_slot[(nu - 1) * m + r] {
+                        if k != NONE {
+                            vals[k] = 0.0;
+                        }
+                    }
+                    vals[sp.diag_slot[(nu - 1) * m + r]] = 1.0;
+                }
             }
         }
         self.jacobians += 1;
