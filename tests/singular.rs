@@ -144,3 +144,20 @@ fn no_solver_reaches_the_end_on_another_branch() {
     // the projecting and symplectic solvers pass
     assert!(reached >= 8, "{reached} runs reached the end");
 }
+
+/// Plain RK4 stops at the four-bar's first flat configuration (t = 0.44 s) with the typed
+/// error naming the time, the rank deficiency and the loop's joints.
+#[test]
+fn the_singular_stop_names_time_rank_deficiency_and_joints() {
+    let (r, _) = rk4(false, true, 1e-4, 1.0);
+    match r {
+        Err(SolveError::Singular { t, detail, .. }) => {
+            assert!((0.4..0.45).contains(&t), "{t}");
+            assert!(detail.contains("rank deficiency 1"), "{detail}");
+            for joint in ["A0", "B0"] {
+                assert!(detail.contains(joint), "{detail}");
+            }
+        }
+        other => panic!("expected the singular stop, got {other:?}"),
+    }
+}

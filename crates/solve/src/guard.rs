@@ -338,7 +338,11 @@ impl RunChecks {
                 .iter()
                 .map(|e| format!("{} (joints {})", e.equation, e.joints.join(", ")))
                 .collect();
-            format!("; equations near dependence: {}", list.join("; "))
+            format!(
+                "; rank deficiency {} (equations within 1e-2 of dependence: {})",
+                near.len(),
+                list.join("; ")
+            )
         };
         SolveError::Singular {
             t: state.t,
