@@ -19,6 +19,17 @@ const ANGLE: f64 = 1.0;
 const SPEED: f64 = 6.0;
 /// An error below this is at the floor of double precision for these runs.
 const FLOOR: f64 = 1e-9;
+/// A run that ends with a coupler turned by this much (rad) is on another branch (on the
+/// parallelogram branch the couplers translate).
+const BRANCH_TOL: f64 = 1e-2;
+use std::f64::consts::TAU;
+/// The documented miss of the free N-four-bar's claims: the issue's target is the driven
+/// mechanism; the free one (released at 6 rad/s, turning over) shows where solvers still lose
+/// accuracy or stop with an untyped error at a singular passage.
+const FREE_MISS: &str = "the free N-four-bar goes beyond the driven target: projected RK4 \
+    loses accuracy at the smallest h, tangent DOPRI5's error does not fall with h, and plain RK4 \
+    and the (2,2) modified scheme can stop with a drift or Newton error instead of the singular \
+    one (open work, issue 22)";
 
 /// How a run ended.
 enum Outcome {
@@ -64,17 +75,17 @@ fn steps(v: &SolverVariant, quick: bool) -> Vec<f64> {
 }
 
 /// Runs `sys` with `v` to `t_end` at step (tolerance) `h`; `measure` gives the error of the
-/// final state.
+/// final state (also returned when the run reached the end).
 fn run_one(
     sys: System,
     v: &SolverVariant,
     t_end: f64,
     h: f64,
     measure: impl Fn(&State) -> f64,
-) -> Outcome {
+) -> (Outcome, Option<State>) {
     let mut sim = match Simulation::new(sys, v.spec) {
         Ok(s) => s,
-        Err(e) => return Outcome::Refused(e.to_string()),
+        Err(e) => return (Outcome::Refused(e.to_string()), None),
     };
     let plan: Plan = if v.spec.starts_with("index1") {
         AdaptiveConfig::new(t_end, h).into()
@@ -82,9 +93,12 @@ fn run_one(
         RunConfig::new(t_end, h).into()
     };
     match sim.run(plan) {
-        Ok(_) => Outcome::Reached(measure(sim.state())),
-        Err(mbd::Error::Solve(SolveError::Singular { t, .. })) => Outcome::Singular(t),
-        Err(e) => Outcome::Other(e.to_string()),
+        Ok(_) => (
+            Outcome::Reached(measure(sim.state())),
+            Some(sim.state().clone()),
+        ),
+        Err(mbd::Error::Solve(SolveError::Singular { t, .. })) => (Outcome::Singular(t), None),
+        Err(e) => (Outcome::Other(e.to_string()), None),
     }
 }
 
@@ -105,7 +119,7 @@ fn passes(outcomes: &[Outcome]) -> bool {
         match o {
             Outcome::Other(_) => return false,
             Outcome::Reached(e) => {
-                if e.is_nan() || *e >= 1e-3 {
+                if e.is_nan() {
                     return false;
                 }
                 if let Some(p) = last {
@@ -140,47 +154,93 @@ pub fn singular(ctx: &Ctx) -> Result<Section, String> {
         "1e-2, 1e-3, 1e-4 s (index-1 DOPRI5: tolerances 1e-6, 1e-8, 1e-10; FA-DAE: the first two)",
     );
     let mut table = Table::new(
-        "N-four-bar driven through its flat configurations: outcome and tracked-point error at the end",
-        &["N", "solver", "h (tol)", "outcome", "error [m]"],
+        "N-four-bar through its flat configurations, driven and free: outcome and tracked-point error at the end",
+        &["N", "motion", "solver", "h (tol)", "outcome", "error [m]"],
     );
     let mut rows = Vec::new();
     let mut stopped_other = Vec::new();
     let mut wrong_branch = Vec::new();
-    for &n in &loops {
+    for (n, driven) in loops.iter().flat_map(|&n| [(n, true), (n, false)]) {
         let cl = ClosedLoop::n_four_bar(n, CRANK, GROUND).map_err(|e| e.to_string())?;
-        let exact = CrankMotion::driven(ANGLE, SPEED).map_err(|e| e.to_string())?;
+        // driven: theta = ANGLE + SPEED t; free: released at SPEED, it turns over (the exact
+        // elliptic-function motion)
+        let exact = if driven {
+            CrankMotion::driven(ANGLE, SPEED)
+        } else {
+            cl.motion(ANGLE, SPEED)
+        }
+        .map_err(|e| e.to_string())?;
         let want = cl.tracked_point(exact.at(t_end)[0]);
+        let motion = if driven { "driven" } else { "free" };
         for (_, v) in mbd::registry().variants() {
+            if v.relative_cost > 20.0 && n > 2 {
+                // (the swarm-based solver: 10 s of the larger mechanism cost minutes)
+                table.row(vec![
+                    n.to_string(),
+                    motion.into(),
+                    v.spec.into(),
+                    "-".into(),
+                    "not run (cost)".into(),
+                    "-".into(),
+                ]);
+                continue;
+            }
             let mut outcomes = Vec::new();
             for h in steps(v, ctx.quick) {
-                let sys = cl.system(ANGLE, SPEED, true).map_err(|e| e.to_string())?;
+                let sys = cl.system(ANGLE, SPEED, driven).map_err(|e| e.to_string())?;
                 let body = sys
                     .body_handle(&cl.tracked_body())
                     .ok_or("the tracked body is missing")?
                     .index();
-                let o = run_one(sys, v, t_end, h, |s| {
+                let couplers: Vec<usize> = (1..=n)
+                    .filter_map(|k| sys.body_handle(&format!("coupler{k}")))
+                    .map(|h| h.index())
+                    .collect();
+                if couplers.len() != n {
+                    return Err("the N-four-bar's couplers are missing".into());
+                }
+                let (o, end) = run_one(sys, v, t_end, h, |s| {
                     let p = tip(s, body);
                     ((p[0] - want[0]).powi(2) + (p[1] - want[1]).powi(2)).sqrt()
+                });
+                // on the parallelogram branch every coupler translates: its angle stays 0
+                // (mod 2 pi); another branch turns them by O(1)
+                let off_branch = end.as_ref().map_or(0.0, |s| {
+                    couplers
+                        .iter()
+                        .map(|&c| {
+                            let a = s.q[3 * c + 2];
+                            (a - (a / TAU).round() * TAU).abs()
+                        })
+                        .fold(0.0f64, f64::max)
                 });
                 let (what, err) = o.cell();
                 table.row(vec![
                     n.to_string(),
+                    motion.into(),
                     v.spec.into(),
                     format!("{h:e}"),
                     what.clone(),
                     err,
                 ]);
                 rows.push(json!({
-                    "loops": n, "solver": v.spec, "h": h, "outcome": what,
+                    "loops": n, "motion": motion, "solver": v.spec, "h": h, "outcome": what,
                     "error": match &o { Outcome::Reached(e) => json!(num(*e)), _ => json!(null) },
                 }));
                 match &o {
-                    Outcome::Reached(e) if e.is_nan() || *e >= 1e-3 => {
-                        wrong_branch.push(format!("{} N = {n} h = {h:e}: {e:.2e}", v.spec))
+                    Outcome::Reached(_) if off_branch.is_nan() || off_branch >= BRANCH_TOL => {
+                        wrong_branch.push((
+                            driven,
+                            format!(
+                                "{} N = {n} {motion} h = {h:e}: couplers turned by {off_branch:.2e} rad",
+                                v.spec
+                            ),
+                        ))
                     }
-                    Outcome::Other(m) => {
-                        stopped_other.push(format!("{} N = {n} h = {h:e}: {}", v.spec, short(m)))
-                    }
+                    Outcome::Other(m) => stopped_other.push((
+                        driven,
+                        format!("{} N = {n} {motion} h = {h:e}: {}", v.spec, short(m)),
+                    )),
                     _ => {}
                 }
                 outcomes.push(o);
@@ -193,11 +253,11 @@ pub fn singular(ctx: &Ctx) -> Result<Section, String> {
                     _ => None,
                 })
                 .collect();
-            sec.claims.push(Claim::check(
+            let claim = Claim::check(
                 format!(
-                    "N-four-bar N = {n}, {}: every run reaches t = {t_end} with the tracked point's \
-                     error falling tenfold per decade of h (to below {FLOOR:e}) or stops with the \
-                     typed singular error (or refuses the model)",
+                    "N-four-bar N = {n} {motion}, {}: every run reaches t = {t_end} with the \
+                     tracked point's error falling tenfold per decade of h (to below {FLOOR:e}) \
+                     or stops with the typed singular error (or refuses the model)",
                     v.spec
                 ),
                 ok,
@@ -205,27 +265,55 @@ pub fn singular(ctx: &Ctx) -> Result<Section, String> {
                     "errors of the runs that reached the end: [{}]",
                     reached.join(", ")
                 ),
-            ));
+            );
+            sec.claims.push(if driven {
+                claim
+            } else {
+                claim.expected_miss(FREE_MISS)
+            });
         }
     }
-    sec.claims.push(Claim::check(
-        "no solver reaches the end of an N-four-bar run on another branch (tracked point off by 1e-3 m or more)",
-        wrong_branch.is_empty(),
-        if wrong_branch.is_empty() {
-            "none".to_string()
+    for driven in [true, false] {
+        let motion = if driven { "driven" } else { "free" };
+        let pick = |v: &[(bool, String)]| -> Vec<String> {
+            v.iter()
+                .filter(|(d, _)| *d == driven)
+                .map(|(_, m)| m.clone())
+                .collect()
+        };
+        let (wrong, other) = (pick(&wrong_branch), pick(&stopped_other));
+        let branch = Claim::check(
+            format!(
+                "no solver reaches the end of a {motion} N-four-bar run on another branch (a \
+                 coupler turned by {BRANCH_TOL:e} rad or more)"
+            ),
+            wrong.is_empty(),
+            if wrong.is_empty() {
+                "none".to_string()
+            } else {
+                wrong.join("; ")
+            },
+        );
+        let typed = Claim::check(
+            format!(
+                "every {motion} N-four-bar run that stops, stops with the typed \
+                 singular-configuration error (or a refusal at construction)"
+            ),
+            other.is_empty(),
+            if other.is_empty() {
+                "none stopped otherwise".to_string()
+            } else {
+                other.join("; ")
+            },
+        );
+        if driven {
+            sec.claims.push(branch);
+            sec.claims.push(typed);
         } else {
-            wrong_branch.join("; ")
-        },
-    ));
-    sec.claims.push(Claim::check(
-        "every N-four-bar run that stops, stops with the typed singular-configuration error (or a refusal at construction)",
-        stopped_other.is_empty(),
-        if stopped_other.is_empty() {
-            "none stopped otherwise".to_string()
-        } else {
-            stopped_other.join("; ")
-        },
-    ));
+            sec.claims.push(branch);
+            sec.claims.push(typed.expected_miss(FREE_MISS));
+        }
+    }
     sec.tables.push(table);
     redundant(ctx, &mut sec)?;
     sec.summary = json!({ "singular": rows });
@@ -279,7 +367,7 @@ fn redundant(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
                     .body_handle(&cl.tracked_body())
                     .ok_or("the tracked body is missing")?
                     .index();
-                let o = run_one(sys, v, t_end, h, |s| (s.q[3 * body + 2] - want).abs());
+                let (o, _) = run_one(sys, v, t_end, h, |s| (s.q[3 * body + 2] - want).abs());
                 let (what, err) = o.cell();
                 match &o {
                     Outcome::Reached(e) => errs.push(*e),
@@ -324,7 +412,7 @@ fn redundant(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
                     } else {
                         observed.is_some_and(|o| o >= order - 0.5)
                     });
-            sec.claims.push(Claim::check(
+            let claim = Claim::check(
                 format!(
                     "{name}, {}: follows the exact motion at its order ({})",
                     v.spec,
@@ -342,7 +430,15 @@ fn redundant(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
                         .collect::<Vec<_>>()
                         .join(", ")
                 ),
-            ));
+            );
+            sec.claims.push(if v.compared {
+                claim
+            } else {
+                claim.expected_miss(
+                    "its error is set by the swarm's stopping rule rather than by h (the \
+                     registry leaves it out of the order comparisons: compared = false)",
+                )
+            });
         }
     }
     sec.tables.push(table);
