@@ -228,50 +228,22 @@ fn every_solver_runs_redundant_models_and_a_refusal_says_which_do() {
     }
 }
 
-/// The sparse and the dense Schur complement drop the same equation and give the same motion.
-#[test]
-fn dense_and_sparse_index1_solves_agree() {
-    use mbd::rk4::{Rk4, Rk4Options};
+/// Runs the double parallelogram for 1 s at h = 1e-3 with the integrator `make` builds for
+/// the dense and for the sparse linear algebra: both keep all twelve equations below 1e-12
+/// and end within `tol` of each other.
+fn dense_and_sparse_agree(
+    label: &str,
+    tol: f64,
+    make: impl Fn(&System, mbd::solve::LinearSolver) -> Box<dyn mbd::solve::Integrator>,
+) {
     use mbd::solve::{run, LinearSolver, NoObserver};
     let sys = double_parallelogram(-0.5, false).expect("model");
     let mut ends = Vec::new();
     for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
-        let mut opts = Rk4Options::projected();
-        opts.linear = linear;
-        let mut rk = Rk4::new(&sys, opts).expect("rk4");
+        let mut integ = make(&sys, linear);
         let mut s = State::consistent(&sys, 0.0).expect("state");
         run(
-            &mut rk,
-            &sys,
-            &mut s,
-            RunConfig::new(1.0, 1e-3),
-            &mut NoObserver,
-        )
-        .expect("run");
-        ends.push(s.q.clone());
-    }
-    let d = (&ends[0] - &ends[1]).amax();
-    assert!(d < 1e-12, "dense vs sparse: {d:e}");
-}
-
-/// The tangent-space chart forced onto its sparse path (all rows, the dependent ones dropped in
-/// each factorisation of `Df Df^T`) and its dense path (the independent rows chosen at each
-/// centre) follow the same motion.
-#[test]
-fn dense_and_sparse_tangent_charts_agree() {
-    use mbd::solve::{run, ButcherTableau, LinearSolver, NoObserver};
-    use mbd::tangent::{TangentOptions, TangentRk};
-    let sys = double_parallelogram(-0.5, false).expect("model");
-    let mut ends = Vec::new();
-    for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
-        let opts = TangentOptions {
-            linear_solver: linear,
-            ..Default::default()
-        };
-        let mut rk = TangentRk::new(&sys, ButcherTableau::rk4(), opts).expect("tangent");
-        let mut s = State::consistent(&sys, 0.0).expect("state");
-        run(
-            &mut rk,
+            &mut integ,
             &sys,
             &mut s,
             RunConfig::new(1.0, 1e-3),
@@ -281,11 +253,38 @@ fn dense_and_sparse_tangent_charts_agree() {
         let mut phi = vec![0.0; sys.n_constraints()];
         sys.phi(s.q.as_slice(), s.t, &mut phi);
         let worst = phi.iter().fold(0.0f64, |w, p| w.max(p.abs()));
-        assert!(worst < 1e-12, "{linear:?}: max|Phi| = {worst:e}");
+        assert!(worst < 1e-12, "{label}, {linear:?}: max|Phi| = {worst:e}");
         ends.push(s.q.clone());
     }
     let d = (&ends[0] - &ends[1]).amax();
-    assert!(d < 1e-11, "dense vs sparse tangent: {d:e}");
+    assert!(d < tol, "{label}: dense vs sparse: {d:e}");
+}
+
+/// The sparse and the dense Schur complement drop the same equation and give the same motion.
+#[test]
+fn dense_and_sparse_index1_solves_agree() {
+    use mbd::rk4::{Rk4, Rk4Options};
+    dense_and_sparse_agree("projected RK4", 1e-12, |sys, linear| {
+        let mut opts = Rk4Options::projected();
+        opts.linear = linear;
+        Box::new(Rk4::new(sys, opts).expect("rk4"))
+    });
+}
+
+/// The tangent-space chart forced onto its sparse path (all rows, the dependent ones dropped in
+/// each factorisation of `Df Df^T`) and its dense path (the independent rows chosen at each
+/// centre) follow the same motion.
+#[test]
+fn dense_and_sparse_tangent_charts_agree() {
+    use mbd::solve::ButcherTableau;
+    use mbd::tangent::{TangentOptions, TangentRk};
+    dense_and_sparse_agree("tangent RK4", 1e-11, |sys, linear| {
+        let opts = TangentOptions {
+            linear_solver: linear,
+            ..Default::default()
+        };
+        Box::new(TangentRk::new(sys, ButcherTableau::rk4(), opts).expect("tangent"))
+    });
 }
 
 /// The symplectic stage equations on the sparse path (the dependent equations' rows made the
@@ -293,37 +292,16 @@ fn dense_and_sparse_tangent_charts_agree() {
 /// motion, for the (1,1) and (2,2) schemes and the (1,1) modified-Lagrangian one.
 #[test]
 fn dense_and_sparse_symplectic_stage_solves_agree() {
-    use mbd::solve::{run, LinearSolver, NoObserver};
     use mbd::symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
-    let sys = double_parallelogram(-0.5, false).expect("model");
     for (s_stages, modified) in [(1, false), (2, false), (1, true)] {
-        let mut ends = Vec::new();
-        for linear in [LinearSolver::Dense, LinearSolver::Sparse] {
+        let label = format!("symplectic ({s_stages},{s_stages}), modified {modified}");
+        dense_and_sparse_agree(&label, 1e-11, |sys, linear| {
             let mut opts = SymplecticOptions::new(s_stages);
             if modified {
                 opts = opts.with_preadjust(PreadjustMode::ModifiedLagrangian);
             }
             opts.linear_solver = linear;
-            let mut g = Galerkin::new(&sys, opts).expect("symplectic");
-            let mut s = State::consistent(&sys, 0.0).expect("state");
-            run(
-                &mut g,
-                &sys,
-                &mut s,
-                RunConfig::new(1.0, 1e-3),
-                &mut NoObserver,
-            )
-            .expect("run");
-            let mut phi = vec![0.0; sys.n_constraints()];
-            sys.phi(s.q.as_slice(), s.t, &mut phi);
-            let worst = phi.iter().fold(0.0f64, |w, p| w.max(p.abs()));
-            assert!(
-                worst < 1e-12,
-                "s = {s_stages}, {linear:?}: max|Phi| = {worst:e}"
-            );
-            ends.push(s.q.clone());
-        }
-        let d = (&ends[0] - &ends[1]).amax();
-        assert!(d < 1e-11, "s = {s_stages}: dense vs sparse: {d:e}");
+            Box::new(Galerkin::new(sys, opts).expect("symplectic"))
+        });
     }
 }

@@ -341,3 +341,39 @@ fn matrix_api_transpose_solve_and_determinant() {
     lu.rows_mut().copy_from_slice(&[1.0, 2.0, 2.0, 4.0]);
     assert!(lu.factor_lu().is_err());
 }
+
+/// A saddle-point matrix `[[M, G^T], [G, 0]]` whose constraint rows 1 and 2 of `G` are equal
+/// (a redundant equation): singular as it is; with one droppable multiplier pivot the LU drops
+/// the second of the two, gives it a zero unknown, and solves a consistent system exactly.
+#[test]
+fn a_dependent_multiplier_pivot_is_dropped_on_request() {
+    // unknowns: x0, x1, x2 (M = diag(2, 1, 4)), then multipliers l0, l1, l2
+    let g = [[1.0, 0.0, 1.0], [0.0, 1.0, -1.0], [0.0, 1.0, -1.0]];
+    let m = [2.0, 1.0, 4.0];
+    let n = 6;
+    let mut a = vec![0.0; n * n];
+    for i in 0..3 {
+        a[i * n + i] = m[i];
+        for r in 0..3 {
+            a[i * n + 3 + r] = g[r][i];
+            a[(3 + r) * n + i] = g[r][i];
+        }
+    }
+    let mut lu = DenseLu::new(n);
+    fill(&mut lu, &a);
+    assert!(lu.factor_lu().is_err());
+    lu.set_droppable(3, 1);
+    fill(&mut lu, &a);
+    lu.factor_lu().unwrap();
+    assert_eq!(lu.dropped().collect::<Vec<_>>(), [5]);
+    // b = A [x; l] with l2 = 0 (in the range)
+    let sol = [0.5, -1.0, 0.25, 2.0, -3.0, 0.0];
+    let mut b: Vec<f64> = (0..n)
+        .map(|i| (0..n).map(|j| a[i * n + j] * sol[j]).sum())
+        .collect();
+    lu.solve_in_place(&mut b);
+    assert_eq!(b[5], 0.0);
+    for i in 0..n {
+        assert!((b[i] - sol[i]).abs() < 1e-14, "{i}: {} vs {}", b[i], sol[i]);
+    }
+}
