@@ -1,5 +1,5 @@
 //! `own-singular`: singular configurations and redundant constraints with every solver of the
-//! registry. The N-four-bar (N parallelogram loops in a row) driven through its flat
+//! registry. The N-four-bar (N parallelogram loops in a row), driven and free, through its flat
 //! configurations, where `Phi_q` loses N ranks, at three step sizes (tolerances) a decade
 //! apart: each run either reaches the end with the tracked point on the exact motion, or stops
 //! with the typed singular-configuration error. The double parallelogram and the pantograph
@@ -11,6 +11,7 @@ use mbd::model::models::{ClosedLoop, CrankMotion};
 use mbd::prelude::*;
 use mbd::solve::registry::SolverVariant;
 use serde_json::json;
+use std::f64::consts::TAU;
 
 /// Crank and ground lengths of every model (m), initial crank angle (rad) and speed (rad/s).
 const CRANK: f64 = 0.4;
@@ -22,7 +23,6 @@ const FLOOR: f64 = 1e-9;
 /// A run that ends with a coupler turned by this much (rad) is on another branch (on the
 /// parallelogram branch the couplers translate).
 const BRANCH_TOL: f64 = 1e-2;
-use std::f64::consts::TAU;
 /// The documented miss of the free N-four-bar's claims: the target is the driven
 /// mechanism; the free one (released at 6 rad/s, turning over) shows where solvers still lose
 /// accuracy or stop with an untyped error at a singular passage.

@@ -325,10 +325,10 @@ impl RunChecks {
 }
 
 impl RunChecks {
-    #[cold]
-    #[inline(never)]
     /// The stop of an integrator that does not keep the constraints at a near-singular step:
     /// the equations nearest to dependence and their joints (allocates: an error path).
+    #[cold]
+    #[inline(never)]
     fn singular_stop(&self, sys: &System, state: &State, condition: f64) -> SolveError {
         let near = sys.nearly_dependent_at(state.q.as_slice(), 1e-2);
         let named = if near.is_empty() {
