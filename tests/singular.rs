@@ -161,3 +161,50 @@ fn the_singular_stop_names_time_rank_deficiency_and_joints() {
         other => panic!("expected the singular stop, got {other:?}"),
     }
 }
+
+/// Runs `spec` on the free 2-four-bar (released at 6 rad/s from 1 rad, turning over through
+/// its flat configurations) with step `h` to `t_end`.
+fn free_two_four_bar(spec: &str, h: f64, t_end: f64) -> Result<(), mbd::Error> {
+    use mbd::model::models::ClosedLoop;
+    use mbd::prelude::*;
+    let cl = ClosedLoop::n_four_bar(2, 0.4, 1.0).unwrap();
+    let sys = cl.system(1.0, 6.0, false).unwrap();
+    let mut sim = Simulation::new(sys, spec)?;
+    sim.run(RunConfig::new(t_end, h))?;
+    Ok(())
+}
+
+/// Plain RK4 at h = 1e-2 passes the free mechanism's flat configurations without landing
+/// near enough to stop, but its drift grows from a passage (at t = 1.41) until the guard stops
+/// it (t = 1.91): that is reported as the singular configuration it is, naming the passage.
+#[test]
+fn drift_grown_from_a_singular_passage_is_the_singular_error() {
+    match free_two_four_bar("rk4", 1e-2, 3.0) {
+        Err(mbd::Error::Solve(SolveError::Singular { t, what, detail })) => {
+            assert!((1.5..2.5).contains(&t), "{t}");
+            assert!(what.contains("drift"), "{what}");
+            assert!(
+                detail.contains("passed near a singular configuration at t = "),
+                "{detail}"
+            );
+            assert!(detail.contains("position residual"), "{detail}");
+        }
+        other => panic!("expected the singular error, got {other:?}"),
+    }
+}
+
+/// The (2,2) modified-Lagrangian scheme at h = 1e-2 fails on the step that crosses a flat
+/// configuration at t = 7.24 (it starts 0.046 rad before it, where the preadjustment's
+/// projected metric degenerates): the configurations along the step, not only its start, are
+/// checked for rank loss, so the error is the typed singular one naming the loops' equations.
+#[test]
+fn a_newton_failure_on_a_step_across_rank_loss_is_the_singular_error() {
+    match free_two_four_bar("symplectic:2:modified", 1e-2, 7.3) {
+        Err(mbd::Error::Solve(SolveError::Singular { t, detail, .. })) => {
+            assert!((7.2..7.3).contains(&t), "{t}");
+            assert!(detail.contains("rank deficiency 2"), "{detail}");
+            assert!(detail.contains("G1.x"), "{detail}");
+        }
+        other => panic!("expected the singular error, got {other:?}"),
+    }
+}

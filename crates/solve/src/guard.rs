@@ -92,6 +92,10 @@ pub(crate) struct GuardState {
     prev_q: Vec<f64>,
     prev_v: Vec<f64>,
     weight: Vec<f64>,
+    /// The last step with a condition estimate above [`BRANCH_WATCH_CONDITION`] (its end time
+    /// and condition): drift that appears later in the run of a solver that does not keep the
+    /// constraints grew from there.
+    passage: Option<(f64, f64)>,
 }
 
 impl GuardState {
@@ -105,6 +109,7 @@ impl GuardState {
             prev_q: state.q.as_slice().to_vec(),
             prev_v: state.v.as_slice().to_vec(),
             weight: sys.mass_diag().as_slice().to_vec(),
+            passage: None,
         }
     }
 
@@ -292,12 +297,21 @@ impl RunChecks {
             });
         }
         if let Some(g) = self.guard.as_mut() {
+            if s.condition > BRANCH_WATCH_CONDITION {
+                g.passage = Some((state.t, s.condition));
+            }
             if let Err(e) = g.check(sys, state) {
+                let passage = if self.keeps_constraints {
+                    None
+                } else {
+                    g.passage
+                };
                 return Err(drift_error(
                     e,
                     state.t,
                     s.condition,
                     g.guard.branch_tol.is_some(),
+                    passage,
                 ));
             }
         }
@@ -360,19 +374,41 @@ impl RunChecks {
 }
 
 /// The drift guard's error `e` after a step ending at `t` with condition estimate
-/// `condition`: drift that appears on a step near a singular configuration means the solver
-/// left the branch there (a solver on the constraints does not drift by 1%), reported as such
-/// while the branch check is on.
+/// `condition`, reported as a singular configuration while the branch check is on: drift
+/// that appears on a step near a singular configuration means the solver left the branch
+/// there (a solver on the constraints does not drift by 1%); drift of a solver that does not
+/// keep the constraints, after it passed near one at `passage` (end time and condition of that
+/// step), grew from the error of that passage (a well-posed mechanism never comes near).
 #[cold]
 #[inline(never)]
-fn drift_error(e: SolveError, t: f64, condition: f64, branch_check: bool) -> SolveError {
-    if condition > BRANCH_WATCH_CONDITION && branch_check {
+fn drift_error(
+    e: SolveError,
+    t: f64,
+    condition: f64,
+    branch_check: bool,
+    passage: Option<(f64, f64)>,
+) -> SolveError {
+    if !branch_check {
+        return e;
+    }
+    if condition > BRANCH_WATCH_CONDITION {
         SolveError::Singular {
             t,
             what: "configuration passed onto another branch",
             detail: format!(
                 "the step ending at t = {t} (condition estimate {condition:.1e}) left the \
                  constraints: {e}"
+            ),
+        }
+    } else if let Some((tp, cp)) = passage {
+        SolveError::Singular {
+            t,
+            what: "configuration passed with growing drift",
+            detail: format!(
+                "the run passed near a singular configuration at t = {tp} (condition estimate \
+                 {cp:.1e}) and its constraints have drifted since: {e}; this solver does not \
+                 keep the constraints: use one that does (a projection, symplectic or \
+                 tangent: `mbd solvers`)"
             ),
         }
     } else {

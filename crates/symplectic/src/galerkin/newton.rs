@@ -102,12 +102,21 @@ impl Galerkin {
             evals += 1;
         }
         let mut it = 0;
-        let fail = |res: f64, it: usize, s: usize, qk: &[f64]| {
-            // (an error path: the rank report allocates)
+        let fail = |res: f64, it: usize, s: usize, qk: &[f64], hvk: &[f64]| {
+            // (an error path: the rank report allocates) the configurations the step passes:
+            // its start and, along the start velocity, its middle and end (a step that crosses
+            // a singular configuration fails there, not at its start)
             let near = if res.is_finite() && res <= 1e3 * tol {
                 Vec::new()
             } else {
-                sys.nearly_dependent_at(qk, 1e-2)
+                [0.0, 0.5, 1.0]
+                    .iter()
+                    .map(|&th| {
+                        let q: Vec<f64> = qk.iter().zip(hvk).map(|(q, d)| q + th * d).collect();
+                        sys.nearly_dependent_at(&q, 1e-2)
+                    })
+                    .find(|near| !near.is_empty())
+                    .unwrap_or_default()
             };
             if res.is_finite() && res <= 1e3 * tol {
                 // stalled a few digits above the tolerance: the iteration cannot contract, as
@@ -123,18 +132,21 @@ impl Galerkin {
                          smaller h does not help (`mbd solvers` lists the other solvers)"
                     ),
                 }
-            } else if let Some(near) = near.first() {
-                // no convergence at a step that starts within 1e-2 of rank loss: the singular
+            } else if !near.is_empty() {
+                // no convergence at a step that passes within 1e-2 of rank loss: the singular
                 // configuration, not the step length, is the cause
                 SolveError::Singular {
                     t,
                     what: "configuration (Phi_q near rank loss: the stage equations failed there)",
                     detail: format!(
                         "symplectic ({s},{s}) stage equations, h = {h}: Newton residual {res:.2e} \
-                         after {it} iterations; equation {} (joints {}) within 1e-2 of \
-                         dependence (`mbd solvers` lists the other solvers)",
-                        near.equation,
-                        near.joints.join(", ")
+                         after {it} iterations; rank deficiency {} (equations within 1e-2 of \
+                         dependence: {}) (`mbd solvers` lists the other solvers)",
+                        near.len(),
+                        near.iter()
+                            .map(|e| format!("{} (joints {})", e.equation, e.joints.join(", ")))
+                            .collect::<Vec<_>>()
+                            .join("; ")
                     ),
                 }
             } else {
@@ -153,7 +165,7 @@ impl Galerkin {
             }
         };
         if !res.is_finite() {
-            return Err(fail(res, 0, self.tab.s, &self.qk));
+            return Err(fail(res, 0, self.tab.s, &self.qk, &self.hvk));
         }
         // simplified Newton: one Jacobian per step (or the last step's, if reuse is on), kept
         // while it contracts by 4x per iteration, recomputed every `jacobian_every` iterations
@@ -171,7 +183,7 @@ impl Galerkin {
         let mut last_dz = f64::INFINITY;
         while !(res <= tol && last_dz <= tol) {
             if it >= o.max_iter {
-                return Err(fail(res, it, self.tab.s, &self.qk));
+                return Err(fail(res, it, self.tab.s, &self.qk, &self.hvk));
             }
             if need_jacobian || since_jacobian >= o.jacobian_every {
                 self.jacobian(sys, t, h)?;
@@ -288,14 +300,14 @@ impl Galerkin {
             prev_step = step;
             last_dz = step;
             if !res.is_finite() {
-                return Err(fail(res, it, self.tab.s, &self.qk));
+                return Err(fail(res, it, self.tab.s, &self.qk, &self.hvk));
             }
             if step <= o.step_tol * qscale {
                 // stagnated at round-off: accept if the residual is sane
                 if res <= 1e-8 * qscale {
                     break;
                 }
-                return Err(fail(res, it, self.tab.s, &self.qk));
+                return Err(fail(res, it, self.tab.s, &self.qk, &self.hvk));
             }
         }
         Ok(StepStats {
