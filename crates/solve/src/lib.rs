@@ -75,7 +75,7 @@ pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTraject
 pub use integrator::{
     observe, observer, run, step_count, DriftGuard, Every, Flow, FnObserver, Integrator,
     NoObserver, Observer, Recorder, RunConfig, RunStats, StateFn, StepStats, StopReason,
-    BRANCH_ARM_CONDITION, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION,
+    BRANCH_ARM_CONDITION, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION, GUARD_QUIET_RATIO, GUARD_STRIDE,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_ROUNDOFF_FACTOR};

@@ -454,3 +454,45 @@ fn sparse_and_dense_projections_agree_and_stop_at_the_roundoff_floor() {
     let dv = mbd_solve::linalg::max_abs_diff(&results[0].1, &results[1].1);
     assert!(dq < 1e-12 && dv < 1e-12, "dense vs sparse: {dq:e} {dv:e}");
 }
+
+/// The drift guard skips steps only while the residuals are far below their limits
+/// (`GUARD_STRIDE`, `GUARD_QUIET_RATIO`): plain RK4 on the manipulator at h = 0.01 stops at
+/// exactly the first step whose residual is over the limit, found by checking every step by
+/// hand.
+#[test]
+fn the_guard_stride_does_not_delay_the_drift_stop() {
+    use mbd_solve::{ButcherTableau, Index1Options, Index1Rk, GUARD_QUIET_RATIO, GUARD_STRIDE};
+    let sys = models::manipulator().unwrap();
+    let h = 0.01;
+    let plain = || Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default()).unwrap();
+    // by hand: the first step with max_i |Phi_i| / (1e-2 scale_i) > 1
+    let scales = sys.equation_scales();
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let mut rk = plain();
+    let mut phi = vec![0.0; sys.n_constraints()];
+    let mut ratios = Vec::new();
+    let first = (1..=5000)
+        .find(|&k| {
+            rk.step(&sys, &mut s, h).unwrap();
+            s.t = k as f64 * h;
+            sys.phi(s.q.as_slice(), s.t, &mut phi);
+            let r = phi
+                .iter()
+                .zip(&scales)
+                .map(|(p, sc)| p.abs() / (DriftGuard::DEFAULT_POSITION_TOL * sc))
+                .fold(0.0, f64::max);
+            ratios.push(r);
+            r > 1.0
+        })
+        .expect("plain RK4 at h = 0.01 drifts within 50 s");
+    // the run skipped checks on this run (residuals below the quiet ratio early on)
+    assert!(ratios.iter().take(GUARD_STRIDE).all(|&r| r < GUARD_QUIET_RATIO));
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let mut rk = plain();
+    match run(&mut rk, &sys, &mut s, RunConfig::new(50.0, h), &mut NoObserver) {
+        Err(SolveError::ConstraintDrift { t, .. }) => {
+            assert!((t - first as f64 * h).abs() < 1e-9, "{t} vs {}", first as f64 * h)
+        }
+        other => panic!("expected the drift stop, got {other:?}"),
+    }
+}

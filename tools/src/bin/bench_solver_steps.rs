@@ -2,7 +2,7 @@
 //! 2N steps is the cost of N steps without the set-up), and prints the time per step.
 //!
 //! `cargo run --release -p mbd-tools --bin bench_solver_steps -- SOLVER [N] [MODEL]` with SOLVER
-//! one of `rk4` (plain RK4), `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1
+//! one of `rk4` (plain RK4), `rk4-projected`, `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1
 //! DOPRI5, fixed steps), `fadae` (firefly-Gauss, default options), and MODEL one of
 //! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
 //! links the index-1 solve takes the sparse path). A fourth argument `state` prints the final
@@ -32,6 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let s0 = State::consistent(&sys, 0.0)?;
     let (mut integ, h): (Box<dyn Integrator>, f64) = match solver.as_str() {
         "rk4" => (Box::new(Rk4::new(&sys, Rk4Options::plain())?), 1e-3),
+        "rk4-projected" => (Box::new(Rk4::new(&sys, Rk4Options::projected())?), 1e-3),
         "tangent-rk4" => (Box::new(TangentRk::rk4(&sys)?), 1e-3),
         "symplectic2" => (
             Box::new(Galerkin::new(&sys, SymplecticOptions::new(2))?),
@@ -51,8 +52,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ),
         other => {
             return Err(format!(
-                "unknown solver '{other}': rk4, tangent-rk4, symplectic2, dopri5, fadae"
-            )
+            "unknown solver '{other}': rk4, rk4-projected, tangent-rk4, symplectic2, dopri5, fadae"
+        )
             .into())
         }
     };
