@@ -2,7 +2,7 @@
 //! their element-local forms for sparse assembly, and the constraint Hessians.
 
 use crate::cache::BodyAngles;
-use crate::hessian_pair::ElementHessian;
+use crate::element_hessians::ElementHessian;
 use crate::jet::{point, sub2, Dual, Frame, Scalar, NV};
 use crate::joints::{JointKind, Revolute};
 use crate::rows::SinCos;
@@ -46,17 +46,7 @@ impl System {
 
     #[inline(always)]
     pub(crate) fn scatter_row(&self, ji: usize, row: usize, g: &[f64; NV], out: &mut DMatrix<f64>) {
-        let at = self.joint_attach[ji];
-        if let Some(i) = at.a {
-            for l in 0..3 {
-                out[(row, 3 * i + l)] += g[l];
-            }
-        }
-        if let Some(i) = at.b {
-            for l in 0..3 {
-                out[(row, 3 * i + l)] += g[3 + l];
-            }
-        }
+        self.joint_attach[ji].scatter_row(row, g, out);
     }
 
     /// The constraint Jacobian `Phi_q` (m x n, dense) into `out` (overwritten).
@@ -343,10 +333,15 @@ impl System {
     ) {
         // the joints' Hessians from the element pass (closed-form revolute rows)
         self.element_hessians(q, false, |el| {
-            let ElementHessian::Joint(ji, at, e) = el else {
+            let ElementHessian::Joint {
+                attach: at,
+                row: o,
+                equations: e,
+                ..
+            } = el
+            else {
                 return;
             };
-            let o = self.row_offset[ji];
             let mut h = [[0.0; NV]; NV];
             for (k, ek) in e.iter().enumerate() {
                 let l = lambda[o + k] * scale;
@@ -361,20 +356,7 @@ impl System {
     }
 
     pub(crate) fn scatter_hess(at: Attach, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {
-        let cols = |l: usize| -> Option<usize> {
-            if l < 3 {
-                at.a.map(|i| 3 * i + l)
-            } else {
-                at.b.map(|i| 3 * i + l - 3)
-            }
-        };
-        for r in 0..NV {
-            let Some(gr) = cols(r) else { continue };
-            for c in 0..NV {
-                let Some(gc) = cols(c) else { continue };
-                out[(gr, gc)] += h[r][c];
-            }
-        }
+        at.scatter_hess(h, out);
     }
 
     // ---------------------------------------------------------------- forces and energy

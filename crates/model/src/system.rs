@@ -6,7 +6,7 @@ use crate::body::{Body, BodyHandle};
 use crate::error::ModelError;
 use crate::forces::Force;
 use crate::init::RedundantEquation;
-use crate::jet::{DirJet, Frame, HessJet};
+use crate::jet::{DirJet, Frame, HessJet, NV};
 use crate::joints::Joint;
 use nalgebra::{DMatrix, DVector};
 
@@ -42,6 +42,43 @@ pub struct Attach {
     pub a: Option<usize>,
     /// Body index of side `b` (local slots 3..6), `None` for ground.
     pub b: Option<usize>,
+}
+
+impl Attach {
+    /// `out += h` in the rows and columns of the element's bodies (`h` is the element's local
+    /// `6 x 6` block, side `a`'s coordinates then side `b`'s; ground rows and columns dropped;
+    /// `out` is `n x n`).
+    pub fn scatter_hess(&self, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {
+        let cols = |l: usize| -> Option<usize> {
+            if l < 3 {
+                self.a.map(|i| 3 * i + l)
+            } else {
+                self.b.map(|i| 3 * i + l - 3)
+            }
+        };
+        for r in 0..NV {
+            let Some(gr) = cols(r) else { continue };
+            for c in 0..NV {
+                let Some(gc) = cols(c) else { continue };
+                out[(gr, gc)] += h[r][c];
+            }
+        }
+    }
+
+    /// `out[row, .] += g` in the columns of the element's bodies (`g` a local row; `out` is
+    /// `m x n`).
+    pub fn scatter_row(&self, row: usize, g: &[f64; NV], out: &mut DMatrix<f64>) {
+        if let Some(i) = self.a {
+            for l in 0..3 {
+                out[(row, 3 * i + l)] += g[l];
+            }
+        }
+        if let Some(i) = self.b {
+            for l in 0..3 {
+                out[(row, 3 * i + l)] += g[3 + l];
+            }
+        }
+    }
 }
 
 /// A joint as [`System::joint_elements`] hands it out.

@@ -1,6 +1,8 @@
 //! The derivative passes only the preadjustment needs: third derivatives, Hessian-vector
-//! products and Hessian rows of the constraints and the potential, and the mixed directional
-//! derivatives of several directions at once with their gradients ([`mbd_model::PolyJet`]).
+//! products and Hessian rows of the constraints and the potential, the mixed directional
+//! derivatives of several directions at once with their gradients ([`mbd_model::PolyJet`]),
+//! and a pair of weighted Lagrangian Hessians from one element Hessian pass
+//! ([`mbd_model::System::element_hessians`]).
 //!
 //! They evaluate the model through its one generic hook: [`mbd_model::System::joint_elements`] and
 //! [`mbd_model::System::force_elements`] hand out every element with its attachment, and
@@ -11,9 +13,11 @@
 
 #[cfg(test)]
 mod directional;
+mod hessian_pair;
 mod poly;
 mod third;
 
+pub(crate) use hessian_pair::*;
 pub(crate) use poly::*;
 pub(crate) use third::*;
 

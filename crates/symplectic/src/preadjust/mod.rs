@@ -261,7 +261,7 @@ impl Preadjustment {
 
     /// `out += scale * (B + 2 C S^-1 C^T)` at `(q, v)` ([`Preadjustment::modified_velocity_hessian`]),
     /// without the overwrite, from one Hessian pass over the elements
-    /// ([`System::add_lagrangian_hessian_pair`]); the same pass assembles
+    /// (`passes::add_lagrangian_hessian_pair`); the same pass assembles
     /// `A = Hess V - mu0 . Hess Phi`, which [`Preadjustment::approximate_hessian`] at the same `q`
     /// then reuses.
     pub fn add_modified_velocity_hessian(

@@ -15,7 +15,10 @@ use super::dot;
 use super::metric::{ProjectedMetric, RowsAlong, Stamp};
 use super::stiffness::TangentStiffness;
 use crate::passes;
-use mbd_model::{LagrangianWeights, System};
+use crate::passes::{
+    add_lagrangian_hessian_pair, add_lagrangian_hessian_pair_diagonals, LagrangianWeights,
+};
+use mbd_model::System;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -230,7 +233,7 @@ impl ModifiedS1 {
     /// (`H_sigma = sum_k sigma_k Hess Phi_k`, `sigma = S^-1 gamma_c(q, v)`) and
     /// `C = [Hess Phi_k v]_k` (the derivative of `sigma` in `v`): `6 d^2 e / dv^2`, for the
     /// Newton Jacobian. One Hessian pass over the elements
-    /// ([`System::add_lagrangian_hessian_pair`]) also assembles `A = Hess V - mu0 . Hess Phi`
+    /// ([`add_lagrangian_hessian_pair`]) also assembles `A = Hess V - mu0 . Hess Phi`
     /// into `stiffness`, which the Newton Hessian of the force term then reuses.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn add_velocity_hessian(
@@ -250,7 +253,8 @@ impl ModifiedS1 {
         for r in 0..m {
             self.scaled_cm[r] = scale * self.cm[r];
         }
-        sys.add_lagrangian_hessian_pair(
+        add_lagrangian_hessian_pair(
+            sys,
             q,
             v,
             (
@@ -331,7 +335,8 @@ impl ModifiedS1 {
         self.ensure_evaluated(metric, sys, q, v);
         wd.fill(0.0);
         ad.fill(0.0);
-        sys.add_lagrangian_hessian_pair_diagonals(
+        add_lagrangian_hessian_pair_diagonals(
+            sys,
             q,
             (
                 LagrangianWeights {
