@@ -2,7 +2,7 @@
 
 use crate::error::AnalysisError;
 use mbd_model::System;
-use mbd_solve::{Flow, Observer, SolveError, State};
+use mbd_solve::{Flow, JointReaction, Observer, ReactionSolver, SolveError, State};
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -115,6 +115,9 @@ pub struct CsvObserver<W: Write> {
     w: W,
     header_written: bool,
     residuals: bool,
+    reactions: bool,
+    /// The reaction workspace (built at the first row that needs it) and its buffer.
+    reaction_solver: Option<(ReactionSolver, Vec<JointReaction>)>,
     every: usize,
     row: Vec<f64>,
     phi: Vec<f64>,
@@ -129,6 +132,8 @@ impl<W: Write> CsvObserver<W> {
             w,
             header_written: false,
             residuals: false,
+            reactions: false,
+            reaction_solver: None,
             every: 1,
             row: Vec::new(),
             phi: Vec::new(),
@@ -140,6 +145,13 @@ impl<W: Write> CsvObserver<W> {
     /// and velocity level, max-norm).
     pub fn with_residuals(mut self) -> Self {
         self.residuals = true;
+        self
+    }
+    /// Adds three columns per joint, `<joint>.fx`, `<joint>.fy`, `<joint>.mz`: the force on the
+    /// joint's second body in global axes and the moment about the joint's point on it
+    /// ([`ReactionSolver`], whose documentation gives the conventions).
+    pub fn with_reactions(mut self) -> Self {
+        self.reactions = true;
         self
     }
     /// Writes only the samples of steps `0, k, 2k, ...` (`k = 0` is treated as 1); call
@@ -159,10 +171,18 @@ impl<W: Write> CsvObserver<W> {
             h.push("max_abs_phi".into());
             h.push("max_abs_phidot".into());
         }
+        if self.reactions {
+            for j in sys.joints() {
+                for c in ["fx", "fy", "mz"] {
+                    h.push(format!("{}.{c}", j.name));
+                }
+            }
+        }
         h
     }
-    /// The values of one row for state `s` (in the order of [`CsvObserver::columns`]).
-    pub fn row(&mut self, sys: &System, s: &State) -> &[f64] {
+    /// The values of one row for state `s` (in the order of [`CsvObserver::columns`]); an
+    /// error only from the reactions' index-1 solve (a singular configuration).
+    pub fn row(&mut self, sys: &System, s: &State) -> Result<&[f64], SolveError> {
         self.row.clear();
         self.row.push(s.t);
         self.row.extend(s.q.iter().chain(s.v.iter()).copied());
@@ -176,15 +196,35 @@ impl<W: Write> CsvObserver<W> {
             self.row.push(a);
             self.row.push(b);
         }
-        &self.row
+        if self.reactions {
+            let (rs, out) = match &mut self.reaction_solver {
+                Some(x) => x,
+                None => self.reaction_solver.insert((
+                    ReactionSolver::new(sys)?,
+                    vec![JointReaction::default(); sys.joints().len()],
+                )),
+            };
+            rs.compute(sys, s, out)?;
+            for r in out.iter() {
+                self.row.extend([r.force[0], r.force[1], r.moment]);
+            }
+        }
+        Ok(&self.row)
     }
-    fn write_state(&mut self, sys: &System, s: &State, step: usize) -> std::io::Result<()> {
+    fn write_state(&mut self, sys: &System, s: &State, step: usize) -> Result<(), SolveError> {
+        let io = |e: std::io::Error| SolveError::Observer {
+            t: s.t,
+            message: e.to_string(),
+        };
         if !self.header_written {
             let h = self.columns(sys);
-            writeln!(self.w, "{}", h.join(","))?;
+            writeln!(self.w, "{}", h.join(",")).map_err(io)?;
             self.header_written = true;
         }
-        self.row(sys, s);
+        self.row(sys, s)?;
+        self.write_row(step, s.t).map_err(io)
+    }
+    fn write_row(&mut self, step: usize, t: f64) -> std::io::Result<()> {
         let mut first = true;
         for x in &self.row {
             if first {
@@ -195,7 +235,7 @@ impl<W: Write> CsvObserver<W> {
             }
         }
         writeln!(self.w)?;
-        self.last_written = Some((step, s.t));
+        self.last_written = Some((step, t));
         Ok(())
     }
     /// Ends a run: writes the final state `s` unless it was the last row written (the run
@@ -209,7 +249,7 @@ impl<W: Write> CsvObserver<W> {
         let written = matches!(self.last_written, Some((_, t)) if t == s.t);
         if !written {
             let step = self.last_step.map_or(0, |k| k + 1);
-            self.write_state(sys, s, step).map_err(err)?;
+            self.write_state(sys, s, step)?;
         }
         self.w.flush().map_err(err)
     }
@@ -223,11 +263,7 @@ impl<W: Write> Observer for CsvObserver<W> {
     fn observe(&mut self, sys: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
         self.last_step = Some(step);
         if step % self.every == 0 {
-            self.write_state(sys, s, step)
-                .map_err(|e| SolveError::Observer {
-                    t: s.t,
-                    message: e.to_string(),
-                })?;
+            self.write_state(sys, s, step)?;
         }
         Ok(Flow::Continue)
     }
@@ -320,7 +356,7 @@ mod tests {
         let s = State::consistent(&sys, 0.0).unwrap();
         let mut csv = CsvObserver::new(std::io::sink()).with_residuals();
         let cols = csv.columns(&sys);
-        let row = csv.row(&sys, &s).to_vec();
+        let row = csv.row(&sys, &s).unwrap().to_vec();
         assert_eq!(cols.len(), row.len());
         assert_eq!(cols.len(), 1 + 2 * sys.n_coords() + 3);
     }

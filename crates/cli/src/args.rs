@@ -22,7 +22,8 @@ Examples:
 
 Columns: t, every coordinate (body.x, body.y, body.theta), every velocity (d_body.x, ...),
 the energy H, and the constraint residuals max_abs_phi = max|Phi| and
-max_abs_phidot = max|Phi_q v + Phi_t|. Without --out the CSV goes to standard output.";
+max_abs_phidot = max|Phi_q v + Phi_t|; with --reactions, JOINT.fx, JOINT.fy and JOINT.mz per
+joint. Without --out the CSV goes to standard output.";
 
 const CHECK_EXAMPLE: &str = "\
 Example:
@@ -109,6 +110,10 @@ pub struct RunArgs {
     /// Write every K-th step (and always the first and the last state).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
     pub every: u64,
+    /// Add each joint's reaction: JOINT.fx, JOINT.fy (force on the joint's second body,
+    /// global axes, N) and JOINT.mz (moment about the joint's point on that body, N m).
+    #[arg(long)]
+    pub reactions: bool,
 }
 
 /// Arguments of `mbd check`.

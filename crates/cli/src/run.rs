@@ -66,7 +66,7 @@ impl Observer for Sink {
                 ..
             } => {
                 if step % *every == 0 {
-                    rows.push(fmt.row(sys, s).to_vec());
+                    rows.push(fmt.row(sys, s)?.to_vec());
                     *last_t = Some(s.t);
                 }
                 Ok(Flow::Continue)
@@ -129,8 +129,21 @@ impl Observer for Progress {
     }
 }
 
+/// The columns of `mbd run`'s output: the state, `H`, the residuals and, if asked, the
+/// reactions.
+fn columns<W: Write>(c: CsvObserver<W>, reactions: bool) -> CsvObserver<W> {
+    let c = c.with_residuals();
+    if reactions {
+        c.with_reactions()
+    } else {
+        c
+    }
+}
+
 fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
-    let csv = |w: Box<dyn Write>| Sink::Csv(CsvObserver::new(w).with_residuals().with_every(every));
+    let csv = |w: Box<dyn Write>| {
+        Sink::Csv(columns(CsvObserver::new(w), args.reactions).with_every(every))
+    };
     let Some(out) = &args.out else {
         return Ok(csv(Box::new(std::io::BufWriter::new(std::io::stdout()))));
     };
@@ -152,7 +165,7 @@ fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
     let file = std::fs::File::create(out).map_err(|e| CliError::write(out, e))?;
     Ok(if json {
         Sink::Json {
-            fmt: CsvObserver::new(std::io::sink()).with_residuals(),
+            fmt: columns(CsvObserver::new(std::io::sink()), args.reactions),
             every,
             rows: Vec::new(),
             last_t: None,
@@ -311,7 +324,11 @@ fn finish(
             ..
         } => {
             if last_t != Some(state.t) {
-                rows.push(fmt.row(sys, state).to_vec());
+                rows.push(
+                    fmt.row(sys, state)
+                        .map_err(|e| solve_error(&args.solver, e))?
+                        .to_vec(),
+                );
             }
             let m = measures.measures();
             let doc = serde_json::json!({

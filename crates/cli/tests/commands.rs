@@ -347,3 +347,45 @@ fn help_shows_examples() {
         );
     }
 }
+
+/// `mbd run --reactions` adds `<joint>.fx, .fy, .mz` per joint, the same in CSV and JSON: on
+/// the slider-crank file every row's reactions equal the library's `ReactionSolver` at that
+/// row's state (the CSV holds the state to full precision).
+#[test]
+fn run_reactions_adds_three_columns_per_joint() {
+    let dir = scratch("reactions");
+    let model = common::repo().join("examples/models/slider_crank_spring.toml");
+    let csv = dir.join("r.csv");
+    let o = run_model(&model, "rk4", &["--h", "0.005", "--reactions"], &csv);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let sys = mbd_model::System::from_path(&model).unwrap();
+    let (head, rows) = read_csv(&csv);
+    let mut want = expected_columns(&model);
+    for j in sys.joints() {
+        for c in ["fx", "fy", "mz"] {
+            want.push(format!("{}.{c}", j.name));
+        }
+    }
+    assert_eq!(head, want);
+    let n = sys.n_coords();
+    let mut rs = mbd_solve::ReactionSolver::new(&sys).unwrap();
+    let mut out = vec![mbd_solve::JointReaction::default(); sys.joints().len()];
+    for row in &rows {
+        let mut s = mbd_solve::State::consistent(&sys, 0.0).unwrap();
+        s.t = row[0];
+        s.q.as_mut_slice().copy_from_slice(&row[1..1 + n]);
+        s.v.as_mut_slice().copy_from_slice(&row[1 + n..1 + 2 * n]);
+        rs.compute(&sys, &s, &mut out).unwrap();
+        let got = &row[row.len() - 3 * out.len()..];
+        for (k, r) in out.iter().enumerate() {
+            assert_eq!(got[3 * k..3 * k + 3], [r.force[0], r.force[1], r.moment]);
+        }
+    }
+    let json = dir.join("r.json");
+    let o = run_model(&model, "rk4", &["--h", "0.005", "--reactions"], &json);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let cols: Vec<String> = serde_json::from_value(doc["columns"].clone()).unwrap();
+    assert_eq!(cols, want);
+}

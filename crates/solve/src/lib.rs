@@ -61,6 +61,7 @@ pub mod linalg;
 mod newton;
 mod projection;
 pub mod quadrature;
+mod reactions;
 pub mod registry;
 pub mod sparse;
 mod state;
@@ -79,6 +80,7 @@ pub use integrator::{
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_ROUNDOFF_FACTOR};
+pub use reactions::{JointReaction, ReactionSolver};
 pub use sparse::{LinearSolver, SparseAccelerationSolver, SPARSE_THRESHOLD};
 pub use state::State;
 pub use tableau::{ButcherTableau, ExplicitRk, StepController};

@@ -486,12 +486,25 @@ fn the_guard_stride_does_not_delay_the_drift_stop() {
         })
         .expect("plain RK4 at h = 0.01 drifts within 50 s");
     // the run skipped checks on this run (residuals below the quiet ratio early on)
-    assert!(ratios.iter().take(GUARD_STRIDE).all(|&r| r < GUARD_QUIET_RATIO));
+    assert!(ratios
+        .iter()
+        .take(GUARD_STRIDE)
+        .all(|&r| r < GUARD_QUIET_RATIO));
     let mut s = State::consistent(&sys, 0.0).unwrap();
     let mut rk = plain();
-    match run(&mut rk, &sys, &mut s, RunConfig::new(50.0, h), &mut NoObserver) {
+    match run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(50.0, h),
+        &mut NoObserver,
+    ) {
         Err(SolveError::ConstraintDrift { t, .. }) => {
-            assert!((t - first as f64 * h).abs() < 1e-9, "{t} vs {}", first as f64 * h)
+            assert!(
+                (t - first as f64 * h).abs() < 1e-9,
+                "{t} vs {}",
+                first as f64 * h
+            )
         }
         other => panic!("expected the drift stop, got {other:?}"),
     }
