@@ -205,6 +205,41 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
     }
 }
 
+/// Warns about given initial values that the consistent initial state changed (at most five
+/// named), with how to keep them.
+fn warn_initial_changes(sys: &System, state: &State) {
+    let changes = mbd_solve::initial_changes(sys, state.q.as_slice(), state.v.as_slice());
+    if changes.is_empty() {
+        return;
+    }
+    let shown: Vec<String> = changes
+        .iter()
+        .take(5)
+        .map(|c| format!("{} given {} used {}", c.name, num(c.given), num(c.used)))
+        .collect();
+    let more = if changes.len() > 5 {
+        format!(" and {} more", changes.len() - 5)
+    } else {
+        String::new()
+    };
+    eprintln!(
+        "warning: the initial state was made consistent with the constraints, which changed \
+         given values: {}{more}; to keep a value, mark it an input of its body (inputs = \
+         [\"d_theta\"] in the model file, Body::input_velocity in code) and the others are \
+         solved for",
+        shown.join("; ")
+    );
+}
+
+/// A number in the messages: up to 6 significant digits, exponent form outside 1e-3..1e6.
+fn num(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
+        format!("{}", (x * 1e6).round() / 1e6)
+    } else {
+        format!("{x:.5e}")
+    }
+}
+
 /// Runs the simulation, writes the output and returns the summary.
 pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     if args.tol.is_some() && !args.solver.adaptive() {
@@ -239,6 +274,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         path: args.model.display().to_string(),
         source: Box::new(source),
     })?;
+    warn_initial_changes(&sys, &state);
     let plan: mbd::Plan = match (args.h, args.tol) {
         (_, Some(tol)) => AdaptiveConfig::new(args.t_end, tol).into(),
         (Some(h), None) => RunConfig::new(args.t_end, h).into(),

@@ -389,3 +389,54 @@ fn run_reactions_adds_three_columns_per_joint() {
     let cols: Vec<String> = serde_json::from_value(doc["columns"].clone()).unwrap();
     assert_eq!(cols, want);
 }
+
+/// A slider-crank file that gives only the crank's 6 rad/s: `mbd run` warns that the
+/// consistent state changed it, naming the value given and used and how to keep it; with
+/// `inputs = ["d_theta"]` on the crank the run starts at exactly 6 rad/s, without the warning.
+#[test]
+fn run_warns_about_changed_initial_values_and_keeps_inputs() {
+    let dir = scratch("inputs");
+    let text =
+        std::fs::read_to_string(common::repo().join("examples/models/slider_crank_spring.toml"))
+            .unwrap();
+    let mut given_only: Vec<String> = Vec::new();
+    for line in text.lines() {
+        if line.starts_with("velocity = ") {
+            let keep_rate = line.ends_with(", 6.0]");
+            given_only.push(if keep_rate {
+                "velocity = [0.0, 0.0, 6.0]".into()
+            } else {
+                "velocity = [0.0, 0.0, 0.0]".into()
+            });
+        } else {
+            given_only.push(line.to_string());
+        }
+    }
+    let plain = dir.join("plain.toml");
+    std::fs::write(&plain, given_only.join("\n")).unwrap();
+    let out = dir.join("plain.csv");
+    let o = run_model(&plain, "rk4", &["--h", "0.005"], &out);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stderr
+            .contains("warning: the initial state was made consistent")
+            && o.stderr.contains("d_crank.theta given 6 used 0.")
+            && o.stderr.contains("inputs = [\"d_theta\"]"),
+        "{}",
+        o.stderr
+    );
+    let marked = dir.join("marked.toml");
+    let with_input = given_only.join("\n").replacen(
+        "velocity = [0.0, 0.0, 6.0]",
+        "velocity = [0.0, 0.0, 6.0]\ninputs = [\"d_theta\"]",
+        1,
+    );
+    std::fs::write(&marked, with_input).unwrap();
+    let out = dir.join("marked.csv");
+    let o = run_model(&marked, "rk4", &["--h", "0.005"], &out);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(!o.stderr.contains("d_crank.theta given"), "{}", o.stderr);
+    let (head, rows) = read_csv(&out);
+    let k = head.iter().position(|h| h == "d_crank.theta").unwrap();
+    assert_eq!(rows[0][k], 6.0);
+}

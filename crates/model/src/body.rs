@@ -59,6 +59,53 @@ pub struct Body {
     /// Initial `(xdot, ydot, thetadot)`.
     #[serde(default)]
     pub velocity: [f64; 3],
+    /// Which of the initial coordinates and velocities are inputs: the consistent-state solve
+    /// keeps them and solves for the others (default: none, every one may move).
+    #[serde(default)]
+    pub inputs: Inputs,
+}
+
+/// One of a body's three coordinates `(x, y, theta)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coord {
+    /// The centre of mass's `x`.
+    X,
+    /// The centre of mass's `y`.
+    Y,
+    /// The rotation angle.
+    Theta,
+}
+
+impl Coord {
+    /// The offset of this coordinate in a body's block `(x, y, theta)`.
+    pub fn offset(self) -> usize {
+        match self {
+            Coord::X => 0,
+            Coord::Y => 1,
+            Coord::Theta => 2,
+        }
+    }
+    /// The name used in coordinate names and model files: `x`, `y`, `theta`.
+    pub fn name(self) -> &'static str {
+        ["x", "y", "theta"][self.offset()]
+    }
+}
+
+/// Which of a body's initial coordinates (`position`) and velocities (`velocity`) are inputs,
+/// in the order `(x, y, theta)`. Initial states are projected onto the constraints
+/// (`mbd_solve::consistent_state`) with the smallest mass-weighted change; an input is not
+/// changed at all, and the other coordinates take up the whole correction (an error names an
+/// equation the inputs leave no free coordinate for).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Inputs {
+    /// Kept coordinates.
+    #[serde(default)]
+    pub position: [bool; 3],
+    /// Kept velocities.
+    #[serde(default)]
+    pub velocity: [bool; 3],
 }
 
 impl Body {
@@ -70,6 +117,7 @@ impl Body {
             inertia: 1.0,
             position: [0.0; 3],
             velocity: [0.0; 3],
+            inputs: Inputs::default(),
         }
     }
     /// Sets the mass.
@@ -96,6 +144,30 @@ impl Body {
     /// Sets the initial velocity `(xdot, ydot, thetadot)`.
     pub fn velocity(mut self, vx: f64, vy: f64, omega: f64) -> Self {
         self.velocity = [vx, vy, omega];
+        self
+    }
+    /// Marks the initial value of coordinate `c` as an input (see [`Inputs`]).
+    pub fn input_position(mut self, c: Coord) -> Self {
+        self.inputs.position[c.offset()] = true;
+        self
+    }
+    /// Marks the initial velocity of coordinate `c` as an input (see [`Inputs`]): e.g. a
+    /// crank's `6 rad/s`, with the other bodies' velocities solved from the constraints.
+    ///
+    /// ```
+    /// use mbd_model::{models::SliderCrankParams, Coord};
+    /// let mut p = SliderCrankParams::default();
+    /// p.speed = 6.0;
+    /// let sys = mbd_model::models::slider_crank_with(&p)?;
+    /// let crank = sys.body_handle("crank").unwrap();
+    /// // the model's crank velocity is not an input unless marked
+    /// assert!(!sys.bodies()[crank.index()].inputs.velocity[2]);
+    /// let marked = sys.bodies()[crank.index()].clone().input_velocity(Coord::Theta);
+    /// assert_eq!(marked.inputs.velocity, [false, false, true]);
+    /// # Ok::<(), mbd_model::ModelError>(())
+    /// ```
+    pub fn input_velocity(mut self, c: Coord) -> Self {
+        self.inputs.velocity[c.offset()] = true;
         self
     }
 }

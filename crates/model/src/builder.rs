@@ -72,6 +72,7 @@ impl SystemBuilder {
             inertia: f64::NAN,
             position: [position[0], position[1], 0.0],
             velocity: [velocity[0], velocity[1], 0.0],
+            inputs: crate::Inputs::default(),
         });
         self.frames[h.0].point_mass = true;
         h
@@ -86,6 +87,16 @@ impl SystemBuilder {
             f.com = com;
         } else {
             self.unknown_frame.get_or_insert(body.0);
+        }
+        self
+    }
+    /// Marks which of `body`'s initial values are inputs (see [`crate::Inputs`]; for a body
+    /// added with [`crate::Body::input_position`] / [`crate::Body::input_velocity`] this is
+    /// not needed). An unknown handle is ignored here and reported by `build` wherever the
+    /// handle is used.
+    pub fn set_inputs(&mut self, body: BodyHandle, inputs: crate::Inputs) -> &mut Self {
+        if let Some(b) = self.bodies.get_mut(body.0) {
+            b.inputs = inputs;
         }
         self
     }
@@ -155,6 +166,19 @@ impl SystemBuilder {
                 return Err(invalid(
                     format!("body '{}'", body.name),
                     format!("body frame: centre of mass {c:?} must be finite"),
+                ));
+            }
+            // inputs are on the centre of mass's coordinates: with a frame offset, an x or y
+            // input would not be the value given (the origin's)
+            let moved = c != [0.0, 0.0];
+            let xy = |m: [bool; 3]| m[0] || m[1];
+            if moved && (xy(body.inputs.position) || xy(body.inputs.velocity)) {
+                return Err(invalid(
+                    format!("body '{}'", body.name),
+                    "inputs on x or y need the body frame's origin at the centre of mass (no \
+                     'com'): the given values are the origin's, the kept ones the centre of \
+                     mass's; mark theta inputs, or give the centre of mass's values"
+                        .into(),
                 ));
             }
             // r_com = r_o + R(theta) c;  v_com = v_o + omega x R(theta) c

@@ -67,13 +67,13 @@ mod scale;
 mod system;
 mod timefn;
 
-pub use body::{Body, BodyHandle, BodyRef};
+pub use body::{Body, BodyHandle, BodyRef, Coord, Inputs};
 pub use builder::SystemBuilder;
 pub use cache::BodyAngles;
 pub use element::Sketch;
 pub use element_hessians::ElementHessian;
 pub use error::ModelError;
-pub use file::{BodyKind, BodySpec, ForceSpec, JointSpec, ModelFile};
+pub use file::{BodyKind, BodySpec, ForceSpec, InitialInput, JointSpec, ModelFile};
 pub use forces::{Force, ForceKind};
 pub use init::{RedundantConstraints, RedundantEquation, SPARSE_RANK_THRESHOLD};
 pub use jet::{Basis, PolyJet, MAX_DIRS};

@@ -269,6 +269,15 @@ impl System {
         (q, v)
     }
 
+    /// The input masks of the initial state (length [`System::n_coords`] each): which
+    /// coordinates and velocities of [`System::initial_guess`] the consistent-state solve keeps
+    /// (see [`crate::Inputs`]).
+    pub fn initial_inputs(&self) -> (Vec<bool>, Vec<bool>) {
+        let q = self.bodies.iter().flat_map(|b| b.inputs.position).collect();
+        let v = self.bodies.iter().flat_map(|b| b.inputs.velocity).collect();
+        (q, v)
+    }
+
     pub(crate) fn check_len(
         &self,
         what: &'static str,

@@ -75,13 +75,17 @@ pub fn consistent_state(sys: &System, t: f64) -> Result<ConsistentState, SolveEr
 /// Projects a guess `(q, v)` onto the constraint manifold at time `t`: positions by Newton with
 /// the minimum `M`-norm correction `dq = -M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T)^-1 Phi`, then
 /// velocities by the `M`-orthogonal projection onto `Phi_q v + Phi_t = 0` (twice, so the
-/// velocity residual is at round-off).
+/// velocity residual is at round-off). The model's inputs ([`mbd_model::Inputs`],
+/// [`System::initial_inputs`]) are kept: their entries of `M^-1` are zero in both corrections,
+/// so the other coordinates take up the whole correction (the smallest change of them, in
+/// their mass metric).
 ///
 /// Errors: a wrong length ([`SolveError::Dimension`] naming `q_guess` or `v_guess`), a
 /// non-finite entry ([`SolveError::NonFinite`]), a Newton iteration that does not converge
 /// ([`SolveError::Newton`] naming the equation with the largest residual), or a projected
 /// configuration where `Phi_q` loses rank ([`mbd_model::ModelError::Redundant`] from
-/// [`System::check_rank`], naming the dependent equation and its joints).
+/// [`System::check_rank`], naming the dependent equation and its joints), or inputs that leave
+/// an equation no free coordinate ([`SolveError::OverdeterminedInputs`]).
 pub fn project_state(
     sys: &System,
     q_guess: &[f64],
@@ -126,7 +130,14 @@ pub fn project_state(
         },
         opts.linear,
     )?;
-    let stats = projector.project_positions(sys, &mut q, t)?;
+    // the model's inputs: weight zero, so the projections leave them as given
+    let (keep_q, keep_v) = sys.initial_inputs();
+    let inputs = Inputs::new(sys, &keep_q, &keep_v);
+    projector.set_weights(inputs.weights(sys, &keep_q));
+    let stats = projector
+        .project_positions(sys, &mut q, t)
+        .map_err(|e| inputs.explain(e, "position", &keep_q))?;
+    projector.set_weights(inputs.weights(sys, &keep_v));
     // Full rank at the projected configuration: the dense path proves it with the model's
     // rank check (which names the dependent joints); the sparse path's Cholesky pivot test is
     // the check, and the model's check runs only to name the joints when that test fails.
@@ -136,7 +147,7 @@ pub fn project_state(
     for _ in 0..2 {
         if let Err(e) = projector.project_velocities(sys, &q, &mut v, t) {
             sys.check_rank(&q, t)?;
-            return Err(e);
+            return Err(inputs.explain(e, "velocity", &keep_v));
         }
     }
     let mut phi = vec![0.0; m];
@@ -152,6 +163,119 @@ pub fn project_state(
         residual: max_abs(&phi),
         velocity_residual: max_abs(&phid),
     })
+}
+
+/// A given initial value that the consistent initial state changed (see [`initial_changes`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialChange {
+    /// The coordinate (`crank.theta`) or velocity (`d_crank.theta`).
+    pub name: String,
+    /// The value the model gives.
+    pub given: f64,
+    /// The value the consistent state uses.
+    pub used: f64,
+}
+
+/// A change of a given initial value below this, relative to `max(1, |given|)`, is the
+/// projection's round-off and not reported by [`initial_changes`].
+pub const INITIAL_CHANGE_TOL: f64 = 1e-8;
+
+/// The given initial values that the consistent state `(q, v)` changed by more than
+/// [`INITIAL_CHANGE_TOL`] (relative to `max(1, |given|)`): every coordinate, and every
+/// velocity the model gives as non-zero (a velocity left at zero is one the model leaves to the
+/// constraints). Inputs ([`mbd_model::Inputs`]) never change. What `mbd run` warns about.
+///
+/// ```
+/// use mbd_model::{models::SliderCrankParams, Coord};
+/// // a slider-crank whose crank is given 6 rad/s: the consistent state keeps the kinetic
+/// // energy's nearest velocities, not the crank's rate
+/// let mut p = SliderCrankParams::default();
+/// p.speed = 6.0;
+/// let sys = mbd_model::models::slider_crank_with(&p)?;
+/// let x = mbd_solve::consistent_state(&sys, 0.0)?;
+/// let changes = mbd_solve::initial_changes(&sys, x.q.as_slice(), x.v.as_slice());
+/// assert!(changes.iter().any(|c| c.name == "d_crank.theta" && c.given == 6.0));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn initial_changes(sys: &System, q: &[f64], v: &[f64]) -> Vec<InitialChange> {
+    let (q0, v0) = sys.initial_guess();
+    let names = sys.coordinate_names();
+    let moved =
+        |given: f64, used: f64| (used - given).abs() > INITIAL_CHANGE_TOL * given.abs().max(1.0);
+    let mut out = Vec::new();
+    for (i, name) in names.iter().enumerate() {
+        if let (Some(&given), Some(&used)) = (q0.get(i), q.get(i)) {
+            if moved(given, used) {
+                out.push(InitialChange {
+                    name: name.clone(),
+                    given,
+                    used,
+                });
+            }
+        }
+    }
+    for (i, name) in names.iter().enumerate() {
+        if let (Some(&given), Some(&used)) = (v0.get(i), v.get(i)) {
+            if given != 0.0 && moved(given, used) {
+                out.push(InitialChange {
+                    name: format!("d_{name}"),
+                    given,
+                    used,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The names of the initial state's inputs, for the weights and the errors of
+/// [`project_state`].
+struct Inputs {
+    names: Vec<String>,
+}
+
+impl Inputs {
+    fn new(sys: &System, keep_q: &[bool], keep_v: &[bool]) -> Self {
+        let names = if keep_q.iter().chain(keep_v).any(|&k| k) {
+            sys.coordinate_names()
+        } else {
+            Vec::new()
+        };
+        Inputs { names }
+    }
+
+    /// `M^-1` with the kept coordinates' weights zero, or `None` when none is kept.
+    fn weights(&self, sys: &System, keep: &[bool]) -> Option<Vec<f64>> {
+        keep.iter().any(|&k| k).then(|| {
+            sys.inv_mass_diag()
+                .iter()
+                .zip(keep)
+                .map(|(&w, &k)| if k { 0.0 } else { w })
+                .collect()
+        })
+    }
+
+    /// A singular projection with inputs at this level: the inputs leave its equation no
+    /// free coordinate.
+    fn explain(&self, e: SolveError, level: &'static str, keep: &[bool]) -> SolveError {
+        match e {
+            SolveError::Singular { detail, .. } if keep.iter().any(|&k| k) => {
+                let prefix = if level == "velocity" { "d_" } else { "" };
+                let inputs: Vec<String> = keep
+                    .iter()
+                    .zip(&self.names)
+                    .filter(|(&k, _)| k)
+                    .map(|(_, n)| format!("{prefix}{n}"))
+                    .collect();
+                SolveError::OverdeterminedInputs {
+                    level,
+                    inputs: inputs.join(", "),
+                    equation: detail,
+                }
+            }
+            e => e,
+        }
+    }
 }
 
 #[cfg(test)]

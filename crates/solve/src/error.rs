@@ -117,6 +117,20 @@ pub enum SolveError {
         /// The equation or pivot at fault.
         detail: String,
     },
+    /// The initial state's inputs (values marked to be kept, [`mbd_model::Inputs`]) leave a
+    /// constraint equation no free coordinate (or velocity) to satisfy it.
+    #[error(
+        "the initial {level} inputs ({inputs}) leave equation {equation} no free {level} to \
+         satisfy it: mark fewer inputs, or give values that satisfy it"
+    )]
+    OverdeterminedInputs {
+        /// "position" or "velocity".
+        level: &'static str,
+        /// The inputs, as coordinate names (`crank.theta`, `d_crank.theta`).
+        inputs: String,
+        /// The equation (`joint.label`).
+        equation: String,
+    },
     /// A vector has the wrong length for the system.
     #[error("{what}: expected length {expected}, got {got}")]
     Dimension {

@@ -69,7 +69,10 @@ mod tableau;
 
 pub use accel::AccelerationSolver;
 pub use adaptive::{run_adaptive, AdaptiveConfig, AdaptiveIntegrator, StepAttempt};
-pub use consistent::{consistent_state, project_state, ConsistentOptions, ConsistentState};
+pub use consistent::{
+    consistent_state, initial_changes, project_state, ConsistentOptions, ConsistentState,
+    InitialChange, INITIAL_CHANGE_TOL,
+};
 pub use dense::{Crossing, DenseOutput, Event, EventFn, EventHit};
 pub use error::{refuse_redundant, SolveError};
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};

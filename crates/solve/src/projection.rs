@@ -51,6 +51,9 @@ pub struct Projector {
     pub settings: ProjectionSettings,
     kernel: Kernel,
     r: Vec<f64>,
+    /// The weights of the corrections in place of `M^-1` (zero: a coordinate the projections
+    /// keep), if set.
+    weights: Option<Vec<f64>>,
 }
 
 /// What a projection did.
@@ -84,7 +87,17 @@ impl Projector {
             settings,
             kernel,
             r: vec![0.0; m],
+            weights: None,
         })
+    }
+
+    /// Weights the corrections by `w` (length n) in place of `M^-1`: the smallest
+    /// `W^-1`-weighted change, and a coordinate with `w_i = 0` is not changed at all (an input
+    /// of the initial state). `None` restores `M^-1`. A weight vector that leaves an equation
+    /// no coordinate to move makes the projection's factorisation singular (the error names
+    /// the equation).
+    pub(crate) fn set_weights(&mut self, w: Option<Vec<f64>>) {
+        self.weights = w;
     }
 
     /// Whether the sparse kernel is in use.
@@ -93,7 +106,10 @@ impl Projector {
     }
 
     fn factor(&mut self, sys: &System, q: &[f64], t: f64) -> Result<(), SolveError> {
-        let minv = sys.inv_mass_diag().as_slice();
+        let minv = self
+            .weights
+            .as_deref()
+            .unwrap_or(sys.inv_mass_diag().as_slice());
         let res = match &mut self.kernel {
             Kernel::Dense(schur) => {
                 sys.phi_q_local(q, &mut schur.grads);
@@ -118,7 +134,10 @@ impl Projector {
 
     /// `x -= M^-1 Phi_q^T S^-1 r` with `r` in `self.r`.
     fn correct(&mut self, sys: &System, x: &mut [f64]) {
-        let minv = sys.inv_mass_diag().as_slice();
+        let minv = self
+            .weights
+            .as_deref()
+            .unwrap_or(sys.inv_mass_diag().as_slice());
         match &mut self.kernel {
             Kernel::Dense(schur) => {
                 schur.chol.solve_in_place(&mut self.r);

@@ -22,7 +22,7 @@
 mod resolve;
 mod spec;
 
-pub use spec::{BodyKind, BodySpec, ForceSpec, JointSpec};
+pub use spec::{BodyKind, BodySpec, ForceSpec, InitialInput, JointSpec};
 
 use crate::builder::SystemBuilder;
 use crate::error::ModelError;

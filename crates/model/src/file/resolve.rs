@@ -68,12 +68,28 @@ impl<'a> Resolver<'a> {
                     ));
                 }
             }
+            let mut inputs = crate::Inputs::default();
+            for i in &s.inputs {
+                let (velocity, k) = i.slot();
+                if k == 2 && s.kind == BodyKind::PointMass {
+                    return Err(invalid(
+                        element,
+                        "inputs: a point mass has no angle to keep (theta, d_theta)".into(),
+                    ));
+                }
+                if velocity {
+                    inputs.velocity[k] = true;
+                } else {
+                    inputs.position[k] = true;
+                }
+            }
             bodies.push(Body {
                 name: s.name.clone(),
                 mass: s.mass,
                 inertia,
                 position: s.position,
                 velocity: s.velocity,
+                inputs,
             });
         }
         let mut index = std::collections::HashMap::with_capacity(file.bodies.len());
@@ -107,7 +123,9 @@ impl ModelFile {
         for (body, spec) in r.bodies.iter().zip(&self.bodies) {
             let h = if spec.kind == BodyKind::PointMass {
                 let (p, v) = (body.position, body.velocity);
-                b.add_point_mass(body.name.clone(), body.mass, [p[0], p[1]], [v[0], v[1]])
+                let h = b.add_point_mass(body.name.clone(), body.mass, [p[0], p[1]], [v[0], v[1]]);
+                b.set_inputs(h, body.inputs);
+                h
             } else {
                 b.add_body(body.clone())
             };
@@ -151,6 +169,7 @@ impl System {
                     position: b.position,
                     velocity: b.velocity,
                     com: None,
+                    inputs: super::spec::InitialInput::list(&b.inputs),
                 })
                 .collect(),
             joints,

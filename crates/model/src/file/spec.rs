@@ -54,6 +54,65 @@ pub struct BodySpec {
     /// part); when absent the frame's origin is the centre of mass.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub com: Option<[f64; 2]>,
+    /// Initial values the consistent-state solve keeps (the others are solved for): any of
+    /// `x`, `y`, `theta` (positions) and `d_x`, `d_y`, `d_theta` (velocities), e.g.
+    /// `inputs = ["d_theta"]` for a crank whose `6 rad/s` must stay. `x`, `y` inputs need no
+    /// `com`; a point mass has no `theta`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<InitialInput>,
+}
+
+/// An initial value a model file marks as an input ([`BodySpec::inputs`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+pub enum InitialInput {
+    /// The centre of mass's `x`.
+    #[serde(rename = "x")]
+    X,
+    /// The centre of mass's `y`.
+    #[serde(rename = "y")]
+    Y,
+    /// The angle.
+    #[serde(rename = "theta")]
+    Theta,
+    /// The velocity `xdot`.
+    #[serde(rename = "d_x")]
+    DX,
+    /// The velocity `ydot`.
+    #[serde(rename = "d_y")]
+    DY,
+    /// The angular velocity.
+    #[serde(rename = "d_theta")]
+    DTheta,
+}
+
+impl InitialInput {
+    /// Whether it is a velocity, and its offset in `(x, y, theta)`.
+    pub fn slot(self) -> (bool, usize) {
+        match self {
+            InitialInput::X => (false, 0),
+            InitialInput::Y => (false, 1),
+            InitialInput::Theta => (false, 2),
+            InitialInput::DX => (true, 0),
+            InitialInput::DY => (true, 1),
+            InitialInput::DTheta => (true, 2),
+        }
+    }
+    /// The inputs of a body's [`crate::Inputs`], positions first.
+    pub fn list(inputs: &crate::Inputs) -> Vec<InitialInput> {
+        use InitialInput::*;
+        let mut out = Vec::new();
+        for (k, v) in [X, Y, Theta].into_iter().enumerate() {
+            if inputs.position[k] {
+                out.push(v);
+            }
+        }
+        for (k, v) in [DX, DY, DTheta].into_iter().enumerate() {
+            if inputs.velocity[k] {
+                out.push(v);
+            }
+        }
+        out
+    }
 }
 
 /// A joint in a model file (bodies by name), tagged by `type`. Each variant's fields are
