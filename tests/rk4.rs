@@ -221,3 +221,41 @@ fn sparse_and_dense_index1_solves_agree_on_a_chain() {
         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
     assert!(d < 1e-10, "dense vs sparse differ by {d}");
 }
+
+/// A run of more than `MAX_FIXED_STEPS` steps is refused as such (not as a bad step size),
+/// with compact numbers; a span far below h is one short step.
+#[test]
+fn step_counts_out_of_range_say_so() {
+    let sys = models::pendulum(1.0, 1.0, 0.2, 9.81).unwrap();
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    let mut rk = Rk4::new(&sys, Rk4Options::plain()).unwrap();
+    let mut s = s0.clone();
+    let e = run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(1e12, 1e-3),
+        &mut NoObserver,
+    )
+    .unwrap_err();
+    assert!(matches!(e, SolveError::TooManySteps { .. }), "{e:?}");
+    let m = e.to_string();
+    assert!(
+        m.contains("1000000000000000 steps of h = 0.001 over 1000000000000 s")
+            && m.contains("larger step"),
+        "{m}"
+    );
+    assert_eq!(s, s0);
+    let stats = run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(1e-300, 1e-3),
+        &mut NoObserver,
+    )
+    .unwrap();
+    assert_eq!(stats.steps, 1);
+    assert_eq!(s.t, 1e-300);
+    let e = SolveError::InvalidStep { h: 1e300 }.to_string();
+    assert!(e.contains("h = 1e300 "), "{e}");
+}

@@ -95,21 +95,33 @@ pub struct RunArgs {
     #[arg(long, short, value_parser = parse_solver)]
     pub solver: SolverSpec,
     /// End time in s (the run starts at t0 = 0).
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_t_end)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_t_end)]
     pub t_end: f64,
     /// Fixed step size in s.
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_h, conflicts_with = "tol")]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_h, conflicts_with = "tol")]
     pub h: Option<f64>,
     /// Error tolerance for adaptive steps (solvers with an embedded error estimate: `mbd
     /// solvers` marks them adaptive).
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_tol)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_tol)]
     pub tol: Option<f64>,
-    /// Output file: .csv or .json (default: CSV on standard output).
+    /// Output file: .csv or .json, or - (or none) for CSV on standard output; a device such as
+    /// /dev/null takes CSV.
     #[arg(long, short)]
     pub out: Option<PathBuf>,
     /// Write every K-th step (and always the first and the last state).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value = "1", value_parser = parse_count)]
     pub every: u64,
+    /// Stop when a constraint residual exceeds this fraction of its equation's scale (the
+    /// mechanism's size, or 1 rad): the drift guard's tolerance (default 0.01).
+    #[arg(long, value_parser = parse_drift_tol, conflicts_with = "no_drift_guard")]
+    pub drift_tol: Option<f64>,
+    /// Run without the drift guard (to measure drift itself).
+    #[arg(long)]
+    pub no_drift_guard: bool,
+    /// Refuse a run of more steps than this (fixed steps: t-end / h; adaptive: the budget of
+    /// step attempts).
+    #[arg(long, default_value = "1e9", value_parser = parse_count)]
+    pub max_steps: u64,
     /// Add each joint's reaction: JOINT.fx, JOINT.fy (force on the joint's second body,
     /// global axes, N) and JOINT.mz (moment about the joint's point on that body, N m).
     #[arg(long)]
@@ -182,6 +194,35 @@ fn parse_tol(s: &str) -> Result<f64, String> {
     } else {
         Err(format!(
             "the tolerance must lie in (0, 1), e.g. --tol 1e-8 (got {s})"
+        ))
+    }
+}
+
+/// A count of steps: a whole number at least 1, written as an integer or in exponent form
+/// (`1e9`).
+fn parse_count(s: &str) -> Result<u64, String> {
+    let bad = || format!("expected a whole number of steps, at least 1 (got {s})");
+    if let Ok(n) = s.trim().parse::<u64>() {
+        return if n >= 1 { Ok(n) } else { Err(bad()) };
+    }
+    let x: f64 = s.trim().parse().map_err(|_| bad())?;
+    if x.fract() == 0.0 && (1.0..=u64::MAX as f64).contains(&x) {
+        Ok(x as u64)
+    } else if x > u64::MAX as f64 {
+        Err(format!("{s} is more than the largest count, {}", u64::MAX))
+    } else {
+        Err(bad())
+    }
+}
+
+fn parse_drift_tol(s: &str) -> Result<f64, String> {
+    let t = parse_number(s)?;
+    if t.is_finite() && t > 0.0 {
+        Ok(t)
+    } else {
+        Err(format!(
+            "the drift tolerance must be a positive fraction of the equations' scale, e.g. \
+             --drift-tol 0.05 (got {s})"
         ))
     }
 }

@@ -8,9 +8,11 @@ use std::path::Path;
 /// name the file; for errors about an element (a body, joint or force named in quotes) the
 /// line where that element's name appears in the file is added.
 pub fn load(path: &Path) -> Result<System, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| CliError::ModelRead {
-        path: path.display().to_string(),
-        message: e.to_string(),
+    let text = mbd_model::read_text(path, mbd_model::MAX_MODEL_FILE_BYTES).map_err(|e| {
+        CliError::ModelRead {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
     })?;
     let result = match path.extension().and_then(|e| e.to_str()) {
         Some("json") => System::from_json(&text),

@@ -7,7 +7,9 @@ use mbd::solve::registry::SolverSpec;
 use mbd::Simulation;
 use mbd_analysis::{CsvObserver, MeasureObserver};
 use mbd_model::System;
-use mbd_solve::{AdaptiveConfig, Flow, Observer, RunConfig, RunStats, SolveError, State};
+use mbd_solve::{
+    AdaptiveConfig, DriftGuard, Flow, Observer, RunConfig, RunStats, SolveError, State,
+};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -144,19 +146,27 @@ fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
     let csv = |w: Box<dyn Write>| {
         Sink::Csv(columns(CsvObserver::new(w), args.reactions).with_every(every))
     };
+    let stdout = || csv(Box::new(std::io::BufWriter::new(std::io::stdout())));
     let Some(out) = &args.out else {
-        return Ok(csv(Box::new(std::io::BufWriter::new(std::io::stdout()))));
+        return Ok(stdout());
     };
+    if out.as_os_str() == "-" {
+        return Ok(stdout());
+    }
     let ext = out
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
+    // a device or pipe (`/dev/null`, a named pipe) takes CSV whatever its name
+    let device = std::fs::metadata(out).is_ok_and(|m| !m.is_file() && !m.is_dir());
     let json = match ext.as_deref() {
         Some("csv") => false,
         Some("json") => true,
+        _ if device => false,
         _ => {
             return Err(CliError::Usage(format!(
-                "--out '{}': the output file must end in .csv or .json",
+                "--out '{}': the output file must end in .csv or .json (or be - for standard \
+                 output)",
                 out.display()
             )))
         }
@@ -179,9 +189,10 @@ fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
 fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
     let hint = match &source {
         SolveError::ConstraintDrift { .. } => {
-            "; the constraints drifted: take a smaller --h, or a solver that holds them \
-             (rk4-projected, symplectic:S, tangent:rk4)"
+            " (solvers that hold them: rk4-projected, symplectic:S, tangent:rk4; --drift-tol \
+             loosens the guard, default 0.01, and --no-drift-guard turns it off)"
         }
+        SolveError::TooManySteps { .. } => "",
         SolveError::Observer { .. } => "; check the output path and the free disk space",
         // a singular configuration: a smaller step does not help a solver that cannot pass
         SolveError::Singular { .. } => {
@@ -215,7 +226,14 @@ fn warn_initial_changes(sys: &System, state: &State) {
     let shown: Vec<String> = changes
         .iter()
         .take(5)
-        .map(|c| format!("{} given {} used {}", c.name, num(c.given), num(c.used)))
+        .map(|c| {
+            format!(
+                "{} given {} used {}",
+                c.name,
+                mbd_model::format_number(c.given),
+                mbd_model::format_number(c.used)
+            )
+        })
         .collect();
     let more = if changes.len() > 5 {
         format!(" and {} more", changes.len() - 5)
@@ -229,15 +247,6 @@ fn warn_initial_changes(sys: &System, state: &State) {
          solved for",
         shown.join("; ")
     );
-}
-
-/// A number in the messages: up to 6 significant digits, exponent form outside 1e-3..1e6.
-fn num(x: f64) -> String {
-    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) {
-        format!("{}", (x * 1e6).round() / 1e6)
-    } else {
-        format!("{x:.5e}")
-    }
 }
 
 /// Runs the simulation, writes the output and returns the summary.
@@ -275,9 +284,38 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         source: Box::new(source),
     })?;
     warn_initial_changes(&sys, &state);
+    let guard = if args.no_drift_guard {
+        None
+    } else {
+        Some(DriftGuard {
+            position_tol: args.drift_tol.unwrap_or(DriftGuard::DEFAULT_POSITION_TOL),
+            ..DriftGuard::default()
+        })
+    };
+    let max_steps = usize::try_from(args.max_steps).unwrap_or(usize::MAX);
     let plan: mbd::Plan = match (args.h, args.tol) {
-        (_, Some(tol)) => AdaptiveConfig::new(args.t_end, tol).into(),
-        (Some(h), None) => RunConfig::new(args.t_end, h).into(),
+        (_, Some(tol)) => {
+            let mut cfg = AdaptiveConfig::new(args.t_end, tol);
+            cfg.drift_guard = guard;
+            cfg.max_steps = max_steps;
+            cfg.into()
+        }
+        (Some(h), None) => {
+            let steps = mbd_solve::step_count(0.0, args.t_end, h)
+                .map_err(|e| CliError::Usage(e.to_string()))?;
+            if steps > max_steps {
+                return Err(CliError::Usage(format!(
+                    "the run needs {steps} steps (--t-end {} / --h {}), more than --max-steps {}: \
+                     raise --max-steps to run it, or take a larger --h",
+                    mbd_model::format_number(args.t_end),
+                    mbd_model::format_number(h),
+                    args.max_steps
+                )));
+            }
+            let mut cfg = RunConfig::new(args.t_end, h);
+            cfg.drift_guard = guard;
+            cfg.into()
+        }
         (None, None) => {
             return Err(CliError::Usage(
                 "give a step size with --h (or a tolerance with --tol)".into(),

@@ -3,6 +3,9 @@
 use crate::error::CliError;
 use std::path::Path;
 
+/// The largest result file `mbd plot` reads (1 GiB: about 5 million rows of a 10-body model).
+pub const MAX_TABLE_BYTES: u64 = 1 << 30;
+
 /// A CSV result: named columns of numbers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Table {
@@ -17,7 +20,8 @@ pub struct Table {
 impl Table {
     /// Reads a CSV file; errors name the file and the line.
     pub fn read(path: &Path) -> Result<Table, CliError> {
-        let text = std::fs::read_to_string(path).map_err(|e| CliError::read(path, e))?;
+        let text =
+            mbd_model::read_text(path, MAX_TABLE_BYTES).map_err(|e| CliError::read(path, e))?;
         Table::parse(&path.display().to_string(), &text)
     }
 

@@ -326,3 +326,99 @@ fn every_must_be_positive() {
     ]);
     assert_fails(&out, 2, &["--every"]);
 }
+
+/// Step counts out of range say so, with compact numbers: a run beyond the library's 1e12
+/// steps, one beyond `--max-steps` (default 1e9) naming the flag; a span far below h runs as
+/// one step.
+#[test]
+fn step_counts_out_of_range() {
+    let out = run_with(&["--solver", "rk4", "--t-end", "1e12", "--h", "1e-3"]);
+    assert_fails(
+        &out,
+        2,
+        &["1000000000000000 steps of h = 0.001", "larger step"],
+    );
+    let out = run_with(&["--solver", "rk4", "--t-end", "1", "--h", "1e-12"]);
+    assert_fails(&out, 2, &["1000000000000 steps", "--max-steps 1000000000"]);
+    let out = run_with(&[
+        "--solver", "rk4", "--t-end", "1e-300", "--h", "1e-3", "--out", "-",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(out.stdout.lines().count(), 3, "header and two rows");
+}
+
+/// Counts accept exponent form and say what is wrong; a negative infinite step is a value
+/// the step-size check names, not an unknown flag.
+#[test]
+fn counts_and_signed_values() {
+    let out = run_with(&[
+        "--solver", "rk4", "--t-end", "0.01", "--h", "1e-3", "--every", "1e20",
+    ]);
+    assert_fails(&out, 2, &["1e20 is more than the largest count"]);
+    let out = run_with(&[
+        "--solver", "rk4", "--t-end", "0.01", "--h", "1e-3", "--every", "2.5",
+    ]);
+    assert_fails(&out, 2, &["whole number of steps"]);
+    let out = run_with(&[
+        "--solver", "rk4", "--t-end", "0.01", "--h", "1e-3", "--every", "1e1", "--out", "-",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(out.stdout.lines().count(), 3, "header, steps 0 and 10");
+    let out = run_with(&["--solver", "rk4", "--t-end", "0.01", "--h", "-inf"]);
+    assert_fails(
+        &out,
+        2,
+        &["'-inf' for '--h <H>'", "positive number of seconds"],
+    );
+}
+
+/// `/dev/null` and `-` are outputs; an endless device is not a model file.
+#[test]
+fn devices_as_files() {
+    let out = run_with(&[
+        "--solver",
+        "rk4",
+        "--t-end",
+        "0.01",
+        "--h",
+        "1e-3",
+        "--out",
+        "/dev/null",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let out = mbd(["check", "/dev/zero"]);
+    assert_fails(&out, 1, &["'/dev/zero'", "more than 67108864 bytes"]);
+}
+
+/// The drift guard's message names the CLI's flags (not a library field), and the flags work:
+/// plain RK4 at h = 0.1 on the pendulum drifts past the default guard at 5.5 s, passes with
+/// --drift-tol 10 and with --no-drift-guard.
+#[test]
+fn drift_guard_flags() {
+    let base = [
+        "--solver",
+        "rk4",
+        "--t-end",
+        "10",
+        "--h",
+        "0.1",
+        "--out",
+        "/dev/null",
+    ];
+    let out = run_with(&base);
+    assert_fails(
+        &out,
+        1,
+        &["constraint drift", "--drift-tol", "--no-drift-guard"],
+    );
+    assert!(!out.stderr.contains("RunConfig"), "{}", out.stderr);
+    let mut loose = base.to_vec();
+    loose.extend(["--drift-tol", "10"]);
+    assert_eq!(run_with(&loose).code, 0);
+    let mut off = base.to_vec();
+    off.push("--no-drift-guard");
+    assert_eq!(run_with(&off).code, 0);
+    let mut both = off.clone();
+    both.extend(["--drift-tol", "1"]);
+    assert_fails(&run_with(&both), 2, &["cannot be used with"]);
+}

@@ -106,8 +106,16 @@ pub enum ModelError {
 }
 
 /// `x` as a reader wants it in a message: plain decimal between 1e-4 and 1e16 (and 0), else in
-/// scientific notation (never 300 digits for `1e300`).
-pub(crate) fn num(x: f64) -> String {
+/// scientific notation (never 300 digits for `1e300`). The one number format of the messages of
+/// every crate (`mbd_model::format_number`).
+///
+/// ```
+/// use mbd_model::format_number;
+/// assert_eq!(format_number(0.001), "0.001");
+/// assert_eq!(format_number(1e300), "1e300");
+/// assert_eq!(format_number(-1e-7), "-1e-7");
+/// ```
+pub fn num(x: f64) -> String {
     if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
         format!("{x}")
     } else {

@@ -72,8 +72,11 @@ pub use builder::SystemBuilder;
 pub use cache::BodyAngles;
 pub use element::Sketch;
 pub use element_hessians::ElementHessian;
-pub use error::ModelError;
-pub use file::{BodyKind, BodySpec, ForceSpec, InitialInput, JointSpec, ModelFile};
+pub use error::{num as format_number, ModelError};
+pub use file::{
+    read_text, BodyKind, BodySpec, ForceSpec, InitialInput, JointSpec, ModelFile,
+    MAX_MODEL_FILE_BYTES,
+};
 pub use forces::{Force, ForceKind};
 pub use init::{RedundantConstraints, RedundantEquation, SPARSE_RANK_THRESHOLD};
 pub use jet::{Basis, PolyJet, MAX_DIRS};

@@ -1,7 +1,7 @@
 //! The one error type of `mbd-solve` (and the error solver crates return).
 
 use mbd_linalg::LinalgError;
-use mbd_model::ModelError;
+use mbd_model::{format_number as num, ModelError};
 use thiserror::Error;
 
 /// Everything that can go wrong while integrating.
@@ -9,13 +9,31 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum SolveError {
     /// The step size is not positive and finite.
-    #[error("step size h = {h} is invalid: it must be positive and finite")]
+    #[error("step size h = {} is invalid: it must be positive and finite", num(*h))]
     InvalidStep {
         /// The step size given.
         h: f64,
     },
+    /// A fixed-step run would take more steps than the library runs
+    /// ([`crate::MAX_FIXED_STEPS`]).
+    #[error(
+        "the run needs {} steps of h = {} over {} s, more than the {} a run may take: take a \
+         larger step or a shorter run",
+        num(*steps),
+        num(*h),
+        num(*span),
+        num(crate::MAX_FIXED_STEPS)
+    )]
+    TooManySteps {
+        /// Steps the interval needs.
+        steps: f64,
+        /// The step size.
+        h: f64,
+        /// The interval's length, s.
+        span: f64,
+    },
     /// The time interval is empty, reversed or not finite.
-    #[error("time interval [{t0}, {t_end}] is invalid: {reason}")]
+    #[error("time interval [{}, {}] is invalid: {reason}", num(*t0), num(*t_end))]
     InvalidInterval {
         /// Start.
         t0: f64,
@@ -25,7 +43,7 @@ pub enum SolveError {
         reason: &'static str,
     },
     /// A setting is out of range.
-    #[error("parameter '{parameter}' = {value} is invalid: {reason}")]
+    #[error("parameter '{parameter}' = {} is invalid: {reason}", num(*value))]
     InvalidParameter {
         /// The setting.
         parameter: &'static str,
@@ -141,12 +159,13 @@ pub enum SolveError {
         /// Given length.
         got: usize,
     },
-    /// The constraints drifted beyond the run's drift guard.
+    /// The constraints drifted beyond the run's drift guard (`RunConfig::drift_guard`,
+    /// `AdaptiveConfig::drift_guard`; `mbd run --drift-tol`, `--no-drift-guard`).
     #[error(
         "constraint drift at t = {t}: {level} residual of {equation} (joint '{joint}') is \
          {residual:e}, beyond the drift guard's {tolerance:e}; the solver has left the \
          constraint manifold: take a smaller step, use a solver that keeps the constraints \
-         (projection, symplectic, tangent), or relax RunConfig::drift_guard"
+         (projection, symplectic, tangent), or relax the drift guard"
     )]
     ConstraintDrift {
         /// Time at the end of the step.

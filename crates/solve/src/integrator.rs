@@ -456,11 +456,18 @@ pub fn step_count(t0: f64, t_end: f64, h: f64) -> Result<usize, SolveError> {
     } else {
         r.ceil()
     };
-    if !(1.0..=1e12).contains(&n) {
-        return Err(SolveError::InvalidStep { h });
+    // (a span far below h is one short step)
+    let n = n.max(1.0);
+    if !(n <= MAX_FIXED_STEPS) {
+        return Err(SolveError::TooManySteps { steps: n, h, span });
     }
     Ok(n as usize)
 }
+
+/// The most steps a fixed-step run takes ([`step_count`]): beyond it a run is refused with
+/// [`SolveError::TooManySteps`] rather than started (1e12 steps of the cheapest solver take
+/// days).
+pub const MAX_FIXED_STEPS: f64 = 1e12;
 
 /// Integrates from `state.t` to `cfg.t_end` with steps of `cfg.h`, calling `observer` with the
 /// initial state (step 0) and after every step.

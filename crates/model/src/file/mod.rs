@@ -122,7 +122,7 @@ impl System {
     /// Loads a model file, JSON or TOML by its extension (`.json`, `.toml`).
     pub fn from_path(path: impl AsRef<std::path::Path>) -> Result<System, ModelError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError::Parse {
+        let text = read_text(path, MAX_MODEL_FILE_BYTES).map_err(|e| ModelError::Parse {
             format: "io",
             message: format!("{}: {e}", path.display()),
         })?;
@@ -135,4 +135,42 @@ impl System {
             }),
         }
     }
+}
+
+/// The largest model file read ([`System::from_path`], `mbd check`, `mbd run`): far above any
+/// real model (a 10,000-link chain's TOML is about 3 MB), and a device such as `/dev/zero` is
+/// refused instead of read forever.
+pub const MAX_MODEL_FILE_BYTES: u64 = 64 << 20;
+
+/// Reads a text file of at most `limit` bytes; a longer one (or an endless device) is an
+/// [`std::io::ErrorKind::InvalidData`] error saying so, after reading `limit + 1` bytes.
+///
+/// ```
+/// let dir = std::env::temp_dir().join("mbd-read-text-doc");
+/// std::fs::create_dir_all(&dir)?;
+/// let p = dir.join("m.toml");
+/// std::fs::write(&p, "gravity = [0.0, -9.81]")?;
+/// assert_eq!(mbd_model::read_text(&p, 100)?, "gravity = [0.0, -9.81]");
+/// let e = mbd_model::read_text(&p, 10).unwrap_err();
+/// assert!(e.to_string().contains("more than 10 bytes"));
+/// # Ok::<(), std::io::Error>(())
+/// ```
+pub fn read_text(path: &std::path::Path, limit: u64) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("the file has more than {limit} bytes (is it the right file?)"),
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("not UTF-8 text: {e}"),
+        )
+    })
 }
