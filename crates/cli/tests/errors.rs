@@ -422,3 +422,62 @@ fn drift_guard_flags() {
     both.extend(["--drift-tol", "1"]);
     assert_fails(&run_with(&both), 2, &["cannot be used with"]);
 }
+
+/// Structural refusals name the element and the reason, say "unsupported" once and give no
+/// step-size advice: the modified Lagrangian on a damped model names the damper and the
+/// solver that takes it; FA-DAE on a model without a degree of freedom says so.
+#[test]
+fn structural_refusals_name_the_cause() {
+    let out = mbd([
+        "run",
+        "examples/models/slider_crank_spring.toml",
+        "--solver",
+        "symplectic:1:modified",
+        "--t-end",
+        "0.1",
+        "--h",
+        "1e-3",
+        "--out",
+        "/dev/null",
+    ]);
+    assert_fails(
+        &out,
+        1,
+        &[
+            "'return_spring' (spring_damper)",
+            "symplectic:S without :modified",
+        ],
+    );
+    assert!(!out.stderr.contains("smaller --h"), "{}", out.stderr);
+    let dir = scratch("welded");
+    let model = dir.join("welded.toml");
+    std::fs::write(
+        &model,
+        "[[bodies]]\nname = \"rod\"\nmass = 1.0\ninertia = 0.1\nposition = [0.5, 0.0, 0.0]\n\n\
+         [[joints]]\ntype = \"weld\"\nname = \"fix\"\nbody_a = \"ground\"\npoint_a = [0.5, 0.0]\n\
+         body_b = \"rod\"\npoint_b = [0.0, 0.0]\n",
+    )
+    .unwrap();
+    let out = mbd([
+        "run".as_ref(),
+        model.as_os_str(),
+        "--solver".as_ref(),
+        "firefly-gauss".as_ref(),
+        "--t-end".as_ref(),
+        "0.1".as_ref(),
+        "--h".as_ref(),
+        "1e-2".as_ref(),
+    ]);
+    assert_fails(
+        &out,
+        1,
+        &["3 constraints on 3 coordinates leave no degree of freedom"],
+    );
+    assert_eq!(
+        out.stderr.matches("unsupported").count(),
+        1,
+        "{}",
+        out.stderr
+    );
+    assert!(!out.stderr.contains("smaller --h"), "{}", out.stderr);
+}

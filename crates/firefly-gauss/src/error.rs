@@ -13,7 +13,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum FaDaeError {
     /// A numeric option is outside its valid range.
-    #[error("invalid option `{name}` = {value}: must be {requirement}")]
+    #[error("invalid option `{name}` = {}: must be {requirement}", mbd_model::format_number(*value))]
     InvalidOption {
         /// The option (field path in [`FaDaeOptions`](crate::FaDaeOptions)).
         name: &'static str,
@@ -89,6 +89,8 @@ impl From<FaDaeError> for SolveError {
                 iterations: generations as usize,
                 context: format!("FA-DAE firefly missed the target {target:e} ({reason})"),
             },
+            // (the refusal's own words: SolveError's display adds "unsupported model")
+            FaDaeError::Unsupported(reason) => SolveError::Unsupported(reason),
             other => SolveError::Unsupported(other.to_string()),
         }
     }

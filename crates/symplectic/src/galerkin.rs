@@ -118,10 +118,19 @@ impl Galerkin {
         let tab = Tables::new(s, options.nodes);
         let modlag = options.preadjust == PreadjustMode::ModifiedLagrangian;
         if modlag && !sys.is_conservative() {
-            return Err(SolveError::Unsupported(
-                "the modified-Lagrangian preadjustment (preadjust) needs a conservative model"
-                    .into(),
-            ));
+            let elements: Vec<String> = sys
+                .forces()
+                .iter()
+                .filter(|f| f.is_nonconservative())
+                .map(|f| format!("'{}' ({})", f.name, f.kind_name()))
+                .collect();
+            return Err(SolveError::Unsupported(format!(
+                "the modified-Lagrangian preadjustment (:modified) is derived for a conservative \
+                 model, and force element(s) {} damp or load it with time: use symplectic:S \
+                 without :modified (it takes such forces by the discrete Lagrange-d'Alembert \
+                 principle)",
+                elements.join(", ")
+            )));
         }
         // (W_s adds a dense block to the Newton matrix; the modified Lagrangian's blocks are
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
