@@ -138,7 +138,7 @@ pub struct CheckArgs {
 /// Arguments of `mbd plot`.
 #[derive(Debug, Args)]
 pub struct PlotArgs {
-    /// A CSV written by `mbd run`.
+    /// A result file written by `mbd run`: CSV, or JSON (`.json`).
     pub csv: PathBuf,
     /// Column(s) to plot against x (repeat --y for several curves).
     #[arg(long, required = true)]

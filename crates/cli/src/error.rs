@@ -70,6 +70,14 @@ pub enum CliError {
         /// What is wrong.
         message: String,
     },
+    /// A result file is not the JSON `mbd run` writes.
+    #[error("'{path}': {message}; give a JSON written by `mbd run --out FILE.json`")]
+    Json {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A column asked for is not in the file.
     #[error("column '{column}' is not in '{path}'; available columns: {available}")]
     UnknownColumn {

@@ -25,23 +25,57 @@ pub struct RunSummary {
     pub wall_time: f64,
     /// Rows written.
     pub rows: usize,
+    /// Why `H` is not conserved (dampers, time-dependent loads, drivers), if it is not: then
+    /// `e(H)` is the energy exchanged, not an error, and the line says so instead.
+    pub not_conserved: Option<String>,
 }
 
 impl RunSummary {
     /// The one-line summary printed on standard error.
     pub fn line(&self, solver: &SolverSpec) -> String {
+        let energy = match &self.not_conserved {
+            None => format!("e(H) = {:.3e}", self.measures.e_h),
+            Some(why) => format!(
+                "H not conserved ({why}): max |H - H0| / |H0| = {:.3e}",
+                self.measures.e_h
+            ),
+        };
         format!(
-            "mbd run: {} steps ({} rejected) with {solver}, {} rows; e(H) = {:.3e}, \
+            "mbd run: {} steps ({} rejected) with {solver}, {} rows; {energy}, \
              e(Phi) = {:.3e}, e(Phidot) = {:.3e}; wall time {:.3} s",
             self.stats.steps,
             self.stats.rejected_steps,
             self.rows,
-            self.measures.e_h,
             self.measures.e_phi,
             self.measures.e_phidot,
             self.wall_time
         )
     }
+}
+
+/// Why the model's energy `H` is not conserved, or `None` if it is: the non-conservative force
+/// elements (dampers, time-dependent loads) and the drivers (rheonomic joints) by name.
+fn not_conserved(sys: &System) -> Option<String> {
+    let forces: Vec<&str> = sys
+        .forces()
+        .iter()
+        .filter(|f| f.is_nonconservative())
+        .map(|f| f.name.as_str())
+        .collect();
+    let drivers: Vec<&str> = sys
+        .joints()
+        .iter()
+        .filter(|j| j.is_rheonomic())
+        .map(|j| j.name.as_str())
+        .collect();
+    let mut parts = Vec::new();
+    if !forces.is_empty() {
+        parts.push(format!("non-conservative forces {}", forces.join(", ")));
+    }
+    if !drivers.is_empty() {
+        parts.push(format!("drivers {}", drivers.join(", ")));
+    }
+    (!parts.is_empty()).then(|| parts.join("; "))
 }
 
 /// Where the rows go.
@@ -363,6 +397,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         measures: measures.measures(),
         wall_time,
         rows,
+        not_conserved: not_conserved(sim.system()),
     })
 }
 

@@ -18,11 +18,69 @@ pub struct Table {
 }
 
 impl Table {
-    /// Reads a CSV file; errors name the file and the line.
+    /// Reads a result file: CSV, or the JSON that `mbd run --out FILE.json` writes (by the
+    /// extension `.json`); errors name the file and the line (CSV) or what is missing (JSON).
     pub fn read(path: &Path) -> Result<Table, CliError> {
         let text =
             mbd_model::read_text(path, MAX_TABLE_BYTES).map_err(|e| CliError::read(path, e))?;
-        Table::parse(&path.display().to_string(), &text)
+        let name = path.display().to_string();
+        match path.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("json") => Table::parse_json(&name, &text),
+            _ => Table::parse(&name, &text),
+        }
+    }
+
+    /// Parses the JSON of `mbd run` (`"columns"`: names, `"rows"`: rows of numbers; `null`
+    /// entries, written for non-finite values, read as NaN).
+    pub fn parse_json(path: &str, text: &str) -> Result<Table, CliError> {
+        let bad = |message: String| CliError::Json {
+            path: path.to_string(),
+            message,
+        };
+        let doc: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| bad(format!("not JSON: {e}")))?;
+        let names: Vec<String> = doc["columns"]
+            .as_array()
+            .ok_or_else(|| bad("no \"columns\" list".into()))?
+            .iter()
+            .map(|c| c.as_str().map(String::from))
+            .collect::<Option<_>>()
+            .ok_or_else(|| bad("\"columns\" must hold names".into()))?;
+        let rows_json = doc["rows"]
+            .as_array()
+            .ok_or_else(|| bad("no \"rows\" list".into()))?;
+        let mut rows = Vec::with_capacity(rows_json.len());
+        for (i, r) in rows_json.iter().enumerate() {
+            let row: Vec<f64> = r
+                .as_array()
+                .ok_or_else(|| bad(format!("row {i} is not a list")))?
+                .iter()
+                .map(|x| {
+                    if x.is_null() {
+                        Some(f64::NAN)
+                    } else {
+                        x.as_f64()
+                    }
+                })
+                .collect::<Option<_>>()
+                .ok_or_else(|| bad(format!("row {i} holds a value that is not a number")))?;
+            if row.len() != names.len() {
+                return Err(bad(format!(
+                    "row {i}: {} values for {} columns",
+                    row.len(),
+                    names.len()
+                )));
+            }
+            rows.push(row);
+        }
+        if rows.is_empty() {
+            return Err(bad("no rows of data".into()));
+        }
+        Ok(Table {
+            path: path.to_string(),
+            names,
+            rows,
+        })
     }
 
     /// Parses CSV text (`path` is used in messages).
@@ -113,5 +171,24 @@ mod tests {
         );
         assert!(Table::parse("r.csv", "").is_err());
         assert!(Table::parse("r.csv", "1,2\n3,4\n").is_err());
+    }
+
+    #[test]
+    fn parses_the_json_of_mbd_run() {
+        let t = Table::parse_json(
+            "r.json",
+            r#"{"columns": ["t", "a.x"], "rows": [[0.0, 1.0], [0.1, null]], "summary": {}}"#,
+        )
+        .unwrap();
+        assert_eq!(t.column("t").unwrap(), vec![0.0, 0.1]);
+        assert!(t.column("a.x").unwrap()[1].is_nan());
+        let e = Table::parse_json("r.json", r#"{"rows": []}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no \"columns\" list"), "{e}");
+        let e = Table::parse_json("r.json", r#"{"columns": ["t"], "rows": [[0.0, 1.0]]}"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("row 0: 2 values for 1 columns"), "{e}");
     }
 }
