@@ -11,7 +11,8 @@
 //!   at the round-off floor);
 //! * [`period`]: oscillation periods from zero crossings of samples (interpolated, least-squares
 //!   slope of the crossing times) and the exact pendulum period ([`period::pendulum_period`]);
-//! * [`TimeSeries`] and [`CsvObserver`]: CSV/JSON output.
+//! * [`TimeSeries`] and [`CsvObserver`]: CSV/JSON output;
+//! * [`save_state`] / [`load_state`]: a state as JSON, read back as an initial state.
 //!
 //! ```
 //! use mbd_analysis::{fit_order, MeasureObserver};
@@ -43,10 +44,12 @@ mod output;
 pub mod period;
 #[cfg(feature = "plot")]
 pub mod plot;
+mod state_file;
 mod trajectory;
 
 pub use error::AnalysisError;
 pub use measures::{measure_trajectory, MeasureObserver, RunMeasures};
 pub use order::{fit_order, OrderFit};
 pub use output::{CsvObserver, TimeSeries};
+pub use state_file::{load_state, save_state, state_from_json, state_to_json, STATE_FORMAT};
 pub use trajectory::{position_error_at, trajectory_errors, Trajectory, TrajectoryErrors};

@@ -118,6 +118,13 @@ pub struct RunArgs {
     /// Run without the drift guard (to measure drift itself).
     #[arg(long)]
     pub no_drift_guard: bool,
+    /// Save the final state as JSON (coordinate names, t, q, v), for --initial-state.
+    #[arg(long)]
+    pub save_state: Option<PathBuf>,
+    /// Start from a state saved with --save-state (at its time; --t-end is the end time) instead
+    /// of the model's initial state.
+    #[arg(long)]
+    pub initial_state: Option<PathBuf>,
     /// Refuse a run of more steps than this (fixed steps: t-end / h; adaptive: the budget of
     /// step attempts).
     #[arg(long, default_value = "1e9", value_parser = parse_count)]

@@ -250,6 +250,12 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
     }
 }
 
+/// The saved state at `path` (`--initial-state`), as saved: not projected again, so a restart
+/// continues the run it was saved from (the run loop's drift guard checks it like every state).
+fn restart_state(sys: &System, path: &Path) -> Result<State, CliError> {
+    mbd_analysis::load_state(sys, path).map_err(|e| CliError::Usage(e.to_string()))
+}
+
 /// Warns about given initial values that the consistent initial state changed (at most five
 /// named), with how to keep them.
 fn warn_initial_changes(sys: &System, state: &State) {
@@ -313,11 +319,25 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
             names.join(", ")
         );
     }
-    let state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {
-        path: args.model.display().to_string(),
-        source: Box::new(source),
-    })?;
-    warn_initial_changes(&sys, &state);
+    let state = match &args.initial_state {
+        None => {
+            let state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {
+                path: args.model.display().to_string(),
+                source: Box::new(source),
+            })?;
+            warn_initial_changes(&sys, &state);
+            state
+        }
+        Some(path) => restart_state(&sys, path)?,
+    };
+    if !(args.t_end > state.t) {
+        return Err(CliError::Usage(format!(
+            "--t-end {} is not after the initial state's time {} (a saved state's time is kept; \
+             --t-end is the end time, not a duration)",
+            mbd_model::format_number(args.t_end),
+            mbd_model::format_number(state.t)
+        )));
+    }
     let guard = if args.no_drift_guard {
         None
     } else {
@@ -335,7 +355,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
             cfg.into()
         }
         (Some(h), None) => {
-            let steps = mbd_solve::step_count(0.0, args.t_end, h)
+            let steps = mbd_solve::step_count(state.t, args.t_end, h)
                 .map_err(|e| CliError::Usage(e.to_string()))?;
             if steps > max_steps {
                 return Err(CliError::Usage(format!(
@@ -422,6 +442,9 @@ fn finish(
     measures: &MeasureObserver,
     wall_time: f64,
 ) -> Result<(), CliError> {
+    if let Some(path) = &args.save_state {
+        mbd_analysis::save_state(sys, state, path).map_err(|e| CliError::write(path, e))?;
+    }
     let out = out_path(args);
     match sink {
         Sink::Csv(mut c) => c.finish(sys, state).map_err(|e| CliError::write(&out, e)),

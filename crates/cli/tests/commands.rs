@@ -474,3 +474,85 @@ fn plot_reads_the_json_of_run() {
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
 }
+
+/// `--save-state` writes the final state and `--initial-state` restarts from it: RUN 0 -> 1 s
+/// then 1 -> 2 s ends where one run 0 -> 2 s ends, bit for bit (RK4 on the pendulum, whose
+/// steps do not depend on t). A state of another model is refused naming the difference, and
+/// an end time before the saved time is a usage error.
+#[test]
+fn save_and_restart_from_a_state() {
+    let dir = scratch("restart");
+    let model = common::repo().join("examples/models/pendulum.toml");
+    let arg = |p: &Path| p.as_os_str().to_owned();
+    let run = |t_end: &str, extra: Vec<std::ffi::OsString>| {
+        let mut a: Vec<std::ffi::OsString> = vec![
+            "run".into(),
+            arg(&model),
+            "--solver".into(),
+            "rk4".into(),
+            "--t-end".into(),
+            t_end.into(),
+            "--h".into(),
+            "1e-3".into(),
+            "--out".into(),
+            "/dev/null".into(),
+        ];
+        a.extend(extra);
+        mbd(a)
+    };
+    let (half, whole, second) = (
+        dir.join("half.json"),
+        dir.join("whole.json"),
+        dir.join("second.json"),
+    );
+    for (t_end, extra) in [
+        ("1", vec!["--save-state".into(), arg(&half)]),
+        ("2", vec!["--save-state".into(), arg(&whole)]),
+        (
+            "2",
+            vec![
+                "--initial-state".into(),
+                arg(&half),
+                "--save-state".into(),
+                arg(&second),
+            ],
+        ),
+    ] {
+        let o = run(t_end, extra);
+        assert_eq!(o.code, 0, "{}", o.stderr);
+    }
+    let read = |p: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let (a, b) = (read(&whole), read(&second));
+    assert_eq!(a["t"], b["t"]);
+    assert_eq!(a["q"], b["q"]);
+    assert_eq!(a["v"], b["v"]);
+    let o = run("0.5", vec!["--initial-state".into(), arg(&half)]);
+    assert_eq!(o.code, 2, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("not after the initial state's time 1"),
+        "{}",
+        o.stderr
+    );
+    let other = mbd([
+        "run".as_ref(),
+        common::repo()
+            .join("examples/models/four_bar.toml")
+            .as_os_str(),
+        "--solver".as_ref(),
+        "rk4".as_ref(),
+        "--t-end".as_ref(),
+        "2".as_ref(),
+        "--h".as_ref(),
+        "1e-3".as_ref(),
+        "--initial-state".as_ref(),
+        half.as_os_str(),
+    ]);
+    assert_eq!(other.code, 2, "{}", other.stderr);
+    assert!(
+        other.stderr.contains("do not match the model's"),
+        "{}",
+        other.stderr
+    );
+}
