@@ -330,7 +330,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         }
         Some(path) => restart_state(&sys, path)?,
     };
-    if !(args.t_end > state.t) {
+    if args.t_end <= state.t {
         return Err(CliError::Usage(format!(
             "--t-end {} is not after the initial state's time {} (a saved state's time is kept; \
              --t-end is the end time, not a duration)",
