@@ -2,7 +2,7 @@
 
 use crate::error::AnalysisError;
 use mbd_model::System;
-use mbd_solve::{Flow, JointReaction, Observer, ReactionSolver, SolveError, State};
+use mbd_solve::{Flow, JointReaction, Observer, ReactionSolver, SensorSolver, SolveError, State};
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -118,6 +118,9 @@ pub struct CsvObserver<W: Write> {
     reactions: bool,
     /// The reaction workspace (built at the first row that needs it) and its buffer.
     reaction_solver: Option<(ReactionSolver, Vec<JointReaction>)>,
+    sensors: bool,
+    /// The sensor workspace (built at the first row that needs it).
+    sensor_solver: Option<SensorSolver>,
     every: usize,
     row: Vec<f64>,
     phi: Vec<f64>,
@@ -134,6 +137,8 @@ impl<W: Write> CsvObserver<W> {
             residuals: false,
             reactions: false,
             reaction_solver: None,
+            sensors: false,
+            sensor_solver: None,
             every: 1,
             row: Vec::new(),
             phi: Vec::new(),
@@ -152,6 +157,12 @@ impl<W: Write> CsvObserver<W> {
     /// ([`ReactionSolver`], whose documentation gives the conventions).
     pub fn with_reactions(mut self) -> Self {
         self.reactions = true;
+        self
+    }
+    /// Adds the columns of the model's sensors ([`SensorSolver::columns`]: `tip.x`, ...,
+    /// `elbow.angle`, ...); none for a model without sensors.
+    pub fn with_sensors(mut self) -> Self {
+        self.sensors = true;
         self
     }
     /// Writes only the samples of steps `0, k, 2k, ...` (`k = 0` is treated as 1); call
@@ -177,6 +188,9 @@ impl<W: Write> CsvObserver<W> {
                     h.push(format!("{}.{c}", j.name));
                 }
             }
+        }
+        if self.sensors {
+            h.extend(SensorSolver::columns(sys));
         }
         h
     }
@@ -208,6 +222,13 @@ impl<W: Write> CsvObserver<W> {
             for r in out.iter() {
                 self.row.extend([r.force[0], r.force[1], r.moment]);
             }
+        }
+        if self.sensors && !sys.sensors().is_empty() {
+            let ss = match &mut self.sensor_solver {
+                Some(x) => x,
+                None => self.sensor_solver.insert(SensorSolver::new(sys)?),
+            };
+            ss.evaluate(sys, s, &mut self.row)?;
         }
         Ok(&self.row)
     }

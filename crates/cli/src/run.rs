@@ -165,10 +165,10 @@ impl Observer for Progress {
     }
 }
 
-/// The columns of `mbd run`'s output: the state, `H`, the residuals and, if asked, the
-/// reactions.
+/// The columns of `mbd run`'s output: the state, `H`, the residuals, if asked the reactions,
+/// and the model's sensors.
 fn columns<W: Write>(c: CsvObserver<W>, reactions: bool) -> CsvObserver<W> {
-    let c = c.with_residuals();
+    let c = c.with_residuals().with_sensors();
     if reactions {
         c.with_reactions()
     } else {

@@ -556,3 +556,43 @@ fn save_and_restart_from_a_state() {
         other.stderr
     );
 }
+
+/// A model file's sensors become `mbd run` columns after the residuals.
+#[test]
+fn run_writes_the_model_sensors() {
+    let dir = scratch("sensors");
+    let model = dir.join("pendulum_tip.toml");
+    let text =
+        std::fs::read_to_string(common::repo().join("examples/models/pendulum.toml")).unwrap();
+    std::fs::write(
+        &model,
+        format!(
+            "{text}\n[[sensors]]\ntype = \"point\"\nname = \"tip\"\nbody = \"rod\"\npoint = [0.5, 0.0]\n\n\
+             [[sensors]]\ntype = \"joint\"\nname = \"swing\"\njoint = \"pivot\"\n"
+        ),
+    )
+    .unwrap();
+    let csv = dir.join("p.csv");
+    let o = run_model(&model, "rk4", &["--h", "0.005"], &csv);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let (head, rows) = read_csv(&csv);
+    let tail: Vec<&str> = head[head.len() - 8..].iter().map(String::as_str).collect();
+    assert_eq!(
+        tail,
+        [
+            "tip.x",
+            "tip.y",
+            "tip.vx",
+            "tip.vy",
+            "tip.ax",
+            "tip.ay",
+            "swing.angle",
+            "swing.rate"
+        ]
+    );
+    // the pivot is at the origin and the tip 1 m from it
+    for r in &rows {
+        let (x, y) = (r[head.len() - 8], r[head.len() - 7]);
+        assert!((x.hypot(y) - 1.0).abs() < 1e-9, "{x} {y}");
+    }
+}

@@ -7,6 +7,7 @@ use crate::error::ModelError;
 use crate::forces::Force;
 use crate::init::RedundantConstraints;
 use crate::joints::{Coordinate, Joint};
+use crate::sensors::{Sensor, SensorKind};
 use crate::system::*;
 use nalgebra::DVector;
 
@@ -16,6 +17,7 @@ pub struct SystemBuilder {
     pub(crate) bodies: Vec<Body>,
     pub(crate) joints: Vec<Joint>,
     pub(crate) forces: Vec<Force>,
+    pub(crate) sensors: Vec<Sensor>,
     pub(crate) gravity: [f64; 2],
     /// Per body: the frame its local points are given in and whether it is a point mass.
     pub(crate) frames: Vec<BodyFrame>,
@@ -104,6 +106,11 @@ impl SystemBuilder {
     pub fn add_joint(&mut self, joint: Joint) -> JointHandle {
         self.joints.push(joint);
         JointHandle(self.joints.len() - 1)
+    }
+    /// Adds a sensor (see [`Sensor`]): its quantities become output columns.
+    pub fn add_sensor(&mut self, sensor: Sensor) -> &mut Self {
+        self.sensors.push(sensor);
+        self
     }
     /// Adds a force element and returns its handle.
     pub fn add_force(&mut self, force: Force) -> ForceHandle {
@@ -245,6 +252,12 @@ impl SystemBuilder {
                 local(&element, anchor.field, anchor.body, anchor.point)?;
             }
         }
+        for s in &mut self.sensors {
+            let element = format!("sensor '{}'", s.name);
+            if let SensorKind::Point { body, point } = &mut s.kind {
+                local(&element, "point", *body, point)?;
+            }
+        }
         for (i, f) in frames.iter().enumerate() {
             if f.point_mass {
                 let b = &mut self.bodies[i];
@@ -290,6 +303,7 @@ impl System {
             bodies,
             mut joints,
             forces,
+            sensors,
             gravity,
             frames: _,
             unknown_frame: _,
@@ -412,6 +426,34 @@ impl System {
             force_attach.push(Attach { a, b: bb });
         }
 
+        let mut snames = std::collections::HashSet::new();
+        for sensor in &sensors {
+            if !snames.insert(sensor.name.clone()) {
+                return Err(ModelError::DuplicateName {
+                    kind: "sensor",
+                    name: sensor.name.clone(),
+                });
+            }
+            let element = format!("sensor '{}'", sensor.name);
+            match &sensor.kind {
+                SensorKind::Point { body, .. } => {
+                    resolve(&element, *body)?;
+                }
+                SensorKind::Joint { joint } if joint.0 >= joints.len() => {
+                    return Err(invalid(
+                        element,
+                        format!(
+                            "joint #{} does not exist (the model has {} joints)",
+                            joint.0,
+                            joints.len()
+                        ),
+                    ))
+                }
+                SensorKind::Joint { .. } => {}
+            }
+            sensor.validate()?;
+        }
+
         let n = 3 * nb;
         let mut row_offset = Vec::with_capacity(joints.len());
         let mut eq_joint = Vec::new();
@@ -435,6 +477,7 @@ impl System {
             bodies,
             joints,
             forces,
+            sensors,
             gravity,
             joint_attach,
             force_attach,

@@ -64,6 +64,7 @@ mod local_rows;
 pub mod models;
 mod rows;
 mod scale;
+mod sensors;
 mod system;
 mod timefn;
 
@@ -83,6 +84,7 @@ pub use jet::{Basis, PolyJet, MAX_DIRS};
 pub use joints::RevoluteSide;
 pub use joints::{Coordinate, Joint, JointKind};
 pub use scale::MAX_INERTIA_RATIO;
+pub use sensors::{Sensor, SensorKind, SensorSpec};
 pub use system::{Attach, ForceHandle, JointElement, JointHandle, System};
 pub use timefn::TimeFunction;
 

@@ -102,6 +102,7 @@ pub struct System {
     pub(crate) bodies: Vec<Body>,
     pub(crate) joints: Vec<Joint>,
     pub(crate) forces: Vec<Force>,
+    pub(crate) sensors: Vec<crate::sensors::Sensor>,
     pub(crate) gravity: [f64; 2],
     pub(crate) joint_attach: Vec<Attach>,
     pub(crate) force_attach: Vec<Attach>,
@@ -179,6 +180,10 @@ impl System {
             .zip(&self.joint_attach)
             .zip(&self.row_offset)
             .map(|((joint, &attach), &row)| JointElement { joint, attach, row })
+    }
+    /// The sensors, in the order they were added (see [`crate::Sensor`]).
+    pub fn sensors(&self) -> &[crate::sensors::Sensor] {
+        &self.sensors
     }
     /// Every force element with its attachment, in the order of [`System::forces`]: with
     /// [`Force::potential`] the hook of the potential's derivative passes (gravity, linear in

@@ -63,6 +63,7 @@ mod projection;
 pub mod quadrature;
 mod reactions;
 pub mod registry;
+mod sensors;
 pub mod sparse;
 mod state;
 mod tableau;
@@ -85,6 +86,7 @@ pub use integrator::{
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_ROUNDOFF_FACTOR};
 pub use reactions::{JointReaction, ReactionSolver};
+pub use sensors::SensorSolver;
 pub use sparse::{LinearSolver, SparseAccelerationSolver, SPARSE_THRESHOLD};
 pub use state::State;
 pub use tableau::{ButcherTableau, ExplicitRk, StepController};

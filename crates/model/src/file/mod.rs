@@ -46,6 +46,10 @@ pub struct ModelFile {
     /// The force elements.
     #[serde(default)]
     pub forces: Vec<ForceSpec>,
+    /// The sensors: quantities written beside the state by `mbd run` (points on bodies, joint
+    /// coordinates).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sensors: Vec<crate::sensors::SensorSpec>,
     /// What to do with constraint equations that are combinations of others at the initial
     /// configuration: `"allow"` (default: the model runs, `mbd check` names them) or
     /// `"reject"` (an error).

@@ -10,6 +10,7 @@ use crate::builder::SystemBuilder;
 use crate::check::invalid;
 use crate::error::ModelError;
 use crate::init::RedundantConstraints;
+use crate::sensors::{Sensor, SensorKind, SensorSpec};
 use crate::system::System;
 
 /// Body names resolved, with each body's frame offset and kind.
@@ -134,11 +135,31 @@ impl ModelFile {
             }
         }
         let find = |element: &str, body: &str| r.find(element, body);
+        let mut joints = std::collections::HashMap::with_capacity(self.joints.len());
         for j in &self.joints {
-            b.add_joint(j.to_joint(&find)?);
+            let joint = j.to_joint(&find)?;
+            let name = joint.name.clone();
+            let h = b.add_joint(joint);
+            joints.entry(name).or_insert(h);
         }
         for f in &self.forces {
             b.add_force(f.to_force(&find)?);
+        }
+        for s in &self.sensors {
+            b.add_sensor(match s {
+                SensorSpec::Point { name, body, point } => {
+                    Sensor::point(name, find(&format!("sensor '{name}'"), body)?, *point)
+                }
+                SensorSpec::Joint { name, joint } => {
+                    let h = joints.get(joint).copied().ok_or_else(|| {
+                        invalid(
+                            format!("sensor '{name}'"),
+                            format!("refers to unknown joint '{joint}'"),
+                        )
+                    })?;
+                    Sensor::joint(name, h)
+                }
+            });
         }
         Ok(b)
     }
@@ -155,7 +176,23 @@ impl System {
         };
         let joints = self.joints.iter().map(|j| j.to_spec(&name)).collect();
         let forces = self.forces.iter().map(|f| f.to_spec(&name)).collect();
+        let sensors = self
+            .sensors
+            .iter()
+            .filter_map(|s| match &s.kind {
+                SensorKind::Point { body, point } => Some(SensorSpec::Point {
+                    name: s.name.clone(),
+                    body: name(*body),
+                    point: *point,
+                }),
+                SensorKind::Joint { joint } => Some(SensorSpec::Joint {
+                    name: s.name.clone(),
+                    joint: self.joints.get(joint.index())?.name.clone(),
+                }),
+            })
+            .collect();
         ModelFile {
+            sensors,
             gravity: self.gravity,
             redundant_constraints: RedundantConstraints::Allow,
             bodies: self
