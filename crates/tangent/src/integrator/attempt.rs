@@ -85,14 +85,6 @@ impl TangentRk {
             let singular_stage = &mut singular_stage;
             let mut rhs = |ti: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
                 let i = stage;
-                // plain RK stage value's normal part
-                zplain.fill(0.0);
-                for j in 0..i {
-                    let a = a_coef[i * s + j];
-                    if a != 0.0 {
-                        axpy(h * a, &g[j * mm..(j + 1) * mm], zplain);
-                    }
-                }
                 if i == 1 && interpolate {
                     // Euler prediction of the end point, x_c + h F(x_c): where the iteration
                     // matrix is interpolated to
@@ -101,12 +93,17 @@ impl TangentRk {
                     chart.set_secondary_point(sys, x);
                 }
                 chart.select_iteration_matrix(c_coef[i]);
+                // stage 0 at (t, xi = 0) is the centre: no starting point, and its normal
+                // coordinates (zeta = eta = 0) need no conversion
+                let at_centre = i == 0 && centre_ok && ti == t;
                 let ysq: f64 = y.iter().map(|v| v * v).sum();
-                if npts > 0 {
+                if at_centre {
+                    eta_now[..mm].fill(0.0);
+                } else if npts > 0 {
                     // the plain extrapolation of this stage, kept for the later stages'
                     // corrections
                     let raw = &mut eta_raw[i * mm..(i + 1) * mm];
-                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, raw);
+                    extrapolate(eta_hist, npts, s * mm, i * mm, raw);
                     eta_pred.copy_from_slice(raw);
                     if jlast > 0 {
                         // correct by the extrapolation error of the latest mapped stage j,
@@ -125,8 +122,17 @@ impl TangentRk {
                     for (z, zl) in zplain.iter_mut().zip(zlast.iter()) {
                         *z = r * zl;
                     }
+                } else {
+                    // the plain RK stage value's normal part
+                    zplain.fill(0.0);
+                    for j in 0..i {
+                        let a = a_coef[i * s + j];
+                        if a != 0.0 {
+                            axpy(h * a, &g[j * mm..(j + 1) * mm], zplain);
+                        }
+                    }
                 }
-                let mapped = if i == 0 && centre_ok && ti == t {
+                let mapped = if at_centre {
                     x.copy_from_slice(chart.centre_point());
                     Ok(MapStats::default())
                 } else if fsal && i + 1 == s {
@@ -135,12 +141,12 @@ impl TangentRk {
                 } else {
                     chart.map(sys, y, ti, zplain, x, &stage_newton, true)
                 };
-                if ysq > 0.0 && mapped.is_ok() {
-                    zlast.copy_from_slice(zplain);
-                    ylast_sq = ysq;
-                    jlast = i;
-                }
-                if mapped.is_ok() {
+                if !at_centre && mapped.is_ok() {
+                    if ysq > 0.0 {
+                        zlast.copy_from_slice(zplain);
+                        ylast_sq = ysq;
+                        jlast = i;
+                    }
                     chart.eta_from_zeta(zplain, &mut eta_now[i * mm..(i + 1) * mm]);
                 }
                 match mapped {
@@ -162,8 +168,7 @@ impl TangentRk {
                 let (q, v) = x.split_at(n);
                 // at the centre: Phi_q and (Phi_q v)_q are the chart's, so (dense path)
                 // gamma = -(Phi_q v)_q v needs no model evaluation
-                let at_centre = i == 0 && centre_ok && ti == t && scleronomic;
-                let solved = chart.accel(sys, q, v, ti, at_centre, acc_a, lambda);
+                let solved = chart.accel(sys, q, v, ti, at_centre && scleronomic, acc_a, lambda);
                 if solved.is_ok() {
                     work.condition = work.condition.max(chart.condition_estimate());
                 }
@@ -256,8 +261,6 @@ impl TangentRk {
                     )
                 }
             }
-            self.path
-                .eta_from_zeta(&self.zeta, &mut self.eta_now[s * mm..(s + 1) * mm]);
         }
         if self.xnew.iter().any(|x| !x.is_finite()) {
             return Err(Attempt::Hard(SolveError::NonFinite {

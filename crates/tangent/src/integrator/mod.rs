@@ -92,8 +92,9 @@ pub struct TangentRk {
     /// Error estimate mapped to `x`, and the error scale.
     ex: Vec<f64>,
     scale: Vec<f64>,
-    /// The paper's normal coefficients `eta` of every map of the attempt in progress (stage `i`
-    /// at `i * 2m`, the end point at `s * 2m`; stage 0 is the centre, `eta = 0`).
+    /// The paper's normal coefficients `eta` of every stage map of the attempt in progress
+    /// (stage `i` at `i * 2m`; stage 0 is the centre, `eta = 0`). The end point's are not kept:
+    /// it starts from the RK quadrature, not from the history.
     eta_now: Vec<f64>,
     /// `eta_now` of the last `hist_len` (at most [`HISTORY`]) accepted steps, most recent
     /// first, all of size `hist_h`, consecutive, the latest ending at `hist_t`.
@@ -222,8 +223,8 @@ impl TangentRk {
             lambda: vec![0.0; m_full],
             ex: vec![0.0; 2 * n],
             scale: vec![0.0; 2 * n],
-            eta_now: vec![0.0; (s + 1) * 2 * m],
-            eta_hist: vec![0.0; HISTORY * (s + 1) * 2 * m],
+            eta_now: vec![0.0; s * 2 * m],
+            eta_hist: vec![0.0; HISTORY * s * 2 * m],
             hist_len: 0,
             hist_rcond: [1.0; HISTORY],
             hist_h: f64::NAN,
