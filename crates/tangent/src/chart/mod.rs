@@ -155,6 +155,13 @@ pub struct TangentChart {
     centred: bool,
     /// The constraint rows the chart works with (all of them without redundant equations).
     sel: rows::RowSelection,
+    /// The largest contraction factor the chord iteration showed since the last centre, and at
+    /// the chart before it (0: none seen).
+    theta_seen: f64,
+    theta_seen_prev: f64,
+    /// The estimate the stage maps stop on after their first correction (infinite: off;
+    /// [`TangentChart::set_contraction_prior`]).
+    theta_prior: f64,
 }
 
 impl TangentChart {
@@ -229,6 +236,9 @@ impl TangentChart {
             singular_tol: 1e-8,
             centred: false,
             sel: rows::RowSelection::new(sys),
+            theta_seen: 0.0,
+            theta_seen_prev: 0.0,
+            theta_prior: f64::INFINITY,
         }
     }
 
@@ -326,6 +336,9 @@ impl TangentChart {
         self.has_e = false;
         self.s = 0.0;
         self.pb_active = false;
+        self.theta_seen_prev = self.theta_seen;
+        self.theta_seen = 0.0;
+        self.theta_prior = f64::INFINITY;
         if q.len() != n || v.len() != n {
             return Err(SolveError::Dimension {
                 what: "chart centre (q, v)",

@@ -89,6 +89,15 @@ impl Path {
         }
     }
 
+    /// The dense chart's predicted stop after the first correction (the sparse chart has
+    /// none).
+    #[inline]
+    pub(super) fn set_contraction_prior(&mut self, follows: bool) {
+        if let Path::Dense { chart, .. } = self {
+            chart.set_contraction_prior(follows);
+        }
+    }
+
     #[inline]
     pub(super) fn select_iteration_matrix(&mut self, s: f64) {
         if let Path::Dense { chart, .. } = self {
