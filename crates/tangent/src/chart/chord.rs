@@ -117,8 +117,9 @@ impl TangentChart {
         }
         let nn = 2 * self.n;
         let mut f = std::mem::take(&mut self.f);
-        // the first residual of a map is evaluated exactly, the iterates' with rotated sin/cos
-        self.angles.invalidate();
+        // sin/cos are rotated from the last evaluation (the previous iterate, or the last point
+        // of the previous map: the stage points of a step lie close together), evaluated
+        // exactly after a larger move or BodyAngles::MAX_ROTATIONS rotations
         self.x0.copy_from_slice(x);
         let res = self.residual_cached(sys, x, t, &mut f);
         let res_start = res;
@@ -169,6 +170,7 @@ impl TangentChart {
         }
         self.f = f;
         if out.is_ok() && !zeta_done {
+            self.form_q();
             for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
                 *d = xv - xc;
             }
@@ -211,8 +213,7 @@ impl TangentChart {
         let (nn, mm) = (2 * self.n, 2 * self.m);
         let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
         lp.theta_prior = self.theta_prior;
-        // the residual's rounding floor, for the observed contractions
-        let floor = f64::EPSILON * (1.0 + self.xc.iter().fold(0.0f64, |m, v| fast_max(m, v.abs())));
+        let floor = self.floor;
         loop {
             if let Some(verdict) = lp.head() {
                 return verdict;
@@ -222,7 +223,7 @@ impl TangentChart {
                 *w = -u;
                 *z -= u;
             }
-            gemv_cols(&self.q[..mm * nn], &self.w, x);
+            self.add_q1_w(x);
             if lp.it == 0 {
                 self.first_step = x
                     .iter()

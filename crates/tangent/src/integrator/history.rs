@@ -106,26 +106,16 @@ impl EtaHistory {
             let mut errs = [0.0f64; MAX_ORDER + 1];
             let (diff, cur, len, off) = (&mut self.diff, &mut self.cur, self.len, map * self.mm);
             let grow = old < self.depth;
-            if old == MAX_ORDER {
-                // the common case, with the table's depth a literal too
-                with_codim!(
-                    self.mm,
-                    push_map(
-                        diff,
-                        len,
-                        off,
-                        &record[off..],
-                        MAX_ORDER,
-                        false,
-                        cur,
-                        &mut errs
-                    )
-                );
-            } else {
-                with_codim!(
-                    self.mm,
-                    push_map(diff, len, off, &record[off..], old, grow, cur, &mut errs)
-                );
+            let new = &record[off..];
+            match (self.mm, old) {
+                // the common cases with the length and the table's depth literals: the
+                // difference vector stays in registers
+                (4, MAX_ORDER) => push_fixed::<4>(diff, len, off, new, MAX_ORDER, false, &mut errs),
+                (8, MAX_ORDER) => push_fixed::<8>(diff, len, off, new, MAX_ORDER, false, &mut errs),
+                (16, MAX_ORDER) => {
+                    push_fixed::<16>(diff, len, off, new, MAX_ORDER, false, &mut errs)
+                }
+                (mm, _) => push_map(diff, len, off, new, old, grow, cur, &mut errs, mm),
             }
             self.order[map] = if old < FILL_ORDER || self.depth == FILL_ORDER {
                 (old + 1).min(FILL_ORDER)
@@ -175,6 +165,38 @@ fn push_map(
     }
     if grow {
         diff[old * len + off..][..mm].copy_from_slice(cur);
+    }
+}
+
+/// [`push_map`] for a map of `MM` coefficients.
+#[inline(always)]
+fn push_fixed<const MM: usize>(
+    diff: &mut [f64],
+    len: usize,
+    off: usize,
+    new: &[f64],
+    old: usize,
+    grow: bool,
+    errs: &mut [f64; MAX_ORDER + 1],
+) {
+    let mut cur: [f64; MM] = new[..MM].try_into().unwrap_or([0.0; MM]);
+    for j in 0..old {
+        let Ok(row) = <&mut [f64; MM]>::try_from(&mut diff[j * len + off..j * len + off + MM])
+        else {
+            continue;
+        };
+        let mut e = 0.0f64;
+        for i in 0..MM {
+            let o = row[i];
+            row[i] = cur[i];
+            cur[i] -= o;
+            let a = cur[i].abs();
+            e = if a > e { a } else { e };
+        }
+        errs[j + 1] = e;
+    }
+    if grow {
+        diff[old * len + off..old * len + off + MM].copy_from_slice(&cur);
     }
 }
 

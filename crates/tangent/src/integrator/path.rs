@@ -204,17 +204,9 @@ impl Path {
     }
 
     /// A vector in chart coordinates mapped to `x` (dense: `U e`; sparse: `e` itself).
-    pub(super) fn to_ambient(&self, e: &[f64], out: &mut [f64]) {
+    pub(super) fn to_ambient(&mut self, e: &[f64], out: &mut [f64]) {
         match self {
-            Path::Dense { chart, .. } => {
-                out.fill(0.0);
-                for (k, &ek) in e.iter().enumerate() {
-                    let col = chart.tangent(k);
-                    for (o, c) in out.iter_mut().zip(col) {
-                        *o += ek * c;
-                    }
-                }
-            }
+            Path::Dense { chart, .. } => chart.tangent_to_ambient(e, out),
             Path::Sparse(_) => out.copy_from_slice(e),
         }
     }
