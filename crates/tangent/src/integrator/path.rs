@@ -204,7 +204,7 @@ impl Path {
     }
 
     /// A vector in chart coordinates mapped to `x` (dense: `U e`; sparse: `e` itself).
-    pub(super) fn to_ambient(&mut self, e: &[f64], out: &mut [f64]) {
+    pub(super) fn tangent_to_ambient(&mut self, e: &[f64], out: &mut [f64]) {
         match self {
             Path::Dense { chart, .. } => chart.tangent_to_ambient(e, out),
             Path::Sparse(_) => out.copy_from_slice(e),
