@@ -124,8 +124,12 @@ fn solve_to(
 /// maps, the eta history) did not change (about 40,800 of its 56,100 instructions). Two rounds
 /// on the chart's own code (tangent-perf, tangent-perf2) brought it to 37,100 instructions,
 /// 3.93x in instructions but about 4.3x by wall clock (latency-bound trigonometry, divisions and
-/// triangular solves).
-const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step; tangent-perf2: 42,600 -> 37,100), 3.93x plain RK4 in instructions but about 4.3x by wall clock (the remaining work is latency-bound: trigonometry, divisions, triangular solves); see docs/report.md, expected misses";
+/// triangular solves). A third (tangent-perf3: fewer chord iterations from an adaptive-order
+/// eta history and a predicted stop after a stage map's first correction, chart products
+/// through the QR factors instead of the 2n x 2n Q, sin/cos carried between maps) brought it
+/// to 33,000 instructions, 3.50x; the rest is the index-1 solves and residual evaluations the
+/// step shares with the model and the solve crate, and the centre's QR.
+const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step; tangent-perf2: 42,600 -> 37,100; tangent-perf3: 37,700 -> 33,000, 3.50x plain RK4 at 9,430), still above 3x in instructions; by wall clock 4.3x after tangent-perf2 (the remaining work is latency-bound: trigonometry, divisions, triangular solves), not re-measured after tangent-perf3 (the shared machine was loaded); see docs/report.md, expected misses";
 
 /// Errors of the order study within this of zero are at the reference's / round-off floor.
 const FLOOR: f64 = 1e-11;

@@ -70,17 +70,30 @@ pub fn reflect(v: &[f64], tau: f64, y: &mut [f64], n: usize) {
 }
 
 /// The explicit orthogonal factor `Q = H_0 ... H_(k-1)` (`n x n`, column-major) of the
-/// reflectors `v`, `tau` of [`qr_padded`] (`k = tau.len()`): `Q e_j` for every column.
+/// reflectors `v`, `tau` of [`qr_padded`] (`k = tau.len()`), by backward accumulation (LAPACK
+/// `dorg2r`): `Q <- H_l Q` for `l = k-1, ..., 0` from the identity. `H_l` leaves the columns
+/// `e_j`, `j < l`, alone (`v_l` vanishes above row `l`) and maps `e_l` to `e_l - tau_l v_l`
+/// (`v_l[l] = 1`), so only the columns after `l` need a reflection: `sum_l (n - 1 - l)`
+/// reflections instead of one per reflector and column.
 #[inline(always)]
 pub fn form_q_padded(v: &[f64], tau: &[f64], q: &mut [f64], n: usize) {
     let k = tau.len();
-    for (j, col) in q[..n * n].chunks_exact_mut(n).enumerate() {
-        col.fill(0.0);
-        col[j] = 1.0;
-        // H_l e_j = e_j for l > j (v_l vanishes above row l)
-        for l in (0..k.min(j + 1)).rev() {
-            reflect(&v[l * n..(l + 1) * n], tau[l], col, n);
+    let q = &mut q[..n * n];
+    q.fill(0.0);
+    for j in k..n {
+        q[j * n + j] = 1.0;
+    }
+    for l in (0..k).rev() {
+        let (vl, tl) = (&v[l * n..(l + 1) * n], tau[l]);
+        let (head, tail) = q.split_at_mut((l + 1) * n);
+        for col in tail.chunks_exact_mut(n) {
+            reflect(vl, tl, col, n);
         }
+        let col = &mut head[l * n..];
+        for i in 0..n {
+            col[i] = -tl * vl[i];
+        }
+        col[l] += 1.0;
     }
 }
 

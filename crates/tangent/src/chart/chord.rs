@@ -2,6 +2,12 @@
 //! Broyden), the plain and Broyden iterations, and the travel bound.
 
 use super::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR, TRAVEL_FACTOR};
+
+/// Factor on the largest contraction factor the chord iteration showed at the current and the
+/// previous chart, for the estimate the stage maps stop on after their first correction: the
+/// factor scales with the distance of the point from the centre, which changes little from one
+/// step to the next at a fixed step size.
+const THETA_PRIOR_SAFETY: f64 = 2.0;
 use crate::kernels::{dot, gemv_cols, gemv_t_cols, rank_one_update, with_codim};
 use mbd_model::System;
 use mbd_solve::linalg::{max_abs, solve_rt};
@@ -111,8 +117,9 @@ impl TangentChart {
         }
         let nn = 2 * self.n;
         let mut f = std::mem::take(&mut self.f);
-        // the first residual of a map is evaluated exactly, the iterates' with rotated sin/cos
-        self.angles.invalidate();
+        // sin/cos are rotated from the last evaluation (the previous iterate, or the last point
+        // of the previous map: the stage points of a step lie close together), evaluated
+        // exactly after a larger move or BodyAngles::MAX_ROTATIONS rotations
         self.x0.copy_from_slice(x);
         let res = self.residual_cached(sys, x, t, &mut f);
         let res_start = res;
@@ -163,6 +170,7 @@ impl TangentChart {
         }
         self.f = f;
         if out.is_ok() && !zeta_done {
+            self.form_q();
             for ((d, xv), xc) in self.dx.iter_mut().zip(x.iter()).zip(&self.xc) {
                 *d = xv - xc;
             }
@@ -204,6 +212,8 @@ impl TangentChart {
     ) -> Result<MapStats, ChartFailure> {
         let (nn, mm) = (2 * self.n, 2 * self.m);
         let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
+        lp.theta_prior = self.theta_prior;
+        let floor = self.floor;
         loop {
             if let Some(verdict) = lp.head() {
                 return verdict;
@@ -213,7 +223,7 @@ impl TangentChart {
                 *w = -u;
                 *z -= u;
             }
-            gemv_cols(&self.q[..mm * nn], &self.w, x);
+            self.add_q1_w(x);
             if lp.it == 0 {
                 self.first_step = x
                     .iter()
@@ -224,13 +234,30 @@ impl TangentChart {
                 return Ok(ms);
             }
             let res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = lp.evaluated(res) {
+            let stop = lp.evaluated(res);
+            if let Some(theta) = lp.observed_theta(floor) {
+                self.theta_seen = fast_max(self.theta_seen, theta);
+            }
+            if let Some(ms) = stop {
                 return Ok(ms);
             }
             if let Some(e) = lp.diverged() {
                 return Err(e);
             }
         }
+    }
+
+    /// Enables the predicted stop after the first correction of the stage maps (see
+    /// [`TangentChart::map_predicted`]) with the contraction factors the chord iteration
+    /// showed at this chart and the previous one, or disables it (`follows = false`: the last
+    /// step had another size, or there was none, so its contraction says little).
+    pub fn set_contraction_prior(&mut self, follows: bool) {
+        let seen = fast_max(self.theta_seen, self.theta_seen_prev);
+        self.theta_prior = if follows && seen > 0.0 {
+            THETA_PRIOR_SAFETY * seen
+        } else {
+            f64::INFINITY
+        };
     }
 
     /// The chord iteration on `x` from its residual `f`.
@@ -408,6 +435,9 @@ pub(crate) struct ChordLoop {
     pub(crate) prev: f64,
     /// Corrections made.
     pub(crate) it: usize,
+    /// An upper estimate of the contraction factor known before the iteration starts
+    /// (infinite: none), for the predicted stop after the first correction.
+    pub(crate) theta_prior: f64,
 }
 
 impl ChordLoop {
@@ -434,6 +464,7 @@ impl ChordLoop {
             res: res0,
             prev: f64::INFINITY,
             it: 0,
+            theta_prior: f64::INFINITY,
         }
     }
 
@@ -453,14 +484,23 @@ impl ChordLoop {
     /// ([`predicted_stop`]).
     pub(crate) fn corrected(&mut self) -> Option<MapStats> {
         self.it += 1;
-        predicted_stop(
-            self.predicted,
-            self.res,
-            self.prev,
-            self.tol,
-            self.it,
-            self.res0,
-        )
+        // before the first correction's result is evaluated, the prior estimate stands in
+        // for the observed contraction
+        let prev = if self.it == 1 && self.theta_prior.is_finite() {
+            self.res / self.theta_prior
+        } else {
+            self.prev
+        };
+        predicted_stop(self.predicted, self.res, prev, self.tol, self.it, self.res0)
+    }
+
+    /// The contraction factor the last correction showed, `res / prev`, with `res` taken at
+    /// least `floor` (a residual below the rounding of its own terms is chance, no evidence
+    /// of faster contraction); `None` before the first evaluation after a correction.
+    pub(crate) fn observed_theta(&self, floor: f64) -> Option<f64> {
+        self.prev
+            .is_finite()
+            .then(|| fast_max(self.res, floor) / self.prev)
     }
 
     /// Records the residual `res` of the corrected point and accepts a stall at the round-off

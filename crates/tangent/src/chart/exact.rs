@@ -25,6 +25,7 @@ impl TangentChart {
     ) -> Result<MapStats, ChartFailure> {
         let (n, m) = (self.n, self.m);
         let (nn, mm) = (2 * n, 2 * m);
+        self.form_q();
         // start from the caller's starting point (the predictor). Its projection onto the
         // tangent plane, x_c + U xi, is only used when the predictor's residual is not finite:
         // the residual is no measure of the distance to the branch near a singular

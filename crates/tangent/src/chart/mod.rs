@@ -1,9 +1,7 @@
 //! The local chart of the constraint manifold at an accepted point (paper B's "local
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
-use crate::kernels::{
-    all_finite, gemv_cols, gemv_t_cols, max_abs_finite, with_codim, with_len, with_rows,
-};
+use crate::kernels::{all_finite, gemv_cols, max_abs_finite, with_codim, with_len, with_rows};
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
 use mbd_solve::linalg::{form_q_padded, mul_r, qr_padded, solve_r};
@@ -21,6 +19,7 @@ pub const ROUNDOFF_FACTOR: f64 = 8.0;
 /// not contract, and its limit need not be the solution nearest to the predictor (near a
 /// singular configuration: another branch), so the map counts as failed.
 pub const TRAVEL_FACTOR: f64 = 4.0;
+mod apply;
 mod chord;
 mod exact;
 mod rank;
@@ -84,8 +83,13 @@ pub struct TangentChart {
     /// The orthogonal factors `Qa` of `Phi_q^T` and `Qb` of `B` (`n x n`, column-major).
     qa: Vec<f64>,
     qb: Vec<f64>,
-    /// `Q = [Q1 U]` (`2n x 2n`, column-major).
+    /// `Q = [Q1 U]` (`2n x 2n`, column-major), formed from `Qa` and `Qb` only when needed
+    /// ([`TangentChart::form_q`]; the hot products use the factors, see `apply.rs`), valid if
+    /// `q_ready`.
     q: Vec<f64>,
+    q_ready: bool,
+    /// Work space of the factored products (`4n`).
+    nbuf: Vec<f64>,
     /// The centre `(q_c, v_c)`.
     xc: Vec<f64>,
     /// Time of the centre.
@@ -155,6 +159,16 @@ pub struct TangentChart {
     centred: bool,
     /// The constraint rows the chart works with (all of them without redundant equations).
     sel: rows::RowSelection,
+    /// The largest contraction factor the chord iteration showed since the last centre, and at
+    /// the chart before it (0: none seen).
+    theta_seen: f64,
+    theta_seen_prev: f64,
+    /// The estimate the stage maps stop on after their first correction (infinite: off;
+    /// [`TangentChart::set_contraction_prior`]).
+    theta_prior: f64,
+    /// `eps (1 + ||x_c||_inf)`: the rounding floor of the residual near the centre, below which
+    /// an observed contraction is chance.
+    floor: f64,
 }
 
 impl TangentChart {
@@ -170,6 +184,11 @@ impl TangentChart {
         for i in 0..nn {
             q[i * nn + i] = 1.0;
         }
+        // Qa = Qb = I until the first centre with constraints (without any, Q = I)
+        let mut qa = vec![0.0; n * n];
+        for i in 0..n {
+            qa[i * n + i] = 1.0;
+        }
         TangentChart {
             n,
             m,
@@ -184,9 +203,11 @@ impl TangentChart {
             rdinv: vec![0.0; mm],
             p0_ready: false,
             bq: vec![0.0; n * m],
-            qa: vec![0.0; n * n],
-            qb: vec![0.0; n * n],
+            qb: qa.clone(),
+            qa,
             q,
+            q_ready: false,
+            nbuf: vec![0.0; 4 * n],
             xc: vec![0.0; nn],
             tc: 0.0,
             f: vec![0.0; mm],
@@ -229,6 +250,10 @@ impl TangentChart {
             singular_tol: 1e-8,
             centred: false,
             sel: rows::RowSelection::new(sys),
+            theta_seen: 0.0,
+            theta_seen_prev: 0.0,
+            theta_prior: f64::INFINITY,
+            floor: 0.0,
         }
     }
 
@@ -260,21 +285,25 @@ impl TangentChart {
         &self.xc
     }
 
-    #[inline]
+    #[cfg(test)]
     fn col(&self, k: usize) -> &[f64] {
         let nn = 2 * self.n;
         &self.q[k * nn..(k + 1) * nn]
     }
 
-    /// Column `k` of the tangent basis `U` (`k < dim()`), a unit vector of length `2n`.
+    /// Column `k` of the tangent basis `U` (`k < dim()`), a unit vector of length `2n` (after
+    /// [`TangentChart::form_q`]).
+    #[cfg(test)]
     pub fn tangent(&self, k: usize) -> &[f64] {
+        debug_assert!(self.q_ready, "form_q first");
         self.col(2 * self.m + k)
     }
 
     /// Column `k` of the normal basis `Q1` (`k < 2m`): an orthonormal basis of the range of
-    /// `Df(x_c)^T`.
+    /// `Df(x_c)^T` (after [`TangentChart::form_q`]).
     #[cfg(test)]
     pub fn normal(&self, k: usize) -> &[f64] {
+        debug_assert!(self.q_ready, "form_q first");
         self.col(k)
     }
 
@@ -323,9 +352,13 @@ impl TangentChart {
         let (n, m) = (self.n, self.m);
         let (nn, mm) = (2 * n, 2 * m);
         self.centred = false;
+        self.q_ready = false;
         self.has_e = false;
         self.s = 0.0;
         self.pb_active = false;
+        self.theta_seen_prev = self.theta_seen;
+        self.theta_seen = 0.0;
+        self.theta_prior = f64::INFINITY;
         if q.len() != n || v.len() != n {
             return Err(SolveError::Dimension {
                 what: "chart centre (q, v)",
@@ -335,6 +368,8 @@ impl TangentChart {
         }
         self.xc[..n].copy_from_slice(q);
         self.xc[n..].copy_from_slice(v);
+        self.floor =
+            f64::EPSILON * (1.0 + self.xc.iter().fold(0.0f64, |m, v| fast_max(m, v.abs())));
         self.tc = t;
         self.rcond = 1.0;
         if m == 0 {
@@ -373,8 +408,13 @@ impl TangentChart {
         }
         // 1. and 2.: the two QRs (see `factor_blocks`)
         with_len!(n, factor_blocks(self));
-        let dmax = (0..mm).fold(0.0f64, |d, i| d.max(self.a[i * nn + i].abs()));
-        let dmin = (0..mm).fold(f64::INFINITY, |d, i| d.min(self.a[i * nn + i].abs()));
+        // (a NaN diagonal entry is caught by the loop below)
+        let (mut dmax, mut dmin) = (0.0f64, f64::INFINITY);
+        for i in 0..mm {
+            let d = self.a[i * nn + i].abs();
+            dmax = if d > dmax { d } else { dmax };
+            dmin = if d < dmin { d } else { dmin };
+        }
         self.rcond = dmin / dmax;
         for i in 0..mm {
             let rii = self.a[i * nn + i].abs();
@@ -401,8 +441,8 @@ impl TangentChart {
             }
             self.rdinv[i] = 1.0 / self.a[i * nn + i];
         }
-        // 3. and 4.: Qa, Qb and Q (see `form_q_blocks`)
-        with_len!(n, form_q_blocks(self));
+        // 3.: Qa and Qb (Q itself only on demand, `form_q`)
+        with_len!(n, form_factors(self));
         // P0 = Q1 R^-T only for the Broyden and interpolated matrices (the plain chord solves
         // with R^T per iteration)
         self.p0_ready = false;
@@ -413,12 +453,23 @@ impl TangentChart {
         Ok(())
     }
 
+    /// Forms the explicit `Q = [Q1 U]` of the current centre from its factors `Qa` and `Qb`
+    /// (once per centre; for the interpolated and Broyden matrices, the exact Newton fallback
+    /// and the column accessors).
+    pub(crate) fn form_q(&mut self) {
+        if !self.q_ready {
+            with_len!(self.n, form_q_blocks(self));
+            self.q_ready = true;
+        }
+    }
+
     /// Forms `R^-1` and `P0 = Q1 R^-T` (the correction matrix of the Broyden and interpolated
     /// iterations) for the current centre, once.
     pub(crate) fn form_p0(&mut self) {
         if self.p0_ready {
             return;
         }
+        self.form_q();
         let (nn, mm) = (2 * self.n, 2 * self.m);
         // R^-1 by back substitution, column by column (diagonal first: 1 / R_ii)
         self.rinv.fill(0.0);
@@ -479,11 +530,9 @@ impl TangentChart {
     }
 
     /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
-    pub fn point(&self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
-        let (nn, mm) = (2 * self.n, 2 * self.m);
+    pub fn point(&mut self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
         x.copy_from_slice(&self.xc);
-        gemv_cols(&self.q[..mm * nn], &zeta[..mm], x);
-        gemv_cols(&self.q[mm * nn..], xi, x);
+        self.add_q(zeta, xi, x);
     }
 
     /// Maps chart coordinates `xi` (length [`TangentChart::dim`]) to the point `x` (length
@@ -542,14 +591,6 @@ impl TangentChart {
         let (nn, mm) = (2 * self.n, 2 * self.m);
         with_codim!(mm, mul_r(&self.a, nn, eta, zeta));
     }
-
-    /// `[Q1 U]^T y` for a vector `y` of length `2n`, in two parts: its normal components
-    /// `normal = Q1^T y` (`2m`) and its tangent components `tangent = U^T y` (`2(n - m)`).
-    pub fn split_coordinates(&self, y: &[f64], normal: &mut [f64], tangent: &mut [f64]) {
-        let (nn, mm) = (2 * self.n, 2 * self.m);
-        gemv_t_cols(&self.q[..mm * nn], y, &mut normal[..mm]);
-        gemv_t_cols(&self.q[mm * nn..], y, tangent);
-    }
 }
 
 /// Steps 1 and 2 of [`TangentChart::centre`] for `n` coordinates (`with_len!` passes the
@@ -600,9 +641,17 @@ fn factor_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
     }
 }
 
-/// Steps 3 and 4 of [`TangentChart::centre`] for `n` coordinates (literal through
-/// `with_len!`): `Qa` and `Qb` explicit (`n x n`), then
-/// `Q = [[Qa1, W Qb, 0], [0, ., Na]]` with `W y = (Na y[..n-m], Qa1 y[n-m..])`: columns
+/// Step 3 of [`TangentChart::centre`] for `n` coordinates (literal through `with_len!`): the
+/// orthogonal factors `Qa` and `Qb` (`n x n`) explicit from their reflectors.
+#[inline(always)]
+fn form_factors(ch: &mut TangentChart, n: usize) {
+    let m = ch.m;
+    form_q_padded(&ch.va, &ch.tau[..m], &mut ch.qa, n);
+    form_q_padded(&ch.vb, &ch.tau_b[..m], &mut ch.qb, n);
+}
+
+/// [`TangentChart::form_q`] for `n` coordinates (literal through `with_len!`): from `Qa` and
+/// `Qb` (`n x n`, formed by the centre), `Q = [[Qa1, W Qb, 0], [0, ., Na]]` with `W y = (Na y[..n-m], Qa1 y[n-m..])`: columns
 /// `0..m` are `(Qa1, 0)`, `m..m+n` are `W Qb` (the last `n - m` of them tangent), `m+n..2n`
 /// are `(0, Na)`. The products `W Qb_j` accumulate column by column from zero, as
 /// [`gemv_cols`] does.
@@ -616,8 +665,6 @@ fn form_q_blocks(ch: &mut TangentChart, n: usize) {
 #[inline(always)]
 fn form_q_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
     let (nn, nm) = (2 * n, n - m);
-    form_q_padded(&ch.va, &ch.tau[..m], &mut ch.qa, n);
-    form_q_padded(&ch.vb, &ch.tau_b[..m], &mut ch.qb, n);
     let (qa, qb) = (&ch.qa[..n * n], &ch.qb[..n * n]);
     for k in 0..m {
         let col = &mut ch.q[k * nn..(k + 1) * nn];

@@ -20,6 +20,7 @@ fn block_chart_factors_df() {
         chart
             .centre(&sys, st.q.as_slice(), v.as_slice(), 0.0)
             .expect("centre");
+        chart.form_q();
         let (dim, mm, nn) = (chart.dim(), chart.codim(), chart.ambient_dim());
         let col = |k: usize| {
             if k < mm {

@@ -27,7 +27,7 @@ impl TangentRk {
             Ok(w) => {
                 self.account(&w);
                 // error estimate mapped to x: e = U err_xi
-                self.path.to_ambient(&self.rk.err, &mut self.ex);
+                self.path.tangent_to_ambient(&self.rk.err, &mut self.ex);
                 for ((s, a), b) in self.scale.iter_mut().zip(&self.cur).zip(&self.xnew) {
                     *s = a.abs().max(b.abs());
                 }

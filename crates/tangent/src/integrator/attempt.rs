@@ -2,7 +2,6 @@
 //! the end-point map, and the `eta` history the starting points are extrapolated from.
 
 use super::*;
-use crate::kernels::with_codim;
 
 impl TangentRk {
     /// One attempted step of size `h` from the chart centre (at time `t`) into `xnew`; the
@@ -34,12 +33,8 @@ impl TangentRk {
         // interior stage maps: inexact after an accepted step of the same size (to rounding:
         // `mbd_solve::run` passes `t_next - t`, which differs from the nominal step in the
         // last bits)
-        let rcond = self.path.rcond();
-        let follows = same_step(self.hist_h, h)
-            && same_time(self.hist_t, t)
-            && self.hist_rcond[..self.hist_len]
-                .iter()
-                .all(|&r| r <= RCOND_DRIFT * rcond && rcond <= RCOND_DRIFT * r);
+        let (usable, recent_ok) = self.hist.usable(self.path.rcond(), RCOND_DRIFT);
+        let follows = same_step(self.hist.h, h) && same_time(self.hist.t, t) && recent_ok;
         let stage_newton = if follows {
             NewtonSettings {
                 tol: self.stage_tol.max(newton.tol),
@@ -54,9 +49,10 @@ impl TangentRk {
         let quadratic = !sys.is_rheonomic();
         let scleronomic = quadratic && self.m > 0;
         if !follows {
-            self.hist_len = 0;
+            self.hist.clear();
         }
-        let npts = self.hist_len;
+        self.path.set_contraction_prior(follows);
+        let npts = if follows { usable } else { 0 };
         let mut ylast_sq = 0.0f64;
         let mut jlast = 0usize;
         let mut work = AttemptWork {
@@ -74,9 +70,9 @@ impl TangentRk {
             let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
             let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
             let fsal = self.fsal;
-            let (eta_now, eta_hist, eta_pred, eta_raw) = (
+            let (eta_now, hist, eta_pred, eta_raw) = (
                 &mut self.eta_now,
-                &self.eta_hist,
+                &self.hist,
                 &mut self.eta_pred,
                 &mut self.eta_raw,
             );
@@ -85,14 +81,6 @@ impl TangentRk {
             let singular_stage = &mut singular_stage;
             let mut rhs = |ti: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
                 let i = stage;
-                // plain RK stage value's normal part
-                zplain.fill(0.0);
-                for j in 0..i {
-                    let a = a_coef[i * s + j];
-                    if a != 0.0 {
-                        axpy(h * a, &g[j * mm..(j + 1) * mm], zplain);
-                    }
-                }
                 if i == 1 && interpolate {
                     // Euler prediction of the end point, x_c + h F(x_c): where the iteration
                     // matrix is interpolated to
@@ -101,12 +89,17 @@ impl TangentRk {
                     chart.set_secondary_point(sys, x);
                 }
                 chart.select_iteration_matrix(c_coef[i]);
+                // stage 0 at (t, xi = 0) is the centre: no starting point, and its normal
+                // coordinates (zeta = eta = 0) need no conversion
+                let at_centre = i == 0 && centre_ok && ti == t;
                 let ysq: f64 = y.iter().map(|v| v * v).sum();
-                if npts > 0 {
+                if at_centre {
+                    eta_now[..mm].fill(0.0);
+                } else if npts > 0 && i > 0 {
                     // the plain extrapolation of this stage, kept for the later stages'
                     // corrections
                     let raw = &mut eta_raw[i * mm..(i + 1) * mm];
-                    extrapolate(eta_hist, npts, (s + 1) * mm, i * mm, raw);
+                    hist.predict(i - 1, npts, raw);
                     eta_pred.copy_from_slice(raw);
                     if jlast > 0 {
                         // correct by the extrapolation error of the latest mapped stage j,
@@ -125,8 +118,17 @@ impl TangentRk {
                     for (z, zl) in zplain.iter_mut().zip(zlast.iter()) {
                         *z = r * zl;
                     }
+                } else {
+                    // the plain RK stage value's normal part
+                    zplain.fill(0.0);
+                    for j in 0..i {
+                        let a = a_coef[i * s + j];
+                        if a != 0.0 {
+                            axpy(h * a, &g[j * mm..(j + 1) * mm], zplain);
+                        }
+                    }
                 }
-                let mapped = if i == 0 && centre_ok && ti == t {
+                let mapped = if at_centre {
                     x.copy_from_slice(chart.centre_point());
                     Ok(MapStats::default())
                 } else if fsal && i + 1 == s {
@@ -135,12 +137,12 @@ impl TangentRk {
                 } else {
                     chart.map(sys, y, ti, zplain, x, &stage_newton, true)
                 };
-                if ysq > 0.0 && mapped.is_ok() {
-                    zlast.copy_from_slice(zplain);
-                    ylast_sq = ysq;
-                    jlast = i;
-                }
-                if mapped.is_ok() {
+                if !at_centre && mapped.is_ok() {
+                    if ysq > 0.0 {
+                        zlast.copy_from_slice(zplain);
+                        ylast_sq = ysq;
+                        jlast = i;
+                    }
                     chart.eta_from_zeta(zplain, &mut eta_now[i * mm..(i + 1) * mm]);
                 }
                 match mapped {
@@ -162,8 +164,7 @@ impl TangentRk {
                 let (q, v) = x.split_at(n);
                 // at the centre: Phi_q and (Phi_q v)_q are the chart's, so (dense path)
                 // gamma = -(Phi_q v)_q v needs no model evaluation
-                let at_centre = i == 0 && centre_ok && ti == t && scleronomic;
-                let solved = chart.accel(sys, q, v, ti, at_centre, acc_a, lambda);
+                let solved = chart.accel(sys, q, v, ti, at_centre && scleronomic, acc_a, lambda);
                 if solved.is_ok() {
                     work.condition = work.condition.max(chart.condition_estimate());
                 }
@@ -256,8 +257,6 @@ impl TangentRk {
                     )
                 }
             }
-            self.path
-                .eta_from_zeta(&self.zeta, &mut self.eta_now[s * mm..(s + 1) * mm]);
         }
         if self.xnew.iter().any(|x| !x.is_finite()) {
             return Err(Attempt::Hard(SolveError::NonFinite {
@@ -276,37 +275,9 @@ impl TangentRk {
         } else {
             tol
         };
-        let len = self.eta_now.len();
-        self.eta_hist.copy_within(0..(HISTORY - 1) * len, len);
-        self.eta_hist[..len].copy_from_slice(&self.eta_now);
-        self.hist_rcond.copy_within(0..HISTORY - 1, 1);
-        self.hist_rcond[0] = self.path.rcond();
-        self.hist_len = (self.hist_len + 1).min(HISTORY);
-        self.hist_h = h;
-        self.hist_t = t_end;
-    }
-}
-
-/// Polynomial extrapolation to the next step of the `eta` of one map (offset `off` within a
-/// step's record of length `len`) from the last `npts` (1 to 3) steps, most recent first.
-pub(super) fn extrapolate(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64]) {
-    with_codim!(out.len(), extrapolate_mm(hist, npts, len, off, out));
-}
-
-/// [`extrapolate`] for `eta` of length `mm` (a literal for the common lengths).
-#[inline(always)]
-fn extrapolate_mm(hist: &[f64], npts: usize, len: usize, off: usize, out: &mut [f64], mm: usize) {
-    let w: &[f64] = match npts {
-        1 => &[1.0],
-        2 => &[2.0, -1.0],
-        _ => &[3.0, -3.0, 1.0],
-    };
-    let out = &mut out[..mm];
-    out.fill(0.0);
-    for (k, &wk) in w.iter().enumerate() {
-        let h = &hist[k * len + off..k * len + off + mm];
-        for i in 0..mm {
-            out[i] += wk * h[i];
-        }
+        self.hist
+            .commit(&self.eta_now[2 * self.m..], self.path.rcond());
+        self.hist.h = h;
+        self.hist.t = t_end;
     }
 }

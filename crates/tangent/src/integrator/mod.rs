@@ -11,9 +11,11 @@ use mbd_solve::{
 };
 mod adaptive;
 mod attempt;
+mod history;
 mod options;
 mod path;
 
+use history::EtaHistory;
 use path::{Path, SparseParts};
 
 pub use options::{IterationMatrix, TangentOptions, TangentStats};
@@ -92,17 +94,12 @@ pub struct TangentRk {
     /// Error estimate mapped to `x`, and the error scale.
     ex: Vec<f64>,
     scale: Vec<f64>,
-    /// The paper's normal coefficients `eta` of every map of the attempt in progress (stage `i`
-    /// at `i * 2m`, the end point at `s * 2m`; stage 0 is the centre, `eta = 0`).
+    /// The paper's normal coefficients `eta` of every stage map of the attempt in progress
+    /// (stage `i` at `i * 2m`; stage 0 is the centre, `eta = 0`). The end point's are not kept:
+    /// it starts from the RK quadrature, not from the history.
     eta_now: Vec<f64>,
-    /// `eta_now` of the last `hist_len` (at most [`HISTORY`]) accepted steps, most recent
-    /// first, all of size `hist_h`, consecutive, the latest ending at `hist_t`.
-    eta_hist: Vec<f64>,
-    hist_len: usize,
-    /// [`TangentChart::rcond`] of the charts of the steps in `eta_hist`.
-    hist_rcond: [f64; HISTORY],
-    hist_h: f64,
-    hist_t: f64,
+    /// The interior stages' `eta` (stages `1..s`) of the last accepted steps of one size.
+    hist: EtaHistory,
     /// Extrapolated and corrected `eta` of the map in progress; the plain extrapolations of
     /// the attempt's stages (stage `i` at `i * 2m`).
     eta_pred: Vec<f64>,
@@ -117,9 +114,6 @@ pub struct TangentRk {
     /// the error test.
     failures_here: usize,
 }
-
-/// Steps of `eta` history kept for the Newton starting points.
-const HISTORY: usize = 3;
 
 /// Largest factor by which [`TangentChart::rcond`] may differ between the current chart and
 /// the charts of the history steps for the history to be used (predictors, inexact stage
@@ -222,12 +216,8 @@ impl TangentRk {
             lambda: vec![0.0; m_full],
             ex: vec![0.0; 2 * n],
             scale: vec![0.0; 2 * n],
-            eta_now: vec![0.0; (s + 1) * 2 * m],
-            eta_hist: vec![0.0; HISTORY * (s + 1) * 2 * m],
-            hist_len: 0,
-            hist_rcond: [1.0; HISTORY],
-            hist_h: f64::NAN,
-            hist_t: f64::NAN,
+            eta_now: vec![0.0; s * 2 * m],
+            hist: EtaHistory::new(s.saturating_sub(1), 2 * m, !sparse),
             eta_pred: vec![0.0; 2 * m],
             eta_raw: vec![0.0; s * 2 * m],
             stage_tol: options.newton.tol,
@@ -318,7 +308,7 @@ impl TangentRk {
             // the state is the end point of our last step: on the manifold to newton.tol
             return Ok(());
         }
-        self.hist_len = 0;
+        self.hist.clear();
         self.centred_at = f64::NAN;
         self.failures_here = 0;
         self.cur[..n].copy_from_slice(state.q.as_slice());
@@ -466,7 +456,7 @@ impl Integrator for TangentRk {
     fn reset(&mut self) {
         self.stats = TangentStats::default();
         self.cur_ok = false;
-        self.hist_len = 0;
+        self.hist.clear();
         self.centred_at = f64::NAN;
         self.failures_here = 0;
     }

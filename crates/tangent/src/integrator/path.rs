@@ -89,6 +89,15 @@ impl Path {
         }
     }
 
+    /// The dense chart's predicted stop after the first correction (the sparse chart has
+    /// none).
+    #[inline]
+    pub(super) fn set_contraction_prior(&mut self, follows: bool) {
+        if let Path::Dense { chart, .. } = self {
+            chart.set_contraction_prior(follows);
+        }
+    }
+
     #[inline]
     pub(super) fn select_iteration_matrix(&mut self, s: f64) {
         if let Path::Dense { chart, .. } = self {
@@ -195,17 +204,9 @@ impl Path {
     }
 
     /// A vector in chart coordinates mapped to `x` (dense: `U e`; sparse: `e` itself).
-    pub(super) fn to_ambient(&self, e: &[f64], out: &mut [f64]) {
+    pub(super) fn tangent_to_ambient(&mut self, e: &[f64], out: &mut [f64]) {
         match self {
-            Path::Dense { chart, .. } => {
-                out.fill(0.0);
-                for (k, &ek) in e.iter().enumerate() {
-                    let col = chart.tangent(k);
-                    for (o, c) in out.iter_mut().zip(col) {
-                        *o += ek * c;
-                    }
-                }
-            }
+            Path::Dense { chart, .. } => chart.tangent_to_ambient(e, out),
             Path::Sparse(_) => out.copy_from_slice(e),
         }
     }

@@ -26,6 +26,7 @@ fn sparse_projector_is_the_dense_u_u_transpose() {
     let (mut g, mut py) = (vec![0.0; mm], vec![0.0; nn]);
     sparse.split(&fx, &mut g, &mut py);
     // U U^T F with the dense chart's orthonormal basis
+    dense.form_q();
     let mut uu = vec![0.0; nn];
     for k in 0..dense.dim() {
         let u = dense.tangent(k);
