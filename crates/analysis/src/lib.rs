@@ -12,7 +12,8 @@
 //! * [`period`]: oscillation periods from zero crossings of samples (interpolated, least-squares
 //!   slope of the crossing times) and the exact pendulum period ([`period::pendulum_period`]);
 //! * [`TimeSeries`] and [`CsvObserver`]: CSV/JSON output;
-//! * [`save_state`] / [`load_state`]: a state as JSON, read back as an initial state.
+//! * [`save_state`] / [`load_state`]: a state as JSON, read back as an initial state;
+//! * [`EnergyBalance`]: the work of loads and drivers and the energy dampers take, along a run.
 //!
 //! ```
 //! use mbd_analysis::{fit_order, MeasureObserver};
@@ -37,6 +38,7 @@
 // Index loops mirror the formulas; negated comparisons deliberately treat NaN as failure.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+mod energy_balance;
 mod error;
 mod measures;
 mod order;
@@ -47,6 +49,7 @@ pub mod plot;
 mod state_file;
 mod trajectory;
 
+pub use energy_balance::EnergyBalance;
 pub use error::AnalysisError;
 pub use measures::{measure_trajectory, MeasureObserver, RunMeasures};
 pub use order::{fit_order, OrderFit};

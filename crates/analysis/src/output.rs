@@ -1,5 +1,6 @@
 //! CSV and JSON writers for time series.
 
+use crate::energy_balance::EnergyBalance;
 use crate::error::AnalysisError;
 use mbd_model::System;
 use mbd_solve::{Flow, JointReaction, Observer, ReactionSolver, SensorSolver, SolveError, State};
@@ -121,6 +122,9 @@ pub struct CsvObserver<W: Write> {
     sensors: bool,
     /// The sensor workspace (built at the first row that needs it).
     sensor_solver: Option<SensorSolver>,
+    energy_balance: bool,
+    /// The running energy balance (built at the first state), advanced at every step.
+    balance: Option<EnergyBalance>,
     every: usize,
     row: Vec<f64>,
     phi: Vec<f64>,
@@ -139,6 +143,8 @@ impl<W: Write> CsvObserver<W> {
             reaction_solver: None,
             sensors: false,
             sensor_solver: None,
+            energy_balance: false,
+            balance: None,
             every: 1,
             row: Vec::new(),
             phi: Vec::new(),
@@ -164,6 +170,32 @@ impl<W: Write> CsvObserver<W> {
     pub fn with_sensors(mut self) -> Self {
         self.sensors = true;
         self
+    }
+    /// Adds the energy balance's columns ([`EnergyBalance`]): `W_external` (work of
+    /// time-dependent loads and drivers, J), `E_dissipated` (taken by dampers, J) and
+    /// `energy_balance` (`H - H0 - W_external + E_dissipated`, J). The balance is advanced at
+    /// every step the observer sees ([`CsvObserver::advance`]), written or not.
+    pub fn with_energy_balance(mut self) -> Self {
+        self.energy_balance = true;
+        self
+    }
+    /// The running energy balance, if [`CsvObserver::with_energy_balance`] asked for it and a
+    /// state was seen.
+    pub fn energy_balance(&self) -> Option<&EnergyBalance> {
+        self.balance.as_ref()
+    }
+    /// Advances what accumulates along the run (the energy balance) to state `s`: called by
+    /// [`Observer::observe`] at every step; a writer that observes through another observer
+    /// calls it at every step too.
+    pub fn advance(&mut self, sys: &System, s: &State) -> Result<(), SolveError> {
+        if self.energy_balance {
+            let b = match &mut self.balance {
+                Some(b) => b,
+                None => self.balance.insert(EnergyBalance::new(sys)?),
+            };
+            b.advance(sys, s)?;
+        }
+        Ok(())
     }
     /// Writes only the samples of steps `0, k, 2k, ...` (`k = 0` is treated as 1); call
     /// [`CsvObserver::finish`] after the run to add the final state.
@@ -191,6 +223,9 @@ impl<W: Write> CsvObserver<W> {
         }
         if self.sensors {
             h.extend(SensorSolver::columns(sys));
+        }
+        if self.energy_balance {
+            h.extend(["W_external", "E_dissipated", "energy_balance"].map(String::from));
         }
         h
     }
@@ -229,6 +264,14 @@ impl<W: Write> CsvObserver<W> {
                 None => self.sensor_solver.insert(SensorSolver::new(sys)?),
             };
             ss.evaluate(sys, s, &mut self.row)?;
+        }
+        if self.energy_balance {
+            let b = self.balance.as_ref();
+            self.row.extend([
+                b.map_or(0.0, EnergyBalance::external_work),
+                b.map_or(0.0, EnergyBalance::dissipated),
+                b.map_or(0.0, EnergyBalance::residual),
+            ]);
         }
         Ok(&self.row)
     }
@@ -283,6 +326,7 @@ impl<W: Write> CsvObserver<W> {
 impl<W: Write> Observer for CsvObserver<W> {
     fn observe(&mut self, sys: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
         self.last_step = Some(step);
+        self.advance(sys, s)?;
         if step % self.every == 0 {
             self.write_state(sys, s, step)?;
         }

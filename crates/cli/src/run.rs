@@ -28,6 +28,9 @@ pub struct RunSummary {
     /// Why `H` is not conserved (dampers, time-dependent loads, drivers), if it is not: then
     /// `e(H)` is the energy exchanged, not an error, and the line says so instead.
     pub not_conserved: Option<String>,
+    /// Where `H` is not conserved: the energy balance's largest residual relative to the
+    /// largest `|H|` (`mbd_analysis::EnergyBalance`).
+    pub balance: Option<f64>,
 }
 
 impl RunSummary {
@@ -36,8 +39,10 @@ impl RunSummary {
         let energy = match &self.not_conserved {
             None => format!("e(H) = {:.3e}", self.measures.e_h),
             Some(why) => format!(
-                "H not conserved ({why}): max |H - H0| / |H0| = {:.3e}",
-                self.measures.e_h
+                "H not conserved ({why}): max |H - H0| / |H0| = {:.3e}, energy balance \
+                 residual {:.3e} of max |H|",
+                self.measures.e_h,
+                self.balance.unwrap_or(f64::NAN)
             ),
         };
         format!(
@@ -101,6 +106,7 @@ impl Observer for Sink {
                 last_t,
                 ..
             } => {
+                fmt.advance(sys, s)?;
                 if step % *every == 0 {
                     rows.push(fmt.row(sys, s)?.to_vec());
                     *last_t = Some(s.t);
@@ -166,19 +172,21 @@ impl Observer for Progress {
 }
 
 /// The columns of `mbd run`'s output: the state, `H`, the residuals, if asked the reactions,
-/// and the model's sensors.
-fn columns<W: Write>(c: CsvObserver<W>, reactions: bool) -> CsvObserver<W> {
-    let c = c.with_residuals().with_sensors();
+/// the model's sensors, and where `H` is not conserved the energy balance.
+fn columns<W: Write>(c: CsvObserver<W>, reactions: bool, balance: bool) -> CsvObserver<W> {
+    let mut c = c.with_residuals().with_sensors();
     if reactions {
-        c.with_reactions()
-    } else {
-        c
+        c = c.with_reactions();
     }
+    if balance {
+        c = c.with_energy_balance();
+    }
+    c
 }
 
-fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
+fn open_sink(args: &RunArgs, every: usize, balance: bool) -> Result<Sink, CliError> {
     let csv = |w: Box<dyn Write>| {
-        Sink::Csv(columns(CsvObserver::new(w), args.reactions).with_every(every))
+        Sink::Csv(columns(CsvObserver::new(w), args.reactions, balance).with_every(every))
     };
     let stdout = || csv(Box::new(std::io::BufWriter::new(std::io::stdout())));
     let Some(out) = &args.out else {
@@ -209,7 +217,7 @@ fn open_sink(args: &RunArgs, every: usize) -> Result<Sink, CliError> {
     let file = std::fs::File::create(out).map_err(|e| CliError::write(out, e))?;
     Ok(if json {
         Sink::Json {
-            fmt: columns(CsvObserver::new(std::io::sink()), args.reactions),
+            fmt: columns(CsvObserver::new(std::io::sink()), args.reactions, balance),
             every,
             rows: Vec::new(),
             last_t: None,
@@ -381,7 +389,8 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         .build(&sys)
         .map_err(|e| solve_error(&args.solver, mbd::registry().with_advice(&sys, e)))?;
     let every = usize::try_from(args.every).unwrap_or(usize::MAX);
-    let sink = open_sink(args, every)?;
+    let why_not_conserved = not_conserved(&sys);
+    let sink = open_sink(args, every, why_not_conserved.is_some())?;
     let measures = MeasureObserver::new(&sys, false);
     let count = RowCount {
         every,
@@ -401,6 +410,11 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     }
     let stats = result.map_err(|e| solve_error(&args.solver, solve_part(e)))?;
     let (measures, (count, (sink, _))) = obs;
+    let balance = match &sink {
+        Sink::Csv(c) => c.energy_balance(),
+        Sink::Json { fmt, .. } => fmt.energy_balance(),
+    }
+    .map(|b| b.max_residual() / b.max_energy().max(f64::MIN_POSITIVE));
     let final_written = count.last_t == Some(sim.state().t);
     let rows = count.rows + usize::from(!final_written);
     finish(
@@ -417,7 +431,8 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         measures: measures.measures(),
         wall_time,
         rows,
-        not_conserved: not_conserved(sim.system()),
+        not_conserved: why_not_conserved,
+        balance,
     })
 }
 

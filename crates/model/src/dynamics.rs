@@ -1,6 +1,7 @@
 //! Energies and forces: potential, kinetic energy, applied and conservative forces and the
 //! potential's derivatives.
 
+use crate::forces::ForceKind;
 use crate::system::*;
 use nalgebra::DMatrix;
 
@@ -77,6 +78,42 @@ impl System {
             }
             Self::scatter_hess(at, &h, out);
         }
+    }
+
+    /// The power of the non-conservative force elements at `(q, v, t)`: `(dissipated,
+    /// external)`, the rate at which dampers (spring-dampers' and rotary spring-dampers'
+    /// damping) take energy out (`>= 0`) and the power time-dependent loads put in. With the
+    /// drivers' power `lambda . Phi_t` it is the whole rate of change of the energy:
+    /// `dH/dt = external - dissipated + lambda . Phi_t` (docs/architecture.md, "Energy
+    /// balance").
+    pub fn nonconservative_power(&self, q: &[f64], v: &[f64], t: f64) -> (f64, f64) {
+        let (mut dissipated, mut external) = (0.0, 0.0);
+        for (fi, f) in self.forces.iter().enumerate() {
+            if !f.is_nonconservative() {
+                continue;
+            }
+            let at = self.force_attach[fi];
+            let (va, vb) = (Self::loc_f64(v, at.a), Self::loc_f64(v, at.b));
+            let mut loc = [0.0; 6];
+            f.nonconservative(
+                &Self::loc_f64(q, at.a),
+                &Self::loc_f64(q, at.b),
+                &va,
+                &vb,
+                t,
+                &mut loc,
+            );
+            let p: f64 = (0..3).map(|l| loc[l] * va[l] + loc[3 + l] * vb[l]).sum();
+            if matches!(
+                f.kind,
+                ForceKind::SpringDamper(_) | ForceKind::RotarySpringDamper(_)
+            ) {
+                dissipated -= p;
+            } else {
+                external += p;
+            }
+        }
+        (dissipated, external)
     }
 
     /// Non-conservative generalized forces (dampers, time-dependent loads) into `out`
