@@ -61,20 +61,26 @@ pub(crate) fn point(element: &str, parameter: &'static str, p: [f64; 2]) -> Resu
     finite(element, parameter, p[1])
 }
 
-/// Every coefficient of a time function must be finite.
+/// Every coefficient of a time function must be finite, and a step's or ramp's end after its
+/// start.
 pub(crate) fn time_function(
     element: &str,
     parameter: &'static str,
     f: &TimeFunction,
 ) -> Result<(), ModelError> {
-    if f.is_finite() {
-        Ok(())
-    } else {
-        Err(ModelError::InvalidParameter {
+    if !f.is_finite() {
+        return Err(ModelError::InvalidParameter {
             element: element.to_string(),
             parameter,
             value: f64::NAN,
             reason: "time function coefficients must be finite",
-        })
+        });
+    }
+    match f.invalid_reason() {
+        None => Ok(()),
+        Some(reason) => Err(ModelError::InvalidElement {
+            element: element.to_string(),
+            message: format!("time function '{parameter}': {reason}"),
+        }),
     }
 }

@@ -646,3 +646,21 @@ fn slider_crank_parameters_are_checked() {
     assert_eq!(driven.dof(), 0);
     assert_eq!(slider_crank_with(&base).unwrap().dof(), 1);
 }
+
+/// A ramp or smooth step whose end is not after its start is refused, naming the element and
+/// the time function.
+#[test]
+fn a_step_that_ends_before_it_starts() {
+    for f in [
+        TimeFunction::ramp(1.0, 1.0, 0.0, 2.0),
+        TimeFunction::smooth_step(2.0, 1.0, 0.0, 2.0),
+    ] {
+        let (mut b, h) = one_body();
+        b.add_force(Force::torque("motor", h, f));
+        let e = err(b).to_string();
+        assert!(
+            e.contains("motor") && e.contains("'torque'") && e.contains("t1 must be after"),
+            "{e}"
+        );
+    }
+}
