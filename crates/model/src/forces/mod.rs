@@ -88,6 +88,22 @@ pub enum ForceKind {
     Torque(Torque),
 }
 
+macro_rules! force_from {
+    ($($variant:ident => $ty:ident),*) => {
+        $(impl From<$ty> for ForceKind {
+            fn from(f: $ty) -> Self {
+                ForceKind::$variant(f)
+            }
+        })*
+    };
+}
+force_from!(
+    SpringDamper => SpringDamper,
+    RotarySpringDamper => RotarySpringDamper,
+    Force => PointForce,
+    Torque => Torque
+);
+
 /// `each_force!(kind, f => expr)`: `expr` with `f` bound to the element struct of whatever kind
 /// `kind` holds.
 macro_rules! each_force {
@@ -177,11 +193,33 @@ impl Force {
         };
         Self::new(name, ForceKind::Torque(kind))
     }
-    /// A force element of any kind.
-    pub fn new(name: impl Into<String>, kind: ForceKind) -> Self {
+    /// A force element of any kind, from its kind's struct with named fields (no stiffness
+    /// and damping to swap, as in the positional [`Force::spring_damper`]):
+    ///
+    /// ```
+    /// use mbd_model::forces::SpringDamper;
+    /// use mbd_model::{BodyRef, Force, SystemBuilder, Body};
+    /// let mut b = SystemBuilder::new();
+    /// let mass = b.add_body(Body::new("mass").position(0.0, -1.0, 0.0));
+    /// b.add_force(Force::new(
+    ///     "suspension",
+    ///     SpringDamper {
+    ///         a: BodyRef::Ground,
+    ///         pa: [0.0, 0.0],
+    ///         b: mass.into(),
+    ///         pb: [0.0, 0.0],
+    ///         stiffness: 100.0,
+    ///         damping: 2.0,
+    ///         rest_length: 0.8,
+    ///     },
+    /// ));
+    /// assert_eq!(b.build()?.forces()[0].kind_name(), "spring_damper");
+    /// # Ok::<(), mbd_model::ModelError>(())
+    /// ```
+    pub fn new(name: impl Into<String>, kind: impl Into<ForceKind>) -> Self {
         Force {
             name: name.into(),
-            kind,
+            kind: kind.into(),
         }
     }
 

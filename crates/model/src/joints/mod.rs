@@ -93,6 +93,17 @@ pub enum JointKind {
 
 /// `each_joint!(kind, j => expr)`: `expr` with `j` bound to the joint struct of whatever kind
 /// `kind` (a `&JointKind` or `&mut JointKind`) holds.
+macro_rules! joint_from {
+    ($($variant:ident),*) => {
+        $(impl From<$variant> for JointKind {
+            fn from(j: $variant) -> Self {
+                JointKind::$variant(j)
+            }
+        })*
+    };
+}
+joint_from!(Revolute, Prismatic, Weld, Distance, Absolute, AngleDriver);
+
 macro_rules! each_joint {
     ($kind:expr, $j:ident => $body:expr) => {
         match $kind {
@@ -232,11 +243,32 @@ impl Joint {
         };
         Self::new(name, JointKind::AngleDriver(kind))
     }
-    /// A joint of any kind.
-    pub fn new(name: impl Into<String>, kind: JointKind) -> Self {
+    /// A joint of any kind, from its kind's struct with named fields (the positional
+    /// constructors above are shorthands):
+    ///
+    /// ```
+    /// use mbd_model::joints::Prismatic;
+    /// use mbd_model::{Body, BodyRef, Joint, SystemBuilder};
+    /// let mut b = SystemBuilder::new();
+    /// let slider = b.add_body(Body::new("slider").position(0.3, 0.0, 0.0));
+    /// b.add_joint(Joint::new(
+    ///     "guide",
+    ///     Prismatic {
+    ///         a: BodyRef::Ground,
+    ///         pa: [0.0, 0.0],
+    ///         b: slider.into(),
+    ///         pb: [0.0, 0.0],
+    ///         axis: [1.0, 0.0],
+    ///         angle: 0.0,
+    ///     },
+    /// ));
+    /// assert_eq!(b.build()?.dof(), 1);
+    /// # Ok::<(), mbd_model::ModelError>(())
+    /// ```
+    pub fn new(name: impl Into<String>, kind: impl Into<JointKind>) -> Self {
         Joint {
             name: name.into(),
-            kind,
+            kind: kind.into(),
         }
     }
 
