@@ -4,7 +4,7 @@
 use crate::{Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, TimeFunction};
 
 /// Every joint kind (revolute, prismatic, weld, distance, absolute x / y / angle, angle
-/// driver) on five bodies: the fixture of the unit tests that check derivatives element by
+/// driver, slide driver) on five bodies: the fixture of the unit tests that check derivatives element by
 /// element.
 pub fn every_joint_kind() -> System {
     let mut b = SystemBuilder::new();
@@ -45,6 +45,17 @@ pub fn every_joint_kind() -> System {
         BodyRef::Ground,
         b2,
         TimeFunction::linear(0.1, 2.0),
+    ));
+    b.add_joint(Joint::new(
+        "slide",
+        crate::joints::SlideDriver {
+            a: b1.into(),
+            pa: [0.2, -0.1],
+            b: b5.into(),
+            pb: [-0.3, 0.2],
+            axis: [0.6, 0.8],
+            f: TimeFunction::linear(0.4, -0.7),
+        },
     ));
     b.build().unwrap()
 }
@@ -98,3 +109,27 @@ pub fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
 }
 
 pub use mbd_jet::fixtures::TwoDirections;
+
+#[cfg(test)]
+mod tests {
+    /// The fixture holds every joint kind, the slide driver among them, and goes through the
+    /// file format unchanged: the same equations at a generic point (to rounding).
+    #[test]
+    fn every_joint_kind_round_trips() {
+        let sys = super::every_joint_kind();
+        let toml = sys.to_model_file().to_toml().unwrap();
+        assert!(toml.contains("type = \"slide_driver\""), "{toml}");
+        let back = crate::ModelFile::from_toml(&toml).unwrap().build().unwrap();
+        let (q, _) = super::generic_point(sys.n_coords());
+        let (mut a, mut b) = (
+            vec![0.0; sys.n_constraints()],
+            vec![0.0; back.n_constraints()],
+        );
+        sys.phi(&q, 0.3, &mut a);
+        back.phi(&q, 0.3, &mut b);
+        // (a normalised axis normalised again moves by rounding)
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-15, "{x} {y}");
+        }
+    }
+}

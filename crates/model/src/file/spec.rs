@@ -2,7 +2,8 @@
 
 use crate::forces::{PointForceSpec, RotarySpringDamperSpec, SpringDamperSpec, TorqueSpec};
 use crate::joints::{
-    AbsoluteSpec, AngleDriverSpec, DistanceSpec, PrismaticSpec, RevoluteSpec, WeldSpec,
+    AbsoluteSpec, AngleDriverSpec, DistanceSpec, PrismaticSpec, RevoluteSpec, SlideDriverSpec,
+    WeldSpec,
 };
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -132,6 +133,8 @@ pub enum JointSpec {
     Absolute(AbsoluteSpec),
     /// An [`AngleDriver`](crate::joints::AngleDriver).
     AngleDriver(AngleDriverSpec),
+    /// A [`SlideDriver`](crate::joints::SlideDriver).
+    SlideDriver(SlideDriverSpec),
 }
 
 /// A force element in a model file (bodies by name), tagged by `type`.

@@ -16,6 +16,7 @@ mod angle_driver;
 mod distance;
 mod prismatic;
 mod revolute;
+mod slide_driver;
 mod weld;
 
 pub use absolute::{Absolute, AbsoluteSpec, Coordinate};
@@ -23,6 +24,7 @@ pub use angle_driver::{AngleDriver, AngleDriverSpec};
 pub use distance::{Distance, DistanceSpec};
 pub use prismatic::{Prismatic, PrismaticSpec};
 pub use revolute::{Revolute, RevoluteSpec};
+pub use slide_driver::{SlideDriver, SlideDriverSpec};
 pub use weld::{Weld, WeldSpec};
 
 use crate::body::BodyRef;
@@ -89,6 +91,8 @@ pub enum JointKind {
     Absolute(Absolute),
     /// Rheonomic driver of a relative angle (1 equation).
     AngleDriver(AngleDriver),
+    /// Rheonomic driver of a point's slide along a body's axis (1 equation).
+    SlideDriver(SlideDriver),
 }
 
 /// `each_joint!(kind, j => expr)`: `expr` with `j` bound to the joint struct of whatever kind
@@ -102,7 +106,15 @@ macro_rules! joint_from {
         })*
     };
 }
-joint_from!(Revolute, Prismatic, Weld, Distance, Absolute, AngleDriver);
+joint_from!(
+    Revolute,
+    Prismatic,
+    Weld,
+    Distance,
+    Absolute,
+    AngleDriver,
+    SlideDriver
+);
 
 macro_rules! each_joint {
     ($kind:expr, $j:ident => $body:expr) => {
@@ -113,6 +125,7 @@ macro_rules! each_joint {
             JointKind::Distance($j) => $body,
             JointKind::Absolute($j) => $body,
             JointKind::AngleDriver($j) => $body,
+            JointKind::SlideDriver($j) => $body,
         }
     };
 }
@@ -409,6 +422,7 @@ impl JointSpec {
             JointSpec::Distance(s) => s.to_joint(find),
             JointSpec::Absolute(s) => s.to_joint(find),
             JointSpec::AngleDriver(s) => s.to_joint(find),
+            JointSpec::SlideDriver(s) => s.to_joint(find),
         }
     }
 }
