@@ -88,3 +88,56 @@ fn a_slide_driver_moves_a_slider_along_its_step() {
     }
     assert!(ran >= 8, "{ran}");
 }
+
+/// A slider on the x axis pulled by a distance driver from the ground point (0, 1): the
+/// distance grows along a smooth step from 1.25 to 2 m, so the slider is at
+/// `x = sqrt(f^2 - 1)`, to 1e-10 with projected RK4 and symplectic (2,2); a prescribed length
+/// that is not positive at the start is refused naming the joint.
+#[test]
+fn a_distance_driver_pulls_a_slider() {
+    use mbd::model::joints::DistanceDriver;
+    let f = TimeFunction::smooth_step(0.1, 0.9, 1.25, 2.0);
+    let build = |f: TimeFunction| {
+        let mut b = SystemBuilder::new();
+        let slider = b.add_body(
+            Body::new("slider")
+                .mass(1.0)
+                .inertia(0.01)
+                .position(0.75, 0.0, 0.0),
+        );
+        b.add_joint(Joint::prismatic(
+            "guide",
+            BodyRef::Ground,
+            [0.0, 0.0],
+            slider,
+            [0.0, 0.0],
+            [1.0, 0.0],
+            0.0,
+        ));
+        b.add_joint(Joint::new(
+            "winch",
+            DistanceDriver {
+                a: BodyRef::Ground,
+                pa: [0.0, 1.0],
+                b: slider.into(),
+                pb: [0.0, 0.0],
+                f,
+            },
+        ));
+        b.build()
+    };
+    for spec in ["rk4-projected", "symplectic:2"] {
+        for t_end in [0.5, 1.2] {
+            let mut sim = Simulation::new(build(f.clone()).unwrap(), spec).unwrap();
+            sim.run(RunConfig::new(t_end, 1e-3)).unwrap();
+            let l = f.eval(t_end)[0];
+            let x = sim.state().q[0];
+            assert!(
+                (x - (l * l - 1.0).sqrt()).abs() < 1e-10,
+                "{spec} t = {t_end}: {x}"
+            );
+        }
+    }
+    let e = build(TimeFunction::constant(0.0)).unwrap_err().to_string();
+    assert!(e.contains("winch") && e.contains("f(0)"), "{e}");
+}

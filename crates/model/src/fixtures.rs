@@ -4,7 +4,7 @@
 use crate::{Body, BodyRef, Coordinate, Force, Joint, System, SystemBuilder, TimeFunction};
 
 /// Every joint kind (revolute, prismatic, weld, distance, absolute x / y / angle, angle
-/// driver, slide driver) on five bodies: the fixture of the unit tests that check derivatives element by
+/// driver, slide driver, distance driver) on five bodies: the fixture of the unit tests that check derivatives element by
 /// element.
 pub fn every_joint_kind() -> System {
     let mut b = SystemBuilder::new();
@@ -55,6 +55,16 @@ pub fn every_joint_kind() -> System {
             pb: [-0.3, 0.2],
             axis: [0.6, 0.8],
             f: TimeFunction::linear(0.4, -0.7),
+        },
+    ));
+    b.add_joint(Joint::new(
+        "winch",
+        crate::joints::DistanceDriver {
+            a: b3.into(),
+            pa: [0.1, 0.1],
+            b: b5.into(),
+            pb: [0.2, -0.2],
+            f: TimeFunction::linear(1.5, 0.3),
         },
     ));
     b.build().unwrap()
@@ -119,6 +129,7 @@ mod tests {
         let sys = super::every_joint_kind();
         let toml = sys.to_model_file().to_toml().unwrap();
         assert!(toml.contains("type = \"slide_driver\""), "{toml}");
+        assert!(toml.contains("type = \"distance_driver\""), "{toml}");
         let back = crate::ModelFile::from_toml(&toml).unwrap().build().unwrap();
         let (q, _) = super::generic_point(sys.n_coords());
         let (mut a, mut b) = (

@@ -2,8 +2,8 @@
 
 use crate::forces::{PointForceSpec, RotarySpringDamperSpec, SpringDamperSpec, TorqueSpec};
 use crate::joints::{
-    AbsoluteSpec, AngleDriverSpec, DistanceSpec, PrismaticSpec, RevoluteSpec, SlideDriverSpec,
-    WeldSpec,
+    AbsoluteSpec, AngleDriverSpec, DistanceDriverSpec, DistanceSpec, PrismaticSpec, RevoluteSpec,
+    SlideDriverSpec, WeldSpec,
 };
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -135,6 +135,8 @@ pub enum JointSpec {
     AngleDriver(AngleDriverSpec),
     /// A [`SlideDriver`](crate::joints::SlideDriver).
     SlideDriver(SlideDriverSpec),
+    /// A [`DistanceDriver`](crate::joints::DistanceDriver).
+    DistanceDriver(DistanceDriverSpec),
 }
 
 /// A force element in a model file (bodies by name), tagged by `type`.

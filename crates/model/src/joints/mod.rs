@@ -14,6 +14,7 @@
 mod absolute;
 mod angle_driver;
 mod distance;
+mod distance_driver;
 mod prismatic;
 mod revolute;
 mod slide_driver;
@@ -22,6 +23,7 @@ mod weld;
 pub use absolute::{Absolute, AbsoluteSpec, Coordinate};
 pub use angle_driver::{AngleDriver, AngleDriverSpec};
 pub use distance::{Distance, DistanceSpec};
+pub use distance_driver::{DistanceDriver, DistanceDriverSpec};
 pub use prismatic::{Prismatic, PrismaticSpec};
 pub use revolute::{Revolute, RevoluteSpec};
 pub use slide_driver::{SlideDriver, SlideDriverSpec};
@@ -93,6 +95,8 @@ pub enum JointKind {
     AngleDriver(AngleDriver),
     /// Rheonomic driver of a point's slide along a body's axis (1 equation).
     SlideDriver(SlideDriver),
+    /// Rheonomic driver of the distance between two points (1 equation).
+    DistanceDriver(DistanceDriver),
 }
 
 /// `each_joint!(kind, j => expr)`: `expr` with `j` bound to the joint struct of whatever kind
@@ -113,7 +117,8 @@ joint_from!(
     Distance,
     Absolute,
     AngleDriver,
-    SlideDriver
+    SlideDriver,
+    DistanceDriver
 );
 
 macro_rules! each_joint {
@@ -126,6 +131,7 @@ macro_rules! each_joint {
             JointKind::Absolute($j) => $body,
             JointKind::AngleDriver($j) => $body,
             JointKind::SlideDriver($j) => $body,
+            JointKind::DistanceDriver($j) => $body,
         }
     };
 }
@@ -423,6 +429,7 @@ impl JointSpec {
             JointSpec::Absolute(s) => s.to_joint(find),
             JointSpec::AngleDriver(s) => s.to_joint(find),
             JointSpec::SlideDriver(s) => s.to_joint(find),
+            JointSpec::DistanceDriver(s) => s.to_joint(find),
         }
     }
 }
