@@ -2,67 +2,27 @@
 //! solved for; the changes of given values reported; inputs that over-determine an equation
 //! are an error naming it.
 
-use mbd::model::{Body, BodyRef, Coord, Joint, ModelFile, System, SystemBuilder};
+use mbd::model::{Body, Coord, ModelFile, System, SystemBuilder};
 use mbd::solve::{consistent_state, initial_changes, SolveError};
 
-/// A slider-crank (crank 0.15 m at 45 degrees, rod 0.5 m, slider on the x axis) whose crank is
-/// given only its angular velocity, 6 rad/s; `mark` adds inputs to the bodies.
+/// The project's slider-crank (crank 0.15 m at 45 degrees, rod 0.5 m, slider on the x axis)
+/// whose crank is given only its angular velocity, 6 rad/s (every other velocity 0); `mark`
+/// changes the bodies (inputs, positions).
 fn slider_crank(mark: impl Fn(&str, Body) -> Body) -> System {
-    let (r, l, th) = (0.15, 0.5, std::f64::consts::FRAC_PI_4);
-    let a = [r * th.cos(), r * th.sin()];
-    let xs = a[0] + (l * l - a[1] * a[1]).sqrt();
-    let phi = (-a[1]).atan2(xs - a[0]);
+    let mut file = mbd::model::models::slider_crank().unwrap().to_model_file();
+    file.gravity = [0.0, 0.0];
+    for body in &mut file.bodies {
+        body.velocity = [0.0; 3];
+    }
+    file.bodies[0].velocity[2] = 6.0;
     let mut b = SystemBuilder::new();
-    let crank = b.add_body(mark(
-        "crank",
-        Body::new("crank")
-            .rod(1.0, r)
-            .position(0.5 * a[0], 0.5 * a[1], th)
-            .velocity(0.0, 0.0, 6.0),
-    ));
-    let rod = b.add_body(mark(
-        "rod",
-        Body::new("rod")
-            .rod(1.0, l)
-            .position(0.5 * (a[0] + xs), 0.5 * a[1], phi),
-    ));
-    let slider = b.add_body(mark(
-        "slider",
-        Body::new("slider")
-            .mass(0.5)
-            .inertia(0.001)
-            .position(xs, 0.0, 0.0),
-    ));
-    b.add_joint(Joint::revolute(
-        "crank_pin",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        crank,
-        [-0.5 * r, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "crank_rod",
-        crank,
-        [0.5 * r, 0.0],
-        rod,
-        [-0.5 * l, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "rod_slider",
-        rod,
-        [0.5 * l, 0.0],
-        slider,
-        [0.0, 0.0],
-    ));
-    b.add_joint(Joint::prismatic(
-        "slide",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        slider,
-        [0.0, 0.0],
-        [1.0, 0.0],
-        0.0,
-    ));
+    let sys = file.build().unwrap();
+    for body in sys.bodies() {
+        b.add_body(mark(&body.name, body.clone()));
+    }
+    for j in sys.joints() {
+        b.add_joint(j.clone());
+    }
     b.build().unwrap()
 }
 

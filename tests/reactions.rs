@@ -1,7 +1,7 @@
 //! Joint reactions (`mbd::solve::ReactionSolver`): Newton's law on a swinging pendulum, the
 //! virtual-work answer on a static slider-crank, and agreement between every registered solver.
 
-use mbd::model::{models, Body, BodyRef, Force, Joint, SystemBuilder, TimeFunction};
+use mbd::model::{models, Force, TimeFunction};
 use mbd::prelude::*;
 use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{run, Flow, JointReaction, ReactionSolver};
@@ -66,55 +66,22 @@ fn static_slider_crank() -> Static {
     let xs = a[0] + root;
     let dxs = -r * th.sin() - r * r * th.sin() * th.cos() / root;
     let tau = -push * dxs;
-    let phi = (-a[1]).atan2(xs - a[0]);
-    let mut b = SystemBuilder::new();
-    b.set_gravity([0.0, 0.0]);
-    let crank = b.add_body(
-        Body::new("crank")
-            .rod(1.0, r)
-            .position(0.5 * a[0], 0.5 * a[1], th),
+    // the project's slider-crank (1 kg rods, 0.5 kg slider) at rest, without gravity
+    let params = models::SliderCrankParams {
+        crank: r,
+        rod: l,
+        angle: th,
+        speed: 0.0,
+        driven: false,
+    };
+    let mut file = models::slider_crank_with(&params).unwrap().to_model_file();
+    file.gravity = [0.0, 0.0];
+    let mut b = file.to_builder().unwrap();
+    let probe = file.build().unwrap();
+    let (crank, slider) = (
+        probe.body_handle("crank").unwrap(),
+        probe.body_handle("slider").unwrap(),
     );
-    let rod = b.add_body(
-        Body::new("rod")
-            .rod(1.0, l)
-            .position(0.5 * (a[0] + xs), 0.5 * a[1], phi),
-    );
-    let slider = b.add_body(
-        Body::new("slider")
-            .mass(0.5)
-            .inertia(0.01)
-            .position(xs, 0.0, 0.0),
-    );
-    b.add_joint(Joint::revolute(
-        "crank_pin",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        crank,
-        [-0.5 * r, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "crank_rod",
-        crank,
-        [0.5 * r, 0.0],
-        rod,
-        [-0.5 * l, 0.0],
-    ));
-    b.add_joint(Joint::revolute(
-        "rod_slider",
-        rod,
-        [0.5 * l, 0.0],
-        slider,
-        [0.0, 0.0],
-    ));
-    b.add_joint(Joint::prismatic(
-        "slide",
-        BodyRef::Ground,
-        [0.0, 0.0],
-        slider,
-        [0.0, 0.0],
-        [1.0, 0.0],
-        0.0,
-    ));
     b.add_force(Force::torque("drive", crank, TimeFunction::constant(tau)));
     b.add_force(Force::force(
         "push",

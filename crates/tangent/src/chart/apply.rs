@@ -15,6 +15,22 @@
 //! ([`TangentChart::form_q`]) for the interpolated and Broyden matrices and the exact Newton
 //! fallback.
 
+/// `$fixed::<N, M>(args)` for the chart sizes compiled with fixed loop bounds (the planar
+/// chains of 1 to 4 bodies the benchmarks and most models have), `$any` for the others.
+macro_rules! by_chart_size {
+    ($n:expr, $m:expr, $fixed:ident($($arg:expr),*), $any:expr) => {
+        match ($n, $m) {
+            (3, 2) => $fixed::<3, 2>($($arg),*),
+            (6, 4) => $fixed::<6, 4>($($arg),*),
+            (6, 5) => $fixed::<6, 5>($($arg),*),
+            (9, 6) => $fixed::<9, 6>($($arg),*),
+            (9, 8) => $fixed::<9, 8>($($arg),*),
+            (12, 8) => $fixed::<12, 8>($($arg),*),
+            _ => $any,
+        }
+    };
+}
+
 use super::TangentChart;
 use crate::kernels::{dot_fixed, gemv_cols, with_len, with_rows};
 
@@ -50,15 +66,12 @@ impl TangentChart {
     pub(super) fn add_q1_w(&mut self, x: &mut [f64]) {
         let (n, m) = (self.n, self.m);
         let (qa, qb, buf, w) = (&self.qa, &self.qb, &mut self.nbuf, &self.w);
-        match (n, m) {
-            (3, 2) => add_q1_fixed::<3, 2>(qa, qb, w, x),
-            (6, 4) => add_q1_fixed::<6, 4>(qa, qb, w, x),
-            (6, 5) => add_q1_fixed::<6, 5>(qa, qb, w, x),
-            (9, 6) => add_q1_fixed::<9, 6>(qa, qb, w, x),
-            (9, 8) => add_q1_fixed::<9, 8>(qa, qb, w, x),
-            (12, 8) => add_q1_fixed::<12, 8>(qa, qb, w, x),
-            _ => add_q_any(qa, qb, w, &[], x, buf, n, m),
-        }
+        by_chart_size!(
+            n,
+            m,
+            add_q1_fixed(qa, qb, w, x),
+            add_q_any(qa, qb, w, &[], x, buf, n, m)
+        )
     }
 }
 
@@ -93,15 +106,12 @@ fn add_q_mn(
     n: usize,
     m: usize,
 ) {
-    match (n, m) {
-        (3, 2) => add_q_fixed::<3, 2>(qa, qb, zeta, xi, x),
-        (6, 4) => add_q_fixed::<6, 4>(qa, qb, zeta, xi, x),
-        (6, 5) => add_q_fixed::<6, 5>(qa, qb, zeta, xi, x),
-        (9, 6) => add_q_fixed::<9, 6>(qa, qb, zeta, xi, x),
-        (9, 8) => add_q_fixed::<9, 8>(qa, qb, zeta, xi, x),
-        (12, 8) => add_q_fixed::<12, 8>(qa, qb, zeta, xi, x),
-        _ => add_q_any(qa, qb, zeta, xi, x, buf, n, m),
-    }
+    by_chart_size!(
+        n,
+        m,
+        add_q_fixed(qa, qb, zeta, xi, x),
+        add_q_any(qa, qb, zeta, xi, x, buf, n, m)
+    )
 }
 
 /// [`TangentChart::add_q`] with `N` coordinates and `M` constraints fixed: every product
@@ -282,15 +292,12 @@ fn split_mn(
     n: usize,
     m: usize,
 ) {
-    match (n, m) {
-        (3, 2) => split_fixed::<3, 2>(qa, qb, y, normal, tangent),
-        (6, 4) => split_fixed::<6, 4>(qa, qb, y, normal, tangent),
-        (6, 5) => split_fixed::<6, 5>(qa, qb, y, normal, tangent),
-        (9, 6) => split_fixed::<9, 6>(qa, qb, y, normal, tangent),
-        (9, 8) => split_fixed::<9, 8>(qa, qb, y, normal, tangent),
-        (12, 8) => split_fixed::<12, 8>(qa, qb, y, normal, tangent),
-        _ => split_any(qa, qb, y, normal, tangent, buf, n, m),
-    }
+    by_chart_size!(
+        n,
+        m,
+        split_fixed(qa, qb, y, normal, tangent),
+        split_any(qa, qb, y, normal, tangent, buf, n, m)
+    )
 }
 
 /// [`TangentChart::split_coordinates`] with `N` coordinates and `M` constraints fixed.
