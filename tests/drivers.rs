@@ -141,3 +141,89 @@ fn a_distance_driver_pulls_a_slider() {
     let e = build(TimeFunction::constant(0.0)).unwrap_err().to_string();
     assert!(e.contains("winch") && e.contains("f(0)"), "{e}");
 }
+
+/// A slider driven along its guide by a tabulated motion read from a CSV file beside the model
+/// (natural cubic spline through samples of x = 0.3 sin(2 t) every 0.05 s): every solver that
+/// runs the model keeps the slider on the interpolant to 1e-10, the interpolant is within the
+/// spline's error of the sampled function, and the driver's force is m times the spline's
+/// second derivative (which enters the acceleration constraint).
+#[test]
+fn a_slide_driver_follows_a_tabulated_motion_from_a_file() {
+    let dir = std::env::temp_dir().join(format!("mbd-table-driver-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut csv = String::from("# lift motion\ntime,x\n");
+    for i in 0..=40 {
+        let t = 0.05 * i as f64;
+        csv.push_str(&format!("{t},{}\n", 0.3 * (2.0 * t).sin()));
+    }
+    std::fs::write(dir.join("lift.csv"), csv).unwrap();
+    let model = r#"
+gravity = [0.0, -9.81]
+[[bodies]]
+name = "slider"
+mass = 2.0
+inertia = 0.01
+position = [0.0, 0.0, 0.0]
+[[joints]]
+type = "prismatic"
+name = "guide"
+body_a = "ground"
+body_b = "slider"
+axis = [1.0, 0.0]
+[[joints]]
+type = "slide_driver"
+name = "actuator"
+body_a = "ground"
+body_b = "slider"
+axis = [1.0, 0.0]
+f = { kind = "table", file = "lift.csv", column = "x" }
+"#;
+    std::fs::write(dir.join("lift.toml"), model).unwrap();
+    let sys = mbd::model::System::from_path(dir.join("lift.toml")).unwrap();
+    let f = match &sys.joints()[1].kind {
+        mbd::model::JointKind::SlideDriver(d) => d.f.clone(),
+        other => panic!("{other:?}"),
+    };
+    // the spline's value error for 0.3 sin(2t) sampled every 0.05 s is of order
+    // 0.3 * 2^4 * 0.05^4 / 384 ~ 8e-8 (and larger near the ends, where sin'' != 0)
+    for t in [0.52, 1.013, 1.4] {
+        let e = (f.eval(t)[0] - 0.3 * (2.0 * t).sin()).abs();
+        assert!(e < 1e-6, "t = {t}: {e}");
+    }
+    let mut ran = 0;
+    for (_, v) in mbd::registry().variants() {
+        if v.spec.starts_with("index1") {
+            continue;
+        }
+        let mut sim = match Simulation::new(sys.clone(), v.spec) {
+            Ok(s) => s,
+            Err(e) => {
+                assert!(
+                    e.to_string().contains("no degree of freedom"),
+                    "{}: {e}",
+                    v.spec
+                );
+                continue;
+            }
+        };
+        let t_end = 1.013;
+        sim.run(RunConfig::new(t_end, 1e-3)).unwrap();
+        let x = sim.state().q[0];
+        let want = f.eval(sim.state().t)[0];
+        assert!((x - want).abs() < 1e-10, "{}: {x} {want}", v.spec);
+        let s = sim.system();
+        let mut rs = ReactionSolver::new(s).unwrap();
+        let mut out = vec![JointReaction::default(); 2];
+        rs.compute(s, sim.state(), &mut out).unwrap();
+        let want = 2.0 * f.eval(sim.state().t)[2];
+        assert!(
+            (out[1].force[0] - want).abs() < 1e-8 * want.abs().max(1.0),
+            "{}: {} {want}",
+            v.spec,
+            out[1].force[0]
+        );
+        ran += 1;
+    }
+    assert!(ran >= 4, "{ran}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,7 +1,7 @@
 //! Loading model files with messages that name the file and, where possible, the line.
 
 use crate::error::CliError;
-use mbd_model::{ModelError, System};
+use mbd_model::{ModelError, ModelFile, System};
 use std::path::Path;
 
 /// Loads a model file (`.toml` or `.json`), turning the loader's errors into [`CliError`]s that
@@ -15,8 +15,7 @@ pub fn load(path: &Path) -> Result<System, CliError> {
         }
     })?;
     let result = match path.extension().and_then(|e| e.to_str()) {
-        Some("json") => System::from_json(&text),
-        Some("toml") => System::from_toml(&text),
+        Some("json" | "toml") => ModelFile::from_text_at(&text, path).and_then(|m| m.build()),
         _ => {
             return Err(CliError::Model {
                 path: path.display().to_string(),

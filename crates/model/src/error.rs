@@ -103,6 +103,9 @@ pub enum ModelError {
         /// The parser's message.
         message: String,
     },
+    /// A tabulated time function built in code is invalid.
+    #[error(transparent)]
+    Table(#[from] crate::timefn::TableError),
 }
 
 /// `x` as a reader wants it in a message: plain decimal between 1e-4 and 1e16 (and 0), else in

@@ -86,6 +86,8 @@ pub use joints::{Coordinate, Joint, JointKind};
 pub use scale::MAX_INERTIA_RATIO;
 pub use sensors::{Sensor, SensorKind, SensorSpec};
 pub use system::{Attach, ForceHandle, JointElement, JointHandle, System};
-pub use timefn::TimeFunction;
+pub use timefn::{
+    Extrapolation, Interpolation, Table, TableError, TableSpec, TimeFunction, MAX_TABLE_FILE_BYTES,
+};
 
 pub use nalgebra;

@@ -123,21 +123,33 @@ impl System {
     pub fn from_toml(s: &str) -> Result<System, ModelError> {
         ModelFile::from_toml(s)?.build()
     }
-    /// Loads a model file, JSON or TOML by its extension (`.json`, `.toml`).
+    /// Loads a model file, JSON or TOML by its extension (`.json`, `.toml`); table files
+    /// named in it are read relative to its directory.
     pub fn from_path(path: impl AsRef<std::path::Path>) -> Result<System, ModelError> {
         let path = path.as_ref();
         let text = read_text(path, MAX_MODEL_FILE_BYTES).map_err(|e| ModelError::Parse {
             format: "io",
             message: format!("{}: {e}", path.display()),
         })?;
-        match path.extension().and_then(|e| e.to_str()) {
-            Some("json") => Self::from_json(&text),
-            Some("toml") => Self::from_toml(&text),
+        ModelFile::from_text_at(&text, path)?.build()
+    }
+}
+
+impl ModelFile {
+    /// Parses the text of the model file at `path`, JSON or TOML by the path's extension;
+    /// the CSV files of tabulated time functions (`file = "..."`) are read relative to the
+    /// path's directory. ([`ModelFile::from_json`] and [`ModelFile::from_toml`] read them
+    /// relative to the working directory.)
+    pub fn from_text_at(text: &str, path: &std::path::Path) -> Result<ModelFile, ModelError> {
+        let dir = path.parent();
+        crate::timefn::with_base_dir(dir, || match path.extension().and_then(|e| e.to_str()) {
+            Some("json") => ModelFile::from_json(text),
+            Some("toml") => ModelFile::from_toml(text),
             _ => Err(ModelError::Parse {
                 format: "io",
                 message: format!("{}: unknown extension (use .json or .toml)", path.display()),
             }),
-        }
+        })
     }
 }
 

@@ -2,6 +2,10 @@
 
 use serde::{Deserialize, Serialize};
 
+mod table;
+pub(crate) use table::with_base_dir;
+pub use table::{Extrapolation, Interpolation, Table, TableError, TableSpec, MAX_TABLE_FILE_BYTES};
+
 /// A scalar function of time with its first two derivatives, serialisable for model files.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
@@ -55,6 +59,9 @@ pub enum TimeFunction {
         /// Value after `t1`.
         to: f64,
     },
+    /// Samples interpolated linearly or by a natural cubic spline, inline or from a CSV file
+    /// (see [`Table`] and [`TableSpec`]).
+    Table(Table),
 }
 
 impl TimeFunction {
@@ -120,6 +127,7 @@ impl TimeFunction {
                     [from + rate * (t - t0), rate, 0.0]
                 }
             }
+            TimeFunction::Table(table) => table.eval(t),
         }
     }
     /// A quintic smooth step from `from` to `to` over `[t0, t1]` (see
@@ -142,6 +150,7 @@ impl TimeFunction {
             TimeFunction::SmoothStep { from, to, .. } | TimeFunction::Ramp { from, to, .. } => {
                 from == to
             }
+            TimeFunction::Table(table) => table.is_constant(),
         }
     }
     /// Whether every parameter is finite.
@@ -164,6 +173,8 @@ impl TimeFunction {
             | TimeFunction::Ramp { t0, t1, from, to } => {
                 [t0, t1, from, to].iter().all(|x| x.is_finite())
             }
+            // checked when the table was built
+            TimeFunction::Table(_) => true,
         }
     }
     /// Why the function's parameters are invalid, if they are: not finite, or a transition
