@@ -8,7 +8,7 @@
 //! links the index-1 solve takes the sparse path). A fourth argument `state` prints the final
 //! state in full (for comparing trajectories between builds).
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
-use mbd::model::models;
+use mbd::model::{models, System};
 use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, State};
 use mbd::symplectic::{Galerkin, SymplecticOptions};
@@ -24,6 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "manipulator" => models::manipulator()?,
         "slider_crank" => models::slider_crank()?,
         "four_bar" => models::four_bar()?,
+        other if other.ends_with(".toml") || other.ends_with(".json") => System::from_path(other)?,
         other => match other.strip_prefix("chain").and_then(|k| k.parse().ok()) {
             Some(k) => models::n_link_chain(k)?,
             None => return Err(format!("unknown model '{other}'").into()),

@@ -96,7 +96,16 @@ impl ModelFile {
     /// into a body with a nominal inertia `m l^2` plus an `absolute` angle joint
     /// `<name>:point_mass` holding its angle at 0 (see `docs/model-files.md`).
     pub fn to_builder(&self) -> Result<SystemBuilder, ModelError> {
-        self.to_builder_impl()
+        self.to_builder_impl(&crate::forces::ForceLaws::new())
+    }
+
+    /// [`ModelFile::to_builder`] for files whose `custom` force elements name laws registered
+    /// in `laws`.
+    pub fn to_builder_with(
+        &self,
+        laws: &crate::forces::ForceLaws,
+    ) -> Result<SystemBuilder, ModelError> {
+        self.to_builder_impl(laws)
     }
 
     /// The JSON Schema (draft 2020-12) of model files, generated from these types; checked in
@@ -111,6 +120,12 @@ impl ModelFile {
     /// Resolves and validates into a [`System`].
     pub fn build(&self) -> Result<System, ModelError> {
         self.to_builder()?.build()
+    }
+
+    /// Resolves and validates into a [`System`], building `custom` force elements from the
+    /// laws registered in `laws`.
+    pub fn build_with(&self, laws: &crate::forces::ForceLaws) -> Result<System, ModelError> {
+        self.to_builder_with(laws)?.build()
     }
 }
 

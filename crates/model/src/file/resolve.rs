@@ -116,7 +116,10 @@ impl<'a> Resolver<'a> {
 
 impl ModelFile {
     /// See [`ModelFile::to_builder`].
-    pub(super) fn to_builder_impl(&self) -> Result<SystemBuilder, ModelError> {
+    pub(super) fn to_builder_impl(
+        &self,
+        laws: &crate::forces::ForceLaws,
+    ) -> Result<SystemBuilder, ModelError> {
         let r = Resolver::new(self)?;
         let mut b = SystemBuilder::new();
         b.set_gravity(self.gravity);
@@ -143,7 +146,7 @@ impl ModelFile {
             joints.entry(name).or_insert(h);
         }
         for f in &self.forces {
-            b.add_force(f.to_force(&find)?);
+            b.add_force(f.to_force(&find, laws)?);
         }
         for s in &self.sensors {
             b.add_sensor(match s {

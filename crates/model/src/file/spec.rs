@@ -151,4 +151,7 @@ pub enum ForceSpec {
     Force(PointForceSpec),
     /// A [`Torque`](crate::forces::Torque).
     Torque(TorqueSpec),
+    /// A [`CustomForce`](crate::forces::CustomForce): a law registered in a
+    /// [`ForceLaws`](crate::forces::ForceLaws).
+    Custom(crate::forces::CustomForceSpec),
 }

@@ -9,11 +9,13 @@
 //! drawing and its model-file form. [`ForceKind`] lists the kinds and `each_force!` dispatches
 //! to them; docs/architecture.md ("How to add a force") walks through adding one.
 
+mod custom;
 mod point_force;
 mod rotary_spring_damper;
 mod spring_damper;
 mod torque;
 
+pub use custom::{CustomForce, CustomForceSpec, ForceInput, ForceLaw, ForceLawFactory, ForceLaws};
 pub use point_force::{PointForce, PointForceSpec};
 pub use rotary_spring_damper::{RotarySpringDamper, RotarySpringDamperSpec};
 pub use spring_damper::{SpringDamper, SpringDamperSpec};
@@ -38,6 +40,11 @@ pub(crate) trait ForceType {
     fn potential<T: Scalar>(&self, qa: &Frame<T>, qb: &Frame<T>) -> T;
     /// Whether the element has a non-conservative part (damping or a time-dependent load).
     fn is_nonconservative(&self) -> bool;
+    /// Whether the non-conservative part only dissipates (the energy balance's
+    /// `E_dissipated`), rather than doing external work (`W_external`).
+    fn dissipative(&self) -> bool {
+        false
+    }
     /// Adds the local generalized force of the non-conservative part (6 entries: body a then
     /// body b) at local coordinates `qa`, `qb`, velocities `va`, `vb` and time `t`.
     fn nonconservative(&self, local: &LocalState, t: f64, out: &mut [f64; 6]);
@@ -86,6 +93,8 @@ pub enum ForceKind {
     Force(PointForce),
     /// Torque on a body.
     Torque(Torque),
+    /// A user's force law (see [`ForceLaw`]).
+    Custom(CustomForce),
 }
 
 macro_rules! force_from {
@@ -101,7 +110,8 @@ force_from!(
     SpringDamper => SpringDamper,
     RotarySpringDamper => RotarySpringDamper,
     Force => PointForce,
-    Torque => Torque
+    Torque => Torque,
+    Custom => CustomForce
 );
 
 /// `each_force!(kind, f => expr)`: `expr` with `f` bound to the element struct of whatever kind
@@ -113,6 +123,7 @@ macro_rules! each_force {
             ForceKind::RotarySpringDamper($f) => $body,
             ForceKind::Force($f) => $body,
             ForceKind::Torque($f) => $body,
+            ForceKind::Custom($f) => $body,
         }
     };
 }
@@ -192,6 +203,21 @@ impl Force {
             torque,
         };
         Self::new(name, ForceKind::Torque(kind))
+    }
+    /// A force element with a user's law between `a` and `b` (`BodyRef::Ground` for a law
+    /// on one body); see [`ForceLaw`].
+    pub fn custom(
+        name: impl Into<String>,
+        a: impl Into<BodyRef>,
+        b: impl Into<BodyRef>,
+        law: std::sync::Arc<dyn ForceLaw>,
+    ) -> Self {
+        let kind = CustomForce {
+            a: a.into(),
+            b: b.into(),
+            law,
+        };
+        Self::new(name, ForceKind::Custom(kind))
     }
     /// A force element of any kind, from its kind's struct with named fields (no stiffness
     /// and damping to swap, as in the positional [`Force::spring_damper`]):
@@ -278,6 +304,52 @@ impl Force {
         each_force!(&self.kind, f => f.nonconservative(&local, t, out))
     }
 
+    /// See [`ForceType::dissipative`].
+    pub(crate) fn dissipative(&self) -> bool {
+        each_force!(&self.kind, f => f.dissipative())
+    }
+
+    /// The Jacobians of the local non-conservative force (6 entries) with respect to the local
+    /// coordinates (`dq`) and velocities (`dv`), both overwritten: a custom law's own, else
+    /// central differences with step `1e-6 (1 + |x|)`.
+    pub(crate) fn nonconservative_jacobian(
+        &self,
+        x: [[f64; 3]; 4],
+        t: f64,
+        dq: &mut [[f64; 6]; 6],
+        dv: &mut [[f64; 6]; 6],
+    ) {
+        if let ForceKind::Custom(c) = &self.kind {
+            let local = LocalState {
+                qa: &x[0],
+                qb: &x[1],
+                va: &x[2],
+                vb: &x[3],
+            };
+            if c.analytic_jacobian(&local, t, dq, dv) {
+                return;
+            }
+        }
+        let mut x = x;
+        for (block, jac) in [(0usize, &mut *dq), (2, &mut *dv)] {
+            for j in 0..6 {
+                let (side, l) = (block + j / 3, j % 3);
+                let x0 = x[side][l];
+                let d = 1e-6 * (1.0 + x0.abs());
+                let mut fp = [0.0; 6];
+                let mut fm = [0.0; 6];
+                x[side][l] = x0 + d;
+                self.nonconservative(&x[0], &x[1], &x[2], &x[3], t, &mut fp);
+                x[side][l] = x0 - d;
+                self.nonconservative(&x[0], &x[1], &x[2], &x[3], t, &mut fm);
+                x[side][l] = x0;
+                for i in 0..6 {
+                    jac[i][j] = (fp[i] - fm[i]) / (2.0 * d);
+                }
+            }
+        }
+    }
+
     /// See [`ForceType::anchors`].
     pub(crate) fn anchors(&mut self) -> [Option<Anchor<'_>>; 2] {
         each_force!(&mut self.kind, f => f.anchors())
@@ -310,12 +382,14 @@ impl ForceSpec {
     pub(crate) fn to_force(
         &self,
         find: &dyn Fn(&str, &str) -> Result<BodyRef, ModelError>,
+        laws: &ForceLaws,
     ) -> Result<Force, ModelError> {
         match self {
             ForceSpec::SpringDamper(s) => s.to_force(find),
             ForceSpec::RotarySpringDamper(s) => s.to_force(find),
             ForceSpec::Force(s) => s.to_force(find),
             ForceSpec::Torque(s) => s.to_force(find),
+            ForceSpec::Custom(s) => s.to_force(find, laws),
         }
     }
 }

@@ -39,6 +39,9 @@ impl ForceType for RotarySpringDamper {
     fn is_nonconservative(&self) -> bool {
         self.damping != 0.0
     }
+    fn dissipative(&self) -> bool {
+        true
+    }
     fn nonconservative(&self, s: &LocalState, _t: f64, out: &mut [f64; 6]) {
         let tau = self.damping * (s.vb[2] - s.va[2]);
         out[2] += tau;

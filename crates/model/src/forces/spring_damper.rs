@@ -49,6 +49,9 @@ impl ForceType for SpringDamper {
     fn is_nonconservative(&self) -> bool {
         self.damping != 0.0
     }
+    fn dissipative(&self) -> bool {
+        true
+    }
     fn nonconservative(&self, s: &LocalState, _t: f64, out: &mut [f64; 6]) {
         if self.damping == 0.0 {
             return;

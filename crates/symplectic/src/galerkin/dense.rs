@@ -227,36 +227,21 @@ impl Galerkin {
         self.stage_error(sys, t, h, res)
     }
 
-    /// Central-difference Jacobians of the non-conservative forces at Gauss point `j`:
+    /// Jacobians of the non-conservative forces at Gauss point `j`, element by element (a
+    /// custom law's own, else central differences of the element):
     /// `hq[j] -= dQnc/dq`, `hv[j] = -dQnc/dv`.
     fn nc_jacobian(&mut self, sys: &System, j: usize, tj: f64, h: f64) {
         let n = self.n;
-        let [q, v, fp, fm] = &mut self.tn;
+        let [q, v, ..] = &mut self.tn;
         q.copy_from_slice(&self.qj[j * n..(j + 1) * n]);
         for i in 0..n {
             v[i] = self.hvj[j * n + i] / h;
         }
-        for l in 0..n {
-            let dq = 1e-6 * (1.0 + q[l].abs());
-            let q0 = q[l];
-            q[l] = q0 + dq;
-            sys.nonconservative_forces(q, v, tj, fp);
-            q[l] = q0 - dq;
-            sys.nonconservative_forces(q, v, tj, fm);
-            q[l] = q0;
-            for i in 0..n {
-                self.hq[j][(i, l)] -= (fp[i] - fm[i]) / (2.0 * dq);
-            }
-            let dv = 1e-6 * (1.0 + v[l].abs());
-            let v0 = v[l];
-            v[l] = v0 + dv;
-            sys.nonconservative_forces(q, v, tj, fp);
-            v[l] = v0 - dv;
-            sys.nonconservative_forces(q, v, tj, fm);
-            v[l] = v0;
-            for i in 0..n {
-                self.hv[j][(i, l)] = -(fp[i] - fm[i]) / (2.0 * dv);
-            }
-        }
+        let (hq, hv) = (&mut self.hq[j], &mut self.hv[j]);
+        hv.fill(0.0);
+        sys.nonconservative_jacobian(q, v, tj, |r, c, dq, dv| {
+            hq[(r, c)] -= dq;
+            hv[(r, c)] -= dv;
+        });
     }
 }
