@@ -25,6 +25,8 @@ pub struct SystemBuilder {
     unknown_frame: Option<usize>,
     /// What `build` does with redundant equations.
     pub(crate) redundant: RedundantConstraints,
+    /// Initial joint coordinates for assembly.
+    pub(crate) joint_initials: Vec<(JointHandle, crate::JointInitial)>,
 }
 
 /// How a body was added (builder side only: the [`System`] keeps centre-of-mass poses).
@@ -106,6 +108,33 @@ impl SystemBuilder {
     pub fn add_joint(&mut self, joint: Joint) -> JointHandle {
         self.joints.push(joint);
         JointHandle(self.joints.len() - 1)
+    }
+    /// Gives a revolute joint's initial relative angle `theta_b - theta_a` or a prismatic
+    /// joint's initial slide, and/or its rate: the consistent initial state places the bodies
+    /// from them and keeps them exactly (assembly from joint coordinates; see
+    /// [`crate::JointInitial`]). Another joint kind, a handle without a joint, a joint given
+    /// twice or a non-finite value is an error of `build`.
+    ///
+    /// ```
+    /// use mbd_model::{Body, BodyRef, Joint, JointInitial, SystemBuilder};
+    /// let mut b = SystemBuilder::new();
+    /// let rod = b.add_body(Body::new("rod").rod(1.0, 1.0));
+    /// let pivot = b.add_joint(Joint::revolute("pivot", BodyRef::Ground, [0.0, 0.0], rod, [-0.5, 0.0]));
+    /// b.set_joint_initial(pivot, JointInitial::coordinate(-1.0).with_rate(2.0));
+    /// let sys = b.build()?;
+    /// let (q, v) = sys.initial_guess();
+    /// assert_eq!(q[2], -1.0);
+    /// assert!((q[0] - 0.5 * (-1.0f64).cos()).abs() < 1e-15);
+    /// assert_eq!(v[2], 2.0);
+    /// # Ok::<(), mbd_model::ModelError>(())
+    /// ```
+    pub fn set_joint_initial(
+        &mut self,
+        joint: JointHandle,
+        initial: crate::JointInitial,
+    ) -> &mut Self {
+        self.joint_initials.push((joint, initial));
+        self
     }
     /// Adds a sensor (see [`Sensor`]): its quantities become output columns.
     pub fn add_sensor(&mut self, sensor: Sensor) -> &mut Self {
@@ -308,6 +337,7 @@ impl System {
             frames: _,
             unknown_frame: _,
             redundant: policy,
+            joint_initials,
         } = b;
         if bodies.is_empty() {
             return Err(ModelError::Empty);
@@ -489,7 +519,9 @@ impl System {
             eq_joint,
             gravity_forces,
             redundant: Vec::new(),
+            joint_initials: Vec::new(),
         };
+        sys.joint_initials = crate::assembly::validate(&sys.joints, &joint_initials)?;
         sys.check_inertia_scale()?;
         let (q0, _) = sys.initial_guess();
         let redundant = sys.redundant_at(q0.as_slice())?;

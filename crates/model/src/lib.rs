@@ -43,6 +43,7 @@
 // Index loops over the fixed-size local jets (6 variables, 6x6 Hessians) read like the maths.
 #![allow(clippy::needless_range_loop)]
 
+mod assembly;
 mod body;
 mod builder;
 mod cache;
@@ -68,6 +69,7 @@ mod sensors;
 mod system;
 mod timefn;
 
+pub use assembly::{JointInitial, JointInitialSpec};
 pub use body::{Body, BodyHandle, BodyRef, Coord, Inputs};
 pub use builder::SystemBuilder;
 pub use cache::BodyAngles;

@@ -117,6 +117,8 @@ pub struct System {
     pub(crate) gravity_forces: Vec<f64>,
     /// The equations found dependent on earlier ones at build time.
     pub(crate) redundant: Vec<RedundantEquation>,
+    /// Initial joint coordinates (joint index, values) for assembly.
+    pub(crate) joint_initials: Vec<(usize, crate::JointInitial)>,
 }
 
 impl System {
@@ -267,10 +269,19 @@ impl System {
         DMatrix::from_diagonal(&self.mass)
     }
 
-    /// The initial guess stored in the bodies: `(q, v)`.
+    /// The initial guess: the bodies' stored state `(q, v)`, with the bodies placed from the
+    /// initial joint coordinates where the model gives some ([`System::joint_initials`]; see
+    /// [`crate::JointInitial`]).
     pub fn initial_guess(&self) -> (DVector<f64>, DVector<f64>) {
-        let q = DVector::from_iterator(self.n, self.bodies.iter().flat_map(|b| b.position));
-        let v = DVector::from_iterator(self.n, self.bodies.iter().flat_map(|b| b.velocity));
+        let (mut q, mut v) = self.stored_state();
+        self.assemble(&mut q, &mut v);
+        (DVector::from_vec(q), DVector::from_vec(v))
+    }
+
+    /// The bodies' stored positions and velocities.
+    pub(crate) fn stored_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let q = self.bodies.iter().flat_map(|b| b.position).collect();
+        let v = self.bodies.iter().flat_map(|b| b.velocity).collect();
         (q, v)
     }
 

@@ -53,7 +53,10 @@ pub struct ConsistentState {
 }
 
 /// Projects the bodies' stored initial state ([`System::initial_guess`]) onto the constraints
-/// at time `t` (see [`project_state`]).
+/// at time `t` (see [`project_state`]). A model with initial joint coordinates
+/// ([`System::joint_initials`]) is assembled from them: the guess places the bodies along a
+/// spanning tree, and the projection holds the given angles, slides and rates exactly
+/// ([`System::with_joint_drivers`]).
 ///
 /// ```
 /// let sys = mbd_model::models::slider_crank()?;
@@ -63,13 +66,28 @@ pub struct ConsistentState {
 /// ```
 pub fn consistent_state(sys: &System, t: f64) -> Result<ConsistentState, SolveError> {
     let (q, v) = sys.initial_guess();
-    project_state(
-        sys,
-        q.as_slice(),
-        v.as_slice(),
-        t,
-        ConsistentOptions::default(),
-    )
+    let opts = ConsistentOptions::default();
+    if sys.joint_initials().next().is_none() {
+        return project_state(sys, q.as_slice(), v.as_slice(), t, opts);
+    }
+    // Assembly from joint coordinates: positions projected with the given angles and slides
+    // held by drivers, then velocities with the given rates held (mbd_model's assembly docs).
+    let held = sys.with_joint_drivers(q.as_slice(), t, false)?;
+    let x = project_state(&held, q.as_slice(), v.as_slice(), t, opts)?;
+    let held = sys.with_joint_drivers(x.q.as_slice(), t, true)?;
+    let mut c = project_state(&held, x.q.as_slice(), v.as_slice(), t, opts)?;
+    c.position_correction = max_abs_diff(c.q.as_slice(), q.as_slice());
+    c.iterations += x.iterations;
+    // the model's own residuals (the drivers' equations are the model's plus the held ones)
+    let (mut phi, mut phid) = (
+        vec![0.0; sys.n_constraints()],
+        vec![0.0; sys.n_constraints()],
+    );
+    sys.phi(c.q.as_slice(), t, &mut phi);
+    sys.phi_dot(c.q.as_slice(), c.v.as_slice(), t, &mut phid);
+    c.residual = max_abs(&phi);
+    c.velocity_residual = max_abs(&phid);
+    Ok(c)
 }
 
 /// Projects a guess `(q, v)` onto the constraint manifold at time `t`: positions by Newton with
@@ -183,7 +201,9 @@ pub const INITIAL_CHANGE_TOL: f64 = 1e-8;
 /// The given initial values that the consistent state `(q, v)` changed by more than
 /// [`INITIAL_CHANGE_TOL`] (relative to `max(1, |given|)`): every coordinate, and every
 /// velocity the model gives as non-zero (a velocity left at zero is one the model leaves to the
-/// constraints). Inputs ([`mbd_model::Inputs`]) never change. What `mbd run` warns about.
+/// constraints). Inputs ([`mbd_model::Inputs`]) never change. Bodies placed from initial joint
+/// coordinates ([`System::assembled_bodies`]) are not reported: the joint coordinates are what
+/// the model gives, and they are kept. What `mbd run` warns about.
 ///
 /// ```
 /// use mbd_model::{models::SliderCrankParams, Coord};
@@ -200,12 +220,15 @@ pub const INITIAL_CHANGE_TOL: f64 = 1e-8;
 pub fn initial_changes(sys: &System, q: &[f64], v: &[f64]) -> Vec<InitialChange> {
     let (q0, v0) = sys.initial_guess();
     let names = sys.coordinate_names();
-    let moved =
-        |given: f64, used: f64| (used - given).abs() > INITIAL_CHANGE_TOL * given.abs().max(1.0);
+    // bodies placed from joint coordinates: their stored values were not what the model gives
+    let assembled = sys.assembled_bodies();
+    let moved = |i: usize, given: f64, used: f64| {
+        !assembled[i / 3] && (used - given).abs() > INITIAL_CHANGE_TOL * given.abs().max(1.0)
+    };
     let mut out = Vec::new();
     for (i, name) in names.iter().enumerate() {
         if let (Some(&given), Some(&used)) = (q0.get(i), q.get(i)) {
-            if moved(given, used) {
+            if moved(i, given, used) {
                 out.push(InitialChange {
                     name: name.clone(),
                     given,
@@ -216,7 +239,7 @@ pub fn initial_changes(sys: &System, q: &[f64], v: &[f64]) -> Vec<InitialChange>
     }
     for (i, name) in names.iter().enumerate() {
         if let (Some(&given), Some(&used)) = (v0.get(i), v.get(i)) {
-            if given != 0.0 && moved(given, used) {
+            if given != 0.0 && moved(i, given, used) {
                 out.push(InitialChange {
                     name: format!("d_{name}"),
                     given,

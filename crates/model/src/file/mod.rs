@@ -50,6 +50,10 @@ pub struct ModelFile {
     /// coordinates).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sensors: Vec<crate::sensors::SensorSpec>,
+    /// Initial joint coordinates: revolute angles and prismatic slides (and rates) from which
+    /// the initial state is assembled and which it keeps.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub assembly: Vec<crate::JointInitialSpec>,
     /// What to do with constraint equations that are combinations of others at the initial
     /// configuration: `"allow"` (default: the model runs, `mbd check` names them) or
     /// `"reject"` (an error).

@@ -148,6 +148,21 @@ impl ModelFile {
         for f in &self.forces {
             b.add_force(f.to_force(&find, laws)?);
         }
+        for a in &self.assembly {
+            let h = joints.get(&a.joint).copied().ok_or_else(|| {
+                invalid(
+                    format!("assembly entry for joint '{}'", a.joint),
+                    "no joint has this name".to_string(),
+                )
+            })?;
+            b.set_joint_initial(
+                h,
+                crate::JointInitial {
+                    coordinate: a.coordinate,
+                    rate: a.rate,
+                },
+            );
+        }
         for s in &self.sensors {
             b.add_sensor(match s {
                 SensorSpec::Point { name, body, point } => {
@@ -194,8 +209,18 @@ impl System {
                 }),
             })
             .collect();
+        let assembly = self
+            .joint_initials
+            .iter()
+            .map(|&(j, init)| crate::JointInitialSpec {
+                joint: self.joints[j].name.clone(),
+                coordinate: init.coordinate,
+                rate: init.rate,
+            })
+            .collect();
         ModelFile {
             sensors,
+            assembly,
             gravity: self.gravity,
             redundant_constraints: RedundantConstraints::Allow,
             bodies: self
