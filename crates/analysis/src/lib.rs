@@ -13,7 +13,9 @@
 //!   slope of the crossing times) and the exact pendulum period ([`period::pendulum_period`]);
 //! * [`TimeSeries`] and [`CsvObserver`]: CSV/JSON output;
 //! * [`save_state`] / [`load_state`]: a state as JSON, read back as an initial state;
-//! * [`EnergyBalance`]: the work of loads and drivers and the energy dampers take, along a run.
+//! * [`EnergyBalance`]: the work of loads and drivers and the energy dampers take, along a run;
+//! * [`units`]: the unit of each output column (axis labels); [`ticks`]: axis ticks at round
+//!   values; `plot` (feature `plot`): SVG figures.
 //!
 //! ```
 //! use mbd_analysis::{fit_order, MeasureObserver};
@@ -47,7 +49,9 @@ pub mod period;
 #[cfg(feature = "plot")]
 pub mod plot;
 mod state_file;
+pub mod ticks;
 mod trajectory;
+pub mod units;
 
 pub use energy_balance::EnergyBalance;
 pub use error::AnalysisError;

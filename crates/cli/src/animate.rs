@@ -1,26 +1,25 @@
 //! `mbd animate`: a self-contained HTML page animating a result CSV.
 //!
 //! The page (template `animate.html`, inline CSS and JavaScript, no network access) embeds the
-//! trajectory and the model's geometry as JSON and draws with inline SVG: each body as the
-//! polygon through its joint and force attachment points and its centre of mass (a line when
-//! there are only two such points), a dot at every centre of mass, circles at the joints,
-//! triangles at ground pins, dashed guides of prismatic joints on ground, and springs. The SVG
-//! element publishes its world-to-pixel transform as `data-scale`, `data-ox`, `data-oy`
-//! (`px = ox + scale x`, `py = oy - scale y`) and the frame shown as `data-frame`, `data-t`.
-//! A URL hash `#t=1.25` opens the page paused at the frame nearest that time.
+//! trajectory, the model's geometry and the world extent of every frame as JSON and draws with
+//! inline SVG: each body as the polygon through its joint and force attachment points and its
+//! centre of mass (a bar when those points lie on one line), a dot at every centre of mass and
+//! its trace over the run, circles at the joints, triangles at ground pins, dashed guides of
+//! prismatic joints on ground, and springs; around it axes in metres, a legend with a scale
+//! bar, and body names placed off the links.
+//!
+//! The SVG fills the window (title and controls included, no scrollbars) and its user units are
+//! CSS pixels; it publishes its world-to-pixel transform as `data-scale`, `data-ox`, `data-oy`
+//! (`px = ox + scale x`, `py = oy - scale y`), the scale bar as `data-scalebar-m` (its length in
+//! metres) and `data-scalebar-x1`, `data-scalebar-x2`, `data-scalebar-y` (its drawn ends), and
+//! the frame shown as `data-frame`, `data-t`. A URL hash `#t=1.25` opens the page paused at the
+//! frame nearest that time.
 
 use crate::args::AnimateArgs;
 use crate::error::CliError;
 use crate::table::Table;
 use mbd_model::{BodyRef, System};
 use serde::Serialize;
-
-/// Width of the drawing in SVG units (pixels at 100 % zoom).
-pub const WIDTH: f64 = 800.0;
-/// Height of the drawing.
-pub const HEIGHT: f64 = 600.0;
-/// Free border around the mechanism's extent.
-const MARGIN: f64 = 40.0;
 
 #[derive(Serialize)]
 struct BodyGeom {
@@ -49,25 +48,20 @@ struct SpringGeom {
     pb: [f64; 2],
 }
 
-/// The world-to-pixel transform `px = ox + scale x`, `py = oy - scale y`.
+/// The world box `[lo, hi]` (metres) that holds every drawn point of every frame; the page fits
+/// it into the window.
 #[derive(Clone, Copy, Debug, Serialize, PartialEq)]
-pub struct View {
-    /// Drawing width.
-    pub width: f64,
-    /// Drawing height.
-    pub height: f64,
-    /// Pixels per metre.
-    pub scale: f64,
-    /// Pixel x of the world origin.
-    pub ox: f64,
-    /// Pixel y of the world origin.
-    pub oy: f64,
+struct Extent {
+    /// Smallest x and y.
+    lo: [f64; 2],
+    /// Largest x and y.
+    hi: [f64; 2],
 }
 
 #[derive(Serialize)]
 struct Page<'a> {
     model: &'a str,
-    view: View,
+    extent: Extent,
     bodies: Vec<BodyGeom>,
     joints: Vec<JointGeom>,
     springs: Vec<SpringGeom>,
@@ -147,7 +141,9 @@ fn body_geom(sys: &System, joints: &[JointGeom], springs: &[SpringGeom]) -> Vec<
                     add(s.pb);
                 }
             }
-            if pts.len() > 2 {
+            if let Some(ends) = bar_ends(&pts) {
+                pts = ends.to_vec();
+            } else if pts.len() > 2 {
                 let n = pts.len() as f64;
                 let cx = pts.iter().map(|p| p[0]).sum::<f64>() / n;
                 let cy = pts.iter().map(|p| p[1]).sum::<f64>() / n;
@@ -165,6 +161,33 @@ fn body_geom(sys: &System, joints: &[JointGeom], springs: &[SpringGeom]) -> Vec<
         .collect()
 }
 
+/// The two extreme points when all of `pts` (three or more) lie on one line (a link drawn as a
+/// bar, not as a polygon without area); `None` otherwise.
+fn bar_ends(pts: &[[f64; 2]]) -> Option<[[f64; 2]; 2]> {
+    if pts.len() < 3 {
+        return None;
+    }
+    // the direction through the two points farthest apart
+    let mut far = (0.0, 0, 0);
+    for i in 0..pts.len() {
+        for j in i + 1..pts.len() {
+            let d = (pts[j][0] - pts[i][0]).hypot(pts[j][1] - pts[i][1]);
+            if d > far.0 {
+                far = (d, i, j);
+            }
+        }
+    }
+    let (len, a, b) = far;
+    if len <= 0.0 {
+        return None;
+    }
+    let u = [(pts[b][0] - pts[a][0]) / len, (pts[b][1] - pts[a][1]) / len];
+    let off_line = |p: &[f64; 2]| ((p[0] - pts[a][0]) * u[1] - (p[1] - pts[a][1]) * u[0]).abs();
+    pts.iter()
+        .all(|p| off_line(p) <= 1e-9 * len)
+        .then_some([pts[a], pts[b]])
+}
+
 fn world(q: &[f64], body: i64, p: [f64; 2]) -> [f64; 2] {
     if body < 0 {
         return p;
@@ -174,13 +197,14 @@ fn world(q: &[f64], body: i64, p: [f64; 2]) -> [f64; 2] {
     [q[k] + c * p[0] - s * p[1], q[k + 1] + s * p[0] + c * p[1]]
 }
 
-/// The transform that fits every drawn point of every frame into the drawing.
-fn fit_view(
+/// The box that holds every drawn point of every frame (a unit box around the origin when
+/// there is none).
+fn extent(
     frames: &[Vec<f64>],
     bodies: &[BodyGeom],
     joints: &[JointGeom],
     springs: &[SpringGeom],
-) -> View {
+) -> Extent {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     let mut grow = |p: [f64; 2]| {
         for k in 0..2 {
@@ -215,16 +239,7 @@ fn fit_view(
         lo = [-1.0, -1.0];
         hi = [1.0, 1.0];
     }
-    let span = [(hi[0] - lo[0]).max(1e-9), (hi[1] - lo[1]).max(1e-9)];
-    let scale = ((WIDTH - 2.0 * MARGIN) / span[0]).min((HEIGHT - 2.0 * MARGIN) / span[1]);
-    let (cx, cy) = (0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]));
-    View {
-        width: WIDTH,
-        height: HEIGHT,
-        scale,
-        ox: 0.5 * WIDTH - scale * cx,
-        oy: 0.5 * HEIGHT + scale * cy,
-    }
+    Extent { lo, hi }
 }
 
 fn html_escape(s: &str) -> String {
@@ -239,10 +254,10 @@ pub fn page(title: &str, sys: &System, t: Vec<f64>, q: Vec<Vec<f64>>) -> Result<
     let joints = joint_geom(sys);
     let springs = spring_geom(sys);
     let bodies = body_geom(sys, &joints, &springs);
-    let view = fit_view(&q, &bodies, &joints, &springs);
+    let extent = extent(&q, &bodies, &joints, &springs);
     let data = Page {
         model: title,
-        view,
+        extent,
         bodies,
         joints,
         springs,
@@ -295,6 +310,9 @@ pub fn animate(args: &AnimateArgs) -> Result<(), CliError> {
             .unwrap_or_default()
     );
     let html = page(&title, &sys, t, q)?;
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| CliError::write(&args.out, e))?;
+    }
     std::fs::write(&args.out, html).map_err(|e| CliError::write(&args.out, e))
 }
 
@@ -303,35 +321,63 @@ mod tests {
     use super::*;
 
     #[test]
-    fn geometry_and_view_of_the_slider_crank() {
+    fn geometry_and_extent_of_the_slider_crank() {
         let sys = mbd_model::models::slider_crank().unwrap();
         let joints = joint_geom(&sys);
         let springs = spring_geom(&sys);
         let bodies = body_geom(&sys, &joints, &springs);
-        // every body has its centre of mass and its joint points, without repeats
+        // every body's outline spans its joint points (a link's two pins), without repeats
         for (i, b) in bodies.iter().enumerate() {
-            assert!(b.outline.contains(&[0.0, 0.0]), "{}", b.name);
             for j in &joints {
-                if j.b == i as i64 {
-                    assert!(b.outline.contains(&j.pb.unwrap()), "{} {}", b.name, j.name);
+                for (body, p) in [(j.a, j.pa), (j.b, j.pb)] {
+                    if let (true, Some(p)) = (body == i as i64, p) {
+                        let on = b.outline.iter().any(|o| {
+                            let (d, e) = (o[0] - p[0], o[1] - p[1]);
+                            d.hypot(e) < 1e-12
+                        });
+                        let between = b.outline.len() == 2 && {
+                            let (a, c) = (b.outline[0], b.outline[1]);
+                            let t = ((p[0] - a[0]) * (c[0] - a[0]) + (p[1] - a[1]) * (c[1] - a[1]))
+                                / ((c[0] - a[0]).powi(2) + (c[1] - a[1]).powi(2));
+                            (-1e-12..=1.0 + 1e-12).contains(&t)
+                        };
+                        assert!(on || between, "{} {}", b.name, j.name);
+                    }
                 }
+            }
+            for (k, p) in b.outline.iter().enumerate() {
+                assert!(!b.outline[..k].contains(p), "{} repeats {p:?}", b.name);
             }
         }
         let (q, _) = sys.initial_guess();
         let mut q2 = q.as_slice().to_vec();
         q2[0] += 3.0; // a frame far to the right
         let frames = vec![q.as_slice().to_vec(), q2];
-        let v = fit_view(&frames, &bodies, &joints, &springs);
+        let e = extent(&frames, &bodies, &joints, &springs);
+        assert!(e.hi[0] - e.lo[0] >= 3.0, "{e:?}");
         for f in &frames {
             for (i, b) in bodies.iter().enumerate() {
                 for &p in &b.outline {
                     let w = world(f, i as i64, p);
-                    let (x, y) = (v.ox + v.scale * w[0], v.oy - v.scale * w[1]);
-                    assert!((MARGIN - 1e-9..=WIDTH - MARGIN + 1e-9).contains(&x), "{x}");
-                    assert!((MARGIN - 1e-9..=HEIGHT - MARGIN + 1e-9).contains(&y), "{y}");
+                    for k in 0..2 {
+                        assert!(e.lo[k] <= w[k] && w[k] <= e.hi[k], "{w:?} outside {e:?}");
+                    }
                 }
             }
         }
+    }
+
+    #[test]
+    fn links_whose_points_lie_on_a_line_are_bars() {
+        // a crank: centre of mass between its two pins
+        let pts = [[0.0, 0.0], [-0.075, 0.0], [0.075, 0.0]];
+        assert_eq!(bar_ends(&pts), Some([[-0.075, 0.0], [0.075, 0.0]]));
+        // a slanted link with its centre of mass beyond one pin
+        let pts = [[0.0, 0.0], [0.1, 0.2], [0.2, 0.4]];
+        assert_eq!(bar_ends(&pts), Some([[0.0, 0.0], [0.2, 0.4]]));
+        // a plate
+        assert_eq!(bar_ends(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), None);
+        assert_eq!(bar_ends(&[[0.0, 0.0], [1.0, 0.0]]), None);
     }
 
     #[test]

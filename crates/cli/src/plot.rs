@@ -1,9 +1,11 @@
-//! `mbd plot`: columns of a result CSV as an SVG figure.
+//! `mbd plot`: columns of a result CSV as an SVG figure, its axes titled with the columns'
+//! units (`mbd_analysis::units`).
 
 use crate::args::PlotArgs;
 use crate::error::CliError;
 use crate::table::Table;
 use mbd_analysis::plot::{Figure, Series};
+use mbd_analysis::units::{axis_label, unit_of};
 use std::path::{Path, PathBuf};
 
 /// Draws the figure and returns the path of the SVG written.
@@ -24,12 +26,28 @@ pub fn plot(args: &PlotArgs) -> Result<PathBuf, CliError> {
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut fig = Figure::new(title, args.x.clone(), args.y.join(", "));
+    let mut fig = Figure::new(title, axis_label(&args.x), y_title(&args.y));
     for (name, y) in ys {
-        fig = fig.with(Series::line(name, x.clone(), y));
+        fig = fig.with(Series::line(axis_label(&name), x.clone(), y));
     }
     save_svg_only(&fig, &out)?;
     Ok(out)
+}
+
+/// The y axis title: the columns and their common unit (`crank.x, slider.x [m]`), or each
+/// column with its own unit when they differ (`slider.x [m], crank.theta [rad]`).
+pub fn y_title(columns: &[String]) -> String {
+    let units: Vec<Option<&str>> = columns.iter().map(|c| unit_of(c)).collect();
+    match units.first() {
+        Some(Some(u)) if units.iter().all(|v| *v == Some(*u)) => {
+            format!("{} [{u}]", columns.join(", "))
+        }
+        _ => columns
+            .iter()
+            .map(|c| axis_label(c))
+            .collect::<Vec<_>>()
+            .join(", "),
+    }
 }
 
 /// `Figure::save` also writes the data next to the SVG (same name, extension `.csv`), which
@@ -43,6 +61,9 @@ fn save_svg_only(fig: &Figure, out: &Path) -> Result<(), CliError> {
         message: e.to_string(),
     });
     let copied = drawn.and_then(|()| {
+        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| CliError::write(out, e))?;
+        }
         std::fs::copy(&svg, out)
             .map(|_| ())
             .map_err(|e| CliError::write(out, e))
@@ -50,4 +71,27 @@ fn save_svg_only(fig: &Figure, out: &Path) -> Result<(), CliError> {
     // best effort: a leftover temporary directory is harmless
     let _ = std::fs::remove_dir_all(&tmp);
     copied
+}
+
+#[cfg(test)]
+mod tests {
+    use super::y_title;
+
+    fn cols(c: &[&str]) -> Vec<String> {
+        c.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn y_titles_carry_units() {
+        assert_eq!(
+            y_title(&cols(&["crank.x", "slider.x"])),
+            "crank.x, slider.x [m]"
+        );
+        assert_eq!(
+            y_title(&cols(&["slider.x", "crank.theta"])),
+            "slider.x [m], crank.theta [rad]"
+        );
+        assert_eq!(y_title(&cols(&["max_abs_phi"])), "max_abs_phi");
+        assert_eq!(y_title(&cols(&["H", "max_abs_phi"])), "H [J], max_abs_phi");
+    }
 }

@@ -1,7 +1,18 @@
-//! Drives the animation page in headless Chromium: at two times the drawn centres of mass and
-//! joints sit where the CSV and the model put them (through the page's published transform, to
-//! within a pixel), and screenshots at the two times differ. Skips (with a message) when
-//! Chromium is not installed.
+//! Drives the animation page in headless Chromium in a 1000 x 700 window, at two times:
+//!
+//! * the drawn centres of mass and joints sit where the CSV and the model put them (through the
+//!   page's published transform, to within a pixel);
+//! * the axes have round tick labels (a `0` on each axis) at the places the transform gives,
+//!   and the titles `x [m]`, `y [m]`;
+//! * the scale bar is a round length whose drawn pixels are its metres times the published
+//!   scale, and the model's crank (its two pins, read from the model file) spans its length
+//!   times the same scale between its drawn joints;
+//! * the legend names what the page draws and lies beside the plot area, clear of the
+//!   mechanism; the body names cross no link;
+//! * the page fits the window (no scrollbar);
+//!
+//! and screenshots at the two times differ. Skips (with a message) when Chromium is not
+//! installed.
 
 mod common;
 use common::{mbd, scratch};
@@ -11,6 +22,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const MODEL: &str = "examples/models/slider_crank_spring.toml";
+const WINDOW: (f64, f64) = (1000.0, 700.0);
 
 fn chromium() -> Option<PathBuf> {
     let p = std::env::var_os("CHROMIUM")
@@ -19,8 +31,8 @@ fn chromium() -> Option<PathBuf> {
     p.exists().then_some(p)
 }
 
-/// Runs Chromium headless with a fresh profile; returns stdout.
-fn chrome(bin: &Path, profile: &Path, extra: &[String]) -> String {
+/// Runs Chromium headless with a fresh profile in a window of `size`; returns stdout.
+fn chrome(bin: &Path, profile: &Path, size: (f64, f64), extra: &[String]) -> String {
     let mut child = Command::new(bin)
         .args([
             "--headless",
@@ -32,6 +44,7 @@ fn chrome(bin: &Path, profile: &Path, extra: &[String]) -> String {
             "--no-first-run",
             "--hide-scrollbars",
         ])
+        .arg(format!("--window-size={},{}", size.0, size.1))
         .arg(format!("--user-data-dir={}", profile.display()))
         .args(extra)
         .stdout(Stdio::piped())
@@ -53,9 +66,52 @@ fn chrome(bin: &Path, profile: &Path, extra: &[String]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
-/// The attributes of every `<tag ...>` element in serialised HTML.
-fn elements(html: &str, tag: &str) -> Vec<HashMap<String, String>> {
+/// The DOM of the page at `url` as laid out in a 1000 x 700 viewport. Headless Chromium's
+/// `--dump-dom` gives the page less than the window (143 px less height in Chromium 156, as if
+/// for a toolbar; `--screenshot` gives it all), so the window is grown by what the page
+/// reported missing and the page loaded again.
+fn dom_at_1000x700(bin: &Path, dir: &Path, url: &str) -> String {
+    let mut size = WINDOW;
+    for attempt in 0..2 {
+        let profile = dir.join(format!("profile-dom-{attempt}"));
+        let dom = chrome(bin, &profile, size, &["--dump-dom".into(), url.to_string()]);
+        let html = &elements(&dom, "html")[0];
+        let inner = (html.num("data-inner-width"), html.num("data-inner-height"));
+        if inner == WINDOW {
+            return dom;
+        }
+        size = (size.0 + WINDOW.0 - inner.0, size.1 + WINDOW.1 - inner.1);
+    }
+    panic!("no window size gives the page a 1000 x 700 viewport");
+}
+
+/// One element of serialised HTML: its attributes and the text up to its closing tag.
+struct Element {
+    attrs: HashMap<String, String>,
+    text: String,
+}
+
+impl Element {
+    fn get(&self, k: &str) -> Option<&str> {
+        self.attrs.get(k).map(String::as_str)
+    }
+    fn num(&self, k: &str) -> f64 {
+        let v = self
+            .get(k)
+            .unwrap_or_else(|| panic!("attribute {k} missing in {:?}", self.attrs));
+        v.parse()
+            .unwrap_or_else(|_| panic!("attribute {k} = {v:?} is not a number"))
+    }
+    fn has_class(&self, c: &str) -> bool {
+        self.get("class")
+            .is_some_and(|s| s.split_whitespace().any(|w| w == c))
+    }
+}
+
+/// Every `<tag ...>` element of serialised HTML.
+fn elements(html: &str, tag: &str) -> Vec<Element> {
     let open = format!("<{tag} ");
+    let close = format!("</{tag}>");
     let mut v = Vec::new();
     let mut rest = html;
     while let Some(i) = rest.find(&open) {
@@ -70,17 +126,362 @@ fn elements(html: &str, tag: &str) -> Vec<HashMap<String, String>> {
             attrs.insert(name, after[..close].to_string());
             s = &after[close + 1..];
         }
-        v.push(attrs);
+        let body = &rest[end + 1..];
+        let text = body.find(&close).map_or("", |k| &body[..k]).to_string();
+        v.push(Element { attrs, text });
     }
     v
 }
 
-fn num(attrs: &HashMap<String, String>, k: &str) -> f64 {
-    attrs
-        .get(k)
-        .unwrap_or_else(|| panic!("attribute {k} missing in {attrs:?}"))
-        .parse()
-        .unwrap()
+fn by_id<'a>(els: &'a [Element], id: &str) -> &'a Element {
+    els.iter()
+        .find(|e| e.get("id") == Some(id))
+        .unwrap_or_else(|| panic!("no element #{id}"))
+}
+
+/// A box `[x0, x1] x [y0, y1]` in pixels.
+#[derive(Clone, Copy, Debug)]
+struct Rect {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl Rect {
+    fn grown(self, m: f64) -> Rect {
+        Rect {
+            x0: self.x0 - m,
+            y0: self.y0 - m,
+            x1: self.x1 + m,
+            y1: self.y1 + m,
+        }
+    }
+    fn contains(&self, p: (f64, f64)) -> bool {
+        (self.x0..=self.x1).contains(&p.0) && (self.y0..=self.y1).contains(&p.1)
+    }
+    fn overlaps(&self, o: &Rect) -> bool {
+        self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
+    }
+    /// Whether the segment a-b passes through the box (Liang-Barsky clipping).
+    fn hit_by(&self, a: (f64, f64), b: (f64, f64)) -> bool {
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let p = [-dx, dx, -dy, dy];
+        let q = [a.0 - self.x0, self.x1 - a.0, a.1 - self.y0, self.y1 - a.1];
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for i in 0..4 {
+            if p[i] == 0.0 {
+                if q[i] < 0.0 {
+                    return false;
+                }
+            } else {
+                let r = q[i] / p[i];
+                if p[i] < 0.0 {
+                    t0 = t0.max(r);
+                } else {
+                    t1 = t1.min(r);
+                }
+                if t0 > t1 {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+}
+
+/// The points of a `points="x,y x,y ..."` attribute.
+fn points(e: &Element) -> Vec<(f64, f64)> {
+    e.get("points")
+        .unwrap_or("")
+        .split_whitespace()
+        .map(|p| {
+            let (x, y) = p.split_once(',').expect("x,y");
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect()
+}
+
+/// Width and height of a PNG (its IHDR chunk).
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert!(bytes.starts_with(b"\x89PNG"), "not a PNG");
+    let be = |k: usize| u32::from_be_bytes([bytes[k], bytes[k + 1], bytes[k + 2], bytes[k + 3]]);
+    (be(16), be(20))
+}
+
+/// Whether `v` is 1, 2 or 5 times a power of ten.
+fn is_round(v: f64) -> bool {
+    let m = v / 10f64.powf(v.log10().floor());
+    [1.0, 2.0, 5.0, 10.0].iter().any(|n| (m - n).abs() < 1e-9)
+}
+
+/// The published transform and the plot area.
+struct View {
+    scale: f64,
+    ox: f64,
+    oy: f64,
+    plot: Rect,
+}
+
+impl View {
+    fn of(stage: &Element) -> View {
+        let p: Vec<f64> = stage
+            .get("data-plot")
+            .expect("data-plot")
+            .split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect();
+        View {
+            scale: stage.num("data-scale"),
+            ox: stage.num("data-ox"),
+            oy: stage.num("data-oy"),
+            plot: Rect {
+                x0: p[0],
+                y0: p[1],
+                x1: p[2],
+                y1: p[3],
+            },
+        }
+    }
+    fn px(&self, p: [f64; 2]) -> (f64, f64) {
+        (self.ox + self.scale * p[0], self.oy - self.scale * p[1])
+    }
+}
+
+/// The page fits the 1000 x 700 window: no scrollbar either way.
+fn check_fits_the_window(dom: &str) {
+    let html = &elements(dom, "html")[0];
+    let (iw, ih) = (html.num("data-inner-width"), html.num("data-inner-height"));
+    assert_eq!(
+        (iw, ih),
+        WINDOW,
+        "the page was laid out in a 1000 x 700 window"
+    );
+    let (sw, sh) = (
+        html.num("data-scroll-width"),
+        html.num("data-scroll-height"),
+    );
+    assert!(
+        sw <= iw && sh <= ih,
+        "the page needs a scrollbar: content {sw} x {sh} in a {iw} x {ih} window"
+    );
+}
+
+/// Tick labels are round numbers placed where the transform puts their values, `0` included.
+fn check_axes(texts: &[Element], v: &View) {
+    for (axis, min) in [("x", 3), ("y", 2)] {
+        let ticks: Vec<&Element> = texts
+            .iter()
+            .filter(|t| t.has_class("tick") && t.has_class(axis))
+            .collect();
+        assert!(
+            ticks.len() >= min,
+            "{} ticks on the {axis} axis",
+            ticks.len()
+        );
+        assert!(
+            ticks.iter().any(|t| t.text == "0"),
+            "no tick labelled 0 on the {axis} axis"
+        );
+        let vals: Vec<f64> = ticks.iter().map(|t| t.num("data-value")).collect();
+        let step = vals[1] - vals[0];
+        assert!(is_round(step), "{axis} tick step {step}");
+        for (t, &val) in ticks.iter().zip(&vals) {
+            let shown: f64 = t
+                .text
+                .parse()
+                .unwrap_or_else(|_| panic!("tick {:?}", t.text));
+            assert_eq!(shown, val, "the label is the tick's value");
+            assert!(
+                t.text.len() <= 6,
+                "compact tick label {:?} on the {axis} axis",
+                t.text
+            );
+            let k = val / step;
+            assert!(
+                (k - k.round()).abs() < 1e-9,
+                "{val} is a multiple of {step}"
+            );
+            let (at, want) = if axis == "x" {
+                (t.num("x"), v.px([val, 0.0]).0)
+            } else {
+                (t.num("y"), v.px([0.0, val]).1)
+            };
+            assert!(
+                (at - want).abs() <= 0.5,
+                "{axis} tick {val} at {at}, not {want}"
+            );
+        }
+    }
+    assert_eq!(by_id(texts, "x-label").text, "x [m]");
+    assert_eq!(by_id(texts, "y-label").text, "y [m]");
+}
+
+/// The scale bar's drawn length is its metres times the scale; so is the crank's, between its
+/// two drawn joints (its length read from the model).
+fn check_scale(dom: &str, stage: &Element, v: &View, sys: &mbd_model::System) {
+    let metres = stage.num("data-scalebar-m");
+    let (x1, x2) = (stage.num("data-scalebar-x1"), stage.num("data-scalebar-x2"));
+    assert!(is_round(metres), "scale bar of {metres} m");
+    let bar_px = x2 - x1;
+    assert!(
+        (bar_px - metres * v.scale).abs() <= 0.5,
+        "scale bar: {bar_px} px drawn for {metres} m at {} px/m",
+        v.scale
+    );
+    assert!(
+        (30.0..=200.0).contains(&bar_px),
+        "scale bar {bar_px} px long"
+    );
+    let lines = elements(dom, "line");
+    let bar = by_id(&lines, "scalebar");
+    assert_eq!(bar.num("data-length-m"), metres);
+    assert!((bar.num("x1") - x1).abs() < 1e-6 && (bar.num("x2") - x2).abs() < 1e-6);
+    let label = elements(dom, "text")
+        .into_iter()
+        .find(|t| t.has_class("scalebar-label"))
+        .expect("the scale bar is labelled");
+    assert_eq!(
+        label.text.strip_suffix(" m").map(str::parse::<f64>),
+        Some(Ok(metres)),
+        "scale bar label {:?}",
+        label.text
+    );
+
+    // the crank: its two pins in its own frame give its length
+    let crank = sys
+        .bodies()
+        .iter()
+        .position(|b| b.name == "crank")
+        .expect("the model has a crank");
+    let mut pins = Vec::new();
+    for j in sys.joints() {
+        let mbd_model::JointKind::Revolute(r) = &j.kind else {
+            continue;
+        };
+        for (body, p) in [(r.a, r.pa), (r.b, r.pb)] {
+            if body.index() == Some(crank) {
+                pins.push((j.name.clone(), p));
+            }
+        }
+    }
+    assert_eq!(pins.len(), 2, "the crank has two pins: {pins:?}");
+    let length = (pins[0].1[0] - pins[1].1[0]).hypot(pins[0].1[1] - pins[1].1[1]);
+    let circles = elements(dom, "circle");
+    let at = |name: &str| {
+        let c = circles
+            .iter()
+            .find(|c| c.has_class("joint") && c.get("data-joint") == Some(name))
+            .unwrap_or_else(|| panic!("joint {name} not drawn"));
+        (c.num("cx"), c.num("cy"))
+    };
+    let (a, b) = (at(&pins[0].0), at(&pins[1].0));
+    let drawn = (a.0 - b.0).hypot(a.1 - b.1);
+    assert!(
+        (drawn - length * v.scale).abs() <= 1.0,
+        "the {length} m crank spans {drawn} px, not {} px",
+        length * v.scale
+    );
+    // the same pixels per metre as the scale bar
+    let (per_m_bar, per_m_crank) = (bar_px / metres, drawn / length);
+    assert!(
+        (per_m_bar - per_m_crank).abs() <= 0.01 * per_m_bar,
+        "scale bar {per_m_bar} px/m, crank {per_m_crank} px/m"
+    );
+}
+
+/// The legend lists what the page draws and sits outside the plot area, clear of every drawn
+/// centre of mass and joint.
+fn check_legend(dom: &str, v: &View) {
+    let rects = elements(dom, "rect");
+    let b = by_id(&rects, "legend-box");
+    let legend = Rect {
+        x0: b.num("x"),
+        y0: b.num("y"),
+        x1: b.num("x") + b.num("width"),
+        y1: b.num("y") + b.num("height"),
+    };
+    assert!(legend.x1 <= WINDOW.0 && legend.y1 <= WINDOW.1, "{legend:?}");
+    assert!(
+        !legend.overlaps(&v.plot),
+        "legend {legend:?} on the plot area"
+    );
+    let keys: Vec<String> = elements(dom, "g")
+        .iter()
+        .filter(|g| g.has_class("legend-entry"))
+        .filter_map(|g| g.get("data-legend").map(String::from))
+        .collect();
+    for k in ["body", "com", "trace", "joint", "ground", "guide", "spring"] {
+        assert!(keys.iter().any(|x| x == k), "legend lacks {k}: {keys:?}");
+    }
+    for c in elements(dom, "circle") {
+        if c.get("data-body").is_some() || c.get("data-joint").is_some() {
+            let p = (c.num("cx"), c.num("cy"));
+            assert!(!legend.contains(p), "{:?} under the legend", c.attrs);
+            assert!(v.plot.contains(p), "{:?} outside the plot area", c.attrs);
+        }
+    }
+}
+
+/// Every body's name lies inside the plot area and crosses no link (the bars and the slider's
+/// block, with half a bar's stroke around them) and no other name.
+fn check_labels(dom: &str, v: &View, sys: &mbd_model::System) {
+    let mut links: Vec<((f64, f64), (f64, f64))> = Vec::new();
+    for shape in ["polyline", "polygon"] {
+        for e in elements(dom, shape) {
+            if e.get("data-body").is_none() {
+                continue;
+            }
+            let p = points(&e);
+            let n = if shape == "polyline" {
+                p.len() - 1
+            } else {
+                p.len()
+            };
+            links.extend((0..n).map(|k| (p[k], p[(k + 1) % p.len()])));
+        }
+    }
+    assert!(links.len() >= 2 + 4, "two bars and a block: {links:?}");
+    let mut boxes: Vec<(String, Rect)> = Vec::new();
+    for t in elements(dom, "text")
+        .iter()
+        .filter(|t| t.has_class("label"))
+    {
+        let r = Rect {
+            x0: t.num("data-bx"),
+            y0: t.num("data-by"),
+            x1: t.num("data-bx") + t.num("data-bw"),
+            y1: t.num("data-by") + t.num("data-bh"),
+        };
+        assert!(
+            r.x1 > r.x0 + 10.0 && r.y1 > r.y0 + 5.0,
+            "{} box {r:?}",
+            t.text
+        );
+        // the text is centred in its box
+        assert!((t.num("x") - 0.5 * (r.x0 + r.x1)).abs() < 0.01);
+        assert!(
+            r.x0 >= v.plot.x0 && r.x1 <= v.plot.x1 && r.y0 >= v.plot.y0 && r.y1 <= v.plot.y1,
+            "label {} at {r:?} leaves the plot area",
+            t.text
+        );
+        for (a, b) in &links {
+            assert!(
+                !r.grown(2.5).hit_by(*a, *b),
+                "label {} at {r:?} overlaps the link {a:?}-{b:?}",
+                t.text
+            );
+        }
+        for (other, o) in &boxes {
+            assert!(!r.overlaps(o), "labels {} and {other} overlap", t.text);
+        }
+        boxes.push((t.text.clone(), r));
+    }
+    let mut names: Vec<String> = boxes.into_iter().map(|(n, _)| n).collect();
+    names.sort();
+    let mut want: Vec<String> = sys.bodies().iter().map(|b| b.name.clone()).collect();
+    want.sort();
+    assert_eq!(names, want, "one label per body");
 }
 
 #[test]
@@ -94,7 +495,7 @@ fn page_draws_the_trajectory_at_the_requested_time() {
     };
     let d = scratch("browser");
     let csv = d.join("slider.csv");
-    let html = d.join("slider.html");
+    let html = d.join("pages").join("slider.html"); // the directory does not exist yet
     let out = mbd([
         "run".as_ref(),
         MODEL.as_ref(),
@@ -139,39 +540,28 @@ fn page_draws_the_trajectory_at_the_requested_time() {
             .map(|n| row[head.iter().position(|h| h == n).unwrap()])
             .collect();
 
-        let dom = chrome(
-            &bin,
-            &d.join(format!("profile-dom-{k}")),
-            &["--dump-dom".into(), url(t)],
-        );
+        let dom = dom_at_1000x700(&bin, &d.join(format!("dom-{k}")), &url(t));
+        std::fs::write(d.join(format!("dom-{k}.html")), &dom).unwrap();
         let svg = elements(&dom, "svg");
         let stage = svg
             .iter()
-            .find(|a| a.get("id").map(String::as_str) == Some("stage"))
+            .find(|a| a.get("id") == Some("stage"))
             .unwrap_or_else(|| panic!("no #stage in the DOM:\n{dom}"));
-        let (scale, ox, oy) = (
-            num(stage, "data-scale"),
-            num(stage, "data-ox"),
-            num(stage, "data-oy"),
-        );
+        let v = View::of(stage);
         assert!(
-            (num(stage, "data-t") - row[0]).abs() < 1e-12,
+            (stage.num("data-t") - row[0]).abs() < 1e-12,
             "frame shown for t = {t}"
         );
-        let px = |p: [f64; 2]| (ox + scale * p[0], oy - scale * p[1]);
 
         let circles = elements(&dom, "circle");
         let mut checked = 0;
         for (i, b) in sys.bodies().iter().enumerate() {
             let c = circles
                 .iter()
-                .find(|a| {
-                    a.get("class").map(String::as_str) == Some("com")
-                        && a.get("data-body") == Some(&b.name)
-                })
+                .find(|a| a.has_class("com") && a.get("data-body") == Some(&b.name))
                 .unwrap_or_else(|| panic!("no centre of mass drawn for {}", b.name));
-            let (ex, ey) = px([q[3 * i], q[3 * i + 1]]);
-            let (cx, cy) = (num(c, "cx"), num(c, "cy"));
+            let (ex, ey) = v.px([q[3 * i], q[3 * i + 1]]);
+            let (cx, cy) = (c.num("cx"), c.num("cy"));
             assert!(
                 (cx - ex).abs() <= 1.0 && (cy - ey).abs() <= 1.0,
                 "{} at t = {t}: drawn ({cx}, {cy}), expected ({ex}, {ey})",
@@ -193,11 +583,11 @@ fn page_draws_the_trajectory_at_the_requested_time() {
             };
             let c = circles
                 .iter()
-                .find(|c| c.get("data-joint") == Some(&j.name))
+                .find(|c| c.has_class("joint") && c.get("data-joint") == Some(&j.name))
                 .unwrap_or_else(|| panic!("joint {} not drawn", j.name));
-            let (ex, ey) = px([w[0], w[1]]);
+            let (ex, ey) = v.px([w[0], w[1]]);
             assert!(
-                (num(c, "cx") - ex).abs() <= 1.0 && (num(c, "cy") - ey).abs() <= 1.0,
+                (c.num("cx") - ex).abs() <= 1.0 && (c.num("cy") - ey).abs() <= 1.0,
                 "joint {} at t = {t}",
                 j.name
             );
@@ -209,19 +599,22 @@ fn page_draws_the_trajectory_at_the_requested_time() {
             "three bodies and three revolute joints checked"
         );
 
+        check_fits_the_window(&dom);
+        check_axes(&elements(&dom, "text"), &v);
+        check_scale(&dom, stage, &v, &sys);
+        check_legend(&dom, &v);
+        check_labels(&dom, &v, &sys);
+
         let png = d.join(format!("shot-{k}.png"));
         chrome(
             &bin,
             &d.join(format!("profile-shot-{k}")),
-            &[
-                format!("--screenshot={}", png.display()),
-                "--window-size=800,600".into(),
-                url(t),
-            ],
+            WINDOW,
+            &[format!("--screenshot={}", png.display()), url(t)],
         );
         let bytes =
             std::fs::read(&png).unwrap_or_else(|e| panic!("no screenshot {}: {e}", png.display()));
-        assert!(bytes.starts_with(b"\x89PNG"), "not a PNG");
+        assert_eq!(png_size(&bytes), (1000, 700), "screenshot size");
         shots.push(bytes);
     }
     assert_ne!(

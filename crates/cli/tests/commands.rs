@@ -316,6 +316,43 @@ fn plot_writes_an_svg_and_leaves_the_csv_alone() {
     );
 }
 
+/// `mbd plot` titles its axes with the columns' units, writes round tick labels and creates
+/// the output's directory.
+#[test]
+fn plot_titles_axes_with_units() {
+    let d = scratch("plot-units");
+    let csv = pendulum_csv(&d);
+    let svg = d.join("figures").join("rod.svg");
+    let out = mbd([
+        "plot".as_ref(),
+        csv.as_os_str(),
+        "--y".as_ref(),
+        "rod.theta".as_ref(),
+        "--y".as_ref(),
+        "d_rod.theta".as_ref(),
+        "-o".as_ref(),
+        svg.as_os_str(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let svg = std::fs::read_to_string(&svg).unwrap();
+    let texts: Vec<&str> = svg
+        .split("<text")
+        .skip(1)
+        .filter_map(|s| {
+            let s = &s[s.find('>')? + 1..];
+            Some(s[..s.find("</text>")?].trim())
+        })
+        .collect();
+    for title in [
+        "t [s]",
+        "rod.theta [rad], d_rod.theta [rad/s]",
+        "rod.theta [rad]",
+    ] {
+        assert!(texts.contains(&title), "no {title:?} in {texts:?}");
+    }
+    assert!(texts.contains(&"0"), "a tick at 0 labelled 0: {texts:?}");
+}
+
 #[test]
 fn animate_writes_a_self_contained_page() {
     let d = scratch("animate");

@@ -258,13 +258,14 @@ pub(super) fn fig5_6(ctx: &Ctx) -> Result<Section, String> {
     let mut f5 = Figure::new(
         "Paper A Fig. 5: E|dx| + E|dy| against gamma",
         "gamma",
-        "E|dx| + E|dy| (m)",
+        // each curve is divided by its own gamma = 0 value: a ratio, without unit
+        "(E|dx| + E|dy|) / its value at gamma = 0 [-]",
     )
     .log(false, true);
     let mut f6 = Figure::new(
         "Paper A Fig. 6: averaged signed error dW against gamma",
         "gamma",
-        "dW = E[dx] + E[dy] (m)",
+        "dW / |dW at gamma = 0| [-]",
     );
     let mut summary = serde_json::Map::new();
     for s in [1usize, 2] {
