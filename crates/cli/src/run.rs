@@ -213,7 +213,10 @@ fn open_sink(args: &RunArgs, every: usize, balance: bool) -> Result<Sink, CliErr
             )))
         }
     };
-    // created before the run, so an unwritable path fails at once
+    // created (with its folder) before the run, so an unwritable path fails at once
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| CliError::write(out, e))?;
+    }
     let file = std::fs::File::create(out).map_err(|e| CliError::write(out, e))?;
     Ok(if json {
         Sink::Json {

@@ -640,3 +640,26 @@ fn run_writes_the_model_sensors() {
         assert!((x.hypot(y) - 1.0).abs() < 1e-9, "{x} {y}");
     }
 }
+
+/// `mbd run --out` creates the output's folders (as `plot` and `animate` do).
+#[test]
+fn run_creates_the_output_folder() {
+    let d = scratch("run-out-folder");
+    let csv = d.join("new").join("sub").join("pendulum.csv");
+    assert!(!csv.parent().unwrap().exists());
+    let out = mbd([
+        "run".as_ref(),
+        "examples/models/pendulum.toml".as_ref(),
+        "--solver".as_ref(),
+        "rk4".as_ref(),
+        "--t-end".as_ref(),
+        "0.1".as_ref(),
+        "--h".as_ref(),
+        "0.01".as_ref(),
+        "--out".as_ref(),
+        csv.as_os_str(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(text.lines().count(), 12, "{text}");
+}
