@@ -12,7 +12,7 @@
 //! Gauss-Legendre: fourth order in the step for fixed and variable steps alike.
 
 use mbd_model::System;
-use mbd_solve::{Flow, Observer, ReactionSolver, SolveError, State};
+use mbd_solve::{Flow, Observer, OutputSolve, SolveError, State};
 
 /// The running energy balance (see the module documentation); an [`Observer`] that must see
 /// every step.
@@ -35,7 +35,9 @@ use mbd_solve::{Flow, Observer, ReactionSolver, SolveError, State};
 /// ```
 #[derive(Debug)]
 pub struct EnergyBalance {
-    multipliers: ReactionSolver,
+    /// The index-1 solve for the multipliers, built at the first [`EnergyBalance::advance`]
+    /// (not needed by [`EnergyBalance::advance_with`]).
+    solve: Option<OutputSolve>,
     phi_t: Vec<f64>,
     /// The last four samples `(t, external + driver power, dissipation)`, oldest first.
     samples: Vec<[f64; 3]>,
@@ -51,7 +53,7 @@ impl EnergyBalance {
     /// A balance for `sys` (its workspace allocated once).
     pub fn new(sys: &System) -> Result<Self, SolveError> {
         Ok(EnergyBalance {
-            multipliers: ReactionSolver::new(sys)?,
+            solve: None,
             phi_t: vec![0.0; sys.n_constraints()],
             samples: Vec::with_capacity(4),
             h0: None,
@@ -66,8 +68,35 @@ impl EnergyBalance {
     /// Adds the state `s` (the next one of the run): integrates the powers over the interval
     /// since the last state.
     pub fn advance(&mut self, sys: &System, s: &State) -> Result<(), SolveError> {
+        let mut solve = match self.solve.take() {
+            Some(x) => x,
+            None => OutputSolve::new(sys)?,
+        };
+        let result = match solve.at(sys, s) {
+            Ok((_, lambda)) => self.advance_with(sys, s, lambda),
+            Err(e) => Err(e),
+        };
+        self.solve = Some(solve);
+        result
+    }
+
+    /// [`EnergyBalance::advance`] with the multipliers `lambda` at `s` solved elsewhere (an
+    /// [`OutputSolve`] shared with the other outputs of a row).
+    pub fn advance_with(
+        &mut self,
+        sys: &System,
+        s: &State,
+        lambda: &[f64],
+    ) -> Result<(), SolveError> {
+        s.check(sys)?;
+        if lambda.len() != sys.n_constraints() {
+            return Err(SolveError::Dimension {
+                what: "lambda",
+                expected: sys.n_constraints(),
+                got: lambda.len(),
+            });
+        }
         let (q, v) = (s.q.as_slice(), s.v.as_slice());
-        let lambda = self.multipliers.multipliers(sys, s)?;
         sys.phi_t(s.t, &mut self.phi_t);
         let drivers: f64 = lambda.iter().zip(&self.phi_t).map(|(l, p)| l * p).sum();
         let (dissipation, external) = sys.nonconservative_power(q, v, s.t);

@@ -3,7 +3,9 @@
 use crate::energy_balance::EnergyBalance;
 use crate::error::AnalysisError;
 use mbd_model::System;
-use mbd_solve::{Flow, JointReaction, Observer, ReactionSolver, SensorSolver, SolveError, State};
+use mbd_solve::{
+    Flow, JointReaction, Observer, OutputSolve, ReactionSolver, SensorSolver, SolveError, State,
+};
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -125,6 +127,9 @@ pub struct CsvObserver<W: Write> {
     energy_balance: bool,
     /// The running energy balance (built at the first state), advanced at every step.
     balance: Option<EnergyBalance>,
+    /// The one index-1 solve of a state shared by the balance, the reactions and the sensors
+    /// (built when one of them first needs it).
+    solve: Option<OutputSolve>,
     every: usize,
     row: Vec<f64>,
     phi: Vec<f64>,
@@ -145,6 +150,7 @@ impl<W: Write> CsvObserver<W> {
             sensor_solver: None,
             energy_balance: false,
             balance: None,
+            solve: None,
             every: 1,
             row: Vec::new(),
             phi: Vec::new(),
@@ -193,7 +199,8 @@ impl<W: Write> CsvObserver<W> {
                 Some(b) => b,
                 None => self.balance.insert(EnergyBalance::new(sys)?),
             };
-            b.advance(sys, s)?;
+            let (_, lambda) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, s)?;
+            b.advance_with(sys, s, lambda)?;
         }
         Ok(())
     }
@@ -253,7 +260,8 @@ impl<W: Write> CsvObserver<W> {
                     vec![JointReaction::default(); sys.joints().len()],
                 )),
             };
-            rs.compute(sys, s, out)?;
+            let (_, lambda) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, s)?;
+            rs.compute_with(sys, s, lambda, out)?;
             for r in out.iter() {
                 self.row.extend([r.force[0], r.force[1], r.moment]);
             }
@@ -263,7 +271,12 @@ impl<W: Write> CsvObserver<W> {
                 Some(x) => x,
                 None => self.sensor_solver.insert(SensorSolver::new(sys)?),
             };
-            ss.evaluate(sys, s, &mut self.row)?;
+            if ss.needs_acceleration() {
+                let (a, _) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, s)?;
+                ss.evaluate_with(sys, s, a, &mut self.row)?;
+            } else {
+                ss.evaluate(sys, s, &mut self.row)?;
+            }
         }
         if self.energy_balance {
             let b = self.balance.as_ref();
@@ -358,6 +371,44 @@ mod tests {
         let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default()).unwrap();
         run(&mut rk, &sys, &mut s, RunConfig::new(t_end, 0.01), csv).unwrap();
         (sys, s)
+    }
+
+    /// The balance, the reactions and a point sensor share one index-1 solve per state (six
+    /// states: six solves, not eighteen), and the row's values equal each consumer's own.
+    #[test]
+    fn one_index1_solve_per_state_serves_every_output() {
+        let mut file = pendulum().to_model_file();
+        let body = file.bodies[0].name.clone();
+        file.sensors.push(mbd_model::SensorSpec::Point {
+            name: "tip".into(),
+            body,
+            point: [0.5, 0.0],
+        });
+        let sys = file.build().unwrap();
+        let mut csv = CsvObserver::new(Vec::new())
+            .with_reactions()
+            .with_sensors()
+            .with_energy_balance();
+        let mut s = State::consistent(&sys, 0.0).unwrap();
+        let mut rk = Index1Rk::new(&sys, ButcherTableau::rk4(), Index1Options::default()).unwrap();
+        run(&mut rk, &sys, &mut s, RunConfig::new(0.05, 0.01), &mut csv).unwrap();
+        assert_eq!(csv.solve.as_ref().map(OutputSolve::solves), Some(6));
+        let row = csv.row(&sys, &s).unwrap().to_vec();
+        assert_eq!(csv.solve.as_ref().map(OutputSolve::solves), Some(6));
+        let mut rs = ReactionSolver::new(&sys).unwrap();
+        let mut out = vec![JointReaction::default(); 1];
+        rs.compute(&sys, &s, &mut out).unwrap();
+        let mut sensors = Vec::new();
+        SensorSolver::new(&sys)
+            .unwrap()
+            .evaluate(&sys, &s, &mut sensors)
+            .unwrap();
+        let head = csv.columns(&sys);
+        let at = |c: &str| head.iter().position(|h| h == c).unwrap();
+        let pin = &sys.joints()[0].name;
+        assert_eq!(row[at(&format!("{pin}.fx"))], out[0].force[0]);
+        assert_eq!(row[at(&format!("{pin}.mz"))], out[0].moment);
+        assert_eq!(row[at("tip.ax")..at("tip.ay") + 1], sensors[4..6]);
     }
 
     #[test]

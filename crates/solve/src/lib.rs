@@ -59,6 +59,7 @@ mod index1;
 mod integrator;
 pub mod linalg;
 mod newton;
+mod output_solve;
 mod projection;
 pub mod quadrature;
 mod reactions;
@@ -84,6 +85,7 @@ pub use integrator::{
     MAX_FIXED_STEPS,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
+pub use output_solve::OutputSolve;
 pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_ROUNDOFF_FACTOR};
 pub use reactions::{JointReaction, ReactionSolver};
 pub use sensors::SensorSolver;

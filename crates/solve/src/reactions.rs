@@ -20,9 +20,8 @@
 //! determine it), and the reported split puts it on the joints of the independent equations
 //! (docs/architecture.md, "Redundant constraints").
 
-use crate::accel::Accel;
 use crate::error::SolveError;
-use crate::sparse::LinearSolver;
+use crate::output_solve::OutputSolve;
 use crate::state::State;
 use mbd_model::{JointElement, System};
 
@@ -59,21 +58,18 @@ pub struct JointReaction {
 /// ```
 #[derive(Debug)]
 pub struct ReactionSolver {
-    acc: Accel,
+    /// The index-1 solve, built at the first use of [`ReactionSolver::compute`] or
+    /// [`ReactionSolver::multipliers`] (not needed by [`ReactionSolver::compute_with`]).
+    solve: Option<OutputSolve>,
     grads: Vec<[f64; 6]>,
-    a: Vec<f64>,
-    lambda: Vec<f64>,
 }
 
 impl ReactionSolver {
     /// A workspace for `sys`.
     pub fn new(sys: &System) -> Result<Self, SolveError> {
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
         Ok(ReactionSolver {
-            acc: Accel::new(sys, LinearSolver::Auto)?,
-            grads: vec![[0.0; 6]; m],
-            a: vec![0.0; n],
-            lambda: vec![0.0; m],
+            solve: None,
+            grads: vec![[0.0; 6]; sys.n_constraints()],
         })
     }
 
@@ -81,11 +77,7 @@ impl ReactionSolver {
     /// [`System::equation_names`]) at `state`; errors as the index-1 solve (a singular
     /// configuration names its equation).
     pub fn multipliers(&mut self, sys: &System, state: &State) -> Result<&[f64], SolveError> {
-        state.check(sys)?;
-        let (q, v) = (state.q.as_slice(), state.v.as_slice());
-        self.acc
-            .solve(sys, q, v, state.t, &mut self.a, &mut self.lambda)?;
-        Ok(&self.lambda)
+        Ok(OutputSolve::lazy(&mut self.solve, sys)?.at(sys, state)?.1)
     }
 
     /// The reactions of every joint (in the order of [`System::joints`]) at `state` into
@@ -96,62 +88,93 @@ impl ReactionSolver {
         state: &State,
         out: &mut [JointReaction],
     ) -> Result<(), SolveError> {
-        if out.len() != sys.joints().len() {
+        let (_, lambda) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, state)?;
+        reactions(&mut self.grads, sys, state, lambda, out)
+    }
+
+    /// [`ReactionSolver::compute`] from the multipliers `lambda` at `state` solved elsewhere
+    /// (an [`OutputSolve`] shared with other outputs of the same row).
+    pub fn compute_with(
+        &mut self,
+        sys: &System,
+        state: &State,
+        lambda: &[f64],
+        out: &mut [JointReaction],
+    ) -> Result<(), SolveError> {
+        state.check(sys)?;
+        if lambda.len() != sys.n_constraints() {
             return Err(SolveError::Dimension {
-                what: "reactions (one per joint)",
-                expected: sys.joints().len(),
-                got: out.len(),
+                what: "lambda",
+                expected: sys.n_constraints(),
+                got: lambda.len(),
             });
         }
-        self.multipliers(sys, state)?;
-        let q = state.q.as_slice();
-        sys.phi_q_local(q, &mut self.grads);
-        let body = |i: usize| ([q[3 * i], q[3 * i + 1]], q[3 * i + 2]);
-        let global = |i: Option<usize>, p: [f64; 2]| match i {
-            Some(i) => {
-                let (r, th) = body(i);
-                let (s, c) = th.sin_cos();
-                [r[0] + c * p[0] - s * p[1], r[1] + s * p[0] + c * p[1]]
-            }
-            None => p,
-        };
-        for (JointElement { joint, attach, row }, res) in sys.joint_elements().zip(out.iter_mut()) {
-            // the joint's generalised force on each side: -Phi_q,j^T lambda_j
-            let mut g = [0.0; 6];
-            for k in 0..joint.n_equations() {
-                let l = self.lambda[row + k];
-                for (gi, &d) in g.iter_mut().zip(&self.grads[row + k]) {
-                    *gi -= l * d;
-                }
-            }
-            let sketch = joint.sketch();
-            // the load on side b, or by action and reaction the negative of side a's
-            let (side, f, tau, sign) = match attach.b {
-                Some(_) => (attach.b, [g[3], g[4]], g[5], 1.0),
-                None => (attach.a, [g[0], g[1]], g[2], -1.0),
-            };
-            let point = match sketch.point_b {
-                Some(p) => global(attach.b, p),
-                None => attach.b.or(attach.a).map_or([0.0; 2], |i| body(i).0),
-            };
-            // the moment about the point of the side the force acts on
-            let centre = side.map_or(point, |i| body(i).0);
-            let m = tau + (centre[0] - point[0]) * f[1] - (centre[1] - point[1]) * f[0];
-            let force = [sign * f[0], sign * f[1]];
-            let local_force = match attach.b {
-                Some(i) => {
-                    let (s, c) = body(i).1.sin_cos();
-                    [c * force[0] + s * force[1], -s * force[0] + c * force[1]]
-                }
-                None => force,
-            };
-            *res = JointReaction {
-                force,
-                local_force,
-                moment: sign * m,
-                point,
-            };
-        }
-        Ok(())
+        reactions(&mut self.grads, sys, state, lambda, out)
     }
+}
+
+/// The joints' reactions from the multipliers (see the module docs).
+fn reactions(
+    grads: &mut [[f64; 6]],
+    sys: &System,
+    state: &State,
+    lambda: &[f64],
+    out: &mut [JointReaction],
+) -> Result<(), SolveError> {
+    if out.len() != sys.joints().len() {
+        return Err(SolveError::Dimension {
+            what: "reactions (one per joint)",
+            expected: sys.joints().len(),
+            got: out.len(),
+        });
+    }
+    let q = state.q.as_slice();
+    sys.phi_q_local(q, grads);
+    let body = |i: usize| ([q[3 * i], q[3 * i + 1]], q[3 * i + 2]);
+    let global = |i: Option<usize>, p: [f64; 2]| match i {
+        Some(i) => {
+            let (r, th) = body(i);
+            let (s, c) = th.sin_cos();
+            [r[0] + c * p[0] - s * p[1], r[1] + s * p[0] + c * p[1]]
+        }
+        None => p,
+    };
+    for (JointElement { joint, attach, row }, res) in sys.joint_elements().zip(out.iter_mut()) {
+        // the joint's generalised force on each side: -Phi_q,j^T lambda_j
+        let mut g = [0.0; 6];
+        for k in 0..joint.n_equations() {
+            let l = lambda[row + k];
+            for (gi, &d) in g.iter_mut().zip(&grads[row + k]) {
+                *gi -= l * d;
+            }
+        }
+        let sketch = joint.sketch();
+        // the load on side b, or by action and reaction the negative of side a's
+        let (side, f, tau, sign) = match attach.b {
+            Some(_) => (attach.b, [g[3], g[4]], g[5], 1.0),
+            None => (attach.a, [g[0], g[1]], g[2], -1.0),
+        };
+        let point = match sketch.point_b {
+            Some(p) => global(attach.b, p),
+            None => attach.b.or(attach.a).map_or([0.0; 2], |i| body(i).0),
+        };
+        // the moment about the point of the side the force acts on
+        let centre = side.map_or(point, |i| body(i).0);
+        let m = tau + (centre[0] - point[0]) * f[1] - (centre[1] - point[1]) * f[0];
+        let force = [sign * f[0], sign * f[1]];
+        let local_force = match attach.b {
+            Some(i) => {
+                let (s, c) = body(i).1.sin_cos();
+                [c * force[0] + s * force[1], -s * force[0] + c * force[1]]
+            }
+            None => force,
+        };
+        *res = JointReaction {
+            force,
+            local_force,
+            moment: sign * m,
+            point,
+        };
+    }
+    Ok(())
 }

@@ -9,9 +9,8 @@
 //! `omega_b - omega_a`; a prismatic joint's slide is `s = (r_pb - r_pa) . u` with `u` its unit
 //! axis turned with body `a`, and `ds = (v_pb - v_pa) . u + (r_pb - r_pa) . (omega_a k x u)`.
 
-use crate::accel::Accel;
 use crate::error::SolveError;
-use crate::sparse::LinearSolver;
+use crate::output_solve::OutputSolve;
 use crate::state::State;
 use mbd_model::{Attach, SensorKind, System};
 
@@ -38,9 +37,10 @@ use mbd_model::{Attach, SensorKind, System};
 /// ```
 #[derive(Debug)]
 pub struct SensorSolver {
-    acc: Accel,
-    a: Vec<f64>,
-    lambda: Vec<f64>,
+    /// The index-1 solve, built at the first [`SensorSolver::evaluate`] that needs it.
+    solve: Option<OutputSolve>,
+    /// Accelerations when no sensor needs them.
+    zeros: Vec<f64>,
     /// Each joint's attachment (for the joint sensors).
     attach: Vec<Attach>,
     /// Whether a sensor needs the accelerations.
@@ -51,9 +51,8 @@ impl SensorSolver {
     /// A workspace for `sys`.
     pub fn new(sys: &System) -> Result<Self, SolveError> {
         Ok(SensorSolver {
-            acc: Accel::new(sys, LinearSolver::Auto)?,
-            a: vec![0.0; sys.n_coords()],
-            lambda: vec![0.0; sys.n_constraints()],
+            solve: None,
+            zeros: vec![0.0; sys.n_coords()],
             attach: sys.joint_elements().map(|e| e.attach).collect(),
             needs_acceleration: sys
                 .sensors()
@@ -94,60 +93,93 @@ impl SensorSolver {
         state: &State,
         out: &mut Vec<f64>,
     ) -> Result<(), SolveError> {
-        state.check(sys)?;
-        let (q, v) = (state.q.as_slice(), state.v.as_slice());
-        if self.needs_acceleration {
-            self.acc
-                .solve(sys, q, v, state.t, &mut self.a, &mut self.lambda)?;
-        }
-        let a = &self.a;
-        // a body point's position, velocity and acceleration (ground: fixed)
-        let kinematics = |i: Option<usize>, p: [f64; 2]| -> [[f64; 2]; 3] {
-            let Some(i) = i else {
-                return [p, [0.0; 2], [0.0; 2]];
-            };
-            let (s, c) = q[3 * i + 2].sin_cos();
-            let rp = [c * p[0] - s * p[1], s * p[0] + c * p[1]];
-            let (w, al) = (v[3 * i + 2], a[3 * i + 2]);
-            [
-                [q[3 * i] + rp[0], q[3 * i + 1] + rp[1]],
-                [v[3 * i] - w * rp[1], v[3 * i + 1] + w * rp[0]],
-                [
-                    a[3 * i] - al * rp[1] - w * w * rp[0],
-                    a[3 * i + 1] + al * rp[0] - w * w * rp[1],
-                ],
-            ]
+        let a = if self.needs_acceleration {
+            OutputSolve::lazy(&mut self.solve, sys)?.at(sys, state)?.0
+        } else {
+            state.check(sys)?;
+            &self.zeros
         };
-        let angle = |i: Option<usize>| i.map_or((0.0, 0.0), |i| (q[3 * i + 2], v[3 * i + 2]));
-        for s in sys.sensors() {
-            match &s.kind {
-                SensorKind::Point { body, point } => {
-                    let [r, vp, ap] = kinematics(body.index(), *point);
-                    out.extend([r[0], r[1], vp[0], vp[1], ap[0], ap[1]]);
-                }
-                SensorKind::Joint { joint } => {
-                    let at = self.attach[joint.index()];
-                    let ((ta, wa), (tb, wb)) = (angle(at.a), angle(at.b));
-                    out.extend([tb - ta, wb - wa]);
-                    let sketch = sys.joints()[joint.index()].sketch();
-                    if let Some(axis) = sketch.axis {
-                        // (no acceleration needed: kinematics' third entry is unused here)
-                        let [ra, va, _] = kinematics(at.a, sketch.point_a.unwrap_or_default());
-                        let [rb, vb, _] = kinematics(at.b, sketch.point_b.unwrap_or_default());
-                        let (sn, cs) = ta.sin_cos();
-                        let u = [cs * axis[0] - sn * axis[1], sn * axis[0] + cs * axis[1]];
-                        let du = [-wa * u[1], wa * u[0]];
-                        let d = [rb[0] - ra[0], rb[1] - ra[1]];
-                        let dd = [vb[0] - va[0], vb[1] - va[1]];
-                        out.extend([
-                            d[0] * u[0] + d[1] * u[1],
-                            dd[0] * u[0] + dd[1] * u[1] + d[0] * du[0] + d[1] * du[1],
-                        ]);
-                    }
-                }
-                _ => {}
-            }
-        }
+        values(&self.attach, sys, state, a, out);
         Ok(())
+    }
+
+    /// Whether a sensor needs the accelerations (a point sensor): what
+    /// [`SensorSolver::evaluate_with`] is to be given.
+    pub fn needs_acceleration(&self) -> bool {
+        self.needs_acceleration
+    }
+
+    /// [`SensorSolver::evaluate`] with the accelerations `a` at `state` solved elsewhere (an
+    /// [`crate::OutputSolve`] shared with other outputs of the same row; any values when no
+    /// sensor [needs them](SensorSolver::needs_acceleration)).
+    pub fn evaluate_with(
+        &self,
+        sys: &System,
+        state: &State,
+        a: &[f64],
+        out: &mut Vec<f64>,
+    ) -> Result<(), SolveError> {
+        state.check(sys)?;
+        if a.len() != sys.n_coords() {
+            return Err(SolveError::Dimension {
+                what: "a",
+                expected: sys.n_coords(),
+                got: a.len(),
+            });
+        }
+        values(&self.attach, sys, state, a, out);
+        Ok(())
+    }
+}
+
+/// The sensors' values from the state and its accelerations (see the module docs).
+fn values(attach: &[Attach], sys: &System, state: &State, a: &[f64], out: &mut Vec<f64>) {
+    let (q, v) = (state.q.as_slice(), state.v.as_slice());
+    // a body point's position, velocity and acceleration (ground: fixed)
+    let kinematics = |i: Option<usize>, p: [f64; 2]| -> [[f64; 2]; 3] {
+        let Some(i) = i else {
+            return [p, [0.0; 2], [0.0; 2]];
+        };
+        let (s, c) = q[3 * i + 2].sin_cos();
+        let rp = [c * p[0] - s * p[1], s * p[0] + c * p[1]];
+        let (w, al) = (v[3 * i + 2], a[3 * i + 2]);
+        [
+            [q[3 * i] + rp[0], q[3 * i + 1] + rp[1]],
+            [v[3 * i] - w * rp[1], v[3 * i + 1] + w * rp[0]],
+            [
+                a[3 * i] - al * rp[1] - w * w * rp[0],
+                a[3 * i + 1] + al * rp[0] - w * w * rp[1],
+            ],
+        ]
+    };
+    let angle = |i: Option<usize>| i.map_or((0.0, 0.0), |i| (q[3 * i + 2], v[3 * i + 2]));
+    for s in sys.sensors() {
+        match &s.kind {
+            SensorKind::Point { body, point } => {
+                let [r, vp, ap] = kinematics(body.index(), *point);
+                out.extend([r[0], r[1], vp[0], vp[1], ap[0], ap[1]]);
+            }
+            SensorKind::Joint { joint } => {
+                let at = attach[joint.index()];
+                let ((ta, wa), (tb, wb)) = (angle(at.a), angle(at.b));
+                out.extend([tb - ta, wb - wa]);
+                let sketch = sys.joints()[joint.index()].sketch();
+                if let Some(axis) = sketch.axis {
+                    // (no acceleration needed: kinematics' third entry is unused here)
+                    let [ra, va, _] = kinematics(at.a, sketch.point_a.unwrap_or_default());
+                    let [rb, vb, _] = kinematics(at.b, sketch.point_b.unwrap_or_default());
+                    let (sn, cs) = ta.sin_cos();
+                    let u = [cs * axis[0] - sn * axis[1], sn * axis[0] + cs * axis[1]];
+                    let du = [-wa * u[1], wa * u[0]];
+                    let d = [rb[0] - ra[0], rb[1] - ra[1]];
+                    let dd = [vb[0] - va[0], vb[1] - va[1]];
+                    out.extend([
+                        d[0] * u[0] + d[1] * u[1],
+                        dd[0] * u[0] + dd[1] * u[1] + d[0] * du[0] + d[1] * du[1],
+                    ]);
+                }
+            }
+            _ => {}
+        }
     }
 }
