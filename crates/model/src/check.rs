@@ -61,6 +61,20 @@ pub(crate) fn point(element: &str, parameter: &'static str, p: [f64; 2]) -> Resu
     finite(element, parameter, p[1])
 }
 
+/// A direction must be finite and non-zero; it is normalised in place (the sliding axis of a
+/// prismatic joint or slide driver).
+pub(crate) fn unit_axis(
+    element: &str,
+    parameter: &'static str,
+    axis: &mut [f64; 2],
+) -> Result<(), ModelError> {
+    point(element, parameter, *axis)?;
+    let len = (axis[0] * axis[0] + axis[1] * axis[1]).sqrt();
+    positive(element, "axis length", len)?;
+    *axis = [axis[0] / len, axis[1] / len];
+    Ok(())
+}
+
 /// Every coefficient of a time function must be finite, and a step's or ramp's end after its
 /// start.
 pub(crate) fn time_function(

@@ -19,6 +19,27 @@ pub struct Sketch {
     pub axis: Option<[f64; 2]>,
 }
 
+impl Sketch {
+    /// An element sliding a point of `b` along an axis of `a` (prismatic joints, slide
+    /// drivers); `axis` is normalised here (a zero one draws no axis).
+    pub(crate) fn sliding(
+        a: BodyRef,
+        pa: [f64; 2],
+        b: BodyRef,
+        pb: [f64; 2],
+        axis: [f64; 2],
+    ) -> Sketch {
+        let n = axis[0].hypot(axis[1]);
+        Sketch {
+            a,
+            point_a: Some(pa),
+            b,
+            point_b: Some(pb),
+            axis: (n > 0.0).then(|| [axis[0] / n, axis[1] / n]),
+        }
+    }
+}
+
 /// A body-fixed point of an element with the body it is on and the name of its parameter
 /// (`point_a`, `point_b`, `point`): what body-frame lowering and point-mass checks visit.
 pub(crate) struct Anchor<'a> {

@@ -61,22 +61,11 @@ impl JointType for Prismatic {
     fn validate(&mut self, element: &str) -> Result<(), ModelError> {
         check::point(element, "point_a", self.pa)?;
         check::point(element, "point_b", self.pb)?;
-        check::point(element, "axis", self.axis)?;
         check::finite(element, "angle", self.angle)?;
-        let len = (self.axis[0] * self.axis[0] + self.axis[1] * self.axis[1]).sqrt();
-        check::positive(element, "axis length", len)?;
-        self.axis = [self.axis[0] / len, self.axis[1] / len];
-        Ok(())
+        check::unit_axis(element, "axis", &mut self.axis)
     }
     fn sketch(&self) -> Sketch {
-        let n = self.axis[0].hypot(self.axis[1]);
-        Sketch {
-            a: self.a,
-            point_a: Some(self.pa),
-            b: self.b,
-            point_b: Some(self.pb),
-            axis: (n > 0.0).then(|| [self.axis[0] / n, self.axis[1] / n]),
-        }
+        Sketch::sliding(self.a, self.pa, self.b, self.pb, self.axis)
     }
     fn to_spec(&self, name: String, name_of: &dyn Fn(BodyRef) -> String) -> JointSpec {
         JointSpec::Prismatic(PrismaticSpec {
