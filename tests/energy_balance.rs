@@ -38,10 +38,10 @@ fn models() -> Vec<(&'static str, System)> {
     ]
 }
 
-/// Symplectic (2,2) at h = 1e-3 over 2 s: the balance's residual at most 2e-8 of max |H|
-/// (measured: 1.5e-8 on the damped slider-crank, the solver's own energy error at this h, and
-/// 2e-11 on the driven arm), while H changes by more than 1e-3 of it (so the balance, not
-/// conservation, closes it).
+/// Symplectic (2,2) at h = 1e-3 over 2 s: the balance's residual at most 1e-8 of max |H| (the
+/// issue's target; measured: 2.0e-9 on the damped slider-crank and 1.9e-13 on the driven
+/// arm), while H changes by more than 1e-3 of it (so the balance, not conservation, closes
+/// it).
 #[test]
 fn symplectic_22_closes_the_balance_to_1e_8() {
     for (name, sys) in models() {
@@ -53,19 +53,20 @@ fn symplectic_22_closes_the_balance_to_1e_8() {
             eb.external_work(),
             eb.dissipated()
         );
-        assert!(rel <= 2e-8, "{name}: {rel:e}");
+        assert!(rel <= 1e-8, "{name}: {rel:e}");
         assert!(change > 1e-3 * eb.max_energy(), "{name}: {change:e}");
         assert!(eb.dissipated() >= 0.0);
     }
 }
 
 /// RK4 (projected) closes it to its order: halving h cuts the residual about 16x (measured
-/// orders 4.1 and 4.0 between h = 4e-3 and 2e-3).
+/// orders 3.9 and 4.0 between h = 2e-3 and 1e-3; between 4e-3 and 2e-3 the damped
+/// slider-crank's spring, at omega h = 0.08, is not yet asymptotic: 3.5).
 #[test]
 fn rk4_closes_the_balance_at_its_order() {
     for (name, sys) in models() {
-        let (a, _) = balance(sys.clone(), "rk4-projected", 4e-3, 1.0);
-        let (b, _) = balance(sys, "rk4-projected", 2e-3, 1.0);
+        let (a, _) = balance(sys.clone(), "rk4-projected", 2e-3, 1.0);
+        let (b, _) = balance(sys, "rk4-projected", 1e-3, 1.0);
         let order = (a.max_residual() / b.max_residual()).log2();
         eprintln!(
             "{name}: residuals {:.2e}, {:.2e} of max|H|: order {order:.2}",
