@@ -647,19 +647,7 @@ fn run_creates_the_output_folder() {
     let d = scratch("run-out-folder");
     let csv = d.join("new").join("sub").join("pendulum.csv");
     assert!(!csv.parent().unwrap().exists());
-    let out = mbd([
-        "run".as_ref(),
-        "examples/models/pendulum.toml".as_ref(),
-        "--solver".as_ref(),
-        "rk4".as_ref(),
-        "--t-end".as_ref(),
-        "0.1".as_ref(),
-        "--h".as_ref(),
-        "0.01".as_ref(),
-        "--out".as_ref(),
-        csv.as_os_str(),
-    ]);
-    assert_eq!(out.code, 0, "{}", out.stderr);
+    common::run_pendulum_to(&csv);
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text.lines().count(), 12, "{text}");
 }

@@ -74,6 +74,12 @@ pub fn assert_fails(out: &Out, code: i32, needles: &[&str]) {
 /// A CSV of a short pendulum run, written to `dir`.
 pub fn pendulum_csv(dir: &Path) -> PathBuf {
     let csv = dir.join("pendulum.csv");
+    run_pendulum_to(&csv);
+    csv
+}
+
+/// Runs the example pendulum for 0.1 s with RK4 (h = 0.01) into `csv`; the run must succeed.
+pub fn run_pendulum_to(csv: &Path) {
     let out = mbd([
         "run".as_ref(),
         "examples/models/pendulum.toml".as_ref(),
@@ -87,5 +93,4 @@ pub fn pendulum_csv(dir: &Path) -> PathBuf {
         csv.as_os_str(),
     ]);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    csv
 }
