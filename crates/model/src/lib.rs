@@ -66,6 +66,7 @@ pub mod models;
 mod rows;
 mod scale;
 mod sensors;
+pub mod spatial;
 mod system;
 mod timefn;
 

@@ -1,0 +1,188 @@
+use super::*;
+use nalgebra::{DMatrix, Matrix3, Vector3};
+
+fn top_like() -> SpatialInertia {
+    // a tensor about a point off the centre of mass, with products of inertia
+    let t = Matrix3::new(2.0, -0.3, 0.1, -0.3, 3.0, 0.2, 0.1, 0.2, 2.5);
+    SpatialInertia::from_tensor(1.5, t, Vector3::new(0.2, -0.1, 0.3)).unwrap()
+}
+
+fn rotation() -> Matrix3<f64> {
+    Orientation::Quaternion([0.8, 0.1, -0.4, 0.3])
+        .matrix()
+        .unwrap()
+}
+
+/// 1/2 q'^T M q' equals 1/2 m |v|^2 + 1/2 omega_p . J omega_p (omega in principal axes): the
+/// constant diagonal mass matrix carries the whole kinetic energy.
+#[test]
+fn the_diagonal_mass_matrix_gives_the_kinetic_energy() {
+    let inertia = top_like();
+    let r = rotation() * inertia.axes();
+    let (v, omega) = (Vector3::new(0.3, -1.2, 0.7), Vector3::new(2.0, -0.5, 1.1));
+    let qd = director_velocities(v, omega, &r);
+    let m = inertia.mass_diagonal();
+    let t_natural: f64 = 0.5 * (0..12).map(|k| m[k] * qd[k] * qd[k]).sum::<f64>();
+    let wp = r.transpose() * omega;
+    let j = inertia.moments();
+    let t_rigid = 0.5 * inertia.mass() * v.norm_squared()
+        + 0.5 * (0..3).map(|i| j[i] * wp[i] * wp[i]).sum::<f64>();
+    assert!(
+        (t_natural - t_rigid).abs() < 1e-13 * t_rigid,
+        "{t_natural} {t_rigid}"
+    );
+}
+
+/// The internal constraints vanish on a rotation, their Jacobian matches central differences
+/// and annihilates the velocities of a rigid motion.
+#[test]
+fn internal_constraints_and_their_jacobian() {
+    let r = rotation();
+    let q = natural_coordinates(Vector3::new(1.0, 2.0, 3.0), &r);
+    assert!(internal_constraints(&q).iter().all(|c| c.abs() < 1e-15));
+    let qd = director_velocities(
+        Vector3::new(0.1, 0.2, 0.3),
+        Vector3::new(1.0, -2.0, 0.5),
+        &r,
+    );
+    let j = internal_jacobian(&q);
+    for row in &j {
+        let rate: f64 = row.iter().zip(&qd).map(|(a, b)| a * b).sum();
+        assert!(rate.abs() < 1e-14, "{rate}");
+    }
+    // an arbitrary (non-rigid) point for the differences
+    let x: [f64; 12] = std::array::from_fn(|k| 0.3 + 0.21 * k as f64 - 0.05 * (k * k) as f64);
+    let j = internal_jacobian(&x);
+    for c in 0..12 {
+        let (mut p, mut m) = (x, x);
+        p[c] += 1e-6;
+        m[c] -= 1e-6;
+        let (fp, fm) = (internal_constraints(&p), internal_constraints(&m));
+        for r in 0..6 {
+            let fd = (fp[r] - fm[r]) / 2e-6;
+            assert!((j[r][c] - fd).abs() < 1e-8, "({r}, {c}): {} {fd}", j[r][c]);
+        }
+    }
+}
+
+/// A body point's position is linear in the coordinates and follows the rotation.
+#[test]
+fn points_ride_on_the_directors() {
+    let r = rotation();
+    let x = Vector3::new(1.0, -1.0, 0.5);
+    let q = natural_coordinates(x, &r);
+    let p = Vector3::new(0.2, -0.7, 1.3);
+    assert!((point_position(&q, p) - (x + r * p)).amax() < 1e-15);
+}
+
+/// The parallel-axis theorem and the diagonalisation: a slender rod's tensor about its end
+/// gives m l^2 / 12 about its centre; a rotated tensor gives its principal moments back with
+/// axes that diagonalise it.
+#[test]
+fn tensors_are_moved_to_the_centre_and_diagonalised() {
+    let (m, l) = (2.0, 3.0);
+    let end = Matrix3::from_diagonal(&Vector3::new(0.0, m * l * l / 3.0, m * l * l / 3.0));
+    let rod = SpatialInertia::from_tensor(m, end, Vector3::new(l / 2.0, 0.0, 0.0)).unwrap();
+    let j = rod.moments();
+    assert!(
+        j[0].abs() < 1e-14 && (j[1] - m * l * l / 12.0).abs() < 1e-13,
+        "{j:?}"
+    );
+    assert!((j[2] - m * l * l / 12.0).abs() < 1e-13, "{j:?}");
+    let r = rotation();
+    let moments = [1.0, 2.0, 2.5];
+    let t = r * Matrix3::from_diagonal(&Vector3::from(moments)) * r.transpose();
+    let b = SpatialInertia::from_tensor(1.0, t, Vector3::zeros()).unwrap();
+    for (a, w) in b.moments().iter().zip(moments) {
+        assert!((a - w).abs() < 1e-13, "{:?}", b.moments());
+    }
+    let a = b.axes();
+    let d = a.transpose() * t * a;
+    assert!((d - Matrix3::from_diagonal(&d.diagonal())).amax() < 1e-13);
+    assert!((a.determinant() - 1.0).abs() < 1e-13);
+}
+
+/// The symmetric top J = (a, 2a, a): M is singular (E_2 = 0), but the KKT matrix of M with the
+/// internal constraints' Jacobian is regular: the smallest singular value stays of the order
+/// of the others.
+#[test]
+fn a_singular_mass_matrix_leaves_the_kkt_matrix_regular() {
+    let top = SpatialInertia::principal(1.0, [0.5, 1.0, 0.5]).unwrap();
+    assert!(top.has_singular_mass_matrix());
+    assert!(!top_like().has_singular_mass_matrix());
+    let q = natural_coordinates(Vector3::zeros(), &rotation());
+    let j = internal_jacobian(&q);
+    let m = top.mass_diagonal();
+    let mut kkt = DMatrix::zeros(18, 18);
+    for k in 0..12 {
+        kkt[(k, k)] = m[k];
+    }
+    for r in 0..6 {
+        for c in 0..12 {
+            kkt[(12 + r, c)] = j[r][c];
+            kkt[(c, 12 + r)] = j[r][c];
+        }
+    }
+    let sv = kkt.singular_values();
+    let (lo, hi) = (sv.min(), sv.max());
+    assert!(lo > 1e-2 * hi, "condition {}", hi / lo);
+    assert_eq!(m[6..9], [0.0; 3]);
+}
+
+#[test]
+fn bad_inertias_and_orientations_are_refused() {
+    let e = SpatialInertia::principal(1.0, [1.0, 1.0, 3.0]).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("J3 = 3e0 exceeds the sum of the other two"),
+        "{e}"
+    );
+    let e = SpatialInertia::principal(0.0, [1.0, 1.0, 1.0]).unwrap_err();
+    assert_eq!(e.to_string(), "mass 0 must be positive and finite");
+    let e = SpatialInertia::principal(1.0, [1.0, f64::NAN, 1.0]).unwrap_err();
+    assert_eq!(e.to_string(), "the principal moments must be finite");
+    let mut t = Matrix3::identity();
+    t[(0, 1)] = 0.5;
+    let e = SpatialInertia::from_tensor(1.0, t, Vector3::zeros()).unwrap_err();
+    assert!(e.to_string().contains("not symmetric"), "{e}");
+    let flip = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
+    let e = SpatialInertia::principal_with_axes(1.0, [1.0, 1.0, 1.0], flip).unwrap_err();
+    assert!(e.to_string().contains("det A = -1"), "{e}");
+    let e = Orientation::Quaternion([0.0; 4]).matrix().unwrap_err();
+    assert!(e.contains("non-zero"), "{e}");
+    let e = Orientation::Matrix(Matrix3::identity() * 2.0)
+        .matrix()
+        .unwrap_err();
+    assert!(e.contains("not a rotation"), "{e}");
+}
+
+/// Euler sequences compose their elementary rotations in order; the three sequences agree with
+/// the quaternion of the same rotation.
+#[test]
+fn euler_sequences() {
+    use std::f64::consts::FRAC_PI_2;
+    let r = Orientation::Euler(EulerSequence::Zyx, [FRAC_PI_2, FRAC_PI_2, 0.0])
+        .matrix()
+        .unwrap();
+    // yaw 90 deg then pitch 90 deg about the new y: the body x axis points down
+    assert!(
+        (r.column(0) - Vector3::new(0.0, 0.0, -1.0)).amax() < 1e-15,
+        "{r}"
+    );
+    let q = rotation();
+    let (yaw, pitch, roll) = {
+        let rot = nalgebra::Rotation3::from_matrix_unchecked(q);
+        let (roll, pitch, yaw) = rot.euler_angles();
+        (yaw, pitch, roll)
+    };
+    let e = Orientation::Euler(EulerSequence::Zyx, [yaw, pitch, roll])
+        .matrix()
+        .unwrap();
+    assert!((e - q).amax() < 1e-14, "{e} {q}");
+    let omega_body = Vector3::new(0.1, 0.2, 0.3);
+    assert_eq!(
+        global_angular_velocity(omega_body, true, &q),
+        q * omega_body
+    );
+    assert_eq!(global_angular_velocity(omega_body, false, &q), omega_body);
+}
