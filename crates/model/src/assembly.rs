@@ -1,24 +1,4 @@
-//! Assembly from joint coordinates: a model may give the initial relative angle of revolute
-//! joints and the initial slide of prismatic joints (and their rates) instead of placing every
-//! body by hand.
-//!
-//! Two steps turn them into a consistent initial state:
-//!
-//! 1. **Tree placement** ([`System::initial_guess`]): starting from the ground, every revolute
-//!    or prismatic joint with one side placed places the other side so that the joint holds
-//!    exactly: a revolute joint's bodies keep the given relative angle `theta_b - theta_a`
-//!    (or, when none is given, the one of the bodies' stored poses) and their joint points
-//!    coincide; a prismatic joint's bodies keep its fixed relative angle and the given slide
-//!    `s = (P_b - P_a) . u_a` (or the stored one) with no offset across the axis. Velocities
-//!    follow in the same order from the rates (`omega_b - omega_a`, `ds/dt`) and the joint
-//!    points' velocities. Bodies no such joint reaches keep their stored state.
-//! 2. **Projection with the joint coordinates held** (`mbd_solve::consistent_state`): the
-//!    loops the tree left open are closed by the usual projection onto the constraints, with a
-//!    temporary driver per given coordinate (an angle or slide driver, constant at the given
-//!    value) and then per given rate (a driver with that rate), so the given values are kept
-//!    exactly and the other coordinates take up the correction ([`System::with_joint_drivers`]).
-//!    Coordinates the constraints already fix, or more coordinates than degrees of freedom,
-//!    make the drivers redundant: the projection's rank check names them.
+//! Assembly from joint coordinates (see [`JointInitial`]).
 
 use crate::builder::SystemBuilder;
 use crate::error::ModelError;
@@ -31,6 +11,29 @@ use serde::{Deserialize, Serialize};
 /// A joint's initial relative coordinate and rate: the angle `theta_b - theta_a` (rad) and its
 /// rate (rad/s) of a revolute joint, the slide `s` (m) and its rate (m/s) of a prismatic joint.
 /// Either may be left out (`None`): it is then taken from the bodies' stored state.
+///
+/// Assembly from joint coordinates: a model may give the initial relative angle of revolute
+/// joints and the initial slide of prismatic joints (and their rates) instead of placing every
+/// body by hand.
+///
+/// Two steps turn them into a consistent initial state:
+///
+/// 1. **Tree placement** ([`System::initial_guess`]): starting from the ground, every revolute
+///    or prismatic joint with one side placed places the other side so that the joint holds
+///    exactly: a revolute joint's bodies keep the given relative angle `theta_b - theta_a`
+///    (or, when none is given, the one of the bodies' stored poses) and their joint points
+///    coincide; a prismatic joint's bodies keep its fixed relative angle and the given slide
+///    `s = (P_b - P_a) . u_a` (or the stored one) with no offset across the axis. Velocities
+///    follow in the same order from the rates (`omega_b - omega_a`, `ds/dt`) and the joint
+///    points' velocities. Bodies no such joint reaches keep their stored state.
+/// 2. **Projection with the joint coordinates held** (`mbd_solve::consistent_state`): the
+///    loops the tree left open are closed by the usual projection onto the constraints, with a
+///    temporary driver per given coordinate (an angle or slide driver, constant at the given
+///    value) and then per given rate (a driver with that rate), so the given values are kept
+///    exactly and the other coordinates take up the correction ([`System::with_joint_drivers`]).
+///    More given coordinates (or rates) than degrees of freedom are refused, naming the
+///    joints; a coordinate the constraints already fix makes its driver redundant, and the
+///    projection's rank check names it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct JointInitial {
     /// The relative angle (revolute) or slide (prismatic).
@@ -196,14 +199,14 @@ impl System {
 
     /// Which bodies the initial joint coordinates place (all `false` without them): those a
     /// chain of revolute and prismatic joints reaches from the ground (see the
-    /// [module](self) docs).
+    /// docs of [`JointInitial`]).
     pub fn assembled_bodies(&self) -> Vec<bool> {
         let (mut q, mut v) = self.stored_state();
         self.assemble(&mut q, &mut v)
     }
 
     /// Places the bodies from the given joint coordinates along a spanning tree from the
-    /// ground (see the [module](self) docs); `q`, `v` hold the stored state on entry. Returns
+    /// ground (see the docs of [`JointInitial`]); `q`, `v` hold the stored state on entry. Returns
     /// which bodies it placed.
     pub(crate) fn assemble(&self, q: &mut [f64], v: &mut [f64]) -> Vec<bool> {
         let mut placed = vec![false; self.bodies.len()];
@@ -262,7 +265,7 @@ impl System {
     /// This model with a driver per given joint coordinate (`rates = false`: the given
     /// angles and slides, constant) or per given rate (`rates = true`: a driver through the
     /// joint's coordinate at `(q, t)` with the given rate), the bodies placed at `q`: the
-    /// system whose projection keeps the given values (see the [module](self) docs). The
+    /// system whose projection keeps the given values (see the docs of [`JointInitial`]). The
     /// drivers are named `<joint>:assembly`; forces and sensors are left out. More held values
     /// than the model's degrees of freedom is an error naming the joints.
     pub fn with_joint_drivers(&self, q: &[f64], t: f64, rates: bool) -> Result<System, ModelError> {

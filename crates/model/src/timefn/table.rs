@@ -1,26 +1,4 @@
-//! Tabulated functions of time: samples `(t_i, y_i)` interpolated linearly or by a natural cubic
-//! spline, given inline or read from a CSV file.
-//!
-//! The natural spline `s` is the C2 piecewise cubic through the samples with `s'' = 0` at both
-//! ends. Its second derivatives `M_i = s''(t_i)` solve the tridiagonal system
-//!
-//! ```text
-//! h_{i-1} M_{i-1} + 2 (h_{i-1} + h_i) M_i + h_i M_{i+1} = 6 (d_i - d_{i-1}),   i = 1..n-2,
-//! ```
-//!
-//! with `h_i = t_{i+1} - t_i`, `d_i = (y_{i+1} - y_i) / h_i` and `M_0 = M_{n-1} = 0`
-//! (diagonally dominant, so the Thomas algorithm needs no pivoting). On `[t_i, t_{i+1}]`, with
-//! `a = (t_{i+1} - t) / h_i` and `b = 1 - a`,
-//!
-//! ```text
-//! s   = a y_i + b y_{i+1} + ((a^3 - a) M_i + (b^3 - b) M_{i+1}) h_i^2 / 6
-//! s'  = d_i + (-(3 a^2 - 1) M_i + (3 b^2 - 1) M_{i+1}) h_i / 6
-//! s'' = a M_i + b M_{i+1}.
-//! ```
-//!
-//! The interpolation error of a smooth function is O(h^4) in the value, O(h^3) in the first
-//! and O(h^2) in the second derivative away from the ends (the natural end condition costs
-//! O(h^2) near them unless the function's second derivative vanishes there).
+//! Tabulated functions of time (see [`Table`]).
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -119,7 +97,30 @@ pub enum TableError {
 /// about 40 MB), and a device such as `/dev/zero` is refused instead of read forever.
 pub const MAX_TABLE_FILE_BYTES: u64 = 64 << 20;
 
-/// A tabulated function of time (see the [module](self) docs for the spline's equations).
+/// A tabulated function of time: samples `(t_i, y_i)` interpolated linearly or by a natural
+/// cubic spline, given inline or read from a CSV file.
+///
+/// The natural spline `s` is the C2 piecewise cubic through the samples with `s'' = 0` at both
+/// ends. Its second derivatives `M_i = s''(t_i)` solve the tridiagonal system
+///
+/// ```text
+/// h_{i-1} M_{i-1} + 2 (h_{i-1} + h_i) M_i + h_i M_{i+1} = 6 (d_i - d_{i-1}),   i = 1..n-2,
+/// ```
+///
+/// with `h_i = t_{i+1} - t_i`, `d_i = (y_{i+1} - y_i) / h_i` and `M_0 = M_{n-1} = 0`
+/// (diagonally dominant, so the Thomas algorithm needs no pivoting). On `[t_i, t_{i+1}]`, with
+/// `a = (t_{i+1} - t) / h_i` and `b = 1 - a`,
+///
+/// ```text
+/// s   = a y_i + b y_{i+1} + ((a^3 - a) M_i + (b^3 - b) M_{i+1}) h_i^2 / 6
+/// s'  = d_i + (-(3 a^2 - 1) M_i + (3 b^2 - 1) M_{i+1}) h_i / 6
+/// s'' = a M_i + b M_{i+1}.
+/// ```
+///
+/// The interpolation error of a smooth function is O(h^4) in the value, O(h^3) in the first
+/// and O(h^2) in the second derivative away from the ends (the natural end condition costs
+/// O(h^2) near them unless the function's second derivative vanishes there).
+///
 ///
 /// ```
 /// use mbd_model::{Interpolation, Table, TimeFunction};
