@@ -56,7 +56,7 @@ pub enum SpatialInertiaError {
 /// use mbd_model::spatial::SpatialInertia;
 /// // the heavy symmetric top J = (a, 2a, a): E_2 = 0, a singular mass matrix
 /// let top = SpatialInertia::principal(1.0, [0.5, 1.0, 0.5])?;
-/// assert_eq!(top.second_moments(), [0.25, 0.0, 0.25]);
+/// assert_eq!(top.second_moments(), [0.5, 0.0, 0.5]);
 /// assert!(top.has_singular_mass_matrix());
 /// # Ok::<(), mbd_model::spatial::SpatialInertiaError>(())
 /// ```
