@@ -123,7 +123,7 @@ def test_the_gil_is_released_while_rust_runs(slider):
     done = threading.Event()
 
     def work():
-        slider.run("symplectic:2", t_end=3.0, h=1e-4, every=1000)
+        slider.run("symplectic:2", t_end=8.0, h=1e-4, every=1000)
         done.set()
 
     th = threading.Thread(target=work)
@@ -135,5 +135,5 @@ def test_the_gil_is_released_while_rust_runs(slider):
     th.join()
     elapsed = time.perf_counter() - t0
     # the main thread ran all along: about one tick per 5 ms of the run
-    assert elapsed > 0.1, "the run was too short to tell"
+    assert elapsed > 0.05, "the run was too short to tell"
     assert len(ticks) > 0.3 * elapsed / 0.005
