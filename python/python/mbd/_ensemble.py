@@ -45,7 +45,7 @@ class EnsembleResult(list):  # type: ignore[type-arg]
     @property
     def failures(self) -> List[Tuple[int, MbdError]]:
         """``(index, exception)`` of every failed member."""
-        return [(i, m) for i, m in enumerate(self) if isinstance(m, BaseException)]
+        return [(i, m) for i, m in enumerate(self) if isinstance(m, MbdError)]
 
     @property
     def ok(self) -> bool:
@@ -246,8 +246,8 @@ def ensemble(
     if client is None:
         raw = _mbd.run_many([(m._core, o.to_dict()) for _, m, o in jobs], threads)
         for (i, _, o), r in zip(jobs, raw):
-            if isinstance(r, BaseException):
-                outcomes[i] = r  # type: ignore[assignment]
+            if isinstance(r, MbdError):
+                outcomes[i] = r
             else:
                 columns, data, nq, stats = r
                 outcomes[i] = Result(columns, data, nq, RunStats(**stats), o, members[i])

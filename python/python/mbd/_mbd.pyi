@@ -5,6 +5,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._errors import MbdError
+
 RunTuple = Tuple[List[str], npt.NDArray[np.float64], int, Dict[str, Any]]
 
 class CoreModel:
@@ -32,6 +34,6 @@ class CoreModel:
 
 def run_many(
     members: Sequence[Tuple[CoreModel, Dict[str, Any]]], threads: Optional[int] = None
-) -> List[Union[RunTuple, BaseException]]: ...
+) -> List[Union[RunTuple, MbdError]]: ...
 def solvers() -> List[Dict[str, Any]]: ...
 def parse_solver(spec: str) -> Tuple[str, bool]: ...

@@ -78,7 +78,8 @@ class Model:
 
     def to_dict(self) -> Dict[str, Any]:
         """The model file as a dict (edit it and pass it to :meth:`from_dict`)."""
-        return json.loads(self.to_json())
+        d: Dict[str, Any] = json.loads(self.to_json())
+        return d
 
     def save(self, path: PathLike) -> None:
         """Writes the model file, TOML or JSON by the extension."""

@@ -174,7 +174,7 @@ class Result:
         return {c: self.data[:, i] for i, c in enumerate(self.columns)}
 
     def __len__(self) -> int:
-        return self.data.shape[0]
+        return int(self.data.shape[0])
 
     def __repr__(self) -> str:
         solver = self.options.solver if self.options else "?"
