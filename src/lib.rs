@@ -35,6 +35,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod output;
 mod registry;
 mod simulation;
 

@@ -3,6 +3,7 @@
 use crate::args::RunArgs;
 use crate::error::CliError;
 use indicatif::{ProgressBar, ProgressStyle};
+use mbd::output::{not_conserved, output_columns, Collector};
 use mbd::solve::registry::SolverSpec;
 use mbd::Simulation;
 use mbd_analysis::{CsvObserver, MeasureObserver};
@@ -58,39 +59,11 @@ impl RunSummary {
     }
 }
 
-/// Why the model's energy `H` is not conserved, or `None` if it is: the non-conservative force
-/// elements (dampers, time-dependent loads) and the drivers (rheonomic joints) by name.
-fn not_conserved(sys: &System) -> Option<String> {
-    let forces: Vec<&str> = sys
-        .forces()
-        .iter()
-        .filter(|f| f.is_nonconservative())
-        .map(|f| f.name.as_str())
-        .collect();
-    let drivers: Vec<&str> = sys
-        .joints()
-        .iter()
-        .filter(|j| j.is_rheonomic())
-        .map(|j| j.name.as_str())
-        .collect();
-    let mut parts = Vec::new();
-    if !forces.is_empty() {
-        parts.push(format!("non-conservative forces {}", forces.join(", ")));
-    }
-    if !drivers.is_empty() {
-        parts.push(format!("drivers {}", drivers.join(", ")));
-    }
-    (!parts.is_empty()).then(|| parts.join("; "))
-}
-
-/// Where the rows go.
+/// Where the rows go: streamed as CSV, or kept for one JSON document.
 enum Sink {
     Csv(CsvObserver<Box<dyn Write>>),
     Json {
-        fmt: CsvObserver<std::io::Sink>,
-        every: usize,
-        rows: Vec<Vec<f64>>,
-        last_t: Option<f64>,
+        rows: Collector,
         file: std::fs::File,
     },
 }
@@ -99,20 +72,7 @@ impl Observer for Sink {
     fn observe(&mut self, sys: &System, s: &State, step: usize) -> Result<Flow, SolveError> {
         match self {
             Sink::Csv(c) => c.observe(sys, s, step),
-            Sink::Json {
-                fmt,
-                every,
-                rows,
-                last_t,
-                ..
-            } => {
-                fmt.advance(sys, s)?;
-                if step % *every == 0 {
-                    rows.push(fmt.row(sys, s)?.to_vec());
-                    *last_t = Some(s.t);
-                }
-                Ok(Flow::Continue)
-            }
+            Sink::Json { rows, .. } => rows.observe(sys, s, step),
         }
     }
 }
@@ -171,22 +131,9 @@ impl Observer for Progress {
     }
 }
 
-/// The columns of `mbd run`'s output: the state, `H`, the residuals, if asked the reactions,
-/// the model's sensors, and where `H` is not conserved the energy balance.
-fn columns<W: Write>(c: CsvObserver<W>, reactions: bool, balance: bool) -> CsvObserver<W> {
-    let mut c = c.with_residuals().with_sensors();
-    if reactions {
-        c = c.with_reactions();
-    }
-    if balance {
-        c = c.with_energy_balance();
-    }
-    c
-}
-
-fn open_sink(args: &RunArgs, every: usize, balance: bool) -> Result<Sink, CliError> {
+fn open_sink(args: &RunArgs, sys: &System, every: usize) -> Result<Sink, CliError> {
     let csv = |w: Box<dyn Write>| {
-        Sink::Csv(columns(CsvObserver::new(w), args.reactions, balance).with_every(every))
+        Sink::Csv(output_columns(CsvObserver::new(w), sys, args.reactions).with_every(every))
     };
     let stdout = || csv(Box::new(std::io::BufWriter::new(std::io::stdout())));
     let Some(out) = &args.out else {
@@ -220,10 +167,7 @@ fn open_sink(args: &RunArgs, every: usize, balance: bool) -> Result<Sink, CliErr
     let file = std::fs::File::create(out).map_err(|e| CliError::write(out, e))?;
     Ok(if json {
         Sink::Json {
-            fmt: columns(CsvObserver::new(std::io::sink()), args.reactions, balance),
-            every,
-            rows: Vec::new(),
-            last_t: None,
+            rows: Collector::new(sys, args.reactions, every),
             file,
         }
     } else {
@@ -393,7 +337,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         .map_err(|e| solve_error(&args.solver, mbd::registry().with_advice(&sys, e)))?;
     let every = usize::try_from(args.every).unwrap_or(usize::MAX);
     let why_not_conserved = not_conserved(&sys);
-    let sink = open_sink(args, every, why_not_conserved.is_some())?;
+    let sink = open_sink(args, &sys, every)?;
     let measures = MeasureObserver::new(&sys, false);
     let count = RowCount {
         every,
@@ -415,7 +359,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     let (measures, (count, (sink, _))) = obs;
     let balance = match &sink {
         Sink::Csv(c) => c.energy_balance(),
-        Sink::Json { fmt, .. } => fmt.energy_balance(),
+        Sink::Json { rows, .. } => rows.energy_balance(),
     }
     .map(|b| b.max_residual() / b.max_energy().max(f64::MIN_POSITIVE));
     let final_written = count.last_t == Some(sim.state().t);
@@ -466,20 +410,11 @@ fn finish(
     let out = out_path(args);
     match sink {
         Sink::Csv(mut c) => c.finish(sys, state).map_err(|e| CliError::write(&out, e)),
-        Sink::Json {
-            mut fmt,
-            mut rows,
-            last_t,
-            file,
-            ..
-        } => {
-            if last_t != Some(state.t) {
-                rows.push(
-                    fmt.row(sys, state)
-                        .map_err(|e| solve_error(&args.solver, e))?
-                        .to_vec(),
-                );
-            }
+        Sink::Json { mut rows, file } => {
+            rows.finish(sys, state)
+                .map_err(|e| solve_error(&args.solver, e))?;
+            let columns = rows.columns(sys);
+            let data: Vec<&[f64]> = rows.data().chunks(columns.len().max(1)).collect();
             let m = measures.measures();
             let doc = serde_json::json!({
                 "model": args.model.display().to_string(),
@@ -488,8 +423,8 @@ fn finish(
                 "tol": args.tol,
                 "t_end": args.t_end,
                 "every": args.every,
-                "columns": fmt.columns(sys),
-                "rows": rows,
+                "columns": columns,
+                "rows": data,
                 "summary": {
                     "steps": stats.steps,
                     "rejected_steps": stats.rejected_steps,
