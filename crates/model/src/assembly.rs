@@ -168,27 +168,46 @@ fn geometry(kind: &JointKind) -> Option<Geometry> {
     }
 }
 
-/// The joint coordinate and rate of a revolute (angle) or prismatic (slide) joint at `(q, v)`.
-fn joint_coordinate(g: &Geometry, a: ([f64; 3], [f64; 3]), b: ([f64; 3], [f64; 3])) -> [f64; 2] {
-    let ((qa, va), (qb, vb)) = (a, b);
-    match g.prismatic {
-        None => [qb[2] - qa[2], vb[2] - va[2]],
-        Some((axis, _)) => {
-            let (ra, rb) = (rot(qa[2], g.pa), rot(qb[2], g.pb));
-            let d = [qb[0] + rb[0] - qa[0] - ra[0], qb[1] + rb[1] - qa[1] - ra[1]];
-            let vpa = [va[0] + spin(va[2], ra)[0], va[1] + spin(va[2], ra)[1]];
-            let vpb = [vb[0] + spin(vb[2], rb)[0], vb[1] + spin(vb[2], rb)[1]];
-            let u = rot(qa[2], axis);
-            let du = spin(va[2], u);
+impl System {
+    /// Joint `joint`'s relative coordinates at `(q, v)`: `[angle, rate]` = `theta_b - theta_a`
+    /// and `omega_b - omega_a` (ground: 0), and for a joint with a sliding axis (prismatic,
+    /// slide driver) `[s, ds]`: the slide `s = (r_pb - r_pa) . u` of its point on `b` from its
+    /// point on `a` along the unit axis `u` turned with `a`, and
+    /// `ds = (v_pb - v_pa) . u + (r_pb - r_pa) . (omega_a k x u)`. What joint sensors report and
+    /// assembly prescribes. `None` for a joint index out of range or `q`, `v` of the wrong length.
+    pub fn joint_coordinates(
+        &self,
+        joint: usize,
+        q: &[f64],
+        v: &[f64],
+    ) -> Option<([f64; 2], Option<[f64; 2]>)> {
+        if q.len() != self.n || v.len() != self.n {
+            return None;
+        }
+        let sketch = self.joints.get(joint)?.sketch();
+        let at = self.joint_attach[joint];
+        let (a, b) = (pose(q, v, at.a), pose(q, v, at.b));
+        let relative = [b.0[2] - a.0[2], b.1[2] - a.1[2]];
+        let slide = sketch.axis.map(|axis| {
+            let point = |(q, v): ([f64; 3], [f64; 3]), p: [f64; 2]| {
+                let r = rot(q[2], p);
+                let w = spin(v[2], r);
+                ([q[0] + r[0], q[1] + r[1]], [v[0] + w[0], v[1] + w[1]])
+            };
+            let (ra, va) = point(a, sketch.point_a.unwrap_or_default());
+            let (rb, vb) = point(b, sketch.point_b.unwrap_or_default());
+            let u = rot(a.0[2], axis);
+            let du = spin(a.1[2], u);
+            let d = [rb[0] - ra[0], rb[1] - ra[1]];
+            let dd = [vb[0] - va[0], vb[1] - va[1]];
             [
                 d[0] * u[0] + d[1] * u[1],
-                (vpb[0] - vpa[0]) * u[0] + (vpb[1] - vpa[1]) * u[1] + d[0] * du[0] + d[1] * du[1],
+                dd[0] * u[0] + dd[1] * u[1] + d[0] * du[0] + d[1] * du[1],
             ]
-        }
+        });
+        Some((relative, slide))
     }
-}
 
-impl System {
     /// The initial joint coordinates given with [`SystemBuilder::set_joint_initial`] (or a
     /// model file's `[[assembly]]`), in the order given.
     pub fn joint_initials(&self) -> impl Iterator<Item = (JointHandle, JointInitial)> + '_ {
@@ -231,11 +250,10 @@ impl System {
                     continue;
                 }
                 // the joint's coordinate and rate: given, else the stored bodies'
-                let [c0, r0] = joint_coordinate(
-                    &g,
-                    pose(&stored.0, &stored.1, at.a),
-                    pose(&stored.0, &stored.1, at.b),
-                );
+                let [c0, r0] = match self.joint_coordinates(j, &stored.0, &stored.1) {
+                    Some((relative, slide)) => slide.unwrap_or(relative),
+                    None => continue,
+                };
                 let c = given[j].coordinate.unwrap_or(c0);
                 let r = given[j].rate.unwrap_or(r0);
                 if pa_done {
@@ -305,10 +323,12 @@ impl System {
             let Some(g) = geometry(&joint.kind) else {
                 continue;
             };
-            let at = self.joint_attach[j];
             let f = if rates {
                 let Some(rate) = init.rate else { continue };
-                let [c, _] = joint_coordinate(&g, pose(q, &zero, at.a), pose(q, &zero, at.b));
+                let Some((relative, slide)) = self.joint_coordinates(j, q, &zero) else {
+                    continue;
+                };
+                let [c, _] = slide.unwrap_or(relative);
                 TimeFunction::linear(c - rate * t, rate)
             } else {
                 let Some(c) = init.coordinate else { continue };

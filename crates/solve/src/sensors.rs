@@ -7,12 +7,13 @@
 //! from the index-1 solve at the state (the same accelerations every solver's dynamics has).
 //! A joint's relative angle is `theta_b - theta_a` (ground: 0) and its rate
 //! `omega_b - omega_a`; a prismatic joint's slide is `s = (r_pb - r_pa) . u` with `u` its unit
-//! axis turned with body `a`, and `ds = (v_pb - v_pa) . u + (r_pb - r_pa) . (omega_a k x u)`.
+//! axis turned with body `a`, and `ds = (v_pb - v_pa) . u + (r_pb - r_pa) . (omega_a k x u)`
+//! ([`System::joint_coordinates`], shared with assembly from joint coordinates).
 
 use crate::error::SolveError;
 use crate::output_solve::OutputSolve;
 use crate::state::State;
-use mbd_model::{Attach, SensorKind, System};
+use mbd_model::{SensorKind, System};
 
 /// Evaluates a model's sensors; a workspace allocated once.
 ///
@@ -41,8 +42,6 @@ pub struct SensorSolver {
     solve: Option<OutputSolve>,
     /// Accelerations when no sensor needs them.
     zeros: Vec<f64>,
-    /// Each joint's attachment (for the joint sensors).
-    attach: Vec<Attach>,
     /// Whether a sensor needs the accelerations.
     needs_acceleration: bool,
 }
@@ -53,7 +52,6 @@ impl SensorSolver {
         Ok(SensorSolver {
             solve: None,
             zeros: vec![0.0; sys.n_coords()],
-            attach: sys.joint_elements().map(|e| e.attach).collect(),
             needs_acceleration: sys
                 .sensors()
                 .iter()
@@ -99,7 +97,7 @@ impl SensorSolver {
             state.check(sys)?;
             &self.zeros
         };
-        values(&self.attach, sys, state, a, out);
+        values(sys, state, a, out);
         Ok(())
     }
 
@@ -127,13 +125,13 @@ impl SensorSolver {
                 got: a.len(),
             });
         }
-        values(&self.attach, sys, state, a, out);
+        values(sys, state, a, out);
         Ok(())
     }
 }
 
 /// The sensors' values from the state and its accelerations (see the module docs).
-fn values(attach: &[Attach], sys: &System, state: &State, a: &[f64], out: &mut Vec<f64>) {
+fn values(sys: &System, state: &State, a: &[f64], out: &mut Vec<f64>) {
     let (q, v) = (state.q.as_slice(), state.v.as_slice());
     // a body point's position, velocity and acceleration (ground: fixed)
     let kinematics = |i: Option<usize>, p: [f64; 2]| -> [[f64; 2]; 3] {
@@ -152,7 +150,6 @@ fn values(attach: &[Attach], sys: &System, state: &State, a: &[f64], out: &mut V
             ],
         ]
     };
-    let angle = |i: Option<usize>| i.map_or((0.0, 0.0), |i| (q[3 * i + 2], v[3 * i + 2]));
     for s in sys.sensors() {
         match &s.kind {
             SensorKind::Point { body, point } => {
@@ -160,23 +157,10 @@ fn values(attach: &[Attach], sys: &System, state: &State, a: &[f64], out: &mut V
                 out.extend([r[0], r[1], vp[0], vp[1], ap[0], ap[1]]);
             }
             SensorKind::Joint { joint } => {
-                let at = attach[joint.index()];
-                let ((ta, wa), (tb, wb)) = (angle(at.a), angle(at.b));
-                out.extend([tb - ta, wb - wa]);
-                let sketch = sys.joints()[joint.index()].sketch();
-                if let Some(axis) = sketch.axis {
-                    // (no acceleration needed: kinematics' third entry is unused here)
-                    let [ra, va, _] = kinematics(at.a, sketch.point_a.unwrap_or_default());
-                    let [rb, vb, _] = kinematics(at.b, sketch.point_b.unwrap_or_default());
-                    let (sn, cs) = ta.sin_cos();
-                    let u = [cs * axis[0] - sn * axis[1], sn * axis[0] + cs * axis[1]];
-                    let du = [-wa * u[1], wa * u[0]];
-                    let d = [rb[0] - ra[0], rb[1] - ra[1]];
-                    let dd = [vb[0] - va[0], vb[1] - va[1]];
-                    out.extend([
-                        d[0] * u[0] + d[1] * u[1],
-                        dd[0] * u[0] + dd[1] * u[1] + d[0] * du[0] + d[1] * du[1],
-                    ]);
+                // a joint index the model checked at build; nothing to add otherwise
+                if let Some((relative, slide)) = sys.joint_coordinates(joint.index(), q, v) {
+                    out.extend(relative);
+                    out.extend(slide.into_iter().flatten());
                 }
             }
             _ => {}

@@ -43,9 +43,7 @@ fn joints_are_placed_from_either_side() {
     assert!(max_abs(&phi) < 1e-14, "{phi:?}");
     // pivot: theta_ground - theta_arm = -0.7, so the arm is at 0.7, turning at -1.3
     assert!((q[2] - 0.7).abs() < 1e-15 && (v[2] + 1.3).abs() < 1e-15);
-    let g = geometry(&sys.joints()[1].kind).unwrap();
-    let at = sys.joint_attach[1];
-    let [s, ds] = joint_coordinate(&g, pose(q, v, at.a), pose(q, v, at.b));
+    let [s, ds] = sys.joint_coordinates(1, q, v).unwrap().1.unwrap();
     assert!(
         (s - 0.25).abs() < 1e-14 && (ds + 0.6).abs() < 1e-14,
         "{s} {ds}"
