@@ -31,6 +31,35 @@ fn simulation(sys: mbd::model::System, spec: &str) -> Option<Simulation> {
     }
 }
 
+/// A slider of mass `m` (inertia 0.01) at `x0` on a prismatic guide along the global x axis,
+/// under `gravity`, moved by the driver `driver(slider)` builds.
+fn slider_on_guide(
+    m: f64,
+    x0: f64,
+    gravity: [f64; 2],
+    driver: impl FnOnce(mbd::model::BodyHandle) -> Joint,
+) -> Result<mbd::model::System, mbd::model::ModelError> {
+    let mut b = SystemBuilder::new();
+    b.set_gravity(gravity);
+    let slider = b.add_body(
+        Body::new("slider")
+            .mass(m)
+            .inertia(0.01)
+            .position(x0, 0.0, 0.0),
+    );
+    b.add_joint(Joint::prismatic(
+        "guide",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        slider,
+        [0.0, 0.0],
+        [1.0, 0.0],
+        0.0,
+    ));
+    b.add_joint(driver(slider));
+    b.build()
+}
+
 /// A 2 kg slider on a horizontal guide, driven from x = 0.1 m to 0.5 m over [0.2, 1.2] s by a
 /// smooth step: with every solver that runs the model (fixed steps of 1e-3 s), the slider is at
 /// the step's value at the end and mid-way; the driver's force at the end of a run through
@@ -39,35 +68,20 @@ fn simulation(sys: mbd::model::System, spec: &str) -> Option<Simulation> {
 fn a_slide_driver_moves_a_slider_along_its_step() {
     let f = TimeFunction::smooth_step(0.2, 1.2, 0.1, 0.5);
     let build = || {
-        let mut b = SystemBuilder::new();
-        b.set_gravity([0.0, -9.81]);
-        let slider = b.add_body(
-            Body::new("slider")
-                .mass(2.0)
-                .inertia(0.01)
-                .position(0.1, 0.0, 0.0),
-        );
-        b.add_joint(Joint::prismatic(
-            "guide",
-            BodyRef::Ground,
-            [0.0, 0.0],
-            slider,
-            [0.0, 0.0],
-            [1.0, 0.0],
-            0.0,
-        ));
-        b.add_joint(Joint::new(
-            "actuator",
-            SlideDriver {
-                a: BodyRef::Ground,
-                pa: [0.0, 0.0],
-                b: slider.into(),
-                pb: [0.0, 0.0],
-                axis: [2.0, 0.0],
-                f: f.clone(),
-            },
-        ));
-        b.build().unwrap()
+        slider_on_guide(2.0, 0.1, [0.0, -9.81], |slider| {
+            Joint::new(
+                "actuator",
+                SlideDriver {
+                    a: BodyRef::Ground,
+                    pa: [0.0, 0.0],
+                    b: slider.into(),
+                    pb: [0.0, 0.0],
+                    axis: [2.0, 0.0],
+                    f: f.clone(),
+                },
+            )
+        })
+        .unwrap()
     };
     let mut ran = 0;
     for spec in fixed_step_specs() {
@@ -110,33 +124,18 @@ fn a_distance_driver_pulls_a_slider() {
     use mbd::model::joints::DistanceDriver;
     let f = TimeFunction::smooth_step(0.1, 0.9, 1.25, 2.0);
     let build = |f: TimeFunction| {
-        let mut b = SystemBuilder::new();
-        let slider = b.add_body(
-            Body::new("slider")
-                .mass(1.0)
-                .inertia(0.01)
-                .position(0.75, 0.0, 0.0),
-        );
-        b.add_joint(Joint::prismatic(
-            "guide",
-            BodyRef::Ground,
-            [0.0, 0.0],
-            slider,
-            [0.0, 0.0],
-            [1.0, 0.0],
-            0.0,
-        ));
-        b.add_joint(Joint::new(
-            "winch",
-            DistanceDriver {
-                a: BodyRef::Ground,
-                pa: [0.0, 1.0],
-                b: slider.into(),
-                pb: [0.0, 0.0],
-                f,
-            },
-        ));
-        b.build()
+        slider_on_guide(1.0, 0.75, [0.0, 0.0], |slider| {
+            Joint::new(
+                "winch",
+                DistanceDriver {
+                    a: BodyRef::Ground,
+                    pa: [0.0, 1.0],
+                    b: slider.into(),
+                    pb: [0.0, 0.0],
+                    f,
+                },
+            )
+        })
     };
     for spec in ["rk4-projected", "symplectic:2"] {
         for t_end in [0.5, 1.2] {
