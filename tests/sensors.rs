@@ -5,7 +5,7 @@
 use mbd::model::{models, ModelFile, SensorSpec};
 use mbd::prelude::*;
 use mbd::rk4::{Rk4, Rk4Options};
-use mbd::solve::{run, Flow, SensorSolver};
+use mbd::solve::{run, Flow, JointReaction, NoObserver, ReactionSolver, SensorSolver};
 
 /// The slider-crank with a point sensor at the crank pin's end of the rod and joint sensors on
 /// the crank pin and the slide.
@@ -126,4 +126,119 @@ fn model_files_name_sensors() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("sensor") && e.contains("rod_end"), "{e}");
+}
+
+/// A reaction sensor's columns are its joint's `JointReaction` (global force, moment, force in
+/// the body's axes), bit for bit; energy sensors give `T`, `V`, `H` of the model, and per body
+/// a kinetic energy summing to the model's and gravity potentials summing to `V` (no springs
+/// in the manipulator); both kinds round-trip through model files.
+#[test]
+fn reaction_and_energy_sensors() {
+    let arm = models::manipulator().unwrap();
+    let joint = arm.joints()[1].name.clone();
+    let mut file = arm.to_model_file();
+    file.sensors.push(SensorSpec::Reaction {
+        name: "elbow_load".into(),
+        joint: joint.clone(),
+    });
+    file.sensors.push(SensorSpec::Energy {
+        name: "all".into(),
+        body: None,
+    });
+    let bodies: Vec<String> = file.bodies.iter().map(|b| b.name.clone()).collect();
+    for b in &bodies {
+        file.sensors.push(SensorSpec::Energy {
+            name: format!("e_{b}"),
+            body: Some(b.clone()),
+        });
+    }
+    let sys = file.build().unwrap();
+    let back = ModelFile::from_toml(&sys.to_model_file().to_toml().unwrap())
+        .unwrap()
+        .build()
+        .unwrap();
+    assert_eq!(back.sensors(), sys.sensors());
+    let columns = SensorSolver::columns(&sys);
+    assert_eq!(
+        columns[..8],
+        [
+            "elbow_load.fx",
+            "elbow_load.fy",
+            "elbow_load.mz",
+            "elbow_load.fx_body",
+            "elbow_load.fy_body",
+            "all.kinetic",
+            "all.potential",
+            "all.total",
+        ]
+    );
+    assert_eq!(columns.len(), 8 + 3 * bodies.len());
+
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let mut rk = Rk4::new(&sys, Rk4Options::projected()).unwrap();
+    run(
+        &mut rk,
+        &sys,
+        &mut s,
+        RunConfig::new(0.3, 1e-3),
+        &mut NoObserver,
+    )
+    .unwrap();
+    let mut out = Vec::new();
+    SensorSolver::new(&sys)
+        .unwrap()
+        .evaluate(&sys, &s, &mut out)
+        .unwrap();
+    let mut loads = vec![JointReaction::default(); sys.joints().len()];
+    ReactionSolver::new(&sys)
+        .unwrap()
+        .compute(&sys, &s, &mut loads)
+        .unwrap();
+    let j = sys.joints().iter().position(|x| x.name == joint).unwrap();
+    let r = loads[j];
+    assert_eq!(
+        out[..5],
+        [
+            r.force[0],
+            r.force[1],
+            r.moment,
+            r.local_force[0],
+            r.local_force[1]
+        ]
+    );
+    assert!(r.force.iter().any(|f| f.abs() > 1e-3), "{r:?}");
+    let (q, v) = (s.q.as_slice(), s.v.as_slice());
+    let (t, u) = (sys.kinetic(v), sys.potential(q));
+    assert_eq!(out[5..8], [t, u, t + u]);
+    assert_eq!(out[7], sys.energy(q, v));
+    let per_body = &out[8..];
+    let t_sum: f64 = per_body.chunks(3).map(|c| c[0]).sum();
+    let u_sum: f64 = per_body.chunks(3).map(|c| c[1]).sum();
+    assert!(t > 1e-3, "the arm moves: T = {t:e}");
+    assert!((t_sum - t).abs() <= 1e-13 * t.abs(), "{t_sum:e} vs {t:e}");
+    assert!(
+        (u_sum - u).abs() <= 1e-13 * u.abs().max(1.0),
+        "{u_sum:e} vs {u:e}"
+    );
+    assert!(per_body.chunks(3).all(|c| c[2] == c[0] + c[1]));
+
+    // an unknown body in an energy sensor and an unknown joint in a reaction sensor
+    let text = sys.to_model_file().to_toml().unwrap();
+    let bad = text.replace(&format!("joint = \"{joint}\""), "joint = \"elbo\"");
+    let e = ModelFile::from_toml(&bad)
+        .unwrap()
+        .build()
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("sensor 'elbow_load'") && e.contains("'elbo'"),
+        "{e}"
+    );
+    let bad = text.replace(&format!("body = \"{}\"", bodies[0]), "body = \"nobody\"");
+    let e = ModelFile::from_toml(&bad)
+        .unwrap()
+        .build()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("sensor") && e.contains("'nobody'"), "{e}");
 }

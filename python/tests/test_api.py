@@ -91,6 +91,16 @@ def test_builder_maps_onto_model_files():
     assert r.v[0, 2] == 6.0  # the input kept
 
 
+def test_reaction_and_energy_sensors(slider):
+    d = slider.to_dict()
+    d["sensors"] = [{"type": "reaction", "name": "pin", "joint": "crank_pin"},
+                    {"type": "energy", "name": "all"}]
+    m = mbd.Model.from_dict(d)
+    r = m.run("rk4", t_end=0.05, h=1e-3)
+    assert "pin.fx_body" in r and "pin.mz" in r
+    assert (r["all.total"] == r["H"]).all()
+
+
 def test_with_parameters_edits_the_model_file(slider):
     m = slider.with_parameters(gravity=[0.0, -1.62], mass={"slider": 2.0},
                                stiffness={"return_spring": 50.0}, damping={"return_spring": 0.0})

@@ -271,9 +271,9 @@ impl<W: Write> CsvObserver<W> {
                 Some(x) => x,
                 None => self.sensor_solver.insert(SensorSolver::new(sys)?),
             };
-            if ss.needs_acceleration() {
-                let (a, _) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, s)?;
-                ss.evaluate_with(sys, s, a, &mut self.row)?;
+            if ss.needs_solve() {
+                let (a, lambda) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, s)?;
+                ss.evaluate_with(sys, s, a, lambda, &mut self.row)?;
             } else {
                 ss.evaluate(sys, s, &mut self.row)?;
             }

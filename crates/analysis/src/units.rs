@@ -4,8 +4,10 @@
 //! The unit follows from the column's name alone: `t` (s); a coordinate `body.x`, `body.y` (m),
 //! `body.theta` (rad); a velocity `d_body.x` (m/s), `d_body.theta` (rad/s); the energy `H` and
 //! the energy balance `W_external`, `E_dissipated`, `energy_balance` (J); a joint reaction
-//! `joint.fx`, `joint.fy` (N), `joint.mz` (N m); a point sensor's `.vx`, `.vy` (m/s), `.ax`,
-//! `.ay` (m/s^2); a joint sensor's `.angle` (rad), `.rate` (rad/s), `.s` (m), `.ds` (m/s).
+//! `joint.fx`, `joint.fy` (N), `joint.mz` (N m) and a reaction sensor's `.fx_body`,
+//! `.fy_body` (N); a point sensor's `.vx`, `.vy` (m/s), `.ax`, `.ay` (m/s^2); a joint sensor's
+//! `.angle` (rad), `.rate` (rad/s), `.s` (m), `.ds` (m/s); an energy sensor's `.kinetic`,
+//! `.potential`, `.total` (J).
 //! The constraint residuals `max_abs_phi`, `max_abs_phidot` have none (their equations mix
 //! lengths and angles), nor has any other name. A point sensor whose own name starts with `d_`
 //! has its `.x`, `.y` read as a velocity: the names carry no more than that.
@@ -38,7 +40,8 @@ pub fn unit_of(column: &str) -> Option<&'static str> {
         ("theta", false) | ("angle", _) => "rad",
         ("theta", true) | ("rate", _) => "rad/s",
         ("ax" | "ay", _) => "m/s^2",
-        ("fx" | "fy", _) => "N",
+        ("fx" | "fy" | "fx_body" | "fy_body", _) => "N",
+        ("kinetic" | "potential" | "total", _) => "J",
         ("mz", _) => "N m",
         _ => return None,
     })
@@ -74,6 +77,15 @@ mod tests {
         assert_eq!(unit_of("d_crank.theta"), Some("rad/s"));
         // a body whose name holds a dot
         assert_eq!(unit_of("arm.link1.theta"), Some("rad"));
+    }
+
+    #[test]
+    fn reaction_and_energy_sensors() {
+        assert_eq!(unit_of("pin.fx_body"), Some("N"));
+        assert_eq!(unit_of("pin.fy_body"), Some("N"));
+        for c in ["e.kinetic", "e.potential", "e.total"] {
+            assert_eq!(unit_of(c), Some("J"), "{c}");
+        }
     }
 
     #[test]

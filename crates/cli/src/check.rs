@@ -2,7 +2,7 @@
 
 use crate::args::CheckArgs;
 use crate::error::CliError;
-use mbd_model::{BodyRef, System};
+use mbd_model::{format_number as num, BodyRef, SensorKind, System};
 use std::fmt::Write;
 
 /// Loads the model, projects its initial state onto the constraints and returns the report
@@ -28,13 +28,15 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
     let g = sys.gravity();
     // writing to a String cannot fail
     let _ = writeln!(s, "model {path}: valid");
-    let _ = writeln!(s, "gravity: [{}, {}] m/s^2", g[0], g[1]);
+    let _ = writeln!(s, "gravity: [{}, {}] m/s^2", num(g[0]), num(g[1]));
     let _ = writeln!(s, "bodies ({}):", sys.bodies().len());
     for b in sys.bodies() {
         let _ = writeln!(
             s,
             "  {:<16} mass {:<10} inertia {}",
-            b.name, b.mass, b.inertia
+            b.name,
+            num(b.mass),
+            num(b.inertia)
         );
     }
     let _ = writeln!(s, "joints ({}):", sys.joints().len());
@@ -81,10 +83,18 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
             let _ = writeln!(s, "  {:<16} joints {}", e.equation, e.joints.join(", "));
         }
     }
+    sensors(&mut s, sys);
+    assembly(&mut s, sys);
     let _ = writeln!(s, "consistent initial state at t = 0:");
-    let _ = writeln!(s, "  {:<24} {:>14} {:>14}", "coordinate", "q", "v");
+    let _ = writeln!(s, "  {:<24} {:>16} {:>16}", "coordinate", "q", "v");
     for (k, name) in sys.coordinate_names().iter().enumerate() {
-        let _ = writeln!(s, "  {:<24} {:>14.9} {:>14.9}", name, c.q[k], c.v[k]);
+        let _ = writeln!(
+            s,
+            "  {:<24} {:>16} {:>16}",
+            name,
+            value(c.q[k]),
+            value(c.v[k])
+        );
     }
     let _ = writeln!(
         s,
@@ -99,8 +109,94 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
     );
     let _ = writeln!(
         s,
-        "energy H(0) = {:.9} J",
-        sys.energy(c.q.as_slice(), c.v.as_slice())
+        "energy H(0) = {} J",
+        value(sys.energy(c.q.as_slice(), c.v.as_slice()))
     );
     s
+}
+
+/// A state value in a table column: nine decimals where that reads well, else scientific
+/// notation with nine significant digits (never 30 digits for `1e20`).
+fn value(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.9}")
+    } else {
+        format!("{x:.8e}")
+    }
+}
+
+/// The sensors and their output columns.
+fn sensors(s: &mut String, sys: &System) {
+    if sys.sensors().is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "sensors ({}):", sys.sensors().len());
+    let joint = |j: mbd_model::JointHandle| {
+        sys.joints()
+            .get(j.index())
+            .map_or_else(|| "?".to_string(), |j| j.name.clone())
+    };
+    for sensor in sys.sensors() {
+        let what = match &sensor.kind {
+            SensorKind::Point { body, point } => format!(
+                "point [{}, {}] of {}",
+                num(point[0]),
+                num(point[1]),
+                body_name(sys, *body)
+            ),
+            SensorKind::Joint { joint: j } => format!("coordinates of joint {}", joint(*j)),
+            SensorKind::Reaction { joint: j } => format!("reaction of joint {}", joint(*j)),
+            SensorKind::Energy { body: None } => "energy of the model".to_string(),
+            SensorKind::Energy { body: Some(b) } => format!("energy of {}", body_name(sys, *b)),
+            _ => "(a sensor kind this version does not describe)".to_string(),
+        };
+        let _ = writeln!(s, "  {:<16} {what}", sensor.name);
+    }
+}
+
+/// The initial joint coordinates and the bodies they place.
+fn assembly(s: &mut String, sys: &System) {
+    let given: Vec<_> = sys.joint_initials().collect();
+    if given.is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "assembly from joint coordinates ({}):", given.len());
+    for (j, init) in &given {
+        let name = sys.joints().get(j.index()).map_or("?", |j| j.name.as_str());
+        let part = |label: &str, x: Option<f64>| {
+            x.map_or_else(
+                || format!("{label} from the bodies"),
+                |x| format!("{label} {}", num(x)),
+            )
+        };
+        let _ = writeln!(
+            s,
+            "  {:<16} {}, {}",
+            name,
+            part("coordinate", init.coordinate),
+            part("rate", init.rate)
+        );
+    }
+    let placed: Vec<&str> = sys
+        .assembled_bodies()
+        .iter()
+        .zip(sys.bodies())
+        .filter(|(placed, _)| **placed)
+        .map(|(_, b)| b.name.as_str())
+        .collect();
+    let others = sys.bodies().len() - placed.len();
+    let placed = if placed.is_empty() {
+        "no body".to_string()
+    } else {
+        placed.join(", ")
+    };
+    let _ = match others {
+        0 => writeln!(s, "  places {placed}"),
+        _ => writeln!(
+            s,
+            "  places {placed} (the other {others} bod{} from their position and velocity, \
+             then projected)",
+            if others == 1 { "y" } else { "ies" }
+        ),
+    };
 }

@@ -651,3 +651,79 @@ fn run_creates_the_output_folder() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text.lines().count(), 12, "{text}");
 }
+
+/// Reaction and energy sensors and assembly from joint coordinates, in a model file: `check`
+/// lists them (and the bodies the assembly places), `run` writes the sensors' columns, and the
+/// energy sensor's total is the `H` column.
+#[test]
+fn check_and_run_show_reaction_and_energy_sensors_and_the_assembly() {
+    let d = scratch("sensors");
+    let text =
+        std::fs::read_to_string(common::repo().join("examples/models/slider_crank_spring.toml"))
+            .unwrap()
+            + r#"
+[[sensors]]
+type = "reaction"
+name = "pin"
+joint = "crank_pin"
+
+[[sensors]]
+type = "energy"
+name = "all"
+
+[[sensors]]
+type = "energy"
+name = "rod_e"
+body = "rod"
+
+[[assembly]]
+joint = "crank_pivot"
+coordinate = 1.0
+rate = 6.0
+"#;
+    let model = d.join("sensors.toml");
+    std::fs::write(&model, text).unwrap();
+    let out = mbd(["check".as_ref(), model.as_os_str()]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    for needle in [
+        "sensors (3):",
+        "pin              reaction of joint crank_pin",
+        "all              energy of the model",
+        "rod_e            energy of rod",
+        "assembly from joint coordinates (1):",
+        "crank_pivot      coordinate 1, rate 6",
+        "places crank, rod, slider",
+    ] {
+        assert!(
+            out.stdout.contains(needle),
+            "lacks {needle:?}:\n{}",
+            out.stdout
+        );
+    }
+    let csv = d.join("out.csv");
+    let out = run_model(&model, "rk4", &["--h", "0.01"], &csv);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let (head, rows) = read_csv(&csv);
+    let at = |c: &str| {
+        head.iter()
+            .position(|h| h == c)
+            .unwrap_or_else(|| panic!("no column {c} in {head:?}"))
+    };
+    for c in [
+        "pin.fx",
+        "pin.fy",
+        "pin.mz",
+        "pin.fx_body",
+        "pin.fy_body",
+        "rod_e.kinetic",
+    ] {
+        at(c);
+    }
+    for r in &rows {
+        assert_eq!(r[at("all.total")], r[at("H")]);
+        assert!(r[at("rod_e.kinetic")] > 0.0);
+    }
+    // the crank starts at the assembled angle and rate
+    assert!((rows[0][at("crank.theta")] - 1.0).abs() < 1e-9);
+    assert!((rows[0][at("d_crank.theta")] - 6.0).abs() < 1e-9);
+}

@@ -466,10 +466,13 @@ impl System {
             }
             let element = format!("sensor '{}'", sensor.name);
             match &sensor.kind {
-                SensorKind::Point { body, .. } => {
+                SensorKind::Point { body, .. } | SensorKind::Energy { body: Some(body) } => {
                     resolve(&element, *body)?;
                 }
-                SensorKind::Joint { joint } if joint.0 >= joints.len() => {
+                _ => {}
+            }
+            if let Some(joint) = sensor.joint_read() {
+                if joint.0 >= joints.len() {
                     return Err(invalid(
                         element,
                         format!(
@@ -477,9 +480,8 @@ impl System {
                             joint.0,
                             joints.len()
                         ),
-                    ))
+                    ));
                 }
-                SensorKind::Joint { .. } => {}
             }
             sensor.validate()?;
         }

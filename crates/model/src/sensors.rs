@@ -37,6 +37,22 @@ pub enum SensorKind {
         /// The joint.
         joint: JointHandle,
     },
+    /// The load a joint exerts on its second body (`mbd_solve::JointReaction`, whose
+    /// documentation gives the conventions): the force in global axes `NAME.fx`, `.fy` (N),
+    /// the moment about the joint's point on that body `NAME.mz` (N m), and the force in the
+    /// body's own axes `NAME.fx_body`, `.fy_body` (N).
+    Reaction {
+        /// The joint.
+        joint: JointHandle,
+    },
+    /// Energies (J), columns `NAME.kinetic`, `.potential`, `.total`. Without a body: the
+    /// model's kinetic energy `T`, potential `V` (gravity, springs, constant loads) and
+    /// `H = T + V`. With a body: its kinetic energy `m |v|^2 / 2 + J omega^2 / 2` and the
+    /// potential of gravity on it, `-m g . r` (springs belong to no single body).
+    Energy {
+        /// The body, or `None` for the whole model.
+        body: Option<BodyRef>,
+    },
 }
 
 impl Sensor {
@@ -56,6 +72,31 @@ impl Sensor {
         Sensor {
             name: name.into(),
             kind: SensorKind::Joint { joint },
+        }
+    }
+
+    /// A reaction sensor (see [`SensorKind::Reaction`]).
+    pub fn reaction(name: impl Into<String>, joint: JointHandle) -> Self {
+        Sensor {
+            name: name.into(),
+            kind: SensorKind::Reaction { joint },
+        }
+    }
+
+    /// An energy sensor for the whole model (`body = None`) or one body (see
+    /// [`SensorKind::Energy`]).
+    pub fn energy(name: impl Into<String>, body: Option<BodyRef>) -> Self {
+        Sensor {
+            name: name.into(),
+            kind: SensorKind::Energy { body },
+        }
+    }
+
+    /// The joint a joint or reaction sensor reads, if any.
+    pub(crate) fn joint_read(&self) -> Option<JointHandle> {
+        match self.kind {
+            SensorKind::Joint { joint } | SensorKind::Reaction { joint } => Some(joint),
+            _ => None,
         }
     }
 
@@ -94,5 +135,22 @@ pub enum SensorSpec {
         name: String,
         /// The joint.
         joint: String,
+    },
+    /// The load a joint exerts on its second body: `NAME.fx`, `.fy` (global axes), `.mz`
+    /// (about the joint's point on that body), `.fx_body`, `.fy_body` (the body's axes).
+    Reaction {
+        /// Unique sensor name.
+        name: String,
+        /// The joint.
+        joint: String,
+    },
+    /// Kinetic, potential and total energy (`NAME.kinetic`, `.potential`, `.total`) of the
+    /// model, or of one body (its kinetic energy and the potential of gravity on it).
+    Energy {
+        /// Unique sensor name.
+        name: String,
+        /// The body; absent for the whole model.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        body: Option<String>,
     },
 }

@@ -89,7 +89,7 @@ impl ReactionSolver {
         out: &mut [JointReaction],
     ) -> Result<(), SolveError> {
         let (_, lambda) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, state)?;
-        reactions(&mut self.grads, sys, state, lambda, out)
+        joint_reactions(&mut self.grads, sys, state, lambda, out)
     }
 
     /// [`ReactionSolver::compute`] from the multipliers `lambda` at `state` solved elsewhere
@@ -109,12 +109,12 @@ impl ReactionSolver {
                 got: lambda.len(),
             });
         }
-        reactions(&mut self.grads, sys, state, lambda, out)
+        joint_reactions(&mut self.grads, sys, state, lambda, out)
     }
 }
 
 /// The joints' reactions from the multipliers (see the module docs).
-fn reactions(
+pub(crate) fn joint_reactions(
     grads: &mut [[f64; 6]],
     sys: &System,
     state: &State,

@@ -9,9 +9,13 @@
 //! `omega_b - omega_a`; a prismatic joint's slide is `s = (r_pb - r_pa) . u` with `u` its unit
 //! axis turned with body `a`, and `ds = (v_pb - v_pa) . u + (r_pb - r_pa) . (omega_a k x u)`
 //! ([`System::joint_coordinates`], shared with assembly from joint coordinates).
+//! A reaction sensor reads its joint's [`JointReaction`] from the multipliers of the same
+//! index-1 solve; an energy sensor evaluates `T` and `V` at the state (for one body, its
+//! kinetic energy and the potential of gravity on it).
 
 use crate::error::SolveError;
 use crate::output_solve::OutputSolve;
+use crate::reactions::{joint_reactions, JointReaction};
 use crate::state::State;
 use mbd_model::{SensorKind, System};
 
@@ -40,22 +44,34 @@ use mbd_model::{SensorKind, System};
 pub struct SensorSolver {
     /// The index-1 solve, built at the first [`SensorSolver::evaluate`] that needs it.
     solve: Option<OutputSolve>,
-    /// Accelerations when no sensor needs them.
+    /// Accelerations and multipliers when no sensor needs them.
     zeros: Vec<f64>,
-    /// Whether a sensor needs the accelerations.
+    zero_lambda: Vec<f64>,
+    /// Whether a sensor needs the accelerations (a point sensor).
     needs_acceleration: bool,
+    /// Every joint's reaction and the constraint gradients behind them, when a reaction
+    /// sensor needs them.
+    reactions: Option<(Vec<[f64; 6]>, Vec<JointReaction>)>,
 }
 
 impl SensorSolver {
     /// A workspace for `sys`.
     pub fn new(sys: &System) -> Result<Self, SolveError> {
+        let kinds = || sys.sensors().iter().map(|s| &s.kind);
+        let reactions = kinds()
+            .any(|k| matches!(k, SensorKind::Reaction { .. }))
+            .then(|| {
+                (
+                    vec![[0.0; 6]; sys.n_constraints()],
+                    vec![JointReaction::default(); sys.joints().len()],
+                )
+            });
         Ok(SensorSolver {
             solve: None,
             zeros: vec![0.0; sys.n_coords()],
-            needs_acceleration: sys
-                .sensors()
-                .iter()
-                .any(|s| matches!(s.kind, SensorKind::Point { .. })),
+            zero_lambda: vec![0.0; sys.n_constraints()],
+            needs_acceleration: kinds().any(|k| matches!(k, SensorKind::Point { .. })),
+            reactions,
         })
     }
 
@@ -76,6 +92,8 @@ impl SensorSolver {
                         &["angle", "rate"]
                     }
                 }
+                SensorKind::Reaction { .. } => &["fx", "fy", "mz", "fx_body", "fy_body"],
+                SensorKind::Energy { .. } => &["kinetic", "potential", "total"],
                 _ => &[],
             };
             out.extend(parts.iter().map(|p| format!("{}.{p}", s.name)));
@@ -91,48 +109,65 @@ impl SensorSolver {
         state: &State,
         out: &mut Vec<f64>,
     ) -> Result<(), SolveError> {
-        let a = if self.needs_acceleration {
-            OutputSolve::lazy(&mut self.solve, sys)?.at(sys, state)?.0
+        let (a, lambda) = if self.needs_solve() {
+            OutputSolve::lazy(&mut self.solve, sys)?.at(sys, state)?
         } else {
             state.check(sys)?;
-            &self.zeros
+            (self.zeros.as_slice(), self.zero_lambda.as_slice())
         };
-        values(sys, state, a, out);
-        Ok(())
+        values(sys, state, a, lambda, &mut self.reactions, out)
     }
 
-    /// Whether a sensor needs the accelerations (a point sensor): what
+    /// Whether a sensor needs the index-1 solve at the state (a point sensor its
+    /// accelerations, a reaction sensor its multipliers): what
     /// [`SensorSolver::evaluate_with`] is to be given.
-    pub fn needs_acceleration(&self) -> bool {
-        self.needs_acceleration
+    pub fn needs_solve(&self) -> bool {
+        self.needs_acceleration || self.reactions.is_some()
     }
 
-    /// [`SensorSolver::evaluate`] with the accelerations `a` at `state` solved elsewhere (an
-    /// [`crate::OutputSolve`] shared with other outputs of the same row; any values when no
-    /// sensor [needs them](SensorSolver::needs_acceleration)).
+    /// [`SensorSolver::evaluate`] with the accelerations `a` and multipliers `lambda` at
+    /// `state` solved elsewhere (an [`crate::OutputSolve`] shared with other outputs of the
+    /// same row; any values of the right sizes when no sensor [needs
+    /// them](SensorSolver::needs_solve)).
     pub fn evaluate_with(
-        &self,
+        &mut self,
         sys: &System,
         state: &State,
         a: &[f64],
+        lambda: &[f64],
         out: &mut Vec<f64>,
     ) -> Result<(), SolveError> {
         state.check(sys)?;
-        if a.len() != sys.n_coords() {
-            return Err(SolveError::Dimension {
-                what: "a",
-                expected: sys.n_coords(),
-                got: a.len(),
-            });
+        for (what, expected, got) in [
+            ("a", sys.n_coords(), a.len()),
+            ("lambda", sys.n_constraints(), lambda.len()),
+        ] {
+            if got != expected {
+                return Err(SolveError::Dimension {
+                    what,
+                    expected,
+                    got,
+                });
+            }
         }
-        values(sys, state, a, out);
-        Ok(())
+        values(sys, state, a, lambda, &mut self.reactions, out)
     }
 }
 
-/// The sensors' values from the state and its accelerations (see the module docs).
-fn values(sys: &System, state: &State, a: &[f64], out: &mut Vec<f64>) {
+/// The sensors' values from the state, its accelerations and multipliers (see the module
+/// docs).
+fn values(
+    sys: &System,
+    state: &State,
+    a: &[f64],
+    lambda: &[f64],
+    reactions: &mut Option<(Vec<[f64; 6]>, Vec<JointReaction>)>,
+    out: &mut Vec<f64>,
+) -> Result<(), SolveError> {
     let (q, v) = (state.q.as_slice(), state.v.as_slice());
+    if let Some((grads, loads)) = reactions {
+        joint_reactions(grads, sys, state, lambda, loads)?;
+    }
     // a body point's position, velocity and acceleration (ground: fixed)
     let kinematics = |i: Option<usize>, p: [f64; 2]| -> [[f64; 2]; 3] {
         let Some(i) = i else {
@@ -150,6 +185,7 @@ fn values(sys: &System, state: &State, a: &[f64], out: &mut Vec<f64>) {
             ],
         ]
     };
+    let (mass, g) = (sys.mass_diag(), sys.gravity());
     for s in sys.sensors() {
         match &s.kind {
             SensorKind::Point { body, point } => {
@@ -163,7 +199,38 @@ fn values(sys: &System, state: &State, a: &[f64], out: &mut Vec<f64>) {
                     out.extend(slide.into_iter().flatten());
                 }
             }
+            SensorKind::Reaction { joint } => {
+                let r = reactions
+                    .as_ref()
+                    .and_then(|(_, loads)| loads.get(joint.index()))
+                    .copied()
+                    .unwrap_or_default();
+                out.extend([
+                    r.force[0],
+                    r.force[1],
+                    r.moment,
+                    r.local_force[0],
+                    r.local_force[1],
+                ]);
+            }
+            SensorKind::Energy { body: None } => {
+                let (t, u) = (sys.kinetic(v), sys.potential(q));
+                out.extend([t, u, t + u]);
+            }
+            SensorKind::Energy { body: Some(body) } => {
+                let (t, u) = match body.index() {
+                    Some(i) => (
+                        (3 * i..3 * i + 3)
+                            .map(|k| 0.5 * mass[k] * v[k] * v[k])
+                            .sum::<f64>(),
+                        -mass[3 * i] * (g[0] * q[3 * i] + g[1] * q[3 * i + 1]),
+                    ),
+                    None => (0.0, 0.0),
+                };
+                out.extend([t, u, t + u]);
+            }
             _ => {}
         }
     }
+    Ok(())
 }

@@ -163,20 +163,32 @@ impl ModelFile {
                 },
             );
         }
+        let sensor_joint = |name: &str, joint: &str| {
+            joints.get(joint).copied().ok_or_else(|| {
+                invalid(
+                    format!("sensor '{name}'"),
+                    format!("refers to unknown joint '{joint}'"),
+                )
+            })
+        };
         for s in &self.sensors {
             b.add_sensor(match s {
                 SensorSpec::Point { name, body, point } => {
                     Sensor::point(name, find(&format!("sensor '{name}'"), body)?, *point)
                 }
                 SensorSpec::Joint { name, joint } => {
-                    let h = joints.get(joint).copied().ok_or_else(|| {
-                        invalid(
-                            format!("sensor '{name}'"),
-                            format!("refers to unknown joint '{joint}'"),
-                        )
-                    })?;
-                    Sensor::joint(name, h)
+                    Sensor::joint(name, sensor_joint(name, joint)?)
                 }
+                SensorSpec::Reaction { name, joint } => {
+                    Sensor::reaction(name, sensor_joint(name, joint)?)
+                }
+                SensorSpec::Energy { name, body } => Sensor::energy(
+                    name,
+                    match body {
+                        Some(body) => Some(find(&format!("sensor '{name}'"), body)?),
+                        None => None,
+                    },
+                ),
             });
         }
         Ok(b)
@@ -206,6 +218,14 @@ impl System {
                 SensorKind::Joint { joint } => Some(SensorSpec::Joint {
                     name: s.name.clone(),
                     joint: self.joints.get(joint.index())?.name.clone(),
+                }),
+                SensorKind::Reaction { joint } => Some(SensorSpec::Reaction {
+                    name: s.name.clone(),
+                    joint: self.joints.get(joint.index())?.name.clone(),
+                }),
+                SensorKind::Energy { body } => Some(SensorSpec::Energy {
+                    name: s.name.clone(),
+                    body: body.map(name),
                 }),
             })
             .collect();
