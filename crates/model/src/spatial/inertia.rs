@@ -47,6 +47,10 @@ pub enum SpatialInertiaError {
         /// The determinant.
         det: f64,
     },
+    /// The body's rigid motion is undetermined at a configuration (what is degenerate and
+    /// why).
+    #[error("degenerate {0}")]
+    Degenerate(&'static str),
 }
 
 /// A spatial body's mass, principal moments of inertia about its centre of mass and principal

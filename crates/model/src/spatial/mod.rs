@@ -28,9 +28,11 @@
 
 mod inertia;
 mod orientation;
+mod rigid;
 
 pub use inertia::{SpatialInertia, SpatialInertiaError};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};
+pub use rigid::{internal_gamma, RigidSolve};
 
 use nalgebra::{Matrix3, Vector3};
 
