@@ -27,10 +27,12 @@
 //! two directors' velocities through `d_i . d_j = 0`), which is what the solvers need.
 
 mod inertia;
+mod joints;
 mod orientation;
 mod rigid;
 
 pub use inertia::{SpatialInertia, SpatialInertiaError};
+pub use joints::{Marker, SpatialFrame, SpatialJoint, SpatialJointError, SpatialJointKind};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};
 pub use rigid::{internal_gamma, RigidSolve};
 
