@@ -3,26 +3,29 @@
 use super::{Scalar, NV};
 use std::ops::{Add, Mul, Sub};
 
-/// Value, gradient (6 local variables) and first/second derivative along one direction.
+/// Value, gradient (`N` local variables) and first/second derivative along one direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DirJet {
+pub struct DirJetN<const N: usize> {
     /// Value.
     pub v: f64,
-    /// Gradient with respect to the 6 local variables.
-    pub g: [f64; NV],
+    /// Gradient with respect to the `N` local variables.
+    pub g: [f64; N],
     /// First derivative along the seeded direction (`g . dir`).
     pub d1: f64,
     /// Second derivative along the seeded direction (`dir^T H dir`).
     pub d2: f64,
 }
 
-impl DirJet {
+/// The planar jet: gradients over the [`NV`] local coordinates of a planar element.
+pub type DirJet = DirJetN<NV>;
+
+impl<const N: usize> DirJetN<N> {
     /// Independent variable number `i` with value `x` and direction component `dir`.
     #[inline(always)]
     pub fn var(i: usize, x: f64, dir: f64) -> Self {
-        let mut g = [0.0; NV];
+        let mut g = [0.0; N];
         g[i] = 1.0;
-        DirJet {
+        DirJetN {
             v: x,
             g,
             d1: dir,
@@ -31,11 +34,11 @@ impl DirJet {
     }
     #[inline(always)]
     fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
-        let mut g = [0.0; NV];
-        for k in 0..NV {
+        let mut g = [0.0; N];
+        for k in 0..N {
             g[k] = df * self.g[k];
         }
-        DirJet {
+        DirJetN {
             v: f,
             g,
             d1: df * self.d1,
@@ -44,15 +47,15 @@ impl DirJet {
     }
 }
 
-impl Add for DirJet {
+impl<const N: usize> Add for DirJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn add(self, o: Self) -> Self {
         let mut g = self.g;
-        for k in 0..NV {
+        for k in 0..N {
             g[k] += o.g[k];
         }
-        DirJet {
+        DirJetN {
             v: self.v + o.v,
             g,
             d1: self.d1 + o.d1,
@@ -60,15 +63,15 @@ impl Add for DirJet {
         }
     }
 }
-impl Sub for DirJet {
+impl<const N: usize> Sub for DirJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn sub(self, o: Self) -> Self {
         let mut g = self.g;
-        for k in 0..NV {
+        for k in 0..N {
             g[k] -= o.g[k];
         }
-        DirJet {
+        DirJetN {
             v: self.v - o.v,
             g,
             d1: self.d1 - o.d1,
@@ -76,15 +79,15 @@ impl Sub for DirJet {
         }
     }
 }
-impl Mul for DirJet {
+impl<const N: usize> Mul for DirJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn mul(self, o: Self) -> Self {
-        let mut g = [0.0; NV];
-        for k in 0..NV {
+        let mut g = [0.0; N];
+        for k in 0..N {
             g[k] = self.g[k] * o.v + o.g[k] * self.v;
         }
-        DirJet {
+        DirJetN {
             v: self.v * o.v,
             g,
             d1: self.d1 * o.v + self.v * o.d1,
@@ -92,7 +95,7 @@ impl Mul for DirJet {
         }
     }
 }
-impl Mul<f64> for DirJet {
+impl<const N: usize> Mul<f64> for DirJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn mul(self, c: f64) -> Self {
@@ -100,7 +103,7 @@ impl Mul<f64> for DirJet {
         for x in g.iter_mut() {
             *x *= c;
         }
-        DirJet {
+        DirJetN {
             v: self.v * c,
             g,
             d1: self.d1 * c,
@@ -108,13 +111,13 @@ impl Mul<f64> for DirJet {
         }
     }
 }
-super::scalar_shift_ops!(DirJet);
-impl Scalar for DirJet {
+super::scalar_shift_ops!(const DirJetN);
+impl<const N: usize> Scalar for DirJetN<N> {
     #[inline(always)]
     fn cst(v: f64) -> Self {
-        DirJet {
+        DirJetN {
             v,
-            g: [0.0; NV],
+            g: [0.0; N],
             d1: 0.0,
             d2: 0.0,
         }

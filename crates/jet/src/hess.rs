@@ -3,39 +3,42 @@
 use super::{Scalar, NV};
 use std::ops::{Add, Mul, Sub};
 
-/// Value, gradient and full Hessian with respect to the 6 local variables.
+/// Value, gradient and full Hessian with respect to the `N` local variables.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HessJet {
+pub struct HessJetN<const N: usize> {
     /// Value.
     pub v: f64,
     /// Gradient.
-    pub g: [f64; NV],
+    pub g: [f64; N],
     /// Hessian (symmetric).
-    pub h: [[f64; NV]; NV],
+    pub h: [[f64; N]; N],
 }
 
-impl HessJet {
+/// The planar jet: gradients over the [`NV`] local coordinates of a planar element.
+pub type HessJet = HessJetN<NV>;
+
+impl<const N: usize> HessJetN<N> {
     /// Independent variable number `i` with value `x`.
     #[inline(always)]
     pub fn var(i: usize, x: f64) -> Self {
-        let mut g = [0.0; NV];
+        let mut g = [0.0; N];
         g[i] = 1.0;
-        HessJet {
+        HessJetN {
             v: x,
             g,
-            h: [[0.0; NV]; NV],
+            h: [[0.0; N]; N],
         }
     }
     #[inline(always)]
     fn chain(self, f: f64, df: f64, ddf: f64) -> Self {
-        let mut out = HessJet {
+        let mut out = HessJetN {
             v: f,
-            g: [0.0; NV],
-            h: [[0.0; NV]; NV],
+            g: [0.0; N],
+            h: [[0.0; N]; N],
         };
-        for i in 0..NV {
+        for i in 0..N {
             out.g[i] = df * self.g[i];
-            for j in 0..NV {
+            for j in 0..N {
                 // `g_i * g_j` first so the Hessian stays exactly symmetric in floating point
                 out.h[i][j] = ddf * (self.g[i] * self.g[j]) + df * self.h[i][j];
             }
@@ -44,39 +47,39 @@ impl HessJet {
     }
 }
 
-impl Add for HessJet {
+impl<const N: usize> Add for HessJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn add(mut self, o: Self) -> Self {
         self.v += o.v;
-        for i in 0..NV {
+        for i in 0..N {
             self.g[i] += o.g[i];
-            for j in 0..NV {
+            for j in 0..N {
                 self.h[i][j] += o.h[i][j];
             }
         }
         self
     }
 }
-impl Sub for HessJet {
+impl<const N: usize> Sub for HessJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn sub(self, o: Self) -> Self {
         self + o * -1.0
     }
 }
-impl Mul for HessJet {
+impl<const N: usize> Mul for HessJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn mul(self, o: Self) -> Self {
-        let mut out = HessJet {
+        let mut out = HessJetN {
             v: self.v * o.v,
-            g: [0.0; NV],
-            h: [[0.0; NV]; NV],
+            g: [0.0; N],
+            h: [[0.0; N]; N],
         };
-        for i in 0..NV {
+        for i in 0..N {
             out.g[i] = self.g[i] * o.v + o.g[i] * self.v;
-            for j in 0..NV {
+            for j in 0..N {
                 out.h[i][j] = self.h[i][j] * o.v
                     + o.h[i][j] * self.v
                     + self.g[i] * o.g[j]
@@ -86,28 +89,28 @@ impl Mul for HessJet {
         out
     }
 }
-impl Mul<f64> for HessJet {
+impl<const N: usize> Mul<f64> for HessJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn mul(mut self, c: f64) -> Self {
         self.v *= c;
-        for i in 0..NV {
+        for i in 0..N {
             self.g[i] *= c;
-            for j in 0..NV {
+            for j in 0..N {
                 self.h[i][j] *= c;
             }
         }
         self
     }
 }
-super::scalar_shift_ops!(HessJet);
-impl Scalar for HessJet {
+super::scalar_shift_ops!(const HessJetN);
+impl<const N: usize> Scalar for HessJetN<N> {
     #[inline(always)]
     fn cst(v: f64) -> Self {
-        HessJet {
+        HessJetN {
             v,
-            g: [0.0; NV],
-            h: [[0.0; NV]; NV],
+            g: [0.0; N],
+            h: [[0.0; N]; N],
         }
     }
     #[inline(always)]

@@ -22,7 +22,9 @@
 //!
 //! Gradients are taken with respect to [`NV`] independent variables (the six coordinates
 //! `(x, y, theta)` of the two bodies a multibody joint or force connects, in `mbd-model`).
-//! The crate has no dependencies and knows nothing about mechanics.
+//! [`DirJetN`], [`HessJetN`] and [`TanJetN`] are the same jets over any number `N` of
+//! variables (`DirJet` is `DirJetN<NV>`): the 24 natural coordinates of two spatial bodies, for
+//! instance. The crate has no dependencies and knows nothing about mechanics.
 //!
 //! ```
 //! use mbd_jet::{Dual, HessJet, Scalar};
@@ -58,6 +60,31 @@ use std::ops::{Add, Mul, Neg, Sub};
 /// `-x` (as `x * -1.0`, bit-identical to negating every component), `x + c` and `x - c` (the
 /// value shifts, the derivatives do not) for a jet type with a `v` field and `Mul<f64>`.
 macro_rules! scalar_shift_ops {
+    (const $t:ident) => {
+        impl<const N: usize> std::ops::Neg for $t<N> {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                self * -1.0
+            }
+        }
+        impl<const N: usize> std::ops::Add<f64> for $t<N> {
+            type Output = Self;
+            #[inline(always)]
+            fn add(mut self, c: f64) -> Self {
+                self.v += c;
+                self
+            }
+        }
+        impl<const N: usize> std::ops::Sub<f64> for $t<N> {
+            type Output = Self;
+            #[inline(always)]
+            fn sub(mut self, c: f64) -> Self {
+                self.v -= c;
+                self
+            }
+        }
+    };
     ($t:ty) => {
         impl std::ops::Neg for $t {
             type Output = Self;
@@ -96,11 +123,11 @@ mod tan;
 mod taylor;
 mod third;
 
-pub use dir::DirJet;
+pub use dir::{DirJet, DirJetN};
 pub use dual::Dual;
-pub use hess::HessJet;
+pub use hess::{HessJet, HessJetN};
 pub use poly::{Basis, PolyJet, MAX_DIRS};
-pub use tan::TanJet;
+pub use tan::{TanJet, TanJetN};
 pub use taylor::{Taylor4, TAYLOR_DEGREE};
 pub use third::ThirdJet;
 

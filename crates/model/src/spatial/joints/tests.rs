@@ -298,3 +298,73 @@ fn bad_parameters_name_the_field() {
         assert_eq!(e.field, "length");
     }
 }
+
+/// The jets of `mbd-jet` over the 24 coordinates of a joint's two bodies differentiate every
+/// spatial joint: gradients equal central differences (exact for quadratics up to round-off),
+/// `DirJet`'s second directional derivative equals `v^T H v` of the `HessJet`, and the
+/// Hessian is the same at two configurations (the equations are quadratic).
+#[test]
+fn jets_differentiate_every_joint() {
+    use mbd_jet::{DirJetN, HessJetN};
+    let xa = Vector3::new(0.4, -0.2, 1.1);
+    let ra = quat([0.9, 0.2, -0.3, 0.25]);
+    let ma = Marker::with_axes([0.1, 0.3, -0.2], quat([0.5, -0.5, 0.3, 0.6]));
+    let mb = Marker::with_axes([-0.25, 0.05, 0.4], quat([0.2, 0.7, 0.1, -0.4]));
+    let dir: [f64; 24] = std::array::from_fn(|k| ((k as f64) * 0.37 + 0.2).sin());
+    for case in cases() {
+        let joint = SpatialJoint::new(case.kind, ma, mb).unwrap();
+        let n = joint.n_equations();
+        let (f, p) = (case.moved)(&(ra * ma.axes), xa + ra * Vector3::from(ma.point));
+        let mut q = place(&joint, xa, &ra, &f, p);
+        // off the constraints, so the values are not all zero
+        q[20] += 0.05;
+        let dj: [DirJetN<24>; 24] = std::array::from_fn(|k| DirJetN::var(k, q[k], dir[k]));
+        let hj: [HessJetN<24>; 24] = std::array::from_fn(|k| HessJetN::var(k, q[k]));
+        let (mut od, mut oh) = ([DirJetN::<24>::cst(0.0); 6], [HessJetN::<24>::cst(0.0); 6]);
+        let (fa, fb) = split(&dj);
+        joint.eval(&fa, &fb, &mut od);
+        let (fa, fb) = split(&hj);
+        joint.eval(&fa, &fb, &mut oh);
+        let fd = jacobian(&joint, &q);
+        let value = eval(&joint, &q);
+        // a second configuration for the Hessian's constancy
+        let q2: [f64; 24] = std::array::from_fn(|k| q[k] + 0.1 * ((k as f64) * 1.3).cos());
+        let hj2: [HessJetN<24>; 24] = std::array::from_fn(|k| HessJetN::var(k, q2[k]));
+        let mut oh2 = [HessJetN::<24>::cst(0.0); 6];
+        let (fa, fb) = split(&hj2);
+        joint.eval(&fa, &fb, &mut oh2);
+        for r in 0..n {
+            assert_eq!(od[r].v, value[r], "{:?} row {r}", case.kind);
+            for c in 0..24 {
+                let e = (od[r].g[c] - fd[(12 + r, c)]).abs();
+                assert!(e < 1e-12, "{:?} row {r} col {c}: {e:e}", case.kind);
+                assert_eq!(oh[r].g[c], od[r].g[c]);
+            }
+            let vhv: f64 = (0..24)
+                .map(|i| {
+                    (0..24)
+                        .map(|j| dir[i] * oh[r].h[i][j] * dir[j])
+                        .sum::<f64>()
+                })
+                .sum();
+            assert!((od[r].d2 - vhv).abs() < 1e-13, "{:?} row {r}", case.kind);
+            for i in 0..24 {
+                for j in 0..24 {
+                    assert!(
+                        (oh[r].h[i][j] - oh2[r].h[i][j]).abs() < 1e-15,
+                        "{:?} row {r}: H not constant",
+                        case.kind
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The frames of a joint's two bodies from the 24 local variables.
+fn split<T: mbd_jet::Scalar>(v: &[T; 24]) -> (SpatialFrame<T>, SpatialFrame<T>) {
+    (
+        SpatialFrame::new(&std::array::from_fn(|k| v[k])),
+        SpatialFrame::new(&std::array::from_fn(|k| v[12 + k])),
+    )
+}
