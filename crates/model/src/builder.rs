@@ -27,6 +27,8 @@ pub struct SystemBuilder {
     pub(crate) redundant: RedundantConstraints,
     /// Initial joint coordinates for assembly.
     pub(crate) joint_initials: Vec<(JointHandle, crate::JointInitial)>,
+    /// Spatial bodies, joints and gravity.
+    pub(crate) spatial: crate::spatial::build::SpatialInput,
 }
 
 /// How a body was added (builder side only: the [`System`] keeps centre-of-mass poses).
@@ -47,6 +49,37 @@ impl SystemBuilder {
     pub fn set_gravity(&mut self, g: [f64; 2]) -> &mut Self {
         self.gravity = g;
         self
+    }
+    /// Sets the gravity vector of the spatial bodies (m/s^2), e.g. `[0.0, 0.0, -9.81]` (the
+    /// planar bodies have theirs, [`SystemBuilder::set_gravity`]).
+    pub fn set_spatial_gravity(&mut self, g: [f64; 3]) -> &mut Self {
+        self.spatial.gravity = g;
+        self
+    }
+    /// Adds a spatial body (natural coordinates, docs/spatial.md) and returns its handle.
+    pub fn add_spatial_body(
+        &mut self,
+        body: crate::spatial::SpatialBody,
+    ) -> crate::spatial::SpatialBodyHandle {
+        self.spatial.bodies.push(body);
+        crate::spatial::SpatialBodyHandle(self.spatial.bodies.len() - 1)
+    }
+    /// Adds a spatial joint between spatial bodies (or ground); its markers are in the bodies'
+    /// frames (ground: global). Returns its index among the spatial joints.
+    pub fn add_spatial_joint(
+        &mut self,
+        name: impl Into<String>,
+        a: impl Into<crate::spatial::SpatialBodyRef>,
+        b: impl Into<crate::spatial::SpatialBodyRef>,
+        joint: crate::spatial::SpatialJoint,
+    ) -> usize {
+        self.spatial.joints.push(crate::spatial::SpatialJointEntry {
+            name: name.into(),
+            a: a.into(),
+            b: b.into(),
+            joint,
+        });
+        self.spatial.joints.len() - 1
     }
     /// Adds a body and returns its handle. Its local points (in joints and forces) are
     /// relative to its centre of mass, unless [`SystemBuilder::set_body_frame`] says otherwise.
@@ -338,9 +371,18 @@ impl System {
             unknown_frame: _,
             redundant: policy,
             joint_initials,
+            spatial,
         } = b;
-        if bodies.is_empty() {
+        if bodies.is_empty() && spatial.bodies.is_empty() {
             return Err(ModelError::Empty);
+        }
+        if !joint_initials.is_empty() && !spatial.bodies.is_empty() {
+            return Err(invalid(
+                "assembly".to_string(),
+                "assembly from joint coordinates takes planar models only; place spatial \
+                 bodies by their position and orientation"
+                    .to_string(),
+            ));
         }
         check::finite("gravity", "gravity", gravity[0])?;
         check::finite("gravity", "gravity", gravity[1])?;
@@ -497,14 +539,33 @@ impl System {
             }
             m += j.n_equations();
         }
-        let mass =
-            DVector::from_iterator(n, bodies.iter().flat_map(|b| [b.mass, b.mass, b.inertia]));
+        let spatial = spatial.build(
+            n,
+            m,
+            &mut bodies.iter().map(|b| b.name.clone()).collect(),
+            &mut jnames,
+        )?;
+        let n = n + 12 * spatial.bodies.len();
+        let m = m + spatial.m;
+        let mass = DVector::from_iterator(
+            n,
+            bodies
+                .iter()
+                .flat_map(|b| [b.mass, b.mass, b.inertia])
+                .chain(
+                    spatial
+                        .bodies
+                        .iter()
+                        .flat_map(|b| b.inertia.mass_diagonal()),
+                ),
+        );
         let inv_mass = mass.map(|x| 1.0 / x);
         // the negated gradient of the gravity potential, as `potential_gradient` writes it
-        let gravity_forces = bodies
+        let mut gravity_forces: Vec<f64> = bodies
             .iter()
             .flat_map(|b| [-(-b.mass * gravity[0]), -(-b.mass * gravity[1]), 0.0])
             .collect();
+        spatial.gravity_forces(&mut gravity_forces);
         let mut sys = System {
             bodies,
             joints,
@@ -522,6 +583,7 @@ impl System {
             gravity_forces,
             redundant: Vec::new(),
             joint_initials: Vec::new(),
+            spatial,
         };
         sys.joint_initials = crate::assembly::validate(&sys.joints, &joint_initials)?;
         sys.check_inertia_scale()?;

@@ -32,6 +32,7 @@ impl System {
                 out[o + k] = e[k] - j.time_part(k, t)[0];
             }
         }
+        self.spatial.phi(q, out);
     }
 
     /// `Phi_t(q, t)` into `out` (length m).
@@ -42,6 +43,8 @@ impl System {
                 out[o + k] = -j.time_part(k, t)[1];
             }
         }
+        // spatial joints have no drivers
+        out[self.spatial.r0..self.m].fill(0.0);
     }
 
     #[inline(always)]
@@ -55,6 +58,9 @@ impl System {
         let sc = SinCos::new(self, q, None);
         self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
             self.scatter_row(ji, r, g, out)
+        });
+        self.spatial.rows(q, None, |r, sides, jet| {
+            self.spatial.scatter_row(r, sides, &jet.g, out)
         });
     }
 
@@ -73,6 +79,10 @@ impl System {
         self.for_each_row(q, Some(v), t, &sc, |ji, r, g, gm| {
             self.scatter_row(ji, r, g, phi_q);
             gamma[r] = gm;
+        });
+        self.spatial.rows(q, Some(v), |r, sides, jet| {
+            self.spatial.scatter_row(r, sides, &jet.g, phi_q);
+            gamma[r] = -jet.d2;
         });
     }
 
@@ -94,6 +104,10 @@ impl System {
         self.for_each_row_tan(q, v, &sc, |ji, r, g, dg| {
             self.scatter_row(ji, r, g, phi_q);
             self.scatter_row(ji, r, dg, out);
+        });
+        self.spatial.rows_tan(q, v, |r, sides, g, dg| {
+            self.spatial.scatter_row(r, sides, g, phi_q);
+            self.spatial.scatter_row(r, sides, dg, out);
         });
     }
 
@@ -150,6 +164,7 @@ impl System {
     pub fn gamma(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         let sc = SinCos::new(self, q, None);
         self.for_each_row(q, Some(v), t, &sc, |_, r, _, gm| out[r] = gm);
+        self.spatial.rows(q, Some(v), |r, _, jet| out[r] = -jet.d2);
     }
 
     /// The velocity constraint `Phi_q v + Phi_t` into `out`.
@@ -180,6 +195,7 @@ impl System {
                 out[o + k] = e[k].d - j.time_part(k, t)[1];
             }
         }
+        self.spatial.rows(q, Some(v), |r, _, jet| out[r] = jet.d1);
     }
 
     /// Joint `ji`'s rows of `Phi` and `Phidot` from its bodies' frames.
@@ -256,6 +272,15 @@ impl System {
                 eval(ji, &fa, &fb);
             }
         }
+        self.spatial_phi_and_phi_dot(q, v, phi, phi_dot);
+    }
+
+    /// The spatial rows of [`System::phi_and_phi_dot`].
+    fn spatial_phi_and_phi_dot(&self, q: &[f64], v: &[f64], phi: &mut [f64], phi_dot: &mut [f64]) {
+        self.spatial.rows(q, Some(v), |r, _, jet| {
+            phi[r] = jet.v;
+            phi_dot[r] = jet.d1;
+        });
     }
 
     /// [`System::phi_and_phi_dot`] with the bodies' `sin`/`cos` brought to `q` by
@@ -294,6 +319,7 @@ impl System {
             );
             self.eval_phi_phi_dot(ji, &fa, &fb, t, phi, phi_dot);
         }
+        self.spatial_phi_and_phi_dot(q, v, phi, phi_dot);
     }
 
     /// `Phi_q` as (row, column, value) triplets of its structural non-zeros, for sparse
@@ -314,6 +340,7 @@ impl System {
                 }
             }
         });
+        self.spatial.triplets(q, out);
     }
 
     /// The lambda-weighted constraint Hessian `sum_k lambda_k d^2 Phi_k / dq^2` (n x n) into `out`
@@ -353,6 +380,7 @@ impl System {
             }
             Self::scatter_hess(at, &h, out);
         });
+        self.spatial.add_hessian(q, lambda, scale, out);
     }
 
     pub(crate) fn scatter_hess(at: Attach, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {

@@ -15,7 +15,7 @@ impl System {
             let at = self.force_attach[fi];
             v += f.potential(&Self::frm_f64(q, at.a), &Self::frm_f64(q, at.b));
         }
-        v
+        v + self.spatial.potential(q)
     }
 
     /// Kinetic energy `1/2 v^T M v`.
@@ -38,6 +38,11 @@ impl System {
             out[3 * i] = -b.mass * self.gravity[0];
             out[3 * i + 1] = -b.mass * self.gravity[1];
             out[3 * i + 2] = 0.0;
+        }
+        // spatial bodies: gravity alone, minus its generalised force
+        let q0 = self.spatial.q0;
+        for (o, g) in out[q0..].iter_mut().zip(&self.gravity_forces[q0..]) {
+            *o = -g;
         }
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];

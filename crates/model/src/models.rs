@@ -489,3 +489,5 @@ pub use loops::{
 };
 mod exact;
 pub use exact::{CrankMotion, Regime};
+mod spatial;
+pub use spatial::{free_body, heavy_top, TOP_LENGTH};

@@ -42,6 +42,7 @@ impl System {
         for b in &self.bodies {
             l = l.max((b.inertia / b.mass).sqrt());
         }
+        l = l.max(self.spatial.length_scale());
         if l > 0.0 && l.is_finite() {
             l
         } else {
@@ -56,6 +57,8 @@ impl System {
     pub fn equation_scale(&self, row: usize) -> f64 {
         if row >= self.m || self.is_angle_equation(row) {
             1.0
+        } else if row >= self.spatial.r0 {
+            self.spatial.equation_scale(row, self.length_scale())
         } else {
             self.length_scale()
         }
@@ -65,7 +68,15 @@ impl System {
     pub fn equation_scales(&self) -> Vec<f64> {
         let l = self.length_scale();
         (0..self.m)
-            .map(|r| if self.is_angle_equation(r) { 1.0 } else { l })
+            .map(|r| {
+                if self.is_angle_equation(r) {
+                    1.0
+                } else if r >= self.spatial.r0 {
+                    self.spatial.equation_scale(r, l)
+                } else {
+                    l
+                }
+            })
             .collect()
     }
 

@@ -119,6 +119,8 @@ pub struct System {
     pub(crate) redundant: Vec<RedundantEquation>,
     /// Initial joint coordinates (joint index, values) for assembly.
     pub(crate) joint_initials: Vec<(usize, crate::JointInitial)>,
+    /// The spatial bodies and joints (after the planar coordinates and rows).
+    pub(crate) spatial: crate::spatial::system::SpatialPart,
 }
 
 impl System {
@@ -146,6 +148,39 @@ impl System {
     /// The force elements.
     pub fn forces(&self) -> &[Force] {
         &self.forces
+    }
+    /// Whether the model has spatial bodies (docs/spatial.md): their coordinates follow the
+    /// planar bodies' and their rows (internal constraints, then spatial joints) the planar
+    /// joints'.
+    pub fn has_spatial(&self) -> bool {
+        !self.spatial.is_empty()
+    }
+    /// The spatial bodies, in handle order; body `k`'s natural coordinates are
+    /// `q[s + 12 k..s + 12 k + 12]` with `s` = [`System::spatial_offset`].
+    pub fn spatial_bodies(&self) -> &[crate::spatial::SpatialBody] {
+        &self.spatial.bodies
+    }
+    /// The spatial joints (markers in the bodies' frames, as given).
+    pub fn spatial_joints(&self) -> &[crate::spatial::SpatialJointEntry] {
+        &self.spatial.joints
+    }
+    /// The first coordinate of the spatial bodies (`3` times the number of planar bodies).
+    pub fn spatial_offset(&self) -> usize {
+        self.spatial.q0
+    }
+    /// The gravity vector of the spatial bodies.
+    pub fn spatial_gravity(&self) -> [f64; 3] {
+        self.spatial.gravity
+    }
+    /// The first spatial body whose mass matrix is singular (a second moment `E_i = 0`: a thin
+    /// disc or plate, the symmetric top), if any: solvers that divide by the mass matrix's
+    /// diagonal refuse such a model by this name.
+    pub fn singular_mass_body(&self) -> Option<&str> {
+        self.spatial
+            .bodies
+            .iter()
+            .find(|b| b.inertia.has_singular_mass_matrix())
+            .map(|b| b.name.as_str())
     }
     /// The gravity vector.
     pub fn gravity(&self) -> [f64; 2] {
@@ -207,21 +242,28 @@ impl System {
     }
     /// Names of the coordinates: `body.x`, `body.y`, `body.theta`.
     pub fn coordinate_names(&self) -> Vec<String> {
-        self.bodies
+        let mut names: Vec<String> = self
+            .bodies
             .iter()
             .flat_map(|b| ["x", "y", "theta"].map(|c| format!("{}.{}", b.name, c)))
-            .collect()
+            .collect();
+        self.spatial.coordinate_names(&mut names);
+        names
     }
     /// Names of the constraint equations: `joint.label`.
     pub fn equation_names(&self) -> Vec<String> {
-        self.joints
+        let mut names: Vec<String> = self
+            .joints
             .iter()
             .flat_map(|j| {
                 j.equation_labels()
                     .iter()
                     .map(move |l| format!("{}.{}", j.name, l))
             })
-            .collect()
+            .collect();
+        let r0 = names.len();
+        names.extend((r0..self.m).map(|r| self.equation_name(r)));
+        names
     }
     /// The name of equation `row`.
     pub fn equation_name(&self, row: usize) -> String {
@@ -234,7 +276,10 @@ impl System {
                     j.equation_labels()[row - self.row_offset[ji]]
                 )
             }
-            None => format!("equation #{row}"),
+            None => self
+                .spatial
+                .equation_name(row)
+                .unwrap_or_else(|| format!("equation #{row}")),
         }
     }
     /// The joint that owns equation `row`.
@@ -280,8 +325,10 @@ impl System {
 
     /// The bodies' stored positions and velocities.
     pub(crate) fn stored_state(&self) -> (Vec<f64>, Vec<f64>) {
-        let q = self.bodies.iter().flat_map(|b| b.position).collect();
-        let v = self.bodies.iter().flat_map(|b| b.velocity).collect();
+        let mut q: Vec<f64> = self.bodies.iter().flat_map(|b| b.position).collect();
+        let mut v: Vec<f64> = self.bodies.iter().flat_map(|b| b.velocity).collect();
+        q.extend(&self.spatial.q_init);
+        v.extend(&self.spatial.v_init);
         (q, v)
     }
 

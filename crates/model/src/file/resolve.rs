@@ -196,7 +196,8 @@ impl ModelFile {
 }
 
 impl System {
-    /// The model as a file description (bodies by name).
+    /// The model as a file description (bodies by name). Model files hold planar models:
+    /// spatial bodies and joints ([`System::spatial_bodies`]) are not written.
     pub fn to_model_file(&self) -> ModelFile {
         let name = |r: BodyRef| -> String {
             match r {

@@ -26,15 +26,20 @@
 //! space of the internal constraints all the same (`d_i'` with `E_i = 0` is fixed by the other
 //! two directors' velocities through `d_i . d_j = 0`), which is what the solvers need.
 
+mod body;
+pub(crate) mod build;
 mod inertia;
 mod joints;
 mod orientation;
 mod rigid;
+pub(crate) mod system;
 
+pub use body::{SpatialBody, SpatialBodyHandle, SpatialBodyRef};
 pub use inertia::{SpatialInertia, SpatialInertiaError};
 pub use joints::{Marker, SpatialFrame, SpatialJoint, SpatialJointError, SpatialJointKind};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};
 pub use rigid::{internal_gamma, RigidSolve};
+pub use system::SpatialJointEntry;
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -42,14 +47,20 @@ use nalgebra::{Matrix3, Vector3};
 /// d_3)`): `[1/2 (|d_1|^2 - 1), 1/2 (|d_2|^2 - 1), 1/2 (|d_3|^2 - 1), d_1 . d_2, d_1 . d_3,
 /// d_2 . d_3]`.
 pub fn internal_constraints(q: &[f64; 12]) -> [f64; 6] {
-    let d = directors(q);
+    internal_eval(&SpatialFrame::new(q))
+}
+
+/// [`internal_constraints`] of a frame, over any scalar (the jets differentiate it).
+pub(crate) fn internal_eval<T: mbd_jet::Scalar>(f: &SpatialFrame<T>) -> [T; 6] {
+    let d = f.d;
+    let dot = joints::dot3::<T>;
     [
-        0.5 * (d[0].norm_squared() - 1.0),
-        0.5 * (d[1].norm_squared() - 1.0),
-        0.5 * (d[2].norm_squared() - 1.0),
-        d[0].dot(&d[1]),
-        d[0].dot(&d[2]),
-        d[1].dot(&d[2]),
+        (dot(d[0], d[0]) - 1.0) * 0.5,
+        (dot(d[1], d[1]) - 1.0) * 0.5,
+        (dot(d[2], d[2]) - 1.0) * 0.5,
+        dot(d[0], d[1]),
+        dot(d[0], d[2]),
+        dot(d[1], d[2]),
     ]
 }
 

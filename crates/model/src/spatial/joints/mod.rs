@@ -255,6 +255,19 @@ impl SpatialJoint {
         }
     }
 
+    /// The physical dimension of equation `k` as a power of length: 0 for the orientation
+    /// equations (dot products of unit axes), 1 for positions, 2 for the distance joint's
+    /// `1/2 (|r|^2 - L^2)`. Scales tolerances on the equation.
+    pub fn length_power(&self, k: usize) -> i32 {
+        use SpatialJointKind::*;
+        match self.kind {
+            Spherical | Weld | Revolute | Universal => i32::from(k < 3),
+            Cylindrical | Prismatic => i32::from((2..4).contains(&k)),
+            Planar => i32::from(k == 2),
+            Distance { .. } => 2,
+        }
+    }
+
     /// The equations at the frames `fa`, `fb` into `out[..n_equations]` (the rest untouched).
     pub fn eval<T: Scalar>(&self, fa: &SpatialFrame<T>, fb: &SpatialFrame<T>, out: &mut [T; 6]) {
         let (ma, mb) = (self.a.on(fa), self.b.on(fb));

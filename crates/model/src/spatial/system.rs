@@ -1,0 +1,339 @@
+//! The spatial bodies and joints of a [`crate::System`]: their place in `q` and `Phi`, and
+//! their rows of the constraint functions, written over the jets of 24 variables.
+//!
+//! Coordinates: after the planar bodies' `3 nb`, spatial body `k` holds
+//! `q[q0 + 12 k .. q0 + 12 k + 12] = (x, d_1, d_2, d_3)`. Rows: after the planar joints' rows,
+//! body `k`'s six internal constraints, then each spatial joint's equations. Every row is an
+//! element of one or two bodies (local variables `0..12` the first side's coordinates,
+//! `12..24` the second's; ground has none), evaluated with `f64`, `DirJetN<24>` (gradient,
+//! `Phi_q v`, `v^T H v`), `TanJetN<24>` (`H v`) or `HessJetN<24>` (the Hessian).
+
+use super::body::{SpatialBody, SpatialBodyRef};
+use super::joints::{SpatialFrame, SpatialJoint};
+use mbd_jet::{DirJetN, HessJetN, Scalar, TanJetN};
+use nalgebra::DMatrix;
+
+/// The local width of a spatial element: two bodies' natural coordinates.
+pub(crate) const SW: usize = 24;
+
+/// A spatial joint of a model: its name, the bodies its markers sit on, and the joint (markers
+/// in each body's frame, as given).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpatialJointEntry {
+    /// Unique joint name.
+    pub name: String,
+    /// The body of the first marker.
+    pub a: SpatialBodyRef,
+    /// The body of the second marker.
+    pub b: SpatialBodyRef,
+    /// The joint, its markers in the bodies' frames.
+    pub joint: SpatialJoint,
+}
+
+/// One element of the spatial rows: a body's internal constraints or a joint.
+#[derive(Clone, Copy, Debug)]
+enum Item {
+    Internal,
+    Joint(usize),
+}
+
+/// The spatial part of a model (empty for a planar model).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SpatialPart {
+    pub(crate) bodies: Vec<SpatialBody>,
+    pub(crate) joints: Vec<SpatialJointEntry>,
+    /// The joints with their markers in the principal frames (what the equations use).
+    lowered: Vec<SpatialJoint>,
+    /// Each joint's bodies (spatial indices; `None`: ground).
+    attach: Vec<[Option<usize>; 2]>,
+    /// Each joint's first row.
+    joint_row: Vec<usize>,
+    /// The first spatial coordinate and row.
+    pub(crate) q0: usize,
+    pub(crate) r0: usize,
+    /// The number of spatial rows.
+    pub(crate) m: usize,
+    /// Gravity (m/s^2).
+    pub(crate) gravity: [f64; 3],
+    /// The initial natural coordinates and velocities, body after body.
+    pub(crate) q_init: Vec<f64>,
+    pub(crate) v_init: Vec<f64>,
+}
+
+impl SpatialPart {
+    /// The part for `bodies` (valid: natural states `q_init`, `v_init`) and `joints` (their
+    /// markers lowered to the principal frames in `lowered`, attachments resolved), after
+    /// `q0` planar coordinates and `r0` planar rows.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        bodies: Vec<SpatialBody>,
+        joints: Vec<SpatialJointEntry>,
+        lowered: Vec<SpatialJoint>,
+        gravity: [f64; 3],
+        q0: usize,
+        r0: usize,
+        q_init: Vec<f64>,
+        v_init: Vec<f64>,
+    ) -> Self {
+        let attach = joints.iter().map(|j| [j.a.index(), j.b.index()]).collect();
+        let mut joint_row = Vec::with_capacity(joints.len());
+        let mut m = 6 * bodies.len();
+        for j in &lowered {
+            joint_row.push(r0 + m);
+            m += j.n_equations();
+        }
+        SpatialPart {
+            bodies,
+            joints,
+            lowered,
+            attach,
+            joint_row,
+            q0,
+            r0,
+            m,
+            gravity,
+            q_init,
+            v_init,
+        }
+    }
+
+    /// Whether the model has no spatial body.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.bodies.is_empty()
+    }
+
+    /// Every element: its sides, first row and row count.
+    fn items(&self) -> impl Iterator<Item = (Item, [Option<usize>; 2], usize, usize)> + '_ {
+        let internal =
+            (0..self.bodies.len()).map(|k| (Item::Internal, [Some(k), None], self.r0 + 6 * k, 6));
+        let joints = (0..self.lowered.len()).map(|j| {
+            (
+                Item::Joint(j),
+                self.attach[j],
+                self.joint_row[j],
+                self.lowered[j].n_equations(),
+            )
+        });
+        internal.chain(joints)
+    }
+
+    /// The global column of local variable `l` (side `l / 12`) of an element with `sides`.
+    fn col(&self, sides: [Option<usize>; 2], l: usize) -> Option<usize> {
+        sides[l / 12].map(|k| self.q0 + 12 * k + l % 12)
+    }
+
+    /// An element's equations at the frames of its sides.
+    fn eval<T: Scalar>(&self, item: Item, fa: &SpatialFrame<T>, fb: &SpatialFrame<T>) -> [T; 6] {
+        let mut out = [T::cst(0.0); 6];
+        match item {
+            Item::Internal => out = super::internal_eval(fa),
+            Item::Joint(j) => self.lowered[j].eval(fa, fb, &mut out),
+        }
+        out
+    }
+
+    /// An element's equations with jets: local variable `l` made by `var(l, column)`.
+    fn eval_jets<T: Scalar>(
+        &self,
+        item: Item,
+        sides: [Option<usize>; 2],
+        var: impl Fn(usize, usize) -> T,
+    ) -> [T; 6] {
+        let frame = |s: usize| match sides[s] {
+            Some(_) => SpatialFrame::new(&std::array::from_fn(|k| {
+                let l = 12 * s + k;
+                var(l, self.col(sides, l).unwrap_or(0))
+            })),
+            None => SpatialFrame::ground(),
+        };
+        self.eval(item, &frame(0), &frame(1))
+    }
+
+    /// The spatial rows of `Phi(q)` into `out` (the whole vector).
+    pub(crate) fn phi(&self, q: &[f64], out: &mut [f64]) {
+        for (item, sides, row, n) in self.items() {
+            let e = self.eval_jets(item, sides, |_, c| q[c]);
+            out[row..row + n].copy_from_slice(&e[..n]);
+        }
+    }
+
+    /// For every spatial row: `visit(row, sides, jet)`, the jet holding the value, the
+    /// gradient, `Phi_q v` (`d1`) and `v^T H v` (`d2`) (`v = None`: zero velocities).
+    pub(crate) fn rows(
+        &self,
+        q: &[f64],
+        v: Option<&[f64]>,
+        mut visit: impl FnMut(usize, [Option<usize>; 2], &DirJetN<SW>),
+    ) {
+        for (item, sides, row, n) in self.items() {
+            let e = self.eval_jets(item, sides, |l, c| {
+                DirJetN::<SW>::var(l, q[c], v.map_or(0.0, |v| v[c]))
+            });
+            for (k, ek) in e.iter().enumerate().take(n) {
+                visit(row + k, sides, ek);
+            }
+        }
+    }
+
+    /// For every spatial row: `visit(row, sides, gradient, H v)`.
+    pub(crate) fn rows_tan(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        mut visit: impl FnMut(usize, [Option<usize>; 2], &[f64; SW], &[f64; SW]),
+    ) {
+        for (item, sides, row, n) in self.items() {
+            let e = self.eval_jets(item, sides, |l, c| TanJetN::<SW>::var(l, q[c], v[c]));
+            for (k, ek) in e.iter().enumerate().take(n) {
+                visit(row + k, sides, &ek.g, &ek.dg);
+            }
+        }
+    }
+
+    /// `out[row, .] += g` in the columns of the element's sides.
+    pub(crate) fn scatter_row(
+        &self,
+        row: usize,
+        sides: [Option<usize>; 2],
+        g: &[f64; SW],
+        out: &mut DMatrix<f64>,
+    ) {
+        for (l, &x) in g.iter().enumerate() {
+            if let Some(c) = self.col(sides, l) {
+                out[(row, c)] += x;
+            }
+        }
+    }
+
+    /// `Phi_q`'s spatial non-zeros as triplets.
+    pub(crate) fn triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+        self.rows(q, None, |row, sides, jet| {
+            for (l, &x) in jet.g.iter().enumerate() {
+                if let Some(c) = self.col(sides, l) {
+                    if x != 0.0 {
+                        out.push((row, c, x));
+                    }
+                }
+            }
+        });
+    }
+
+    /// `out += scale sum_k lambda_k Hess(Phi_k)` over the spatial rows.
+    pub(crate) fn add_hessian(
+        &self,
+        q: &[f64],
+        lambda: &[f64],
+        scale: f64,
+        out: &mut DMatrix<f64>,
+    ) {
+        for (item, sides, row, n) in self.items() {
+            let e = self.eval_jets(item, sides, |l, c| HessJetN::<SW>::var(l, q[c]));
+            for (k, ek) in e.iter().enumerate().take(n) {
+                let w = scale * lambda[row + k];
+                if w == 0.0 {
+                    continue;
+                }
+                for r in 0..SW {
+                    let Some(gr) = self.col(sides, r) else {
+                        continue;
+                    };
+                    for c in 0..SW {
+                        let Some(gc) = self.col(sides, c) else {
+                            continue;
+                        };
+                        out[(gr, gc)] += w * ek.h[r][c];
+                    }
+                }
+            }
+        }
+    }
+
+    /// The potential of gravity on the spatial bodies, `-sum_k m_k g . x_k`.
+    pub(crate) fn potential(&self, q: &[f64]) -> f64 {
+        let g = self.gravity;
+        self.bodies
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                let x = &q[self.q0 + 12 * k..self.q0 + 12 * k + 3];
+                -b.inertia.mass() * (g[0] * x[0] + g[1] * x[1] + g[2] * x[2])
+            })
+            .sum()
+    }
+
+    /// Gravity's generalised forces `(m g, 0, 0, 0)` per spatial body, appended to `out`.
+    pub(crate) fn gravity_forces(&self, out: &mut Vec<f64>) {
+        for b in &self.bodies {
+            let m = b.inertia.mass();
+            out.extend(self.gravity.map(|g| m * g));
+            out.extend([0.0; 9]);
+        }
+    }
+
+    /// The coordinate names: `body.x`, `.y`, `.z`, then the directors `body.d1x`, ...,
+    /// `body.d3z`.
+    pub(crate) fn coordinate_names(&self, out: &mut Vec<String>) {
+        for b in &self.bodies {
+            for c in ["x", "y", "z"] {
+                out.push(format!("{}.{c}", b.name));
+            }
+            for i in 1..=3 {
+                for c in ["x", "y", "z"] {
+                    out.push(format!("{}.d{i}{c}", b.name));
+                }
+            }
+        }
+    }
+
+    /// The unit of spatial row `row` for a model of length scale `l`: 1 for the internal
+    /// constraints and orientation equations, `l` for positions, `l^2` for distances.
+    pub(crate) fn equation_scale(&self, row: usize, l: f64) -> f64 {
+        let Some(rel) = row.checked_sub(self.r0) else {
+            return 1.0;
+        };
+        if rel < 6 * self.bodies.len() {
+            return 1.0;
+        }
+        match self.joint_row.iter().rposition(|&r| r <= row) {
+            Some(j) => l.powi(self.lowered[j].length_power(row - self.joint_row[j])),
+            None => 1.0,
+        }
+    }
+
+    /// The largest lever arm (marker point from a centre of mass), joint distance and radius
+    /// of gyration of the spatial bodies (0 without them).
+    pub(crate) fn length_scale(&self) -> f64 {
+        let norm = |p: [f64; 3]| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        let mut l = 0.0f64;
+        for b in &self.bodies {
+            let j = b.inertia.moments();
+            l = l.max((j[0].max(j[1]).max(j[2]) / b.inertia.mass()).sqrt());
+        }
+        for (entry, sides) in self.joints.iter().zip(&self.attach) {
+            let (ma, mb) = entry.joint.markers();
+            for (m, side) in [(ma, sides[0]), (mb, sides[1])] {
+                if side.is_some() {
+                    l = l.max(norm(m.point));
+                }
+            }
+            if let super::joints::SpatialJointKind::Distance { length } = entry.joint.kind() {
+                l = l.max(length);
+            }
+        }
+        l
+    }
+
+    /// The name of spatial row `row`: `body.unit1`, ..., `body.orth23` for the internal
+    /// constraints, `joint.eK` for a joint's `K`-th equation.
+    pub(crate) fn equation_name(&self, row: usize) -> Option<String> {
+        let rel = row.checked_sub(self.r0)?;
+        let nb = self.bodies.len();
+        if rel < 6 * nb {
+            const LABELS: [&str; 6] = ["unit1", "unit2", "unit3", "orth12", "orth13", "orth23"];
+            return Some(format!("{}.{}", self.bodies[rel / 6].name, LABELS[rel % 6]));
+        }
+        let j = self.joint_row.iter().rposition(|&r| r <= row)?;
+        let k = row - self.joint_row[j];
+        (k < self.lowered[j].n_equations()).then(|| format!("{}.e{}", self.joints[j].name, k + 1))
+    }
+}

@@ -1,0 +1,267 @@
+//! Spatial bodies in a `System`: the constraint functions over the spatial rows against finite
+//! differences, gravity's potential and forces, names, a model mixing planar and spatial
+//! bodies, and the builder's errors.
+
+use mbd_model::models::{heavy_top, pendulum, TOP_LENGTH};
+use mbd_model::spatial::{
+    Marker, Orientation, SpatialBody, SpatialBodyRef, SpatialInertia, SpatialJoint,
+    SpatialJointKind,
+};
+use mbd_model::{System, SystemBuilder};
+use nalgebra::{DMatrix, Matrix3};
+
+/// The heavy top off its constraints a little (so every row is exercised away from zero).
+fn top_state(sys: &System) -> (Vec<f64>, Vec<f64>) {
+    let (q, v) = sys.initial_guess();
+    let mut q: Vec<f64> = q.iter().copied().collect();
+    for (k, x) in q.iter_mut().enumerate() {
+        *x += 1e-2 * ((k as f64) * 0.7).sin();
+    }
+    (q, v.iter().copied().collect())
+}
+
+fn dense(m: usize, n: usize) -> DMatrix<f64> {
+    DMatrix::zeros(m, n)
+}
+
+fn max_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).amax()
+}
+
+/// `Phi` vanishes at the assembled top; `Phi_q`, `gamma`, `Phi_q v`, `(Phi_q v)_q`, the
+/// lambda-weighted Hessian and the triplets agree with central differences (exact for these
+/// quadratic equations up to round-off).
+#[test]
+fn spatial_rows_match_finite_differences() {
+    let sys = heavy_top([0.3, 0.3, 0.1], 0.4, 15.0).unwrap();
+    let (n, m) = (sys.n_coords(), sys.n_constraints());
+    let (q0, _) = sys.initial_guess();
+    let mut phi = vec![0.0; m];
+    sys.phi(q0.as_slice(), 0.0, &mut phi);
+    assert!(phi.iter().all(|e| e.abs() < 1e-15), "{phi:?}");
+
+    let (q, v) = top_state(&sys);
+    let h = 1e-4;
+    let phi_at = |q: &[f64]| {
+        let mut p = vec![0.0; m];
+        sys.phi(q, 0.0, &mut p);
+        p
+    };
+    let mut fd = dense(m, n);
+    for c in 0..n {
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[c] += h;
+        qm[c] -= h;
+        let (p, mm) = (phi_at(&qp), phi_at(&qm));
+        for r in 0..m {
+            fd[(r, c)] = (p[r] - mm[r]) / (2.0 * h);
+        }
+    }
+    let mut jac = dense(m, n);
+    let mut gamma = vec![0.0; m];
+    sys.phi_q_gamma(&q, &v, 0.0, &mut jac, &mut gamma);
+    assert!(max_diff(&jac, &fd) < 1e-9, "{}", max_diff(&jac, &fd));
+    let mut jac2 = dense(m, n);
+    sys.phi_q(&q, &mut jac2);
+    assert_eq!(jac, jac2);
+    let mut triplets = Vec::new();
+    sys.phi_q_triplets(&q, &mut triplets);
+    let mut from_triplets = dense(m, n);
+    for (r, c, x) in triplets {
+        from_triplets[(r, c)] += x;
+    }
+    assert_eq!(from_triplets, jac);
+
+    // Phi_q v and gamma = -(Phi_q v)_q v
+    let jv = &jac * nalgebra::DVector::from_column_slice(&v);
+    let mut phid = vec![0.0; m];
+    sys.phi_dot(&q, &v, 0.0, &mut phid);
+    let mut both = (vec![0.0; m], vec![0.0; m]);
+    sys.phi_and_phi_dot(&q, &v, 0.0, &mut both.0, &mut both.1);
+    for r in 0..m {
+        assert!((phid[r] - jv[r]).abs() < 1e-12);
+        assert_eq!(both.1[r], phid[r]);
+        assert_eq!(both.0[r], phi_at(&q)[r]);
+    }
+    let jv_at = |q: &[f64]| {
+        let mut j = dense(m, n);
+        sys.phi_q(q, &mut j);
+        j * nalgebra::DVector::from_column_slice(&v)
+    };
+    let mut dqv = dense(m, n);
+    for c in 0..n {
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[c] += h;
+        qm[c] -= h;
+        let d = (jv_at(&qp) - jv_at(&qm)) / (2.0 * h);
+        for r in 0..m {
+            dqv[(r, c)] = d[r];
+        }
+    }
+    let want_gamma = -(&dqv * nalgebra::DVector::from_column_slice(&v));
+    for r in 0..m {
+        assert!(
+            (gamma[r] - want_gamma[r]).abs() < 1e-8,
+            "row {r}: {} vs {}",
+            gamma[r],
+            want_gamma[r]
+        );
+    }
+    let (mut j3, mut tan) = (dense(m, n), dense(m, n));
+    sys.phi_q_dot_jacobian(&q, &v, &mut j3, &mut tan);
+    assert_eq!(j3, jac);
+    assert!(max_diff(&tan, &dqv) < 1e-8, "{}", max_diff(&tan, &dqv));
+
+    // sum_k lambda_k Hess(Phi_k) = d/dq (Phi_q^T lambda)
+    let lambda: Vec<f64> = (0..m).map(|k| (k as f64 * 0.9).cos()).collect();
+    let mut hess = dense(n, n);
+    sys.constraint_hessian(&q, &lambda, &mut hess);
+    let jtl = |q: &[f64]| {
+        let mut j = dense(m, n);
+        sys.phi_q(q, &mut j);
+        j.transpose() * nalgebra::DVector::from_column_slice(&lambda)
+    };
+    for c in 0..n {
+        let (mut qp, mut qm) = (q.clone(), q.clone());
+        qp[c] += h;
+        qm[c] -= h;
+        let d = (jtl(&qp) - jtl(&qm)) / (2.0 * h);
+        for r in 0..n {
+            assert!((hess[(r, c)] - d[r]).abs() < 1e-8, "H[{r},{c}]");
+        }
+    }
+}
+
+/// Gravity: `V = -m g . x`, its gradient, the forces `-grad V`, and `T` from the mass matrix
+/// equals `1/2 w . J w` of the spin at the initial state.
+#[test]
+fn gravity_and_energy_of_a_spatial_body() {
+    let moments = [0.3, 0.3, 0.1];
+    let (tilt, spin) = (0.4, 15.0);
+    let sys = heavy_top(moments, tilt, spin).unwrap();
+    let (q, v) = sys.initial_guess();
+    let (q, v) = (q.as_slice(), v.as_slice());
+    let z = TOP_LENGTH * tilt.cos();
+    assert!((sys.potential(q) - 9.81 * z).abs() < 1e-14);
+    let mut grad = vec![0.0; 12];
+    sys.potential_gradient(q, &mut grad);
+    assert_eq!(grad[..3], [0.0, 0.0, 9.81]);
+    assert!(grad[3..].iter().all(|&g| g == 0.0));
+    let mut f = vec![0.0; 12];
+    sys.forces_into(q, v, 0.0, &mut f);
+    assert_eq!(f[..3], [0.0, 0.0, -9.81]);
+    // spin about the symmetry axis through the tip: the centre of mass is at rest
+    let t = 0.5 * moments[2] * spin * spin;
+    assert!(
+        (sys.kinetic(v) - t).abs() < 1e-12 * t,
+        "{} vs {t}",
+        sys.kinetic(v)
+    );
+}
+
+/// Names: `body.x` ... `body.d3z`; `body.unit1` ... `body.orth23`, `joint.e1` ...; a planar
+/// pendulum and a spatial top in one model keep the planar layout and put the spatial one after.
+#[test]
+fn names_and_a_mixed_model() {
+    let top = heavy_top([0.3, 0.3, 0.1], 0.4, 15.0).unwrap();
+    let names = top.coordinate_names();
+    assert_eq!(names[..4], ["top.x", "top.y", "top.z", "top.d1x"]);
+    assert_eq!(names[11], "top.d3z");
+    let eq = top.equation_names();
+    assert_eq!(
+        eq[..6],
+        [
+            "top.unit1",
+            "top.unit2",
+            "top.unit3",
+            "top.orth12",
+            "top.orth13",
+            "top.orth23"
+        ]
+    );
+    assert_eq!(eq[6..], ["tip.e1", "tip.e2", "tip.e3"]);
+
+    // the pendulum's model with the top added
+    let p = pendulum(1.0, 1.0, 0.3, 9.81).unwrap();
+    let mut b = p.to_model_file().to_builder().unwrap();
+    b.set_spatial_gravity([0.0, 0.0, -9.81]);
+    let inertia = SpatialInertia::principal(1.0, [0.3, 0.3, 0.1]).unwrap();
+    let body =
+        b.add_spatial_body(SpatialBody::new("top", inertia).position([0.0, 0.0, TOP_LENGTH]));
+    b.add_spatial_joint(
+        "tip",
+        SpatialBodyRef::Ground,
+        body,
+        SpatialJoint::new(
+            SpatialJointKind::Spherical,
+            Marker::at([0.0; 3]),
+            Marker::at([0.0, 0.0, -TOP_LENGTH]),
+        )
+        .unwrap(),
+    );
+    let mixed = b.build().unwrap();
+    assert_eq!(
+        (mixed.n_coords(), mixed.n_constraints(), mixed.dof()),
+        (15, 11, 4)
+    );
+    assert_eq!(mixed.spatial_offset(), 3);
+    let (q, v) = mixed.initial_guess();
+    let mut phi = vec![0.0; 11];
+    mixed.phi(q.as_slice(), 0.0, &mut phi);
+    let mut phi_p = vec![0.0; 2];
+    p.phi(&q.as_slice()[..3], 0.0, &mut phi_p);
+    assert_eq!(phi[..2], phi_p[..]);
+    let e = mixed.energy(q.as_slice(), v.as_slice());
+    let (pq, pv) = p.initial_guess();
+    let want = p.energy(pq.as_slice(), pv.as_slice()) + 9.81 * TOP_LENGTH;
+    assert!((e - want).abs() < 1e-12, "{e} vs {want}");
+    assert_eq!(mixed.equation_name(2), "top.unit1");
+}
+
+/// Bad spatial input: a duplicate name (also against planar bodies), a marker on a body of
+/// another model, a joint from a body to itself, an orientation that is not a rotation.
+#[test]
+fn spatial_builder_errors_name_the_element() {
+    let inertia = SpatialInertia::principal(1.0, [0.3, 0.3, 0.1]).unwrap();
+    let ball = || {
+        SpatialJoint::new(
+            SpatialJointKind::Spherical,
+            Marker::at([0.0; 3]),
+            Marker::at([0.0; 3]),
+        )
+        .unwrap()
+    };
+
+    let mut b = SystemBuilder::new();
+    b.add_body(mbd_model::Body::new("arm").mass(1.0).inertia(0.1));
+    b.add_spatial_body(SpatialBody::new("arm", inertia.clone()));
+    let e = b.build().unwrap_err().to_string();
+    assert!(e.contains("arm"), "{e}");
+
+    let mut b = SystemBuilder::new();
+    let k = b.add_spatial_body(SpatialBody::new("k", inertia.clone()));
+    b.add_spatial_joint("self", k, k, ball());
+    let e = b.build().unwrap_err().to_string();
+    assert!(
+        e.contains("self") && e.contains("'k'") || e.contains("self") && e.contains("k"),
+        "{e}"
+    );
+
+    let mut other = SystemBuilder::new();
+    other.add_spatial_body(SpatialBody::new("a", inertia.clone()));
+    let far = other.add_spatial_body(SpatialBody::new("b", inertia.clone()));
+    let mut b = SystemBuilder::new();
+    b.add_spatial_body(SpatialBody::new("only", inertia.clone()));
+    b.add_spatial_joint("lost", SpatialBodyRef::Ground, far, ball());
+    let e = b.build().unwrap_err().to_string();
+    assert!(e.contains("lost") && e.contains("spatial #1"), "{e}");
+
+    let mut b = SystemBuilder::new();
+    b.add_spatial_body(
+        SpatialBody::new("skew", inertia).orientation(Orientation::Matrix(Matrix3::new(
+            1.0, 0.2, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0,
+        ))),
+    );
+    let e = b.build().unwrap_err().to_string();
+    assert!(e.contains("skew") && e.contains("orientation"), "{e}");
+}
