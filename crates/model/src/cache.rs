@@ -41,7 +41,8 @@ impl BodyAngles {
     /// `sys.n_coords()`), in place.
     pub fn update(&mut self, sys: &System, q: &[f64]) {
         let nb = sys.bodies.len();
-        debug_assert_eq!(q.len(), 3 * nb);
+        // the planar bodies come first (spatial coordinates, if any, follow)
+        debug_assert!(q.len() >= 3 * nb);
         self.resize(nb);
         for (i, e) in self.sc.iter_mut().enumerate() {
             let th = q[3 * i + 2];
@@ -75,7 +76,8 @@ impl BodyAngles {
     /// `sin d = d - d^3/6 + d^5/120` are exact to rounding (the next terms are below 1.4e-21).
     pub fn update_near(&mut self, sys: &System, q: &[f64]) {
         let nb = sys.bodies.len();
-        debug_assert_eq!(q.len(), 3 * nb);
+        // the planar bodies come first (spatial coordinates, if any, follow)
+        debug_assert!(q.len() >= 3 * nb);
         if self.sc.len() != nb {
             self.resize(nb);
             self.valid = false;

@@ -31,6 +31,9 @@ pub struct AccelerationSolver {
     schur: DenseSchur,
     /// The bodies' `sin`/`cos` at the last solve's `q`.
     angles: BodyAngles,
+    /// The model has spatial bodies: its rows come from the whole dense `Phi_q`
+    /// ([`System::phi_q_gamma`]), not from planar element rows.
+    global: bool,
 }
 
 impl AccelerationSolver {
@@ -46,6 +49,7 @@ impl AccelerationSolver {
             schur: DenseSchur::new(sys),
             // sized now: the first solve allocates nothing
             angles: BodyAngles::new(sys, sys.initial_guess().0.as_slice()),
+            global: sys.has_spatial(),
         }
     }
 
@@ -122,6 +126,9 @@ impl AccelerationSolver {
             return Ok(());
         }
         self.rows(sys, q, v, t);
+        if self.global {
+            return self.finish_dense(sys, t, a, lambda);
+        }
         self.schur.scatter(&mut self.phi_q);
         self.finish_rows(sys, t, a, lambda)
     }
@@ -129,6 +136,10 @@ impl AccelerationSolver {
     /// `Phi_q` in element-local rows and `gamma` at `(q, v, t)` (one `sin_cos` per body).
     #[inline]
     fn rows(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) {
+        if self.global {
+            sys.phi_q_gamma(q, v, t, &mut self.phi_q, &mut self.gamma);
+            return;
+        }
         self.angles.update(sys, q);
         sys.phi_q_local_gamma_at(
             q,
@@ -148,7 +159,7 @@ impl AccelerationSolver {
         a: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
-        if self.schur.gather(&self.phi_q) {
+        if !self.global && self.schur.gather(&self.phi_q) {
             self.finish_rows(sys, t, a, lambda)
         } else {
             self.finish_dense(sys, t, a, lambda)
@@ -247,11 +258,15 @@ pub(crate) enum Accel {
 impl Accel {
     /// The solver [`LinearSolver::use_sparse`] picks for `sys` (the one policy of the crate).
     pub(crate) fn new(sys: &System, linear: LinearSolver) -> Result<Self, SolveError> {
-        Ok(if linear.use_sparse(sys.n_constraints()) {
-            Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?))
-        } else {
-            Accel::Dense(AccelerationSolver::new(sys))
-        })
+        crate::error::refuse_singular_mass(sys, "the index-1 solve")?;
+        // spatial bodies: the dense solve from the whole Phi_q
+        Ok(
+            if linear.use_sparse(sys.n_constraints()) && !sys.has_spatial() {
+                Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?))
+            } else {
+                Accel::Dense(AccelerationSolver::new(sys))
+            },
+        )
     }
 
     /// Accelerations `a` and multipliers `lambda` at `(q, v, t)`.
@@ -318,7 +333,11 @@ impl Accel {
                 // needed here)
                 acc.rows(sys, q, v, t);
                 stab(sys, &mut acc.gamma, phi, phid);
-                acc.finish_rows(sys, t, a, lambda)
+                if acc.global {
+                    acc.finish_dense(sys, t, a, lambda)
+                } else {
+                    acc.finish_rows(sys, t, a, lambda)
+                }
             }
             Accel::Sparse(sp) => {
                 sp.prepare(sys, q, v, t);

@@ -4,7 +4,7 @@
 //! [`crate::SPARSE_THRESHOLD`] constraints.
 
 use crate::error::SolveError;
-use crate::linalg::{max_abs, DenseSchur, FactorError};
+use crate::linalg::{max_abs, DenseSchur, FactorError, GlobalSchur};
 use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;
 
@@ -40,6 +40,8 @@ enum Kernel {
     /// `Phi_q` in element-local rows and the dense factorisation of `S`.
     Dense(DenseSchur),
     Sparse(Box<ConstraintSchur>),
+    /// The whole dense `Phi_q` and the factorisation of `S` (models with spatial bodies).
+    Global(GlobalSchur),
 }
 
 /// Projects `q` onto `Phi(q, t) = 0` by Newton with the minimum `M`-norm correction
@@ -78,7 +80,10 @@ impl Projector {
         linear: LinearSolver,
     ) -> Result<Self, SolveError> {
         let m = sys.n_constraints();
-        let kernel = if linear.use_sparse(m) {
+        crate::error::refuse_singular_mass(sys, "the projection")?;
+        let kernel = if sys.has_spatial() {
+            Kernel::Global(GlobalSchur::new(sys))
+        } else if linear.use_sparse(m) {
             Kernel::Sparse(Box::new(ConstraintSchur::new(sys)?))
         } else {
             Kernel::Dense(DenseSchur::new(sys))
@@ -119,6 +124,10 @@ impl Projector {
                 schur.update(sys, q);
                 schur.factor(minv)
             }
+            Kernel::Global(schur) => {
+                sys.phi_q(q, &mut schur.phi_q);
+                schur.factor(minv, None)
+            }
         };
         res.map_err(|e| {
             let i = match e {
@@ -146,6 +155,10 @@ impl Projector {
             Kernel::Sparse(schur) => {
                 schur.solve_in_place(&mut self.r);
                 schur.add_weighted_transpose(-1.0, minv, &self.r, x);
+            }
+            Kernel::Global(schur) => {
+                schur.chol.solve_in_place(&mut self.r);
+                schur.sub_weighted_transpose(minv, &self.r, x);
             }
         }
     }

@@ -112,6 +112,7 @@ impl Galerkin {
     /// points).
     pub fn new(sys: &System, options: SymplecticOptions) -> Result<Galerkin, SolveError> {
         options.validate()?;
+        mbd_solve::refuse_spatial(sys, "the symplectic solver")?;
         let s = options.s;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let dim = s * (n + m);

@@ -1,7 +1,8 @@
 //! The factorisations and small kernels of [`mbd_linalg`], re-exported so the solver crates
 //! reach them through `mbd-solve` ([`DenseCholesky`], [`DenseLu`], the errors, [`max_abs`],
 //! [`axpy`], ...), and the dense Schur complement of the constraint Jacobian that the index-1
-//! solve and the projection factor (`local.rs`: it knows the [`mbd_model::System`]).
+//! solve and the projection factor (`local.rs`: it knows the [`mbd_model::System`]; `global.rs`
+//! the same from the whole dense `Phi_q`, for models with spatial bodies).
 
 pub use mbd_linalg::{
     axpy, dot, form_q_padded, max_abs, max_abs_diff, mul_r, pow2_inverse, qr_padded, reflect,
@@ -10,6 +11,8 @@ pub use mbd_linalg::{
     SMALL_CHOLESKY_SOLVE,
 };
 
+mod global;
 mod local;
 
+pub(crate) use global::GlobalSchur;
 pub(crate) use local::DenseSchur;

@@ -146,6 +146,7 @@ impl TangentRk {
         options: TangentOptions,
     ) -> Result<Self, SolveError> {
         options.validate()?;
+        mbd_solve::refuse_spatial(sys, "the tangent-space solver")?;
         let (n, m_full) = (sys.n_coords(), sys.n_constraints());
         let sparse = options.linear_solver.use_sparse(m_full);
         // the dense chart works with the m - k independent rows (chosen at each centre); the
