@@ -164,6 +164,11 @@ impl System {
     pub fn spatial_joints(&self) -> &[crate::spatial::SpatialJointEntry] {
         &self.spatial.joints
     }
+    /// The rows of the spatial bodies' internal constraints (six per body, contiguous, after
+    /// the planar joints' rows and before the spatial joints').
+    pub fn spatial_internal_rows(&self) -> std::ops::Range<usize> {
+        self.spatial.r0..self.spatial.r0 + 6 * self.spatial.bodies.len()
+    }
     /// The first coordinate of the spatial bodies (`3` times the number of planar bodies).
     pub fn spatial_offset(&self) -> usize {
         self.spatial.q0

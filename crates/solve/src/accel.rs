@@ -11,7 +11,7 @@
 //! the failing pivot.
 
 use crate::error::SolveError;
-use crate::linalg::{DenseSchur, FactorError};
+use crate::linalg::{BodySchur, DenseSchur, FactorError};
 use crate::sparse::{LinearSolver, SparseAccelerationSolver};
 use mbd_model::{BodyAngles, System};
 use nalgebra::DMatrix;
@@ -31,9 +31,9 @@ pub struct AccelerationSolver {
     schur: DenseSchur,
     /// The bodies' `sin`/`cos` at the last solve's `q`.
     angles: BodyAngles,
-    /// The model has spatial bodies: its rows come from the whole dense `Phi_q`
-    /// ([`System::phi_q_gamma`]), not from planar element rows.
-    global: bool,
+    /// The model has spatial bodies: the solve from the whole dense `Phi_q`
+    /// ([`System::phi_q_gamma`]), their internal constraints eliminated body by body.
+    bodies: Option<Box<BodySchur>>,
 }
 
 impl AccelerationSolver {
@@ -49,7 +49,7 @@ impl AccelerationSolver {
             schur: DenseSchur::new(sys),
             // sized now: the first solve allocates nothing
             angles: BodyAngles::new(sys, sys.initial_guess().0.as_slice()),
-            global: sys.has_spatial(),
+            bodies: sys.has_spatial().then(|| Box::new(BodySchur::new(sys))),
         }
     }
 
@@ -60,6 +60,8 @@ impl AccelerationSolver {
     pub fn condition_estimate(&self) -> f64 {
         if self.m == 0 {
             1.0
+        } else if let Some(b) = &self.bodies {
+            b.chol.condition_estimate()
         } else {
             self.schur.chol.condition_estimate()
         }
@@ -125,21 +127,46 @@ impl AccelerationSolver {
             }
             return Ok(());
         }
-        self.rows(sys, q, v, t);
-        if self.global {
-            return self.finish_dense(sys, t, a, lambda);
+        if self.bodies.is_some() {
+            self.body_rows(sys, q, v, t)?;
+            self.finish_bodies(sys, a, lambda);
+            return Ok(());
         }
+        self.rows(sys, q, v, t);
         self.schur.scatter(&mut self.phi_q);
         self.finish_rows(sys, t, a, lambda)
+    }
+
+    /// The spatial path's rows: `Phi_q` and `gamma` at `(q, v, t)`, each spatial body's
+    /// elimination and the factorisation of `S = Phi_e C Phi_e^T`.
+    fn body_rows(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) -> Result<(), SolveError> {
+        let Some(b) = self.bodies.as_deref_mut() else {
+            return Ok(());
+        };
+        sys.phi_q_gamma(q, v, t, &mut b.phi_q, &mut self.gamma);
+        self.phi_q.copy_from(&b.phi_q);
+        b.factor(sys, q, sys.inv_mass_diag().as_slice())
+            .map_err(|e| crate::projection::bodies_error(sys, t, e))
+    }
+
+    /// The spatial path's solve from [`AccelerationSolver::body_rows`], `gamma` and the forces.
+    fn finish_bodies(&mut self, sys: &System, a: &mut [f64], lambda: &mut [f64]) {
+        let Some(b) = self.bodies.as_deref_mut() else {
+            return;
+        };
+        // Phi_q a = gamma
+        b.solve(
+            sys.inv_mass_diag().as_slice(),
+            &self.forces,
+            &self.gamma,
+            a,
+            lambda,
+        );
     }
 
     /// `Phi_q` in element-local rows and `gamma` at `(q, v, t)` (one `sin_cos` per body).
     #[inline]
     fn rows(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) {
-        if self.global {
-            sys.phi_q_gamma(q, v, t, &mut self.phi_q, &mut self.gamma);
-            return;
-        }
         self.angles.update(sys, q);
         sys.phi_q_local_gamma_at(
             q,
@@ -159,7 +186,7 @@ impl AccelerationSolver {
         a: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
-        if !self.global && self.schur.gather(&self.phi_q) {
+        if self.bodies.is_none() && self.schur.gather(&self.phi_q) {
             self.finish_rows(sys, t, a, lambda)
         } else {
             self.finish_dense(sys, t, a, lambda)
@@ -258,7 +285,6 @@ pub(crate) enum Accel {
 impl Accel {
     /// The solver [`LinearSolver::use_sparse`] picks for `sys` (the one policy of the crate).
     pub(crate) fn new(sys: &System, linear: LinearSolver) -> Result<Self, SolveError> {
-        crate::error::refuse_singular_mass(sys, "the index-1 solve")?;
         // spatial bodies: the dense solve from the whole Phi_q
         Ok(
             if linear.use_sparse(sys.n_constraints()) && !sys.has_spatial() {
@@ -331,13 +357,15 @@ impl Accel {
                 }
                 // the element-local rows alone (the dense `phi_q` of the public solve is not
                 // needed here)
+                if acc.bodies.is_some() {
+                    acc.body_rows(sys, q, v, t)?;
+                    stab(sys, &mut acc.gamma, phi, phid);
+                    acc.finish_bodies(sys, a, lambda);
+                    return Ok(());
+                }
                 acc.rows(sys, q, v, t);
                 stab(sys, &mut acc.gamma, phi, phid);
-                if acc.global {
-                    acc.finish_dense(sys, t, a, lambda)
-                } else {
-                    acc.finish_rows(sys, t, a, lambda)
-                }
+                acc.finish_rows(sys, t, a, lambda)
             }
             Accel::Sparse(sp) => {
                 sp.prepare(sys, q, v, t);
@@ -452,6 +480,57 @@ mod tests {
             let (ea2, el2) = saddle_point(&sys, &j2, &forces, &gamma);
             close(&a2, &ea2, "a (dense path)");
             close(&l2, &el2, "lambda (dense path)");
+        }
+    }
+
+    /// With spatial bodies, the body-eliminated solve equals the plain Schur complement with
+    /// `M^-1` (all rows, internal constraints included) for a solid body, accelerations and
+    /// every multiplier, to round-off; and it runs a disc whose `M` is singular.
+    #[test]
+    fn the_body_eliminated_solve_equals_the_plain_one_for_a_solid_body() {
+        let sys = mbd_model::models::heavy_top([0.3, 0.3, 0.1], 0.4, 15.0).unwrap();
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let (q, v) = sys.initial_guess();
+        let (q, v) = (q.as_slice(), v.as_slice());
+        let mut acc = AccelerationSolver::new(&sys);
+        let (mut a, mut l) = (vec![0.0; n], vec![0.0; m]);
+        acc.solve(&sys, q, v, 0.2, &mut a, &mut l).unwrap();
+        // the plain path: Phi_q, gamma and forces as they are, through `finish`
+        let (mut a2, mut l2) = (vec![0.0; n], vec![0.0; m]);
+        acc.finish(&sys, 0.2, &mut a2, &mut l2).unwrap();
+        let scale = a.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+        for k in 0..n {
+            assert!(
+                (a[k] - a2[k]).abs() < 1e-12 * scale,
+                "a[{k}]: {} vs {}",
+                a[k],
+                a2[k]
+            );
+        }
+        let lscale = l.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+        for k in 0..m {
+            assert!(
+                (l[k] - l2[k]).abs() < 1e-11 * lscale,
+                "lambda[{k}]: {} vs {}",
+                l[k],
+                l2[k]
+            );
+        }
+        // the disc on a massless axle: E_3 = 0, M singular; the solve is finite and keeps the
+        // acceleration constraints
+        let disc = mbd_model::models::heavy_top([0.25, 0.25, 0.5], 0.4, 15.0).unwrap();
+        let (q, v) = disc.initial_guess();
+        let mut acc = AccelerationSolver::new(&disc);
+        acc.solve(&disc, q.as_slice(), v.as_slice(), 0.0, &mut a, &mut l)
+            .unwrap();
+        let res = &acc.phi_q * nalgebra::DVector::from_column_slice(&a);
+        for r in 0..m {
+            assert!(
+                (res[r] - acc.gamma[r]).abs() < 1e-10,
+                "row {r}: {} vs {}",
+                res[r],
+                acc.gamma[r]
+            );
         }
     }
 }

@@ -246,21 +246,6 @@ pub fn refuse_redundant(sys: &mbd_model::System, solver: &str) -> Result<(), Sol
     )))
 }
 
-/// The refusal of a solver path that divides by the mass matrix's diagonal, for a model with a
-/// spatial body whose mass matrix is singular (a second moment `E_i = 0`: a thin disc or
-/// plate, the symmetric top; [`mbd_model::System::singular_mass_body`]): `Ok` otherwise.
-pub fn refuse_singular_mass(sys: &mbd_model::System, what: &str) -> Result<(), SolveError> {
-    match sys.singular_mass_body() {
-        None => Ok(()),
-        Some(body) => Err(SolveError::Unsupported(format!(
-            "{what} divides by the mass matrix's diagonal, and spatial body '{body}' has a \
-             singular one (a principal moment equals the sum of the other two: a thin disc or \
-             plate); give it a small thickness until the body-local elimination \
-             (docs/spatial.md) reaches this solver"
-        ))),
-    }
-}
-
 /// The refusal of a solver that does not run spatial bodies yet: `Ok` for a planar model,
 /// else [`SolveError::Unsupported`] naming `solver` and the first spatial body.
 pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), SolveError> {

@@ -4,7 +4,7 @@
 //! [`crate::SPARSE_THRESHOLD`] constraints.
 
 use crate::error::SolveError;
-use crate::linalg::{max_abs, DenseSchur, FactorError, GlobalSchur};
+use crate::linalg::{max_abs, BodyFactorError, BodySchur, DenseSchur, FactorError};
 use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;
 
@@ -40,8 +40,18 @@ enum Kernel {
     /// `Phi_q` in element-local rows and the dense factorisation of `S`.
     Dense(DenseSchur),
     Sparse(Box<ConstraintSchur>),
-    /// The whole dense `Phi_q` and the factorisation of `S` (models with spatial bodies).
-    Global(GlobalSchur),
+    /// Models with spatial bodies: their internal constraints eliminated body by body.
+    Bodies(Box<BodiesKernel>),
+}
+
+/// The body-eliminated kernel and its buffers: the correction and the multipliers.
+#[derive(Debug)]
+struct BodiesKernel {
+    schur: BodySchur,
+    delta: Vec<f64>,
+    lambda: Vec<f64>,
+    zeros: Vec<f64>,
+    target: Vec<f64>,
 }
 
 /// Projects `q` onto `Phi(q, t) = 0` by Newton with the minimum `M`-norm correction
@@ -80,9 +90,15 @@ impl Projector {
         linear: LinearSolver,
     ) -> Result<Self, SolveError> {
         let m = sys.n_constraints();
-        crate::error::refuse_singular_mass(sys, "the projection")?;
         let kernel = if sys.has_spatial() {
-            Kernel::Global(GlobalSchur::new(sys))
+            let n = sys.n_coords();
+            Kernel::Bodies(Box::new(BodiesKernel {
+                schur: BodySchur::new(sys),
+                delta: vec![0.0; n],
+                lambda: vec![0.0; m],
+                zeros: vec![0.0; n],
+                target: vec![0.0; m],
+            }))
         } else if linear.use_sparse(m) {
             Kernel::Sparse(Box::new(ConstraintSchur::new(sys)?))
         } else {
@@ -124,9 +140,12 @@ impl Projector {
                 schur.update(sys, q);
                 schur.factor(minv)
             }
-            Kernel::Global(schur) => {
-                sys.phi_q(q, &mut schur.phi_q);
-                schur.factor(minv, None)
+            Kernel::Bodies(k) => {
+                sys.phi_q(q, &mut k.schur.phi_q);
+                return k
+                    .schur
+                    .factor(sys, q, minv)
+                    .map_err(|e| bodies_error(sys, t, e));
             }
         };
         res.map_err(|e| {
@@ -156,9 +175,16 @@ impl Projector {
                 schur.solve_in_place(&mut self.r);
                 schur.add_weighted_transpose(-1.0, minv, &self.r, x);
             }
-            Kernel::Global(schur) => {
-                schur.chol.solve_in_place(&mut self.r);
-                schur.sub_weighted_transpose(minv, &self.r, x);
+            Kernel::Bodies(k) => {
+                // the smallest correction with Phi_q dx = -r
+                for (t, r) in k.target.iter_mut().zip(&self.r) {
+                    *t = -r;
+                }
+                k.schur
+                    .solve(minv, &k.zeros, &k.target, &mut k.delta, &mut k.lambda);
+                for (xi, d) in x.iter_mut().zip(&k.delta) {
+                    *xi += d;
+                }
             }
         }
     }
@@ -268,5 +294,22 @@ impl Projector {
         let s = self.project_positions(sys, q, t)?;
         self.project_velocities(sys, q, v, t)?;
         Ok(s)
+    }
+}
+
+/// A failed body-eliminated factorisation as the solver's error: a degenerate spatial body
+/// (named) or a singular constraint matrix (the equation named).
+pub(crate) fn bodies_error(sys: &System, t: f64, e: BodyFactorError) -> SolveError {
+    match e {
+        BodyFactorError::Body(body, reason) => SolveError::Singular {
+            t,
+            what: "spatial body",
+            detail: format!("'{body}': {reason}"),
+        },
+        BodyFactorError::Row(i) => SolveError::Singular {
+            t,
+            what: "constraint matrix Phi_e C Phi_e^T",
+            detail: sys.equation_name(i),
+        },
     }
 }

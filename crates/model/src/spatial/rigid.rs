@@ -163,6 +163,17 @@ impl RigidSolve {
     }
 }
 
+impl RigidSolve {
+    /// The internal constraints' multipliers `mu` of the body's saddle-point system for the
+    /// force `f` and the accelerations `a` it gave: from `G^T mu = f - M a`,
+    /// `mu = (G G^T)^-1 G (f - M a)` (the centre of mass does not enter `G`).
+    pub fn multipliers(&self, f: &[f64; 12], a: &[f64; 12]) -> [f64; 6] {
+        let res = SVector::<f64, 9>::from_fn(|k, _| f[3 + k] - self.e[k / 3] * a[3 + k]);
+        let mu = self.gg_inv * (self.g * res);
+        std::array::from_fn(|k| mu[k])
+    }
+}
+
 /// The internal constraints' `gamma` at director velocities `qd`: `G(q) a = -gamma` is their
 /// acceleration level, with `gamma = qd^T Hess(g) qd = (|d_1'|^2, |d_2'|^2, |d_3'|^2,
 /// 2 d_1' . d_2', 2 d_1' . d_3', 2 d_2' . d_3')` (the Hessians are constant, so `gamma` does not

@@ -1,8 +1,9 @@
 //! The factorisations and small kernels of [`mbd_linalg`], re-exported so the solver crates
 //! reach them through `mbd-solve` ([`DenseCholesky`], [`DenseLu`], the errors, [`max_abs`],
 //! [`axpy`], ...), and the dense Schur complement of the constraint Jacobian that the index-1
-//! solve and the projection factor (`local.rs`: it knows the [`mbd_model::System`]; `global.rs`
-//! the same from the whole dense `Phi_q`, for models with spatial bodies).
+//! solve and the projection factor (`local.rs`: it knows the [`mbd_model::System`]; `bodies.rs`
+//! the solve of models with spatial bodies, their internal constraints eliminated body by
+//! body).
 
 pub use mbd_linalg::{
     axpy, dot, form_q_padded, max_abs, max_abs_diff, mul_r, pow2_inverse, qr_padded, reflect,
@@ -11,8 +12,8 @@ pub use mbd_linalg::{
     SMALL_CHOLESKY_SOLVE,
 };
 
-mod global;
+mod bodies;
 mod local;
 
-pub(crate) use global::GlobalSchur;
+pub(crate) use bodies::{BodyFactorError, BodySchur};
 pub(crate) use local::DenseSchur;
