@@ -489,3 +489,5 @@ pub use loops::{
 };
 mod exact;
 pub use exact::{CrankMotion, Regime};
+mod tumbling;
+pub use tumbling::{TorqueFreeBody, TorqueFreeMotion};
