@@ -491,3 +491,5 @@ mod exact;
 pub use exact::{CrankMotion, Regime};
 mod spatial;
 pub use spatial::{free_body, heavy_top, TOP_LENGTH};
+mod tumbling;
+pub use tumbling::{TorqueFreeBody, TorqueFreeMotion};

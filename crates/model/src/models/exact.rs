@@ -39,7 +39,7 @@ const AGM_STEPS: usize = 64;
 /// relative accuracy near `m = 1`): `a_n` and `c_n`, `a_0 = 1`, `b_0 = sqrt(m1)`,
 /// `c_0 = sqrt(m)`, `a_{n+1} = (a_n + b_n)/2`, `b_{n+1} = sqrt(a_n b_n)`,
 /// `c_{n+1} = c_n^2 / (4 a_{n+1}) = (a_n - b_n)/2`, until `c_n <= eps a_n`.
-struct Agm {
+pub(crate) struct Agm {
     a: [f64; AGM_STEPS + 1],
     b: [f64; AGM_STEPS + 1],
     c: [f64; AGM_STEPS + 1],
@@ -47,7 +47,7 @@ struct Agm {
 }
 
 impl Agm {
-    fn new(m: f64, m1: f64) -> Agm {
+    pub(crate) fn new(m: f64, m1: f64) -> Agm {
         let mut s = Agm {
             a: [0.0; AGM_STEPS + 1],
             b: [0.0; AGM_STEPS + 1],
@@ -67,14 +67,14 @@ impl Agm {
     }
 
     /// `K(m) = pi / (2 a_N)`.
-    fn k(&self) -> f64 {
+    pub(crate) fn k(&self) -> f64 {
         FRAC_PI_2 / self.a[self.n]
     }
 
     /// `[am, sn, cn, dn](u | m)`, by the descending Landen recurrence
     /// `phi_N = 2^N a_N u`, `phi_{n-1} = (phi_n + asin(c_n / a_n sin phi_n)) / 2`,
     /// `am = phi_0`; `dn = sqrt(m1 + m cn^2)` (no cancellation). Accurate for `|u| <= K`.
-    fn jacobi(&self, u: f64, m: f64, m1: f64) -> [f64; 4] {
+    pub(crate) fn jacobi(&self, u: f64, m: f64, m1: f64) -> [f64; 4] {
         let mut phi = (self.a[self.n] * u) * 2f64.powi(self.n as i32);
         for j in (1..=self.n).rev() {
             phi = 0.5 * (phi + (self.c[j] / self.a[j] * phi.sin()).asin());
@@ -87,7 +87,7 @@ impl Agm {
     /// `|r| <= pi/2`, `F = 2 j K + F(r)`, and `F(r)` by the AGM with phase
     /// `phi_{n+1} = phi_n + atan(b_n / a_n tan phi_n)` (branch: `phi_{n+1}` near `2 phi_n`),
     /// `F = phi_N / (2^N a_N)`.
-    fn f(&self, psi: f64) -> f64 {
+    pub(crate) fn f(&self, psi: f64) -> f64 {
         let j = (psi / PI).round();
         let mut phi = (-PI).mul_add(j, psi);
         for i in 0..self.n {
@@ -100,7 +100,7 @@ impl Agm {
 }
 
 /// The argument `u` reduced by the half period `2K`: `(n, r)` with `u = 2 K n + r`, `|r| <= K`.
-fn reduce(u: f64, k: f64) -> (f64, f64) {
+pub(crate) fn reduce(u: f64, k: f64) -> (f64, f64) {
     let n = (u / (2.0 * k)).round();
     (n, (-2.0 * k).mul_add(n, u))
 }
