@@ -178,7 +178,10 @@ impl AccelerationSolver {
         );
     }
 
-    /// Completes the solve from `phi_q`, `gamma` and `forces` already set (advanced use).
+    /// Completes the solve from `phi_q`, `gamma` and `forces` already set (advanced use). With
+    /// spatial bodies it reuses the last solve's factorisation (their elimination needs the
+    /// configuration), so `phi_q` must be the one that solve left: a changed `phi_q` is
+    /// [`SolveError::Unsupported`].
     pub fn finish(
         &mut self,
         sys: &System,
@@ -186,7 +189,18 @@ impl AccelerationSolver {
         a: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
-        if self.bodies.is_none() && self.schur.gather(&self.phi_q) {
+        if let Some(b) = self.bodies.as_deref() {
+            if b.phi_q != self.phi_q {
+                return Err(SolveError::Unsupported(
+                    "AccelerationSolver::finish with spatial bodies takes the Phi_q of the last \
+                     solve; call solve at the new configuration"
+                        .into(),
+                ));
+            }
+            self.finish_bodies(sys, a, lambda);
+            return Ok(());
+        }
+        if self.schur.gather(&self.phi_q) {
             self.finish_rows(sys, t, a, lambda)
         } else {
             self.finish_dense(sys, t, a, lambda)
@@ -495,9 +509,13 @@ mod tests {
         let mut acc = AccelerationSolver::new(&sys);
         let (mut a, mut l) = (vec![0.0; n], vec![0.0; m]);
         acc.solve(&sys, q, v, 0.2, &mut a, &mut l).unwrap();
-        // the plain path: Phi_q, gamma and forces as they are, through `finish`
+        // the plain path: Phi_q, gamma and forces as they are, M^-1 on every row
         let (mut a2, mut l2) = (vec![0.0; n], vec![0.0; m]);
-        acc.finish(&sys, 0.2, &mut a2, &mut l2).unwrap();
+        acc.finish_dense(&sys, 0.2, &mut a2, &mut l2).unwrap();
+        // `finish` on the same rows repeats the body-eliminated solve
+        let (mut a3, mut l3) = (vec![0.0; n], vec![0.0; m]);
+        acc.finish(&sys, 0.2, &mut a3, &mut l3).unwrap();
+        assert_eq!((&a3, &l3), (&a, &l));
         let scale = a.iter().fold(0.0f64, |s, x| s.max(x.abs()));
         for k in 0..n {
             assert!(

@@ -253,7 +253,7 @@ pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), Solve
         None => Ok(()),
         Some(b) => Err(SolveError::Unsupported(format!(
             "{solver} does not run spatial bodies yet (body '{}'); the index-1 solvers rk4, \
-             rk4-projected and index1:dopri5 do",
+             rk4-projected, index1:dopri5 and the firefly-gauss solvers do",
             b.name
         ))),
     }

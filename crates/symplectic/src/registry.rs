@@ -24,7 +24,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 3.0,
-            refuses: "",
+            refuses: "spatial bodies",
             compared: true,
         },
         SolverVariant {
@@ -35,7 +35,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "",
+            refuses: "spatial bodies",
             compared: true,
         },
         SolverVariant {
@@ -46,7 +46,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads)",
+            refuses: "non-conservative force elements (dampers, time-varying loads); spatial bodies",
             compared: true,
         },
         SolverVariant {
@@ -57,7 +57,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 20.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads)",
+            refuses: "non-conservative force elements (dampers, time-varying loads); spatial bodies",
             compared: true,
         },
     ],

@@ -131,11 +131,6 @@ impl FireflyGauss {
     /// found (`k` redundant equations; [`FaDaeError::Unsupported`]).
     pub fn new(sys: &System, options: FaDaeOptions) -> Result<Self, FaDaeError> {
         options.validate()?;
-        if let Err(mbd_solve::SolveError::Unsupported(reason)) =
-            mbd_solve::refuse_spatial(sys, "the firefly-Gauss solver")
-        {
-            return Err(FaDaeError::Unsupported(reason));
-        }
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let (q0, _) = sys.initial_guess();
         let partition = match &options.partition {
