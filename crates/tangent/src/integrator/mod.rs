@@ -146,9 +146,9 @@ impl TangentRk {
         options: TangentOptions,
     ) -> Result<Self, SolveError> {
         options.validate()?;
-        mbd_solve::refuse_spatial(sys, "the tangent-space solver")?;
         let (n, m_full) = (sys.n_coords(), sys.n_constraints());
-        let sparse = options.linear_solver.use_sparse(m_full);
+        // spatial bodies take the dense path (docs/spatial.md)
+        let sparse = options.linear_solver.use_sparse(m_full) && !sys.has_spatial();
         // the dense chart works with the m - k independent rows (chosen at each centre); the
         // sparse chart with all m, its factorisations dropping the dependent ones
         let m = if sparse {

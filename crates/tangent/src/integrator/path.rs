@@ -163,8 +163,9 @@ impl Path {
     ) -> Result<(), SolveError> {
         match self {
             Path::Dense { chart, acc } => {
-                // (with redundant equations the chart keeps only its rows of Phi_q)
-                if at_centre && !chart.drops_rows() {
+                // (with redundant equations the chart keeps only its rows of Phi_q; spatial
+                // bodies' solve needs the configuration for their elimination)
+                if at_centre && !chart.drops_rows() && !sys.has_spatial() {
                     sys.forces_into(q, v, t, &mut acc.forces);
                     acc.phi_q.copy_from(chart.centre_phi_q());
                     let dphi = chart.centre_phi_q_dot_jacobian().as_slice();
