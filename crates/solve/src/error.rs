@@ -253,7 +253,8 @@ pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), Solve
         None => Ok(()),
         Some(b) => Err(SolveError::Unsupported(format!(
             "{solver} does not run spatial bodies yet (body '{}'); the index-1 solvers (rk4, \
-             rk4-projected, index1:dopri5), the tangent and the firefly-gauss solvers do",
+             rk4-projected, index1:dopri5), the plain symplectic, the tangent and the \
+             firefly-gauss solvers do",
             b.name
         ))),
     }

@@ -112,12 +112,14 @@ impl Galerkin {
     /// points).
     pub fn new(sys: &System, options: SymplecticOptions) -> Result<Galerkin, SolveError> {
         options.validate()?;
-        mbd_solve::refuse_spatial(sys, "the symplectic solver")?;
         let s = options.s;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let dim = s * (n + m);
         let tab = Tables::new(s, options.nodes);
         let modlag = options.preadjust == PreadjustMode::ModifiedLagrangian;
+        if sys.has_spatial() {
+            spatial_support(sys, modlag, options.gamma)?;
+        }
         if modlag && !sys.is_conservative() {
             let elements: Vec<String> = sys
                 .forces()
@@ -136,7 +138,9 @@ impl Galerkin {
         // (W_s adds a dense block to the Newton matrix; the modified Lagrangian's blocks are
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
         let sparse_ok = options.gamma == 0.0;
-        let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
+        // spatial bodies take the dense path (docs/spatial.md)
+        let use_sparse =
+            options.linear_solver.use_sparse(m) && m > 0 && sparse_ok && !sys.has_spatial();
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
                 "the sparse symplectic stage solve needs gamma = 0 (the Hessian of the paper's \
@@ -569,5 +573,25 @@ pub(super) fn with_time(e: SolveError, t: f64) -> SolveError {
     match e {
         SolveError::Singular { what, detail, .. } => SolveError::Singular { t, what, detail },
         other => other,
+    }
+}
+
+/// What the symplectic scheme runs with spatial bodies: the plain (s,s) scheme on the dense
+/// path, for bodies with a regular mass matrix (its residual is scaled by `M^-1`). The
+/// preadjustments' derivative passes are planar.
+fn spatial_support(sys: &System, modlag: bool, gamma: f64) -> Result<(), SolveError> {
+    if modlag || gamma != 0.0 {
+        return mbd_solve::refuse_spatial(
+            sys,
+            "the preadjusted symplectic scheme (gamma or :modified)",
+        );
+    }
+    match sys.singular_mass_body() {
+        Some(body) => Err(SolveError::Unsupported(format!(
+            "the symplectic scheme scales its residual by M^-1, and spatial body '{body}' has a \
+             singular mass matrix (a principal moment equals the sum of the other two: a thin \
+             disc or plate); run it with rk4-projected, index1:dopri5 or tangent:rk4"
+        ))),
+        None => Ok(()),
     }
 }
