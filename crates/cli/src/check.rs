@@ -53,6 +53,56 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
             if j.n_equations() == 1 { "" } else { "s" }
         );
     }
+    if sys.has_spatial() {
+        let g = sys.spatial_gravity();
+        let _ = writeln!(
+            s,
+            "spatial gravity: [{}, {}, {}] m/s^2",
+            num(g[0]),
+            num(g[1]),
+            num(g[2])
+        );
+        let _ = writeln!(s, "spatial bodies ({}):", sys.spatial_bodies().len());
+        for b in sys.spatial_bodies() {
+            let j = b.inertia.moments();
+            let _ = writeln!(
+                s,
+                "  {:<16} mass {:<10} principal moments [{}, {}, {}]{}",
+                b.name,
+                num(b.inertia.mass()),
+                num(j[0]),
+                num(j[1]),
+                num(j[2]),
+                if b.inertia.has_singular_mass_matrix() {
+                    " (singular mass matrix: a flat body)"
+                } else {
+                    ""
+                }
+            );
+        }
+        let _ = writeln!(s, "spatial joints ({}):", sys.spatial_joints().len());
+        let name = |r: mbd_model::spatial::SpatialBodyRef| {
+            r.index()
+                .and_then(|k| sys.spatial_bodies().get(k))
+                .map_or_else(|| "ground".to_string(), |b| b.name.clone())
+        };
+        for j in sys.spatial_joints() {
+            let n = j.joint.n_equations();
+            let _ = writeln!(
+                s,
+                "  {:<16} {:<12} {} - {} ({n} equation{})",
+                j.name,
+                format!("{:?}", j.joint.kind())
+                    .split(' ')
+                    .next()
+                    .unwrap_or("")
+                    .to_lowercase(),
+                name(j.a),
+                name(j.b),
+                if n == 1 { "" } else { "s" }
+            );
+        }
+    }
     let _ = writeln!(s, "forces ({}):", sys.forces().len());
     for f in sys.forces() {
         let (a, b) = f.bodies();

@@ -84,6 +84,19 @@ fn every_solver_runs_every_example_model() {
             let csv = d.join(format!("{k}.csv"));
             let out = run_model(&model, solver, step, &csv);
             let what = format!("{} with {solver} {step:?}", model.display());
+            // a solver that does not run the model's spatial bodies refuses it, saying so
+            let sys = mbd_model::System::from_path(&model).unwrap();
+            if sys.has_spatial() {
+                if let Err(e) = mbd::Simulation::new(sys, solver) {
+                    assert_eq!(out.code, 1, "{what}: {}", out.stderr);
+                    assert!(
+                        out.stderr.contains("spatial"),
+                        "{what}: {} ({e})",
+                        out.stderr
+                    );
+                    continue;
+                }
+            }
             if !conservative && refuses.contains("non-conservative") {
                 // a documented refusal: a runtime error that says why
                 assert_eq!(out.code, 1, "{what}: {}", out.stderr);
@@ -726,4 +739,25 @@ rate = 6.0
     // the crank starts at the assembled angle and rate
     assert!((rows[0][at("crank.theta")] - 1.0).abs() < 1e-9);
     assert!((rows[0][at("d_crank.theta")] - 6.0).abs() < 1e-9);
+}
+
+/// `mbd check` on a spatial model lists its spatial bodies and joints.
+#[test]
+fn check_lists_spatial_bodies_and_joints() {
+    let out = mbd(["check", "examples/models/heavy_top.toml"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    for needle in [
+        "spatial gravity: [0, 0, -9.81] m/s^2",
+        "spatial bodies (1):",
+        "principal moments [0.3, 0.3, 0.1]",
+        "tip              spherical    ground - top (3 equations)",
+        "degrees of freedom: 3",
+        "top.d3z",
+    ] {
+        assert!(
+            out.stdout.contains(needle),
+            "lacks {needle:?}:\n{}",
+            out.stdout
+        );
+    }
 }

@@ -79,8 +79,8 @@ pub use element::Sketch;
 pub use element_hessians::ElementHessian;
 pub use error::{num as format_number, ModelError};
 pub use file::{
-    read_text, BodyKind, BodySpec, ForceSpec, InitialInput, JointSpec, ModelFile,
-    MAX_MODEL_FILE_BYTES,
+    read_text, BodyKind, BodySpec, EulerSpec, ForceSpec, InitialInput, JointSpec, ModelFile,
+    OrientationSpec, SpatialBodySpec, SpatialJointSpec, SpatialJointType, MAX_MODEL_FILE_BYTES,
 };
 pub use forces::{Force, ForceKind};
 pub use init::{RedundantConstraints, RedundantEquation, SPARSE_RANK_THRESHOLD};

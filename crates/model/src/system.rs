@@ -341,8 +341,11 @@ impl System {
     /// coordinates and velocities of [`System::initial_guess`] the consistent-state solve keeps
     /// (see [`crate::Inputs`]).
     pub fn initial_inputs(&self) -> (Vec<bool>, Vec<bool>) {
-        let q = self.bodies.iter().flat_map(|b| b.inputs.position).collect();
-        let v = self.bodies.iter().flat_map(|b| b.inputs.velocity).collect();
+        let mut q: Vec<bool> = self.bodies.iter().flat_map(|b| b.inputs.position).collect();
+        let mut v: Vec<bool> = self.bodies.iter().flat_map(|b| b.inputs.velocity).collect();
+        // spatial bodies have no inputs (yet)
+        q.resize(self.n, false);
+        v.resize(self.n, false);
         (q, v)
     }
 

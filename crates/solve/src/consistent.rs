@@ -223,7 +223,9 @@ pub fn initial_changes(sys: &System, q: &[f64], v: &[f64]) -> Vec<InitialChange>
     // bodies placed from joint coordinates: their stored values were not what the model gives
     let assembled = sys.assembled_bodies();
     let moved = |i: usize, given: f64, used: f64| {
-        !assembled[i / 3] && (used - given).abs() > INITIAL_CHANGE_TOL * given.abs().max(1.0)
+        // (spatial coordinates, after the planar bodies', are never assembled)
+        !assembled.get(i / 3).copied().unwrap_or(false)
+            && (used - given).abs() > INITIAL_CHANGE_TOL * given.abs().max(1.0)
     };
     let mut out = Vec::new();
     for (i, name) in names.iter().enumerate() {

@@ -20,8 +20,12 @@
 //! ```
 
 mod resolve;
+mod spatial;
 mod spec;
 
+pub use spatial::{
+    EulerSpec, OrientationSpec, SpatialBodySpec, SpatialJointSpec, SpatialJointType,
+};
 pub use spec::{BodyKind, BodySpec, ForceSpec, InitialInput, JointSpec};
 
 use crate::builder::SystemBuilder;
@@ -38,7 +42,8 @@ pub struct ModelFile {
     /// Gravity vector `[gx, gy]`, m/s^2 (default zero).
     #[serde(default)]
     pub gravity: [f64; 2],
-    /// The bodies.
+    /// The (planar) bodies.
+    #[serde(default)]
     pub bodies: Vec<BodySpec>,
     /// The joints.
     #[serde(default)]
@@ -59,6 +64,19 @@ pub struct ModelFile {
     /// `"reject"` (an error).
     #[serde(default, skip_serializing_if = "is_allow")]
     pub redundant_constraints: RedundantConstraints,
+    /// Gravity of the spatial bodies `[gx, gy, gz]`, m/s^2 (default zero).
+    #[serde(default, skip_serializing_if = "is_zero3")]
+    pub spatial_gravity: [f64; 3],
+    /// Spatial (3D) rigid bodies (docs/spatial.md).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub spatial_bodies: Vec<SpatialBodySpec>,
+    /// Joints between spatial bodies.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub spatial_joints: Vec<SpatialJointSpec>,
+}
+
+fn is_zero3(g: &[f64; 3]) -> bool {
+    *g == [0.0; 3]
 }
 
 fn is_allow(r: &RedundantConstraints) -> bool {

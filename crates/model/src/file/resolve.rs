@@ -191,13 +191,21 @@ impl ModelFile {
                 ),
             });
         }
+        let planar = |n: &str| self.bodies.iter().any(|b| b.name == n);
+        super::spatial::add_spatial(
+            &mut b,
+            self.spatial_gravity,
+            &self.spatial_bodies,
+            &self.spatial_joints,
+            &planar,
+        )?;
         Ok(b)
     }
 }
 
 impl System {
-    /// The model as a file description (bodies by name). Model files hold planar models:
-    /// spatial bodies and joints ([`System::spatial_bodies`]) are not written.
+    /// The model as a file description (bodies by name; spatial bodies with their inertia as
+    /// principal moments and axes and their orientation as a matrix).
     pub fn to_model_file(&self) -> ModelFile {
         let name = |r: BodyRef| -> String {
             match r {
@@ -239,11 +247,28 @@ impl System {
                 rate: init.rate,
             })
             .collect();
+        let spatial_name = |r: crate::spatial::SpatialBodyRef| match r.index() {
+            Some(k) => self.spatial.bodies[k].name.clone(),
+            None => "ground".to_string(),
+        };
         ModelFile {
             sensors,
             assembly,
             gravity: self.gravity,
             redundant_constraints: RedundantConstraints::Allow,
+            spatial_gravity: self.spatial.gravity,
+            spatial_bodies: self
+                .spatial
+                .bodies
+                .iter()
+                .map(super::spatial::SpatialBodySpec::from_body)
+                .collect(),
+            spatial_joints: self
+                .spatial
+                .joints
+                .iter()
+                .map(|j| super::spatial::SpatialJointSpec::from_entry(j, &spatial_name))
+                .collect(),
             bodies: self
                 .bodies
                 .iter()
