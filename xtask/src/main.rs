@@ -9,6 +9,7 @@
 mod own;
 mod own_scaling;
 mod own_singular;
+mod own_spatial;
 mod paper_a;
 mod paper_b;
 mod paper_c;

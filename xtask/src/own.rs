@@ -470,6 +470,12 @@ pub fn experiments() -> Vec<Experiment> {
             run: crate::own_singular::singular,
         },
         Experiment {
+            id: "own-spatial",
+            part: Part::Own,
+            title: "Spatial bodies: heavy top, tumbling plate, torque-free body",
+            run: crate::own_spatial::spatial,
+        },
+        Experiment {
             id: "own-orders",
             part: Part::Own,
             title: "Convergence orders of every solver",

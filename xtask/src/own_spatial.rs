@@ -1,0 +1,227 @@
+//! `own-spatial`: spatial bodies (natural coordinates, docs/spatial.md) with every solver of the
+//! registry that takes them. The heavy top (a solid body and a disc on a massless axle, whose
+//! mass matrix is singular): convergence orders. A flat plate tumbling about its intermediate
+//! axis: the flip times located by events against the exact Jacobi-elliptic solution. A
+//! torque-free body with symplectic (2,2) over a long time: energy and angular momentum.
+
+use crate::report::{fmt_e, num, Claim, Ctx, Section, Table};
+use mbd::model::models::{free_body, heavy_top, TorqueFreeBody};
+use mbd::prelude::*;
+use mbd::solve::{DenseOutput, Event, NoObserver};
+use mbd::Simulation;
+use mbd_analysis::fit_order;
+use mbd_solve::nalgebra::{Matrix3, Vector3};
+use serde_json::json;
+
+/// Tolerance on a fitted order (the issue's).
+const ORDER_TOL: f64 = 0.3;
+/// Errors below this are at the floor of the reference.
+const FLOOR: f64 = 1e-11;
+/// The documented miss of the long-time energy claim.
+const ENERGY_MISS: &str =
+    "the plain (2,2) scheme's energy error at h = T/50 is 7.8e-8: the target \
+    needs the modified-Lagrangian preadjustment (order 6), which does not take spatial bodies yet";
+
+fn run(sys: &System, spec: &str, t_end: f64, h: f64) -> Result<State, String> {
+    let mut sim = Simulation::new(sys.clone(), spec).map_err(|e| e.to_string())?;
+    sim.run(RunConfig::new(t_end, h))
+        .map_err(|e| format!("{spec}: {e}"))?;
+    Ok(sim.state().clone())
+}
+
+/// Angular momentum about the origin of the spatial bodies.
+fn angular_momentum(sys: &System, s: &State) -> Vector3<f64> {
+    let o = sys.spatial_offset();
+    let mut l = Vector3::zeros();
+    for (k, b) in sys.spatial_bodies().iter().enumerate() {
+        let at = |x: &[f64], i: usize| {
+            Vector3::new(
+                x[o + 12 * k + i],
+                x[o + 12 * k + i + 1],
+                x[o + 12 * k + i + 2],
+            )
+        };
+        let (q, v) = (s.q.as_slice(), s.v.as_slice());
+        l += at(q, 0).cross(&at(v, 0)) * b.inertia.mass();
+        let e = b.inertia.second_moments();
+        for i in 0..3 {
+            l += at(q, 3 + 3 * i).cross(&at(v, 3 + 3 * i)) * e[i];
+        }
+    }
+    l
+}
+
+/// Body-frame angular velocity of spatial body 0.
+fn body_omega(q: &[f64], v: &[f64], o: usize) -> Vector3<f64> {
+    let d =
+        |x: &[f64], i: usize| Vector3::new(x[o + 3 + 3 * i], x[o + 4 + 3 * i], x[o + 5 + 3 * i]);
+    let w: Vector3<f64> = (0..3)
+        .map(|i| d(q, i).cross(&d(v, i)))
+        .sum::<Vector3<f64>>()
+        * 0.5;
+    Vector3::new(d(q, 0).dot(&w), d(q, 1).dot(&w), d(q, 2).dot(&w))
+}
+
+pub fn spatial(ctx: &Ctx) -> Result<Section, String> {
+    let mut sec = Section::default();
+    orders(ctx, &mut sec)?;
+    flips(&mut sec)?;
+    long_time(ctx, &mut sec)?;
+    Ok(sec)
+}
+
+/// Convergence orders of every solver that takes the heavy top.
+fn orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
+    let t_end = 0.5;
+    let hs: Vec<f64> = if ctx.quick {
+        vec![4e-3, 2e-3]
+    } else {
+        vec![4e-3, 2e-3, 1e-3]
+    };
+    sec.setting(
+        "heavy top",
+        "1 kg, centre of mass 0.5 m from the tip, tilted 0.3 rad, spinning at 20 rad/s; t = 0.5 s; error: max-norm of q against RK4 at h = 1.25e-4",
+    );
+    sec.setting("step sizes", format!("{hs:?}"));
+    let mut table = Table::new(
+        "Heavy top: convergence orders (least-squares slope) of every solver that takes spatial bodies",
+        &["solver", "body", "nominal", "fitted", "errors"],
+    );
+    let mut rows = Vec::new();
+    let mut refused = Vec::new();
+    for (body, moments) in [
+        ("solid", [0.3, 0.3, 0.1]),
+        ("disc, E_3 = 0", [0.25, 0.25, 0.5]),
+    ] {
+        let sys = heavy_top(moments, 0.3, 20.0).map_err(|e| e.to_string())?;
+        let reference = run(&sys, "rk4", t_end, 1.25e-4)?;
+        for (_, v) in mbd::registry().variants().filter(|(_, v)| v.compared) {
+            if Simulation::new(sys.clone(), v.spec).is_err() {
+                refused.push(format!("{} ({body})", v.spec));
+                continue;
+            }
+            // the swarm-based solver costs about 100 plain steps a step: two step sizes
+            let hs_v: Vec<f64> = if v.relative_cost > 20.0 {
+                hs[..2].to_vec()
+            } else {
+                hs.clone()
+            };
+            let mut errs = Vec::new();
+            for &h in &hs_v {
+                let s = run(&sys, v.spec, t_end, h)?;
+                errs.push(mbd_solve::linalg::max_abs_diff(
+                    s.q.as_slice(),
+                    reference.q.as_slice(),
+                ));
+            }
+            let fit = fit_order(&hs_v, &errs, FLOOR).map_err(|e| e.to_string())?;
+            table.row(vec![
+                v.spec.to_string(),
+                body.to_string(),
+                format!("{}", v.order),
+                format!("{:.2}", fit.order),
+                errs.iter()
+                    .map(|e| fmt_e(*e))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            ]);
+            sec.claims.push(Claim::check(
+                format!(
+                    "{} reaches its order {} on the heavy top ({body}) within {ORDER_TOL}",
+                    v.spec, v.order
+                ),
+                (fit.order - v.order as f64).abs() <= ORDER_TOL,
+                format!("fitted {:.3} from errors {errs:?}", fit.order),
+            ));
+            rows.push(json!({"solver": v.spec, "body": body, "order": num(fit.order), "errors": errs.iter().map(|e| num(*e)).collect::<Vec<_>>()}));
+        }
+    }
+    sec.tables.push(table);
+    sec.notes.push(format!(
+        "Refused by name (their derivative passes or residual scaling are planar or need a regular mass matrix): {}.",
+        refused.join(", ")
+    ));
+    sec.summary = json!({ "spatial_orders": rows });
+    Ok(())
+}
+
+/// The tumbling flat plate's flips against the exact solution.
+fn flips(sec: &mut Section) -> Result<(), String> {
+    let (j, w0) = ([1.0, 2.0, 3.0], [0.05, 2.0, 0.05]);
+    let sys = free_body(j, w0).map_err(|e| e.to_string())?;
+    let exact = TorqueFreeBody::new(j, Vector3::from(w0), Matrix3::identity())
+        .map_err(|e| e.to_string())?;
+    let t_end = exact.period().ok_or("the plate does not tumble")? * 0.8;
+    let want = exact.flip_times(t_end);
+    let o = sys.spatial_offset();
+    let mut dense = DenseOutput::new(&sys, NoObserver)
+        .with_event(Event::new("omega_2 = 0", move |_, q, v| {
+            body_omega(q, v, o)[1]
+        }));
+    let mut sim = Simulation::new(sys.clone(), "index1:dopri5").map_err(|e| e.to_string())?;
+    sim.run_observed(AdaptiveConfig::new(t_end, 1e-12), &mut dense)
+        .map_err(|e| e.to_string())?;
+    let found: Vec<f64> = dense.events().iter().map(|e| e.t).collect();
+    let mut table = Table::new(
+        "Flat plate J = (1, 2, 3) (E_3 = 0) tumbling about its intermediate axis, omega0 = (0.05, 2, 0.05): flips (zeros of the intermediate angular velocity) located by events with index1:dopri5 at tol 1e-12, against the exact Jacobi-elliptic solution",
+        &["flip", "located (s)", "exact (s)", "relative error"],
+    );
+    let mut worst = 0.0f64;
+    for (k, (f, e)) in found.iter().zip(&want).enumerate() {
+        let rel = (f - e).abs() / e;
+        worst = worst.max(rel);
+        table.row(vec![
+            format!("{}", k + 1),
+            format!("{f:.12}"),
+            format!("{e:.12}"),
+            fmt_e(rel),
+        ]);
+    }
+    sec.tables.push(table);
+    sec.claims.push(Claim::check(
+        "flip times of a tumbling body within 1e-8 relative of the exact solution at tol 1e-12 (event location)",
+        found.len() == want.len() && worst < 1e-8,
+        format!("{} flips located, {} exact; largest relative error {}", found.len(), want.len(), fmt_e(worst)),
+    ));
+    Ok(())
+}
+
+/// Symplectic (2,2) on a torque-free body over a long time.
+fn long_time(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
+    let sys = free_body([1.0, 2.0, 2.5], [0.05, 2.0, 0.05]).map_err(|e| e.to_string())?;
+    let t_end = if ctx.quick { 100.0 } else { 1000.0 };
+    let h = std::f64::consts::PI / 50.0;
+    let mut sim = Simulation::new(sys.clone(), "symplectic:2").map_err(|e| e.to_string())?;
+    let s0 = sim.state().clone();
+    let (h0, l0) = (
+        sys.energy(s0.q.as_slice(), s0.v.as_slice()),
+        angular_momentum(&sys, &s0),
+    );
+    let mut worst = (0.0f64, 0.0f64);
+    let mut watch = |_: &System, s: &State, _: usize| -> Result<Flow, SolveError> {
+        let e = (sys.energy(s.q.as_slice(), s.v.as_slice()) - h0).abs() / h0;
+        let l = (angular_momentum(&sys, s) - l0).amax() / l0.norm();
+        worst = (worst.0.max(e), worst.1.max(l));
+        Ok(Flow::Continue)
+    };
+    sim.run_observed(RunConfig::new(t_end, h), &mut watch)
+        .map_err(|e| e.to_string())?;
+    sec.setting(
+        "torque-free body",
+        format!("J = (1, 2, 2.5), omega0 = (0.05, 2, 0.05) rad/s, symplectic:2 at h = pi/50 (1/50 of the spin period), {t_end} s"),
+    );
+    sec.claims.push(Claim::check(
+        "symplectic (2,2) keeps all three components of a torque-free body's angular momentum to 1e-10 relative at 1/50 of the spin period",
+        worst.1 < 1e-10,
+        format!("max relative deviation {} over {t_end} s", fmt_e(worst.1)),
+    ));
+    sec.claims.push(
+        Claim::check(
+            "symplectic (2,2) keeps a torque-free body's energy to 1e-10 relative at 1/50 of the spin period",
+            worst.0 < 1e-10,
+            format!("max relative deviation {} over {t_end} s", fmt_e(worst.0)),
+        )
+        .expected_miss(ENERGY_MISS),
+    );
+    Ok(())
+}
