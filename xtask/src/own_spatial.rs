@@ -31,35 +31,7 @@ fn run(sys: &System, spec: &str, t_end: f64, h: f64) -> Result<State, String> {
 
 /// Angular momentum about the origin of the spatial bodies.
 fn angular_momentum(sys: &System, s: &State) -> Vector3<f64> {
-    let o = sys.spatial_offset();
-    let mut l = Vector3::zeros();
-    for (k, b) in sys.spatial_bodies().iter().enumerate() {
-        let at = |x: &[f64], i: usize| {
-            Vector3::new(
-                x[o + 12 * k + i],
-                x[o + 12 * k + i + 1],
-                x[o + 12 * k + i + 2],
-            )
-        };
-        let (q, v) = (s.q.as_slice(), s.v.as_slice());
-        l += at(q, 0).cross(&at(v, 0)) * b.inertia.mass();
-        let e = b.inertia.second_moments();
-        for i in 0..3 {
-            l += at(q, 3 + 3 * i).cross(&at(v, 3 + 3 * i)) * e[i];
-        }
-    }
-    l
-}
-
-/// Body-frame angular velocity of spatial body 0.
-fn body_omega(q: &[f64], v: &[f64], o: usize) -> Vector3<f64> {
-    let d =
-        |x: &[f64], i: usize| Vector3::new(x[o + 3 + 3 * i], x[o + 4 + 3 * i], x[o + 5 + 3 * i]);
-    let w: Vector3<f64> = (0..3)
-        .map(|i| d(q, i).cross(&d(v, i)))
-        .sum::<Vector3<f64>>()
-        * 0.5;
-    Vector3::new(d(q, 0).dot(&w), d(q, 1).dot(&w), d(q, 2).dot(&w))
+    Vector3::from(sys.spatial_angular_momentum(s.q.as_slice(), s.v.as_slice()))
 }
 
 pub fn spatial(ctx: &Ctx) -> Result<Section, String> {
@@ -153,10 +125,12 @@ fn flips(sec: &mut Section) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let t_end = exact.period().ok_or("the plate does not tumble")? * 0.8;
     let want = exact.flip_times(t_end);
-    let o = sys.spatial_offset();
-    let mut dense = DenseOutput::new(&sys, NoObserver)
-        .with_event(Event::new("omega_2 = 0", move |_, q, v| {
-            body_omega(q, v, o)[1]
+    let probe = sys.clone();
+    let mut dense =
+        DenseOutput::new(&sys, NoObserver).with_event(Event::new("omega_2 = 0", move |_, q, v| {
+            probe
+                .spatial_body_angular_velocity(0, q, v)
+                .map_or(0.0, |w| w[1])
         }));
     let mut sim = Simulation::new(sys.clone(), "index1:dopri5").map_err(|e| e.to_string())?;
     sim.run_observed(AdaptiveConfig::new(t_end, 1e-12), &mut dense)

@@ -265,3 +265,25 @@ fn spatial_builder_errors_name_the_element() {
     let e = b.build().unwrap_err().to_string();
     assert!(e.contains("skew") && e.contains("orientation"), "{e}");
 }
+
+/// On a rigid motion, the angular momentum of the natural coordinates is
+/// `m x x v + R J R^T omega`, and the body angular velocity is `R^T omega`.
+#[test]
+fn angular_momentum_and_body_angular_velocity() {
+    let moments = [0.3, 0.4, 0.2];
+    let sys = heavy_top(moments, 0.4, 15.0).unwrap();
+    let (q, v) = sys.initial_guess();
+    let (q, v) = (q.as_slice(), v.as_slice());
+    let r = nalgebra::Matrix3::from_fn(|row, col| q[3 + 3 * col + row]);
+    let axis = r.column(2).into_owned();
+    let omega = axis * 15.0;
+    let x = nalgebra::Vector3::new(q[0], q[1], q[2]);
+    let xd = nalgebra::Vector3::new(v[0], v[1], v[2]);
+    let j = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::from(moments));
+    let want = x.cross(&xd) + r * j * r.transpose() * omega;
+    let l = nalgebra::Vector3::from(sys.spatial_angular_momentum(q, v));
+    assert!((l - want).amax() < 1e-13 * want.norm(), "{l:?} vs {want:?}");
+    let wb = nalgebra::Vector3::from(sys.spatial_body_angular_velocity(0, q, v).unwrap());
+    assert!((wb - r.transpose() * omega).amax() < 1e-13 * 15.0, "{wb:?}");
+    assert!(sys.spatial_body_angular_velocity(1, q, v).is_none());
+}

@@ -337,3 +337,50 @@ impl SpatialPart {
         (k < self.lowered[j].n_equations()).then(|| format!("{}.e{}", self.joints[j].name, k + 1))
     }
 }
+
+impl crate::System {
+    /// The angular momentum of the spatial bodies about the origin, global axes:
+    /// `sum_k (m_k x_k x x_k' + sum_i E_ik d_ik x d_ik')` (the spin part is the body's
+    /// `R J omega` on rigid motions).
+    pub fn spatial_angular_momentum(&self, q: &[f64], v: &[f64]) -> [f64; 3] {
+        let o = self.spatial.q0;
+        let mut l = [0.0; 3];
+        for (k, b) in self.spatial.bodies.iter().enumerate() {
+            let at = |x: &[f64], i: usize| {
+                let s = o + 12 * k + i;
+                nalgebra::Vector3::new(x[s], x[s + 1], x[s + 2])
+            };
+            let mut lk = at(q, 0).cross(&at(v, 0)) * b.inertia.mass();
+            for (i, e) in b.inertia.second_moments().iter().enumerate() {
+                lk += at(q, 3 + 3 * i).cross(&at(v, 3 + 3 * i)) * *e;
+            }
+            for c in 0..3 {
+                l[c] += lk[c];
+            }
+        }
+        l
+    }
+
+    /// The angular velocity of spatial body `k` in its principal axes,
+    /// `omega_i = d_i . omega` with `omega = 1/2 sum_i d_i x d_i'` (exact on rigid motions:
+    /// `d_i x (omega x d_i)` sums to `2 omega`); `None` for a body index out of range.
+    pub fn spatial_body_angular_velocity(
+        &self,
+        k: usize,
+        q: &[f64],
+        v: &[f64],
+    ) -> Option<[f64; 3]> {
+        if k >= self.spatial.bodies.len() {
+            return None;
+        }
+        let s = self.spatial.q0 + 12 * k;
+        let d = |x: &[f64], i: usize| {
+            nalgebra::Vector3::new(x[s + 3 + 3 * i], x[s + 4 + 3 * i], x[s + 5 + 3 * i])
+        };
+        let w: nalgebra::Vector3<f64> = (0..3)
+            .map(|i| d(q, i).cross(&d(v, i)))
+            .sum::<nalgebra::Vector3<f64>>()
+            * 0.5;
+        Some([d(q, 0).dot(&w), d(q, 1).dot(&w), d(q, 2).dot(&w)])
+    }
+}
