@@ -278,6 +278,18 @@ pub fn page(title: &str, sys: &System, t: Vec<f64>, q: Vec<Vec<f64>>) -> Result<
 /// Reads the CSV and the model, checks that they belong together and writes the page.
 pub fn animate(args: &AnimateArgs) -> Result<(), CliError> {
     let sys = crate::model::load(&args.model)?;
+    if sys.has_spatial() {
+        eprintln!(
+            "warning: the animation is planar: the model's {} spatial bod{} not drawn \
+             (plot the columns with `mbd plot`)",
+            sys.spatial_bodies().len(),
+            if sys.spatial_bodies().len() == 1 {
+                "y is"
+            } else {
+                "ies are"
+            }
+        );
+    }
     let table = Table::read(&args.csv)?;
     let names = sys.coordinate_names();
     let missing: Vec<&str> = std::iter::once("t")

@@ -761,3 +761,35 @@ fn check_lists_spatial_bodies_and_joints() {
         );
     }
 }
+
+/// `mbd run` writes a spatial model's columns; `mbd animate` says its spatial bodies are not
+/// drawn.
+#[test]
+fn a_spatial_model_runs_and_the_animation_says_it_is_planar() {
+    let d = scratch("top");
+    let model = common::repo().join("examples/models/heavy_top.toml");
+    let csv = d.join("top.csv");
+    let out = run_model(&model, "rk4-projected", &["--h", "0.01"], &csv);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let (head, rows) = read_csv(&csv);
+    assert!(
+        head.iter().any(|h| h == "top.d3z") && rows.len() == 3,
+        "{head:?}"
+    );
+    let page = d.join("top.html");
+    let out = mbd([
+        "animate".as_ref(),
+        "--model".as_ref(),
+        model.as_os_str(),
+        "--out".as_ref(),
+        page.as_os_str(),
+        csv.as_os_str(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("the animation is planar: the model's 1 spatial body is not drawn"),
+        "{}",
+        out.stderr
+    );
+}
