@@ -70,7 +70,8 @@ impl CoreModel {
             .map_err(|e| Failure::from(e).to_pyerr(py))
     }
 
-    /// A summary: names of bodies, joints, forces, sensors; coordinate names; sizes.
+    /// A summary: names of bodies, joints, forces, spatial bodies and joints; coordinate names;
+    /// sizes.
     fn describe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.system;
         let d = PyDict::new(py);
@@ -86,6 +87,14 @@ impl CoreModel {
         d.set_item(
             "forces",
             names(s.forces().iter().map(|f| f.name.as_str()).collect()),
+        )?;
+        d.set_item(
+            "spatial_bodies",
+            names(s.spatial_bodies().iter().map(|b| b.name.as_str()).collect()),
+        )?;
+        d.set_item(
+            "spatial_joints",
+            names(s.spatial_joints().iter().map(|j| j.name.as_str()).collect()),
         )?;
         d.set_item("coordinates", s.coordinate_names())?;
         d.set_item("n_constraints", s.n_constraints())?;

@@ -147,3 +147,14 @@ def test_the_gil_is_released_while_rust_runs(slider):
     # the main thread ran all along: about one tick per 5 ms of the run
     assert elapsed > 0.05, "the run was too short to tell"
     assert len(ticks) > 0.3 * elapsed / 0.005
+
+
+def test_a_spatial_model_from_a_file_runs():
+    m = mbd.Model.from_file(MODELS / "heavy_top.toml")
+    assert m.spatial_bodies == ["top"] and m.spatial_joints == ["tip"] and m.dof == 3
+    assert "1 spatial bodies" in repr(m)
+    r = m.run("tangent:rk4", t_end=0.2, h=1e-3)
+    assert "top.d3z" in r
+    # the centre of mass stays 0.5 m from the tip
+    radius = (r["top.x"] ** 2 + r["top.y"] ** 2 + r["top.z"] ** 2) ** 0.5
+    assert abs(radius - 0.5).max() < 1e-12

@@ -21,7 +21,8 @@ def _model_from_json(text: str) -> "Model":
 
 
 class Model:
-    """A validated planar multibody model: bodies, joints, forces, sensors.
+    """A validated multibody model: planar bodies, joints, forces, sensors, and spatial bodies
+    and joints.
 
     Read one from a model file (``.toml`` or ``.json``, see ``docs/model-files.md``), from a
     string, or build one with :class:`ModelBuilder`; then :meth:`run` it with any solver of
@@ -101,6 +102,16 @@ class Model:
         return list(self._describe()["bodies"])
 
     @property
+    def spatial_bodies(self) -> List[str]:
+        """The spatial (3D) bodies' names (docs/spatial.md)."""
+        return list(self._describe()["spatial_bodies"])
+
+    @property
+    def spatial_joints(self) -> List[str]:
+        """The spatial joints' names."""
+        return list(self._describe()["spatial_joints"])
+
+    @property
     def joints(self) -> List[str]:
         """The joints' names (point masses add a ``<name>:point_mass`` joint)."""
         return list(self._describe()["joints"])
@@ -127,9 +138,14 @@ class Model:
 
     def __repr__(self) -> str:
         d = self._describe()
+        spatial = (
+            f"{len(d['spatial_bodies'])} spatial bodies, {len(d['spatial_joints'])} spatial joints, "
+            if d["spatial_bodies"]
+            else ""
+        )
         return (
             f"<mbd.Model {len(d['bodies'])} bodies, {len(d['joints'])} joints, "
-            f"{len(d['forces'])} forces, {d['dof']} DOF>"
+            f"{spatial}{len(d['forces'])} forces, {d['dof']} DOF>"
         )
 
     # -- running ---------------------------------------------------------------------------
