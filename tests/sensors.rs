@@ -100,31 +100,19 @@ fn model_files_name_sensors() {
     let back = ModelFile::from_toml(&text).unwrap().build().unwrap();
     assert_eq!(back.sensors(), sys.sensors());
     let bad = text.replace("joint = \"slide\"", "joint = \"slyde\"");
-    let e = ModelFile::from_toml(&bad)
-        .unwrap()
-        .build()
-        .unwrap_err()
-        .to_string();
+    let e = build_error(&bad);
     assert!(
         e.contains("sensor 'stroke'") && e.contains("'slyde'"),
         "{e}"
     );
     let bad = text.replace("body = \"rod\"", "body = \"rood\"");
-    let e = ModelFile::from_toml(&bad)
-        .unwrap()
-        .build()
-        .unwrap_err()
-        .to_string();
+    let e = build_error(&bad);
     assert!(
         e.contains("sensor 'rod_end'") && e.contains("'rood'"),
         "{e}"
     );
     let bad = text.replace("name = \"stroke\"", "name = \"rod_end\"");
-    let e = ModelFile::from_toml(&bad)
-        .unwrap()
-        .build()
-        .unwrap_err()
-        .to_string();
+    let e = build_error(&bad);
     assert!(e.contains("sensor") && e.contains("rod_end"), "{e}");
 }
 
@@ -225,20 +213,21 @@ fn reaction_and_energy_sensors() {
     // an unknown body in an energy sensor and an unknown joint in a reaction sensor
     let text = sys.to_model_file().to_toml().unwrap();
     let bad = text.replace(&format!("joint = \"{joint}\""), "joint = \"elbo\"");
-    let e = ModelFile::from_toml(&bad)
-        .unwrap()
-        .build()
-        .unwrap_err()
-        .to_string();
+    let e = build_error(&bad);
     assert!(
         e.contains("sensor 'elbow_load'") && e.contains("'elbo'"),
         "{e}"
     );
     let bad = text.replace(&format!("body = \"{}\"", bodies[0]), "body = \"nobody\"");
-    let e = ModelFile::from_toml(&bad)
+    let e = build_error(&bad);
+    assert!(e.contains("sensor") && e.contains("'nobody'"), "{e}");
+}
+
+/// The build error of a model file's text.
+fn build_error(text: &str) -> String {
+    ModelFile::from_toml(text)
         .unwrap()
         .build()
         .unwrap_err()
-        .to_string();
-    assert!(e.contains("sensor") && e.contains("'nobody'"), "{e}");
+        .to_string()
 }

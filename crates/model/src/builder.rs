@@ -388,18 +388,7 @@ impl System {
         check::finite("gravity", "gravity", gravity[1])?;
         let mut names = std::collections::HashSet::new();
         for body in &bodies {
-            if body.name.eq_ignore_ascii_case("ground") {
-                return Err(ModelError::DuplicateName {
-                    kind: "body (reserved for the ground)",
-                    name: body.name.clone(),
-                });
-            }
-            if !names.insert(body.name.as_str()) {
-                return Err(ModelError::DuplicateName {
-                    kind: "body",
-                    name: body.name.clone(),
-                });
-            }
+            check::body_name(&mut names, &body.name)?;
             check::positive(&body.name, "mass", body.mass)?;
             if !(body.inertia.is_finite() && body.inertia > 0.0) {
                 return Err(ModelError::InvalidParameter {
@@ -539,12 +528,7 @@ impl System {
             }
             m += j.n_equations();
         }
-        let spatial = spatial.build(
-            n,
-            m,
-            &mut bodies.iter().map(|b| b.name.clone()).collect(),
-            &mut jnames,
-        )?;
+        let spatial = spatial.build(n, m, &mut names, &mut jnames)?;
         let n = n + 12 * spatial.bodies.len();
         let m = m + spatial.m;
         let mass = DVector::from_iterator(

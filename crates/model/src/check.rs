@@ -98,3 +98,24 @@ pub(crate) fn time_function(
         }),
     }
 }
+
+/// Checks a body's name: not the reserved `ground` (any case) and not already in `names` (all
+/// bodies, planar and spatial), which it joins.
+pub(crate) fn body_name(
+    names: &mut std::collections::HashSet<String>,
+    name: &str,
+) -> Result<(), ModelError> {
+    if name.eq_ignore_ascii_case("ground") {
+        return Err(ModelError::DuplicateName {
+            kind: "body (reserved for the ground)",
+            name: name.to_string(),
+        });
+    }
+    if !names.insert(name.to_string()) {
+        return Err(ModelError::DuplicateName {
+            kind: "body",
+            name: name.to_string(),
+        });
+    }
+    Ok(())
+}

@@ -154,13 +154,7 @@ fn gauss(f: &dyn Fn(f64) -> f64, len: f64, panels: usize) -> f64 {
         for (x, w) in GL_NODES.iter().zip(GL_WEIGHTS) {
             panel += w * (f(mid - 0.5 * h * x) + f(mid + 0.5 * h * x));
         }
-        let t = sum + panel;
-        carry += if sum.abs() >= panel.abs() {
-            (sum - t) + panel
-        } else {
-            (panel - t) + sum
-        };
-        sum = t;
+        super::exact::neumaier_add(&mut sum, &mut carry, panel);
     }
     0.5 * h * (sum + carry)
 }

@@ -37,18 +37,7 @@ impl SpatialInput {
         }
         let (mut q_init, mut v_init) = (Vec::new(), Vec::new());
         for b in &bodies {
-            if b.name.eq_ignore_ascii_case("ground") {
-                return Err(ModelError::DuplicateName {
-                    kind: "body (reserved for the ground)",
-                    name: b.name.clone(),
-                });
-            }
-            if !body_names.insert(b.name.clone()) {
-                return Err(ModelError::DuplicateName {
-                    kind: "body",
-                    name: b.name.clone(),
-                });
-            }
+            crate::check::body_name(body_names, &b.name)?;
             let (q, v) = b.natural_state()?;
             let kinetic: f64 = b
                 .inertia
