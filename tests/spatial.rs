@@ -12,6 +12,13 @@ fn angular_momentum(sys: &System, s: &State) -> Vector3<f64> {
     Vector3::from(sys.spatial_angular_momentum(s.q.as_slice(), s.v.as_slice()))
 }
 
+/// The state of `sys` after a run with `spec` (fixed steps or adaptive).
+fn end_state(sys: &System, spec: &str, plan: impl Into<Plan>) -> State {
+    let mut sim = Simulation::new(sys.clone(), spec).unwrap();
+    sim.run(plan).unwrap();
+    sim.state().clone()
+}
+
 fn max_phi(sys: &System, s: &State) -> f64 {
     let mut phi = vec![0.0; sys.n_constraints()];
     sys.phi(s.q.as_slice(), s.t, &mut phi);
@@ -64,11 +71,7 @@ fn top_keeps_its_invariants(moments: [f64; 3]) {
 #[test]
 fn rk4_converges_with_order_four_on_the_heavy_top() {
     let sys = heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap();
-    let end = |spec: &str, plan: Plan| -> DVector<f64> {
-        let mut sim = Simulation::new(sys.clone(), spec).unwrap();
-        sim.run(plan).unwrap();
-        sim.state().q.clone()
-    };
+    let end = |spec: &str, plan: Plan| -> DVector<f64> { end_state(&sys, spec, plan).q };
     let reference = end("rk4", RunConfig::new(0.5, 1.25e-4).into());
     let errs: Vec<f64> = [4e-3, 2e-3, 1e-3]
         .iter()
@@ -218,11 +221,7 @@ fn flips_of_a_tumbling_plate_match_the_exact_solution() {
 fn firefly_gauss_runs_spatial_tops() {
     for moments in [[0.3, 0.3, 0.1], [0.25, 0.25, 0.5]] {
         let sys = heavy_top(moments, 0.3, 20.0).unwrap();
-        let end = |spec: &str, h: f64| {
-            let mut sim = Simulation::new(sys.clone(), spec).unwrap();
-            sim.run(RunConfig::new(0.1, h)).unwrap();
-            sim.state().clone()
-        };
+        let end = |spec: &str, h: f64| end_state(&sys, spec, RunConfig::new(0.1, h));
         let reference = end("rk4", 1e-4);
         let s = end("firefly-gauss:polish", 1e-3);
         let d = (&s.q - &reference.q).amax();
@@ -242,11 +241,7 @@ fn firefly_gauss_runs_spatial_tops() {
 fn the_tangent_solvers_reach_their_orders_on_spatial_tops() {
     for moments in [[0.3, 0.3, 0.1], [0.25, 0.25, 0.5]] {
         let sys = heavy_top(moments, 0.3, 20.0).unwrap();
-        let end = |spec: &str, h: f64| {
-            let mut sim = Simulation::new(sys.clone(), spec).unwrap();
-            sim.run(RunConfig::new(0.5, h)).unwrap();
-            sim.state().clone()
-        };
+        let end = |spec: &str, h: f64| end_state(&sys, spec, RunConfig::new(0.5, h));
         let reference = end("rk4", 1.25e-4);
         for (spec, order) in [("tangent:rk4", 4.0), ("tangent:dopri5", 5.0)] {
             let mut errs = Vec::new();
@@ -274,11 +269,7 @@ fn the_tangent_solvers_reach_their_orders_on_spatial_tops() {
 #[test]
 fn the_plain_symplectic_scheme_reaches_its_orders_on_the_solid_top() {
     let sys = heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap();
-    let end = |spec: &str, h: f64| {
-        let mut sim = Simulation::new(sys.clone(), spec).unwrap();
-        sim.run(RunConfig::new(0.5, h)).unwrap();
-        sim.state().clone()
-    };
+    let end = |spec: &str, h: f64| end_state(&sys, spec, RunConfig::new(0.5, h));
     let reference = end("rk4", 1.25e-4);
     for (spec, order) in [("symplectic:1", 2.0), ("symplectic:2", 4.0)] {
         let errs: Vec<f64> = [4e-3, 2e-3, 1e-3]
@@ -399,11 +390,7 @@ fn a_spatial_hinge_swings_like_the_planar_pendulum() {
         [-0.5 * l, 0.0],
     ));
     let planar = p.build().unwrap();
-    let end = |sys: &System| {
-        let mut sim = Simulation::new(sys.clone(), "index1:dopri5").unwrap();
-        sim.run(AdaptiveConfig::new(2.0, 1e-12)).unwrap();
-        sim.state().clone()
-    };
+    let end = |sys: &System| end_state(sys, "index1:dopri5", AdaptiveConfig::new(2.0, 1e-12));
     let (s, pl) = (end(&spatial), end(&planar));
     // the rod's direction: body x = d_1; its angle from the downward vertical in x-z
     let d1 = Vector3::new(s.q[3], s.q[4], s.q[5]);
