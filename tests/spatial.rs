@@ -496,3 +496,70 @@ fn a_spatial_double_pendulum_conserves_energy() {
     // it fell
     assert!(s.q[12 + 2] < -0.5, "{}", s.q[14]);
 }
+
+/// Spatial joint reactions from the multipliers: on the heavy top (solid and disc) the ball
+/// joint's force on the top is `m a - m g` (Newton's law for the body) and its moment about
+/// the tip is zero (a ball joint transmits none); along the run the same holds.
+#[test]
+fn spatial_joint_reactions_obey_newton_and_the_ball_joint_carries_no_moment() {
+    use mbd::solve::OutputSolve;
+    for moments in [[0.3, 0.3, 0.1], [0.25, 0.25, 0.5]] {
+        let sys = heavy_top(moments, 0.3, 20.0).unwrap();
+        let mut out = OutputSolve::new(&sys).unwrap();
+        let mut sim = Simulation::new(sys.clone(), "rk4-projected").unwrap();
+        for _ in 0..3 {
+            let s = sim.state().clone();
+            let (a, lambda) = out.at(&sys, &s).unwrap();
+            let r = sys.spatial_joint_reactions(s.q.as_slice(), lambda).unwrap();
+            assert_eq!(r.len(), 1);
+            let want = Vector3::new(a[0], a[1], a[2] + 9.81);
+            let f = Vector3::from(r[0].force);
+            assert!(
+                (f - want).amax() < 1e-10 * want.norm(),
+                "{moments:?}: {f:?} vs {want:?}"
+            );
+            assert!(
+                Vector3::from(r[0].moment).amax() < 1e-10,
+                "{moments:?}: {:?}",
+                r[0].moment
+            );
+            assert!(
+                Vector3::from(r[0].point).norm() < 1e-12,
+                "the tip is at the origin"
+            );
+            sim.run(RunConfig::new(sim.state().t + 0.1, 1e-3)).unwrap();
+        }
+        let e = sys
+            .spatial_joint_reactions(&[0.0; 3], &[0.0; 9])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains('q'), "{e}");
+    }
+    // the joint written the other way round (ground second): the load on the ground, the
+    // negative of the load on the top, about the same point
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/heavy_top.toml"),
+    )
+    .unwrap();
+    let swapped = text
+        .replace("body_a = \"ground\"", "body_a = \"top\"")
+        .replace("body_b = \"top\"", "body_b = \"ground\"")
+        .replace("point_a = [0.0, 0.0, 0.0]", "point_a = [0.0, 0.0, -0.5]")
+        .replace("point_b = [0.0, 0.0, -0.5]", "point_b = [0.0, 0.0, 0.0]");
+    assert_ne!(swapped, text);
+    let (fwd, rev) = (
+        mbd::model::System::from_toml(&text).unwrap(),
+        mbd::model::System::from_toml(&swapped).unwrap(),
+    );
+    let load = |sys: &System| {
+        let s = State::consistent(sys, 0.0).unwrap();
+        let mut out = OutputSolve::new(sys).unwrap();
+        let (_, lambda) = out.at(sys, &s).unwrap();
+        sys.spatial_joint_reactions(s.q.as_slice(), lambda).unwrap()[0]
+    };
+    let (a, b) = (load(&fwd), load(&rev));
+    for c in 0..3 {
+        assert!((a.force[c] + b.force[c]).abs() < 1e-12, "{a:?} vs {b:?}");
+        assert!((a.point[c] - b.point[c]).abs() < 1e-12, "{a:?} vs {b:?}");
+    }
+}

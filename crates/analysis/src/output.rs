@@ -166,7 +166,9 @@ impl<W: Write> CsvObserver<W> {
     }
     /// Adds three columns per joint, `<joint>.fx`, `<joint>.fy`, `<joint>.mz`: the force on the
     /// joint's second body in global axes and the moment about the joint's point on it
-    /// ([`ReactionSolver`], whose documentation gives the conventions).
+    /// ([`ReactionSolver`], whose documentation gives the conventions); six per spatial joint,
+    /// `.fx`, `.fy`, `.fz`, `.mx`, `.my`, `.mz`
+    /// ([`mbd_model::System::spatial_joint_reactions`]).
     pub fn with_reactions(mut self) -> Self {
         self.reactions = true;
         self
@@ -227,6 +229,11 @@ impl<W: Write> CsvObserver<W> {
                     h.push(format!("{}.{c}", j.name));
                 }
             }
+            for j in sys.spatial_joints() {
+                for c in ["fx", "fy", "fz", "mx", "my", "mz"] {
+                    h.push(format!("{}.{c}", j.name));
+                }
+            }
         }
         if self.sensors {
             h.extend(SensorSolver::columns(sys));
@@ -264,6 +271,11 @@ impl<W: Write> CsvObserver<W> {
             rs.compute_with(sys, s, lambda, out)?;
             for r in out.iter() {
                 self.row.extend([r.force[0], r.force[1], r.moment]);
+            }
+            if !sys.spatial_joints().is_empty() {
+                for r in sys.spatial_joint_reactions(s.q.as_slice(), lambda)? {
+                    self.row.extend(r.force.iter().chain(&r.moment));
+                }
             }
         }
         if self.sensors && !sys.sensors().is_empty() {

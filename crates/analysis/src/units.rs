@@ -4,7 +4,8 @@
 //! The unit follows from the column's name alone: `t` (s); a coordinate `body.x`, `body.y` (m),
 //! `body.theta` (rad); a velocity `d_body.x` (m/s), `d_body.theta` (rad/s); the energy `H` and
 //! the energy balance `W_external`, `E_dissipated`, `energy_balance` (J); a joint reaction
-//! `joint.fx`, `joint.fy` (N), `joint.mz` (N m) and a reaction sensor's `.fx_body`,
+//! `joint.fx`, `joint.fy`, a spatial joint's `.fz` (N), `joint.mz`, `.mx`, `.my` (N m) and a
+//! reaction sensor's `.fx_body`,
 //! `.fy_body` (N); a point sensor's `.vx`, `.vy` (m/s), `.ax`, `.ay` (m/s^2); a joint sensor's
 //! `.angle` (rad), `.rate` (rad/s), `.s` (m), `.ds` (m/s); an energy sensor's `.kinetic`,
 //! `.potential`, `.total` (J).
@@ -40,7 +41,8 @@ pub fn unit_of(column: &str) -> Option<&'static str> {
         ("theta", false) | ("angle", _) => "rad",
         ("theta", true) | ("rate", _) => "rad/s",
         ("ax" | "ay", _) => "m/s^2",
-        ("fx" | "fy" | "fx_body" | "fy_body", _) => "N",
+        ("fx" | "fy" | "fz" | "fx_body" | "fy_body", _) => "N",
+        ("mx" | "my", _) => "N m",
         ("kinetic" | "potential" | "total", _) => "J",
         ("mz", _) => "N m",
         _ => return None,
@@ -93,6 +95,10 @@ mod tests {
         assert_eq!(unit_of("crank_pin.fx"), Some("N"));
         assert_eq!(unit_of("crank_pin.fy"), Some("N"));
         assert_eq!(unit_of("crank_pin.mz"), Some("N m"));
+        // a spatial joint's
+        assert_eq!(unit_of("tip.fz"), Some("N"));
+        assert_eq!(unit_of("tip.mx"), Some("N m"));
+        assert_eq!(unit_of("tip.my"), Some("N m"));
     }
 
     #[test]

@@ -762,20 +762,33 @@ fn check_lists_spatial_bodies_and_joints() {
     }
 }
 
-/// `mbd run` writes a spatial model's columns; `mbd animate` says its spatial bodies are not
-/// drawn.
+/// `mbd run` writes a spatial model's columns (with `--reactions`, the ball joint's force and
+/// zero moment); `mbd animate` says its spatial bodies are not drawn.
 #[test]
 fn a_spatial_model_runs_and_the_animation_says_it_is_planar() {
     let d = scratch("top");
     let model = common::repo().join("examples/models/heavy_top.toml");
     let csv = d.join("top.csv");
-    let out = run_model(&model, "rk4-projected", &["--h", "0.01"], &csv);
+    let out = run_model(
+        &model,
+        "rk4-projected",
+        &["--h", "0.01", "--reactions"],
+        &csv,
+    );
     assert_eq!(out.code, 0, "{}", out.stderr);
     let (head, rows) = read_csv(&csv);
     assert!(
         head.iter().any(|h| h == "top.d3z") && rows.len() == 3,
         "{head:?}"
     );
+    // the ball joint's reaction: a force and no moment about the tip
+    let at = |c: &str| head.iter().position(|h| h == c).unwrap();
+    for r in &rows {
+        assert!(r[at("tip.fz")] > 1.0, "{}", r[at("tip.fz")]);
+        for c in ["tip.mx", "tip.my", "tip.mz"] {
+            assert!(r[at(c)].abs() < 1e-9, "{c} = {}", r[at(c)]);
+        }
+    }
     let page = d.join("top.html");
     let out = mbd([
         "animate".as_ref(),

@@ -39,7 +39,7 @@ pub use inertia::{SpatialInertia, SpatialInertiaError};
 pub use joints::{Marker, SpatialFrame, SpatialJoint, SpatialJointError, SpatialJointKind};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};
 pub use rigid::{internal_gamma, RigidSolve};
-pub use system::SpatialJointEntry;
+pub use system::{SpatialJointEntry, SpatialJointReaction};
 
 use nalgebra::{Matrix3, Vector3};
 
