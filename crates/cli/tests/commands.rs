@@ -2,7 +2,7 @@
 //! `check`, `plot` and `animate` produce what they promise.
 
 mod common;
-use common::{example_models, mbd, pendulum_csv, scratch};
+use common::{example_models, mbd, pendulum_csv, read_csv, run_model, scratch};
 use std::path::Path;
 
 fn expected_columns(model: &Path) -> Vec<String> {
@@ -17,30 +17,6 @@ fn expected_columns(model: &Path) -> Vec<String> {
         c.extend(["W_external", "E_dissipated", "energy_balance"].map(String::from));
     }
     c
-}
-
-fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(p).unwrap();
-    let mut lines = text.lines();
-    let head = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-        .collect();
-    (head, rows)
-}
-
-fn run_model(model: &Path, solver: &str, step: &[&str], out: &Path) -> common::Out {
-    let mut a: Vec<std::ffi::OsString> = vec![
-        "run".into(),
-        model.into(),
-        "--solver".into(),
-        solver.into(),
-        "--t-end".into(),
-        "0.02".into(),
-    ];
-    a.extend(step.iter().map(Into::into));
-    a.extend(["--out".into(), out.into()]);
-    mbd(a)
 }
 
 /// Every registered solver (`mbd::registry()`), with `--h` and, for adaptive ones, `--tol`,
@@ -663,146 +639,4 @@ fn run_creates_the_output_folder() {
     common::run_pendulum_to(&csv);
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text.lines().count(), 12, "{text}");
-}
-
-/// Reaction and energy sensors and assembly from joint coordinates, in a model file: `check`
-/// lists them (and the bodies the assembly places), `run` writes the sensors' columns, and the
-/// energy sensor's total is the `H` column.
-#[test]
-fn check_and_run_show_reaction_and_energy_sensors_and_the_assembly() {
-    let d = scratch("sensors");
-    let text =
-        std::fs::read_to_string(common::repo().join("examples/models/slider_crank_spring.toml"))
-            .unwrap()
-            + r#"
-[[sensors]]
-type = "reaction"
-name = "pin"
-joint = "crank_pin"
-
-[[sensors]]
-type = "energy"
-name = "all"
-
-[[sensors]]
-type = "energy"
-name = "rod_e"
-body = "rod"
-
-[[assembly]]
-joint = "crank_pivot"
-coordinate = 1.0
-rate = 6.0
-"#;
-    let model = d.join("sensors.toml");
-    std::fs::write(&model, text).unwrap();
-    let out = mbd(["check".as_ref(), model.as_os_str()]);
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    for needle in [
-        "sensors (3):",
-        "pin              reaction of joint crank_pin",
-        "all              energy of the model",
-        "rod_e            energy of rod",
-        "assembly from joint coordinates (1):",
-        "crank_pivot      coordinate 1, rate 6",
-        "places crank, rod, slider",
-    ] {
-        assert!(
-            out.stdout.contains(needle),
-            "lacks {needle:?}:\n{}",
-            out.stdout
-        );
-    }
-    let csv = d.join("out.csv");
-    let out = run_model(&model, "rk4", &["--h", "0.01"], &csv);
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    let (head, rows) = read_csv(&csv);
-    let at = |c: &str| {
-        head.iter()
-            .position(|h| h == c)
-            .unwrap_or_else(|| panic!("no column {c} in {head:?}"))
-    };
-    for c in [
-        "pin.fx",
-        "pin.fy",
-        "pin.mz",
-        "pin.fx_body",
-        "pin.fy_body",
-        "rod_e.kinetic",
-    ] {
-        at(c);
-    }
-    for r in &rows {
-        assert_eq!(r[at("all.total")], r[at("H")]);
-        assert!(r[at("rod_e.kinetic")] > 0.0);
-    }
-    // the crank starts at the assembled angle and rate
-    assert!((rows[0][at("crank.theta")] - 1.0).abs() < 1e-9);
-    assert!((rows[0][at("d_crank.theta")] - 6.0).abs() < 1e-9);
-}
-
-/// `mbd check` on a spatial model lists its spatial bodies and joints.
-#[test]
-fn check_lists_spatial_bodies_and_joints() {
-    let out = mbd(["check", "examples/models/heavy_top.toml"]);
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    for needle in [
-        "spatial gravity: [0, 0, -9.81] m/s^2",
-        "spatial bodies (1):",
-        "principal moments [0.3, 0.3, 0.1]",
-        "tip              spherical    ground - top (3 equations)",
-        "degrees of freedom: 3",
-        "top.d3z",
-    ] {
-        assert!(
-            out.stdout.contains(needle),
-            "lacks {needle:?}:\n{}",
-            out.stdout
-        );
-    }
-}
-
-/// `mbd run` writes a spatial model's columns (with `--reactions`, the ball joint's force and
-/// zero moment); `mbd animate` says its spatial bodies are not drawn.
-#[test]
-fn a_spatial_model_runs_and_the_animation_says_it_is_planar() {
-    let d = scratch("top");
-    let model = common::repo().join("examples/models/heavy_top.toml");
-    let csv = d.join("top.csv");
-    let out = run_model(
-        &model,
-        "rk4-projected",
-        &["--h", "0.01", "--reactions"],
-        &csv,
-    );
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    let (head, rows) = read_csv(&csv);
-    assert!(
-        head.iter().any(|h| h == "top.d3z") && rows.len() == 3,
-        "{head:?}"
-    );
-    // the ball joint's reaction: a force and no moment about the tip
-    let at = |c: &str| head.iter().position(|h| h == c).unwrap();
-    for r in &rows {
-        assert!(r[at("tip.fz")] > 1.0, "{}", r[at("tip.fz")]);
-        for c in ["tip.mx", "tip.my", "tip.mz"] {
-            assert!(r[at(c)].abs() < 1e-9, "{c} = {}", r[at(c)]);
-        }
-    }
-    let page = d.join("top.html");
-    let out = mbd([
-        "animate".as_ref(),
-        "--model".as_ref(),
-        model.as_os_str(),
-        "--out".as_ref(),
-        page.as_os_str(),
-        csv.as_os_str(),
-    ]);
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    assert!(
-        out.stderr
-            .contains("the animation is planar: the model's 1 spatial body is not drawn"),
-        "{}",
-        out.stderr
-    );
 }

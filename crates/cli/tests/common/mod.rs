@@ -94,3 +94,29 @@ pub fn run_pendulum_to(csv: &Path) {
     ]);
     assert_eq!(out.code, 0, "{}", out.stderr);
 }
+
+/// A result CSV's header and rows.
+pub fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(p).unwrap();
+    let mut lines = text.lines();
+    let head = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    (head, rows)
+}
+
+/// `mbd run MODEL --solver SOLVER --t-end 0.02 STEP.. --out OUT`.
+pub fn run_model(model: &Path, solver: &str, step: &[&str], out: &Path) -> Out {
+    let mut a: Vec<std::ffi::OsString> = vec![
+        "run".into(),
+        model.into(),
+        "--solver".into(),
+        solver.into(),
+        "--t-end".into(),
+        "0.02".into(),
+    ];
+    a.extend(step.iter().map(Into::into));
+    a.extend(["--out".into(), out.into()]);
+    mbd(a)
+}
