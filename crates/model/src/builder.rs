@@ -81,6 +81,12 @@ impl SystemBuilder {
         });
         self.spatial.joints.len() - 1
     }
+    /// Adds a force element on spatial bodies (spring-damper, force or torque; points and
+    /// load axes in the bodies' frames). Returns its index among the spatial force elements.
+    pub fn add_spatial_force(&mut self, force: crate::spatial::SpatialForce) -> usize {
+        self.spatial.forces.push(force);
+        self.spatial.forces.len() - 1
+    }
     /// Adds a body and returns its handle. Its local points (in joints and forces) are
     /// relative to its centre of mass, unless [`SystemBuilder::set_body_frame`] says otherwise.
     pub fn add_body(&mut self, body: Body) -> BodyHandle {
@@ -528,7 +534,7 @@ impl System {
             }
             m += j.n_equations();
         }
-        let spatial = spatial.build(n, m, &mut names, &mut jnames)?;
+        let spatial = spatial.build(n, m, &mut names, &mut jnames, &mut fnames)?;
         let n = n + 12 * spatial.bodies.len();
         let m = m + spatial.m;
         let mass = DVector::from_iterator(

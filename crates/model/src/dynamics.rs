@@ -15,7 +15,7 @@ impl System {
             let at = self.force_attach[fi];
             v += f.potential(&Self::frm_f64(q, at.a), &Self::frm_f64(q, at.b));
         }
-        v + self.spatial.potential(q)
+        v + self.spatial.potential(q) + self.spatial.force_potential(q)
     }
 
     /// Kinetic energy `1/2 v^T M v`.
@@ -44,6 +44,9 @@ impl System {
         for (o, g) in out[q0..].iter_mut().zip(&self.gravity_forces[q0..]) {
             *o = -g;
         }
+        if self.spatial.has_forces() {
+            self.spatial.add_force_gradient(q, 1.0, out);
+        }
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
             let e = f.potential(
@@ -71,6 +74,9 @@ impl System {
 
     /// Adds `scale * d^2 V / dq^2` into `out`.
     pub fn add_potential_hessian(&self, q: &[f64], scale: f64, out: &mut DMatrix<f64>) {
+        if self.spatial.has_forces() {
+            self.spatial.add_force_hessian(q, scale, out);
+        }
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
             let e = f.potential(&Self::loc_hess(q, at.a, 0), &Self::loc_hess(q, at.b, 3));
@@ -91,7 +97,7 @@ impl System {
     /// `dH/dt = external - dissipated + lambda . Phi_t` (docs/architecture.md, "Energy
     /// balance").
     pub fn nonconservative_power(&self, q: &[f64], v: &[f64], t: f64) -> (f64, f64) {
-        let (mut dissipated, mut external) = (0.0, 0.0);
+        let (mut dissipated, mut external) = self.spatial.nonconservative_power(q, v, t);
         for (fi, f) in self.forces.iter().enumerate() {
             if !f.is_nonconservative() {
                 continue;
@@ -121,6 +127,9 @@ impl System {
     /// (overwritten).
     pub fn nonconservative_forces(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         out.fill(0.0);
+        if self.spatial.has_forces() {
+            self.spatial.add_nonconservative(q, v, t, out);
+        }
         for (fi, f) in self.forces.iter().enumerate() {
             if !f.is_nonconservative() {
                 continue;
@@ -161,6 +170,9 @@ impl System {
         t: f64,
         mut add: impl FnMut(usize, usize, f64, f64),
     ) {
+        if self.spatial.has_forces() {
+            self.spatial.nonconservative_jacobian(q, v, t, &mut add);
+        }
         let (mut dq, mut dv) = ([[0.0; 6]; 6], [[0.0; 6]; 6]);
         for (fi, f) in self.forces.iter().enumerate() {
             if !f.is_nonconservative() {
@@ -195,6 +207,10 @@ impl System {
         // gravity (constant), then minus the elements' potential gradients: what negating
         // `potential_gradient` gives, bit for bit
         out.copy_from_slice(&self.gravity_forces);
+        if self.spatial.has_forces() {
+            self.spatial.add_force_gradient(q, -1.0, out);
+            self.spatial.add_nonconservative(q, v, t, out);
+        }
         for (fi, f) in self.forces.iter().enumerate() {
             let at = self.force_attach[fi];
             let e = f.potential(

@@ -160,6 +160,10 @@ impl System {
     pub fn spatial_bodies(&self) -> &[crate::spatial::SpatialBody] {
         &self.spatial.bodies
     }
+    /// The spatial force elements (points and load axes in the bodies' frames, as given).
+    pub fn spatial_forces(&self) -> &[crate::spatial::SpatialForce] {
+        &self.spatial.forces
+    }
     /// The spatial joints (markers in the bodies' frames, as given).
     pub fn spatial_joints(&self) -> &[crate::spatial::SpatialJointEntry] {
         &self.spatial.joints
@@ -303,7 +307,11 @@ impl System {
     /// Whether all applied forces derive from the potential [`System::potential`] (no damping, no
     /// time-dependent loads).
     pub fn is_conservative(&self) -> bool {
-        !self.forces.iter().any(|f| f.is_nonconservative())
+        !self.forces.iter().any(|f| f.is_nonconservative()) && self.spatial.forces_conservative()
+    }
+    /// Whether the model has force elements (planar or spatial; gravity is not one).
+    pub fn has_force_elements(&self) -> bool {
+        !self.forces.is_empty() || self.spatial.has_forces()
     }
 
     /// The diagonal of the (constant, diagonal) mass matrix `M = diag(m_i, m_i, J_i)`.

@@ -256,7 +256,7 @@ impl Galerkin {
             hist_len: 0,
             end_phiq_valid: false,
             gk: 0.0,
-            has_forces: !sys.forces().is_empty(),
+            has_forces: sys.has_force_elements(),
             jac_valid: false,
             jac_h: f64::NAN,
             jac_gk: f64::NAN,

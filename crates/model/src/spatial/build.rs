@@ -2,6 +2,7 @@
 //! the bodies' frames to their principal frames.
 
 use super::body::SpatialBody;
+use super::forces::SpatialForce;
 use super::joints::{Marker, SpatialJoint};
 use super::system::{SpatialJointEntry, SpatialPart};
 use crate::check::invalid;
@@ -13,23 +14,26 @@ use std::collections::HashSet;
 pub(crate) struct SpatialInput {
     pub(crate) bodies: Vec<SpatialBody>,
     pub(crate) joints: Vec<SpatialJointEntry>,
+    pub(crate) forces: Vec<SpatialForce>,
     pub(crate) gravity: [f64; 3],
 }
 
 impl SpatialInput {
     /// Validates and assembles the spatial part after `q0` planar coordinates and `r0` planar
-    /// rows; `body_names` and `joint_names` hold the planar names (spatial names must differ
-    /// from them and from each other).
+    /// rows; `body_names`, `joint_names` and `force_names` hold the planar names (spatial
+    /// names must differ from them and from each other).
     pub(crate) fn build(
         self,
         q0: usize,
         r0: usize,
         body_names: &mut HashSet<String>,
         joint_names: &mut HashSet<String>,
+        force_names: &mut HashSet<String>,
     ) -> Result<SpatialPart, ModelError> {
         let SpatialInput {
             bodies,
             joints,
+            forces,
             gravity,
         } = self;
         for &g in &gravity {
@@ -95,8 +99,53 @@ impl SpatialInput {
                 .map_err(|e| invalid(element.clone(), e.to_string()))?;
             lowered.push(joint);
         }
-        Ok(SpatialPart::new(
-            bodies, joints, lowered, gravity, q0, r0, q_init, v_init,
-        ))
+        let (lowered_forces, force_attach) = lower_forces(&bodies, &forces, force_names)?;
+        let mut part = SpatialPart::new(bodies, joints, lowered, gravity, q0, r0, q_init, v_init);
+        part.forces = forces;
+        part.lowered_forces = lowered_forces;
+        part.force_attach = force_attach;
+        Ok(part)
     }
+}
+
+/// Validates the force elements (names unique among all forces, bodies known, parameters) and
+/// lowers their points and load axes to the principal frames; returns them with their bodies.
+#[allow(clippy::type_complexity)]
+fn lower_forces(
+    bodies: &[SpatialBody],
+    forces: &[SpatialForce],
+    force_names: &mut HashSet<String>,
+) -> Result<(Vec<SpatialForce>, Vec<[Option<usize>; 2]>), ModelError> {
+    let nb = bodies.len();
+    let (mut lowered, mut attach) = (Vec::new(), Vec::new());
+    for f in forces {
+        let element = format!("spatial force '{}'", f.name);
+        if !force_names.insert(f.name.clone()) {
+            return Err(ModelError::DuplicateName {
+                kind: "force",
+                name: f.name.clone(),
+            });
+        }
+        let side = |r: super::SpatialBodyRef| -> Result<Option<usize>, ModelError> {
+            match r.index() {
+                Some(k) if k >= nb => Err(ModelError::UnknownBody {
+                    element: element.clone(),
+                    body: format!("spatial #{k} (the model has {nb} spatial bodies)"),
+                }),
+                k => Ok(k),
+            }
+        };
+        let (a, b) = (side(f.a)?, side(f.b)?);
+        if a.is_none() && b.is_none() {
+            return Err(invalid(
+                element,
+                "acts on ground only: attach it to a spatial body".to_string(),
+            ));
+        }
+        f.validate()?;
+        let axes = |k: Option<usize>| k.map(|k| bodies[k].inertia.axes());
+        lowered.push(f.lowered(axes(a), axes(b)));
+        attach.push([a, b]);
+    }
+    Ok((lowered, attach))
 }

@@ -9,6 +9,7 @@
 //! `Phi_q v`, `v^T H v`), `TanJetN<24>` (`H v`) or `HessJetN<24>` (the Hessian).
 
 use super::body::{SpatialBody, SpatialBodyRef};
+use super::forces::SpatialForce;
 use super::joints::{SpatialFrame, SpatialJoint};
 use mbd_jet::{DirJetN, HessJetN, Scalar, TanJetN};
 use nalgebra::DMatrix;
@@ -55,6 +56,11 @@ pub(crate) struct SpatialPart {
     pub(crate) m: usize,
     /// Gravity (m/s^2).
     pub(crate) gravity: [f64; 3],
+    /// The force elements as given, and with their points and axes in the principal frames.
+    pub(crate) forces: Vec<SpatialForce>,
+    pub(crate) lowered_forces: Vec<SpatialForce>,
+    /// Each force element's bodies (spatial indices; `None`: ground).
+    pub(crate) force_attach: Vec<[Option<usize>; 2]>,
     /// The initial natural coordinates and velocities, body after body.
     pub(crate) q_init: Vec<f64>,
     pub(crate) v_init: Vec<f64>,
@@ -92,6 +98,9 @@ impl SpatialPart {
             r0,
             m,
             gravity,
+            forces: Vec::new(),
+            lowered_forces: Vec::new(),
+            force_attach: Vec::new(),
             q_init,
             v_init,
         }
@@ -118,7 +127,7 @@ impl SpatialPart {
     }
 
     /// The global column of local variable `l` (side `l / 12`) of an element with `sides`.
-    fn col(&self, sides: [Option<usize>; 2], l: usize) -> Option<usize> {
+    pub(crate) fn col(&self, sides: [Option<usize>; 2], l: usize) -> Option<usize> {
         sides[l / 12].map(|k| self.q0 + 12 * k + l % 12)
     }
 
@@ -139,14 +148,24 @@ impl SpatialPart {
         sides: [Option<usize>; 2],
         var: impl Fn(usize, usize) -> T,
     ) -> [T; 6] {
-        let frame = |s: usize| match sides[s] {
+        let [fa, fb] = self.frames(sides, var);
+        self.eval(item, &fa, &fb)
+    }
+
+    /// The frames of an element's two sides, local variable `l` made by `var(l, column)`
+    /// (ground: the constant global frame).
+    pub(crate) fn frames<T: Scalar>(
+        &self,
+        sides: [Option<usize>; 2],
+        var: impl Fn(usize, usize) -> T,
+    ) -> [SpatialFrame<T>; 2] {
+        std::array::from_fn(|s| match sides[s] {
             Some(_) => SpatialFrame::new(&std::array::from_fn(|k| {
                 let l = 12 * s + k;
                 var(l, self.col(sides, l).unwrap_or(0))
             })),
             None => SpatialFrame::ground(),
-        };
-        self.eval(item, &frame(0), &frame(1))
+        })
     }
 
     /// The spatial rows of `Phi(q)` into `out` (the whole vector).
