@@ -21,6 +21,12 @@ pub fn not_conserved(sys: &System) -> Option<String> {
         .iter()
         .filter(|f| f.is_nonconservative())
         .map(|f| f.name.as_str())
+        .chain(
+            sys.spatial_forces()
+                .iter()
+                .filter(|f| f.is_nonconservative())
+                .map(|f| f.name.as_str()),
+        )
         .collect();
     let drivers: Vec<&str> = sys
         .joints()

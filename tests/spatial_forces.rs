@@ -122,7 +122,7 @@ fn a_damped_spatial_pendulum_closes_its_energy_balance() {
         )
         .position([0.0, 0.0, -0.4])
         .velocity([0.5, 0.2, 0.0])
-        .angular_velocity([-0.5, 1.25, 0.0]),
+        .angular_velocity([0.5, -1.25, 2.0]),
     );
     let ball = SpatialJoint::new(
         SpatialJointKind::Spherical,

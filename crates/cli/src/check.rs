@@ -102,6 +102,24 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
                 if n == 1 { "" } else { "s" }
             );
         }
+        if !sys.spatial_forces().is_empty() {
+            let _ = writeln!(s, "spatial forces ({}):", sys.spatial_forces().len());
+        }
+        for f in sys.spatial_forces() {
+            let _ = writeln!(
+                s,
+                "  {:<16} {:<14} {} - {}{}",
+                f.name,
+                f.kind_name(),
+                name(f.a),
+                name(f.b),
+                if f.is_nonconservative() {
+                    " (non-conservative)"
+                } else {
+                    ""
+                }
+            );
+        }
     }
     let _ = writeln!(s, "forces ({}):", sys.forces().len());
     for f in sys.forces() {

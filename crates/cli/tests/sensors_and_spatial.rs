@@ -101,6 +101,49 @@ fn check_lists_spatial_bodies_and_joints() {
     }
 }
 
+/// `mbd check` lists spatial force elements; `mbd run` with `--energy` books the damper's
+/// loss and the thruster's work so that the balance closes.
+#[test]
+fn spatial_forces_are_listed_and_balanced() {
+    let model = common::repo().join("examples/models/spatial_spring_pendulum.toml");
+    let out = mbd(["check".as_ref(), model.as_os_str()]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    for needle in [
+        "spatial forces (2):",
+        "strut            spring_damper  ground - rod (non-conservative)",
+        "thruster         force          rod - ground (non-conservative)",
+    ] {
+        assert!(
+            out.stdout.contains(needle),
+            "lacks {needle:?}:\n{}",
+            out.stdout
+        );
+    }
+    let d = scratch("spatial-forces");
+    let csv = d.join("pendulum.csv");
+    let out = run_model(&model, "symplectic:2", &["--h", "1e-3"], &csv);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("H not conserved (non-conservative forces strut, thruster)"),
+        "{}",
+        out.stderr
+    );
+    let residual: f64 = out
+        .stderr
+        .split("energy balance residual ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|x| x.parse().ok())
+        .expect("the summary states the balance residual");
+    assert!(residual < 1e-9, "{residual:e}");
+    let (head, rows) = read_csv(&csv);
+    assert!(
+        head.iter().any(|h| h == "rod.d3z") && rows.len() > 2,
+        "{head:?}"
+    );
+}
+
 /// `mbd run` writes a spatial model's columns (with `--reactions`, the ball joint's force and
 /// zero moment); `mbd animate` says its spatial bodies are not drawn.
 #[test]

@@ -261,6 +261,7 @@ fn every_example_loads_with_its_dof_and_a_consistent_state() {
         ("pendulum.toml", 1, false),
         ("point_mass_pendulum.toml", 1, false),
         ("slider_crank_spring.toml", 1, false),
+        ("spatial_spring_pendulum.toml", 3, false),
     ];
     let files = examples();
     assert_eq!(files.len(), expected.len(), "{files:?}");

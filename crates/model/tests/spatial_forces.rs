@@ -334,3 +334,124 @@ fn spatial_force_errors_name_the_element_and_field() {
         other => panic!("expected a duplicate name, got {other:?}"),
     }
 }
+
+/// Every kind in a model file: the file builds the model the code builds (potential, forces and
+/// Jacobians equal), and `to_model_file` writes it back (TOML and JSON round trips).
+#[test]
+fn spatial_forces_in_model_files() {
+    let text = r#"
+spatial_gravity = [0.0, 0.0, -9.81]
+
+[[spatial_bodies]]
+name = "p"
+mass = 2.0
+moments = [0.2, 0.3, 0.4]
+position = [0.1, -0.2, 0.3]
+velocity = [0.3, -0.1, 0.2]
+angular_velocity = [1.0, -2.0, 0.5]
+
+[[spatial_forces]]
+type = "spring_damper"
+name = "anchor"
+body_a = "ground"
+point_a = [0.0, 0.0, 1.0]
+body_b = "p"
+point_b = [0.0, 0.1, 0.0]
+stiffness = 50.0
+damping = 0.5
+
+[[spatial_forces]]
+type = "force"
+name = "thrust"
+body = "p"
+point = [0.2, -0.1, 0.0]
+fx = { kind = "harmonic", amplitude = 3.0, omega = 0.1 }
+fz = { kind = "constant", value = -1.0 }
+frame = "body"
+
+[[spatial_forces]]
+type = "torque"
+name = "motor"
+body = "p"
+tz = { kind = "constant", value = 0.7 }
+"#;
+    let file = mbd_model::ModelFile::from_toml(text).expect("parses");
+    let sys = file.build().expect("builds");
+    let mut b = SystemBuilder::new();
+    b.set_spatial_gravity([0.0, 0.0, -9.81]);
+    let p = b.add_spatial_body(
+        SpatialBody::new(
+            "p",
+            SpatialInertia::principal(2.0, [0.2, 0.3, 0.4]).expect("inertia"),
+        )
+        .position([0.1, -0.2, 0.3])
+        .velocity([0.3, -0.1, 0.2])
+        .angular_velocity([1.0, -2.0, 0.5]),
+    );
+    let g = mbd_model::spatial::SpatialBodyRef::Ground;
+    b.add_spatial_force(SpatialForce::spring_damper(
+        "anchor",
+        g,
+        [0.0, 0.0, 1.0],
+        p,
+        [0.0, 0.1, 0.0],
+        50.0,
+        0.5,
+        0.0,
+    ));
+    let zero = TimeFunction::constant(0.0);
+    let wave = TimeFunction::Harmonic {
+        offset: 0.0,
+        amplitude: 3.0,
+        omega: 0.1,
+        phase: 0.0,
+    };
+    b.add_spatial_force(SpatialForce::force(
+        "thrust",
+        p,
+        [0.2, -0.1, 0.0],
+        [wave, zero.clone(), TimeFunction::constant(-1.0)],
+        LoadFrame::Body,
+    ));
+    b.add_spatial_force(SpatialForce::torque(
+        "motor",
+        p,
+        [zero.clone(), zero, TimeFunction::constant(0.7)],
+        LoadFrame::Global,
+    ));
+    let code = b.build().expect("builds");
+    assert_eq!(sys.spatial_forces(), code.spatial_forces());
+    let (q, v) = state(&sys);
+    let (mut a, mut c) = (vec![0.0; 12], vec![0.0; 12]);
+    sys.forces_into(&q, &v, 2.0, &mut a);
+    code.forces_into(&q, &v, 2.0, &mut c);
+    assert_eq!(a, c);
+    assert_eq!(sys.potential(&q), code.potential(&q));
+    let back = sys.to_model_file();
+    let toml = back.to_toml().expect("writes TOML");
+    let again = mbd_model::ModelFile::from_toml(&toml).expect("reads back");
+    assert_eq!(again, back);
+    let json = mbd_model::ModelFile::from_json(&back.to_json().expect("JSON")).expect("reads");
+    assert_eq!(
+        json.build().expect("builds").spatial_forces(),
+        sys.spatial_forces()
+    );
+    // errors name the element and what is wrong
+    let bad = text.replace("body = \"p\"\ntz", "body = \"q\"\ntz");
+    let e = mbd_model::ModelFile::from_toml(&bad)
+        .and_then(|f| f.build())
+        .expect_err("unknown body")
+        .to_string();
+    assert!(e.contains("'motor'") && e.contains("'q'"), "{e}");
+    let bad = text.replace("stiffness = 50.0", "stiffness = -50.0");
+    let e = mbd_model::ModelFile::from_toml(&bad)
+        .and_then(|f| f.build())
+        .expect_err("negative stiffness")
+        .to_string();
+    assert!(e.contains("'anchor'") && e.contains("stiffness"), "{e}");
+    let bad = text.replace("frame = \"body\"", "frame = \"local\"");
+    let e = mbd_model::ModelFile::from_toml(&bad)
+        .expect_err("unknown frame")
+        .to_string();
+    assert!(e.contains("local"), "{e}");
+}

@@ -21,10 +21,14 @@
 
 mod resolve;
 mod spatial;
+mod spatial_forces;
 mod spec;
 
 pub use spatial::{
     EulerSpec, OrientationSpec, SpatialBodySpec, SpatialJointSpec, SpatialJointType,
+};
+pub use spatial_forces::{
+    SpatialForceSpec, SpatialPointForceSpec, SpatialSpringDamperSpec, SpatialTorqueSpec,
 };
 pub use spec::{BodyKind, BodySpec, ForceSpec, InitialInput, JointSpec};
 
@@ -73,6 +77,9 @@ pub struct ModelFile {
     /// Joints between spatial bodies.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub spatial_joints: Vec<SpatialJointSpec>,
+    /// Force elements on spatial bodies: spring-dampers, forces and torques.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub spatial_forces: Vec<SpatialForceSpec>,
 }
 
 fn is_zero3(g: &[f64; 3]) -> bool {

@@ -197,6 +197,7 @@ impl ModelFile {
             self.spatial_gravity,
             &self.spatial_bodies,
             &self.spatial_joints,
+            &self.spatial_forces,
             &planar,
         )?;
         Ok(b)
@@ -268,6 +269,12 @@ impl System {
                 .joints
                 .iter()
                 .map(|j| super::spatial::SpatialJointSpec::from_entry(j, &spatial_name))
+                .collect(),
+            spatial_forces: self
+                .spatial
+                .forces
+                .iter()
+                .map(|f| super::SpatialForceSpec::from_force(f, &spatial_name))
                 .collect(),
             bodies: self
                 .bodies

@@ -304,13 +304,14 @@ impl SpatialJointSpec {
     }
 }
 
-/// Adds a file's spatial part to the builder: gravity, bodies, joints (bodies by name;
-/// `planar` names the planar bodies, which spatial joints cannot use).
+/// Adds a file's spatial part to the builder: gravity, bodies, joints and force elements
+/// (bodies by name; `planar` names the planar bodies, which spatial elements cannot use).
 pub(crate) fn add_spatial(
     b: &mut SystemBuilder,
     gravity: [f64; 3],
     bodies: &[SpatialBodySpec],
     joints: &[SpatialJointSpec],
+    forces: &[super::SpatialForceSpec],
     planar: &dyn Fn(&str) -> bool,
 ) -> Result<(), ModelError> {
     b.set_spatial_gravity(gravity);
@@ -327,7 +328,7 @@ pub(crate) fn add_spatial(
             Some(&h) => Ok(SpatialBodyRef::Body(h)),
             None if planar(name) => Err(invalid(
                 element.to_string(),
-                format!("'{name}' is a planar body: spatial joints join spatial bodies"),
+                format!("'{name}' is a planar body: spatial elements join spatial bodies"),
             )),
             None => Err(ModelError::UnknownBody {
                 element: element.to_string(),
@@ -338,6 +339,9 @@ pub(crate) fn add_spatial(
     for j in joints {
         let e = j.to_entry(&find)?;
         b.add_spatial_joint(e.name, e.a, e.b, e.joint);
+    }
+    for f in forces {
+        b.add_spatial_force(f.to_force(&find)?);
     }
     Ok(())
 }
