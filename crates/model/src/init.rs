@@ -177,22 +177,41 @@ impl System {
         found
     }
 
-    /// The sparse test of [`System::redundant_at`]: `S = Phi_q M^-1 Phi_q^T` from the
-    /// element-local rows, its pattern from the bodies the rows share (O(m) entries for a
-    /// chain), factored by [`SparseCholesky`] allowing every row to be dropped.
+    /// The sparse test of [`System::redundant_at`]: `S = Phi_q W Phi_q^T` from the
+    /// element-local rows over the body blocks (planar and spatial), its pattern from the
+    /// blocks the rows share (O(m) entries for a chain), factored by [`SparseCholesky`]
+    /// allowing every row to be dropped. `W` is `M^-1` for planar bodies; for a spatial body,
+    /// whose `M` may be singular, `1/m` on its centre and `1/J_max` on its directors: any
+    /// positive weight gives `S` the rank of `Phi_q`, and these keep it scaled like `M^-1`.
     fn redundant_sparse(&self, q: &[f64]) -> Result<Vec<RedundantEquation>, ModelError> {
         let m = self.m;
-        let mut grads = vec![[0.0; 6]; m];
-        self.phi_q_local(q, &mut grads);
-        // per body, the rows that touch it and the slot of the body in each row
-        let mut touching: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.bodies.len()];
-        for (ji, at) in self.joint_attach.iter().enumerate() {
-            let o = self.row_offset[ji];
-            for r in o..o + self.joints[ji].n_equations() {
-                for (slot, body) in [(0, at.a), (3, at.b)] {
-                    if let Some(i) = body {
-                        touching[i].push((r, slot));
-                    }
+        let mut w = self.inv_mass.as_slice().to_vec();
+        for (k, b) in self.spatial.bodies.iter().enumerate() {
+            let o = self.spatial.q0 + 12 * k;
+            let j = b.inertia.moments();
+            let jmax = j[0].max(j[1]).max(j[2]);
+            w[o..o + 3].fill(1.0 / b.inertia.mass());
+            w[o + 3..o + 12].fill(1.0 / jmax);
+        }
+        // each row's sides: (block, first coordinate, offset of its gradient in `grads`)
+        let mut sides: Vec<[Option<(usize, usize, usize)>; 2]> = vec![[None; 2]; m];
+        let mut grads: Vec<f64> = Vec::new();
+        self.local_rows_gamma(q, None, 0.0, |r, s, _| {
+            for (k, side) in s.iter().enumerate() {
+                if let Some((block, g)) = side {
+                    let col = self.body_block(*block).map_or(0, |(c, _)| c);
+                    sides[r][k] = Some((*block, col, grads.len()));
+                    grads.extend_from_slice(g);
+                }
+            }
+        });
+        let width = |block: usize| self.body_block(block).map_or(0, |(_, w)| w);
+        // per block, the rows that touch it and the side of the block in each row
+        let mut touching: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.n_body_blocks()];
+        for (r, s) in sides.iter().enumerate() {
+            for (k, side) in s.iter().enumerate() {
+                if let Some((block, _, _)) = side {
+                    touching[*block].push((r, k));
                 }
             }
         }
@@ -212,16 +231,16 @@ impl System {
                 message: format!("the sparse rank check could not analyse its pattern: {e}"),
             })?;
         chol.set_max_dependent(m);
-        for (i, rows) in touching.iter().enumerate() {
-            let w = [
-                self.inv_mass[3 * i],
-                self.inv_mass[3 * i + 1],
-                self.inv_mass[3 * i + 2],
-            ];
-            for (a, &(r, sr)) in rows.iter().enumerate() {
-                for &(s, ss) in &rows[..=a] {
-                    let v: f64 = (0..3)
-                        .map(|l| w[l] * grads[r][sr + l] * grads[s][ss + l])
+        for (block, rows) in touching.iter().enumerate() {
+            let wd = width(block);
+            for (a, &(r, kr)) in rows.iter().enumerate() {
+                for &(s, ks) in &rows[..=a] {
+                    let (Some((_, col, gr)), Some((_, _, gs))) = (sides[r][kr], sides[s][ks])
+                    else {
+                        continue;
+                    };
+                    let v: f64 = (0..wd)
+                        .map(|l| w[col + l] * grads[gr + l] * grads[gs + l])
                         .sum();
                     let (hi, lo) = (r.max(s), r.min(s));
                     if let Some(k) = chol.slot(hi, lo) {
@@ -239,14 +258,12 @@ impl System {
         let mut found: Vec<RedundantEquation> = dependent
             .into_iter()
             .map(|r| {
-                let ji = self.eq_joint[r];
-                let at = self.joint_attach[ji];
-                let mut joints: Vec<String> = vec![self.joints[ji].name.clone()];
-                for body in [at.a, at.b].into_iter().flatten() {
-                    for &(s, _) in &touching[body] {
-                        let name = &self.joints[self.eq_joint[s]].name;
-                        if !joints.contains(name) {
-                            joints.push(name.clone());
+                let mut joints: Vec<String> = vec![self.row_element(r)];
+                for (block, _, _) in sides[r].iter().flatten() {
+                    for &(s, _) in &touching[*block] {
+                        let name = self.row_element(s);
+                        if !joints.contains(&name) {
+                            joints.push(name);
                         }
                     }
                 }
@@ -259,6 +276,21 @@ impl System {
             .collect();
         found.sort_by_key(|e| e.row);
         Ok(found)
+    }
+
+    /// The element that owns equation `row`: its joint's name (planar or spatial), or the
+    /// spatial body of an internal constraint.
+    fn row_element(&self, row: usize) -> String {
+        match self.eq_joint.get(row) {
+            Some(&ji) => self.joints[ji].name.clone(),
+            None => {
+                let name = self.equation_name(row);
+                match name.rsplit_once('.') {
+                    Some((element, _)) => element.to_string(),
+                    None => name,
+                }
+            }
+        }
     }
 
     /// `S = Phi_q M^-1 Phi_q^T` (dense), accumulated column by column over the few non-zeros of

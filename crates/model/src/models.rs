@@ -493,3 +493,5 @@ mod spatial;
 pub use spatial::{free_body, heavy_top, TOP_LENGTH};
 mod tumbling;
 pub use tumbling::{TorqueFreeBody, TorqueFreeMotion};
+mod spatial_chain;
+pub use spatial_chain::{spatial_chain, SPATIAL_CHAIN_LINK};

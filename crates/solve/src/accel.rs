@@ -299,14 +299,11 @@ pub(crate) enum Accel {
 impl Accel {
     /// The solver [`LinearSolver::use_sparse`] picks for `sys` (the one policy of the crate).
     pub(crate) fn new(sys: &System, linear: LinearSolver) -> Result<Self, SolveError> {
-        // spatial bodies: the dense solve from the whole Phi_q
-        Ok(
-            if linear.use_sparse(sys.n_constraints()) && !sys.has_spatial() {
-                Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?))
-            } else {
-                Accel::Dense(AccelerationSolver::new(sys))
-            },
-        )
+        Ok(if linear.use_sparse(sys.n_constraints()) {
+            Accel::Sparse(Box::new(SparseAccelerationSolver::new(sys)?))
+        } else {
+            Accel::Dense(AccelerationSolver::new(sys))
+        })
     }
 
     /// Accelerations `a` and multipliers `lambda` at `(q, v, t)`.

@@ -5,7 +5,7 @@
 
 use crate::error::SolveError;
 use crate::linalg::{max_abs, BodyFactorError, BodySchur, DenseSchur, FactorError};
-use crate::sparse::{ConstraintSchur, LinearSolver};
+use crate::sparse::{ConstraintSchur, LinearSolver, SparseBodySchur};
 use mbd_model::System;
 
 /// The position projection stops at `max(tol, PROJECTION_ROUNDOFF_FACTOR eps max(1, |x, y|,
@@ -47,11 +47,20 @@ enum Kernel {
 /// The body-eliminated kernel and its buffers: the correction and the multipliers.
 #[derive(Debug)]
 struct BodiesKernel {
-    schur: BodySchur,
+    schur: BodySolve,
+    /// `gamma` of the sparse kernel's row update (not used by a projection).
+    gamma: Vec<f64>,
     delta: Vec<f64>,
     lambda: Vec<f64>,
     zeros: Vec<f64>,
     target: Vec<f64>,
+}
+
+/// The body-eliminated solve from the dense `Phi_q`, or over body blocks on the sparse path.
+#[derive(Debug)]
+enum BodySolve {
+    Dense(BodySchur),
+    Sparse(SparseBodySchur),
 }
 
 /// Projects `q` onto `Phi(q, t) = 0` by Newton with the minimum `M`-norm correction
@@ -93,7 +102,12 @@ impl Projector {
         let kernel = if sys.has_spatial() {
             let n = sys.n_coords();
             Kernel::Bodies(Box::new(BodiesKernel {
-                schur: BodySchur::new(sys),
+                schur: if linear.use_sparse(m) {
+                    BodySolve::Sparse(SparseBodySchur::new(sys)?)
+                } else {
+                    BodySolve::Dense(BodySchur::new(sys))
+                },
+                gamma: vec![0.0; m],
                 delta: vec![0.0; n],
                 lambda: vec![0.0; m],
                 zeros: vec![0.0; n],
@@ -123,7 +137,11 @@ impl Projector {
 
     /// Whether the sparse kernel is in use.
     pub fn is_sparse(&self) -> bool {
-        matches!(self.kernel, Kernel::Sparse(_))
+        match &self.kernel {
+            Kernel::Sparse(_) => true,
+            Kernel::Bodies(k) => matches!(k.schur, BodySolve::Sparse(_)),
+            Kernel::Dense(_) => false,
+        }
     }
 
     fn factor(&mut self, sys: &System, q: &[f64], t: f64) -> Result<(), SolveError> {
@@ -141,11 +159,17 @@ impl Projector {
                 schur.factor(minv)
             }
             Kernel::Bodies(k) => {
-                sys.phi_q(q, &mut k.schur.phi_q);
-                return k
-                    .schur
-                    .factor(sys, q, minv)
-                    .map_err(|e| bodies_error(sys, t, e));
+                let res = match &mut k.schur {
+                    BodySolve::Dense(schur) => {
+                        sys.phi_q(q, &mut schur.phi_q);
+                        schur.factor(sys, q, minv)
+                    }
+                    BodySolve::Sparse(schur) => {
+                        schur.update(sys, q, None, t, &mut k.gamma);
+                        schur.factor(sys, minv)
+                    }
+                };
+                return res.map_err(|e| bodies_error(sys, t, e));
             }
         };
         res.map_err(|e| {
@@ -180,8 +204,14 @@ impl Projector {
                 for (t, r) in k.target.iter_mut().zip(&self.r) {
                     *t = -r;
                 }
-                k.schur
-                    .solve(minv, &k.zeros, &k.target, &mut k.delta, &mut k.lambda);
+                match &mut k.schur {
+                    BodySolve::Dense(schur) => {
+                        schur.solve(minv, &k.zeros, &k.target, &mut k.delta, &mut k.lambda)
+                    }
+                    BodySolve::Sparse(schur) => {
+                        schur.solve(minv, &k.zeros, &k.target, &mut k.delta, &mut k.lambda)
+                    }
+                }
                 for (xi, d) in x.iter_mut().zip(&k.delta) {
                     *xi += d;
                 }

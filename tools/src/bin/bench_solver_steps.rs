@@ -5,7 +5,8 @@
 //! one of `rk4` (plain RK4), `rk4-projected`, `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1
 //! DOPRI5, fixed steps), `fadae` (firefly-Gauss, default options), and MODEL one of
 //! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
-//! links the index-1 solve takes the sparse path). A fourth argument `state` prints the final
+//! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
+//! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
 //! state in full (for comparing trajectories between builds).
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
@@ -25,9 +26,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "slider_crank" => models::slider_crank()?,
         "four_bar" => models::four_bar()?,
         other if other.ends_with(".toml") || other.ends_with(".json") => System::from_path(other)?,
-        other => match other.strip_prefix("chain").and_then(|k| k.parse().ok()) {
-            Some(k) => models::n_link_chain(k)?,
-            None => return Err(format!("unknown model '{other}'").into()),
+        other => match (
+            other.strip_prefix("chain").and_then(|k| k.parse().ok()),
+            other.strip_prefix("spatial").and_then(|k| k.parse().ok()),
+        ) {
+            (Some(k), _) => models::n_link_chain(k)?,
+            (None, Some(k)) => models::spatial_chain(k)?,
+            _ => return Err(format!("unknown model '{other}'").into()),
         },
     };
     let s0 = State::consistent(&sys, 0.0)?;

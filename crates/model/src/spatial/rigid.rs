@@ -66,8 +66,8 @@ pub struct RigidSolve {
     j_inv: Matrix3<f64>,
     /// The director columns of `G` (6 x 9; the centre of mass does not enter).
     g: SMatrix<f64, 6, 9>,
-    /// `(G G^T)^-1`.
-    gg_inv: SMatrix<f64, 6, 6>,
+    /// The Cholesky factor of `G G^T` (solved against, not inverted).
+    gg: nalgebra::Cholesky<f64, nalgebra::Const<6>>,
 }
 
 impl RigidSolve {
@@ -103,10 +103,9 @@ impl RigidSolve {
         let g = SMatrix::<f64, 6, 9>::from_fn(|r, c| jac[r][3 + c]);
         let gg = g * g.transpose();
         let scale = gg.diagonal().max();
-        let gg_inv = gg
+        let gg = gg
             .cholesky()
             .filter(|c| (0..6).all(|k| c.l()[(k, k)].powi(2) > 1e-12 * scale))
-            .map(|c| c.inverse())
             .ok_or(SpatialInertiaError::Degenerate(
                 "directors: they are (nearly) dependent, so the internal constraints lose rank",
             ))?;
@@ -116,7 +115,7 @@ impl RigidSolve {
             d,
             j_inv,
             g,
-            gg_inv,
+            gg,
         })
     }
 
@@ -145,7 +144,7 @@ impl RigidSolve {
     pub fn solve(&self, f: &[f64; 12], r: &[f64; 6]) -> [f64; 12] {
         let mut a = self.apply_inverse_mass(f);
         // the minimum-norm particular solution of G d0 = r (directors only)
-        let d0: SVector<f64, 9> = self.g.transpose() * (self.gg_inv * SVector::from(*r));
+        let d0: SVector<f64, 9> = self.g.transpose() * self.gg.solve(&SVector::from(*r));
         // minus its rigid part C M d0 (no translation part: d0_x = 0)
         let mut torque = Vector3::zeros();
         for i in 0..3 {
@@ -169,7 +168,7 @@ impl RigidSolve {
     /// `mu = (G G^T)^-1 G (f - M a)` (the centre of mass does not enter `G`).
     pub fn multipliers(&self, f: &[f64; 12], a: &[f64; 12]) -> [f64; 6] {
         let res = SVector::<f64, 9>::from_fn(|k, _| f[3 + k] - self.e[k / 3] * a[3 + k]);
-        let mu = self.gg_inv * (self.g * res);
+        let mu = self.gg.solve(&(self.g * res));
         std::array::from_fn(|k| mu[k])
     }
 }

@@ -185,13 +185,65 @@ impl SpatialPart {
         mut visit: impl FnMut(usize, [Option<usize>; 2], &DirJetN<SW>),
     ) {
         for (item, sides, row, n) in self.items() {
-            let e = self.eval_jets(item, sides, |l, c| {
-                DirJetN::<SW>::var(l, q[c], v.map_or(0.0, |v| v[c]))
-            });
+            if let (Item::Internal, Some(k)) = (item, sides[0]) {
+                // in closed form: the generic jets spend most of a solve's time here
+                for (r, jet) in self.internal_jets(q, v, k).iter().enumerate() {
+                    visit(row + r, sides, jet);
+                }
+                continue;
+            }
+            let Item::Joint(j) = item else {
+                continue;
+            };
+            const ZERO: [f64; 12] = [0.0; 12];
+            let local = |s: usize| {
+                sides[s].map(|k| {
+                    let o = self.q0 + 12 * k;
+                    (&q[o..o + 12], v.map_or(&ZERO[..], |v| &v[o..o + 12]))
+                })
+            };
+            let mut e = [DirJetN::<SW>::cst(0.0); 6];
+            self.lowered[j].eval_jets(local(0), local(1), &mut e);
             for (k, ek) in e.iter().enumerate().take(n) {
                 visit(row + k, sides, ek);
             }
         }
+    }
+
+    /// Body `k`'s six internal constraints as the jets [`SpatialPart::rows`] gives (local
+    /// variables `0..12`): `1/2 (|d_i|^2 - 1)` has gradient `d_i` on director `i`,
+    /// `d1 = d_i . d_i'`, `d2 = |d_i'|^2`; `d_i . d_j` has gradient `d_j` on `i` and `d_i` on
+    /// `j`, `d1 = d_i' . d_j + d_i . d_j'`, `d2 = 2 d_i' . d_j'`.
+    fn internal_jets(&self, q: &[f64], v: Option<&[f64]>, k: usize) -> [DirJetN<SW>; 6] {
+        let o = self.q0 + 12 * k;
+        let d: [[f64; 3]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|c| q[o + 3 + 3 * i + c]));
+        let dd: [[f64; 3]; 3] = std::array::from_fn(|i| {
+            std::array::from_fn(|c| v.map_or(0.0, |v| v[o + 3 + 3 * i + c]))
+        });
+        let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+        PAIRS.map(|(i, j)| {
+            let mut g = [0.0; SW];
+            if i == j {
+                g[3 + 3 * i..6 + 3 * i].copy_from_slice(&d[i]);
+                DirJetN {
+                    v: 0.5 * (dot(&d[i], &d[i]) - 1.0),
+                    g,
+                    d1: dot(&d[i], &dd[i]),
+                    d2: dot(&dd[i], &dd[i]),
+                }
+            } else {
+                g[3 + 3 * i..6 + 3 * i].copy_from_slice(&d[j]);
+                g[3 + 3 * j..6 + 3 * j].copy_from_slice(&d[i]);
+                DirJetN {
+                    v: dot(&d[i], &d[j]),
+                    g,
+                    d1: dot(&dd[i], &d[j]) + dot(&d[i], &dd[j]),
+                    d2: 2.0 * dot(&dd[i], &dd[j]),
+                }
+            }
+        })
     }
 
     /// For every spatial row: `visit(row, sides, gradient, H v)`.

@@ -4,8 +4,11 @@
 //! Cholesky kernel. The symbolic analysis is done once in [`SparseAccelerationSolver::new`];
 //! each solve refills the values and refactors into preallocated storage, so a solve allocates
 //! nothing. For a chain of `N` bodies `S` is block tridiagonal and a solve costs `O(N)`, against
-//! `O(N^3)` for the dense path.
+//! `O(N^3)` for the dense path. A model with spatial bodies takes the body-eliminated kernel
+//! ([`SparseBodySchur`]: its rows over body blocks of any width, each spatial body's internal
+//! constraints eliminated body by body), `O(N)` for chains as well.
 
+use super::bodies::SparseBodySchur;
 use super::schur::ConstraintSchur;
 use crate::error::SolveError;
 use crate::linalg::FactorError;
@@ -16,7 +19,7 @@ use mbd_model::{BodyAngles, System};
 pub struct SparseAccelerationSolver {
     n: usize,
     m: usize,
-    schur: ConstraintSchur,
+    schur: Kernel,
     /// `gamma` at the last solve (callers may modify it before [`SparseAccelerationSolver::finish`]).
     pub gamma: Vec<f64>,
     /// Applied forces `Q` at the last solve.
@@ -26,6 +29,13 @@ pub struct SparseAccelerationSolver {
     angles: BodyAngles,
 }
 
+/// The Schur complement of the planar rows, or of the rows over body blocks.
+#[derive(Debug)]
+enum Kernel {
+    Rows(ConstraintSchur),
+    Bodies(Box<SparseBodySchur>),
+}
+
 impl SparseAccelerationSolver {
     /// Analyses the pattern of `S` for `sys` (allocates; done once).
     pub fn new(sys: &System) -> Result<Self, SolveError> {
@@ -33,7 +43,11 @@ impl SparseAccelerationSolver {
         Ok(SparseAccelerationSolver {
             n,
             m,
-            schur: ConstraintSchur::new(sys)?,
+            schur: if sys.has_spatial() {
+                Kernel::Bodies(Box::new(SparseBodySchur::new(sys)?))
+            } else {
+                Kernel::Rows(ConstraintSchur::new(sys)?)
+            },
             gamma: vec![0.0; m],
             forces: vec![0.0; n],
             w: vec![0.0; n],
@@ -43,18 +57,28 @@ impl SparseAccelerationSolver {
 
     /// Non-zeros stored for the lower triangle of `S`.
     pub fn nnz(&self) -> usize {
-        self.schur.nnz()
+        match &self.schur {
+            Kernel::Rows(s) => s.nnz(),
+            Kernel::Bodies(b) => b.nnz(),
+        }
     }
 
     /// The condition estimate of the last factored `S` (see
     /// [`crate::sparse::SparseCholesky::condition_estimate`]); 1 for an unconstrained system.
     pub fn condition_estimate(&self) -> f64 {
-        self.schur.condition_estimate()
+        match &self.schur {
+            Kernel::Rows(s) => s.condition_estimate(),
+            Kernel::Bodies(b) => b.condition_estimate(),
+        }
     }
 
-    /// The constraint Jacobian and Schur complement of the last solve.
-    pub fn schur(&self) -> &ConstraintSchur {
-        &self.schur
+    /// The constraint Jacobian and Schur complement of the last solve (`None` for a model
+    /// with spatial bodies, whose rows are held per body block).
+    pub fn schur(&self) -> Option<&ConstraintSchur> {
+        match &self.schur {
+            Kernel::Rows(s) => Some(s),
+            Kernel::Bodies(_) => None,
+        }
     }
 
     /// Accelerations `a` and multipliers `lambda` at `(q, v, t)`.
@@ -84,15 +108,13 @@ impl SparseAccelerationSolver {
     /// [`SparseAccelerationSolver::finish`].
     pub fn prepare(&mut self, sys: &System, q: &[f64], v: &[f64], t: f64) {
         sys.forces_into(q, v, t, &mut self.forces);
-        self.angles.update(sys, q);
-        sys.phi_q_local_gamma_at(
-            q,
-            &self.angles,
-            v,
-            t,
-            self.schur.grads_mut(),
-            &mut self.gamma,
-        );
+        match &mut self.schur {
+            Kernel::Rows(schur) => {
+                self.angles.update(sys, q);
+                sys.phi_q_local_gamma_at(q, &self.angles, v, t, schur.grads_mut(), &mut self.gamma);
+            }
+            Kernel::Bodies(b) => b.update(sys, q, Some(v), t, &mut self.gamma),
+        }
     }
 
     /// Completes the solve from `Phi_q`, `gamma` and `forces` already set.
@@ -122,7 +144,16 @@ impl SparseAccelerationSolver {
             a.copy_from_slice(&self.w);
             return Ok(());
         }
-        self.schur.factor(minv).map_err(|e| {
+        let schur = match &mut self.schur {
+            Kernel::Rows(schur) => schur,
+            Kernel::Bodies(b) => {
+                b.factor(sys, minv)
+                    .map_err(|e| crate::projection::bodies_error(sys, t, e))?;
+                b.solve(minv, &self.forces, &self.gamma, a, lambda);
+                return Self::check_finite(t, lambda);
+            }
+        };
+        schur.factor(minv).map_err(|e| {
             let i = match e {
                 FactorError::Singular(i) | FactorError::NotPositiveDefinite(i) => i,
             };
@@ -133,14 +164,18 @@ impl SparseAccelerationSolver {
             }
         })?;
         // rhs = Phi_q M^-1 Q - gamma
-        self.schur.apply(&self.w, lambda);
+        schur.apply(&self.w, lambda);
         for (l, g) in lambda.iter_mut().zip(&self.gamma) {
             *l -= g;
         }
-        self.schur.solve_in_place(lambda);
+        schur.solve_in_place(lambda);
         // a = M^-1 (Q - Phi_q^T lambda)
         a.copy_from_slice(&self.w);
-        self.schur.add_weighted_transpose(-1.0, minv, lambda, a);
+        schur.add_weighted_transpose(-1.0, minv, lambda, a);
+        Self::check_finite(t, lambda)
+    }
+
+    fn check_finite(t: f64, lambda: &[f64]) -> Result<(), SolveError> {
         if !lambda.iter().all(|x| x.is_finite()) {
             return Err(SolveError::Singular {
                 t,

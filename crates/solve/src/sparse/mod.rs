@@ -15,7 +15,10 @@
 //! For a chain of `N` bodies every one of them costs `O(N)` per call.
 
 mod accel;
+mod bodies;
 mod schur;
+
+pub(crate) use bodies::SparseBodySchur;
 
 pub use accel::SparseAccelerationSolver;
 pub use mbd_linalg::{SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};

@@ -37,7 +37,7 @@ mod weld;
 #[cfg(test)]
 mod tests;
 
-use mbd_jet::Scalar;
+use mbd_jet::{DirJetN, Scalar};
 use nalgebra::Matrix3;
 use thiserror::Error;
 
@@ -112,12 +112,72 @@ impl Marker {
     pub fn with_axes(point: [f64; 3], axes: Matrix3<f64>) -> Self {
         Marker { point, axes }
     }
-    /// The marker's point and its three axes on the moving `frame`.
-    fn on<T: Scalar>(&self, frame: &SpatialFrame<T>) -> MarkerAt<T> {
-        let axis =
-            |k: usize| frame.direction([self.axes[(0, k)], self.axes[(1, k)], self.axes[(2, k)]]);
+    /// The marker's point and, if `axes`, its three axes on the moving `frame` (else zeros:
+    /// the ball and distance joints use the point alone).
+    fn on<T: Scalar>(&self, frame: &SpatialFrame<T>, axes: bool) -> MarkerAt<T> {
+        let axis = |k: usize| {
+            if axes {
+                frame.direction([self.axes[(0, k)], self.axes[(1, k)], self.axes[(2, k)]])
+            } else {
+                [T::cst(0.0); 3]
+            }
+        };
         MarkerAt {
             p: frame.point(self.point),
+            x: axis(0),
+            y: axis(1),
+            z: axis(2),
+        }
+    }
+}
+
+impl Marker {
+    /// [`Marker::on`] with the jets of an element's 24 local variables, in closed form (the
+    /// point and axes are linear in the side's coordinates, so the generic jet arithmetic is
+    /// not needed): side `side` (0 or 1) with local coordinates and velocities `qv`, or ground
+    /// (`None`).
+    pub(crate) fn on_jets(
+        &self,
+        side: usize,
+        qv: Option<(&[f64], &[f64])>,
+        axes: bool,
+    ) -> MarkerAt<DirJetN<24>> {
+        // the global vector `c0 x + sum_i u_i d_i` as three jets
+        let linear = |c0: f64, u: [f64; 3]| -> [DirJetN<24>; 3] {
+            std::array::from_fn(|c| match qv {
+                // ground: the origin and the global axes
+                None => DirJetN::cst(u[c]),
+                Some((q, v)) => {
+                    let o = 12 * side;
+                    let mut g = [0.0; 24];
+                    g[o + c] = c0;
+                    let (mut val, mut d1) = (c0 * q[c], c0 * v[c]);
+                    for i in 0..3 {
+                        g[o + 3 + 3 * i + c] = u[i];
+                        val += u[i] * q[3 + 3 * i + c];
+                        d1 += u[i] * v[3 + 3 * i + c];
+                    }
+                    DirJetN {
+                        v: val,
+                        g,
+                        d1,
+                        d2: 0.0,
+                    }
+                }
+            })
+        };
+        let axis = |k: usize| {
+            if axes {
+                linear(
+                    0.0,
+                    [self.axes[(0, k)], self.axes[(1, k)], self.axes[(2, k)]],
+                )
+            } else {
+                [DirJetN::cst(0.0); 3]
+            }
+        };
+        MarkerAt {
+            p: linear(1.0, self.point),
             x: axis(0),
             y: axis(1),
             z: axis(2),
@@ -270,7 +330,35 @@ impl SpatialJoint {
 
     /// The equations at the frames `fa`, `fb` into `out[..n_equations]` (the rest untouched).
     pub fn eval<T: Scalar>(&self, fa: &SpatialFrame<T>, fb: &SpatialFrame<T>, out: &mut [T; 6]) {
-        let (ma, mb) = (self.a.on(fa), self.b.on(fb));
+        let axes = self.uses_axes();
+        let (ma, mb) = (self.a.on(fa, axes), self.b.on(fb, axes));
+        self.eval_at(&ma, &mb, out);
+    }
+
+    /// Whether the equations use the markers' axes (all but the ball and distance joints).
+    fn uses_axes(&self) -> bool {
+        !matches!(
+            self.kind,
+            SpatialJointKind::Spherical | SpatialJointKind::Distance { .. }
+        )
+    }
+
+    /// [`SpatialJoint::eval`] with the jets of the two sides' 24 local variables, the markers
+    /// built in closed form ([`Marker::on_jets`]); `a`, `b`: each side's local coordinates
+    /// and velocities, `None` for ground.
+    pub(crate) fn eval_jets(
+        &self,
+        a: Option<(&[f64], &[f64])>,
+        b: Option<(&[f64], &[f64])>,
+        out: &mut [DirJetN<24>; 6],
+    ) {
+        let axes = self.uses_axes();
+        let (ma, mb) = (self.a.on_jets(0, a, axes), self.b.on_jets(1, b, axes));
+        self.eval_at(&ma, &mb, out);
+    }
+
+    /// The equations at the markers `ma`, `mb` (global components).
+    fn eval_at<T: Scalar>(&self, ma: &MarkerAt<T>, mb: &MarkerAt<T>, out: &mut [T; 6]) {
         match self.kind {
             SpatialJointKind::Spherical => spherical::eval(&ma, &mb, out),
             SpatialJointKind::Revolute => revolute::eval(&ma, &mb, out),

@@ -1,0 +1,348 @@
+//! The body-eliminated constrained solve of [`crate::linalg::BodySchur`] on the sparse path:
+//! bodies of any kind (planar, 3 coordinates; spatial, 12 with six internal constraints) as
+//! blocks, constraint rows in element-local form (each acts on at most two blocks), and
+//! `S = Phi_e C Phi_e^T` over the external rows (all but the spatial internal constraints)
+//! assembled on its sparse pattern and factored by the sparse Cholesky kernel.
+//!
+//! `C` is block diagonal: a planar block is its diagonal weight (`M^-1`), a spatial block the
+//! body's constrained inverse mass (`mbd_model::spatial::RigidSolve`), formed once per
+//! factorisation as a 12 x 12 matrix. `S` couples two rows only when they share a block, so for
+//! a chain it is block tridiagonal and every operation is `O(N)`. The solve is that of the
+//! dense module: `x = C f + d(r_int)`, `S lambda_e = Phi_e x - r_e`, `a = x - C Phi_e^T
+//! lambda_e`, and each spatial body's internal multipliers from its own rows.
+
+use super::SparseCholesky;
+use crate::error::SolveError;
+use crate::linalg::{BodyFactorError, FactorError};
+use mbd_model::spatial::RigidSolve;
+use mbd_model::System;
+
+/// One side of an external row: its block, first coordinate, width and the offset of its local
+/// gradient in the flat gradient store.
+#[derive(Clone, Copy, Debug)]
+struct Side {
+    block: usize,
+    col: usize,
+    width: usize,
+    off: usize,
+}
+
+/// One contribution to `S`: sides `s1` of external row `e1` and `s2` of `e2` share a block.
+#[derive(Clone, Copy, Debug)]
+struct Contribution {
+    g1: usize,
+    c2: usize,
+    width: usize,
+    slot: usize,
+}
+
+/// The sparse body-eliminated solve (see the module documentation).
+#[derive(Debug)]
+pub(crate) struct SparseBodySchur {
+    n: usize,
+    m: usize,
+    /// Each external row's global row.
+    ext: Vec<usize>,
+    /// Each global row's external index (`usize::MAX` for an internal row).
+    ext_of: Vec<usize>,
+    /// Each external row's sides.
+    sides: Vec<[Option<Side>; 2]>,
+    /// The external rows' local gradients, side after side.
+    grads: Vec<f64>,
+    /// `C_b g` for each side's gradient, in the same layout.
+    cg: Vec<f64>,
+    contributions: Vec<Contribution>,
+    /// Per block: the external rows acting on it (external index, side).
+    by_block: Vec<Vec<(usize, usize)>>,
+    /// The planar blocks and the first spatial coordinate and internal row.
+    planar: usize,
+    q0: usize,
+    r0: usize,
+    /// The spatial coordinates at the last [`SparseBodySchur::update`].
+    qs: Vec<f64>,
+    /// Each spatial body's elimination and its `C_b` (row-major 12 x 12) at the last
+    /// factorisation.
+    rigid: Vec<RigidSolve>,
+    cmat: Vec<[f64; 144]>,
+    chol: SparseCholesky,
+    x: Vec<f64>,
+    le: Vec<f64>,
+}
+
+impl SparseBodySchur {
+    /// Analyses the pattern of `S` for `sys` (allocates; once).
+    pub(crate) fn new(sys: &System) -> Result<Self, SolveError> {
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let internal = sys.spatial_internal_rows();
+        let nblocks = sys.n_body_blocks();
+        let mut ext_of = vec![usize::MAX; m];
+        let mut ext = Vec::new();
+        let mut sides: Vec<[Option<Side>; 2]> = Vec::new();
+        let mut off = 0;
+        let mut rows: Vec<(usize, [Option<(usize, usize)>; 2])> = Vec::with_capacity(m);
+        let q = sys.initial_guess().0;
+        sys.local_rows_gamma(q.as_slice(), None, 0.0, |r, s, _| {
+            rows.push((r, s.map(|s| s.map(|(b, g)| (b, g.len())))));
+        });
+        rows.sort_by_key(|&(r, _)| r);
+        for (r, s) in rows {
+            if internal.contains(&r) {
+                continue;
+            }
+            ext_of[r] = ext.len();
+            ext.push(r);
+            let mut side = [None; 2];
+            for (k, s) in s.iter().enumerate() {
+                if let Some((block, width)) = *s {
+                    let (col, w) = sys.body_block(block).ok_or_else(|| {
+                        SolveError::Unsupported(format!("row {r} names body block {block}"))
+                    })?;
+                    debug_assert_eq!(w, width);
+                    side[k] = Some(Side {
+                        block,
+                        col,
+                        width,
+                        off,
+                    });
+                    off += width;
+                }
+            }
+            sides.push(side);
+        }
+        let me = ext.len();
+        let mut by_block: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nblocks];
+        for (e, s) in sides.iter().enumerate() {
+            for (k, side) in s.iter().enumerate() {
+                if let Some(side) = side {
+                    by_block[side.block].push((e, k));
+                }
+            }
+        }
+        let mut pattern = Vec::new();
+        for rows in &by_block {
+            for &(e1, _) in rows {
+                for &(e2, _) in rows {
+                    if e1 > e2 {
+                        pattern.push((e1, e2));
+                    }
+                }
+            }
+        }
+        let mut chol = SparseCholesky::new(me, &pattern)?;
+        chol.set_max_dependent(sys.n_redundant());
+        let mut contributions = Vec::new();
+        for rows in &by_block {
+            for &(e1, k1) in rows {
+                for &(e2, k2) in rows {
+                    if e1 < e2 {
+                        continue;
+                    }
+                    let slot = chol.slot(e1, e2).ok_or_else(|| {
+                        SolveError::Unsupported(format!(
+                            "sparse Schur pattern lacks entry ({e1}, {e2})"
+                        ))
+                    })?;
+                    let (s1, s2) = (sides[e1][k1], sides[e2][k2]);
+                    if let (Some(s1), Some(s2)) = (s1, s2) {
+                        contributions.push(Contribution {
+                            g1: s1.off,
+                            c2: s2.off,
+                            width: s1.width,
+                            slot,
+                        });
+                    }
+                }
+            }
+        }
+        let ns = sys.spatial_bodies().len();
+        Ok(SparseBodySchur {
+            n,
+            m,
+            ext,
+            ext_of,
+            sides,
+            grads: vec![0.0; off],
+            cg: vec![0.0; off],
+            contributions,
+            by_block,
+            planar: nblocks - ns,
+            q0: sys.spatial_offset(),
+            r0: internal.start,
+            qs: vec![0.0; 12 * ns],
+            rigid: Vec::with_capacity(ns),
+            cmat: vec![[0.0; 144]; ns],
+            chol,
+            x: vec![0.0; n],
+            le: vec![0.0; me],
+        })
+    }
+
+    /// Evaluates the rows at `(q, v, t)` (`v = None`: zero velocities): the local gradients, and
+    /// `gamma` (length m) for every row.
+    pub(crate) fn update(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: Option<&[f64]>,
+        t: f64,
+        gamma: &mut [f64],
+    ) {
+        self.qs.copy_from_slice(&q[self.q0..]);
+        let (ext_of, sides, grads) = (&self.ext_of, &self.sides, &mut self.grads);
+        sys.local_rows_gamma(q, v, t, |r, s, gm| {
+            gamma[r] = gm;
+            let e = ext_of[r];
+            if e == usize::MAX {
+                return;
+            }
+            for (side, g) in sides[e].iter().zip(s) {
+                if let (Some(side), Some((_, g))) = (side, g) {
+                    grads[side.off..side.off + side.width].copy_from_slice(g);
+                }
+            }
+        });
+    }
+
+    /// `out = C_b f` on block `b` (`w` the planar weights).
+    fn apply_block(&self, b: usize, col: usize, w: &[f64], f: &[f64], out: &mut [f64]) {
+        if b < self.planar {
+            for l in 0..3 {
+                out[l] = w[col + l] * f[l];
+            }
+        } else {
+            let c = &self.cmat[b - self.planar];
+            for (i, o) in out.iter_mut().enumerate().take(12) {
+                *o = (0..12).map(|j| c[12 * i + j] * f[j]).sum();
+            }
+        }
+    }
+
+    /// Each spatial body's elimination at the last [`SparseBodySchur::update`], `C_b` times
+    /// each row's gradient, and the factorisation of `S`. Errors: a degenerate spatial body
+    /// (named) or the row of the failing pivot.
+    pub(crate) fn factor(&mut self, sys: &System, w: &[f64]) -> Result<(), BodyFactorError> {
+        self.rigid.clear();
+        for (k, b) in sys.spatial_bodies().iter().enumerate() {
+            let qb: [f64; 12] = std::array::from_fn(|l| self.qs[12 * k + l]);
+            let r = RigidSolve::new(&b.inertia, &qb)
+                .map_err(|e| BodyFactorError::Body(b.name.clone(), e.to_string()))?;
+            let c = &mut self.cmat[k];
+            for j in 0..12 {
+                let mut unit = [0.0; 12];
+                unit[j] = 1.0;
+                let col = r.apply_inverse_mass(&unit);
+                for i in 0..12 {
+                    c[12 * i + j] = col[i];
+                }
+            }
+            self.rigid.push(r);
+        }
+        let mut cg = std::mem::take(&mut self.cg);
+        for s in self.sides.iter().flatten().flatten() {
+            let range = s.off..s.off + s.width;
+            self.apply_block(
+                s.block,
+                s.col,
+                w,
+                &self.grads[range.clone()],
+                &mut cg[range],
+            );
+        }
+        self.cg = cg;
+        self.chol.clear();
+        let vals = self.chol.values_mut();
+        for c in &self.contributions {
+            let g = &self.grads[c.g1..c.g1 + c.width];
+            let cg = &self.cg[c.c2..c.c2 + c.width];
+            vals[c.slot] += g.iter().zip(cg).map(|(a, b)| a * b).sum::<f64>();
+        }
+        self.chol.factor().map_err(|e| {
+            let i = match e {
+                FactorError::Singular(i) | FactorError::NotPositiveDefinite(i) => i,
+            };
+            BodyFactorError::Row(self.ext.get(i).copied().unwrap_or(i))
+        })
+    }
+
+    /// Non-zeros stored for the lower triangle of `S`.
+    pub(crate) fn nnz(&self) -> usize {
+        self.chol.nnz()
+    }
+
+    /// The condition estimate of the last factored `S` (1 without external rows).
+    pub(crate) fn condition_estimate(&self) -> f64 {
+        if self.ext.is_empty() {
+            1.0
+        } else {
+            self.chol.condition_estimate()
+        }
+    }
+
+    /// The solution `a` of `M a + Phi^T lambda = f`, `Phi a = r` at the last factorisation,
+    /// with its multipliers `lambda` (length m).
+    pub(crate) fn solve(
+        &mut self,
+        w: &[f64],
+        f: &[f64],
+        r: &[f64],
+        a: &mut [f64],
+        lambda: &mut [f64],
+    ) {
+        debug_assert!(a.len() == self.n && lambda.len() == self.m);
+        let mut x = std::mem::take(&mut self.x);
+        for k in 0..self.q0 {
+            x[k] = w[k] * f[k];
+        }
+        for (b, rigid) in self.rigid.iter().enumerate() {
+            let o = self.q0 + 12 * b;
+            let fb: [f64; 12] = std::array::from_fn(|l| f[o + l]);
+            let ri: [f64; 6] = std::array::from_fn(|l| r[self.r0 + 6 * b + l]);
+            x[o..o + 12].copy_from_slice(&rigid.solve(&fb, &ri));
+        }
+        // S lambda_e = Phi_e x - r_e
+        let mut le = std::mem::take(&mut self.le);
+        for (e, (l, s)) in le.iter_mut().zip(&self.sides).enumerate() {
+            let mut acc = -r[self.ext[e]];
+            for s in s.iter().flatten() {
+                let g = &self.grads[s.off..s.off + s.width];
+                acc += g
+                    .iter()
+                    .zip(&x[s.col..s.col + s.width])
+                    .map(|(g, x)| g * x)
+                    .sum::<f64>();
+            }
+            *l = acc;
+        }
+        if !le.is_empty() {
+            self.chol.solve_in_place(&mut le);
+        }
+        a.copy_from_slice(&x);
+        lambda.fill(0.0);
+        for (e, s) in self.sides.iter().enumerate() {
+            lambda[self.ext[e]] = le[e];
+            for s in s.iter().flatten() {
+                let cg = &self.cg[s.off..s.off + s.width];
+                for (ak, c) in a[s.col..s.col + s.width].iter_mut().zip(cg) {
+                    *ak -= c * le[e];
+                }
+            }
+        }
+        // each spatial body's internal multipliers: G^T mu = f - Phi_e^T lambda_e - M a
+        for (k, rigid) in self.rigid.iter().enumerate() {
+            let o = self.q0 + 12 * k;
+            let mut g: [f64; 12] = std::array::from_fn(|l| f[o + l]);
+            for &(e, side) in &self.by_block[self.planar + k] {
+                if let Some(s) = self.sides[e][side] {
+                    for (gl, d) in g.iter_mut().zip(&self.grads[s.off..s.off + 12]) {
+                        *gl -= d * le[e];
+                    }
+                }
+            }
+            let ab: [f64; 12] = std::array::from_fn(|l| a[o + l]);
+            let mu = rigid.multipliers(&g, &ab);
+            lambda[self.r0 + 6 * k..self.r0 + 6 * k + 6].copy_from_slice(&mu);
+        }
+        self.x = x;
+        self.le = le;
+    }
+}
