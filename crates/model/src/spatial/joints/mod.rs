@@ -360,14 +360,14 @@ impl SpatialJoint {
     /// The equations at the markers `ma`, `mb` (global components).
     fn eval_at<T: Scalar>(&self, ma: &MarkerAt<T>, mb: &MarkerAt<T>, out: &mut [T; 6]) {
         match self.kind {
-            SpatialJointKind::Spherical => spherical::eval(&ma, &mb, out),
-            SpatialJointKind::Revolute => revolute::eval(&ma, &mb, out),
-            SpatialJointKind::Universal => universal::eval(&ma, &mb, out),
-            SpatialJointKind::Cylindrical => cylindrical::eval(&ma, &mb, out),
-            SpatialJointKind::Prismatic => prismatic::eval(&ma, &mb, out),
-            SpatialJointKind::Planar => planar::eval(&ma, &mb, out),
-            SpatialJointKind::Weld => weld::eval(&ma, &mb, out),
-            SpatialJointKind::Distance { length } => distance::eval(&ma, &mb, length, out),
+            SpatialJointKind::Spherical => spherical::eval(ma, mb, out),
+            SpatialJointKind::Revolute => revolute::eval(ma, mb, out),
+            SpatialJointKind::Universal => universal::eval(ma, mb, out),
+            SpatialJointKind::Cylindrical => cylindrical::eval(ma, mb, out),
+            SpatialJointKind::Prismatic => prismatic::eval(ma, mb, out),
+            SpatialJointKind::Planar => planar::eval(ma, mb, out),
+            SpatialJointKind::Weld => weld::eval(ma, mb, out),
+            SpatialJointKind::Distance { length } => distance::eval(ma, mb, length, out),
         }
     }
 }
