@@ -60,7 +60,7 @@ struct BodiesKernel {
 #[derive(Debug)]
 enum BodySolve {
     Dense(BodySchur),
-    Sparse(SparseBodySchur),
+    Sparse(Box<SparseBodySchur>),
 }
 
 /// Projects `q` onto `Phi(q, t) = 0` by Newton with the minimum `M`-norm correction
@@ -103,7 +103,7 @@ impl Projector {
             let n = sys.n_coords();
             Kernel::Bodies(Box::new(BodiesKernel {
                 schur: if linear.use_sparse(m) {
-                    BodySolve::Sparse(SparseBodySchur::new(sys)?)
+                    BodySolve::Sparse(Box::new(SparseBodySchur::new(sys)?))
                 } else {
                     BodySolve::Dense(BodySchur::new(sys))
                 },

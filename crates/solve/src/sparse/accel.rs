@@ -32,7 +32,7 @@ pub struct SparseAccelerationSolver {
 /// The Schur complement of the planar rows, or of the rows over body blocks.
 #[derive(Debug)]
 enum Kernel {
-    Rows(ConstraintSchur),
+    Rows(Box<ConstraintSchur>),
     Bodies(Box<SparseBodySchur>),
 }
 
@@ -46,7 +46,7 @@ impl SparseAccelerationSolver {
             schur: if sys.has_spatial() {
                 Kernel::Bodies(Box::new(SparseBodySchur::new(sys)?))
             } else {
-                Kernel::Rows(ConstraintSchur::new(sys)?)
+                Kernel::Rows(Box::new(ConstraintSchur::new(sys)?))
             },
             gamma: vec![0.0; m],
             forces: vec![0.0; n],
