@@ -59,7 +59,7 @@ struct BodiesKernel {
 /// The body-eliminated solve from the dense `Phi_q`, or over body blocks on the sparse path.
 #[derive(Debug)]
 enum BodySolve {
-    Dense(BodySchur),
+    Dense(Box<BodySchur>),
     Sparse(Box<SparseBodySchur>),
 }
 
@@ -105,7 +105,7 @@ impl Projector {
                 schur: if linear.use_sparse(m) {
                     BodySolve::Sparse(Box::new(SparseBodySchur::new(sys)?))
                 } else {
-                    BodySolve::Dense(BodySchur::new(sys))
+                    BodySolve::Dense(Box::new(BodySchur::new(sys)))
                 },
                 gamma: vec![0.0; m],
                 delta: vec![0.0; n],

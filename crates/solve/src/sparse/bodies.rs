@@ -79,7 +79,9 @@ impl SparseBodySchur {
         let mut ext = Vec::new();
         let mut sides: Vec<[Option<Side>; 2]> = Vec::new();
         let mut off = 0;
-        let mut rows: Vec<(usize, [Option<(usize, usize)>; 2])> = Vec::with_capacity(m);
+        // each row's sides as (block, width)
+        type Sides = [Option<(usize, usize)>; 2];
+        let mut rows: Vec<(usize, Sides)> = Vec::with_capacity(m);
         let q = sys.initial_guess().0;
         sys.local_rows_gamma(q.as_slice(), None, 0.0, |r, s, _| {
             rows.push((r, s.map(|s| s.map(|(b, g)| (b, g.len())))));
