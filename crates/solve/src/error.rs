@@ -259,3 +259,24 @@ pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), Solve
         ))),
     }
 }
+
+/// The refusal of a solver whose sparse path does not take spatial bodies yet, for a spatial
+/// model on that path (`linear` picks it: above [`crate::SPARSE_THRESHOLD`] equations by
+/// default), where its dense matrices would take `O(m n)` memory: `Ok` otherwise. The error
+/// names `solver`, the equation count and the solvers that run such models.
+pub fn refuse_large_spatial(
+    sys: &mbd_model::System,
+    solver: &str,
+    linear: crate::LinearSolver,
+) -> Result<(), SolveError> {
+    let m = sys.n_constraints();
+    if !sys.has_spatial() || !linear.use_sparse(m) {
+        return Ok(());
+    }
+    Err(SolveError::Unsupported(format!(
+        "{solver} takes spatial bodies on its dense path only, and this model has {m} \
+         equations (the sparse path starts above {}): run it with rk4, rk4-projected or \
+         index1:dopri5, whose sparse path takes spatial bodies in O(N)",
+        crate::SPARSE_THRESHOLD
+    )))
+}

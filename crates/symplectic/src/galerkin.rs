@@ -139,6 +139,7 @@ impl Galerkin {
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
         let sparse_ok = options.gamma == 0.0;
         // spatial bodies take the dense path (docs/spatial.md)
+        mbd_solve::refuse_large_spatial(sys, "the symplectic scheme", options.linear_solver)?;
         let use_sparse =
             options.linear_solver.use_sparse(m) && m > 0 && sparse_ok && !sys.has_spatial();
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {

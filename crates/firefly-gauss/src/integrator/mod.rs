@@ -131,6 +131,9 @@ impl FireflyGauss {
     /// found (`k` redundant equations; [`FaDaeError::Unsupported`]).
     pub fn new(sys: &System, options: FaDaeOptions) -> Result<Self, FaDaeError> {
         options.validate()?;
+        // its acceleration solves are dense
+        mbd_solve::refuse_large_spatial(sys, "the FA-DAE solver", mbd_solve::LinearSolver::Auto)
+            .map_err(FaDaeError::Solve)?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let (q0, _) = sys.initial_guess();
         let partition = match &options.partition {
