@@ -61,7 +61,7 @@ struct Cell {
 }
 
 /// Best-of-blocks time per step of `integ` and of the plain RK4 peer, blocks interleaved.
-fn measure(
+pub(crate) fn measure(
     sys: &System,
     s0: &State,
     integ: &mut dyn Integrator,
