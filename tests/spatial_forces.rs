@@ -3,7 +3,7 @@
 //! balance of a damped spatial spring pendulum, and every spatial solver's agreement on it.
 
 use mbd::model::spatial::{
-    LoadFrame, Marker, SpatialBody, SpatialBodyRef, SpatialForce, SpatialInertia, SpatialJoint,
+    Axes, Marker, SpatialBody, SpatialBodyRef, SpatialForce, SpatialInertia, SpatialJoint,
     SpatialJointKind,
 };
 use mbd::model::{SystemBuilder, TimeFunction};
@@ -85,7 +85,7 @@ fn a_body_torque_spins_a_body_up_about_its_axis() {
         "motor",
         body,
         cst([0.0, 0.0, tau]),
-        LoadFrame::Body,
+        Axes::Body,
     ));
     let sys = b.build().unwrap();
     assert!(!sys.is_conservative());
@@ -150,7 +150,7 @@ fn a_damped_spatial_pendulum_closes_its_energy_balance() {
             TimeFunction::constant(0.0),
             TimeFunction::constant(0.0),
         ],
-        LoadFrame::Body,
+        Axes::Body,
     ));
     let sys = b.build().unwrap();
     let (t_end, h) = (2.0, 1e-3);

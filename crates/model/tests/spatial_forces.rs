@@ -4,7 +4,7 @@
 //! turned principal axes, and the builder's errors.
 
 use mbd_model::spatial::{
-    director_velocities, LoadFrame, Orientation, SpatialBody, SpatialForce, SpatialInertia,
+    director_velocities, Axes, Orientation, SpatialBody, SpatialForce, SpatialInertia,
 };
 use mbd_model::{ModelError, System, SystemBuilder, TimeFunction};
 use nalgebra::{DMatrix, Rotation3, Vector3};
@@ -72,7 +72,7 @@ fn loaded() -> System {
         r,
         [0.1, 0.0, 0.05],
         cst([1.0, -2.0, 0.5]),
-        LoadFrame::Global,
+        Axes::Global,
     ));
     let wave = [
         TimeFunction::Harmonic {
@@ -89,19 +89,19 @@ fn loaded() -> System {
         p,
         [0.2, -0.1, 0.0],
         wave,
-        LoadFrame::Body,
+        Axes::Body,
     ));
     b.add_spatial_force(SpatialForce::torque(
         "motor",
         r,
         cst([0.3, 0.1, -0.7]),
-        LoadFrame::Body,
+        Axes::Body,
     ));
     b.add_spatial_force(SpatialForce::torque(
         "twist",
         p,
         cst([-0.4, 0.2, 0.9]),
-        LoadFrame::Global,
+        Axes::Global,
     ));
     b.build().expect("loaded model builds")
 }
@@ -212,18 +212,13 @@ fn loads_do_the_work_of_a_force_and_a_torque() {
     let body = b.add_spatial_body(
         SpatialBody::new("p", turned_inertia(2.0)).orientation(Orientation::Matrix(frame)),
     );
-    b.add_spatial_force(SpatialForce::torque(
-        "motor",
-        body,
-        cst(tau_b),
-        LoadFrame::Body,
-    ));
+    b.add_spatial_force(SpatialForce::torque("motor", body, cst(tau_b), Axes::Body));
     b.add_spatial_force(SpatialForce::force(
         "thrust",
         body,
         p_b,
         cst(f_b),
-        LoadFrame::Body,
+        Axes::Body,
     ));
     let sys = b.build().expect("builds");
     let (q, _) = state(&sys);
@@ -304,7 +299,7 @@ fn spatial_force_errors_name_the_element_and_field() {
             TimeFunction::constant(0.0),
             TimeFunction::constant(0.0),
         ],
-        LoadFrame::Body,
+        Axes::Body,
     ));
     assert!(e.contains("'m'") && e.contains("tx"), "{e}");
     let g = mbd_model::spatial::SpatialBodyRef::Ground;
@@ -314,18 +309,8 @@ fn spatial_force_errors_name_the_element_and_field() {
     assert!(e.contains("ground"), "{e}");
     let mut b = SystemBuilder::new();
     let [p, _] = two_bodies(&mut b);
-    b.add_spatial_force(SpatialForce::torque(
-        "m",
-        p,
-        cst([1.0; 3]),
-        LoadFrame::Global,
-    ));
-    b.add_spatial_force(SpatialForce::torque(
-        "m",
-        p,
-        cst([1.0; 3]),
-        LoadFrame::Global,
-    ));
+    b.add_spatial_force(SpatialForce::torque("m", p, cst([1.0; 3]), Axes::Global));
+    b.add_spatial_force(SpatialForce::torque("m", p, cst([1.0; 3]), Axes::Global));
     match b.build() {
         Err(ModelError::DuplicateName {
             kind: "force",
@@ -411,13 +396,13 @@ tz = { kind = "constant", value = 0.7 }
         p,
         [0.2, -0.1, 0.0],
         [wave, zero.clone(), TimeFunction::constant(-1.0)],
-        LoadFrame::Body,
+        Axes::Body,
     ));
     b.add_spatial_force(SpatialForce::torque(
         "motor",
         p,
         [zero.clone(), zero, TimeFunction::constant(0.7)],
-        LoadFrame::Global,
+        Axes::Global,
     ));
     let code = b.build().expect("builds");
     assert_eq!(sys.spatial_forces(), code.spatial_forces());

@@ -287,3 +287,75 @@ fn angular_momentum_and_body_angular_velocity() {
     assert!((wb - r.transpose() * omega).amax() < 1e-13 * 15.0, "{wb:?}");
     assert!(sys.spatial_body_angular_velocity(1, q, v).is_none());
 }
+
+/// `angular_velocity_body` turns with the initial orientation (through turned principal axes),
+/// and `tensor_about` moves a tensor to the centre of mass by the parallel-axis theorem; both
+/// round-trip through `to_model_file`, and giving both angular velocities is an error.
+#[test]
+fn body_axes_angular_velocity_and_a_tensor_about_a_point() {
+    use nalgebra::{Rotation3, Vector3};
+    let turned = || {
+        let axes = *Rotation3::from_euler_angles(0.3, -0.5, 0.8).matrix();
+        SpatialInertia::principal_with_axes(2.0, [0.2, 0.3, 0.4], axes).expect("inertia")
+    };
+    let frame = *Rotation3::from_euler_angles(0.4, -0.2, 1.1).matrix();
+    let w_body = [0.3, -1.2, 2.0];
+    let build = |body: SpatialBody| {
+        let mut b = SystemBuilder::new();
+        b.add_spatial_body(body);
+        b.build().expect("builds")
+    };
+    let base = SpatialBody::new("p", turned()).orientation(Orientation::Matrix(frame));
+    let body_axes = build(base.clone().angular_velocity_body(w_body));
+    let global = build(base.angular_velocity((frame * Vector3::from(w_body)).into()));
+    let (vb, vg) = (body_axes.initial_guess().1, global.initial_guess().1);
+    let d = vb
+        .iter()
+        .zip(&vg)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(d < 1e-14, "{d:e}");
+    // the same body's angular velocity read back in its principal axes
+    let (q, v) = body_axes.initial_guess();
+    let omega = body_axes
+        .spatial_body_angular_velocity(0, q.as_slice(), v.as_slice())
+        .expect("body 0");
+    let expect = turned().axes().transpose() * Vector3::from(w_body);
+    assert!((Vector3::from(omega) - expect).amax() < 1e-14);
+    let back = body_axes.to_model_file().build().expect("round trip");
+    assert_eq!(back.spatial_bodies(), body_axes.spatial_bodies());
+
+    // a 2 kg box with its tensor about a corner 0.1, 0.2, 0.3 m from the centre of mass
+    let (m, c) = (2.0, Vector3::new(0.1, 0.2, 0.3));
+    let jc = nalgebra::Matrix3::from_diagonal(&Vector3::new(0.05, 0.07, 0.09));
+    let jp: nalgebra::Matrix3<f64> =
+        jc + (nalgebra::Matrix3::identity() * c.norm_squared() - c * c.transpose()) * m;
+    let rows: Vec<String> = (0..3)
+        .map(|r| format!("[{:e}, {:e}, {:e}]", jp[(r, 0)], jp[(r, 1)], jp[(r, 2)]))
+        .collect();
+    let text = format!(
+        "[[spatial_bodies]]\nname = \"box\"\nmass = 2.0\ntensor = [{}]\ntensor_about = [0.1, 0.2, 0.3]\n",
+        rows.join(", ")
+    );
+    let sys = mbd_model::ModelFile::from_toml(&text)
+        .and_then(|f| f.build())
+        .expect("builds");
+    let moments = sys.spatial_bodies()[0].inertia.moments();
+    for (got, want) in moments.iter().zip([0.05, 0.07, 0.09]) {
+        assert!((got - want).abs() < 1e-14, "{moments:?}");
+    }
+    let both = "[[spatial_bodies]]\nname = \"b\"\nmass = 1.0\nmoments = [1.0, 1.0, 1.0]\nangular_velocity = [1.0, 0.0, 0.0]\nangular_velocity_body = [1.0, 0.0, 0.0]\n";
+    let e = mbd_model::ModelFile::from_toml(both)
+        .and_then(|f| f.build())
+        .expect_err("both angular velocities")
+        .to_string();
+    assert!(
+        e.contains("'b'") && e.contains("angular_velocity_body"),
+        "{e}"
+    );
+    let stray = "[[spatial_bodies]]\nname = \"b\"\nmass = 1.0\nmoments = [1.0, 1.0, 1.0]\ntensor_about = [1.0, 0.0, 0.0]\n";
+    let e = mbd_model::ModelFile::from_toml(stray)
+        .and_then(|f| f.build())
+        .expect_err("tensor_about without tensor")
+        .to_string();
+    assert!(e.contains("tensor_about"), "{e}");
+}

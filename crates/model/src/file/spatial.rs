@@ -5,8 +5,8 @@ use crate::builder::SystemBuilder;
 use crate::check::invalid;
 use crate::error::ModelError;
 use crate::spatial::{
-    EulerSequence, Marker, Orientation, SpatialBody, SpatialBodyRef, SpatialInertia, SpatialJoint,
-    SpatialJointEntry, SpatialJointKind,
+    Axes, EulerSequence, Marker, Orientation, SpatialBody, SpatialBodyRef, SpatialInertia,
+    SpatialJoint, SpatialJointEntry, SpatialJointKind,
 };
 use nalgebra::{Matrix3, Vector3};
 use schemars::JsonSchema;
@@ -28,10 +28,15 @@ pub struct SpatialBodySpec {
     /// axes), a rotation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axes: Option<[[f64; 3]; 3]>,
-    /// The inertia tensor about the centre of mass in the body frame, kg m^2 (instead of
-    /// `moments` and `axes`).
+    /// The inertia tensor in the body frame, kg m^2 (instead of `moments` and `axes`), about
+    /// the centre of mass or about `tensor_about`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tensor: Option<[[f64; 3]; 3]>,
+    /// The point `tensor` is taken about, from the centre of mass in the body frame, m
+    /// (default: the centre of mass); moved to the centre of mass by the parallel-axis
+    /// theorem.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tensor_about: Option<[f64; 3]>,
     /// Initial position of the centre of mass, m.
     #[serde(default)]
     pub position: [f64; 3],
@@ -44,6 +49,10 @@ pub struct SpatialBodySpec {
     /// Initial angular velocity in global axes, rad/s.
     #[serde(default)]
     pub angular_velocity: [f64; 3],
+    /// Initial angular velocity in the body frame's axes, rad/s (instead of
+    /// `angular_velocity`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_velocity_body: Option<[f64; 3]>,
 }
 
 /// An orientation in a model file: exactly one of its fields.
@@ -148,7 +157,8 @@ impl SpatialBodySpec {
             (None, None, Some(t)) => SpatialInertia::from_tensor(
                 self.mass,
                 Matrix3::from_fn(|r, c| t[r][c]),
-                Vector3::zeros(),
+                // the centre of mass seen from the tensor's point
+                -Vector3::from(self.tensor_about.unwrap_or([0.0; 3])),
             ),
             _ => {
                 return Err(bad(
@@ -159,6 +169,9 @@ impl SpatialBodySpec {
             }
         }
         .map_err(|e| bad(format!("inertia: {e}")))?;
+        if self.tensor_about.is_some() && self.tensor.is_none() {
+            return Err(bad("`tensor_about` belongs to `tensor`".into()));
+        }
         let orientation = match &self.orientation {
             None => Orientation::Matrix(Matrix3::identity()),
             Some(OrientationSpec::Matrix(m)) => {
@@ -174,11 +187,17 @@ impl SpatialBodySpec {
                 *angles,
             ),
         };
-        Ok(SpatialBody::new(self.name.clone(), inertia)
+        let body = SpatialBody::new(self.name.clone(), inertia)
             .position(self.position)
             .orientation(orientation)
-            .velocity(self.velocity)
-            .angular_velocity(self.angular_velocity))
+            .velocity(self.velocity);
+        match self.angular_velocity_body {
+            None => Ok(body.angular_velocity(self.angular_velocity)),
+            Some(w) if self.angular_velocity == [0.0; 3] => Ok(body.angular_velocity_body(w)),
+            Some(_) => Err(bad(
+                "give `angular_velocity` (global axes) or `angular_velocity_body`, not both".into(),
+            )),
+        }
     }
 
     /// The file form of a model's body (inertia as principal moments and axes, orientation as
@@ -195,10 +214,18 @@ impl SpatialBodySpec {
             moments: Some(b.inertia.moments()),
             axes: (axes != Matrix3::identity()).then(|| vectors(&axes)),
             tensor: None,
+            tensor_about: None,
             position: b.position,
             orientation,
             velocity: b.velocity,
-            angular_velocity: b.angular_velocity,
+            angular_velocity: match b.angular_velocity_axes {
+                Axes::Global => b.angular_velocity,
+                Axes::Body => [0.0; 3],
+            },
+            angular_velocity_body: match b.angular_velocity_axes {
+                Axes::Global => None,
+                Axes::Body => Some(b.angular_velocity),
+            },
         }
     }
 }

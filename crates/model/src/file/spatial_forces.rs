@@ -1,7 +1,7 @@
 //! Force elements on spatial bodies in a model file (`[[spatial_forces]]`, tagged by `type`).
 
 use crate::error::ModelError;
-use crate::spatial::{LoadFrame, SpatialBodyRef, SpatialForce, SpatialForceKind};
+use crate::spatial::{Axes, SpatialBodyRef, SpatialForce, SpatialForceKind};
 use crate::timefn::TimeFunction;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -67,7 +67,7 @@ pub struct SpatialPointForceSpec {
     pub fz: TimeFunction,
     /// The axes of the components: `"global"` (default) or `"body"` (turning with the body).
     #[serde(default)]
-    pub frame: LoadFrame,
+    pub frame: Axes,
 }
 
 /// A torque on a spatial body in a model file.
@@ -89,7 +89,7 @@ pub struct SpatialTorqueSpec {
     pub tz: TimeFunction,
     /// The axes of the components: `"global"` (default) or `"body"`.
     #[serde(default)]
-    pub frame: LoadFrame,
+    pub frame: Axes,
 }
 
 fn zero() -> TimeFunction {

@@ -67,8 +67,10 @@ pub struct SpatialBody {
     pub orientation: Orientation,
     /// Initial velocity of the centre of mass, global (m/s).
     pub velocity: [f64; 3],
-    /// Initial angular velocity, global axes (rad/s).
+    /// Initial angular velocity (rad/s), in the axes `angular_velocity_axes` says.
     pub angular_velocity: [f64; 3],
+    /// The axes of `angular_velocity`: global (default) or the body frame's.
+    pub angular_velocity_axes: super::Axes,
 }
 
 impl SpatialBody {
@@ -81,6 +83,7 @@ impl SpatialBody {
             orientation: Orientation::Matrix(Matrix3::identity()),
             velocity: [0.0; 3],
             angular_velocity: [0.0; 3],
+            angular_velocity_axes: super::Axes::Global,
         }
     }
     /// Sets the initial position of the centre of mass.
@@ -101,6 +104,14 @@ impl SpatialBody {
     /// Sets the initial angular velocity (global axes).
     pub fn angular_velocity(mut self, w: [f64; 3]) -> Self {
         self.angular_velocity = w;
+        self.angular_velocity_axes = super::Axes::Global;
+        self
+    }
+    /// Sets the initial angular velocity in the body frame's axes (its global value is the
+    /// initial orientation times `w`).
+    pub fn angular_velocity_body(mut self, w: [f64; 3]) -> Self {
+        self.angular_velocity = w;
+        self.angular_velocity_axes = super::Axes::Body;
         self
     }
 
@@ -128,13 +139,15 @@ impl SpatialBody {
             }
         }
         let r = self.principal_rotation()?;
+        let w = Vector3::from(self.angular_velocity);
+        let omega = match self.angular_velocity_axes {
+            super::Axes::Global => w,
+            // the body frame's rotation is the principal one times A^T
+            super::Axes::Body => r * self.inertia.axes().transpose() * w,
+        };
         Ok((
             natural_coordinates(Vector3::from(self.position), &r),
-            director_velocities(
-                Vector3::from(self.velocity),
-                Vector3::from(self.angular_velocity),
-                &r,
-            ),
+            director_velocities(Vector3::from(self.velocity), omega, &r),
         ))
     }
 }

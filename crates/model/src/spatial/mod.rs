@@ -36,7 +36,7 @@ mod rigid;
 pub(crate) mod system;
 
 pub use body::{SpatialBody, SpatialBodyHandle, SpatialBodyRef};
-pub use forces::{LoadFrame, SpatialForce, SpatialForceKind, SpatialLoad, SpatialSpringDamper};
+pub use forces::{Axes, SpatialForce, SpatialForceKind, SpatialLoad, SpatialSpringDamper};
 pub use inertia::{SpatialInertia, SpatialInertiaError};
 pub use joints::{Marker, SpatialFrame, SpatialJoint, SpatialJointError, SpatialJointKind};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};

@@ -11,14 +11,14 @@ use nalgebra::{Matrix3, Vector3};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-/// The axes a load's components are given in.
+/// The axes a vector is given in: a load's components, a body's initial angular velocity.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
-pub enum LoadFrame {
-    /// The global (inertial) axes: the load keeps its direction in space.
+pub enum Axes {
+    /// The global (inertial) axes: a load keeps its direction in space.
     #[default]
     Global,
-    /// The body's axes: the load turns with the body (a follower load, e.g. a thruster or a
+    /// The body's axes: a load turns with the body (a follower load, e.g. a thruster or a
     /// motor's torque).
     Body,
 }
@@ -32,7 +32,7 @@ pub struct SpatialLoad {
     /// The components (N or N m) along the axes of `frame`.
     pub components: [TimeFunction; 3],
     /// The axes of the components.
-    pub frame: LoadFrame,
+    pub frame: Axes,
     /// Body-frame components to principal-frame ones (`A^T` once lowered; the identity for
     /// global loads and before lowering).
     pub(crate) to_principal: Matrix3<f64>,
@@ -40,7 +40,7 @@ pub struct SpatialLoad {
 
 impl SpatialLoad {
     /// A load with these components.
-    pub fn new(point: [f64; 3], components: [TimeFunction; 3], frame: LoadFrame) -> Self {
+    pub fn new(point: [f64; 3], components: [TimeFunction; 3], frame: Axes) -> Self {
         SpatialLoad {
             point,
             components,
@@ -51,7 +51,7 @@ impl SpatialLoad {
 
     /// Whether the load is constant in global axes (a force of this kind is conservative).
     pub(crate) fn is_constant_global(&self) -> bool {
-        self.frame == LoadFrame::Global && self.components.iter().all(|c| c.is_constant())
+        self.frame == Axes::Global && self.components.iter().all(|c| c.is_constant())
     }
 
     /// The components at time `t`.
@@ -63,8 +63,8 @@ impl SpatialLoad {
     fn global(&self, f: &SpatialFrame<f64>, t: f64) -> [f64; 3] {
         let u = self.at(t);
         match self.frame {
-            LoadFrame::Global => u,
-            LoadFrame::Body => f.direction((self.to_principal * Vector3::from(u)).into()),
+            Axes::Global => u,
+            Axes::Body => f.direction((self.to_principal * Vector3::from(u)).into()),
         }
     }
 

@@ -19,7 +19,7 @@ mod assemble;
 mod load;
 mod spring_damper;
 
-pub use load::{LoadFrame, SpatialLoad};
+pub use load::{Axes, SpatialLoad};
 pub use spring_damper::SpatialSpringDamper;
 
 use super::joints::SpatialFrame;
@@ -47,12 +47,12 @@ pub enum SpatialForceKind {
 /// A named force element on spatial bodies.
 ///
 /// ```
-/// use mbd_model::spatial::{LoadFrame, SpatialBody, SpatialForce, SpatialInertia};
+/// use mbd_model::spatial::{Axes, SpatialBody, SpatialForce, SpatialInertia};
 /// use mbd_model::{SystemBuilder, TimeFunction};
 /// let mut b = SystemBuilder::new();
 /// let body = b.add_spatial_body(SpatialBody::new("box", SpatialInertia::principal(2.0, [0.1, 0.2, 0.25])?));
 /// let spin = [0.0, 0.0, 0.5].map(TimeFunction::constant);
-/// b.add_spatial_force(SpatialForce::torque("motor", body, spin, LoadFrame::Body));
+/// b.add_spatial_force(SpatialForce::torque("motor", body, spin, Axes::Body));
 /// let sys = b.build()?;
 /// assert!(!sys.is_conservative());
 /// # Ok::<(), Box<dyn std::error::Error>>(())
@@ -106,7 +106,7 @@ impl SpatialForce {
         body: impl Into<SpatialBodyRef>,
         point: [f64; 3],
         components: [TimeFunction; 3],
-        frame: LoadFrame,
+        frame: Axes,
     ) -> Self {
         SpatialForce {
             name: name.into(),
@@ -123,7 +123,7 @@ impl SpatialForce {
         name: impl Into<String>,
         body: impl Into<SpatialBodyRef>,
         components: [TimeFunction; 3],
-        frame: LoadFrame,
+        frame: Axes,
     ) -> Self {
         SpatialForce {
             name: name.into(),
@@ -188,7 +188,7 @@ impl SpatialForce {
             }
             SpatialForceKind::Force(l) | SpatialForceKind::Torque(l) => {
                 l.point = lower(axes_a, l.point);
-                if let (LoadFrame::Body, Some(a)) = (l.frame, axes_a) {
+                if let (Axes::Body, Some(a)) = (l.frame, axes_a) {
                     l.to_principal = a.transpose();
                 }
             }
