@@ -18,6 +18,15 @@ use serde_json::json;
 const ORDER_TOL: f64 = 0.3;
 /// Errors below this are at the floor of the reference.
 const FLOOR: f64 = 1e-11;
+/// Solvers that miss their order on the tumbling body, and what is known.
+const TUMBLING_MISSES: [(&str, &str); 1] = [(
+    "tangent:dopri5",
+    "fixed-step tangent DOPRI5 fits 4.6 on the tumbling body (slopes 4.3 and 5.0 between \
+     h = 0.05, 0.025, 0.0125; 4.8 and 5.1 on the heavy tops): the cause is not found yet",
+)];
+/// The tumbling body's floor: its reference (symplectic (4,4) at h = 0.0125) is good to about
+/// 1e-15, and the order-8 errors need the decade below the heavy top's floor.
+const TUMBLING_FLOOR: f64 = 1e-13;
 /// The documented miss of the long-time energy claim.
 const ENERGY_MISS: &str =
     "the plain (2,2) scheme's energy error at h = T/50 is 7.8e-8: the target \
@@ -38,8 +47,10 @@ fn angular_momentum(sys: &System, s: &State) -> Vector3<f64> {
 pub fn spatial(ctx: &Ctx) -> Result<Section, String> {
     let mut sec = Section::default();
     orders(ctx, &mut sec)?;
+    tumbling_orders(ctx, &mut sec)?;
     flips(&mut sec)?;
     long_time(ctx, &mut sec)?;
+    director_drift(ctx, &mut sec)?;
     scaling(ctx, &mut sec)?;
     Ok(sec)
 }
@@ -116,6 +127,77 @@ fn orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
         refused.join(", ")
     ));
     sec.summary = json!({ "spatial_orders": rows });
+    Ok(())
+}
+
+/// Orders on a body tumbling about its intermediate axis: every compared solver that takes it,
+/// and the plain symplectic (s,s) scheme for s = 1..4 (order 2s), at step sizes where even the
+/// order-8 errors stay above round-off.
+fn tumbling_orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
+    let sys = free_body([1.0, 2.0, 2.5], [0.05, 2.0, 0.05]).map_err(|e| e.to_string())?;
+    let t_end = 4.0;
+    // orders 6 and 8 reach round-off sooner: they take steps eight times as large
+    let hs_for = |order: u32| -> Vec<f64> {
+        let base = if order >= 6 { 0.4 } else { 0.05 };
+        let n = if ctx.quick { 2 } else { 3 };
+        (0..n).map(|k| base / f64::from(1 << k)).collect()
+    };
+    sec.setting(
+        "tumbling body",
+        format!("J = (1, 2, 2.5), omega0 = (0.05, 2, 0.05) rad/s (about the intermediate axis), t = {t_end} s, h = {:?} (orders 6 and 8: {:?}); error: max-norm of q against symplectic:4 at h = 0.0125, errors below {TUMBLING_FLOOR:e} left out of the fits", hs_for(4), hs_for(8)),
+    );
+    let reference = run(&sys, "symplectic:4", t_end, 0.0125)?;
+    let mut table = Table::new(
+        "Tumbling body: convergence orders (least-squares slope)",
+        &["solver", "nominal", "fitted", "errors"],
+    );
+    let mut specs: Vec<(String, u32)> = mbd::registry()
+        .variants()
+        .filter(|(_, v)| v.compared && v.relative_cost <= 20.0)
+        .map(|(_, v)| (v.spec.to_string(), v.order))
+        .collect();
+    for s in 3..=4 {
+        specs.push((format!("symplectic:{s}"), 2 * s));
+    }
+    let mut rows = Vec::new();
+    for (spec, order) in specs {
+        if Simulation::new(sys.clone(), &spec).is_err() {
+            continue;
+        }
+        let hs = hs_for(order);
+        let mut errs = Vec::new();
+        for &h in &hs {
+            let s = run(&sys, &spec, t_end, h)?;
+            errs.push(mbd_solve::linalg::max_abs_diff(
+                s.q.as_slice(),
+                reference.q.as_slice(),
+            ));
+        }
+        let fit =
+            fit_order(&hs, &errs, TUMBLING_FLOOR).map_err(|e| format!("{spec}: {e} ({errs:?})"))?;
+        table.row(vec![
+            spec.clone(),
+            format!("{order}"),
+            format!("{:.2}", fit.order),
+            errs.iter()
+                .map(|e| fmt_e(*e))
+                .collect::<Vec<_>>()
+                .join(", "),
+        ]);
+        let claim = Claim::check(
+            format!("{spec} reaches its order {order} on a body tumbling about its intermediate axis within {ORDER_TOL}"),
+            (fit.order - f64::from(order)).abs() <= ORDER_TOL,
+            format!("fitted {:.3} from errors {errs:?}", fit.order),
+        );
+        sec.claims
+            .push(match TUMBLING_MISSES.iter().find(|m| m.0 == spec) {
+                Some((_, why)) => claim.expected_miss(*why),
+                None => claim,
+            });
+        rows.push(json!({"solver": spec, "order": num(fit.order), "errors": errs.iter().map(|e| num(*e)).collect::<Vec<_>>()}));
+    }
+    sec.tables.push(table);
+    sec.summary["spatial_tumbling_orders"] = json!(rows);
     Ok(())
 }
 
@@ -199,6 +281,32 @@ fn long_time(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
         )
         .expected_miss(ENERGY_MISS),
     );
+    Ok(())
+}
+
+/// The director constraints over a million steps of the torque-free body (a hundred thousand
+/// in quick mode): symplectic (2,2) and projected RK4 at 1/50 of the spin period.
+fn director_drift(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
+    let sys = free_body([1.0, 2.0, 2.5], [0.05, 2.0, 0.05]).map_err(|e| e.to_string())?;
+    let steps: usize = if ctx.quick { 100_000 } else { 1_000_000 };
+    let h = std::f64::consts::PI / 50.0;
+    let mut phi = vec![0.0; sys.n_constraints()];
+    for spec in ["symplectic:2", "rk4-projected"] {
+        let mut sim = Simulation::new(sys.clone(), spec).map_err(|e| e.to_string())?;
+        let mut worst = 0.0f64;
+        let mut watch = |sys: &System, s: &State, _: usize| -> Result<Flow, SolveError> {
+            sys.phi(s.q.as_slice(), s.t, &mut phi);
+            worst = phi.iter().fold(worst, |m, x| m.max(x.abs()));
+            Ok(Flow::Continue)
+        };
+        sim.run_observed(RunConfig::new(steps as f64 * h, h), &mut watch)
+            .map_err(|e| format!("{spec}: {e}"))?;
+        sec.claims.push(Claim::check(
+            format!("{spec} keeps a torque-free body's director constraints at round-off (1e-13) over {steps} steps"),
+            worst <= 1e-13,
+            format!("max abs(Phi) {} over {steps} steps of h = pi/50", fmt_e(worst)),
+        ));
+    }
     Ok(())
 }
 
