@@ -52,6 +52,7 @@
 mod accel;
 mod adaptive;
 mod consistent;
+mod constrained;
 mod dense;
 mod error;
 mod guard;
@@ -70,6 +71,7 @@ mod state;
 mod tableau;
 
 pub use accel::AccelerationSolver;
+pub use constrained::ConstrainedSolve;
 pub use adaptive::{run_adaptive, AdaptiveConfig, AdaptiveIntegrator, StepAttempt};
 pub use consistent::{
     consistent_state, initial_changes, project_state, ConsistentOptions, ConsistentState,

@@ -4,8 +4,9 @@
 //! [`crate::SPARSE_THRESHOLD`] constraints.
 
 use crate::error::SolveError;
-use crate::linalg::{max_abs, BodyFactorError, BodySchur, DenseSchur, FactorError};
-use crate::sparse::{ConstraintSchur, LinearSolver, SparseBodySchur};
+use crate::constrained::ConstrainedSolve;
+use crate::linalg::{max_abs, BodyFactorError, DenseSchur, FactorError};
+use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;
 
 /// The position projection stops at `max(tol, PROJECTION_ROUNDOFF_FACTOR eps max(1, |x, y|,
@@ -47,20 +48,11 @@ enum Kernel {
 /// The body-eliminated kernel and its buffers: the correction and the multipliers.
 #[derive(Debug)]
 struct BodiesKernel {
-    schur: BodySolve,
-    /// `gamma` of the sparse kernel's row update (not used by a projection).
-    gamma: Vec<f64>,
+    schur: ConstrainedSolve,
     delta: Vec<f64>,
     lambda: Vec<f64>,
     zeros: Vec<f64>,
     target: Vec<f64>,
-}
-
-/// The body-eliminated solve from the dense `Phi_q`, or over body blocks on the sparse path.
-#[derive(Debug)]
-enum BodySolve {
-    Dense(Box<BodySchur>),
-    Sparse(Box<SparseBodySchur>),
 }
 
 /// Projects `q` onto `Phi(q, t) = 0` by Newton with the minimum `M`-norm correction
@@ -102,12 +94,7 @@ impl Projector {
         let kernel = if sys.has_spatial() {
             let n = sys.n_coords();
             Kernel::Bodies(Box::new(BodiesKernel {
-                schur: if linear.use_sparse(m) {
-                    BodySolve::Sparse(Box::new(SparseBodySchur::new(sys)?))
-                } else {
-                    BodySolve::Dense(Box::new(BodySchur::new(sys)))
-                },
-                gamma: vec![0.0; m],
+                schur: ConstrainedSolve::new(sys, linear)?,
                 delta: vec![0.0; n],
                 lambda: vec![0.0; m],
                 zeros: vec![0.0; n],
@@ -139,7 +126,7 @@ impl Projector {
     pub fn is_sparse(&self) -> bool {
         match &self.kernel {
             Kernel::Sparse(_) => true,
-            Kernel::Bodies(k) => matches!(k.schur, BodySolve::Sparse(_)),
+            Kernel::Bodies(k) => k.schur.is_sparse(),
             Kernel::Dense(_) => false,
         }
     }
@@ -158,19 +145,7 @@ impl Projector {
                 schur.update(sys, q);
                 schur.factor(minv)
             }
-            Kernel::Bodies(k) => {
-                let res = match &mut k.schur {
-                    BodySolve::Dense(schur) => {
-                        sys.phi_q(q, &mut schur.phi_q);
-                        schur.factor(sys, q, minv)
-                    }
-                    BodySolve::Sparse(schur) => {
-                        schur.update(sys, q, None, t, &mut k.gamma);
-                        schur.factor(sys, minv)
-                    }
-                };
-                return res.map_err(|e| bodies_error(sys, t, e));
-            }
+            Kernel::Bodies(k) => return k.schur.factor_weighted(sys, q, t, minv),
         };
         res.map_err(|e| {
             let i = match e {
@@ -204,14 +179,10 @@ impl Projector {
                 for (t, r) in k.target.iter_mut().zip(&self.r) {
                     *t = -r;
                 }
-                match &mut k.schur {
-                    BodySolve::Dense(schur) => {
-                        schur.solve(minv, &k.zeros, &k.target, &mut k.delta, &mut k.lambda)
-                    }
-                    BodySolve::Sparse(schur) => {
-                        schur.solve(minv, &k.zeros, &k.target, &mut k.delta, &mut k.lambda)
-                    }
-                }
+                // (the sizes are the model's: the solve cannot refuse them)
+                let _ = k
+                    .schur
+                    .solve(&k.zeros, &k.target, &mut k.delta, &mut k.lambda);
                 for (xi, d) in x.iter_mut().zip(&k.delta) {
                     *xi += d;
                 }
