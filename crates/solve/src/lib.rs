@@ -71,12 +71,12 @@ mod state;
 mod tableau;
 
 pub use accel::AccelerationSolver;
-pub use constrained::ConstrainedSolve;
 pub use adaptive::{run_adaptive, AdaptiveConfig, AdaptiveIntegrator, StepAttempt};
 pub use consistent::{
     consistent_state, initial_changes, project_state, ConsistentOptions, ConsistentState,
     InitialChange, INITIAL_CHANGE_TOL,
 };
+pub use constrained::ConstrainedSolve;
 pub use dense::{Crossing, DenseOutput, Event, EventFn, EventHit};
 pub use error::{refuse_large_spatial, refuse_redundant, refuse_spatial, SolveError};
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};

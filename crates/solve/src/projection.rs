@@ -3,8 +3,8 @@
 //! Dense for small systems, on the sparse kernel ([`ConstraintSchur`]) above
 //! [`crate::SPARSE_THRESHOLD`] constraints.
 
-use crate::error::SolveError;
 use crate::constrained::ConstrainedSolve;
+use crate::error::SolveError;
 use crate::linalg::{max_abs, BodyFactorError, DenseSchur, FactorError};
 use crate::sparse::{ConstraintSchur, LinearSolver};
 use mbd_model::System;

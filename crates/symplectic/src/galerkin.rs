@@ -6,7 +6,9 @@ use crate::tables::Tables;
 use dense::stage_lu;
 use mbd_model::System;
 use mbd_solve::linalg::{DenseCholesky, DenseLu};
-use mbd_solve::{AccelerationSolver, Integrator, LinearSolver, SolveError, State, StepStats};
+use mbd_solve::{
+    AccelerationSolver, ConstrainedSolve, Integrator, LinearSolver, SolveError, State, StepStats,
+};
 use nalgebra::DMatrix;
 use sparse::{add_transpose, SparseStage};
 
@@ -32,7 +34,16 @@ pub struct Galerkin {
     n: usize,
     m: usize,
     dim: usize,
+    /// The momentum rows' scale: `M^-1` on coordinates with mass; on a massless one (a
+    /// director of a spatial body with `E_i = 0`) the inverse of its body's largest second
+    /// moment, its row being a force balance (`unit` 0).
     minv: Vec<f64>,
+    /// 1 on coordinates with mass, 0 on massless ones: the kinetic terms' factor in the
+    /// `M^-1`-scaled momentum rows.
+    unit: Vec<f64>,
+    /// Models with spatial bodies: the end velocity from the end momentum by the constrained
+    /// solve (`M` may be singular), with its right-hand side and multipliers.
+    end_solve: Option<Box<EndSolve>>,
     kappa: f64,
     nonconservative: bool,
     x: Vec<f64>,
@@ -198,7 +209,21 @@ impl Galerkin {
             n,
             m,
             dim,
-            minv: sys.inv_mass_diag().as_slice().to_vec(),
+            minv: row_scale(sys),
+            unit: sys
+                .mass_diag()
+                .iter()
+                .map(|&m| if m > 0.0 { 1.0 } else { 0.0 })
+                .collect(),
+            end_solve: if sys.has_spatial() {
+                Some(Box::new(EndSolve {
+                    solve: ConstrainedSolve::new(sys, LinearSolver::Dense)?,
+                    p: vec![0.0; n],
+                    r: vec![0.0; m],
+                }))
+            } else {
+                None
+            },
             kappa: kappa(s),
             nonconservative: !sys.is_conservative(),
             x: vec![0.0; dim],
@@ -472,9 +497,9 @@ impl Galerkin {
                         ak += bd[j] * self.hvj[j * n + i];
                         ag += ba[j] * self.gj[j * n + i];
                     }
-                    let mut res = ak - h2 * self.minv[i] * (ag + sp.al[i]);
+                    let mut res = self.unit[i] * ak - h2 * self.minv[i] * (ag + sp.al[i]);
                     if nu == 0 {
-                        res += self.hvk[i];
+                        res += self.unit[i] * self.hvk[i];
                     }
                     self.r[nu * n + i] = res;
                 }
@@ -502,9 +527,9 @@ impl Galerkin {
                     .zip(lam)
                     .map(|(a, b)| a * b)
                     .sum();
-                let mut res = ak - h2 * self.minv[i] * (ag + al);
+                let mut res = self.unit[i] * ak - h2 * self.minv[i] * (ag + al);
                 if nu == 0 {
-                    res += self.hvk[i];
+                    res += self.unit[i] * self.hvk[i];
                 }
                 self.r[nu * n + i] = res;
             }
@@ -578,8 +603,9 @@ pub(super) fn with_time(e: SolveError, t: f64) -> SolveError {
 }
 
 /// What the symplectic scheme runs with spatial bodies: the plain (s,s) scheme on the dense
-/// path, for bodies with a regular mass matrix (its residual is scaled by `M^-1`). The
-/// preadjustments' derivative passes are planar.
+/// path, singular mass matrices included (their massless coordinates' momentum rows are force
+/// balances, and the end velocity comes from the constrained solve). The preadjustments'
+/// derivative passes are planar.
 fn spatial_support(sys: &System, modlag: bool, gamma: f64) -> Result<(), SolveError> {
     if modlag || gamma != 0.0 {
         return mbd_solve::refuse_spatial(
@@ -587,12 +613,31 @@ fn spatial_support(sys: &System, modlag: bool, gamma: f64) -> Result<(), SolveEr
             "the preadjusted symplectic scheme (gamma or :modified)",
         );
     }
-    match sys.singular_mass_body() {
-        Some(body) => Err(SolveError::Unsupported(format!(
-            "the symplectic scheme scales its residual by M^-1, and spatial body '{body}' has a \
-             singular mass matrix (a principal moment equals the sum of the other two: a thin \
-             disc or plate); run it with rk4-projected, index1:dopri5 or tangent:rk4"
-        ))),
-        None => Ok(()),
+    Ok(())
+}
+
+/// The momentum rows' scale ([`Galerkin`]'s `minv`): `M^-1`, and on a massless coordinate of
+/// a spatial body the inverse of that body's largest second moment.
+fn row_scale(sys: &System) -> Vec<f64> {
+    let mut w = sys.inv_mass_diag().as_slice().to_vec();
+    let q0 = sys.spatial_offset();
+    for (k, b) in sys.spatial_bodies().iter().enumerate() {
+        let e = b.inertia.second_moments();
+        let e_max = e[0].max(e[1]).max(e[2]);
+        for x in &mut w[q0 + 12 * k + 3..q0 + 12 * k + 12] {
+            if !x.is_finite() {
+                *x = 1.0 / e_max;
+            }
+        }
     }
+    w
+}
+
+/// The end velocity of a model with spatial bodies: `M v + Phi_q^T mu = p`,
+/// `Phi_q v = -Phi_t` at the end of the step.
+#[derive(Debug)]
+pub(super) struct EndSolve {
+    pub(super) solve: ConstrainedSolve,
+    pub(super) p: Vec<f64>,
+    pub(super) r: Vec<f64>,
 }

@@ -107,7 +107,7 @@ impl Galerkin {
                 let (ro, co) = (nu * n, (mu - 1) * n);
                 let kk = tab.k[nu * s1 + mu];
                 for i in 0..n {
-                    jm.add(ro + i, co + i, kk);
+                    jm.add(ro + i, co + i, kk * self.unit[i]);
                 }
                 for j in 0..s {
                     if !self.hess_nz[j] {

@@ -144,6 +144,19 @@ impl Integrator for Galerkin {
             sp.schur.solve_in_place(&mut self.mu);
             sp.schur
                 .add_weighted_transpose(-1.0, &self.minv, &self.mu, &mut self.vm);
+        } else if let Some(es) = self.end_solve.as_deref_mut() {
+            // singular mass matrices: M v + Phi_q^T mu = M v_k - h f, Phi_q v = -Phi_t
+            for (i, p) in es.p.iter_mut().enumerate() {
+                *p = sys.mass_diag()[i] * state.v[i] - h * f[i];
+            }
+            sys.phi_t(t1, &mut es.r);
+            for r in es.r.iter_mut() {
+                *r = -*r;
+            }
+            es.solve.factor(sys, qn1, t1)?;
+            es.solve.solve(&es.p, &es.r, &mut self.vm, &mut self.mu)?;
+            sys.phi_q(qn1, &mut self.phiq[s]);
+            self.end_phiq_valid = true;
         } else if m > 0 {
             sys.phi_q(qn1, &mut self.phiq[s]);
             self.end_phiq_valid = true;
