@@ -121,6 +121,8 @@ pub struct CsvObserver<W: Write> {
     reactions: bool,
     /// The reaction workspace (built at the first row that needs it) and its buffer.
     reaction_solver: Option<(ReactionSolver, Vec<JointReaction>)>,
+    /// The spatial joints' reactions of the current row.
+    spatial_reactions: Vec<mbd_model::spatial::SpatialJointReaction>,
     sensors: bool,
     /// The sensor workspace (built at the first row that needs it).
     sensor_solver: Option<SensorSolver>,
@@ -146,6 +148,7 @@ impl<W: Write> CsvObserver<W> {
             residuals: false,
             reactions: false,
             reaction_solver: None,
+            spatial_reactions: Vec::new(),
             sensors: false,
             sensor_solver: None,
             energy_balance: false,
@@ -273,7 +276,15 @@ impl<W: Write> CsvObserver<W> {
                 self.row.extend([r.force[0], r.force[1], r.moment]);
             }
             if !sys.spatial_joints().is_empty() {
-                for r in sys.spatial_joint_reactions(s.q.as_slice(), lambda)? {
+                // sized once: a written row allocates nothing
+                self.spatial_reactions
+                    .resize(sys.spatial_joints().len(), Default::default());
+                sys.spatial_joint_reactions_into(
+                    s.q.as_slice(),
+                    lambda,
+                    &mut self.spatial_reactions,
+                )?;
+                for r in &self.spatial_reactions {
                     self.row.extend(r.force.iter().chain(&r.moment));
                 }
             }

@@ -485,26 +485,53 @@ impl crate::System {
         q: &[f64],
         lambda: &[f64],
     ) -> Result<Vec<SpatialJointReaction>, crate::ModelError> {
+        let mut out = vec![SpatialJointReaction::default(); self.spatial.joints.len()];
+        self.spatial_joint_reactions_into(q, lambda, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`crate::System::spatial_joint_reactions`] into `out` (one entry per spatial joint),
+    /// allocating nothing: what an output loop calls at every row. Errors: `q`, `lambda` or
+    /// `out` of the wrong length.
+    pub fn spatial_joint_reactions_into(
+        &self,
+        q: &[f64],
+        lambda: &[f64],
+        out: &mut [SpatialJointReaction],
+    ) -> Result<(), crate::ModelError> {
         self.check_len("q", q, self.n)?;
         self.check_len("lambda", lambda, self.m)?;
         let sp = &self.spatial;
-        let mut loads = vec![[0.0; SW]; sp.lowered.len()];
-        sp.rows(q, None, |row, _, jet| {
-            if let Some(j) = sp.joint_row.iter().rposition(|&r| r <= row) {
-                if row < sp.joint_row[j] + sp.lowered[j].n_equations() {
-                    for (l, g) in loads[j].iter_mut().zip(&jet.g) {
-                        *l -= lambda[row] * g;
-                    }
-                }
-            }
-        });
+        if out.len() != sp.joints.len() {
+            return Err(crate::ModelError::Dimension {
+                what: "reactions",
+                expected: sp.joints.len(),
+                got: out.len(),
+            });
+        }
+        const ZERO: [f64; 12] = [0.0; 12];
         let frame = |k: usize| {
             let o = sp.q0 + 12 * k;
             let v = |i: usize| nalgebra::Vector3::new(q[o + i], q[o + i + 1], q[o + i + 2]);
             (v(0), [v(3), v(6), v(9)])
         };
-        let mut out = Vec::with_capacity(loads.len());
-        for (j, g) in loads.iter().enumerate() {
+        for (j, slot) in out.iter_mut().enumerate() {
+            // the joint's share of the constraint force: g = -Phi_q,j^T lambda_j
+            let local = |s: usize| {
+                sp.attach[j][s].map(|k| {
+                    let o = sp.q0 + 12 * k;
+                    (&q[o..o + 12], &ZERO[..])
+                })
+            };
+            let mut e = [mbd_jet::DirJetN::<SW>::cst(0.0); 6];
+            sp.lowered[j].eval_jets(local(0), local(1), &mut e);
+            let mut g = [0.0; SW];
+            let row0 = sp.joint_row[j];
+            for (k, ek) in e.iter().enumerate().take(sp.lowered[j].n_equations()) {
+                for (gl, d) in g.iter_mut().zip(&ek.g) {
+                    *gl -= lambda[row0 + k] * d;
+                }
+            }
             let (ma, mb) = sp.lowered[j].markers();
             // the second side, or the first with the sign of action and reaction
             let (side, marker, off, sign) = match (sp.attach[j][1], sp.attach[j][0]) {
@@ -513,7 +540,7 @@ impl crate::System {
                 (None, None) => (None, mb, 12, 1.0),
             };
             let Some(k) = side else {
-                out.push(SpatialJointReaction::default());
+                *slot = SpatialJointReaction::default();
                 continue;
             };
             let (x, d) = frame(k);
@@ -529,12 +556,12 @@ impl crate::System {
             }
             let p = x + d[0] * marker.point[0] + d[1] * marker.point[1] + d[2] * marker.point[2];
             let m = tau + (x - p).cross(&f);
-            out.push(SpatialJointReaction {
+            *slot = SpatialJointReaction {
                 force: (f * sign).into(),
                 moment: (m * sign).into(),
                 point: p.into(),
-            });
+            };
         }
-        Ok(out)
+        Ok(())
     }
 }
