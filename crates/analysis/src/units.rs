@@ -1,12 +1,15 @@
 //! SI units of the columns that [`CsvObserver`](crate::CsvObserver) writes (and `mbd run`
 //! with it), for axis labels: the one place that knows them.
 //!
-//! The unit follows from the column's name alone: `t` (s); a coordinate `body.x`, `body.y` (m),
-//! `body.theta` (rad); a velocity `d_body.x` (m/s), `d_body.theta` (rad/s); the energy `H` and
+//! The unit follows from the column's name alone: `t` (s); a coordinate `body.x`, `body.y`,
+//! `body.z` (m), `body.theta` (rad); a velocity `d_body.x` (m/s), `d_body.theta` (rad/s); the
+//! energy `H` and
 //! the energy balance `W_external`, `E_dissipated`, `energy_balance` (J); a joint reaction
 //! `joint.fx`, `joint.fy`, a spatial joint's `.fz` (N), `joint.mz`, `.mx`, `.my` (N m) and a
 //! reaction sensor's `.fx_body`,
-//! `.fy_body` (N); a point sensor's `.vx`, `.vy` (m/s), `.ax`, `.ay` (m/s^2); a joint sensor's
+//! `.fy_body` (N); a point sensor's `.vx`, `.vy`, `.vz` (m/s), `.ax`, `.ay`, `.az` (m/s^2); an
+//! angular velocity sensor's `.wx`, `.wy`, `.wz`, `.wx_body`, `.wy_body`, `.wz_body` (rad/s);
+//! a joint sensor's
 //! `.angle` (rad), `.rate` (rad/s), `.s` (m), `.ds` (m/s); an energy sensor's `.kinetic`,
 //! `.potential`, `.total` (J).
 //! The constraint residuals `max_abs_phi`, `max_abs_phidot` have none (their equations mix
@@ -36,11 +39,12 @@ pub fn unit_of(column: &str) -> Option<&'static str> {
     }
     let rate = owner.starts_with("d_") && owner.len() > 2;
     Some(match (part, rate) {
-        ("x" | "y", false) | ("s", _) => "m",
-        ("x" | "y", true) | ("vx" | "vy" | "ds", _) => "m/s",
+        ("x" | "y" | "z", false) | ("s", _) => "m",
+        ("x" | "y" | "z", true) | ("vx" | "vy" | "vz" | "ds", _) => "m/s",
         ("theta", false) | ("angle", _) => "rad",
         ("theta", true) | ("rate", _) => "rad/s",
-        ("ax" | "ay", _) => "m/s^2",
+        ("wx" | "wy" | "wz" | "wx_body" | "wy_body" | "wz_body", _) => "rad/s",
+        ("ax" | "ay" | "az", _) => "m/s^2",
         ("fx" | "fy" | "fz" | "fx_body" | "fy_body", _) => "N",
         ("mx" | "my", _) => "N m",
         ("kinetic" | "potential" | "total", _) => "J",
@@ -84,6 +88,9 @@ mod tests {
     #[test]
     fn reaction_and_energy_sensors() {
         assert_eq!(unit_of("pin.fx_body"), Some("N"));
+        assert_eq!(unit_of("tip.az"), Some("m/s^2"));
+        assert_eq!(unit_of("top.wz_body"), Some("rad/s"));
+        assert_eq!(unit_of("d_top.z"), Some("m/s"));
         assert_eq!(unit_of("pin.fy_body"), Some("N"));
         for c in ["e.kinetic", "e.potential", "e.total"] {
             assert_eq!(unit_of(c), Some("J"), "{c}");

@@ -521,6 +521,7 @@ impl System {
                 }
             }
             sensor.validate()?;
+            sensor.check_spatial(spatial.bodies.len(), spatial.joints.len())?;
         }
 
         let n = 3 * nb;

@@ -5,6 +5,7 @@
 use crate::body::BodyRef;
 use crate::check::invalid;
 use crate::error::ModelError;
+use crate::spatial::{SpatialBodyHandle, SpatialBodyRef};
 use crate::system::JointHandle;
 use serde::{Deserialize, Serialize};
 
@@ -53,6 +54,34 @@ pub enum SensorKind {
         /// The body, or `None` for the whole model.
         body: Option<BodyRef>,
     },
+    /// A point of a spatial body (body frame, from the centre of mass; ground: a global fixed
+    /// point): its position, velocity and acceleration in global axes, columns `NAME.x`, `.y`,
+    /// `.z`, `.vx`, `.vy`, `.vz`, `.ax`, `.ay`, `.az`.
+    SpatialPoint {
+        /// The body.
+        body: SpatialBodyRef,
+        /// The point.
+        point: [f64; 3],
+    },
+    /// A spatial body's angular velocity (rad/s): global components `NAME.wx`, `.wy`, `.wz`
+    /// and the body frame's `NAME.wx_body`, `.wy_body`, `.wz_body`.
+    AngularVelocity {
+        /// The body.
+        body: SpatialBodyHandle,
+    },
+    /// The load a spatial joint exerts on its second body
+    /// ([`crate::System::spatial_joint_reactions`]): force `NAME.fx`, `.fy`, `.fz` (N) and moment
+    /// about the joint's point on that body `NAME.mx`, `.my`, `.mz` (N m), global axes.
+    SpatialReaction {
+        /// The joint's index among the spatial joints.
+        joint: usize,
+    },
+    /// A spatial body's kinetic energy and the potential of gravity on it (J), columns
+    /// `NAME.kinetic`, `.potential`, `.total`.
+    SpatialEnergy {
+        /// The body.
+        body: SpatialBodyHandle,
+    },
 }
 
 impl Sensor {
@@ -92,6 +121,46 @@ impl Sensor {
         }
     }
 
+    /// A point sensor on a spatial body (see [`SensorKind::SpatialPoint`]).
+    pub fn spatial_point(
+        name: impl Into<String>,
+        body: impl Into<SpatialBodyRef>,
+        point: [f64; 3],
+    ) -> Self {
+        Sensor {
+            name: name.into(),
+            kind: SensorKind::SpatialPoint {
+                body: body.into(),
+                point,
+            },
+        }
+    }
+
+    /// A spatial body's angular velocity (see [`SensorKind::AngularVelocity`]).
+    pub fn angular_velocity(name: impl Into<String>, body: SpatialBodyHandle) -> Self {
+        Sensor {
+            name: name.into(),
+            kind: SensorKind::AngularVelocity { body },
+        }
+    }
+
+    /// A spatial joint's reaction (see [`SensorKind::SpatialReaction`]); `joint` is its index
+    /// among the spatial joints (what [`crate::SystemBuilder::add_spatial_joint`] returns).
+    pub fn spatial_reaction(name: impl Into<String>, joint: usize) -> Self {
+        Sensor {
+            name: name.into(),
+            kind: SensorKind::SpatialReaction { joint },
+        }
+    }
+
+    /// A spatial body's energies (see [`SensorKind::SpatialEnergy`]).
+    pub fn spatial_energy(name: impl Into<String>, body: SpatialBodyHandle) -> Self {
+        Sensor {
+            name: name.into(),
+            kind: SensorKind::SpatialEnergy { body },
+        }
+    }
+
     /// The joint a joint or reaction sensor reads, if any.
     pub(crate) fn joint_read(&self) -> Option<JointHandle> {
         match self.kind {
@@ -101,15 +170,42 @@ impl Sensor {
     }
 
     pub(crate) fn validate(&self) -> Result<(), ModelError> {
-        if let SensorKind::Point { point, .. } = &self.kind {
-            if !(point[0].is_finite() && point[1].is_finite()) {
-                return Err(invalid(
-                    format!("sensor '{}'", self.name),
-                    format!("point {point:?} must be finite"),
-                ));
-            }
+        let finite = match &self.kind {
+            SensorKind::Point { point, .. } => point.iter().all(|x| x.is_finite()),
+            SensorKind::SpatialPoint { point, .. } => point.iter().all(|x| x.is_finite()),
+            _ => true,
+        };
+        if !finite {
+            return Err(invalid(
+                format!("sensor '{}'", self.name),
+                "its point must be finite".to_string(),
+            ));
         }
         Ok(())
+    }
+
+    /// Checks the spatial body or joint a sensor reads against the model's `bodies` and
+    /// `joints` spatial counts; errors name the sensor.
+    pub(crate) fn check_spatial(&self, bodies: usize, joints: usize) -> Result<(), ModelError> {
+        let (what, k, n) = match self.kind {
+            SensorKind::SpatialPoint { body, .. } => match body.index() {
+                Some(k) => ("spatial body", k, bodies),
+                None => return Ok(()),
+            },
+            SensorKind::AngularVelocity { body } | SensorKind::SpatialEnergy { body } => {
+                ("spatial body", body.index(), bodies)
+            }
+            SensorKind::SpatialReaction { joint } => ("spatial joint", joint, joints),
+            _ => return Ok(()),
+        };
+        if k < n {
+            Ok(())
+        } else {
+            Err(invalid(
+                format!("sensor '{}'", self.name),
+                format!("{what} #{k} does not exist (the model has {n})"),
+            ))
+        }
     }
 }
 
@@ -145,12 +241,32 @@ pub enum SensorSpec {
         joint: String,
     },
     /// Kinetic, potential and total energy (`NAME.kinetic`, `.potential`, `.total`) of the
-    /// model, or of one body (its kinetic energy and the potential of gravity on it).
+    /// model, or of one body, planar or spatial (its kinetic energy and the potential of
+    /// gravity on it).
     Energy {
         /// Unique sensor name.
         name: String,
         /// The body; absent for the whole model.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         body: Option<String>,
+    },
+    /// A point of a spatial body: position, velocity and acceleration in global axes
+    /// (`NAME.x`, `.y`, `.z`, `.vx`, `.vy`, `.vz`, `.ax`, `.ay`, `.az`).
+    SpatialPoint {
+        /// Unique sensor name.
+        name: String,
+        /// The spatial body (`ground` for a fixed point).
+        body: String,
+        /// The point on it (body frame, from the centre of mass), m.
+        #[serde(default)]
+        point: [f64; 3],
+    },
+    /// A spatial body's angular velocity, global (`NAME.wx`, `.wy`, `.wz`) and in its body
+    /// frame (`NAME.wx_body`, `.wy_body`, `.wz_body`), rad/s.
+    AngularVelocity {
+        /// Unique sensor name.
+        name: String,
+        /// The spatial body.
+        body: String,
     },
 }

@@ -17,6 +17,7 @@ use crate::error::SolveError;
 use crate::output_solve::OutputSolve;
 use crate::reactions::{joint_reactions, JointReaction};
 use crate::state::State;
+use mbd_model::spatial::SpatialJointReaction;
 use mbd_model::{SensorKind, System};
 
 /// Evaluates a model's sensors; a workspace allocated once.
@@ -52,6 +53,8 @@ pub struct SensorSolver {
     /// Every joint's reaction and the constraint gradients behind them, when a reaction
     /// sensor needs them.
     reactions: Option<(Vec<[f64; 6]>, Vec<JointReaction>)>,
+    /// The spatial joints' reactions, when a spatial reaction sensor needs them.
+    spatial_reactions: Option<Vec<SpatialJointReaction>>,
 }
 
 impl SensorSolver {
@@ -70,8 +73,16 @@ impl SensorSolver {
             solve: None,
             zeros: vec![0.0; sys.n_coords()],
             zero_lambda: vec![0.0; sys.n_constraints()],
-            needs_acceleration: kinds().any(|k| matches!(k, SensorKind::Point { .. })),
+            needs_acceleration: kinds().any(|k| {
+                matches!(
+                    k,
+                    SensorKind::Point { .. } | SensorKind::SpatialPoint { .. }
+                )
+            }),
             reactions,
+            spatial_reactions: kinds()
+                .any(|k| matches!(k, SensorKind::SpatialReaction { .. }))
+                .then(|| vec![SpatialJointReaction::default(); sys.spatial_joints().len()]),
         })
     }
 
@@ -93,7 +104,16 @@ impl SensorSolver {
                     }
                 }
                 SensorKind::Reaction { .. } => &["fx", "fy", "mz", "fx_body", "fy_body"],
-                SensorKind::Energy { .. } => &["kinetic", "potential", "total"],
+                SensorKind::Energy { .. } | SensorKind::SpatialEnergy { .. } => {
+                    &["kinetic", "potential", "total"]
+                }
+                SensorKind::SpatialPoint { .. } => {
+                    &["x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"]
+                }
+                SensorKind::AngularVelocity { .. } => {
+                    &["wx", "wy", "wz", "wx_body", "wy_body", "wz_body"]
+                }
+                SensorKind::SpatialReaction { .. } => &["fx", "fy", "fz", "mx", "my", "mz"],
                 _ => &[],
             };
             out.extend(parts.iter().map(|p| format!("{}.{p}", s.name)));
@@ -115,14 +135,22 @@ impl SensorSolver {
             state.check(sys)?;
             (self.zeros.as_slice(), self.zero_lambda.as_slice())
         };
-        values(sys, state, a, lambda, &mut self.reactions, out)
+        values(
+            sys,
+            state,
+            a,
+            lambda,
+            &mut self.reactions,
+            &mut self.spatial_reactions,
+            out,
+        )
     }
 
     /// Whether a sensor needs the index-1 solve at the state (a point sensor its
     /// accelerations, a reaction sensor its multipliers): what
     /// [`SensorSolver::evaluate_with`] is to be given.
     pub fn needs_solve(&self) -> bool {
-        self.needs_acceleration || self.reactions.is_some()
+        self.needs_acceleration || self.reactions.is_some() || self.spatial_reactions.is_some()
     }
 
     /// [`SensorSolver::evaluate`] with the accelerations `a` and multipliers `lambda` at
@@ -150,7 +178,15 @@ impl SensorSolver {
                 });
             }
         }
-        values(sys, state, a, lambda, &mut self.reactions, out)
+        values(
+            sys,
+            state,
+            a,
+            lambda,
+            &mut self.reactions,
+            &mut self.spatial_reactions,
+            out,
+        )
     }
 }
 
@@ -162,11 +198,15 @@ fn values(
     a: &[f64],
     lambda: &[f64],
     reactions: &mut Option<(Vec<[f64; 6]>, Vec<JointReaction>)>,
+    spatial_reactions: &mut Option<Vec<SpatialJointReaction>>,
     out: &mut Vec<f64>,
 ) -> Result<(), SolveError> {
     let (q, v) = (state.q.as_slice(), state.v.as_slice());
     if let Some((grads, loads)) = reactions {
         joint_reactions(grads, sys, state, lambda, loads)?;
+    }
+    if let Some(loads) = spatial_reactions {
+        sys.spatial_joint_reactions_into(q, lambda, loads)?;
     }
     // a body point's position, velocity and acceleration (ground: fixed)
     let kinematics = |i: Option<usize>, p: [f64; 2]| -> [[f64; 2]; 3] {
@@ -229,8 +269,79 @@ fn values(
                 };
                 out.extend([t, u, t + u]);
             }
+            SensorKind::SpatialPoint { body, point } => {
+                spatial_point(sys, body.index(), *point, [q, v, a], out);
+            }
+            SensorKind::AngularVelocity { body } => {
+                let k = body.index();
+                let w = sys
+                    .spatial_body_angular_velocity(k, q, v)
+                    .unwrap_or_default();
+                let (d, axes) = match sys.spatial_bodies().get(k) {
+                    Some(b) => (directors(sys, k, q), *b.inertia.axes()),
+                    None => ([[0.0; 3]; 3], nalgebra::Matrix3::identity()),
+                };
+                // global: sum_i w_i d_i; body frame: A w (A the principal axes in it)
+                let global: [f64; 3] =
+                    std::array::from_fn(|c| (0..3).map(|i| w[i] * d[i][c]).sum());
+                let body_axes = axes * nalgebra::Vector3::from(w);
+                out.extend(global);
+                out.extend(body_axes.iter());
+            }
+            SensorKind::SpatialReaction { joint } => {
+                let r = spatial_reactions
+                    .as_ref()
+                    .and_then(|loads| loads.get(*joint))
+                    .copied()
+                    .unwrap_or_default();
+                out.extend(r.force.iter().chain(&r.moment));
+            }
+            SensorKind::SpatialEnergy { body } => {
+                let k = body.index();
+                let o = sys.spatial_offset() + 12 * k;
+                let g = sys.spatial_gravity();
+                let (t, u) = match sys.spatial_bodies().get(k) {
+                    Some(b) => (
+                        (o..o + 12)
+                            .map(|i| 0.5 * mass[i] * v[i] * v[i])
+                            .sum::<f64>(),
+                        -b.inertia.mass() * (0..3).map(|c| g[c] * q[o + c]).sum::<f64>(),
+                    ),
+                    None => (0.0, 0.0),
+                };
+                out.extend([t, u, t + u]);
+            }
             _ => {}
         }
     }
     Ok(())
+}
+
+/// Spatial body `k`'s directors at `q`.
+fn directors(sys: &System, k: usize, q: &[f64]) -> [[f64; 3]; 3] {
+    let o = sys.spatial_offset() + 12 * k;
+    std::array::from_fn(|i| std::array::from_fn(|c| q[o + 3 + 3 * i + c]))
+}
+
+/// A spatial body point's position, velocity and acceleration (linear in the natural
+/// coordinates: `P = x + sum_i p_i d_i` with `p` in the principal frame), or a fixed point.
+fn spatial_point(
+    sys: &System,
+    body: Option<usize>,
+    point: [f64; 3],
+    [q, v, a]: [&[f64]; 3],
+    out: &mut Vec<f64>,
+) {
+    let Some((k, b)) = body.and_then(|k| sys.spatial_bodies().get(k).map(|b| (k, b))) else {
+        out.extend(point);
+        out.extend([0.0; 6]);
+        return;
+    };
+    let p = b.inertia.axes().transpose() * nalgebra::Vector3::from(point);
+    let o = sys.spatial_offset() + 12 * k;
+    for y in [q, v, a] {
+        for c in 0..3 {
+            out.push(y[o + c] + (0..3).map(|i| p[i] * y[o + 3 + 3 * i + c]).sum::<f64>());
+        }
+    }
 }

@@ -171,6 +171,21 @@ impl ModelFile {
                 )
             })
         };
+        // spatial bodies and joints by name: their handles are their places in the file
+        // (`add_spatial` adds them in order)
+        let spatial_body = |name: &str| {
+            self.spatial_bodies
+                .iter()
+                .position(|b| b.name == name)
+                .map(crate::spatial::SpatialBodyHandle)
+        };
+        let spatial_joint = |name: &str| self.spatial_joints.iter().position(|j| j.name == name);
+        let unknown_spatial = |sensor: &str, body: &str| {
+            invalid(
+                format!("sensor '{sensor}'"),
+                format!("refers to unknown spatial body '{body}'"),
+            )
+        };
         for s in &self.sensors {
             b.add_sensor(match s {
                 SensorSpec::Point { name, body, point } => {
@@ -179,15 +194,33 @@ impl ModelFile {
                 SensorSpec::Joint { name, joint } => {
                     Sensor::joint(name, sensor_joint(name, joint)?)
                 }
-                SensorSpec::Reaction { name, joint } => {
-                    Sensor::reaction(name, sensor_joint(name, joint)?)
+                SensorSpec::Reaction { name, joint } => match spatial_joint(joint) {
+                    Some(k) if !joints.contains_key(joint) => Sensor::spatial_reaction(name, k),
+                    _ => Sensor::reaction(name, sensor_joint(name, joint)?),
+                },
+                SensorSpec::Energy { name, body } => match body.as_deref().map(spatial_body) {
+                    Some(Some(h)) => Sensor::spatial_energy(name, h),
+                    _ => Sensor::energy(
+                        name,
+                        match body {
+                            Some(body) => Some(find(&format!("sensor '{name}'"), body)?),
+                            None => None,
+                        },
+                    ),
+                },
+                SensorSpec::SpatialPoint { name, body, point } => {
+                    let r = if body.eq_ignore_ascii_case("ground") {
+                        crate::spatial::SpatialBodyRef::Ground
+                    } else {
+                        spatial_body(body)
+                            .ok_or_else(|| unknown_spatial(name, body))?
+                            .into()
+                    };
+                    Sensor::spatial_point(name, r, *point)
                 }
-                SensorSpec::Energy { name, body } => Sensor::energy(
+                SensorSpec::AngularVelocity { name, body } => Sensor::angular_velocity(
                     name,
-                    match body {
-                        Some(body) => Some(find(&format!("sensor '{name}'"), body)?),
-                        None => None,
-                    },
+                    spatial_body(body).ok_or_else(|| unknown_spatial(name, body))?,
                 ),
             });
         }
@@ -216,6 +249,10 @@ impl System {
         };
         let joints = self.joints.iter().map(|j| j.to_spec(&name)).collect();
         let forces = self.forces.iter().map(|f| f.to_spec(&name)).collect();
+        let spatial_name = |r: crate::spatial::SpatialBodyRef| match r.index() {
+            Some(k) => self.spatial.bodies[k].name.clone(),
+            None => "ground".to_string(),
+        };
         let sensors = self
             .sensors
             .iter()
@@ -233,6 +270,23 @@ impl System {
                     name: s.name.clone(),
                     joint: self.joints.get(joint.index())?.name.clone(),
                 }),
+                SensorKind::SpatialPoint { body, point } => Some(SensorSpec::SpatialPoint {
+                    name: s.name.clone(),
+                    body: spatial_name(*body),
+                    point: *point,
+                }),
+                SensorKind::AngularVelocity { body } => Some(SensorSpec::AngularVelocity {
+                    name: s.name.clone(),
+                    body: spatial_name((*body).into()),
+                }),
+                SensorKind::SpatialReaction { joint } => Some(SensorSpec::Reaction {
+                    name: s.name.clone(),
+                    joint: self.spatial.joints.get(*joint)?.name.clone(),
+                }),
+                SensorKind::SpatialEnergy { body } => Some(SensorSpec::Energy {
+                    name: s.name.clone(),
+                    body: Some(spatial_name((*body).into())),
+                }),
                 SensorKind::Energy { body } => Some(SensorSpec::Energy {
                     name: s.name.clone(),
                     body: body.map(name),
@@ -248,10 +302,6 @@ impl System {
                 rate: init.rate,
             })
             .collect();
-        let spatial_name = |r: crate::spatial::SpatialBodyRef| match r.index() {
-            Some(k) => self.spatial.bodies[k].name.clone(),
-            None => "ground".to_string(),
-        };
         ModelFile {
             sensors,
             assembly,
