@@ -27,6 +27,7 @@
 #![warn(missing_docs)]
 
 pub mod animate;
+pub mod animate3d;
 pub mod args;
 pub mod check;
 pub mod error;
