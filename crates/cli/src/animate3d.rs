@@ -7,7 +7,7 @@
 //! * each spatial body as its **equivalent inertia box** ([`equivalent_box`]): the uniform box
 //!   with the body's mass and principal moments, centred at the centre of mass, its edges along
 //!   the directors `d_1, d_2, d_3` (a zero half-extent, a flat plate or a thin rod, is drawn
-//!   with a small thickness, [`Page3`]'s `drawn` half-extents);
+//!   with a small thickness: 0.6 % of the scene's half diagonal);
 //! * a dot at every centre of mass, every joint's marker points (a square for a point on
 //!   ground), lines from each centre of mass to its body's joint points (chains read as
 //!   chains), lines for distance joints and spring-dampers;
