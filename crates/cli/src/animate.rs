@@ -1,4 +1,5 @@
-//! `mbd animate`: a self-contained HTML page animating a result CSV.
+//! `mbd animate`: a self-contained HTML page animating a result CSV (the planar page; a model
+//! with spatial bodies gets the 3D page of [`crate::animate3d`]).
 //!
 //! The page (template `animate.html`, inline CSS and JavaScript, no network access) embeds the
 //! trajectory, the model's geometry and the world extent of every frame as JSON and draws with
@@ -275,20 +276,29 @@ pub fn page(title: &str, sys: &System, t: Vec<f64>, q: Vec<Vec<f64>>) -> Result<
         .replace("__DATA__", &json))
 }
 
-/// Reads the CSV and the model, checks that they belong together and writes the page.
+/// Reads the CSV and the model, checks that they belong together and writes the page: the
+/// planar page, or for a model with spatial bodies the 3D page of [`crate::animate3d`].
 pub fn animate(args: &AnimateArgs) -> Result<(), CliError> {
     let sys = crate::model::load(&args.model)?;
     if sys.has_spatial() {
-        eprintln!(
-            "warning: the animation is planar: the model's {} spatial bod{} not drawn \
-             (plot the columns with `mbd plot`)",
-            sys.spatial_bodies().len(),
-            if sys.spatial_bodies().len() == 1 {
-                "y is"
-            } else {
-                "ies are"
-            }
-        );
+        crate::animate3d::check_trace(&sys, args.trace.as_ref())?;
+        if !sys.bodies().is_empty() {
+            eprintln!(
+                "note: the model's {} planar bod{} drawn as centres of mass in the plane z = 0",
+                sys.bodies().len(),
+                if sys.bodies().len() == 1 {
+                    "y is"
+                } else {
+                    "ies are"
+                }
+            );
+        }
+    } else if let Some(t) = &args.trace {
+        return Err(CliError::Usage(format!(
+            "--trace {}: the model has no spatial bodies; the planar page draws the path of \
+             every centre of mass",
+            t.body
+        )));
     }
     let table = Table::read(&args.csv)?;
     let names = sys.coordinate_names();
@@ -321,7 +331,11 @@ pub fn animate(args: &AnimateArgs) -> Result<(), CliError> {
             .map(|f| f.to_string_lossy())
             .unwrap_or_default()
     );
-    let html = page(&title, &sys, t, q)?;
+    let html = if sys.has_spatial() {
+        crate::animate3d::page(&title, &sys, args.trace.as_ref(), t, q)?
+    } else {
+        page(&title, &sys, t, q)?
+    };
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| CliError::write(&args.out, e))?;
     }

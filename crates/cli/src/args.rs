@@ -41,10 +41,16 @@ Example:
   mbd run examples/models/pendulum.toml --solver symplectic:2:gamma=1 --t-end 2 --h 1e-3";
 
 const ANIMATE_EXAMPLE: &str = "\
-Example:
+Examples:
   mbd animate slider.csv --model examples/models/slider_crank_spring.toml -o slider.html
+  mbd run examples/models/heavy_top.toml --solver rk4-projected --t-end 2 --h 1e-3 --out top.csv
+  mbd animate top.csv --model examples/models/heavy_top.toml --trace top:0,0,0.5 -o top.html
 
-Open the page in a browser; append #t=1.25 to its address to open it paused at t = 1.25 s.";
+A planar model gives a 2D page; a model with spatial bodies a 3D page (each spatial body as its
+equivalent inertia box, joints, links from centres of mass to joints, the path of the --trace
+point; drag to orbit, wheel to zoom, double-click to reset the view). Open the page in a
+browser; append #t=1.25 to its address to open it paused at t = 1.25 s, and on the 3D page
+&az=30&el=20&zoom=1.5 to set the camera (degrees).";
 
 /// `mbd`: simulate planar rigid multibody systems from model files.
 #[derive(Debug, Parser)]
@@ -169,6 +175,56 @@ pub struct AnimateArgs {
     /// Output HTML page.
     #[arg(long, short)]
     pub out: PathBuf,
+    /// The point whose path the 3D page draws (models with spatial bodies): BODY (its centre
+    /// of mass) or BODY:x,y,z (a point in the body's frame, metres from its centre of mass, as
+    /// in model files). Default: the last spatial body's centre of mass.
+    #[arg(long, value_name = "BODY[:x,y,z]", value_parser = parse_trace, allow_hyphen_values = true)]
+    pub trace: Option<TraceSpec>,
+}
+
+/// The `--trace` option of `mbd animate`: a spatial body's name and a point in its body frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceSpec {
+    /// The body's name (checked against the model by `mbd animate`).
+    pub body: String,
+    /// The point in the body frame (m, from the centre of mass); `None`: the centre of mass.
+    pub point: Option<[f64; 3]>,
+}
+
+/// `BODY` or `BODY:x,y,z` (the last `:` followed by a comma-separated triple separates the
+/// point; a body name may itself contain `:`).
+fn parse_trace(s: &str) -> Result<TraceSpec, String> {
+    let s = s.trim();
+    if let Some((body, point)) = s.rsplit_once(':').filter(|(_, p)| p.contains(',')) {
+        let xs: Vec<&str> = point.split(',').collect();
+        let nums: Vec<f64> = xs
+            .iter()
+            .filter_map(|x| x.trim().parse::<f64>().ok())
+            .filter(|x| x.is_finite())
+            .collect();
+        if xs.len() != 3 || nums.len() != 3 {
+            return Err(format!(
+                "'{point}' is not a point x,y,z of three finite numbers (metres in the body's \
+                 frame), e.g. --trace {body}:0,0,0.5"
+            ));
+        }
+        if body.is_empty() {
+            return Err(format!(
+                "no body name before ':{point}', e.g. --trace rod:{point}"
+            ));
+        }
+        return Ok(TraceSpec {
+            body: body.to_string(),
+            point: Some([nums[0], nums[1], nums[2]]),
+        });
+    }
+    if s.is_empty() {
+        return Err("give a spatial body's name, e.g. --trace top or --trace top:0,0,0.5".into());
+    }
+    Ok(TraceSpec {
+        body: s.to_string(),
+        point: None,
+    })
 }
 
 fn parse_solver(s: &str) -> Result<SolverSpec, String> {

@@ -9,7 +9,8 @@
 //! * `mbd check MODEL` validates a model and prints its bodies, joints, degrees of freedom and
 //!   consistent initial state;
 //! * `mbd plot RESULT.csv --y COL [--y COL ...] [--x t] [-o out.svg]` draws an SVG figure;
-//! * `mbd animate RESULT.csv --model MODEL -o anim.html` writes a self-contained animated page;
+//! * `mbd animate RESULT.csv --model MODEL -o anim.html [--trace BODY]` writes a self-contained
+//!   animated page (2D for planar models, 3D for models with spatial bodies);
 //! * `mbd solvers` lists the solvers of the registry (`mbd::registry()`).
 //!
 //! `docs/cli.md` describes the commands, the output columns and the solvers. The library side
@@ -27,6 +28,7 @@
 #![warn(missing_docs)]
 
 pub mod animate;
+pub mod animate3d;
 pub mod args;
 pub mod check;
 pub mod error;

@@ -15,130 +15,13 @@
 //! installed.
 
 mod common;
+use common::browser::{
+    by_id, check_fits_the_window, chrome, chromium, dom_at_1000x700, elements, png_size, Element,
+    WINDOW,
+};
 use common::{mbd, scratch};
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 const MODEL: &str = "examples/models/slider_crank_spring.toml";
-const WINDOW: (f64, f64) = (1000.0, 700.0);
-
-fn chromium() -> Option<PathBuf> {
-    let p = std::env::var_os("CHROMIUM")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
-    p.exists().then_some(p)
-}
-
-/// Runs Chromium headless with a fresh profile in a window of `size`; returns stdout.
-fn chrome(bin: &Path, profile: &Path, size: (f64, f64), extra: &[String]) -> String {
-    let mut child = Command::new(bin)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--no-first-run",
-            "--hide-scrollbars",
-        ])
-        .arg(format!("--window-size={},{}", size.0, size.1))
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args(extra)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("chromium starts");
-    let start = Instant::now();
-    loop {
-        if child.try_wait().expect("wait on chromium").is_some() {
-            break;
-        }
-        if start.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("chromium did not finish within 120 s");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().expect("chromium output");
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// The DOM of the page at `url` as laid out in a 1000 x 700 viewport. Headless Chromium's
-/// `--dump-dom` gives the page less than the window (143 px less height in Chromium 156, as if
-/// for a toolbar; `--screenshot` gives it all), so the window is grown by what the page
-/// reported missing and the page loaded again.
-fn dom_at_1000x700(bin: &Path, dir: &Path, url: &str) -> String {
-    let mut size = WINDOW;
-    for attempt in 0..2 {
-        let profile = dir.join(format!("profile-dom-{attempt}"));
-        let dom = chrome(bin, &profile, size, &["--dump-dom".into(), url.to_string()]);
-        let html = &elements(&dom, "html")[0];
-        let inner = (html.num("data-inner-width"), html.num("data-inner-height"));
-        if inner == WINDOW {
-            return dom;
-        }
-        size = (size.0 + WINDOW.0 - inner.0, size.1 + WINDOW.1 - inner.1);
-    }
-    panic!("no window size gives the page a 1000 x 700 viewport");
-}
-
-/// One element of serialised HTML: its attributes and the text up to its closing tag.
-struct Element {
-    attrs: HashMap<String, String>,
-    text: String,
-}
-
-impl Element {
-    fn get(&self, k: &str) -> Option<&str> {
-        self.attrs.get(k).map(String::as_str)
-    }
-    fn num(&self, k: &str) -> f64 {
-        let v = self
-            .get(k)
-            .unwrap_or_else(|| panic!("attribute {k} missing in {:?}", self.attrs));
-        v.parse()
-            .unwrap_or_else(|_| panic!("attribute {k} = {v:?} is not a number"))
-    }
-    fn has_class(&self, c: &str) -> bool {
-        self.get("class")
-            .is_some_and(|s| s.split_whitespace().any(|w| w == c))
-    }
-}
-
-/// Every `<tag ...>` element of serialised HTML.
-fn elements(html: &str, tag: &str) -> Vec<Element> {
-    let open = format!("<{tag} ");
-    let close = format!("</{tag}>");
-    let mut v = Vec::new();
-    let mut rest = html;
-    while let Some(i) = rest.find(&open) {
-        rest = &rest[i + open.len()..];
-        let end = rest.find('>').expect("tag closes");
-        let mut attrs = HashMap::new();
-        let mut s = &rest[..end];
-        while let Some(eq) = s.find("=\"") {
-            let name = s[..eq].trim().to_string();
-            let after = &s[eq + 2..];
-            let close = after.find('"').expect("attribute closes");
-            attrs.insert(name, after[..close].to_string());
-            s = &after[close + 1..];
-        }
-        let body = &rest[end + 1..];
-        let text = body.find(&close).map_or("", |k| &body[..k]).to_string();
-        v.push(Element { attrs, text });
-    }
-    v
-}
-
-fn by_id<'a>(els: &'a [Element], id: &str) -> &'a Element {
-    els.iter()
-        .find(|e| e.get("id") == Some(id))
-        .unwrap_or_else(|| panic!("no element #{id}"))
-}
-
 /// A box `[x0, x1] x [y0, y1]` in pixels.
 #[derive(Clone, Copy, Debug)]
 struct Rect {
@@ -202,13 +85,6 @@ fn points(e: &Element) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Width and height of a PNG (its IHDR chunk).
-fn png_size(bytes: &[u8]) -> (u32, u32) {
-    assert!(bytes.starts_with(b"\x89PNG"), "not a PNG");
-    let be = |k: usize| u32::from_be_bytes([bytes[k], bytes[k + 1], bytes[k + 2], bytes[k + 3]]);
-    (be(16), be(20))
-}
-
 /// Whether `v` is 1, 2 or 5 times a power of ten.
 fn is_round(v: f64) -> bool {
     let m = v / 10f64.powf(v.log10().floor());
@@ -246,25 +122,6 @@ impl View {
     fn px(&self, p: [f64; 2]) -> (f64, f64) {
         (self.ox + self.scale * p[0], self.oy - self.scale * p[1])
     }
-}
-
-/// The page fits the 1000 x 700 window: no scrollbar either way.
-fn check_fits_the_window(dom: &str) {
-    let html = &elements(dom, "html")[0];
-    let (iw, ih) = (html.num("data-inner-width"), html.num("data-inner-height"));
-    assert_eq!(
-        (iw, ih),
-        WINDOW,
-        "the page was laid out in a 1000 x 700 window"
-    );
-    let (sw, sh) = (
-        html.num("data-scroll-width"),
-        html.num("data-scroll-height"),
-    );
-    assert!(
-        sw <= iw && sh <= ih,
-        "the page needs a scrollbar: content {sw} x {sh} in a {iw} x {ih} window"
-    );
 }
 
 /// Tick labels are round numbers placed where the transform puts their values, `0` included.

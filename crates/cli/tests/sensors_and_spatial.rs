@@ -145,9 +145,10 @@ fn spatial_forces_are_listed_and_balanced() {
 }
 
 /// `mbd run` writes a spatial model's columns (with `--reactions`, the ball joint's force and
-/// zero moment); `mbd animate` says its spatial bodies are not drawn.
+/// zero moment); `mbd animate` draws it on the 3D page without a warning, and a `--trace` body
+/// the model lacks is an error naming it.
 #[test]
-fn a_spatial_model_runs_and_the_animation_says_it_is_planar() {
+fn a_spatial_model_runs_and_is_animated_in_3d() {
     let d = scratch("top");
     let model = common::repo().join("examples/models/heavy_top.toml");
     let csv = d.join("top.csv");
@@ -182,9 +183,44 @@ fn a_spatial_model_runs_and_the_animation_says_it_is_planar() {
     ]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(
-        out.stderr
-            .contains("the animation is planar: the model's 1 spatial body is not drawn"),
+        !out.stderr.contains("warning") && !out.stderr.contains("planar"),
         "{}",
         out.stderr
     );
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(
+        html.contains("data-matrix") || html.contains("mbdCamera"),
+        "the 3D page"
+    );
+    std::fs::remove_file(&page).unwrap();
+    for (trace, needles) in [
+        ("tpo", &["--trace", "'tpo'", "not a body", "top"][..]),
+        ("top:1,2", &["--trace", "'1,2'", "three finite numbers"][..]),
+    ] {
+        let out = mbd([
+            "animate".as_ref(),
+            "--model".as_ref(),
+            model.as_os_str(),
+            "--out".as_ref(),
+            page.as_os_str(),
+            "--trace".as_ref(),
+            trace.as_ref(),
+            csv.as_os_str(),
+        ]);
+        common::assert_fails(&out, 2, needles);
+        assert!(!page.exists(), "no page written for --trace {trace}");
+    }
+    // a planar model has no body to trace in 3D
+    let pend = common::pendulum_csv(&d);
+    let out = mbd([
+        "animate".as_ref(),
+        pend.as_os_str(),
+        "--model".as_ref(),
+        "examples/models/pendulum.toml".as_ref(),
+        "-o".as_ref(),
+        page.as_os_str(),
+        "--trace".as_ref(),
+        "bob".as_ref(),
+    ]);
+    common::assert_fails(&out, 2, &["--trace bob", "no spatial bodies"]);
 }

@@ -2,6 +2,8 @@
 //! scratch directories.
 #![allow(dead_code)]
 
+pub mod browser;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
