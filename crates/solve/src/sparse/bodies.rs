@@ -5,8 +5,9 @@
 //! assembled on its sparse pattern and factored by the sparse Cholesky kernel.
 //!
 //! `C` is block diagonal: a planar block is its diagonal weight (`M^-1`), a spatial block the
-//! body's constrained inverse mass (`mbd_model::spatial::RigidSolve`), formed once per
-//! factorisation as a 12 x 12 matrix. `S` couples two rows only when they share a block, so for
+//! body's constrained inverse mass (`mbd_model::spatial::RigidSolve`), applied to each row's
+//! gradient on the block once per factorisation (`C_b g`, kept for the products with `S` and
+//! the solve). `S` couples two rows only when they share a block, so for
 //! a chain it is block tridiagonal and every operation is `O(N)`. The solve is that of the
 //! dense module: `x = C f + d(r_int)`, `S lambda_e = Phi_e x - r_e`, `a = x - C Phi_e^T
 //! lambda_e`, and each spatial body's internal multipliers from its own rows.
@@ -60,10 +61,8 @@ pub(crate) struct SparseBodySchur {
     r0: usize,
     /// The spatial coordinates at the last [`SparseBodySchur::update`].
     qs: Vec<f64>,
-    /// Each spatial body's elimination and its `C_b` (row-major 12 x 12) at the last
-    /// factorisation.
+    /// Each spatial body's elimination at the last factorisation.
     rigid: Vec<RigidSolve>,
-    cmat: Vec<[f64; 144]>,
     chol: SparseCholesky,
     x: Vec<f64>,
     le: Vec<f64>,
@@ -172,7 +171,6 @@ impl SparseBodySchur {
             r0: internal.start,
             qs: vec![0.0; 12 * ns],
             rigid: Vec::with_capacity(ns),
-            cmat: vec![[0.0; 144]; ns],
             chol,
             x: vec![0.0; n],
             le: vec![0.0; me],
@@ -212,10 +210,8 @@ impl SparseBodySchur {
                 out[l] = w[col + l] * f[l];
             }
         } else {
-            let c = &self.cmat[b - self.planar];
-            for (i, o) in out.iter_mut().enumerate().take(12) {
-                *o = (0..12).map(|j| c[12 * i + j] * f[j]).sum();
-            }
+            let fb: [f64; 12] = std::array::from_fn(|l| f[l]);
+            out[..12].copy_from_slice(&self.rigid[b - self.planar].apply_inverse_mass(&fb));
         }
     }
 
@@ -228,15 +224,6 @@ impl SparseBodySchur {
             let qb: [f64; 12] = std::array::from_fn(|l| self.qs[12 * k + l]);
             let r = RigidSolve::new(&b.inertia, &qb)
                 .map_err(|e| BodyFactorError::Body(b.name.clone(), e.to_string()))?;
-            let c = &mut self.cmat[k];
-            for j in 0..12 {
-                let mut unit = [0.0; 12];
-                unit[j] = 1.0;
-                let col = r.apply_inverse_mass(&unit);
-                for i in 0..12 {
-                    c[12 * i + j] = col[i];
-                }
-            }
             self.rigid.push(r);
         }
         let mut cg = std::mem::take(&mut self.cg);
