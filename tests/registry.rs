@@ -82,11 +82,15 @@ fn modified_lagrangian_refusal_names_the_cause() {
 }
 
 /// A registry entry that names the equation count above which it refuses spatial models names
-/// the sparse threshold the refusal uses (`mbd_solve::refuse_large_spatial`), and the refusal
-/// happens there: a spatial chain one rod past it is refused, one at or below it is not.
+/// the limit the refusal uses (`mbd_solve::DENSE_SPATIAL_LIMIT`), and the refusal happens
+/// there: a spatial chain of more equations is refused, one of 108 (above the sparse threshold,
+/// so on the dense path) is taken.
 #[test]
-fn refusals_of_large_spatial_models_name_the_sparse_threshold() {
-    let threshold = mbd::solve::SPARSE_THRESHOLD;
+fn refusals_of_large_spatial_models_name_the_dense_limit() {
+    let limit = mbd::solve::DENSE_SPATIAL_LIMIT;
+    let large = mbd::model::models::spatial_chain(limit / 9 + 1).unwrap();
+    let small = mbd::model::models::spatial_chain(12).unwrap();
+    assert!(small.n_constraints() > mbd::solve::SPARSE_THRESHOLD);
     let mut named = 0;
     for (_, v) in mbd::registry().variants() {
         let Some(rest) = v.refuses.split("spatial models above ").nth(1) else {
@@ -98,13 +102,20 @@ fn refusals_of_large_spatial_models_name_the_sparse_threshold() {
             .next()
             .and_then(|x| x.parse().ok())
             .unwrap_or_else(|| panic!("{}: '{}'", v.spec, v.refuses));
-        assert_eq!(n, threshold, "{}", v.spec);
-        // 9 equations per rod: 5 rods = 45 run, 6 rods = 54 are refused
-        let small = mbd::model::models::spatial_chain(threshold / 9).unwrap();
-        let large = mbd::model::models::spatial_chain(threshold / 9 + 1).unwrap();
-        assert!(mbd::Simulation::new(small, v.spec).is_ok(), "{}", v.spec);
-        let e = mbd::Simulation::new(large, v.spec).unwrap_err().to_string();
-        assert!(e.contains("equations"), "{}: {e}", v.spec);
+        assert_eq!(n, limit, "{}", v.spec);
+        assert!(
+            mbd::Simulation::new(small.clone(), v.spec).is_ok(),
+            "{}",
+            v.spec
+        );
+        let e = mbd::Simulation::new(large.clone(), v.spec)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("{} equations", large.n_constraints())),
+            "{}: {e}",
+            v.spec
+        );
     }
     assert!(named >= 4, "{named}");
 }

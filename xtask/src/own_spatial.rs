@@ -320,7 +320,8 @@ const SCALING_SOLVERS: [(&str, bool); 5] = [
 ];
 /// Why the tangent and symplectic solvers do not run the long spatial chains.
 const SCALING_MISS: &str = "the tangent and symplectic solvers' sparse paths take planar rows \
-    only; above the sparse threshold they refuse spatial models by name (issue 24, left open)";
+    only; above mbd_solve::DENSE_SPATIAL_LIMIT equations they refuse spatial models by name \
+    (issue 24, left open)";
 
 /// Cost of a step on a chain of spatial rods against its length, as ratios to plain RK4.
 fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {

@@ -260,23 +260,38 @@ pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), Solve
     }
 }
 
-/// The refusal of a solver whose sparse path does not take spatial bodies yet, for a spatial
-/// model on that path (`linear` picks it: above [`crate::SPARSE_THRESHOLD`] equations by
-/// default), where its dense matrices would take `O(m n)` memory: `Ok` otherwise. The error
-/// names `solver`, the equation count and the solvers that run such models.
+/// The largest spatial model (constraint equations) the solvers without a spatial sparse path
+/// (tangent, symplectic, FA-DAE) take on their dense path: above it their dense matrices
+/// (`O(m n)` memory, `O(m^3)` work per step) would make a step take seconds to minutes.
+pub const DENSE_SPATIAL_LIMIT: usize = 600;
+
+/// The refusal of a solver whose sparse path does not take spatial bodies yet: `Ok` for a
+/// planar model, or a spatial one of at most [`DENSE_SPATIAL_LIMIT`] equations on its dense
+/// path; an error for a larger spatial model or an explicit `LinearSolver::Sparse`, naming
+/// `solver`, the equation count and the solvers that run such models.
 pub fn refuse_large_spatial(
     sys: &mbd_model::System,
     solver: &str,
     linear: crate::LinearSolver,
 ) -> Result<(), SolveError> {
     let m = sys.n_constraints();
-    if !sys.has_spatial() || !linear.use_sparse(m) {
+    if !sys.has_spatial() {
+        return Ok(());
+    }
+    if linear == crate::LinearSolver::Sparse {
+        return Err(SolveError::Unsupported(format!(
+            "{solver} has no sparse path for spatial bodies yet: use LinearSolver::Dense or \
+             Auto (it takes spatial models of up to {DENSE_SPATIAL_LIMIT} equations densely), or \
+             rk4, rk4-projected or index1:dopri5, whose sparse path takes them"
+        )));
+    }
+    if m <= DENSE_SPATIAL_LIMIT {
         return Ok(());
     }
     Err(SolveError::Unsupported(format!(
         "{solver} takes spatial bodies on its dense path only, and this model has {m} \
-         equations (the sparse path starts above {}): run it with rk4, rk4-projected or \
-         index1:dopri5, whose sparse path takes spatial bodies in O(N)",
-        crate::SPARSE_THRESHOLD
+         equations (more than {DENSE_SPATIAL_LIMIT}, where its dense matrices make a step \
+         take seconds to minutes): run it with rk4, rk4-projected or index1:dopri5, whose \
+         sparse path takes spatial bodies in O(N)"
     )))
 }

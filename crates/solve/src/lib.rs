@@ -78,7 +78,9 @@ pub use consistent::{
 };
 pub use constrained::ConstrainedSolve;
 pub use dense::{Crossing, DenseOutput, Event, EventFn, EventHit};
-pub use error::{refuse_large_spatial, refuse_redundant, refuse_spatial, SolveError};
+pub use error::{
+    refuse_large_spatial, refuse_redundant, refuse_spatial, SolveError, DENSE_SPATIAL_LIMIT,
+};
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{
     observe, observer, run, step_count, DriftGuard, Every, Flow, FnObserver, Integrator,

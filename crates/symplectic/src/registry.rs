@@ -24,7 +24,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 3.0,
-            refuses: "spatial models above 48 equations (its sparse path is planar)",
+            refuses: "spatial models above 600 equations (its sparse path is planar)",
             compared: true,
         },
         SolverVariant {
@@ -35,7 +35,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "spatial models above 48 equations (its sparse path is planar)",
+            refuses: "spatial models above 600 equations (its sparse path is planar)",
             compared: true,
         },
         SolverVariant {
