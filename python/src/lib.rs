@@ -96,6 +96,10 @@ impl CoreModel {
             "spatial_joints",
             names(s.spatial_joints().iter().map(|j| j.name.as_str()).collect()),
         )?;
+        d.set_item(
+            "spatial_forces",
+            names(s.spatial_forces().iter().map(|f| f.name.as_str()).collect()),
+        )?;
         d.set_item("coordinates", s.coordinate_names())?;
         d.set_item("n_constraints", s.n_constraints())?;
         d.set_item("dof", s.dof())?;

@@ -152,6 +152,9 @@ def test_the_gil_is_released_while_rust_runs(slider):
 def test_a_spatial_model_from_a_file_runs():
     m = mbd.Model.from_file(MODELS / "heavy_top.toml")
     assert m.spatial_bodies == ["top"] and m.spatial_joints == ["tip"] and m.dof == 3
+    assert m.spatial_forces == []
+    p = mbd.Model.from_file(MODELS / "spatial_spring_pendulum.toml")
+    assert p.spatial_forces == ["strut", "thruster"]
     assert "1 spatial bodies" in repr(m)
     r = m.run("tangent:rk4", t_end=0.2, h=1e-3)
     assert "top.d3z" in r

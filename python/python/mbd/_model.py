@@ -112,6 +112,11 @@ class Model:
         return list(self._describe()["spatial_joints"])
 
     @property
+    def spatial_forces(self) -> List[str]:
+        """The names of the force elements on spatial bodies."""
+        return list(self._describe()["spatial_forces"])
+
+    @property
     def joints(self) -> List[str]:
         """The joints' names (point masses add a ``<name>:point_mass`` joint)."""
         return list(self._describe()["joints"])
