@@ -33,6 +33,12 @@ pub fn not_conserved(sys: &System) -> Option<String> {
         .iter()
         .filter(|j| j.is_rheonomic())
         .map(|j| j.name.as_str())
+        .chain(
+            sys.spatial_joints()
+                .iter()
+                .filter(|j| j.motion.is_some())
+                .map(|j| j.name.as_str()),
+        )
         .collect();
     let mut parts = Vec::new();
     if !forces.is_empty() {

@@ -92,11 +92,7 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
                 s,
                 "  {:<16} {:<12} {} - {} ({n} equation{})",
                 j.name,
-                format!("{:?}", j.joint.kind())
-                    .split(' ')
-                    .next()
-                    .unwrap_or("")
-                    .to_lowercase(),
+                j.joint.type_name(),
                 name(j.a),
                 name(j.b),
                 if n == 1 { "" } else { "s" }

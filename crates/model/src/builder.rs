@@ -78,8 +78,26 @@ impl SystemBuilder {
             a: a.into(),
             b: b.into(),
             joint,
+            motion: None,
         });
         self.spatial.joints.len() - 1
+    }
+    /// Adds a spatial driver (a joint of a driver kind,
+    /// [`crate::spatial::SpatialJointKind::SlideDriver`] or
+    /// [`crate::spatial::SpatialJointKind::DistanceDriver`]) whose slide or distance follows
+    /// `motion` (m, a function of time). Returns its index among the spatial joints; `build`
+    /// checks the kind and the function.
+    pub fn add_spatial_driver(
+        &mut self,
+        name: impl Into<String>,
+        a: impl Into<crate::spatial::SpatialBodyRef>,
+        b: impl Into<crate::spatial::SpatialBodyRef>,
+        joint: crate::spatial::SpatialJoint,
+        motion: crate::timefn::TimeFunction,
+    ) -> usize {
+        let k = self.add_spatial_joint(name, a, b, joint);
+        self.spatial.joints[k].motion = Some(motion);
+        k
     }
     /// Adds a force element on spatial bodies (spring-damper, force or torque; points and
     /// load axes in the bodies' frames). Returns its index among the spatial force elements.

@@ -32,7 +32,7 @@ impl System {
                 out[o + k] = e[k] - j.time_part(k, t)[0];
             }
         }
-        self.spatial.phi(q, out);
+        self.spatial.phi(q, t, out);
     }
 
     /// `Phi_t(q, t)` into `out` (length m).
@@ -43,8 +43,7 @@ impl System {
                 out[o + k] = -j.time_part(k, t)[1];
             }
         }
-        // spatial joints have no drivers
-        out[self.spatial.r0..self.m].fill(0.0);
+        self.spatial.phi_t(t, out);
     }
 
     #[inline(always)]
@@ -59,7 +58,7 @@ impl System {
         self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
             self.scatter_row(ji, r, g, out)
         });
-        self.spatial.rows(q, None, |r, sides, jet| {
+        self.spatial.rows(q, None, 0.0, |r, sides, jet| {
             self.spatial.scatter_row(r, sides, &jet.g, out)
         });
     }
@@ -87,7 +86,7 @@ impl System {
             );
         });
         let nb = self.bodies.len();
-        self.spatial.rows(q, v, |r, sides, jet| {
+        self.spatial.rows(q, v, t, |r, sides, jet| {
             visit(
                 r,
                 [
@@ -133,7 +132,7 @@ impl System {
             self.scatter_row(ji, r, g, phi_q);
             gamma[r] = gm;
         });
-        self.spatial.rows(q, Some(v), |r, sides, jet| {
+        self.spatial.rows(q, Some(v), t, |r, sides, jet| {
             self.spatial.scatter_row(r, sides, &jet.g, phi_q);
             gamma[r] = -jet.d2;
         });
@@ -217,7 +216,8 @@ impl System {
     pub fn gamma(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         let sc = SinCos::new(self, q, None);
         self.for_each_row(q, Some(v), t, &sc, |_, r, _, gm| out[r] = gm);
-        self.spatial.rows(q, Some(v), |r, _, jet| out[r] = -jet.d2);
+        self.spatial
+            .rows(q, Some(v), t, |r, _, jet| out[r] = -jet.d2);
     }
 
     /// The velocity constraint `Phi_q v + Phi_t` into `out`.
@@ -248,7 +248,8 @@ impl System {
                 out[o + k] = e[k].d - j.time_part(k, t)[1];
             }
         }
-        self.spatial.rows(q, Some(v), |r, _, jet| out[r] = jet.d1);
+        self.spatial
+            .rows(q, Some(v), t, |r, _, jet| out[r] = jet.d1);
     }
 
     /// Joint `ji`'s rows of `Phi` and `Phidot` from its bodies' frames.
@@ -325,12 +326,19 @@ impl System {
                 eval(ji, &fa, &fb);
             }
         }
-        self.spatial_phi_and_phi_dot(q, v, phi, phi_dot);
+        self.spatial_phi_and_phi_dot(q, v, t, phi, phi_dot);
     }
 
     /// The spatial rows of [`System::phi_and_phi_dot`].
-    fn spatial_phi_and_phi_dot(&self, q: &[f64], v: &[f64], phi: &mut [f64], phi_dot: &mut [f64]) {
-        self.spatial.rows(q, Some(v), |r, _, jet| {
+    fn spatial_phi_and_phi_dot(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        phi_dot: &mut [f64],
+    ) {
+        self.spatial.rows(q, Some(v), t, |r, _, jet| {
             phi[r] = jet.v;
             phi_dot[r] = jet.d1;
         });
@@ -372,7 +380,7 @@ impl System {
             );
             self.eval_phi_phi_dot(ji, &fa, &fb, t, phi, phi_dot);
         }
-        self.spatial_phi_and_phi_dot(q, v, phi, phi_dot);
+        self.spatial_phi_and_phi_dot(q, v, t, phi, phi_dot);
     }
 
     /// `Phi_q` as (row, column, value) triplets of its structural non-zeros, for sparse

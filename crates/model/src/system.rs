@@ -302,7 +302,7 @@ impl System {
     }
     /// Whether some constraint depends explicitly on time.
     pub fn is_rheonomic(&self) -> bool {
-        self.joints.iter().any(|j| j.is_rheonomic())
+        self.joints.iter().any(|j| j.is_rheonomic()) || self.spatial.is_rheonomic()
     }
     /// Whether all applied forces derive from the potential [`System::potential`] (no damping, no
     /// time-dependent loads).

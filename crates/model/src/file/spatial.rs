@@ -105,6 +105,10 @@ pub enum SpatialJointType {
     Weld,
     /// Massless rod of `length` between the points.
     Distance,
+    /// Driver: the slide of `point_b` along `a`'s `z` axis follows `motion`.
+    SlideDriver,
+    /// Driver: the points' distance follows `motion`.
+    DistanceDriver,
 }
 
 /// A spatial joint in a model file: markers (point and axes) on two bodies.
@@ -143,6 +147,10 @@ pub struct SpatialJointSpec {
     /// The rod's length of a distance joint, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<f64>,
+    /// A driver's motion (m, a function of time): the slide of a `slide_driver`, the distance
+    /// of a `distance_driver`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<crate::timefn::TimeFunction>,
 }
 
 impl SpatialBodySpec {
@@ -271,6 +279,8 @@ impl SpatialJointSpec {
             SpatialJointType::Prismatic => SpatialJointKind::Prismatic,
             SpatialJointType::Planar => SpatialJointKind::Planar,
             SpatialJointType::Weld => SpatialJointKind::Weld,
+            SpatialJointType::SlideDriver => SpatialJointKind::SlideDriver,
+            SpatialJointType::DistanceDriver => SpatialJointKind::DistanceDriver,
             SpatialJointType::Distance => SpatialJointKind::Distance {
                 length: self.length.ok_or_else(|| {
                     invalid(
@@ -291,6 +301,7 @@ impl SpatialJointSpec {
         let joint =
             SpatialJoint::new(kind, a, b).map_err(|e| invalid(element.clone(), e.to_string()))?;
         Ok(SpatialJointEntry {
+            motion: self.motion.clone(),
             name: self.name.clone(),
             a: find(&element, &self.body_a)?,
             b: find(&element, &self.body_b)?,
@@ -313,6 +324,8 @@ impl SpatialJointSpec {
             SpatialJointKind::Planar => (SpatialJointType::Planar, None),
             SpatialJointKind::Weld => (SpatialJointType::Weld, None),
             SpatialJointKind::Distance { length } => (SpatialJointType::Distance, Some(length)),
+            SpatialJointKind::SlideDriver => (SpatialJointType::SlideDriver, None),
+            SpatialJointKind::DistanceDriver => (SpatialJointType::DistanceDriver, None),
         };
         let axes = |m: &Marker| (m.axes != Matrix3::identity()).then(|| vectors(&m.axes));
         SpatialJointSpec {
@@ -327,6 +340,7 @@ impl SpatialJointSpec {
             axes_b: axes(mb),
             axis_b: None,
             length,
+            motion: j.motion.clone(),
         }
     }
 }
@@ -365,7 +379,10 @@ pub(crate) fn add_spatial(
     };
     for j in joints {
         let e = j.to_entry(&find)?;
-        b.add_spatial_joint(e.name, e.a, e.b, e.joint);
+        match e.motion {
+            Some(motion) => b.add_spatial_driver(e.name, e.a, e.b, e.joint, motion),
+            None => b.add_spatial_joint(e.name, e.a, e.b, e.joint),
+        };
     }
     for f in forces {
         b.add_spatial_force(f.to_force(&find)?);

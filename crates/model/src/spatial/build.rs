@@ -94,6 +94,25 @@ impl SpatialInput {
                     Marker::with_axes((at * nalgebra::Vector3::from(m.point)).into(), at * m.axes)
                 }
             };
+            match (&j.motion, j.joint.is_driver()) {
+                (None, true) => {
+                    return Err(invalid(
+                        element,
+                        "a driver needs its motion (SystemBuilder::add_spatial_driver; `motion` \
+                         in a model file)"
+                            .to_string(),
+                    ))
+                }
+                (Some(_), false) => {
+                    return Err(invalid(
+                        element,
+                        "only the driver kinds (slide_driver, distance_driver) take a motion"
+                            .to_string(),
+                    ))
+                }
+                (Some(f), true) => crate::check::time_function(&element, "motion", f)?,
+                (None, false) => {}
+            }
             let (ma, mb) = j.joint.markers();
             let joint = SpatialJoint::new(j.joint.kind(), lower(a, ma), lower(b, mb))
                 .map_err(|e| invalid(element.clone(), e.to_string()))?;

@@ -29,6 +29,10 @@ pub struct SpatialJointEntry {
     pub b: SpatialBodyRef,
     /// The joint, its markers in the bodies' frames.
     pub joint: SpatialJoint,
+    /// A driver's motion: the slide `s(t)` (m) of a [`super::SpatialJointKind::SlideDriver`],
+    /// the distance `L(t)` (m) of a [`super::SpatialJointKind::DistanceDriver`]; `None` for
+    /// every other kind.
+    pub motion: Option<crate::timefn::TimeFunction>,
 }
 
 /// One element of the spatial rows: a body's internal constraints or a joint.
@@ -168,20 +172,53 @@ impl SpatialPart {
         })
     }
 
-    /// The spatial rows of `Phi(q)` into `out` (the whole vector).
-    pub(crate) fn phi(&self, q: &[f64], out: &mut [f64]) {
+    /// The spatial rows of `Phi(q, t)` into `out` (the whole vector).
+    pub(crate) fn phi(&self, q: &[f64], t: f64, out: &mut [f64]) {
         for (item, sides, row, n) in self.items() {
             let e = self.eval_jets(item, sides, |_, c| q[c]);
             out[row..row + n].copy_from_slice(&e[..n]);
+            if let Item::Joint(j) = item {
+                out[row] -= self.drive(j, t)[0];
+            }
         }
     }
 
-    /// For every spatial row: `visit(row, sides, jet)`, the jet holding the value, the
-    /// gradient, `Phi_q v` (`d1`) and `v^T H v` (`d2`) (`v = None`: zero velocities).
+    /// The time part `c(t)`, `c'`, `c''` a driver joint's equation subtracts (zeros for
+    /// every other joint): `s(t)` for a slide driver, `1/2 L(t)^2` for a distance driver.
+    pub(crate) fn drive(&self, j: usize, t: f64) -> [f64; 3] {
+        let Some(motion) = &self.joints[j].motion else {
+            return [0.0; 3];
+        };
+        let [f, df, ddf] = motion.eval(t);
+        match self.lowered[j].kind() {
+            super::joints::SpatialJointKind::DistanceDriver => {
+                [0.5 * f * f, f * df, df * df + f * ddf]
+            }
+            _ => [f, df, ddf],
+        }
+    }
+
+    /// `Phi_t` of the spatial rows into `out` (the whole vector): `-c'(t)` on driver rows.
+    pub(crate) fn phi_t(&self, t: f64, out: &mut [f64]) {
+        out[self.r0..self.r0 + self.m].fill(0.0);
+        for (j, &row) in self.joint_row.iter().enumerate() {
+            out[row] = -self.drive(j, t)[1];
+        }
+    }
+
+    /// Whether a spatial joint is a driver.
+    pub(crate) fn is_rheonomic(&self) -> bool {
+        self.joints.iter().any(|j| j.motion.is_some())
+    }
+
+    /// For every spatial row at time `t`: `visit(row, sides, jet)`, the jet holding the value
+    /// `Phi`, the gradient `Phi_q`, `Phi_q v + Phi_t` (`d1`) and `v^T H v + Phi_tt` (`d2`, so
+    /// that `gamma = -d2`; `Phi_qt = 0` for every spatial joint) (`v = None`: zero velocities).
     pub(crate) fn rows(
         &self,
         q: &[f64],
         v: Option<&[f64]>,
+        t: f64,
         mut visit: impl FnMut(usize, [Option<usize>; 2], &DirJetN<SW>),
     ) {
         for (item, sides, row, n) in self.items() {
@@ -204,6 +241,12 @@ impl SpatialPart {
             };
             let mut e = [DirJetN::<SW>::cst(0.0); 6];
             self.lowered[j].eval_jets(local(0), local(1), &mut e);
+            if self.joints[j].motion.is_some() {
+                let [c, dc, ddc] = self.drive(j, t);
+                e[0].v -= c;
+                e[0].d1 -= dc;
+                e[0].d2 -= ddc;
+            }
             for (k, ek) in e.iter().enumerate().take(n) {
                 visit(row + k, sides, ek);
             }
@@ -278,7 +321,7 @@ impl SpatialPart {
 
     /// `Phi_q`'s spatial non-zeros as triplets.
     pub(crate) fn triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
-        self.rows(q, None, |row, sides, jet| {
+        self.rows(q, None, 0.0, |row, sides, jet| {
             for (l, &x) in jet.g.iter().enumerate() {
                 if let Some(c) = self.col(sides, l) {
                     if x != 0.0 {

@@ -20,6 +20,12 @@
 //! | [`SpatialJointKind::Planar`] | `Z_b . X_a`, `Z_b . Y_a`, `(P_b - P_a) . Z_a` | slides in `X`-`Y`, rotation about `Z` |
 //! | [`SpatialJointKind::Weld`] | `P_a - P_b` (3), `X_a . Y_b`, `X_a . Z_b`, `Y_a . Z_b` | nothing |
 //! | [`SpatialJointKind::Distance`] | `1/2 (|P_b - P_a|^2 - L^2)` | everything but the distance |
+//! | [`SpatialJointKind::SlideDriver`] | `(P_b - P_a) . Z_a - s(t)` | everything but the slide along `Z_a` |
+//! | [`SpatialJointKind::DistanceDriver`] | `1/2 (|P_b - P_a|^2 - L(t)^2)` | everything but the distance |
+//!
+//! The drivers' motions (`s(t)`, `L(t)`) are functions of time the system holds beside the
+//! joint ([`crate::SystemBuilder::add_spatial_driver`]); their equations' Jacobians do not
+//! depend on time (a rotation driver's would, which the model's interfaces do not take yet).
 //!
 //! The orientation equations are the linearly independent ones at assembly: a small relative
 //! rotation `dtheta` of `b` changes `X_a . Y_b` by `-dtheta . Z`, `X_a . Z_b` by `dtheta . Y`,
@@ -30,6 +36,7 @@ mod distance;
 mod planar;
 mod prismatic;
 mod revolute;
+mod slide_driver;
 mod spherical;
 mod universal;
 mod weld;
@@ -217,6 +224,12 @@ pub enum SpatialJointKind {
         /// The distance (m), positive.
         length: f64,
     },
+    /// Driver: the second point's slide along the first marker's `z` axis follows a function
+    /// of time (1 equation; a linear actuator along a guide).
+    SlideDriver,
+    /// Driver: the points' distance follows a function of time (1 equation; a linear
+    /// actuator between two pins).
+    DistanceDriver,
 }
 
 /// Why a spatial joint's parameters are invalid (the field and the reason).
@@ -295,6 +308,30 @@ impl SpatialJoint {
         Ok(SpatialJoint { kind, a, b })
     }
 
+    /// The kind as the model file's `type` tag (`spherical`, ..., `distance_driver`).
+    pub fn type_name(&self) -> &'static str {
+        match self.kind {
+            SpatialJointKind::Spherical => "spherical",
+            SpatialJointKind::Revolute => "revolute",
+            SpatialJointKind::Universal => "universal",
+            SpatialJointKind::Cylindrical => "cylindrical",
+            SpatialJointKind::Prismatic => "prismatic",
+            SpatialJointKind::Planar => "planar",
+            SpatialJointKind::Weld => "weld",
+            SpatialJointKind::Distance { .. } => "distance",
+            SpatialJointKind::SlideDriver => "slide_driver",
+            SpatialJointKind::DistanceDriver => "distance_driver",
+        }
+    }
+
+    /// Whether the joint is a driver (its motion a function of time the system holds).
+    pub fn is_driver(&self) -> bool {
+        matches!(
+            self.kind,
+            SpatialJointKind::SlideDriver | SpatialJointKind::DistanceDriver
+        )
+    }
+
     /// The kind.
     pub fn kind(&self) -> SpatialJointKind {
         self.kind
@@ -311,7 +348,9 @@ impl SpatialJoint {
             SpatialJointKind::Universal | SpatialJointKind::Cylindrical => 4,
             SpatialJointKind::Revolute | SpatialJointKind::Prismatic => 5,
             SpatialJointKind::Weld => 6,
-            SpatialJointKind::Distance { .. } => 1,
+            SpatialJointKind::Distance { .. }
+            | SpatialJointKind::SlideDriver
+            | SpatialJointKind::DistanceDriver => 1,
         }
     }
 
@@ -324,7 +363,8 @@ impl SpatialJoint {
             Spherical | Weld | Revolute | Universal => i32::from(k < 3),
             Cylindrical | Prismatic => i32::from((2..4).contains(&k)),
             Planar => i32::from(k == 2),
-            Distance { .. } => 2,
+            SlideDriver => 1,
+            Distance { .. } | DistanceDriver => 2,
         }
     }
 
@@ -339,7 +379,9 @@ impl SpatialJoint {
     fn uses_axes(&self) -> bool {
         !matches!(
             self.kind,
-            SpatialJointKind::Spherical | SpatialJointKind::Distance { .. }
+            SpatialJointKind::Spherical
+                | SpatialJointKind::Distance { .. }
+                | SpatialJointKind::DistanceDriver
         )
     }
 
@@ -368,6 +410,9 @@ impl SpatialJoint {
             SpatialJointKind::Planar => planar::eval(ma, mb, out),
             SpatialJointKind::Weld => weld::eval(ma, mb, out),
             SpatialJointKind::Distance { length } => distance::eval(ma, mb, length, out),
+            SpatialJointKind::SlideDriver => slide_driver::eval(ma, mb, out),
+            // the system subtracts 1/2 L(t)^2
+            SpatialJointKind::DistanceDriver => distance::eval(ma, mb, 0.0, out),
         }
     }
 }
