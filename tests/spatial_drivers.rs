@@ -151,7 +151,10 @@ fn spatial_drivers_in_model_files() {
     let mut no_motion = sys.to_model_file();
     no_motion.spatial_joints[1].motion = None;
     let e = no_motion.build().unwrap_err().to_string();
-    assert!(e.contains("'lift'") && e.contains("needs its motion"), "{e}");
+    assert!(
+        e.contains("'lift'") && e.contains("needs its motion"),
+        "{e}"
+    );
     let mut b = SystemBuilder::new();
     let body = b.add_spatial_body(SpatialBody::new(
         "b",

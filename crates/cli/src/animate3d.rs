@@ -131,20 +131,6 @@ struct Page3<'a> {
     q: Vec<Vec<f64>>,
 }
 
-fn kind_name(k: SpatialJointKind) -> &'static str {
-    match k {
-        SpatialJointKind::Spherical => "spherical",
-        SpatialJointKind::Revolute => "revolute",
-        SpatialJointKind::Universal => "universal",
-        SpatialJointKind::Cylindrical => "cylindrical",
-        SpatialJointKind::Prismatic => "prismatic",
-        SpatialJointKind::Planar => "planar",
-        SpatialJointKind::Weld => "weld",
-        SpatialJointKind::Distance { .. } => "distance",
-        _ => "joint",
-    }
-}
-
 /// `p` (body frame) in spatial body `k`'s principal frame, `A^T p` (ground: unchanged), and
 /// the body's index (-1: ground).
 fn lower(sys: &System, k: Option<usize>, p: [f64; 3]) -> (i64, [f64; 3]) {
@@ -186,7 +172,7 @@ fn links(sys: &System) -> (Vec<Link>, Vec<Link>) {
         .iter()
         .map(|j| {
             let (ma, mb) = j.joint.markers();
-            let kind = kind_name(j.joint.kind());
+            let kind = j.joint.type_name();
             link(sys, &j.name, kind, j.a, ma.point, j.b, mb.point)
         })
         .collect();

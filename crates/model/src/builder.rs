@@ -50,61 +50,6 @@ impl SystemBuilder {
         self.gravity = g;
         self
     }
-    /// Sets the gravity vector of the spatial bodies (m/s^2), e.g. `[0.0, 0.0, -9.81]` (the
-    /// planar bodies have theirs, [`SystemBuilder::set_gravity`]).
-    pub fn set_spatial_gravity(&mut self, g: [f64; 3]) -> &mut Self {
-        self.spatial.gravity = g;
-        self
-    }
-    /// Adds a spatial body (natural coordinates, docs/spatial.md) and returns its handle.
-    pub fn add_spatial_body(
-        &mut self,
-        body: crate::spatial::SpatialBody,
-    ) -> crate::spatial::SpatialBodyHandle {
-        self.spatial.bodies.push(body);
-        crate::spatial::SpatialBodyHandle(self.spatial.bodies.len() - 1)
-    }
-    /// Adds a spatial joint between spatial bodies (or ground); its markers are in the bodies'
-    /// frames (ground: global). Returns its index among the spatial joints.
-    pub fn add_spatial_joint(
-        &mut self,
-        name: impl Into<String>,
-        a: impl Into<crate::spatial::SpatialBodyRef>,
-        b: impl Into<crate::spatial::SpatialBodyRef>,
-        joint: crate::spatial::SpatialJoint,
-    ) -> usize {
-        self.spatial.joints.push(crate::spatial::SpatialJointEntry {
-            name: name.into(),
-            a: a.into(),
-            b: b.into(),
-            joint,
-            motion: None,
-        });
-        self.spatial.joints.len() - 1
-    }
-    /// Adds a spatial driver (a joint of a driver kind,
-    /// [`crate::spatial::SpatialJointKind::SlideDriver`] or
-    /// [`crate::spatial::SpatialJointKind::DistanceDriver`]) whose slide or distance follows
-    /// `motion` (m, a function of time). Returns its index among the spatial joints; `build`
-    /// checks the kind and the function.
-    pub fn add_spatial_driver(
-        &mut self,
-        name: impl Into<String>,
-        a: impl Into<crate::spatial::SpatialBodyRef>,
-        b: impl Into<crate::spatial::SpatialBodyRef>,
-        joint: crate::spatial::SpatialJoint,
-        motion: crate::timefn::TimeFunction,
-    ) -> usize {
-        let k = self.add_spatial_joint(name, a, b, joint);
-        self.spatial.joints[k].motion = Some(motion);
-        k
-    }
-    /// Adds a force element on spatial bodies (spring-damper, force or torque; points and
-    /// load axes in the bodies' frames). Returns its index among the spatial force elements.
-    pub fn add_spatial_force(&mut self, force: crate::spatial::SpatialForce) -> usize {
-        self.spatial.forces.push(force);
-        self.spatial.forces.len() - 1
-    }
     /// Adds a body and returns its handle. Its local points (in joints and forces) are
     /// relative to its centre of mass, unless [`SystemBuilder::set_body_frame`] says otherwise.
     pub fn add_body(&mut self, body: Body) -> BodyHandle {

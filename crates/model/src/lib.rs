@@ -46,6 +46,7 @@
 
 mod assembly;
 mod body;
+mod body_blocks;
 mod builder;
 mod cache;
 mod check;

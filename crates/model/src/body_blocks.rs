@@ -1,0 +1,62 @@
+//! The constraint rows over **body blocks**: every row's local gradient per body, whatever the
+//! body's kind (planar, 3 coordinates; spatial, 12), with its `gamma`. What the solves over
+//! bodies of any kind (`mbd_solve`'s sparse body-eliminated kernel, the sparse rank check) are
+//! built from.
+
+use crate::rows::SinCos;
+use crate::system::System;
+
+impl System {
+    /// Every row of `Phi_q` in element-local form, with its `gamma` at `(q, v, t)` (`v = None`:
+    /// zero velocities): `visit(row, sides, gamma)`, `sides` the row's bodies (at most two;
+    /// `None`: ground) as `(block, local gradient)`. Block `b` is planar body `b` (3
+    /// coordinates at `3 b`) for `b` below the planar body count, else spatial body
+    /// `b - nb` (12 coordinates at [`System::spatial_offset`] `+ 12 (b - nb)`); see
+    /// [`System::body_block`]. What the sparse solves over bodies of any kind are built from.
+    pub fn local_rows_gamma(
+        &self,
+        q: &[f64],
+        v: Option<&[f64]>,
+        t: f64,
+        mut visit: impl FnMut(usize, [Option<(usize, &[f64])>; 2], f64),
+    ) {
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row(q, v, t, &sc, |ji, r, g, gm| {
+            let at = self.joint_attach[ji];
+            visit(
+                r,
+                [at.a.map(|i| (i, &g[0..3])), at.b.map(|i| (i, &g[3..6]))],
+                gm,
+            );
+        });
+        let nb = self.bodies.len();
+        self.spatial.rows(q, v, t, |r, sides, jet| {
+            visit(
+                r,
+                [
+                    sides[0].map(|k| (nb + k, &jet.g[0..12])),
+                    sides[1].map(|k| (nb + k, &jet.g[12..24])),
+                ],
+                -jet.d2,
+            );
+        });
+    }
+
+    /// The number of body blocks (planar and spatial bodies) of [`System::local_rows_gamma`].
+    pub fn n_body_blocks(&self) -> usize {
+        self.bodies.len() + self.spatial.bodies.len()
+    }
+
+    /// Body block `b`'s first coordinate and width (3 planar, 12 spatial), or `None` past the
+    /// last block.
+    pub fn body_block(&self, b: usize) -> Option<(usize, usize)> {
+        let nb = self.bodies.len();
+        if b < nb {
+            Some((3 * b, 3))
+        } else if b < self.n_body_blocks() {
+            Some((self.spatial.q0 + 12 * (b - nb), 12))
+        } else {
+            None
+        }
+    }
+}
