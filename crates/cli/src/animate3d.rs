@@ -35,7 +35,7 @@
 
 use crate::args::TraceSpec;
 use crate::error::CliError;
-use mbd_model::spatial::{SpatialBodyRef, SpatialForceKind, SpatialJointKind};
+use mbd_model::spatial::{SpatialBodyRef, SpatialForceKind};
 use mbd_model::System;
 use serde::Serialize;
 

@@ -165,7 +165,7 @@ fn side(element: &str, r: super::SpatialBodyRef, nb: usize) -> Result<Option<usi
 
 impl crate::SystemBuilder {
     /// Sets the gravity vector of the spatial bodies (m/s^2), e.g. `[0.0, 0.0, -9.81]` (the
-    /// planar bodies have theirs, [`SystemBuilder::set_gravity`]).
+    /// planar bodies have theirs, [`crate::SystemBuilder::set_gravity`]).
     pub fn set_spatial_gravity(&mut self, g: [f64; 3]) -> &mut Self {
         self.spatial.gravity = g;
         self
