@@ -157,11 +157,15 @@ impl System {
                     coef += &combo[k] * *p;
                 }
                 let cmax = max_abs(coef.as_slice()).max(1e-300);
-                let mut joints: Vec<String> = vec![self.joints[self.eq_joint[r]].name.clone()];
+                // (the owning element of a row, planar or spatial: `eq_joint` covers the planar
+                // joints' rows only)
+                let mut joints: Vec<String> = vec![self.row_element(r)];
                 for j in 0..m {
-                    let name = &self.joints[self.eq_joint[j]].name;
-                    if coef[j].abs() > 1e-8 * cmax && !joints.contains(name) {
-                        joints.push(name.clone());
+                    if coef[j].abs() > 1e-8 * cmax {
+                        let name = self.row_element(j);
+                        if !joints.contains(&name) {
+                            joints.push(name);
+                        }
                     }
                 }
                 found.push(RedundantEquation {

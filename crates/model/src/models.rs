@@ -490,7 +490,10 @@ pub use loops::{
 mod exact;
 pub use exact::{CrankMotion, Regime};
 mod spatial;
-pub use spatial::{free_body, heavy_top, TOP_LENGTH};
+pub use spatial::{
+    bricard, free_body, heavy_top, spatial_double_pendulum, spatial_slider_crank, BRICARD_POINTS,
+    DOUBLE_PENDULUM_ROD, TOP_LENGTH,
+};
 mod tumbling;
 pub use tumbling::{TorqueFreeBody, TorqueFreeMotion};
 mod spatial_chain;

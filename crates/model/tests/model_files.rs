@@ -254,6 +254,7 @@ fn the_doc_example_loads() {
 #[test]
 fn every_example_loads_with_its_dof_and_a_consistent_state() {
     let expected = [
+        ("bricard.toml", 1, false),
         ("driven_three_link_arm.json", 1, true),
         ("four_bar.toml", 1, false),
         ("heavy_top.toml", 3, false),
@@ -261,6 +262,8 @@ fn every_example_loads_with_its_dof_and_a_consistent_state() {
         ("pendulum.toml", 1, false),
         ("point_mass_pendulum.toml", 1, false),
         ("slider_crank_spring.toml", 1, false),
+        ("spatial_double_pendulum.toml", 6, false),
+        ("spatial_slider_crank.toml", 1, false),
         ("spatial_spring_pendulum.toml", 3, false),
     ];
     let files = examples();
