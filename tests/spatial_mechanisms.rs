@@ -141,6 +141,7 @@ fn solvers_keep_their_bounds(
     scale: f64,
     checks: &[Check],
     must_run: &[&str],
+    known_failures: &[(&str, &str)],
 ) -> Result<()> {
     let mut ran = Vec::new();
     for &(spec, h, t_end, phi_max, energy_max) in checks {
@@ -148,6 +149,20 @@ fn solvers_keep_their_bounds(
             let e = e.to_string();
             assert!(e.contains("spatial"), "{name}, {spec}: {e}");
             eprintln!("{name}: {spec} refuses: {e}");
+            continue;
+        }
+        // a documented defect: the run stops with this error (a fix makes this fail, and the
+        // documentation is then to be updated)
+        if let Some((_, why)) = known_failures.iter().find(|k| k.0 == spec) {
+            let e = run_watched(sys, spec, t_end, h, scale)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            eprintln!("{name}: {spec} stops (known): {e}");
+            assert!(
+                e.contains(why),
+                "{name}, {spec}: expected the known failure, got '{e}'"
+            );
             continue;
         }
         let k = run_watched(sys, spec, t_end, h, scale)?;
@@ -214,7 +229,7 @@ fn the_double_pendulum_keeps_constraints_and_energy_with_every_solver() -> Resul
         ("firefly-gauss", 1e-3, 0.3, 1e-12, 1e-9),
     ];
     let all: Vec<&str> = checks.iter().map(|c| c.0).collect();
-    solvers_keep_their_bounds("double pendulum", &sys, scale, &checks, &all)
+    solvers_keep_their_bounds("double pendulum", &sys, scale, &checks, &all, &[])
 }
 
 /// The spatial slider-crank: every spatial solver over 2 s at h = 1e-3 (index-1 DOPRI5 at
@@ -238,15 +253,16 @@ fn the_slider_crank_keeps_constraints_and_energy_with_every_solver() -> Result<(
         ("firefly-gauss", 2e-3, 2.0, 1e-12, 1e-6),
     ];
     let all: Vec<&str> = checks.iter().map(|c| c.0).collect();
-    solvers_keep_their_bounds("slider-crank", &sys, scale, &checks, &all)
+    solvers_keep_their_bounds("slider-crank", &sys, scale, &checks, &all, &[])
 }
 
-/// The Bricard linkage: the solvers that run it (its 60 equations are above the dense limit of
-/// the tangent, symplectic and firefly-Gauss solvers for spatial models, which refuse it by
-/// name) keep the constraints, all 60 equations including the redundant one, and the energy
-/// (relative to `m g L` for the five bars, 49 J) over 3 s. Measured: max |Phi| 5.6e-12 (RK4),
-/// 1.0e-14 (projected RK4), 1.6e-8 (index-1 DOPRI5 at tolerance 1e-8); energy 1.5e-12,
-/// 2.3e-14, 2.5e-9.
+/// The Bricard linkage with every spatial solver: all 60 equations, the redundant one
+/// included, and the energy (relative to `m g L` for the five bars, 49 J) kept over 3 s.
+/// Measured: max |Phi| 5.6e-12 (RK4), 1.0e-14 (projected RK4), 1.6e-8 (index-1 DOPRI5 at
+/// tolerance 1e-8), 7.1e-14 / 2.1e-13 (tangent RK4 / DOPRI5), 6.7e-16 (symplectic (1,1)),
+/// 5.2e-16 (FA-DAE); energy 1.6e-12, 2.3e-14, 2.5e-9, 2.0e-14 / 2.5e-14, 7.9e-8, 1.3e-11.
+/// Symplectic (2,2) stops at t = 0.173 with a typed singular-matrix error naming the
+/// redundant equation (a defect of its stage pivoting with redundant spatial rows, left open).
 #[test]
 fn the_bricard_linkage_keeps_constraints_and_energy() -> Result<()> {
     let sys = bricard()?;
@@ -266,7 +282,18 @@ fn the_bricard_linkage_keeps_constraints_and_energy() -> Result<()> {
         &sys,
         scale,
         &checks,
-        &["rk4", "rk4-projected", "index1:dopri5"],
+        &[
+            "rk4",
+            "rk4-projected",
+            "index1:dopri5",
+            "tangent:rk4",
+            "tangent:dopri5",
+            "symplectic:1",
+            "firefly-gauss",
+        ],
+        // the (2,2) stage Newton matrix's pivoting loses the redundant row's multiplier at
+        // t = 0.173 (docs/spatial.md, "Mechanisms")
+        &[("symplectic:2", "no pivot for the multiplier of hinge6.e5")],
     )
 }
 
