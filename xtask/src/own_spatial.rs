@@ -408,18 +408,18 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
         .filter(|s| refused.iter().any(|r| r.starts_with(&format!("{s} at"))))
         .collect();
     refused_solvers.dedup();
-    sec.claims.push(Claim::check(
+    sec.claims.push(Claim::timing(
         "on a spatial chain, plain RK4 and the index-1 solvers' cost per step grows at most like N^1.2 (sparse path)",
         worst_exp.max(peer_exp) <= 1.2,
         format!("largest fitted exponent {:.2} (plain RK4 {peer_exp:.2})", worst_exp.max(peer_exp)),
     ));
-    sec.claims.push(Claim::check(
+    sec.claims.push(Claim::timing(
         format!("on a {largest}-rod spatial chain, projected RK4 and index-1 DOPRI5 cost within 10x plain RK4 per step"),
         worst_ratio <= 10.0,
         format!("largest ratio {worst_ratio:.2}"),
     ));
     sec.claims.push(
-        Claim::check(
+        Claim::timing(
             format!("every solver but FA-DAE runs a {largest}-rod spatial chain within 10x plain RK4 per step"),
             refused_solvers.is_empty() && worst_ratio <= 10.0,
             format!(
