@@ -141,7 +141,6 @@ fn solvers_keep_their_bounds(
     scale: f64,
     checks: &[Check],
     must_run: &[&str],
-    known_failures: &[(&str, &str)],
 ) -> Result<()> {
     let mut ran = Vec::new();
     for &(spec, h, t_end, phi_max, energy_max) in checks {
@@ -149,20 +148,6 @@ fn solvers_keep_their_bounds(
             let e = e.to_string();
             assert!(e.contains("spatial"), "{name}, {spec}: {e}");
             eprintln!("{name}: {spec} refuses: {e}");
-            continue;
-        }
-        // a documented defect: the run stops with this error (a fix makes this fail, and the
-        // documentation is then to be updated)
-        if let Some((_, why)) = known_failures.iter().find(|k| k.0 == spec) {
-            let e = run_watched(sys, spec, t_end, h, scale)
-                .err()
-                .map(|e| e.to_string())
-                .unwrap_or_default();
-            eprintln!("{name}: {spec} stops (known): {e}");
-            assert!(
-                e.contains(why),
-                "{name}, {spec}: expected the known failure, got '{e}'"
-            );
             continue;
         }
         let k = run_watched(sys, spec, t_end, h, scale)?;
@@ -229,7 +214,7 @@ fn the_double_pendulum_keeps_constraints_and_energy_with_every_solver() -> Resul
         ("firefly-gauss", 1e-3, 0.3, 1e-12, 1e-9),
     ];
     let all: Vec<&str> = checks.iter().map(|c| c.0).collect();
-    solvers_keep_their_bounds("double pendulum", &sys, scale, &checks, &all, &[])
+    solvers_keep_their_bounds("double pendulum", &sys, scale, &checks, &all)
 }
 
 /// The spatial slider-crank: every spatial solver over 2 s at h = 1e-3 (index-1 DOPRI5 at
@@ -253,16 +238,16 @@ fn the_slider_crank_keeps_constraints_and_energy_with_every_solver() -> Result<(
         ("firefly-gauss", 2e-3, 2.0, 1e-12, 1e-6),
     ];
     let all: Vec<&str> = checks.iter().map(|c| c.0).collect();
-    solvers_keep_their_bounds("slider-crank", &sys, scale, &checks, &all, &[])
+    solvers_keep_their_bounds("slider-crank", &sys, scale, &checks, &all)
 }
 
 /// The Bricard linkage with every spatial solver: all 60 equations, the redundant one
 /// included, and the energy (relative to `m g L` for the five bars, 49 J) kept over 3 s.
 /// Measured: max |Phi| 5.6e-12 (RK4), 1.0e-14 (projected RK4), 1.6e-8 (index-1 DOPRI5 at
-/// tolerance 1e-8), 7.1e-14 / 2.1e-13 (tangent RK4 / DOPRI5), 6.7e-16 (symplectic (1,1)),
-/// 5.2e-16 (FA-DAE); energy 1.6e-12, 2.3e-14, 2.5e-9, 2.0e-14 / 2.5e-14, 7.9e-8, 1.3e-11.
-/// Symplectic (2,2) stops at t = 0.173 with a typed singular-matrix error naming the
-/// redundant equation (a defect of its stage pivoting with redundant spatial rows, left open).
+/// tolerance 1e-8), 7.1e-14 / 2.1e-13 (tangent RK4 / DOPRI5), 6.7e-16 / 6.7e-16 (symplectic
+/// (1,1) / (2,2)), 5.2e-16 (FA-DAE); energy 1.6e-12, 2.3e-14, 2.5e-9, 2.0e-14 / 2.5e-14,
+/// 7.9e-8 / 2.2e-15, 1.3e-11. (Symplectic (2,2) needs the stage LU's pivoting fallback to drop
+/// the redundant multiplier: without it the run stopped at t = 0.173.)
 #[test]
 fn the_bricard_linkage_keeps_constraints_and_energy() -> Result<()> {
     let sys = bricard()?;
@@ -274,7 +259,7 @@ fn the_bricard_linkage_keeps_constraints_and_energy() -> Result<()> {
         ("tangent:rk4", 1e-3, 3.0, 1e-12, 1e-9),
         ("tangent:dopri5", 1e-3, 3.0, 1e-12, 1e-9),
         ("symplectic:1", 1e-3, 3.0, 1e-13, 1e-5),
-        ("symplectic:2", 1e-3, 3.0, 1e-13, 1e-9),
+        ("symplectic:2", 1e-3, 3.0, 1e-13, 1e-12),
         ("firefly-gauss", 5e-3, 3.0, 1e-12, 1e-5),
     ];
     solvers_keep_their_bounds(
@@ -289,11 +274,9 @@ fn the_bricard_linkage_keeps_constraints_and_energy() -> Result<()> {
             "tangent:rk4",
             "tangent:dopri5",
             "symplectic:1",
+            "symplectic:2",
             "firefly-gauss",
         ],
-        // the (2,2) stage Newton matrix's pivoting loses the redundant row's multiplier at
-        // t = 0.173 (docs/spatial.md, "Mechanisms")
-        &[("symplectic:2", "no pivot for the multiplier of hinge6.e5")],
     )
 }
 

@@ -196,35 +196,58 @@ impl DenseLu {
 
     /// Threshold partial pivoting, recording the nonzeros of `L` and `U`; `Err((i, k))` if
     /// column `k` has no usable pivot (`i`: the physical row at position `k`).
+    ///
+    /// Droppable columns (see [`DenseLu::set_droppable`]) whose best scaled pivot is at most
+    /// [`crate::DEPENDENT_PIVOT_TOL`] `n` are dropped as on the static path: the reduced
+    /// column is zero, so the column depends on the earlier ones; its unknown is zero and no
+    /// row is consumed for it. The rows left over at the end (one per dropped column) are the
+    /// dependent equations: after the elimination they are zero, and they are left out.
     fn factor_dynamic(&mut self, tol: f64) -> Result<(), (usize, usize)> {
         let n = self.n;
+        let dep_tol = crate::DEPENDENT_PIVOT_TOL * n as f64;
         let a = &mut self.f;
         let p = &mut self.dynamic;
         for (k, r) in self.rp.iter_mut().enumerate() {
             *r = k;
         }
+        // pivot row of each column (usize::MAX: dropped), chosen from positions r..n
+        let prow = &mut self.prow;
+        let mut r = 0;
         let (mut nl, mut nu) = (0, 0);
         let (rs, cs) = (&self.rscale, &self.cscale);
         for k in 0..n {
             // scaled partial pivoting: magnitudes in the equilibrated matrix
-            let diag = a[self.rp[k] * n + k].abs() * rs[self.rp[k]];
-            let mut piv = k;
-            let mut best = diag;
-            for i in k + 1..n {
-                let v = a[self.rp[i] * n + k].abs() * rs[self.rp[i]];
-                // (a NaN is taken, and fails the test below)
-                if v > best || v.is_nan() {
-                    best = v;
-                    piv = i;
+            let (mut piv, mut best, mut diag) = (r, f64::NAN, 0.0);
+            if r < n {
+                diag = a[self.rp[r] * n + k].abs() * rs[self.rp[r]];
+                best = diag;
+                for i in r + 1..n {
+                    let v = a[self.rp[i] * n + k].abs() * rs[self.rp[i]];
+                    // (a NaN is taken, and fails the test below)
+                    if v > best || v.is_nan() {
+                        best = v;
+                        piv = i;
+                    }
                 }
             }
-            if best.is_nan() || best * cs[k] <= tol {
-                return Err((self.rp[piv], k));
+            let droppable = k >= self.drop_from && self.dropped.len() < self.drop_max;
+            let negligible = r == n || (!best.is_nan() && best * cs[k] <= dep_tol);
+            if droppable && negligible {
+                self.dropped.push(k);
+                self.dinv[k] = 0.0;
+                prow[k] = usize::MAX;
+                p.u_start[k] = nu;
+                p.l_start[k] = nl;
+                continue;
+            }
+            if r == n || best.is_nan() || best * cs[k] <= tol {
+                return Err((self.rp[piv.min(n - 1)], k));
             }
             if diag < PIVOT_THRESHOLD * best {
-                self.rp.swap(k, piv);
+                self.rp.swap(r, piv);
             }
-            let pk = self.rp[k];
+            let pk = self.rp[r];
+            prow[k] = pk;
             // the nonzeros of the pivot row right of the diagonal: the row of U
             p.u_start[k] = nu;
             for (j, &v) in a[pk * n..(pk + 1) * n].iter().enumerate().skip(k + 1) {
@@ -239,7 +262,7 @@ impl DenseLu {
             let inv = 1.0 / a[pk * n + k];
             self.dinv[k] = inv;
             p.l_start[k] = nl;
-            for &ph in &self.rp[k + 1..] {
+            for &ph in &self.rp[r + 1..] {
                 let row = &mut a[ph * n..(ph + 1) * n];
                 let f = row[k];
                 if f != 0.0 {
@@ -252,9 +275,22 @@ impl DenseLu {
                     nl += 1;
                 }
             }
+            r += 1;
         }
         p.l_start[n] = nl;
         p.u_start[n] = nu;
+        if !self.dropped.is_empty() {
+            // pivot k is physical row rp[k]; a dropped column takes a left-over row (its
+            // solve reads that row's value and multiplies it by dinv = 0)
+            let mut left = r;
+            for pr in prow.iter_mut() {
+                if *pr == usize::MAX {
+                    *pr = self.rp[left];
+                    left += 1;
+                }
+            }
+            self.rp.copy_from_slice(prow);
+        }
         Ok(())
     }
 }

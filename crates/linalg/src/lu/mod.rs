@@ -95,6 +95,8 @@ pub struct DenseLu {
     backup: Vec<f64>,
     /// `rp[k]`: the physical row of the `k`-th pivot.
     rp: Vec<usize>,
+    /// The general path's pivot row per column while it eliminates (`usize::MAX`: dropped).
+    prow: Vec<usize>,
     /// Nonzeros of the last factorisation of the general path.
     dynamic: Pattern,
     /// Entries (ordered numbering) that have been nonzero in some matrix so far.
@@ -176,6 +178,7 @@ impl DenseLu {
             n_nz: 0,
             backup: vec![0.0; n * n],
             rp: (0..n).collect(),
+            prow: vec![0; n],
             dynamic: Pattern::new(n),
             mask: (0..n * n).map(|k| k % (n + 1) == 0).collect(),
             fill: vec![false; n * n],
@@ -209,8 +212,9 @@ impl DenseLu {
     /// matrix whose multipliers are ordered last (`from` = the first multiplier) and whose
     /// constraint rows are dependent (redundant constraints), that is the basic solution: the
     /// dependent equations carry zero multipliers, as with
-    /// [`crate::DenseCholesky::set_max_dependent`]. Only the static elimination order drops
-    /// pivots (a factorisation that needs the pivoting fallback drops none). Allocates once.
+    /// [`crate::DenseCholesky::set_max_dependent`]. The static elimination order drops
+    /// such pivots; the general path (partial pivoting) drops a column without a usable pivot, and
+    /// the row left over for it is the dependent equation. Allocates once.
     pub fn set_droppable(&mut self, from: usize, max: usize) {
         self.drop_from = from.min(self.n);
         self.drop_max = max.min(self.n - self.drop_from);

@@ -377,3 +377,54 @@ fn a_dependent_multiplier_pivot_is_dropped_on_request() {
         assert!((b[i] - sol[i]).abs() < 1e-14, "{i}: {} vs {}", b[i], sol[i]);
     }
 }
+
+/// The same redundant saddle-point matrix when the static order fails its threshold test
+/// (a tiny first diagonal entry forces the pivoting fallback): the general path drops the
+/// dependent multiplier column and leaves the dependent equation out, and the consistent
+/// system is solved exactly, by both the direct and the transposed solve.
+#[test]
+fn the_pivoting_fallback_drops_a_dependent_multiplier_too() {
+    let g = [[1.0, 0.0, 1.0], [0.0, 1.0, -1.0], [0.0, 1.0, -1.0]];
+    let m = [1e-6, 1.0, 4.0];
+    let n = 6;
+    let mut a = vec![0.0; n * n];
+    for i in 0..3 {
+        a[i * n + i] = m[i];
+        for r in 0..3 {
+            a[i * n + 3 + r] = g[r][i];
+            a[(3 + r) * n + i] = g[r][i];
+        }
+    }
+    let mut lu = DenseLu::new(n);
+    lu.set_droppable(3, 1);
+    fill(&mut lu, &a);
+    lu.factor_lu().unwrap();
+    assert_eq!(lu.fallbacks(), 1, "the static order must have failed");
+    let dropped: Vec<usize> = lu.dropped().collect();
+    assert_eq!(dropped.len(), 1);
+    assert!(dropped[0] == 4 || dropped[0] == 5, "{dropped:?}");
+    let mut sol = [0.5, -1.0, 0.25, 2.0, -3.0, 1.5];
+    sol[dropped[0]] = 0.0;
+    let mut b: Vec<f64> = (0..n)
+        .map(|i| (0..n).map(|j| a[i * n + j] * sol[j]).sum())
+        .collect();
+    let mut bt = b.clone();
+    lu.solve_in_place(&mut b);
+    for i in 0..n {
+        assert!((b[i] - sol[i]).abs() < 1e-12, "{i}: {} vs {}", b[i], sol[i]);
+    }
+    // A is symmetric: the transposed solve gives the same basic solution
+    lu.solve_transpose_in_place(&mut bt);
+    for i in 0..n {
+        assert!(
+            (bt[i] - sol[i]).abs() < 1e-12,
+            "{i}: {} vs {}",
+            bt[i],
+            sol[i]
+        );
+    }
+    // without the drop the fallback reports the dependent column
+    let mut plain = DenseLu::new(n);
+    fill(&mut plain, &a);
+    assert!(plain.factor_lu().is_err());
+}
