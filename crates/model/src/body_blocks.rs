@@ -42,6 +42,39 @@ impl System {
         });
     }
 
+    /// Every row of `Phi_q` and of `(Phi_q v)_q` in element-local form over body blocks (see
+    /// [`System::local_rows_gamma`]): `visit(row, sides)`, each side `(block, gradient,
+    /// gradient of Phi_q v)`. What the sparse tangent chart's `Df = [[Phi_q, 0], [(Phi_q v)_q,
+    /// Phi_q]]` is built from.
+    pub fn local_rows_tan(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        mut visit: impl FnMut(usize, [Option<(usize, &[f64], &[f64])>; 2]),
+    ) {
+        let sc = SinCos::new(self, q, None);
+        self.for_each_row_tan(q, v, &sc, |ji, r, g, dg| {
+            let at = self.joint_attach[ji];
+            visit(
+                r,
+                [
+                    at.a.map(|i| (i, &g[0..3], &dg[0..3])),
+                    at.b.map(|i| (i, &g[3..6], &dg[3..6])),
+                ],
+            );
+        });
+        let nb = self.bodies.len();
+        self.spatial.rows_tan(q, v, |r, sides, g, dg| {
+            visit(
+                r,
+                [
+                    sides[0].map(|k| (nb + k, &g[0..12], &dg[0..12])),
+                    sides[1].map(|k| (nb + k, &g[12..24], &dg[12..24])),
+                ],
+            );
+        });
+    }
+
     /// The number of body blocks (planar and spatial bodies) of [`System::local_rows_gamma`].
     pub fn n_body_blocks(&self) -> usize {
         self.bodies.len() + self.spatial.bodies.len()

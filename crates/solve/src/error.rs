@@ -282,7 +282,8 @@ pub fn refuse_large_spatial(
         return Err(SolveError::Unsupported(format!(
             "{solver} has no sparse path for spatial bodies yet: use LinearSolver::Dense or \
              Auto (it takes spatial models of up to {DENSE_SPATIAL_LIMIT} equations densely), or \
-             rk4, rk4-projected or index1:dopri5, whose sparse path takes them"
+             rk4, rk4-projected, index1:dopri5 or the tangent solvers, whose sparse path takes \
+             them"
         )));
     }
     if m <= DENSE_SPATIAL_LIMIT {
@@ -291,7 +292,7 @@ pub fn refuse_large_spatial(
     Err(SolveError::Unsupported(format!(
         "{solver} takes spatial bodies on its dense path only, and this model has {m} \
          equations (more than {DENSE_SPATIAL_LIMIT}, where its dense matrices make a step \
-         take seconds to minutes): run it with rk4, rk4-projected or index1:dopri5, whose \
-         sparse path takes spatial bodies in O(N)"
+         take seconds to minutes): run it with rk4, rk4-projected, index1:dopri5 or the tangent \
+         solvers, whose sparse path takes spatial bodies in O(N)"
     )))
 }

@@ -19,7 +19,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 3.5,
-            refuses: "spatial models above 600 equations (its sparse path is planar)",
+            refuses: "",
             compared: true,
         },
         SolverVariant {
@@ -30,7 +30,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: true,
             scales: true,
             relative_cost: 6.0,
-            refuses: "spatial models above 600 equations (its sparse path is planar)",
+            refuses: "",
             compared: true,
         },
     ],

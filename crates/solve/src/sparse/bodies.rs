@@ -12,23 +12,14 @@
 //! dense module: `x = C f + d(r_int)`, `S lambda_e = Phi_e x - r_e`, `a = x - C Phi_e^T
 //! lambda_e`, and each spatial body's internal multipliers from its own rows.
 
-use super::SparseCholesky;
+use super::{BlockRows, SparseCholesky};
 use crate::error::SolveError;
 use crate::linalg::{BodyFactorError, FactorError};
 use mbd_model::spatial::RigidSolve;
 use mbd_model::System;
 
-/// One side of an external row: its block, first coordinate, width and the offset of its local
-/// gradient in the flat gradient store.
-#[derive(Clone, Copy, Debug)]
-struct Side {
-    block: usize,
-    col: usize,
-    width: usize,
-    off: usize,
-}
-
-/// One contribution to `S`: sides `s1` of external row `e1` and `s2` of `e2` share a block.
+/// One contribution to `S`: a side of external row `e1` and one of `e2` share a block
+/// (offsets of the first's gradient and the second's `C_b g`).
 #[derive(Clone, Copy, Debug)]
 struct Contribution {
     g1: usize,
@@ -42,19 +33,13 @@ struct Contribution {
 pub(crate) struct SparseBodySchur {
     n: usize,
     m: usize,
-    /// Each external row's global row.
-    ext: Vec<usize>,
-    /// Each global row's external index (`usize::MAX` for an internal row).
-    ext_of: Vec<usize>,
-    /// Each external row's sides.
-    sides: Vec<[Option<Side>; 2]>,
-    /// The external rows' local gradients, side after side.
+    /// The external rows (every row but the spatial internal constraints) over body blocks.
+    rows: BlockRows,
+    /// The external rows' local gradients (the layout of `rows`).
     grads: Vec<f64>,
     /// `C_b g` for each side's gradient, in the same layout.
     cg: Vec<f64>,
     contributions: Vec<Contribution>,
-    /// Per block: the external rows acting on it (external index, side).
-    by_block: Vec<Vec<(usize, usize)>>,
     /// The planar blocks and the first spatial coordinate and internal row.
     planar: usize,
     q0: usize,
@@ -74,98 +59,37 @@ impl SparseBodySchur {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let internal = sys.spatial_internal_rows();
         let nblocks = sys.n_body_blocks();
-        let mut ext_of = vec![usize::MAX; m];
-        let mut ext = Vec::new();
-        let mut sides: Vec<[Option<Side>; 2]> = Vec::new();
-        let mut off = 0;
-        // each row's sides as (block, width)
-        type Sides = [Option<(usize, usize)>; 2];
-        let mut rows: Vec<(usize, Sides)> = Vec::with_capacity(m);
-        let q = sys.initial_guess().0;
-        sys.local_rows_gamma(q.as_slice(), None, 0.0, |r, s, _| {
-            rows.push((r, s.map(|s| s.map(|(b, g)| (b, g.len())))));
-        });
-        rows.sort_by_key(|&(r, _)| r);
-        for (r, s) in rows {
-            if internal.contains(&r) {
-                continue;
-            }
-            ext_of[r] = ext.len();
-            ext.push(r);
-            let mut side = [None; 2];
-            for (k, s) in s.iter().enumerate() {
-                if let Some((block, width)) = *s {
-                    let (col, w) = sys.body_block(block).ok_or_else(|| {
-                        SolveError::Unsupported(format!("row {r} names body block {block}"))
-                    })?;
-                    debug_assert_eq!(w, width);
-                    side[k] = Some(Side {
-                        block,
-                        col,
-                        width,
-                        off,
-                    });
-                    off += width;
-                }
-            }
-            sides.push(side);
-        }
-        let me = ext.len();
-        let mut by_block: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nblocks];
-        for (e, s) in sides.iter().enumerate() {
-            for (k, side) in s.iter().enumerate() {
-                if let Some(side) = side {
-                    by_block[side.block].push((e, k));
-                }
-            }
-        }
-        let mut pattern = Vec::new();
-        for rows in &by_block {
-            for &(e1, _) in rows {
-                for &(e2, _) in rows {
-                    if e1 > e2 {
-                        pattern.push((e1, e2));
-                    }
-                }
-            }
-        }
+        let rows = BlockRows::new(sys, |r| !internal.contains(&r))?;
+        let me = rows.len();
+        let mut pairs = Vec::new();
+        rows.shared_pairs(|s1, s2, e1, e2| pairs.push((s1, s2, e1, e2)));
+        let pattern: Vec<(usize, usize)> = pairs
+            .iter()
+            .filter(|p| p.2 > p.3)
+            .map(|p| (p.2, p.3))
+            .collect();
         let mut chol = SparseCholesky::new(me, &pattern)?;
         chol.set_max_dependent(sys.n_redundant());
-        let mut contributions = Vec::new();
-        for rows in &by_block {
-            for &(e1, k1) in rows {
-                for &(e2, k2) in rows {
-                    if e1 < e2 {
-                        continue;
-                    }
-                    let slot = chol.slot(e1, e2).ok_or_else(|| {
-                        SolveError::Unsupported(format!(
-                            "sparse Schur pattern lacks entry ({e1}, {e2})"
-                        ))
-                    })?;
-                    let (s1, s2) = (sides[e1][k1], sides[e2][k2]);
-                    if let (Some(s1), Some(s2)) = (s1, s2) {
-                        contributions.push(Contribution {
-                            g1: s1.off,
-                            c2: s2.off,
-                            width: s1.width,
-                            slot,
-                        });
-                    }
-                }
-            }
+        let mut contributions = Vec::with_capacity(pairs.len());
+        for (s1, s2, e1, e2) in pairs {
+            let slot = chol.slot(e1, e2).ok_or_else(|| {
+                SolveError::Unsupported(format!("sparse Schur pattern lacks entry ({e1}, {e2})"))
+            })?;
+            contributions.push(Contribution {
+                g1: s1.off,
+                c2: s2.off,
+                width: s1.width,
+                slot,
+            });
         }
         let ns = sys.spatial_bodies().len();
         Ok(SparseBodySchur {
             n,
             m,
-            ext,
-            ext_of,
-            sides,
-            grads: vec![0.0; off],
-            cg: vec![0.0; off],
+            grads: vec![0.0; rows.n_values()],
+            cg: vec![0.0; rows.n_values()],
+            rows,
             contributions,
-            by_block,
             planar: nblocks - ns,
             q0: sys.spatial_offset(),
             r0: internal.start,
@@ -188,19 +112,7 @@ impl SparseBodySchur {
         gamma: &mut [f64],
     ) {
         self.qs.copy_from_slice(&q[self.q0..]);
-        let (ext_of, sides, grads) = (&self.ext_of, &self.sides, &mut self.grads);
-        sys.local_rows_gamma(q, v, t, |r, s, gm| {
-            gamma[r] = gm;
-            let e = ext_of[r];
-            if e == usize::MAX {
-                return;
-            }
-            for (side, g) in sides[e].iter().zip(s) {
-                if let (Some(side), Some((_, g))) = (side, g) {
-                    grads[side.off..side.off + side.width].copy_from_slice(g);
-                }
-            }
-        });
+        self.rows.gather(sys, q, v, t, &mut self.grads, gamma);
     }
 
     /// `out = C_b f` on block `b` (`w` the planar weights).
@@ -227,7 +139,7 @@ impl SparseBodySchur {
             self.rigid.push(r);
         }
         let mut cg = std::mem::take(&mut self.cg);
-        for s in self.sides.iter().flatten().flatten() {
+        for s in self.rows.sides().iter().flatten().flatten() {
             let range = s.off..s.off + s.width;
             self.apply_block(
                 s.block,
@@ -249,7 +161,11 @@ impl SparseBodySchur {
             let i = match e {
                 FactorError::Singular(i) | FactorError::NotPositiveDefinite(i) => i,
             };
-            BodyFactorError::Row(self.ext.get(i).copied().unwrap_or(i))
+            BodyFactorError::Row(if i < self.rows.len() {
+                self.rows.row(i)
+            } else {
+                i
+            })
         })
     }
 
@@ -260,7 +176,7 @@ impl SparseBodySchur {
 
     /// The condition estimate of the last factored `S` (1 without external rows).
     pub(crate) fn condition_estimate(&self) -> f64 {
-        if self.ext.is_empty() {
+        if self.rows.is_empty() {
             1.0
         } else {
             self.chol.condition_estimate()
@@ -290,38 +206,24 @@ impl SparseBodySchur {
         }
         // S lambda_e = Phi_e x - r_e
         let mut le = std::mem::take(&mut self.le);
-        for (e, (l, s)) in le.iter_mut().zip(&self.sides).enumerate() {
-            let mut acc = -r[self.ext[e]];
-            for s in s.iter().flatten() {
-                let g = &self.grads[s.off..s.off + s.width];
-                acc += g
-                    .iter()
-                    .zip(&x[s.col..s.col + s.width])
-                    .map(|(g, x)| g * x)
-                    .sum::<f64>();
-            }
-            *l = acc;
+        for (e, l) in le.iter_mut().enumerate() {
+            *l = self.rows.dot(&self.grads, e, &x) - r[self.rows.row(e)];
         }
         if !le.is_empty() {
             self.chol.solve_in_place(&mut le);
         }
         a.copy_from_slice(&x);
         lambda.fill(0.0);
-        for (e, s) in self.sides.iter().enumerate() {
-            lambda[self.ext[e]] = le[e];
-            for s in s.iter().flatten() {
-                let cg = &self.cg[s.off..s.off + s.width];
-                for (ak, c) in a[s.col..s.col + s.width].iter_mut().zip(cg) {
-                    *ak -= c * le[e];
-                }
-            }
+        for (e, &l) in le.iter().enumerate() {
+            lambda[self.rows.row(e)] = l;
+            self.rows.add_scaled(&self.cg, e, -l, a);
         }
         // each spatial body's internal multipliers: G^T mu = f - Phi_e^T lambda_e - M a
         for (k, rigid) in self.rigid.iter().enumerate() {
             let o = self.q0 + 12 * k;
             let mut g: [f64; 12] = std::array::from_fn(|l| f[o + l]);
-            for &(e, side) in &self.by_block[self.planar + k] {
-                if let Some(s) = self.sides[e][side] {
+            for &(e, side) in &self.rows.by_block()[self.planar + k] {
+                if let Some(s) = self.rows.sides()[e][side] {
                     for (gl, d) in g.iter_mut().zip(&self.grads[s.off..s.off + 12]) {
                         *gl -= d * le[e];
                     }

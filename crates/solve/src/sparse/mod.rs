@@ -15,12 +15,14 @@
 //! For a chain of `N` bodies every one of them costs `O(N)` per call.
 
 mod accel;
+mod block_rows;
 mod bodies;
 mod schur;
 
 pub(crate) use bodies::SparseBodySchur;
 
 pub use accel::SparseAccelerationSolver;
+pub use block_rows::{BlockRows, RowSide};
 pub use mbd_linalg::{SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};
 pub use schur::{ConstraintSchur, RowIncidence};
 

@@ -147,9 +147,7 @@ impl TangentRk {
     ) -> Result<Self, SolveError> {
         options.validate()?;
         let (n, m_full) = (sys.n_coords(), sys.n_constraints());
-        // spatial bodies take the dense path (docs/spatial.md)
-        mbd_solve::refuse_large_spatial(sys, "the tangent solver", options.linear_solver)?;
-        let sparse = options.linear_solver.use_sparse(m_full) && !sys.has_spatial();
+        let sparse = options.linear_solver.use_sparse(m_full);
         // the dense chart works with the m - k independent rows (chosen at each centre); the
         // sparse chart with all m, its factorisations dropping the dependent ones
         let m = if sparse {

@@ -7,37 +7,39 @@ use crate::chart::{ChartFailure, MapStats, NewtonSettings};
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::max_abs;
 use mbd_solve::linalg::FactorError;
-use mbd_solve::sparse::{RowIncidence, SparseCholesky};
+use mbd_solve::sparse::{BlockRows, SparseCholesky};
 use mbd_solve::SolveError;
 
 mod rank;
 #[cfg(test)]
 mod tests;
 
-/// One contribution of a body shared by rows `r1 >= r2` to the four entries of `G` that couple
-/// them: `o1`, `o2` are the body's offsets (0 or 3) in the rows' local gradients, and `pp`, `vp`, `pv`, `vv` the value slots of (position `r1`, position `r2`),
-/// (velocity `r1`, position `r2`), (position `r1`, velocity `r2`) and (velocity `r1`,
-/// velocity `r2`) (`pv` is unused when `r1 == r2`: it is `vp` by symmetry).
+/// One contribution of a block shared by rows `r1 >= r2` to the four entries of `G` that
+/// couple them: `o1`, `o2` are the offsets of the rows' sides on that block in the flat
+/// gradient arrays, `w` the block's width, and `pp`, `vp`, `pv`, `vv` the value slots of
+/// (position `r1`, position `r2`), (velocity `r1`, position `r2`), (position `r1`, velocity
+/// `r2`) and (velocity `r1`, velocity `r2`) (`pv` is unused when `r1 == r2`: it is `vp` by
+/// symmetry).
 #[derive(Clone, Copy, Debug)]
 struct Contribution {
     r1: usize,
     r2: usize,
     o1: usize,
     o2: usize,
+    w: usize,
     pp: usize,
     vp: usize,
     pv: usize,
     vv: usize,
 }
 
-/// One contribution of a shared body to `Phi_q Phi_q^T` (rank report): rows `r1 >= r2`, body
-/// offsets, value slot.
+/// One contribution of a shared block to `Phi_q Phi_q^T` (rank report): gradient offsets,
+/// width, value slot.
 #[derive(Clone, Copy, Debug)]
 struct PosContribution {
-    r1: usize,
-    r2: usize,
     o1: usize,
     o2: usize,
+    w: usize,
     idx: usize,
 }
 
@@ -50,8 +52,9 @@ struct PosContribution {
 ///
 /// with `eta` (`2m`) from the chord iteration `G d = -f(x)`, `x <- x + Df^T d`, `eta <- eta + d`
 /// and `G = Df(x_c) Df(x_c)^T` (`2m x 2m`). `Df = [[Phi_q, 0], [X, Phi_q]]` (`X = (Phi_q v)_q`)
-/// is kept in element-local form (each equation acts on at most two bodies), so `G` couples two
-/// equations only when they act on a common body: block tridiagonal for a chain. Its pattern
+/// is kept in element-local form over body blocks of any kind ([`BlockRows`]: each equation
+/// acts on at most two bodies, planar or spatial), so `G` couples two equations only when they
+/// act on a common body: block tridiagonal for a chain. Its pattern
 /// is analysed once in [`SparseChart::new`]; [`SparseChart::centre`] refills and refactors it,
 /// and the same factorisation gives the projector `P F = F - Df^T G^-1 Df F` of the state
 /// equation `y' = P F(x(y), t)` ([`SparseChart::split`]). Every operation costs `O(n + m)` for
@@ -69,18 +72,22 @@ struct PosContribution {
 pub struct SparseChart {
     n: usize,
     m: usize,
-    /// The bodies of each equation (`None` = ground).
-    row_bodies: Vec<(Option<usize>, Option<usize>)>,
-    /// Element-local rows of `Phi_q` and `(Phi_q v)_q` at the centre.
-    grads: Vec<[f64; 6]>,
-    dgrads: Vec<[f64; 6]>,
+    /// The model's redundant equations (dropped by each factorisation).
+    redundant: usize,
+    /// Every equation over body blocks.
+    rows: BlockRows,
+    /// Element-local rows of `Phi_q` and `(Phi_q v)_q` at the centre (the layout of `rows`).
+    grads: Vec<f64>,
+    dgrads: Vec<f64>,
     contributions: Vec<Contribution>,
     /// `G = Df Df^T` (`2m x 2m`; index `r` position equation `r`, `m + r` velocity equation `r`).
     chol: SparseCholesky,
     /// `Phi_q Phi_q^T` at a configuration (rank report), its contributions and rows of `Phi_q`.
     pos_chol: SparseCholesky,
     pos_contributions: Vec<PosContribution>,
-    grads_x: Vec<[f64; 6]>,
+    grads_x: Vec<f64>,
+    /// `gamma` of the rank report's pass (unused; length m).
+    gamma_x: Vec<f64>,
     /// The centre `(q_c, v_c)` and its time.
     xc: Vec<f64>,
     tc: f64,
@@ -104,24 +111,17 @@ impl SparseChart {
     /// `Phi_q Phi_q^T` (allocates once).
     pub fn new(sys: &System) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let RowIncidence {
-            row_bodies,
-            by_body,
-        } = RowIncidence::new(sys);
-        let mut pattern = Vec::new();
-        let mut pos_pattern = Vec::new();
-        for rows in &by_body {
-            for &(r1, _) in rows {
-                for &(r2, _) in rows {
-                    if r1 >= r2 {
-                        pattern.push((r1, r2));
-                        pattern.push((m + r1, r2));
-                        pattern.push((m + r2, r1));
-                        pattern.push((m + r1, m + r2));
-                        pos_pattern.push((r1, r2));
-                    }
-                }
-            }
+        let rows = BlockRows::new(sys, |_| true)?;
+        let mut pairs = Vec::new();
+        rows.shared_pairs(|s1, s2, r1, r2| pairs.push((s1, s2, r1, r2)));
+        let mut pattern = Vec::with_capacity(4 * pairs.len());
+        let mut pos_pattern = Vec::with_capacity(pairs.len());
+        for &(_, _, r1, r2) in &pairs {
+            pattern.push((r1, r2));
+            pattern.push((m + r1, r2));
+            pattern.push((m + r2, r1));
+            pattern.push((m + r1, m + r2));
+            pos_pattern.push((r1, r2));
         }
         let mut chol = SparseCholesky::new(2 * m, &pattern)?;
         let mut pos_chol = SparseCholesky::new(m, &pos_pattern)?;
@@ -136,44 +136,42 @@ impl SparseChart {
         };
         let slot =
             |ch: &SparseCholesky, r: usize, c: usize| ch.slot(r, c).ok_or_else(|| missing(r, c));
-        let mut contributions = Vec::new();
-        let mut pos_contributions = Vec::new();
-        for rows in &by_body {
-            for &(r1, o1) in rows {
-                for &(r2, o2) in rows {
-                    if r1 >= r2 {
-                        contributions.push(Contribution {
-                            r1,
-                            r2,
-                            o1,
-                            o2,
-                            pp: slot(&chol, r1, r2)?,
-                            vp: slot(&chol, m + r1, r2)?,
-                            pv: slot(&chol, r1, m + r2)?,
-                            vv: slot(&chol, m + r1, m + r2)?,
-                        });
-                        pos_contributions.push(PosContribution {
-                            r1,
-                            r2,
-                            o1,
-                            o2,
-                            idx: slot(&pos_chol, r1, r2)?,
-                        });
-                    }
-                }
-            }
+        let mut contributions = Vec::with_capacity(pairs.len());
+        let mut pos_contributions = Vec::with_capacity(pairs.len());
+        for (s1, s2, r1, r2) in pairs {
+            let (o1, o2, w) = (s1.off, s2.off, s1.width);
+            contributions.push(Contribution {
+                r1,
+                r2,
+                o1,
+                o2,
+                w,
+                pp: slot(&chol, r1, r2)?,
+                vp: slot(&chol, m + r1, r2)?,
+                pv: slot(&chol, r1, m + r2)?,
+                vv: slot(&chol, m + r1, m + r2)?,
+            });
+            pos_contributions.push(PosContribution {
+                o1,
+                o2,
+                w,
+                idx: slot(&pos_chol, r1, r2)?,
+            });
         }
+        let nv = rows.n_values();
         Ok(SparseChart {
             n,
             m,
-            row_bodies,
-            grads: vec![[0.0; 6]; m],
-            dgrads: vec![[0.0; 6]; m],
+            redundant: k,
+            rows,
+            grads: vec![0.0; nv],
+            dgrads: vec![0.0; nv],
             contributions,
             chol,
             pos_chol,
             pos_contributions,
-            grads_x: vec![[0.0; 6]; m],
+            grads_x: vec![0.0; nv],
+            gamma_x: vec![0.0; m],
             xc: vec![0.0; 2 * n],
             tc: 0.0,
             f: vec![0.0; 2 * m],
@@ -187,10 +185,15 @@ impl SparseChart {
         })
     }
 
-    /// Dimension of the manifold, `2 (n - m)` (the chart's coordinates `y` are redundant:
-    /// `2n` numbers in a `2 (n - m)`-dimensional subspace).
+    /// Dimension of the manifold, `2 (n - m + k)` with `k` redundant equations (the chart's
+    /// coordinates `y` are redundant: `2n` numbers in a `2 (n - m + k)`-dimensional subspace).
     pub fn dim(&self) -> usize {
-        2 * (self.n - self.m.min(self.n))
+        2 * (self.n - self.independent().min(self.n))
+    }
+
+    /// The number of independent equations, `m - k`.
+    pub(super) fn independent(&self) -> usize {
+        self.m - self.redundant.min(self.m)
     }
 
     /// Dimension of the ambient space, `2n`: the length of `y`.
@@ -236,19 +239,20 @@ impl SparseChart {
             self.centred = true;
             return Ok(());
         }
-        sys.phi_q_dot_local(q, v, &mut self.grads, &mut self.dgrads);
+        self.rows
+            .gather_tan(sys, q, v, &mut self.grads, &mut self.dgrads);
         if self
             .grads
             .iter()
             .chain(&self.dgrads)
-            .any(|g| g.iter().any(|x| !x.is_finite()))
+            .any(|x| !x.is_finite())
         {
             return Err(SolveError::NonFinite {
                 t,
                 what: "constraint Jacobian at the chart centre",
             });
         }
-        if m > n {
+        if self.independent() > n {
             return Err(SolveError::Singular {
                 t,
                 what: "constraint Jacobian Df of the tangent chart",
@@ -258,12 +262,15 @@ impl SparseChart {
         self.chol.clear();
         let vals = self.chol.values_mut();
         for c in &self.contributions {
-            let (a1, a2) = (&self.grads[c.r1], &self.grads[c.r2]);
-            let (x1, x2) = (&self.dgrads[c.r1], &self.dgrads[c.r2]);
+            let (a1, a2) = (&self.grads[c.o1..c.o1 + c.w], &self.grads[c.o2..c.o2 + c.w]);
+            let (x1, x2) = (
+                &self.dgrads[c.o1..c.o1 + c.w],
+                &self.dgrads[c.o2..c.o2 + c.w],
+            );
             let (mut aa, mut xa, mut ax, mut xx) = (0.0, 0.0, 0.0, 0.0);
-            for l in 0..3 {
-                let (p1, p2) = (a1[c.o1 + l], a2[c.o2 + l]);
-                let (d1, d2) = (x1[c.o1 + l], x2[c.o2 + l]);
+            for l in 0..c.w {
+                let (p1, p2) = (a1[l], a2[l]);
+                let (d1, d2) = (x1[l], x2[l]);
                 aa += p1 * p2;
                 xa += d1 * p2;
                 ax += p1 * d2;
@@ -315,20 +322,14 @@ impl SparseChart {
         let (n, m) = (self.n, self.m);
         let (zq, zv) = z.split_at(n);
         let (op, ov) = out[..2 * m].split_at_mut(m);
-        for r in 0..m {
-            let (a, x) = (&self.grads[r], &self.dgrads[r]);
+        for (r, sides) in self.rows.sides().iter().enumerate() {
             let (mut p, mut d) = (0.0, 0.0);
-            let (ba, bb) = self.row_bodies[r];
-            if let Some(b) = ba {
-                for l in 0..3 {
-                    p += a[l] * zq[3 * b + l];
-                    d += x[l] * zq[3 * b + l] + a[l] * zv[3 * b + l];
-                }
-            }
-            if let Some(b) = bb {
-                for l in 0..3 {
-                    p += a[3 + l] * zq[3 * b + l];
-                    d += x[3 + l] * zq[3 * b + l] + a[3 + l] * zv[3 * b + l];
+            for s in sides.iter().flatten() {
+                let (a, x) = (&self.grads[s.off..], &self.dgrads[s.off..]);
+                let (zq, zv) = (&zq[s.col..s.col + s.width], &zv[s.col..s.col + s.width]);
+                for l in 0..s.width {
+                    p += a[l] * zq[l];
+                    d += x[l] * zq[l] + a[l] * zv[l];
                 }
             }
             op[r] = p;
@@ -340,20 +341,17 @@ impl SparseChart {
     pub fn add_df_t(&self, alpha: f64, e: &[f64], out: &mut [f64]) {
         let (n, m) = (self.n, self.m);
         let (oq, ov) = out.split_at_mut(n);
-        for r in 0..m {
-            let (a, x) = (&self.grads[r], &self.dgrads[r]);
+        for (r, sides) in self.rows.sides().iter().enumerate() {
             let (ep, ev) = (alpha * e[r], alpha * e[m + r]);
-            let (ba, bb) = self.row_bodies[r];
-            if let Some(b) = ba {
-                for l in 0..3 {
-                    oq[3 * b + l] += a[l] * ep + x[l] * ev;
-                    ov[3 * b + l] += a[l] * ev;
-                }
-            }
-            if let Some(b) = bb {
-                for l in 0..3 {
-                    oq[3 * b + l] += a[3 + l] * ep + x[3 + l] * ev;
-                    ov[3 * b + l] += a[3 + l] * ev;
+            for s in sides.iter().flatten() {
+                let (a, x) = (&self.grads[s.off..], &self.dgrads[s.off..]);
+                let (oq, ov) = (
+                    &mut oq[s.col..s.col + s.width],
+                    &mut ov[s.col..s.col + s.width],
+                );
+                for l in 0..s.width {
+                    oq[l] += a[l] * ep + x[l] * ev;
+                    ov[l] += a[l] * ev;
                 }
             }
         }

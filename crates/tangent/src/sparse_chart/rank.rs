@@ -12,7 +12,7 @@ impl SparseChart {
     /// as [`SolveError::Singular`] naming the dependent equation and its joint (`None` if it
     /// factors well). Allocates only for the report.
     pub fn singular_error(&mut self, sys: &System, t: f64, rel_tol: f64) -> Option<SolveError> {
-        if self.m == 0 || self.m > self.n {
+        if self.m == 0 || self.independent() > self.n {
             return None;
         }
         self.grads_x.copy_from_slice(&self.grads);
@@ -27,10 +27,11 @@ impl SparseChart {
         t: f64,
         rel_tol: f64,
     ) -> Option<SolveError> {
-        if self.m == 0 || self.m > self.n || q.len() != self.n {
+        if self.m == 0 || self.independent() > self.n || q.len() != self.n {
             return None;
         }
-        sys.phi_q_local(q, &mut self.grads_x);
+        self.rows
+            .gather(sys, q, None, t, &mut self.grads_x, &mut self.gamma_x);
         self.pos_report(sys, t, rel_tol)
     }
 
@@ -38,12 +39,11 @@ impl SparseChart {
         self.pos_chol.clear();
         let vals = self.pos_chol.values_mut();
         for c in &self.pos_contributions {
-            let (a1, a2) = (&self.grads_x[c.r1], &self.grads_x[c.r2]);
-            let mut acc = 0.0;
-            for l in 0..3 {
-                acc += a1[c.o1 + l] * a2[c.o2 + l];
-            }
-            vals[c.idx] += acc;
+            let (a1, a2) = (
+                &self.grads_x[c.o1..c.o1 + c.w],
+                &self.grads_x[c.o2..c.o2 + c.w],
+            );
+            vals[c.idx] += a1.iter().zip(a2).map(|(a, b)| a * b).sum::<f64>();
         }
         let what = "configuration (rank-deficient constraint Jacobian Phi_q)";
         match self.pos_chol.factor() {

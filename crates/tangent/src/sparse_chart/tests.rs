@@ -5,20 +5,50 @@ use crate::chart::TangentChart;
 use mbd_model::models;
 use mbd_solve::State;
 
+/// On a planar chain, a spatial chain (12-coordinate blocks with their internal constraints)
+/// and the Bricard linkage (a redundant equation, which both charts leave out).
 #[test]
 fn sparse_projector_is_the_dense_u_u_transpose() {
-    // off the manifold in v on purpose: only Df(x_c) matters
-    let sys = models::n_link_chain(6).expect("model");
-    let s = State::consistent(&sys, 0.0).expect("state");
+    for (sys, tangent_v) in [
+        (models::n_link_chain(6).expect("planar chain"), false),
+        (models::spatial_chain(4).expect("spatial chain"), false),
+        (models::bricard().expect("Bricard"), true),
+    ] {
+        projector_matches(&sys, tangent_v);
+    }
+}
+
+/// The projectors agree at a consistent `q` with a velocity off the manifold (only `Df(x_c)`
+/// matters), or, with `tangent_v`, projected onto `ker Phi_q`: the Bricard linkage's
+/// redundancy holds on its constraint manifold only, so an off-manifold velocity gives its
+/// velocity rows one more rank, which the sparse chart sees and the dense chart (choosing
+/// its rows from `Phi_q`) does not.
+fn projector_matches(sys: &mbd_model::System, tangent_v: bool) {
+    let s = State::consistent(sys, 0.0).expect("state");
     let n = sys.n_coords();
-    let v: Vec<f64> = (0..n).map(|i| 0.3 * (i as f64 + 1.0).sin()).collect();
-    let mut dense = TangentChart::new(&sys);
+    let mut v: Vec<f64> = (0..n).map(|i| 0.3 * (i as f64 + 1.0).sin()).collect();
+    if tangent_v {
+        let mut pq = nalgebra::DMatrix::zeros(sys.n_constraints(), n);
+        sys.phi_q(s.q.as_slice(), &mut pq);
+        let svd = pq.svd(false, true);
+        let vt = svd.v_t.expect("V^T");
+        let v0 = nalgebra::DVector::from_column_slice(&v);
+        let mut p = v0.clone();
+        for (k, &sv) in svd.singular_values.iter().enumerate() {
+            if sv > 1e-10 * svd.singular_values[0] {
+                let row = vt.row(k).transpose();
+                p -= &row * row.dot(&v0);
+            }
+        }
+        v.copy_from_slice(p.as_slice());
+    }
+    let mut dense = TangentChart::new(sys);
     dense
-        .centre(&sys, s.q.as_slice(), &v, 0.0)
+        .centre(sys, s.q.as_slice(), &v, 0.0)
         .expect("dense centre");
-    let mut sparse = SparseChart::new(&sys).expect("sparse chart");
+    let mut sparse = SparseChart::new(sys).expect("sparse chart");
     sparse
-        .centre(&sys, s.q.as_slice(), &v, 0.0)
+        .centre(sys, s.q.as_slice(), &v, 0.0)
         .expect("sparse centre");
     assert_eq!(sparse.dim(), dense.dim());
     let (nn, mm) = (sparse.ambient_dim(), sparse.codim());
