@@ -400,8 +400,8 @@ fn the_bricard_linkage_moves_with_one_degree_of_freedom() -> Result<()> {
         let (sa, sb) = (a.state(), b.state());
         let pa = bricard_corner(&sys, &sa.q);
         worst_path = worst_path.max((pa - bricard_corner(&sys, &sb.q)).amax());
-        assert_eq!(sys.redundant_at(sa.q.as_slice())?.len(), 1, "t = {t}");
-        sys.phi_q(sa.q.as_slice(), &mut jac);
+        assert_eq!(sys.redundant_at(sa.q.as_slice(), sa.t)?.len(), 1, "t = {t}");
+        sys.phi_q(sa.q.as_slice(), 0.0, &mut jac);
         let mut sv: Vec<f64> = jac.clone().singular_values().iter().copied().collect();
         sv.sort_by(f64::total_cmp);
         let top = sv[n - 1];

@@ -103,7 +103,7 @@ impl EnergyBalance {
             });
         }
         let (q, v) = (s.q.as_slice(), s.v.as_slice());
-        sys.phi_t(s.t, &mut self.phi_t);
+        sys.phi_t(q, s.t, &mut self.phi_t);
         let drivers: f64 = lambda.iter().zip(&self.phi_t).map(|(l, p)| l * p).sum();
         let (dissipation, external) = sys.nonconservative_power(q, v, s.t);
         let sample = [s.t, external + drivers, dissipation];

@@ -74,8 +74,6 @@ pub(crate) struct StepProblem {
     pub q_start: Vec<f64>,
     /// LU of the dependent block of `Phi_q(q_start)` (chord Newton).
     pub chord: DenseLu,
-    /// `Phi_t(t1)` (all `m` equations).
-    pub phi_t1: Vec<f64>,
     /// LU of `G0 = N0^T M N0` at `q0` (the tangent metric that turns the projected residual
     /// into independent-coordinate accelerations).
     pub metric: DenseLu,
@@ -88,7 +86,7 @@ pub(crate) struct StepProblem {
 
 impl StepProblem {
     pub fn new(sys: &System, part: &Partition) -> Self {
-        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        let n = sys.n_coords();
         let r = part.dependent.len();
         let dof = n - r;
         StepProblem {
@@ -105,7 +103,6 @@ impl StepProblem {
             v0: vec![0.0; n],
             q_start: vec![0.0; n],
             chord: crate::objective::small_lu(r),
-            phi_t1: vec![0.0; m],
             metric: crate::objective::small_lu(dof),
             mass: sys.mass_diag().iter().copied().collect(),
             nodes: gauss_nodes(),
@@ -142,15 +139,14 @@ impl StepProblem {
         self.t1 = t0 + h;
         self.q0.copy_from_slice(q0);
         self.v0.copy_from_slice(v0);
-        sys.phi_t(self.t1, &mut self.phi_t1);
         // chord Jacobian at the predicted positions
-        sys.phi_q(&self.q_start, &mut ws.jac);
+        sys.phi_q(&self.q_start, self.t1, &mut ws.jac);
         fill_block(&ws.jac, &self.rows, &self.dep, self.chord.rows_mut());
         self.chord
             .factor_lu()
             .map_err(|_| "dependent block of Phi_q at the predicted state")?;
         // metric G0 = M_z + X^T M_d X with X = Phi_d^-1 Phi_z at q0
-        sys.phi_q(q0, &mut ws.jac);
+        sys.phi_q(q0, t0, &mut ws.jac);
         fill_block(&ws.jac, &self.rows, &self.dep, ws.lu.rows_mut());
         ws.lu
             .factor_lu()
@@ -214,12 +210,14 @@ impl StepProblem {
             }
             iters += 1;
         }
-        // velocities: Phi_d v_d = -Phi_t - Phi_z zdot at the converged q1
-        sys.phi_q(&ws.q1, &mut ws.jac);
+        // velocities: Phi_d v_d = -Phi_t - Phi_z zdot at the converged q1 (Phi_t into the
+        // residual's buffer, free now)
+        sys.phi_q(&ws.q1, self.t1, &mut ws.jac);
+        sys.phi_t(&ws.q1, self.t1, &mut ws.phi);
         fill_block(&ws.jac, &self.rows, &self.dep, ws.lu.rows_mut());
         ws.lu.factor_lu().ok()?;
         for (r, &row) in self.rows.iter().enumerate() {
-            let mut s = -self.phi_t1[row];
+            let mut s = -ws.phi[row];
             for (k, &i) in self.ind.iter().enumerate() {
                 s -= ws.jac[(row, i)] * x[dof + k];
             }
@@ -259,7 +257,7 @@ impl StepProblem {
                 ws.r[i] -= ws.force[i];
             }
             // eliminate lambda: rho = N^T r = r_z - Phi_z^T mu,  Phi_d^T mu = r_d
-            sys.phi_q(&ws.qg, &mut ws.jac);
+            sys.phi_q(&ws.qg, tg, &mut ws.jac);
             fill_block(&ws.jac, &self.rows, &self.dep, ws.lu.rows_mut());
             if ws.lu.factor_lu().is_err() {
                 return false;

@@ -86,13 +86,13 @@ impl Partition {
     /// rank below `m - k` (a singular configuration: a pivot at most `1e-10` of the largest
     /// entry) or above it (the redundancy found at build is gone: a row left after `m - k`
     /// pivots has an entry above that tolerance); the message names the equation.
-    pub fn auto(sys: &System, q: &[f64]) -> Result<Partition, FaDaeError> {
+    pub fn auto(sys: &System, q: &[f64], t: f64) -> Result<Partition, FaDaeError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         if sys.dof() == 0 {
             return Err(no_dof(sys));
         }
         let mut j = DMatrix::zeros(m, n);
-        sys.phi_q(q, &mut j);
+        sys.phi_q(q, t, &mut j);
         let mut piv = Pivoting::new(m, n, sys.n_redundant());
         match piv.eliminate(&j) {
             Ok(_) => Ok(piv.partition()),
@@ -101,7 +101,7 @@ impl Partition {
     }
 
     /// A partition with the given independent coordinates; checks the indices and that the
-    /// dependent block of `Phi_q(q)` is invertible. With `k > 0` redundant equations the `r`
+    /// dependent block of `Phi_q(q, t)` is invertible. With `k > 0` redundant equations the `r`
     /// equations are chosen by Gaussian elimination with complete pivoting of `Phi_q(q)` with
     /// the pivot columns restricted to the dependent coordinates.
     ///
@@ -110,7 +110,12 @@ impl Partition {
     /// [`System::dof`], `n - m + k`), an index out of range, a duplicate, or a singular
     /// dependent block at `q`; [`FaDaeError::Unsupported`] for a system without degrees of
     /// freedom or (with redundant equations) a `Phi_q(q)` whose rank is not `m - k`.
-    pub fn given(sys: &System, q: &[f64], independent: &[usize]) -> Result<Partition, FaDaeError> {
+    pub fn given(
+        sys: &System,
+        q: &[f64],
+        t: f64,
+        independent: &[usize],
+    ) -> Result<Partition, FaDaeError> {
         let (n, m, k) = (sys.n_coords(), sys.n_constraints(), sys.n_redundant());
         let bad = |reason: String| FaDaeError::InvalidPartition {
             given: independent.to_vec(),
@@ -153,7 +158,7 @@ impl Partition {
             )
         };
         let mut j = DMatrix::zeros(m, n);
-        sys.phi_q(q, &mut j);
+        sys.phi_q(q, t, &mut j);
         let equations = if k == 0 {
             (0..m).collect()
         } else {

@@ -150,7 +150,7 @@ fn auto_partition_names_the_rank_and_the_equations() {
         ("pantograph", pantograph()),
     ] {
         let (q0, _) = sys.initial_guess();
-        let p = Partition::auto(&sys, q0.as_slice()).expect(name);
+        let p = Partition::auto(&sys, q0.as_slice(), 0.0).expect(name);
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let r = m - sys.n_redundant();
         assert_eq!(p.dof(), sys.dof(), "{name}");
@@ -170,7 +170,7 @@ fn given_partition_checks_the_count_against_the_dof_and_runs() {
     let (sys, cl) = double_parallelogram();
     let (q0, _) = sys.initial_guess();
     // two indices, one degree of freedom (12 coordinates, 12 equations, one redundant)
-    match Partition::given(&sys, q0.as_slice(), &[2, 5]) {
+    match Partition::given(&sys, q0.as_slice(), 0.0, &[2, 5]) {
         Err(FaDaeError::InvalidPartition { reason, .. }) => {
             assert!(reason.contains("1 degrees of freedom"), "{reason}");
             assert!(reason.contains("1 of them redundant"), "{reason}");
@@ -179,11 +179,11 @@ fn given_partition_checks_the_count_against_the_dof_and_runs() {
     }
     // a coupler coordinate cannot be chosen: the coupler does not turn
     assert!(matches!(
-        Partition::given(&sys, q0.as_slice(), &[11]),
+        Partition::given(&sys, q0.as_slice(), 0.0, &[11]),
         Err(FaDaeError::InvalidPartition { .. })
     ));
     // the first crank's angle: eleven equations chosen for the other coordinates
-    let p = Partition::given(&sys, q0.as_slice(), &[2]).expect("crank angle");
+    let p = Partition::given(&sys, q0.as_slice(), 0.0, &[2]).expect("crank angle");
     assert_eq!((p.dependent.len(), p.equations.len()), (11, 11));
     let opts = FaDaeOptions::polished().partition(PartitionChoice::Given(vec![2]));
     let (e, p, v, _) = run(&sys, &cl, &mut *solver(&sys, opts), 1e-2);
@@ -196,7 +196,7 @@ fn a_rank_other_than_m_minus_k_is_an_error_naming_it() {
     let (sys, cl) = double_parallelogram();
     // flat (all links on the x-axis): rank 10 < 11, a singular configuration
     let (flat, _) = cl.branch_state(0.0, 0.0);
-    match Partition::auto(&sys, &flat) {
+    match Partition::auto(&sys, &flat, 0.0) {
         Err(FaDaeError::Unsupported(msg)) => {
             assert!(msg.contains("rank deficient"), "{msg}");
             assert!(msg.contains("1 redundant"), "{msg}");
@@ -207,7 +207,7 @@ fn a_rank_other_than_m_minus_k_is_an_error_naming_it() {
     // redundancy found at build is gone
     let (mut q, _) = cl.branch_state(ANGLE, 0.0);
     q[5] += 0.3;
-    match Partition::auto(&sys, &q) {
+    match Partition::auto(&sys, &q, 0.0) {
         Err(FaDaeError::Unsupported(msg)) => {
             assert!(msg.contains("redundancy found at build is gone"), "{msg}");
             assert!(msg.contains("M.y") || msg.contains("M.x"), "{msg}");

@@ -42,14 +42,15 @@ impl System {
         });
     }
 
-    /// Every row of `Phi_q` and of `(Phi_q v)_q` in element-local form over body blocks (see
-    /// [`System::local_rows_gamma`]): `visit(row, sides)`, each side `(block, gradient,
-    /// gradient of Phi_q v)`. What the sparse tangent chart's `Df = [[Phi_q, 0], [(Phi_q v)_q,
-    /// Phi_q]]` is built from.
+    /// Every row of `Phi_q` and of `(Phi_q v + Phi_t)_q` at time `t` in element-local form over
+    /// body blocks (see [`System::local_rows_gamma`]): `visit(row, sides)`, each side
+    /// `(block, gradient, gradient of Phi_q v + Phi_t)`. What the sparse tangent chart's
+    /// `Df = [[Phi_q, 0], [(Phi_q v + Phi_t)_q, Phi_q]]` is built from.
     pub fn local_rows_tan(
         &self,
         q: &[f64],
         v: &[f64],
+        t: f64,
         mut visit: impl FnMut(usize, [Option<(usize, &[f64], &[f64])>; 2]),
     ) {
         let sc = SinCos::new(self, q, None);
@@ -64,7 +65,7 @@ impl System {
             );
         });
         let nb = self.bodies.len();
-        self.spatial.rows_tan(q, v, |r, sides, g, dg| {
+        self.spatial.rows_tan(q, v, t, |r, sides, g, dg| {
             visit(
                 r,
                 [

@@ -35,15 +35,17 @@ impl System {
         self.spatial.phi(q, t, out);
     }
 
-    /// `Phi_t(q, t)` into `out` (length m).
-    pub fn phi_t(&self, t: f64, out: &mut [f64]) {
+    /// `Phi_t(q, t)` into `out` (length m). Planar drivers and the spatial slide and distance
+    /// drivers subtract a function of time, so theirs does not depend on `q`; a spatial angle
+    /// driver's does.
+    pub fn phi_t(&self, q: &[f64], t: f64, out: &mut [f64]) {
         for (ji, j) in self.joints.iter().enumerate() {
             let o = self.row_offset[ji];
             for k in 0..j.n_equations() {
                 out[o + k] = -j.time_part(k, t)[1];
             }
         }
-        self.spatial.phi_t(t, out);
+        self.spatial.phi_t(q, t, out);
     }
 
     #[inline(always)]
@@ -51,14 +53,15 @@ impl System {
         self.joint_attach[ji].scatter_row(row, g, out);
     }
 
-    /// The constraint Jacobian `Phi_q` (m x n, dense) into `out` (overwritten).
-    pub fn phi_q(&self, q: &[f64], out: &mut DMatrix<f64>) {
+    /// The constraint Jacobian `Phi_q(q, t)` (m x n, dense) into `out` (overwritten). It
+    /// depends on `t` only through spatial angle drivers.
+    pub fn phi_q(&self, q: &[f64], t: f64, out: &mut DMatrix<f64>) {
         out.as_mut_slice().fill(0.0);
         let sc = SinCos::new(self, q, None);
-        self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
+        self.for_each_row(q, None, t, &sc, |ji, r, g, _| {
             self.scatter_row(ji, r, g, out)
         });
-        self.spatial.rows(q, None, 0.0, |r, sides, jet| {
+        self.spatial.rows(q, None, t, |r, sides, jet| {
             self.spatial.scatter_row(r, sides, &jet.g, out)
         });
     }
@@ -86,14 +89,16 @@ impl System {
     }
 
     /// `Phi_q` and the Jacobian of the velocity constraint with respect to `q`,
-    /// `(Phi_q v)_q = d/dq (Phi_q(q) v)` (m x n; row `k` is `v^T Hess(Phi_k)`), in one pass.
-    /// Together they form the Jacobian `[[Phi_q, 0], [(Phi_q v)_q, Phi_q]]` of the first-order
-    /// constraints `(Phi, Phi_q v + Phi_t)` in `(q, v)` (`Phi_qt = 0` for every joint, so
-    /// `Phi_t` adds nothing). Exact (Hessian jets), both outputs overwritten.
+    /// `(Phi_q v + Phi_t)_q` (m x n; row `k` is `v^T Hess(Phi_k)`, plus `Phi_tq` on a spatial
+    /// angle driver's row, the only rows whose `Phi_qt` is not zero), at time `t`, in one pass.
+    /// Together they form the Jacobian `[[Phi_q, 0], [(Phi_q v + Phi_t)_q, Phi_q]]` of the
+    /// first-order constraints `(Phi, Phi_q v + Phi_t)` in `(q, v)`. Exact (Hessian jets),
+    /// both outputs overwritten.
     pub fn phi_q_dot_jacobian(
         &self,
         q: &[f64],
         v: &[f64],
+        t: f64,
         phi_q: &mut DMatrix<f64>,
         out: &mut DMatrix<f64>,
     ) {
@@ -104,7 +109,7 @@ impl System {
             self.scatter_row(ji, r, g, phi_q);
             self.scatter_row(ji, r, dg, out);
         });
-        self.spatial.rows_tan(q, v, |r, sides, g, dg| {
+        self.spatial.rows_tan(q, v, t, |r, sides, g, dg| {
             self.spatial.scatter_row(r, sides, g, phi_q);
             self.spatial.scatter_row(r, sides, dg, out);
         });
@@ -330,12 +335,12 @@ impl System {
         self.spatial_phi_and_phi_dot(q, v, t, phi, phi_dot);
     }
 
-    /// `Phi_q` as (row, column, value) triplets of its structural non-zeros, for sparse
+    /// `Phi_q(q, t)` as (row, column, value) triplets of its structural non-zeros, for sparse
     /// factorisations. `out` is cleared first; its capacity is reused.
-    pub fn phi_q_triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
+    pub fn phi_q_triplets(&self, q: &[f64], t: f64, out: &mut Vec<(usize, usize, f64)>) {
         out.clear();
         let sc = SinCos::new(self, q, None);
-        self.for_each_row(q, None, 0.0, &sc, |ji, r, g, _| {
+        self.for_each_row(q, None, t, &sc, |ji, r, g, _| {
             let at = self.joint_attach[ji];
             if let Some(i) = at.a {
                 for l in 0..3 {
@@ -348,20 +353,21 @@ impl System {
                 }
             }
         });
-        self.spatial.triplets(q, out);
+        self.spatial.triplets(q, t, out);
     }
 
-    /// The lambda-weighted constraint Hessian `sum_k lambda_k d^2 Phi_k / dq^2` (n x n) into `out`
-    /// (overwritten).
-    pub fn constraint_hessian(&self, q: &[f64], lambda: &[f64], out: &mut DMatrix<f64>) {
+    /// The lambda-weighted constraint Hessian `sum_k lambda_k d^2 Phi_k / dq^2` (n x n) at time
+    /// `t` into `out` (overwritten).
+    pub fn constraint_hessian(&self, q: &[f64], t: f64, lambda: &[f64], out: &mut DMatrix<f64>) {
         out.fill(0.0);
-        self.add_constraint_hessian(q, lambda, 1.0, out);
+        self.add_constraint_hessian(q, t, lambda, 1.0, out);
     }
 
-    /// Adds `scale * sum_k lambda_k d^2 Phi_k / dq^2` into `out`.
+    /// Adds `scale * sum_k lambda_k d^2 Phi_k / dq^2` at time `t` into `out`.
     pub fn add_constraint_hessian(
         &self,
         q: &[f64],
+        t: f64,
         lambda: &[f64],
         scale: f64,
         out: &mut DMatrix<f64>,
@@ -388,7 +394,7 @@ impl System {
             }
             Self::scatter_hess(at, &h, out);
         });
-        self.spatial.add_hessian(q, lambda, scale, out);
+        self.spatial.add_hessian(q, t, lambda, scale, out);
     }
 
     pub(crate) fn scatter_hess(at: Attach, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {
@@ -475,9 +481,9 @@ mod phi_q_dot_jacobian_tests {
             let v: Vec<f64> = (0..n).map(|i| 1.3 - 0.41 * i as f64).collect();
             let mut jq = DMatrix::zeros(m, n);
             let mut d = DMatrix::zeros(m, n);
-            sys.phi_q_dot_jacobian(&q, &v, &mut jq, &mut d);
+            sys.phi_q_dot_jacobian(&q, &v, 0.0, &mut jq, &mut d);
             let mut jref = DMatrix::zeros(m, n);
-            sys.phi_q(&q, &mut jref);
+            sys.phi_q(&q, 0.0, &mut jref);
             assert!((&jq - &jref).amax() < 1e-15);
             let (mut p1, mut p2, mut d1, mut d2) =
                 (vec![0.0; m], vec![0.0; m], vec![0.0; m], vec![0.0; m]);
@@ -497,8 +503,8 @@ mod phi_q_dot_jacobian_tests {
                 let mut qm = q.clone();
                 qp[c] += eps;
                 qm[c] -= eps;
-                sys.phi_q(&qp, &mut jp);
-                sys.phi_q(&qm, &mut jm);
+                sys.phi_q(&qp, 0.0, &mut jp);
+                sys.phi_q(&qm, 0.0, &mut jm);
                 let fd = (&jp * &vv - &jm * &vv) / (2.0 * eps);
                 for r in 0..m {
                     assert!(

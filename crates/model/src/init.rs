@@ -67,22 +67,22 @@ impl System {
         self.redundant.len()
     }
 
-    /// The equations of `Phi_q(q)` that depend on the ones before them, in row order (the rows
+    /// The equations of `Phi_q(q, t)` that depend on the ones before them, in row order (the rows
     /// a factorisation in the natural order drops). Below [`SPARSE_RANK_THRESHOLD`] equations
     /// a Gram-Schmidt pass over the rows (a row is dependent when its part outside the span of
     /// the earlier rows is below `1e-9` of the largest row norm); above, a semidefinite sparse
     /// Cholesky factorisation of `Phi_q M^-1 Phi_q^T` (pivot ratios below
     /// [`mbd_linalg::DEPENDENT_PIVOT_TOL`]), linear in the size of a chain.
-    pub fn redundant_at(&self, q: &[f64]) -> Result<Vec<RedundantEquation>, ModelError> {
+    pub fn redundant_at(&self, q: &[f64], t: f64) -> Result<Vec<RedundantEquation>, ModelError> {
         self.check_len("q", q, self.n)?;
         if self.m == 0 {
             return Ok(Vec::new());
         }
         if self.m > SPARSE_RANK_THRESHOLD {
-            return self.redundant_sparse(q);
+            return self.redundant_sparse(q, t);
         }
         let mut jac = DMatrix::zeros(self.m, self.n);
-        self.phi_q(q, &mut jac);
+        self.phi_q(q, t, &mut jac);
         // Fast path: a well-conditioned Cholesky factor of Phi_q M^-1 Phi_q^T proves full rank.
         if self.schur_well_conditioned(&jac) {
             return Ok(Vec::new());
@@ -95,12 +95,12 @@ impl System {
     /// of the largest row norm (Gram-Schmidt, as [`System::redundant_at`]), without the ones
     /// found redundant at build time. Empty above [`SPARSE_RANK_THRESHOLD`] equations (the
     /// sparse factorisation reports exact dependence only).
-    pub fn nearly_dependent_at(&self, q: &[f64], rel_tol: f64) -> Vec<RedundantEquation> {
+    pub fn nearly_dependent_at(&self, q: &[f64], t: f64, rel_tol: f64) -> Vec<RedundantEquation> {
         if q.len() != self.n || self.m == 0 || self.m > SPARSE_RANK_THRESHOLD {
             return Vec::new();
         }
         let mut jac = DMatrix::zeros(self.m, self.n);
-        self.phi_q(q, &mut jac);
+        self.phi_q(q, t, &mut jac);
         let mut found = self.redundant_dense(&jac, rel_tol);
         found.retain(|e| !self.redundant.iter().any(|r| r.row == e.row));
         found
@@ -110,8 +110,8 @@ impl System {
     /// equations ([`System::n_redundant`]): full row rank for a mechanism without redundancy.
     /// On failure returns [`ModelError::Redundant`] naming a dependent equation (the first one
     /// not found at build time) and the joints whose equations it combines.
-    pub fn check_rank(&self, q: &[f64], _t: f64) -> Result<(), ModelError> {
-        let found = self.redundant_at(q)?;
+    pub fn check_rank(&self, q: &[f64], t: f64) -> Result<(), ModelError> {
+        let found = self.redundant_at(q, t)?;
         if found.len() <= self.redundant.len() {
             return Ok(());
         }
@@ -187,7 +187,7 @@ impl System {
     /// allowing every row to be dropped. `W` is `M^-1` for planar bodies; for a spatial body,
     /// whose `M` may be singular, `1/m` on its centre and `1/J_max` on its directors: any
     /// positive weight gives `S` the rank of `Phi_q`, and these keep it scaled like `M^-1`.
-    fn redundant_sparse(&self, q: &[f64]) -> Result<Vec<RedundantEquation>, ModelError> {
+    fn redundant_sparse(&self, q: &[f64], t: f64) -> Result<Vec<RedundantEquation>, ModelError> {
         let m = self.m;
         let mut w = self.inv_mass.as_slice().to_vec();
         for (k, b) in self.spatial.bodies.iter().enumerate() {
@@ -200,7 +200,7 @@ impl System {
         // each row's sides: (block, first coordinate, offset of its gradient in `grads`)
         let mut sides: Vec<[Option<(usize, usize, usize)>; 2]> = vec![[None; 2]; m];
         let mut grads: Vec<f64> = Vec::new();
-        self.local_rows_gamma(q, None, 0.0, |r, s, _| {
+        self.local_rows_gamma(q, None, t, |r, s, _| {
             for (k, side) in s.iter().enumerate() {
                 if let Some((block, g)) = side {
                     let col = self.body_block(*block).map_or(0, |(c, _)| c);

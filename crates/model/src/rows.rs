@@ -358,10 +358,10 @@ mod tests {
             let (mut dense, mut dense2) = (DMatrix::from_element(m, n, 9.0), DMatrix::zeros(m, n));
             let mut gamma3 = vec![9.0; m];
             sys.phi_q_gamma(&q, &v, t, &mut dense, &mut gamma3);
-            sys.phi_q(&q, &mut dense2);
+            sys.phi_q(&q, t, &mut dense2);
             assert_eq!(gl_dense(sys, &gl), gl_dense(sys, &g));
             let mut trip = Vec::new();
-            sys.phi_q_triplets(&q, &mut trip);
+            sys.phi_q_triplets(&q, t, &mut trip);
             let mut from_trip = DMatrix::zeros(m, n);
             for &(r, c, x) in &trip {
                 from_trip[(r, c)] += x;
@@ -372,7 +372,7 @@ mod tests {
             sys.phi_dot(&q, &v, t, &mut pd);
             sys.phi_and_phi_dot(&q, &v, t, &mut phi, &mut pd2);
             let mut phit = vec![0.0; m];
-            sys.phi_t(t, &mut phit);
+            sys.phi_t(&q, t, &mut phit);
             let mut local = DMatrix::zeros(m, n);
             sys.local_rows_dense(&g, &mut local);
             for r in 0..m {
@@ -409,7 +409,7 @@ mod tests {
             let (q, _) = crate::fixtures::generic_point(n);
             let lambda: Vec<f64> = (0..m).map(|r| 0.4 - 0.13 * r as f64).collect();
             let mut h = DMatrix::from_element(n, n, 7.0);
-            sys.constraint_hessian(&q, &lambda, &mut h);
+            sys.constraint_hessian(&q, 0.0, &lambda, &mut h);
             let eps = 1e-6;
             let (mut jp, mut jm) = (DMatrix::zeros(m, n), DMatrix::zeros(m, n));
             let lv = nalgebra::DVector::from_column_slice(&lambda);
@@ -417,8 +417,8 @@ mod tests {
                 let (mut qp, mut qm) = (q.clone(), q.clone());
                 qp[c] += eps;
                 qm[c] -= eps;
-                sys.phi_q(&qp, &mut jp);
-                sys.phi_q(&qm, &mut jm);
+                sys.phi_q(&qp, 0.0, &mut jp);
+                sys.phi_q(&qm, 0.0, &mut jm);
                 let fd = (jp.transpose() * &lv - jm.transpose() * &lv) / (2.0 * eps);
                 for r in 0..n {
                     assert!(

@@ -288,7 +288,7 @@ fn check_rank(lp: &ClosedLoop, flat_loss: usize) {
     let mut jac = DMatrix::zeros(m, n);
     for th in ANGLES {
         let (q, _) = lp.branch_state(th, 1.0);
-        sys.phi_q(&q, &mut jac);
+        sys.phi_q(&q, 0.0, &mut jac);
         let sv = jac.clone().singular_values();
         let big = sv.max();
         let rank = sv.iter().filter(|&&x| x > 1e-10 * big).count();

@@ -35,8 +35,8 @@ fn same_equations(a: &System, b: &System, seed: u64) {
             let mut f = vec![0.0; n];
             s.phi(&q, t, &mut phi);
             s.phi_q_gamma(&q, &v, t, &mut jac, &mut gamma);
-            s.phi_t(t, &mut pt);
-            s.constraint_hessian(&q, &lam, &mut hess);
+            s.phi_t(&q, t, &mut pt);
+            s.constraint_hessian(&q, 0.0, &lam, &mut hess);
             s.potential_hessian(&q, &mut kq);
             s.forces_into(&q, &v, t, &mut f);
             (phi, jac, gamma, pt, hess, kq, f, s.energy(&q, &v))

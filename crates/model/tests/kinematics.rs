@@ -157,13 +157,13 @@ fn check_at(sys: &System, r: &mut ChaCha8Rng) -> Worst {
 
     // Phi_q vs FD of Phi
     let mut jac = DMatrix::zeros(m, n);
-    sys.phi_q(&q, &mut jac);
+    sys.phi_q(&q, 0.0, &mut jac);
     let fd = fd_jacobian(|x, out| sys.phi(x, t, out), &q, m, H1);
     w.jac = max_rel_mat(&fd, &jac);
 
     // triplets reproduce the dense Jacobian exactly (duplicates are summed)
     let mut trip = Vec::new();
-    sys.phi_q_triplets(&q, &mut trip);
+    sys.phi_q_triplets(&q, 0.0, &mut trip);
     let mut dense = DMatrix::zeros(m, n);
     for &(i, j, x) in &trip {
         assert!(i < m && j < n);
@@ -173,7 +173,7 @@ fn check_at(sys: &System, r: &mut ChaCha8Rng) -> Worst {
 
     // Phi_t vs FD in t
     let mut pt = vec![0.0; m];
-    sys.phi_t(t, &mut pt);
+    sys.phi_t(&q, t, &mut pt);
     let fdt = fd_jacobian(|x, out| sys.phi(&q, x[0], out), &[t], m, H1);
     w.phi_t = max_rel(fdt.as_slice(), &pt);
     if !sys.is_rheonomic() {
@@ -212,12 +212,12 @@ fn check_at(sys: &System, r: &mut ChaCha8Rng) -> Worst {
 
     // constraint Hessian vs FD of Phi_q^T lambda
     let mut hess = DMatrix::zeros(n, n);
-    sys.constraint_hessian(&q, &lambda, &mut hess);
+    sys.constraint_hessian(&q, 0.0, &lambda, &mut hess);
     let lam = mbd_model::nalgebra::DVector::from_column_slice(&lambda);
     let fdh = fd_jacobian(
         |x, out| {
             let mut j = DMatrix::zeros(m, n);
-            sys.phi_q(x, &mut j);
+            sys.phi_q(x, 0.0, &mut j);
             out.copy_from_slice(j.tr_mul(&lam).as_slice());
         },
         &q,
@@ -228,7 +228,7 @@ fn check_at(sys: &System, r: &mut ChaCha8Rng) -> Worst {
     assert_eq!(hess, hess.transpose(), "Hessian not symmetric");
     // add_constraint_hessian accumulates with a scale
     let mut acc = hess.clone();
-    sys.add_constraint_hessian(&q, &lambda, -2.0, &mut acc);
+    sys.add_constraint_hessian(&q, 0.0, &lambda, -2.0, &mut acc);
     assert!((acc + &hess).amax() <= 1e-13 * hess.amax().max(1.0));
     w
 }
@@ -287,7 +287,7 @@ fn driver_time_derivatives_are_exact() {
     let v = [0.1, 0.2, 0.3, -0.4, 0.5, 0.6];
     let (mut phi, mut pt, mut gamma, mut pd) = ([0.0], [0.0], [0.0], [0.0]);
     sys.phi(&q, t, &mut phi);
-    sys.phi_t(t, &mut pt);
+    sys.phi_t(&q, t, &mut pt);
     sys.gamma(&q, &v, t, &mut gamma);
     sys.phi_dot(&q, &v, t, &mut pd);
     assert_eq!(phi[0], -0.2 - 0.3 - f0);
@@ -398,7 +398,7 @@ fn local_jacobians_scatter_to_the_dense_ones() {
     let v: Vec<f64> = (0..n).map(|i| (0.7 * i as f64).cos()).collect();
     let mut pq = nalgebra::DMatrix::zeros(m, n);
     let mut pd = nalgebra::DMatrix::zeros(m, n);
-    sys.phi_q_dot_jacobian(&q, &v, &mut pq, &mut pd);
+    sys.phi_q_dot_jacobian(&q, &v, 0.0, &mut pq, &mut pd);
     let (mut g, mut dg, mut g2) = (vec![[0.0; 6]; m], vec![[0.0; 6]; m], vec![[0.0; 6]; m]);
     sys.phi_q_dot_local(&q, &v, &mut g, &mut dg);
     sys.phi_q_local(&q, &mut g2);

@@ -184,7 +184,7 @@ fn velocity_projection_is_m_orthogonal() {
     let mdv = dv.component_mul(sys.mass_diag());
     assert!(mdv.dot(w).abs() < 1e-12 * (mdv.norm() * w.norm()));
     let mut jac = DMatrix::zeros(8, 9);
-    sys.phi_q(x.q.as_slice(), &mut jac);
+    sys.phi_q(x.q.as_slice(), 0.0, &mut jac);
     assert!((&jac * &x.v).amax() < 1e-12);
     // the crank keeps turning the same way
     assert!(x.v[2] > 0.0, "crank speed {}", x.v[2]);
@@ -219,7 +219,7 @@ fn rheonomic_projection_includes_phi_t() {
     let m = sys.n_constraints();
     let (mut phi, mut pt, mut pd) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     sys.phi(x.q.as_slice(), t, &mut phi);
-    sys.phi_t(t, &mut pt);
+    sys.phi_t(x.q.as_slice(), t, &mut pt);
     sys.phi_dot(x.q.as_slice(), x.v.as_slice(), t, &mut pd);
     assert!(inf_norm(&phi) <= 1e-12 && inf_norm(&pd) <= 1e-12);
     // the driven angle and its rate follow the driver
@@ -229,7 +229,7 @@ fn rheonomic_projection_includes_phi_t() {
     assert!((x.v[2] - omega).abs() < 1e-12);
     // Phi_q v alone is -Phi_t, far from zero: dropping Phi_t would be caught
     let mut jac = DMatrix::zeros(m, sys.n_coords());
-    sys.phi_q(x.q.as_slice(), &mut jac);
+    sys.phi_q(x.q.as_slice(), 0.0, &mut jac);
     let jv = &jac * &x.v;
     assert!((jv[m - 1] + pt[m - 1]).abs() < 1e-12 && pt[m - 1].abs() > 0.2);
     // a pin velocity consistent with the motion: pin2 tip of link 1 moves at omega * L1

@@ -62,10 +62,10 @@ fn spatial_rows_match_finite_differences() {
     sys.phi_q_gamma(&q, &v, 0.0, &mut jac, &mut gamma);
     assert!(max_diff(&jac, &fd) < 1e-9, "{}", max_diff(&jac, &fd));
     let mut jac2 = dense(m, n);
-    sys.phi_q(&q, &mut jac2);
+    sys.phi_q(&q, 0.0, &mut jac2);
     assert_eq!(jac, jac2);
     let mut triplets = Vec::new();
-    sys.phi_q_triplets(&q, &mut triplets);
+    sys.phi_q_triplets(&q, 0.0, &mut triplets);
     let mut from_triplets = dense(m, n);
     for (r, c, x) in triplets {
         from_triplets[(r, c)] += x;
@@ -85,7 +85,7 @@ fn spatial_rows_match_finite_differences() {
     }
     let jv_at = |q: &[f64]| {
         let mut j = dense(m, n);
-        sys.phi_q(q, &mut j);
+        sys.phi_q(q, 0.0, &mut j);
         j * nalgebra::DVector::from_column_slice(&v)
     };
     let mut dqv = dense(m, n);
@@ -108,17 +108,17 @@ fn spatial_rows_match_finite_differences() {
         );
     }
     let (mut j3, mut tan) = (dense(m, n), dense(m, n));
-    sys.phi_q_dot_jacobian(&q, &v, &mut j3, &mut tan);
+    sys.phi_q_dot_jacobian(&q, &v, 0.0, &mut j3, &mut tan);
     assert_eq!(j3, jac);
     assert!(max_diff(&tan, &dqv) < 1e-8, "{}", max_diff(&tan, &dqv));
 
     // sum_k lambda_k Hess(Phi_k) = d/dq (Phi_q^T lambda)
     let lambda: Vec<f64> = (0..m).map(|k| (k as f64 * 0.9).cos()).collect();
     let mut hess = dense(n, n);
-    sys.constraint_hessian(&q, &lambda, &mut hess);
+    sys.constraint_hessian(&q, 0.0, &lambda, &mut hess);
     let jtl = |q: &[f64]| {
         let mut j = dense(m, n);
-        sys.phi_q(q, &mut j);
+        sys.phi_q(q, 0.0, &mut j);
         j.transpose() * nalgebra::DVector::from_column_slice(&lambda)
     };
     for c in 0..n {

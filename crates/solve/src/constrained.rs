@@ -99,7 +99,7 @@ impl ConstrainedSolve {
         }
         let res = match &mut self.kernel {
             Kernel::Dense(schur) => {
-                sys.phi_q(q, &mut schur.phi_q);
+                sys.phi_q(q, t, &mut schur.phi_q);
                 schur.factor(sys, q, &self.w)
             }
             Kernel::Sparse(schur) => {

@@ -380,7 +380,7 @@ impl RunChecks {
     #[cold]
     #[inline(never)]
     fn singular_stop(&self, sys: &System, state: &State, condition: f64) -> SolveError {
-        let near = sys.nearly_dependent_at(state.q.as_slice(), 1e-2);
+        let near = sys.nearly_dependent_at(state.q.as_slice(), state.t, 1e-2);
         let named = if near.is_empty() {
             String::new()
         } else {

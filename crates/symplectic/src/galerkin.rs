@@ -339,8 +339,9 @@ impl Galerkin {
             .map_or((0, 0), |sp| (sp.lu.nnz(), sp.lu.factor_nnz()))
     }
 
-    /// `Phi_q` at the start of a step, `q_k` (or copied from the end of the last step).
-    fn start_phiq(&mut self, sys: &System, reuse: bool) {
+    /// `Phi_q` at the start of a step, `q_k` at time `t` (or copied from the end of the last
+    /// step).
+    fn start_phiq(&mut self, sys: &System, t: f64, reuse: bool) {
         let s = self.tab.s;
         if self.sparse.is_some() {
             if reuse {
@@ -353,7 +354,7 @@ impl Galerkin {
             let (first, rest) = self.phiq.split_at_mut(1);
             first[0].copy_from(&rest[s - 1]);
         } else {
-            sys.phi_q(&self.qk, &mut self.phiq[0]);
+            sys.phi_q(&self.qk, t, &mut self.phiq[0]);
         }
     }
 
@@ -368,7 +369,7 @@ impl Galerkin {
     /// Residual of the stage equations at `self.x` into `self.r`.
     fn residual(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
         self.kinematics(sys, t, h)?;
-        self.momentum_rows(sys, h);
+        self.momentum_rows(sys, t, h);
         self.constraint_rows(sys, t, h);
         Ok(())
     }
@@ -466,20 +467,20 @@ impl Galerkin {
     /// `Phi_q` at the interior control points `Q_1 .. Q_(s-1)` at `self.x` (after
     /// `place_control_points`): what the end momentum needs when Newton's last update was
     /// applied without a new residual (`momentum_rows` evaluates them otherwise).
-    pub(super) fn refresh_interior_phiq(&mut self, sys: &System) {
+    pub(super) fn refresh_interior_phiq(&mut self, sys: &System, t: f64, h: f64) {
         let (n, s) = (self.n, self.tab.s);
         for nu in 1..s {
             let q = &self.qn[nu * n..(nu + 1) * n];
             if self.sparse.is_some() {
                 sys.phi_q_local(q, &mut self.grads[nu]);
             } else {
-                sys.phi_q(q, &mut self.phiq[nu]);
+                sys.phi_q(q, t + self.tab.tau[nu] * h, &mut self.phiq[nu]);
             }
         }
     }
 
     /// The momentum rows of the residual (after `kinematics`).
-    fn momentum_rows(&mut self, sys: &System, h: f64) {
+    fn momentum_rows(&mut self, sys: &System, t: f64, h: f64) {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let tab = &self.tab;
         let h2 = h * h;
@@ -511,7 +512,11 @@ impl Galerkin {
         }
         for nu in 0..s {
             if nu >= 1 {
-                sys.phi_q(&self.qn[nu * n..(nu + 1) * n], &mut self.phiq[nu]);
+                sys.phi_q(
+                    &self.qn[nu * n..(nu + 1) * n],
+                    t + tab.tau[nu] * h,
+                    &mut self.phiq[nu],
+                );
             }
             let g = self.phiq[nu].as_slice();
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];

@@ -137,8 +137,8 @@ impl FireflyGauss {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let (q0, _) = sys.initial_guess();
         let partition = match &options.partition {
-            PartitionChoice::Auto => Partition::auto(sys, q0.as_slice())?,
-            PartitionChoice::Given(ind) => Partition::given(sys, q0.as_slice(), ind)?,
+            PartitionChoice::Auto => Partition::auto(sys, q0.as_slice(), 0.0)?,
+            PartitionChoice::Given(ind) => Partition::given(sys, q0.as_slice(), 0.0, ind)?,
         };
         let dof = partition.dof();
         let mut prob = StepProblem::new(sys, &partition);

@@ -16,7 +16,7 @@ impl FireflyGauss {
         state: &State,
     ) -> Result<(bool, f64), FaDaeError> {
         let q = state.q.as_slice();
-        sys.phi_q(q, &mut self.ws.jac);
+        sys.phi_q(q, state.t, &mut self.ws.jac);
         self.partition
             .fill_dependent_block(&self.ws.jac, self.ws.lu.rows_mut());
         let factored = self.ws.lu.factor_lu().map(|()| self.ws.lu.pivot_range());

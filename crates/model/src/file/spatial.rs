@@ -109,6 +109,9 @@ pub enum SpatialJointType {
     SlideDriver,
     /// Driver: the points' distance follows `motion`.
     DistanceDriver,
+    /// Driver: `b`'s `x` axis turns about `a`'s `z` axis (from `a`'s `x` towards its `y`) by
+    /// `motion` (rad); beside a revolute or cylindrical joint.
+    AngleDriver,
 }
 
 /// A spatial joint in a model file: markers (point and axes) on two bodies.
@@ -147,8 +150,8 @@ pub struct SpatialJointSpec {
     /// The rod's length of a distance joint, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<f64>,
-    /// A driver's motion (m, a function of time): the slide of a `slide_driver`, the distance
-    /// of a `distance_driver`.
+    /// A driver's motion (a function of time): the slide (m) of a `slide_driver`, the distance
+    /// (m) of a `distance_driver`, the angle (rad) of an `angle_driver`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<crate::timefn::TimeFunction>,
 }
@@ -281,6 +284,7 @@ impl SpatialJointSpec {
             SpatialJointType::Weld => SpatialJointKind::Weld,
             SpatialJointType::SlideDriver => SpatialJointKind::SlideDriver,
             SpatialJointType::DistanceDriver => SpatialJointKind::DistanceDriver,
+            SpatialJointType::AngleDriver => SpatialJointKind::AngleDriver,
             SpatialJointType::Distance => SpatialJointKind::Distance {
                 length: self.length.ok_or_else(|| {
                     invalid(
@@ -326,6 +330,7 @@ impl SpatialJointSpec {
             SpatialJointKind::Distance { length } => (SpatialJointType::Distance, Some(length)),
             SpatialJointKind::SlideDriver => (SpatialJointType::SlideDriver, None),
             SpatialJointKind::DistanceDriver => (SpatialJointType::DistanceDriver, None),
+            SpatialJointKind::AngleDriver => (SpatialJointType::AngleDriver, None),
         };
         let axes = |m: &Marker| (m.axes != Matrix3::identity()).then(|| vectors(&m.axes));
         SpatialJointSpec {

@@ -1,8 +1,9 @@
 //! Joints: holonomic constraints between two bodies (or a body and ground), one file per kind.
 //!
-//! Every joint equation has the form `Phi_k(q, t) = g_k(q_a, q_b) - f_k(t)`: time enters only
-//! additively, through a driver's function. So `Phi_q` does not depend on `t`, `Phi_qt = 0`,
-//! `Phi_t = -f'(t)` and `Phi_tt = -f''(t)`.
+//! Every planar joint equation has the form `Phi_k(q, t) = g_k(q_a, q_b) - f_k(t)`: time enters
+//! only additively, through a driver's function. So its `Phi_q` does not depend on `t`,
+//! `Phi_qt = 0`, `Phi_t = -f'(t)` and `Phi_tt = -f''(t)`. (The spatial angle driver's Jacobian
+//! does depend on `t`: `crate::spatial`, and the model's Jacobian passes take `t`.)
 //!
 //! Each kind is a struct in its own file implementing the crate-internal trait `JointType`: its
 //! equations `g(q_a, q_b)` written once over a generic scalar (every derivative pass of the

@@ -97,7 +97,7 @@ impl SpatialInput {
                 (Some(_), false) => {
                     return Err(invalid(
                         element,
-                        "only the driver kinds (slide_driver, distance_driver) take a motion"
+                        "only the driver kinds (slide_driver, distance_driver, angle_driver) take a motion"
                             .to_string(),
                     ))
                 }
@@ -197,9 +197,10 @@ impl crate::SystemBuilder {
         self.spatial.joints.len() - 1
     }
     /// Adds a spatial driver (a joint of a driver kind,
-    /// [`crate::spatial::SpatialJointKind::SlideDriver`] or
-    /// [`crate::spatial::SpatialJointKind::DistanceDriver`]) whose slide or distance follows
-    /// `motion` (m, a function of time). Returns its index among the spatial joints; `build`
+    /// [`crate::spatial::SpatialJointKind::SlideDriver`],
+    /// [`crate::spatial::SpatialJointKind::DistanceDriver`] or
+    /// [`crate::spatial::SpatialJointKind::AngleDriver`]) whose slide, distance (m) or angle
+    /// (rad) follows `motion`, a function of time. Returns its index among the spatial joints; `build`
     /// checks the kind and the function.
     pub fn add_spatial_driver(
         &mut self,

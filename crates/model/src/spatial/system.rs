@@ -30,8 +30,9 @@ pub struct SpatialJointEntry {
     /// The joint, its markers in the bodies' frames.
     pub joint: SpatialJoint,
     /// A driver's motion: the slide `s(t)` (m) of a [`super::SpatialJointKind::SlideDriver`],
-    /// the distance `L(t)` (m) of a [`super::SpatialJointKind::DistanceDriver`]; `None` for
-    /// every other kind.
+    /// the distance `L(t)` (m) of a [`super::SpatialJointKind::DistanceDriver`], the angle
+    /// `theta(t)` (rad) of a [`super::SpatialJointKind::AngleDriver`]; `None` for every other
+    /// kind.
     pub motion: Option<crate::timefn::TimeFunction>,
 }
 
@@ -135,25 +136,48 @@ impl SpatialPart {
         sides[l / 12].map(|k| self.q0 + 12 * k + l % 12)
     }
 
-    /// An element's equations at the frames of its sides.
-    fn eval<T: Scalar>(&self, item: Item, fa: &SpatialFrame<T>, fb: &SpatialFrame<T>) -> [T; 6] {
+    /// An element's equations at the frames of its sides at time `t`, a driver's without the
+    /// motion it subtracts; an angle driver's equation in `out[0]` and its derivative in
+    /// `theta` in `out[1]` ([`angle_combine`]).
+    fn eval<T: Scalar>(
+        &self,
+        item: Item,
+        fa: &SpatialFrame<T>,
+        fb: &SpatialFrame<T>,
+        t: f64,
+    ) -> [T; 6] {
         let mut out = [T::cst(0.0); 6];
         match item {
             Item::Internal => out = super::internal_eval(fa),
-            Item::Joint(j) => self.lowered[j].eval(fa, fb, &mut out),
+            Item::Joint(j) => {
+                self.lowered[j].eval(fa, fb, &mut out);
+                if let Some([theta, ..]) = self.angle(j, t) {
+                    (out[0], out[1]) = angle_combine(theta, out[0], out[1]);
+                }
+            }
         }
         out
     }
 
-    /// An element's equations with jets: local variable `l` made by `var(l, column)`.
+    /// An angle driver's `theta`, `theta'`, `theta''` at `t` (`None` for every other joint).
+    pub(crate) fn angle(&self, j: usize, t: f64) -> Option<[f64; 3]> {
+        if self.lowered[j].kind() != super::joints::SpatialJointKind::AngleDriver {
+            return None;
+        }
+        self.joints[j].motion.as_ref().map(|m| m.eval(t))
+    }
+
+    /// An element's equations at time `t` with jets: local variable `l` made by
+    /// `var(l, column)` (see [`SpatialPart::eval`]).
     fn eval_jets<T: Scalar>(
         &self,
         item: Item,
         sides: [Option<usize>; 2],
+        t: f64,
         var: impl Fn(usize, usize) -> T,
     ) -> [T; 6] {
         let [fa, fb] = self.frames(sides, var);
-        self.eval(item, &fa, &fb)
+        self.eval(item, &fa, &fb, t)
     }
 
     /// The frames of an element's two sides, local variable `l` made by `var(l, column)`
@@ -175,7 +199,7 @@ impl SpatialPart {
     /// The spatial rows of `Phi(q, t)` into `out` (the whole vector).
     pub(crate) fn phi(&self, q: &[f64], t: f64, out: &mut [f64]) {
         for (item, sides, row, n) in self.items() {
-            let e = self.eval_jets(item, sides, |_, c| q[c]);
+            let e = self.eval_jets(item, sides, t, |_, c| q[c]);
             out[row..row + n].copy_from_slice(&e[..n]);
             if let Item::Joint(j) = item {
                 out[row] -= self.drive(j, t)[0];
@@ -184,7 +208,8 @@ impl SpatialPart {
     }
 
     /// The time part `c(t)`, `c'`, `c''` a driver joint's equation subtracts (zeros for
-    /// every other joint): `s(t)` for a slide driver, `1/2 L(t)^2` for a distance driver.
+    /// every other joint, the angle driver included: its time enters through its Jacobian):
+    /// `s(t)` for a slide driver, `1/2 L(t)^2` for a distance driver.
     pub(crate) fn drive(&self, j: usize, t: f64) -> [f64; 3] {
         let Some(motion) = &self.joints[j].motion else {
             return [0.0; 3];
@@ -194,15 +219,23 @@ impl SpatialPart {
             super::joints::SpatialJointKind::DistanceDriver => {
                 [0.5 * f * f, f * df, df * df + f * ddf]
             }
+            super::joints::SpatialJointKind::AngleDriver => [0.0; 3],
             _ => [f, df, ddf],
         }
     }
 
-    /// `Phi_t` of the spatial rows into `out` (the whole vector): `-c'(t)` on driver rows.
-    pub(crate) fn phi_t(&self, t: f64, out: &mut [f64]) {
+    /// `Phi_t(q, t)` of the spatial rows into `out` (the whole vector): `-c'(t)` on slide and
+    /// distance driver rows, `theta' dE/dtheta` on angle driver rows.
+    pub(crate) fn phi_t(&self, q: &[f64], t: f64, out: &mut [f64]) {
         out[self.r0..self.r0 + self.m].fill(0.0);
         for (j, &row) in self.joint_row.iter().enumerate() {
-            out[row] = -self.drive(j, t)[1];
+            out[row] = match self.angle(j, t) {
+                Some([_, dtheta, _]) => {
+                    let e = self.eval_jets(Item::Joint(j), self.attach[j], t, |_, c| q[c]);
+                    dtheta * e[1]
+                }
+                None => -self.drive(j, t)[1],
+            };
         }
     }
 
@@ -212,8 +245,9 @@ impl SpatialPart {
     }
 
     /// For every spatial row at time `t`: `visit(row, sides, jet)`, the jet holding the value
-    /// `Phi`, the gradient `Phi_q`, `Phi_q v + Phi_t` (`d1`) and `v^T H v + Phi_tt` (`d2`, so
-    /// that `gamma = -d2`; `Phi_qt = 0` for every spatial joint) (`v = None`: zero velocities).
+    /// `Phi`, the gradient `Phi_q`, `Phi_q v + Phi_t` (`d1`) and
+    /// `v^T H v + 2 Phi_qt v + Phi_tt` (`d2`, so that `gamma = -d2`) (`v = None`: zero
+    /// velocities). `Phi_qt` is zero but on angle driver rows.
     pub(crate) fn rows(
         &self,
         q: &[f64],
@@ -241,7 +275,15 @@ impl SpatialPart {
             };
             let mut e = [DirJetN::<SW>::cst(0.0); 6];
             self.lowered[j].eval_jets(local(0), local(1), &mut e);
-            if self.joints[j].motion.is_some() {
+            if let Some([theta, dth, ddth]) = self.angle(j, t) {
+                // Phi = E(q, theta(t)): d/dt = E_q v + E_theta theta', and the second
+                // derivative v^T E_qq v + 2 theta' E_theta,q v + theta'^2 E_theta,theta +
+                // theta'' E_theta, with E_theta,theta = -E
+                let (ee, et) = angle_combine(theta, e[0], e[1]);
+                e[0] = ee;
+                e[0].d1 += dth * et.v;
+                e[0].d2 += 2.0 * dth * et.d1 + ddth * et.v - dth * dth * ee.v;
+            } else if self.joints[j].motion.is_some() {
                 let [c, dc, ddc] = self.drive(j, t);
                 e[0].v -= c;
                 e[0].d1 -= dc;
@@ -289,15 +331,25 @@ impl SpatialPart {
         })
     }
 
-    /// For every spatial row: `visit(row, sides, gradient, H v)`.
+    /// For every spatial row at time `t`: `visit(row, sides, gradient, (Phi_q v + Phi_t)_q)`
+    /// (`H v`, plus `Phi_tq` on angle driver rows).
     pub(crate) fn rows_tan(
         &self,
         q: &[f64],
         v: &[f64],
+        t: f64,
         mut visit: impl FnMut(usize, [Option<usize>; 2], &[f64; SW], &[f64; SW]),
     ) {
         for (item, sides, row, n) in self.items() {
-            let e = self.eval_jets(item, sides, |l, c| TanJetN::<SW>::var(l, q[c], v[c]));
+            let mut e = self.eval_jets(item, sides, t, |l, c| TanJetN::<SW>::var(l, q[c], v[c]));
+            if let (Item::Joint(j), true) = (item, n == 1) {
+                if let Some([_, dth, _]) = self.angle(j, t) {
+                    let et = e[1];
+                    for (d, g) in e[0].dg.iter_mut().zip(&et.g) {
+                        *d += dth * g;
+                    }
+                }
+            }
             for (k, ek) in e.iter().enumerate().take(n) {
                 visit(row + k, sides, &ek.g, &ek.dg);
             }
@@ -319,9 +371,9 @@ impl SpatialPart {
         }
     }
 
-    /// `Phi_q`'s spatial non-zeros as triplets.
-    pub(crate) fn triplets(&self, q: &[f64], out: &mut Vec<(usize, usize, f64)>) {
-        self.rows(q, None, 0.0, |row, sides, jet| {
+    /// `Phi_q`'s spatial non-zeros at time `t` as triplets.
+    pub(crate) fn triplets(&self, q: &[f64], t: f64, out: &mut Vec<(usize, usize, f64)>) {
+        self.rows(q, None, t, |row, sides, jet| {
             for (l, &x) in jet.g.iter().enumerate() {
                 if let Some(c) = self.col(sides, l) {
                     if x != 0.0 {
@@ -332,16 +384,17 @@ impl SpatialPart {
         });
     }
 
-    /// `out += scale sum_k lambda_k Hess(Phi_k)` over the spatial rows.
+    /// `out += scale sum_k lambda_k Hess(Phi_k)` over the spatial rows at time `t`.
     pub(crate) fn add_hessian(
         &self,
         q: &[f64],
+        t: f64,
         lambda: &[f64],
         scale: f64,
         out: &mut DMatrix<f64>,
     ) {
         for (item, sides, row, n) in self.items() {
-            let e = self.eval_jets(item, sides, |l, c| HessJetN::<SW>::var(l, q[c]));
+            let e = self.eval_jets(item, sides, t, |l, c| HessJetN::<SW>::var(l, q[c]));
             for (k, ek) in e.iter().enumerate().take(n) {
                 let w = scale * lambda[row + k];
                 if w == 0.0 {
@@ -497,4 +550,12 @@ impl crate::System {
             * 0.5;
         Some([d(q, 0).dot(&w), d(q, 1).dot(&w), d(q, 2).dot(&w)])
     }
+}
+
+/// An angle driver's equation `E = cos theta e0 - sin theta e1` and its derivative in theta,
+/// `E_theta = -sin theta e0 - cos theta e1`, from its components `e0 = X_b . Y_a`,
+/// `e1 = X_b . X_a` (any scalar: values and jets alike, the combination being linear).
+fn angle_combine<T: Scalar>(theta: f64, e0: T, e1: T) -> (T, T) {
+    let (s, c) = theta.sin_cos();
+    (e0 * c - e1 * s, -(e0 * s) - e1 * c)
 }

@@ -200,17 +200,18 @@ impl BlockRows {
         });
     }
 
-    /// The kept rows of `Phi_q` into `vals` and of `(Phi_q v)_q` into `dvals` (both of length
-    /// [`BlockRows::n_values`]).
+    /// The kept rows of `Phi_q` into `vals` and of `(Phi_q v + Phi_t)_q` into `dvals` at time
+    /// `t` (both of length [`BlockRows::n_values`]).
     pub fn gather_tan(
         &self,
         sys: &System,
         q: &[f64],
         v: &[f64],
+        t: f64,
         vals: &mut [f64],
         dvals: &mut [f64],
     ) {
-        sys.local_rows_tan(q, v, |r, s| {
+        sys.local_rows_tan(q, v, t, |r, s| {
             let Some(e) = self.index(r) else {
                 return;
             };

@@ -43,7 +43,7 @@ impl Galerkin {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let s1 = s + 1;
         let qs = &self.qn[s * n..(s + 1) * n];
-        sys.phi_q(qs, &mut self.phiq[s]);
+        sys.phi_q(qs, t + self.tab.tau[s] * h, &mut self.phiq[s]);
         let any_hessian = self.has_forces || !self.pre.is_empty() || self.nonconservative;
         // The W_s term of the momentum rows' Jacobian is h^2 gk M^-1 A (Pi A)^s, at most
         // h^2 |gk| rho^(s+1) against the identity blocks (rho: a bound on the spectral radius
@@ -194,7 +194,12 @@ impl Galerkin {
         // constraint curvature at the interior control points
         for nu in 1..s {
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
-            sys.constraint_hessian(&self.qn[nu * n..(nu + 1) * n], lam, &mut self.hc);
+            sys.constraint_hessian(
+                &self.qn[nu * n..(nu + 1) * n],
+                t + self.tab.tau[nu] * h,
+                lam,
+                &mut self.hc,
+            );
             let jm = &mut self.lu;
             let o = (nu - 1) * n;
             for l in 0..n {

@@ -113,7 +113,7 @@ impl Galerkin {
                     .iter()
                     .map(|&th| {
                         let q: Vec<f64> = qk.iter().zip(hvk).map(|(q, d)| q + th * d).collect();
-                        sys.nearly_dependent_at(&q, 1e-2)
+                        sys.nearly_dependent_at(&q, t + th * h, 1e-2)
                     })
                     .find(|near| !near.is_empty())
                     .unwrap_or_default()
@@ -246,14 +246,14 @@ impl Galerkin {
                         // is only bounded by tol / theta, and that error is smooth in time
                         // (an energy drift of about 1e-11 per step on the rod at 90 degrees,
                         // h = 0.025, s = 2)
-                        self.refresh_interior_phiq(sys);
+                        self.refresh_interior_phiq(sys, t, h);
                         res = cres.max(left);
                         break;
                     }
                     // the constraints are not met yet: complete the residual (with the
                     // preadjustment terms here) and go on
                     self.kinematics(sys, t, h)?;
-                    self.momentum_rows(sys, h);
+                    self.momentum_rows(sys, t, h);
                     res = norm_inf(&self.r);
                     prev_step = dz;
                     continue;

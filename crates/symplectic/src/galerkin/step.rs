@@ -70,7 +70,7 @@ impl Integrator for Galerkin {
         }
         // (reuse: Phi_q at the end of the previous step, which is where this one starts)
         let reuse = self.end_phiq_valid && self.hist_q == self.qk;
-        self.start_phiq(sys, reuse);
+        self.start_phiq(sys, t, reuse);
         self.end_phiq_valid = false;
         self.gk = self.opts.gamma * self.kappa * h.powi(2 * s as i32);
         self.mlhist.first = self.hist_valid
@@ -136,7 +136,7 @@ impl Integrator for Galerkin {
                     what: "momentum projection matrix Phi_q M^-1 Phi_q^T",
                     detail: "redundant constraints or a singular configuration".into(),
                 })?;
-            sys.phi_t(t1, &mut self.mu);
+            sys.phi_t(qn1, t1, &mut self.mu);
             sp.schur.apply(&self.vm, &mut sp.pv);
             for (mu, &pv) in self.mu.iter_mut().zip(&sp.pv) {
                 *mu += pv;
@@ -149,16 +149,16 @@ impl Integrator for Galerkin {
             for (i, p) in es.p.iter_mut().enumerate() {
                 *p = sys.mass_diag()[i] * state.v[i] - h * f[i];
             }
-            sys.phi_t(t1, &mut es.r);
+            sys.phi_t(qn1, t1, &mut es.r);
             for r in es.r.iter_mut() {
                 *r = -*r;
             }
             es.solve.factor(sys, qn1, t1)?;
             es.solve.solve(&es.p, &es.r, &mut self.vm, &mut self.mu)?;
-            sys.phi_q(qn1, &mut self.phiq[s]);
+            sys.phi_q(qn1, t1, &mut self.phiq[s]);
             self.end_phiq_valid = true;
         } else if m > 0 {
-            sys.phi_q(qn1, &mut self.phiq[s]);
+            sys.phi_q(qn1, t1, &mut self.phiq[s]);
             self.end_phiq_valid = true;
             let g = &self.phiq[s];
             {
@@ -176,7 +176,7 @@ impl Integrator for Galerkin {
                     what: "momentum projection matrix Phi_q M^-1 Phi_q^T",
                     detail: "redundant constraints or a singular configuration".into(),
                 })?;
-            sys.phi_t(t1, &mut self.mu);
+            sys.phi_t(qn1, t1, &mut self.mu);
             for r in 0..m {
                 self.mu[r] += (0..n).map(|k| g[(r, k)] * self.vm[k]).sum::<f64>();
             }

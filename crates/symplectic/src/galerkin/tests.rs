@@ -23,7 +23,7 @@ fn check_jacobian(sys: &System, s: usize, gamma: f64, solver: LinearSolver) {
     for i in 0..g.n {
         g.hvk[i] = h * st.v[i];
     }
-    g.start_phiq(sys, false);
+    g.start_phiq(sys, st.t, false);
     g.gk = gamma * g.kappa * h.powi(2 * s as i32);
     g.predict(sys, &st, h).unwrap();
     for i in 0..g.dim {
@@ -132,7 +132,7 @@ fn singular_stage_matrix_is_reported() {
             for (q, at_dead) in [(st.q.as_slice(), false), (&dead[..], true)] {
                 g.qk.copy_from_slice(q);
                 g.hvk.fill(0.0);
-                g.start_phiq(&sys, false);
+                g.start_phiq(&sys, 0.0, false);
                 g.x.fill(0.0);
                 g.residual(&sys, 0.0, h).unwrap();
                 match (g.jacobian(&sys, 0.0, h), at_dead) {

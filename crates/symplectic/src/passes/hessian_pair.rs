@@ -168,11 +168,11 @@ mod tests {
             let mut hv = DMatrix::zeros(n, n);
             sys.potential_hessian(&q, &mut hv);
             let mut ea = DMatrix::from_element(n, n, 0.25) + &hv;
-            sys.add_constraint_hessian(&q, &wa, 1.0, &mut ea);
+            sys.add_constraint_hessian(&q, 0.0, &wa, 1.0, &mut ea);
             let mut eb = &hv * -0.5;
-            sys.add_constraint_hessian(&q, &wb, 1.0, &mut eb);
+            sys.add_constraint_hessian(&q, 0.0, &wb, 1.0, &mut eb);
             let (mut gq, mut ect) = (DMatrix::zeros(m, n), DMatrix::zeros(m, n));
-            sys.phi_q_dot_jacobian(&q, &v, &mut gq, &mut ect);
+            sys.phi_q_dot_jacobian(&q, &v, 0.0, &mut gq, &mut ect);
             let close = |x: &DMatrix<f64>, y: &DMatrix<f64>, what: &str| {
                 let scale = 1.0 + y.amax();
                 assert!((x - y).amax() < 1e-13 * scale, "{what}: {}", (x - y).amax());

@@ -139,7 +139,7 @@ fn constraint_third_matches_hessian_differences() {
         let mut out = vec![0.0; n];
         for w in &weights {
             constraint_third(sys, &q, &v, w, &mut out);
-            let fd = fd_third(&|qq, hm| sys.constraint_hessian(qq, w, hm), &q, &v);
+            let fd = fd_third(&|qq, hm| sys.constraint_hessian(qq, 0.0, w, hm), &q, &v);
             check(&out, &fd, "constraint_third");
         }
     }
@@ -180,7 +180,7 @@ fn lagrangian_products_match_assembled_hessians() {
         let mut hm = DMatrix::zeros(n, n);
         sys.potential_hessian(&q, &mut hm);
         hm *= 0.5;
-        sys.add_constraint_hessian(&q, &w, 1.0, &mut hm);
+        sys.add_constraint_hessian(&q, 0.0, &w, 1.0, &mut hm);
         let dense = &hm * nalgebra::DVector::from_column_slice(&v);
         let (mut hv, mut hv2, mut d3) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         lagrangian_hessian_vector(&sys, &q, &v, 0.5, &w, &mut hv);
@@ -263,7 +263,7 @@ fn hessian_rows_match_assembled_hessians() {
         for (r, d) in dirs.iter().enumerate() {
             let mut e = vec![0.0; m];
             e[r] = 1.0;
-            sys.constraint_hessian(&q, &e, &mut h);
+            sys.constraint_hessian(&q, 0.0, &e, &mut h);
             let (a, b) = sys.joint_bodies(sys.equation_joint(r).unwrap());
             let mut g = vec![0.0; n];
             for (slot, body) in [(0, a), (3, b)] {

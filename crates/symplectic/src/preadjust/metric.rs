@@ -373,7 +373,8 @@ impl ProjectedMetric {
                 }
                 _ => match &mut self.schur {
                     Some(sc) => sc.update(sys, q),
-                    None => sys.phi_q(q, &mut self.gq),
+                    // (the preadjustments take planar models, whose Phi_q does not depend on t)
+                    None => sys.phi_q(q, 0.0, &mut self.gq),
                 },
             }
             let singular = || SolveError::Singular {

@@ -403,7 +403,7 @@ pub(crate) mod modlag_tests {
         // A already holds Hess V once: the weight left to add is POTENTIAL_WEIGHT - 1 = -3/2
         hs *= POTENTIAL_WEIGHT - 1.0;
         if p.metric.m() > 0 {
-            sys.add_constraint_hessian(q, p.s1.sigma(), 1.0, &mut hs);
+            sys.add_constraint_hessian(q, 0.0, p.s1.sigma(), 1.0, &mut hs);
         }
         let mut t = vec![0.0; n];
         crate::preadjust::stiffness::matvec(&hs, v, &mut t);

@@ -55,7 +55,8 @@ impl TangentStiffness {
         }
         sys.potential_hessian(q, &mut self.amat);
         if metric.m() > 0 {
-            sys.add_constraint_hessian(q, metric.mu0(), -1.0, &mut self.amat);
+            // (planar models: the constraint Hessian does not depend on t)
+            sys.add_constraint_hessian(q, 0.0, metric.mu0(), -1.0, &mut self.amat);
         }
         self.stamp = metric.stamp();
     }

@@ -16,8 +16,9 @@ impl TangentChart {
     /// Evaluates `Df` at a second point `x_e` (typically the Euler prediction `x_c + h F(x_c)` of
     /// the step's end point) and stores `E = (Df(x_e) - Df(x_c)) Q1`, so that
     /// [`TangentChart::select_iteration_matrix`] can interpolate the Newton matrix along the
-    /// step. A non-finite `Df(x_e)` leaves the chart with the centre matrix `R^T` only.
-    pub fn set_secondary_point(&mut self, sys: &System, x_e: &[f64]) {
+    /// step; `t_e` is its time. A non-finite `Df(x_e)` leaves the chart with the centre matrix
+    /// `R^T` only.
+    pub fn set_secondary_point(&mut self, sys: &System, x_e: &[f64], t_e: f64) {
         let (n, m) = (self.n, self.m);
         let (nn, mm) = (2 * n, 2 * m);
         self.has_e = false;
@@ -30,6 +31,7 @@ impl TangentChart {
             sys,
             &x_e[..n],
             &x_e[n..],
+            t_e,
             &mut self.pq_e,
             &mut self.dphi_e,
             false,

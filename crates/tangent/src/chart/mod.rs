@@ -378,7 +378,7 @@ impl TangentChart {
         }
         let selected = self
             .sel
-            .jacobian(sys, q, v, &mut self.phi_q, &mut self.dphi, true);
+            .jacobian(sys, q, v, t, &mut self.phi_q, &mut self.dphi, true);
         if !all_finite(self.phi_q.as_slice()) || !all_finite(self.dphi.as_slice()) {
             return Err(SolveError::NonFinite {
                 t,

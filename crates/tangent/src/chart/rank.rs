@@ -40,7 +40,7 @@ impl TangentChart {
         if m == 0 || m > n || q.len() != n {
             return None;
         }
-        self.sel.phi_q(sys, q, &mut self.pq_x);
+        self.sel.phi_q(sys, q, t, &mut self.pq_x);
         self.rank_report(sys, t, rel_tol)
     }
 

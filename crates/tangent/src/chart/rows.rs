@@ -68,25 +68,28 @@ impl RowSelection {
         self.rows.get(i).copied().unwrap_or(i)
     }
 
-    /// `Phi_q` and `(Phi_q v)_q` at `(q, v)`, kept rows (`m - k` x `n`), into `pq`, `dp`; with
+    /// `Phi_q` and `(Phi_q v + Phi_t)_q` at `(q, v, t)`, kept rows (`m - k` x `n`), into `pq`,
+    /// `dp`; with
     /// `select`, the rows are chosen afresh at this point first (a centre). `false` if the
     /// selection failed: `Phi_q` has more than `k` dependent rows here (a singular
     /// configuration), or fewer (the redundancy found at build time is gone).
     #[inline]
+    #[allow(clippy::too_many_arguments)] // (the point (q, v, t), two outputs and a flag)
     pub(crate) fn jacobian(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
+        t: f64,
         pq: &mut DMatrix<f64>,
         dp: &mut DMatrix<f64>,
         select: bool,
     ) -> bool {
         if self.k == 0 {
-            sys.phi_q_dot_jacobian(q, v, pq, dp);
+            sys.phi_q_dot_jacobian(q, v, t, pq, dp);
             return true;
         }
-        sys.phi_q_dot_jacobian(q, v, &mut self.pq, &mut self.dp);
+        sys.phi_q_dot_jacobian(q, v, t, &mut self.pq, &mut self.dp);
         if select && !self.select() {
             return false;
         }
@@ -159,13 +162,13 @@ impl RowSelection {
         }
     }
 
-    /// `Phi_q(q)`, kept rows, into `pq` (the rank report).
-    pub(crate) fn phi_q(&mut self, sys: &System, q: &[f64], pq: &mut DMatrix<f64>) {
+    /// `Phi_q(q, t)`, kept rows, into `pq` (the rank report).
+    pub(crate) fn phi_q(&mut self, sys: &System, q: &[f64], t: f64, pq: &mut DMatrix<f64>) {
         if self.k == 0 {
-            sys.phi_q(q, pq);
+            sys.phi_q(q, t, pq);
             return;
         }
-        sys.phi_q(q, &mut self.pq);
+        sys.phi_q(q, t, &mut self.pq);
         gather_rows(&self.pq, &self.rows, pq);
     }
 }

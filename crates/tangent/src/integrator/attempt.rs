@@ -86,7 +86,7 @@ impl TangentRk {
                     // matrix is interpolated to
                     x.copy_from_slice(chart.centre_point());
                     axpy(h, fx, x);
-                    chart.set_secondary_point(sys, x);
+                    chart.set_secondary_point(sys, x, t + h);
                 }
                 chart.select_iteration_matrix(c_coef[i]);
                 // stage 0 at (t, xi = 0) is the centre: no starting point, and its normal

@@ -83,9 +83,9 @@ impl Path {
     /// The dense chart's interpolated iteration matrix (the sparse path has only the
     /// centre's; [`super::TangentRk::new`] rejects the other choices there).
     #[inline]
-    pub(super) fn set_secondary_point(&mut self, sys: &System, x_e: &[f64]) {
+    pub(super) fn set_secondary_point(&mut self, sys: &System, x_e: &[f64], t_e: f64) {
         if let Path::Dense { chart, .. } = self {
-            chart.set_secondary_point(sys, x_e);
+            chart.set_secondary_point(sys, x_e, t_e);
         }
     }
 

@@ -240,7 +240,7 @@ impl SparseChart {
             return Ok(());
         }
         self.rows
-            .gather_tan(sys, q, v, &mut self.grads, &mut self.dgrads);
+            .gather_tan(sys, q, v, t, &mut self.grads, &mut self.dgrads);
         if self
             .grads
             .iter()
@@ -326,11 +326,14 @@ impl SparseChart {
             let (mut p, mut d) = (0.0, 0.0);
             for s in sides.iter().flatten() {
                 let (a, x) = (&self.grads[s.off..], &self.dgrads[s.off..]);
-                let (zq, zv) = (&zq[s.col..s.col + s.width], &zv[s.col..s.col + s.width]);
-                for l in 0..s.width {
-                    p += a[l] * zq[l];
-                    d += x[l] * zq[l] + a[l] * zv[l];
-                }
+                let (zq, zv) = (&zq[s.col..], &zv[s.col..]);
+                let (dp, dd) = match s.width {
+                    3 => side_dot::<3>(a, x, zq, zv),
+                    12 => side_dot::<12>(a, x, zq, zv),
+                    w => side_dot_n(w, a, x, zq, zv),
+                };
+                p += dp;
+                d += dd;
             }
             op[r] = p;
             ov[r] = d;
@@ -345,13 +348,11 @@ impl SparseChart {
             let (ep, ev) = (alpha * e[r], alpha * e[m + r]);
             for s in sides.iter().flatten() {
                 let (a, x) = (&self.grads[s.off..], &self.dgrads[s.off..]);
-                let (oq, ov) = (
-                    &mut oq[s.col..s.col + s.width],
-                    &mut ov[s.col..s.col + s.width],
-                );
-                for l in 0..s.width {
-                    oq[l] += a[l] * ep + x[l] * ev;
-                    ov[l] += a[l] * ev;
+                let (oq, ov) = (&mut oq[s.col..], &mut ov[s.col..]);
+                match s.width {
+                    3 => side_add::<3>(a, x, ep, ev, oq, ov),
+                    12 => side_add::<12>(a, x, ep, ev, oq, ov),
+                    w => side_add_n(w, a, x, ep, ev, oq, ov),
                 }
             }
         }
@@ -506,5 +507,67 @@ impl SparseChart {
                 return Err(e);
             }
         }
+    }
+}
+
+/// One side's part of a row of `Df z`: `(a . zq, x . zq + a . zv)` over `W` coordinates (fixed
+/// widths unrolled: planar 3, spatial 12; [`side_dot_n`] for others).
+#[inline(always)]
+fn side_dot<const W: usize>(a: &[f64], x: &[f64], zq: &[f64], zv: &[f64]) -> (f64, f64) {
+    match (
+        a.first_chunk::<W>(),
+        x.first_chunk::<W>(),
+        zq.first_chunk::<W>(),
+        zv.first_chunk::<W>(),
+    ) {
+        (Some(a), Some(x), Some(zq), Some(zv)) => {
+            let (mut p, mut d) = (0.0, 0.0);
+            for l in 0..W {
+                p += a[l] * zq[l];
+                d += x[l] * zq[l] + a[l] * zv[l];
+            }
+            (p, d)
+        }
+        _ => side_dot_n(W, a, x, zq, zv),
+    }
+}
+
+/// [`side_dot`] for a width known at run time.
+fn side_dot_n(w: usize, a: &[f64], x: &[f64], zq: &[f64], zv: &[f64]) -> (f64, f64) {
+    let (mut p, mut d) = (0.0, 0.0);
+    for l in 0..w {
+        p += a[l] * zq[l];
+        d += x[l] * zq[l] + a[l] * zv[l];
+    }
+    (p, d)
+}
+
+/// One side's part of `Df^T e`: `oq += a ep + x ev`, `ov += a ev` over `W` coordinates.
+#[inline(always)]
+fn side_add<const W: usize>(
+    a: &[f64],
+    x: &[f64],
+    ep: f64,
+    ev: f64,
+    oq: &mut [f64],
+    ov: &mut [f64],
+) {
+    if let (Some(a), Some(x)) = (a.first_chunk::<W>(), x.first_chunk::<W>()) {
+        if let (Some(oq), Some(ov)) = (oq.first_chunk_mut::<W>(), ov.first_chunk_mut::<W>()) {
+            for l in 0..W {
+                oq[l] += a[l] * ep + x[l] * ev;
+                ov[l] += a[l] * ev;
+            }
+            return;
+        }
+    }
+    side_add_n(W, a, x, ep, ev, oq, ov);
+}
+
+/// [`side_add`] for a width known at run time.
+fn side_add_n(w: usize, a: &[f64], x: &[f64], ep: f64, ev: f64, oq: &mut [f64], ov: &mut [f64]) {
+    for l in 0..w {
+        oq[l] += a[l] * ep + x[l] * ev;
+        ov[l] += a[l] * ev;
     }
 }

@@ -29,7 +29,7 @@ fn projector_matches(sys: &mbd_model::System, tangent_v: bool) {
     let mut v: Vec<f64> = (0..n).map(|i| 0.3 * (i as f64 + 1.0).sin()).collect();
     if tangent_v {
         let mut pq = nalgebra::DMatrix::zeros(sys.n_constraints(), n);
-        sys.phi_q(s.q.as_slice(), &mut pq);
+        sys.phi_q(s.q.as_slice(), 0.0, &mut pq);
         let svd = pq.svd(false, true);
         let vt = svd.v_t.expect("V^T");
         let v0 = nalgebra::DVector::from_column_slice(&v);

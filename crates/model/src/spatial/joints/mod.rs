@@ -22,15 +22,20 @@
 //! | [`SpatialJointKind::Distance`] | `1/2 (|P_b - P_a|^2 - L^2)` | everything but the distance |
 //! | [`SpatialJointKind::SlideDriver`] | `(P_b - P_a) . Z_a - s(t)` | everything but the slide along `Z_a` |
 //! | [`SpatialJointKind::DistanceDriver`] | `1/2 (|P_b - P_a|^2 - L(t)^2)` | everything but the distance |
+//! | [`SpatialJointKind::AngleDriver`] | `cos theta(t) X_b . Y_a - sin theta(t) X_b . X_a` | everything but the turn of `X_b` about `Z_a` |
 //!
-//! The drivers' motions (`s(t)`, `L(t)`) are functions of time the system holds beside the
-//! joint ([`crate::SystemBuilder::add_spatial_driver`]); their equations' Jacobians do not
-//! depend on time (a rotation driver's would, which the model's interfaces do not take yet).
+//! The drivers' motions (`s(t)`, `L(t)`, `theta(t)`) are functions of time the system holds
+//! beside the joint ([`crate::SystemBuilder::add_spatial_driver`]). The slide and distance
+//! drivers subtract their motion, so their Jacobians do not depend on time; the angle driver's
+//! equation is `sin(phi - theta)` for the turn `phi` of `X_b` (with the `z` axes aligned by a
+//! revolute or cylindrical joint beside it), whose Jacobian turns with `theta(t)`
+//! (`Phi_qt != 0`; docs/spatial.md, "Drivers").
 //!
 //! The orientation equations are the linearly independent ones at assembly: a small relative
 //! rotation `dtheta` of `b` changes `X_a . Y_b` by `-dtheta . Z`, `X_a . Z_b` by `dtheta . Y`,
 //! `Y_a . Z_b` by `-dtheta . X`, `Z_b . X_a` by `-dtheta . Y` and `Z_b . Y_a` by `dtheta . X`.
 
+mod angle_driver;
 mod cylindrical;
 mod distance;
 mod planar;
@@ -230,6 +235,10 @@ pub enum SpatialJointKind {
     /// Driver: the points' distance follows a function of time (1 equation; a linear
     /// actuator between two pins).
     DistanceDriver,
+    /// Driver: the second marker's `x` axis turns about the first marker's `z` axis, from its
+    /// `x` axis towards its `y` axis, by a function of time (1 equation; a motor on a hinge,
+    /// used beside a revolute or cylindrical joint that aligns the `z` axes).
+    AngleDriver,
 }
 
 /// Why a spatial joint's parameters are invalid (the field and the reason).
@@ -321,6 +330,7 @@ impl SpatialJoint {
             SpatialJointKind::Distance { .. } => "distance",
             SpatialJointKind::SlideDriver => "slide_driver",
             SpatialJointKind::DistanceDriver => "distance_driver",
+            SpatialJointKind::AngleDriver => "angle_driver",
         }
     }
 
@@ -328,7 +338,9 @@ impl SpatialJoint {
     pub fn is_driver(&self) -> bool {
         matches!(
             self.kind,
-            SpatialJointKind::SlideDriver | SpatialJointKind::DistanceDriver
+            SpatialJointKind::SlideDriver
+                | SpatialJointKind::DistanceDriver
+                | SpatialJointKind::AngleDriver
         )
     }
 
@@ -350,7 +362,8 @@ impl SpatialJoint {
             SpatialJointKind::Weld => 6,
             SpatialJointKind::Distance { .. }
             | SpatialJointKind::SlideDriver
-            | SpatialJointKind::DistanceDriver => 1,
+            | SpatialJointKind::DistanceDriver
+            | SpatialJointKind::AngleDriver => 1,
         }
     }
 
@@ -363,12 +376,16 @@ impl SpatialJoint {
             Spherical | Weld | Revolute | Universal => i32::from(k < 3),
             Cylindrical | Prismatic => i32::from((2..4).contains(&k)),
             Planar => i32::from(k == 2),
+            AngleDriver => 0,
             SlideDriver => 1,
             Distance { .. } | DistanceDriver => 2,
         }
     }
 
-    /// The equations at the frames `fa`, `fb` into `out[..n_equations]` (the rest untouched).
+    /// The equations at the frames `fa`, `fb` into `out[..n_equations]` (the rest untouched),
+    /// a driver's without its motion: an angle driver writes its two components `X_b . Y_a`
+    /// and `X_b . X_a` into `out[0]` and `out[1]` (its equation at `theta = 0` is `out[0]`; the
+    /// system combines them at `theta(t)`).
     pub fn eval<T: Scalar>(&self, fa: &SpatialFrame<T>, fb: &SpatialFrame<T>, out: &mut [T; 6]) {
         let axes = self.uses_axes();
         let (ma, mb) = (self.a.on(fa, axes), self.b.on(fb, axes));
@@ -413,6 +430,7 @@ impl SpatialJoint {
             SpatialJointKind::SlideDriver => slide_driver::eval(ma, mb, out),
             // the system subtracts 1/2 L(t)^2
             SpatialJointKind::DistanceDriver => distance::eval(ma, mb, 0.0, out),
+            SpatialJointKind::AngleDriver => angle_driver::eval(ma, mb, out),
         }
     }
 }
