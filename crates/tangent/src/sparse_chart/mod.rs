@@ -76,6 +76,13 @@ pub struct SparseChart {
     redundant: usize,
     /// Every equation over body blocks.
     rows: BlockRows,
+    /// Every row side in the order of the value arrays: its first coordinate, row and value
+    /// offset (`side_off` has one more entry, the total), and the common width of all sides
+    /// (`None`: mixed widths, e.g. planar and spatial bodies in one model).
+    side_col: Vec<usize>,
+    side_row: Vec<usize>,
+    side_off: Vec<usize>,
+    uniform: Option<usize>,
     /// Element-local rows of `Phi_q` and `(Phi_q v)_q` at the centre (the layout of `rows`).
     grads: Vec<f64>,
     dgrads: Vec<f64>,
@@ -159,10 +166,39 @@ impl SparseChart {
             });
         }
         let nv = rows.n_values();
+        let (mut side_col, mut side_row, mut side_off) = (Vec::new(), Vec::new(), Vec::new());
+        let mut widths = Vec::new();
+        for (r, sides) in rows.sides().iter().enumerate() {
+            for s in sides.iter().flatten() {
+                side_col.push(s.col);
+                side_row.push(r);
+                side_off.push(s.off);
+                widths.push(s.width);
+            }
+        }
+        side_off.push(nv);
+        // (the values are stored side after side in this order: BlockRows' layout)
+        if side_off
+            .windows(2)
+            .zip(&widths)
+            .any(|(o, &w)| o[1] - o[0] != w)
+        {
+            return Err(SolveError::Unsupported(
+                "sparse chart: row sides not stored in order".into(),
+            ));
+        }
+        let uniform = match widths.first() {
+            Some(&w) if widths.iter().all(|&x| x == w) => Some(w),
+            _ => None,
+        };
         Ok(SparseChart {
             n,
             m,
             redundant: k,
+            side_col,
+            side_row,
+            side_off,
+            uniform,
             rows,
             grads: vec![0.0; nv],
             dgrads: vec![0.0; nv],
@@ -322,21 +358,45 @@ impl SparseChart {
         let (n, m) = (self.n, self.m);
         let (zq, zv) = z.split_at(n);
         let (op, ov) = out[..2 * m].split_at_mut(m);
-        for (r, sides) in self.rows.sides().iter().enumerate() {
-            let (mut p, mut d) = (0.0, 0.0);
-            for s in sides.iter().flatten() {
-                let (a, x) = (&self.grads[s.off..], &self.dgrads[s.off..]);
-                let (zq, zv) = (&zq[s.col..], &zv[s.col..]);
-                let (dp, dd) = match s.width {
-                    3 => side_dot::<3>(a, x, zq, zv),
-                    12 => side_dot::<12>(a, x, zq, zv),
-                    w => side_dot_n(w, a, x, zq, zv),
-                };
-                p += dp;
-                d += dd;
+        op.fill(0.0);
+        ov.fill(0.0);
+        match self.uniform {
+            Some(3) => self.apply_df_w::<3>(zq, zv, op, ov),
+            Some(12) => self.apply_df_w::<12>(zq, zv, op, ov),
+            _ => {
+                for (k, (&c, &r)) in self.side_col.iter().zip(&self.side_row).enumerate() {
+                    let (o, w) = (self.side_off[k], self.side_off[k + 1] - self.side_off[k]);
+                    let (a, x) = (&self.grads[o..o + w], &self.dgrads[o..o + w]);
+                    let (zq, zv) = (&zq[c..c + w], &zv[c..c + w]);
+                    for l in 0..w {
+                        op[r] += a[l] * zq[l];
+                        ov[r] += x[l] * zq[l] + a[l] * zv[l];
+                    }
+                }
             }
-            op[r] = p;
-            ov[r] = d;
+        }
+    }
+
+    /// [`SparseChart::apply_df`] when every side has width `W` (the loops unrolled).
+    fn apply_df_w<const W: usize>(&self, zq: &[f64], zv: &[f64], op: &mut [f64], ov: &mut [f64]) {
+        let (a, _) = self.grads.as_chunks::<W>();
+        let (x, _) = self.dgrads.as_chunks::<W>();
+        for ((a, x), (&c, &r)) in a
+            .iter()
+            .zip(x)
+            .zip(self.side_col.iter().zip(&self.side_row))
+        {
+            let (Some(zq), Some(zv)) = (zq[c..].first_chunk::<W>(), zv[c..].first_chunk::<W>())
+            else {
+                continue;
+            };
+            let (mut p, mut d) = (0.0, 0.0);
+            for l in 0..W {
+                p += a[l] * zq[l];
+                d += x[l] * zq[l] + a[l] * zv[l];
+            }
+            op[r] += p;
+            ov[r] += d;
         }
     }
 
@@ -344,16 +404,50 @@ impl SparseChart {
     pub fn add_df_t(&self, alpha: f64, e: &[f64], out: &mut [f64]) {
         let (n, m) = (self.n, self.m);
         let (oq, ov) = out.split_at_mut(n);
-        for (r, sides) in self.rows.sides().iter().enumerate() {
-            let (ep, ev) = (alpha * e[r], alpha * e[m + r]);
-            for s in sides.iter().flatten() {
-                let (a, x) = (&self.grads[s.off..], &self.dgrads[s.off..]);
-                let (oq, ov) = (&mut oq[s.col..], &mut ov[s.col..]);
-                match s.width {
-                    3 => side_add::<3>(a, x, ep, ev, oq, ov),
-                    12 => side_add::<12>(a, x, ep, ev, oq, ov),
-                    w => side_add_n(w, a, x, ep, ev, oq, ov),
+        let (ep, ev) = e[..2 * m].split_at(m);
+        match self.uniform {
+            Some(3) => self.add_df_t_w::<3>(alpha, ep, ev, oq, ov),
+            Some(12) => self.add_df_t_w::<12>(alpha, ep, ev, oq, ov),
+            _ => {
+                for (k, (&c, &r)) in self.side_col.iter().zip(&self.side_row).enumerate() {
+                    let (o, w) = (self.side_off[k], self.side_off[k + 1] - self.side_off[k]);
+                    let (a, x) = (&self.grads[o..o + w], &self.dgrads[o..o + w]);
+                    let (p, v) = (alpha * ep[r], alpha * ev[r]);
+                    for l in 0..w {
+                        oq[c + l] += a[l] * p + x[l] * v;
+                        ov[c + l] += a[l] * v;
+                    }
                 }
+            }
+        }
+    }
+
+    /// [`SparseChart::add_df_t`] when every side has width `W` (the loops unrolled).
+    fn add_df_t_w<const W: usize>(
+        &self,
+        alpha: f64,
+        ep: &[f64],
+        ev: &[f64],
+        oq: &mut [f64],
+        ov: &mut [f64],
+    ) {
+        let (a, _) = self.grads.as_chunks::<W>();
+        let (x, _) = self.dgrads.as_chunks::<W>();
+        for ((a, x), (&c, &r)) in a
+            .iter()
+            .zip(x)
+            .zip(self.side_col.iter().zip(&self.side_row))
+        {
+            let (p, v) = (alpha * ep[r], alpha * ev[r]);
+            let (Some(oq), Some(ov)) = (
+                oq[c..].first_chunk_mut::<W>(),
+                ov[c..].first_chunk_mut::<W>(),
+            ) else {
+                continue;
+            };
+            for l in 0..W {
+                oq[l] += a[l] * p + x[l] * v;
+                ov[l] += a[l] * v;
             }
         }
     }
@@ -507,67 +601,5 @@ impl SparseChart {
                 return Err(e);
             }
         }
-    }
-}
-
-/// One side's part of a row of `Df z`: `(a . zq, x . zq + a . zv)` over `W` coordinates (fixed
-/// widths unrolled: planar 3, spatial 12; [`side_dot_n`] for others).
-#[inline(always)]
-fn side_dot<const W: usize>(a: &[f64], x: &[f64], zq: &[f64], zv: &[f64]) -> (f64, f64) {
-    match (
-        a.first_chunk::<W>(),
-        x.first_chunk::<W>(),
-        zq.first_chunk::<W>(),
-        zv.first_chunk::<W>(),
-    ) {
-        (Some(a), Some(x), Some(zq), Some(zv)) => {
-            let (mut p, mut d) = (0.0, 0.0);
-            for l in 0..W {
-                p += a[l] * zq[l];
-                d += x[l] * zq[l] + a[l] * zv[l];
-            }
-            (p, d)
-        }
-        _ => side_dot_n(W, a, x, zq, zv),
-    }
-}
-
-/// [`side_dot`] for a width known at run time.
-fn side_dot_n(w: usize, a: &[f64], x: &[f64], zq: &[f64], zv: &[f64]) -> (f64, f64) {
-    let (mut p, mut d) = (0.0, 0.0);
-    for l in 0..w {
-        p += a[l] * zq[l];
-        d += x[l] * zq[l] + a[l] * zv[l];
-    }
-    (p, d)
-}
-
-/// One side's part of `Df^T e`: `oq += a ep + x ev`, `ov += a ev` over `W` coordinates.
-#[inline(always)]
-fn side_add<const W: usize>(
-    a: &[f64],
-    x: &[f64],
-    ep: f64,
-    ev: f64,
-    oq: &mut [f64],
-    ov: &mut [f64],
-) {
-    if let (Some(a), Some(x)) = (a.first_chunk::<W>(), x.first_chunk::<W>()) {
-        if let (Some(oq), Some(ov)) = (oq.first_chunk_mut::<W>(), ov.first_chunk_mut::<W>()) {
-            for l in 0..W {
-                oq[l] += a[l] * ep + x[l] * ev;
-                ov[l] += a[l] * ev;
-            }
-            return;
-        }
-    }
-    side_add_n(W, a, x, ep, ev, oq, ov);
-}
-
-/// [`side_add`] for a width known at run time.
-fn side_add_n(w: usize, a: &[f64], x: &[f64], ep: f64, ev: f64, oq: &mut [f64], ov: &mut [f64]) {
-    for l in 0..w {
-        oq[l] += a[l] * ep + x[l] * ev;
-        ov[l] += a[l] * ev;
     }
 }
