@@ -379,15 +379,14 @@ impl SparseChart {
 
     /// [`SparseChart::apply_df`] when every side has width `W` (the loops unrolled).
     fn apply_df_w<const W: usize>(&self, zq: &[f64], zv: &[f64], op: &mut [f64], ov: &mut [f64]) {
-        let (a, _) = self.grads.as_chunks::<W>();
-        let (x, _) = self.dgrads.as_chunks::<W>();
-        for ((a, x), (&c, &r)) in a
-            .iter()
-            .zip(x)
-            .zip(self.side_col.iter().zip(&self.side_row))
-        {
-            let (Some(zq), Some(zv)) = (zq[c..].first_chunk::<W>(), zv[c..].first_chunk::<W>())
-            else {
+        let (a, x) = (self.grads.chunks_exact(W), self.dgrads.chunks_exact(W));
+        for ((a, x), (&c, &r)) in a.zip(x).zip(self.side_col.iter().zip(&self.side_row)) {
+            let (Some(a), Some(x), Some(zq), Some(zv)) = (
+                a.first_chunk::<W>(),
+                x.first_chunk::<W>(),
+                zq[c..].first_chunk::<W>(),
+                zv[c..].first_chunk::<W>(),
+            ) else {
                 continue;
             };
             let (mut p, mut d) = (0.0, 0.0);
@@ -431,15 +430,12 @@ impl SparseChart {
         oq: &mut [f64],
         ov: &mut [f64],
     ) {
-        let (a, _) = self.grads.as_chunks::<W>();
-        let (x, _) = self.dgrads.as_chunks::<W>();
-        for ((a, x), (&c, &r)) in a
-            .iter()
-            .zip(x)
-            .zip(self.side_col.iter().zip(&self.side_row))
-        {
+        let (a, x) = (self.grads.chunks_exact(W), self.dgrads.chunks_exact(W));
+        for ((a, x), (&c, &r)) in a.zip(x).zip(self.side_col.iter().zip(&self.side_row)) {
             let (p, v) = (alpha * ep[r], alpha * ev[r]);
-            let (Some(oq), Some(ov)) = (
+            let (Some(a), Some(x), Some(oq), Some(ov)) = (
+                a.first_chunk::<W>(),
+                x.first_chunk::<W>(),
                 oq[c..].first_chunk_mut::<W>(),
                 ov[c..].first_chunk_mut::<W>(),
             ) else {
