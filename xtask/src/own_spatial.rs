@@ -315,13 +315,16 @@ const SCALING_SOLVERS: [(&str, bool); 5] = [
     ("rk4-projected", true),
     ("index1:dopri5", true),
     ("tangent:rk4", true),
-    ("symplectic:2", false),
-    ("symplectic:1", false),
+    ("symplectic:2", true),
+    ("symplectic:1", true),
 ];
-/// Why the symplectic solvers do not run the long spatial chains.
-const SCALING_MISS: &str = "the symplectic scheme's sparse stage system takes planar rows \
-    only; above mbd_solve::DENSE_SPATIAL_LIMIT equations it refuses spatial models by name \
-    (issue 24, left open)";
+/// The solvers of the 10x claim that every solver must meet.
+const INDEX1_AND_TANGENT: [&str; 3] = ["rk4-projected", "index1:dopri5", "tangent:rk4"];
+/// Why symplectic (2,2) misses the 10x target on the spatial chain.
+const SCALING_MISS: &str = "symplectic (2,2)'s sparse stage Jacobian takes the constraint \
+    curvature at its interior control point from coloured seed passes over every row's jets \
+    (12 per colour for 12-coordinate blocks), about 8x the cost of its (1,1) step; the spatial \
+    rows' Hessians are constant and could be assembled once (issue 24, open)";
 
 /// Cost of a step on a chain of spatial rods against its length, as ratios to plain RK4.
 fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
@@ -342,6 +345,7 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     );
     let mut peer_cost = [0.0; 2];
     let mut worst_ratio = 0.0f64;
+    let mut worst_all = 0.0f64;
     let mut worst_exp = 0.0f64;
     let mut refused = Vec::new();
     for (spec, runs) in SCALING_SOLVERS {
@@ -376,7 +380,10 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
             peer_cost[k] = tp;
             row.push(format!("{:.0} ({:.2}x)", t * 1e6, t / tp));
             if k == 1 {
-                worst_ratio = worst_ratio.max(t / tp);
+                if INDEX1_AND_TANGENT.contains(&spec) {
+                    worst_ratio = worst_ratio.max(t / tp);
+                }
+                worst_all = worst_all.max(t / tp);
             }
         }
         let exp = (per[1] / per[0]).ln() / (ns[1] as f64 / ns[0] as f64).ln();
@@ -409,7 +416,7 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
         .collect();
     refused_solvers.dedup();
     sec.claims.push(Claim::timing(
-        "on a spatial chain, plain RK4, the index-1 solvers' and tangent RK4's cost per step grows at most like N^1.2 (sparse path)",
+        "on a spatial chain, every timed solver's cost per step grows at most like N^1.2 (sparse paths)",
         worst_exp.max(peer_exp) <= 1.2,
         format!("largest fitted exponent {:.2} (plain RK4 {peer_exp:.2})", worst_exp.max(peer_exp)),
     ));
@@ -421,9 +428,9 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     sec.claims.push(
         Claim::timing(
             format!("every solver but FA-DAE runs a {largest}-rod spatial chain within 10x plain RK4 per step"),
-            refused_solvers.is_empty() && worst_ratio <= 10.0,
+            refused_solvers.is_empty() && worst_all <= 10.0,
             format!(
-                "{} refused it ({}); largest ratio of those that ran {worst_ratio:.2}",
+                "{} refused it ({}); largest ratio of those that ran {worst_all:.2}",
                 refused_solvers.len(),
                 refused_solvers.join(", ")
             ),

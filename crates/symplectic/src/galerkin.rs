@@ -65,7 +65,7 @@ pub struct Galerkin {
     /// Dense path: `Phi_q` at the control points `0..=s` (empty on the sparse path).
     phiq: Vec<DMatrix<f64>>,
     /// Sparse path: `Phi_q` at the control points in element-local rows (empty when dense).
-    grads: Vec<Vec<[f64; 6]>>,
+    grads: Vec<Vec<f64>>,
     /// The sparse stage solve, if the system takes the sparse path.
     sparse: Option<Box<SparseStage>>,
     hc: DMatrix<f64>,
@@ -151,10 +151,18 @@ impl Galerkin {
         // (W_s adds a dense block to the Newton matrix; the modified Lagrangian's blocks are
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
         let sparse_ok = options.gamma == 0.0;
-        // spatial bodies take the dense path (docs/spatial.md)
-        mbd_solve::refuse_large_spatial(sys, "the symplectic scheme", options.linear_solver)?;
+        // spatial bodies with redundant equations take the dense path (the sparse path finds
+        // the dependent rows through the planar Schur complement): up to the dense limit
+        let spatial_redundant = sys.has_spatial() && sys.n_redundant() > 0;
+        if spatial_redundant {
+            mbd_solve::refuse_large_spatial(
+                sys,
+                "the symplectic scheme (spatial bodies with redundant equations)",
+                options.linear_solver,
+            )?;
+        }
         let use_sparse =
-            options.linear_solver.use_sparse(m) && m > 0 && sparse_ok && !sys.has_spatial();
+            options.linear_solver.use_sparse(m) && m > 0 && sparse_ok && !spatial_redundant;
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
                 "the sparse symplectic stage solve needs gamma = 0 (the Hessian of the paper's \
@@ -219,7 +227,14 @@ impl Galerkin {
                 .collect(),
             end_solve: if sys.has_spatial() {
                 Some(Box::new(EndSolve {
-                    solve: ConstrainedSolve::new(sys, LinearSolver::Dense)?,
+                    solve: ConstrainedSolve::new(
+                        sys,
+                        if use_sparse {
+                            LinearSolver::Sparse
+                        } else {
+                            LinearSolver::Dense
+                        },
+                    )?,
                     p: vec![0.0; n],
                     r: vec![0.0; m],
                 }))
@@ -251,8 +266,8 @@ impl Galerkin {
             } else {
                 vec![DMatrix::zeros(m, n); s + 1]
             },
-            grads: if use_sparse {
-                vec![vec![[0.0; 6]; m]; s + 1]
+            grads: if let Some(sp) = &sparse {
+                vec![vec![0.0; sp.rows.n_values()]; s + 1]
             } else {
                 Vec::new()
             },
@@ -343,12 +358,12 @@ impl Galerkin {
     /// step).
     fn start_phiq(&mut self, sys: &System, t: f64, reuse: bool) {
         let s = self.tab.s;
-        if self.sparse.is_some() {
+        if let Some(sp) = self.sparse.as_deref_mut() {
             if reuse {
                 let (first, rest) = self.grads.split_at_mut(1);
                 first[0].copy_from_slice(&rest[s - 1]);
             } else {
-                sys.phi_q_local(&self.qk, &mut self.grads[0]);
+                sp.gather(sys, &self.qk, t, &mut self.grads[0]);
             }
         } else if reuse {
             let (first, rest) = self.phiq.split_at_mut(1);
@@ -471,8 +486,8 @@ impl Galerkin {
         let (n, s) = (self.n, self.tab.s);
         for nu in 1..s {
             let q = &self.qn[nu * n..(nu + 1) * n];
-            if self.sparse.is_some() {
-                sys.phi_q_local(q, &mut self.grads[nu]);
+            if let Some(sp) = self.sparse.as_deref_mut() {
+                sp.gather(sys, q, t + self.tab.tau[nu] * h, &mut self.grads[nu]);
             } else {
                 sys.phi_q(q, t + self.tab.tau[nu] * h, &mut self.phiq[nu]);
             }
@@ -487,11 +502,12 @@ impl Galerkin {
         if let Some(sp) = &mut self.sparse {
             for nu in 0..s {
                 if nu >= 1 {
-                    sys.phi_q_local(&self.qn[nu * n..(nu + 1) * n], &mut self.grads[nu]);
+                    let tn = t + tab.tau[nu] * h;
+                    sp.gather(sys, &self.qn[nu * n..(nu + 1) * n], tn, &mut self.grads[nu]);
                 }
                 let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
                 sp.al.fill(0.0);
-                add_transpose(&self.grads[nu], &sp.row_bodies, lam, &mut sp.al);
+                add_transpose(&sp.rows, &self.grads[nu], lam, &mut sp.al);
                 let (bd, ba) = (&tab.bd[nu * s..(nu + 1) * s], &tab.ba[nu * s..(nu + 1) * s]);
                 for i in 0..n {
                     let mut ak = 0.0;

@@ -24,7 +24,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 3.0,
-            refuses: "spatial models above 600 equations (its sparse path is planar)",
+            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only)",
             compared: true,
         },
         SolverVariant {
@@ -35,7 +35,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "spatial models above 600 equations (its sparse path is planar)",
+            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only)",
             compared: true,
         },
         SolverVariant {

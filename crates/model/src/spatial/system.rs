@@ -340,7 +340,25 @@ impl SpatialPart {
         t: f64,
         mut visit: impl FnMut(usize, [Option<usize>; 2], &[f64; SW], &[f64; SW]),
     ) {
+        const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
         for (item, sides, row, n) in self.items() {
+            if let (Item::Internal, Some(k)) = (item, sides[0]) {
+                // in closed form (see `internal_jets`): the Hessian of 1/2 |d_i|^2 is the
+                // identity on director i, that of d_i . d_j pairs directors i and j
+                let o = self.q0 + 12 * k;
+                let dv = |i: usize| &v[o + 3 + 3 * i..o + 6 + 3 * i];
+                for (r, (jet, (i, j))) in
+                    self.internal_jets(q, None, k).iter().zip(PAIRS).enumerate()
+                {
+                    let mut dg = [0.0; SW];
+                    dg[3 + 3 * i..6 + 3 * i].copy_from_slice(dv(j));
+                    if i != j {
+                        dg[3 + 3 * j..6 + 3 * j].copy_from_slice(dv(i));
+                    }
+                    visit(row + r, sides, &jet.g, &dg);
+                }
+                continue;
+            }
             let mut e = self.eval_jets(item, sides, t, |l, c| TanJetN::<SW>::var(l, q[c], v[c]));
             if let (Item::Joint(j), true) = (item, n == 1) {
                 if let Some([_, dth, _]) = self.angle(j, t) {

@@ -36,6 +36,11 @@ pub struct BlockRows {
     /// Per block: the kept rows acting on it (kept index, side).
     by_block: Vec<Vec<(usize, usize)>>,
     n_values: usize,
+    /// Every side in storage order: its first coordinate and its kept row; and the width all
+    /// sides share (`None`: mixed widths, planar and spatial bodies in one model).
+    side_col: Vec<usize>,
+    side_row: Vec<usize>,
+    uniform: Option<usize>,
 }
 
 impl BlockRows {
@@ -88,13 +93,67 @@ impl BlockRows {
                 }
             }
         }
+        let (mut side_col, mut side_row, mut widths) = (Vec::new(), Vec::new(), Vec::new());
+        for (e, s) in sides.iter().enumerate() {
+            for side in s.iter().flatten() {
+                side_col.push(side.col);
+                side_row.push(e);
+                widths.push(side.width);
+            }
+        }
+        let uniform = match widths.first() {
+            Some(&w) if widths.iter().all(|&x| x == w) => Some(w),
+            _ => None,
+        };
         Ok(BlockRows {
             rows,
             index,
             sides,
             by_block,
             n_values: off,
+            side_col,
+            side_row,
+            uniform,
         })
+    }
+
+    /// Every side in storage order as (first coordinate, kept row), and the width all sides
+    /// share (`None`: mixed widths). The values of side `k` start at the sum of the widths
+    /// before it.
+    pub fn side_order(&self) -> (&[usize], &[usize], Option<usize>) {
+        (&self.side_col, &self.side_row, self.uniform)
+    }
+
+    /// `out += Phi^T y` for the kept rows' gradients `vals` (`y` by kept row): every side's
+    /// gradient times its row's `y` added on its block, the loops unrolled when all sides
+    /// have one width.
+    pub fn add_transpose(&self, vals: &[f64], y: &[f64], out: &mut [f64]) {
+        match self.uniform {
+            Some(3) => self.add_transpose_w::<3>(vals, y, out),
+            Some(12) => self.add_transpose_w::<12>(vals, y, out),
+            _ => {
+                for (e, &ye) in y.iter().enumerate().take(self.len()) {
+                    if ye != 0.0 {
+                        self.add_scaled(vals, e, ye, out);
+                    }
+                }
+            }
+        }
+    }
+
+    fn add_transpose_w<const W: usize>(&self, vals: &[f64], y: &[f64], out: &mut [f64]) {
+        let sides = self.side_col.iter().zip(&self.side_row);
+        for (g, (&c, &e)) in vals.chunks_exact(W).zip(sides) {
+            let ye = y[e];
+            if ye == 0.0 {
+                continue;
+            }
+            if let (Some(g), Some(o)) = (g.first_chunk::<W>(), out[c..].first_chunk_mut::<W>()) {
+                for l in 0..W {
+                    o[l] += g[l] * ye;
+                }
+            }
+        }
     }
 
     /// Number of kept rows.

@@ -1,13 +1,15 @@
 //! The sparse stage solve: the stage Jacobian assembled on its fixed pattern from the
-//! element-local constraint rows and factored by [`SparseLu`]; the end-of-step momentum
-//! projection by [`ConstraintSchur`] and the first-step predictor by
+//! element-local constraint rows over body blocks of any width (planar bodies 3 coordinates,
+//! spatial bodies 12: `mbd_solve::sparse::BlockRows`) and factored by [`SparseLu`]; the
+//! end-of-step momentum projection by [`ConstraintSchur`] (planar models) or the constrained
+//! solve (spatial bodies, `EndSolve`), and the first-step predictor by
 //! [`SparseAccelerationSolver`]. Every operation of a step is `O(N)` for a chain of `N`
 //! bodies (see `docs/symplectic.md`, "Sparse stage solve").
 
 use super::{with_time, Galerkin};
 use mbd_model::{BodyRef, System};
 use mbd_solve::linalg::LuError;
-use mbd_solve::sparse::{ConstraintSchur, RowIncidence, SparseLu};
+use mbd_solve::sparse::{BlockRows, ConstraintSchur, SparseLu};
 use mbd_solve::{SolveError, SparseAccelerationSolver};
 
 /// No slot: the entry belongs to ground.
@@ -18,43 +20,61 @@ const NONE: usize = usize::MAX;
 pub(super) struct SparseStage {
     /// The stage Jacobian on its pattern, and its LU.
     pub(super) lu: SparseLu,
-    /// The bodies `(first, second)` of each constraint row (`None` = ground).
-    pub(super) row_bodies: Vec<(Option<usize>, Option<usize>)>,
-    /// `Phi_q M^-1 Phi_q^T` for the end-of-step momentum projection.
-    pub(super) schur: ConstraintSchur,
+    /// Every constraint row over body blocks (its local gradients side after side, row after
+    /// row: row `r`'s values are `rstart[r]..rstart[r + 1]` of a flat array).
+    pub(super) rows: BlockRows,
+    /// The coordinate of each local value.
+    vcol: Vec<usize>,
+    /// Each row's first local value (one more entry: the total).
+    rstart: Vec<usize>,
+    /// `Phi_q M^-1 Phi_q^T` for the end-of-step momentum projection and the rows a redundant
+    /// model drops (planar models; `None` with spatial bodies, whose end velocity is the
+    /// constrained solve).
+    pub(super) schur: Option<ConstraintSchur>,
     /// Index-1 accelerations for the first step's predictor.
     pub(super) acc: SparseAccelerationSolver,
     /// `k_slot[(nu s + mu - 1) n + i]`: entry (momentum row `(nu, i)`, `Z_mu,i`).
     k_slot: Vec<usize>,
-    /// `lam_slot[nu m + r][a]`: entry (momentum row `(nu, coord(a))`, multiplier `(nu, r)`).
-    lam_slot: Vec<[usize; 6]>,
+    /// `lam_slot[nu nv + k]`: entry (momentum row `(nu, vcol[k])`, multiplier `(nu, r)`) for
+    /// local value `k` of row `r`.
+    lam_slot: Vec<usize>,
     /// `diag_slot[(nu - 1) m + r]`: entry (constraint `(nu, r)`, multiplier `(nu - 1, r)`),
     /// only for a model with redundant equations (else empty).
     diag_slot: Vec<usize>,
-    /// `con_slot[(nu - 1) m + r][c]`: entry (constraint `(nu, r)`, `Z_nu,coord(c)`).
-    con_slot: Vec<[usize; 6]>,
-    /// `curv_slot[(nu - 1) m + r][a][c]` (`nu = 1..s-1`): entry (momentum row
-    /// `(nu, coord(a))`, `Z_nu,coord(c)`), the constraint curvature.
-    curv_slot: Vec<[[usize; 6]; 6]>,
-    /// Colour of each body: bodies sharing a joint have different colours.
+    /// `con_slot[(nu - 1) nv + k]`: entry (constraint `(nu, r)`, `Z_nu,vcol[k]`).
+    con_slot: Vec<usize>,
+    /// `curv_slot[(nu - 1) nc + cstart[r] + a len_r + c]` (`nu = 1..s-1`): entry (momentum
+    /// row `(nu, vcol[a])`, `Z_nu,vcol[c]`) of row `r`'s local values `a`, `c`, the constraint
+    /// curvature; `nc = cstart[m]`.
+    curv_slot: Vec<usize>,
+    cstart: Vec<usize>,
+    /// Colour of each block: blocks sharing a row have different colours.
     color: Vec<usize>,
-    /// Bodies of each colour.
-    color_bodies: Vec<Vec<usize>>,
-    /// Workspaces of the curvature (a seed direction, and `Phi_q`, `(Phi_q v)_q` rows).
+    /// Blocks of each colour, and the widest block.
+    color_blocks: Vec<Vec<usize>>,
+    max_width: usize,
+    /// Each block's first coordinate and width.
+    blocks: Vec<(usize, usize)>,
+    /// Workspaces of the curvature: a seed direction, the rows of `Phi_q` and of
+    /// `(Phi_q v + Phi_t)_q` along it, and (rheonomic models) the rows of `Phi_tq` alone,
+    /// which the curvature leaves out.
     vdir: Vec<f64>,
-    gscratch: Vec<[f64; 6]>,
-    dgrads: Vec<[f64; 6]>,
-    /// Force-Hessian entries `(row coordinate, column coordinate)`: every body that a force
-    /// element acts on, with itself and with each body it shares an element with.
+    zero: Vec<f64>,
+    gscratch: Vec<f64>,
+    dgrads: Vec<f64>,
+    dtime: Vec<f64>,
+    /// Force-Hessian entries `(row coordinate, column coordinate)`: every block that a force
+    /// element acts on, with itself and with each block it shares an element with.
     fent: Vec<(usize, usize)>,
     /// `fent_slot[(nu s + mu - 1) E + e]`: the slot of entry `e` in block (momentum row `nu`,
     /// `Z_mu`).
     fent_slot: Vec<usize>,
-    /// `fseed[3 k + l]`: the entries whose column is coordinate `l` of a body of force colour
-    /// `k` (a distance-2 colouring of the force graph: no row sees two bodies of one colour).
+    /// `fseed[max_width k + l]`: the entries whose column is coordinate `l` of a block of
+    /// force colour `k` (a distance-2 colouring of the force graph: no row sees two blocks of
+    /// one colour).
     fseed: Vec<Vec<usize>>,
-    /// Bodies of each force colour.
-    fcolor_bodies: Vec<Vec<usize>>,
+    /// Blocks of each force colour.
+    fcolor_blocks: Vec<Vec<usize>>,
     /// Values of the entries at one Gauss point: `d(grad V - Qnc)/dq` and `-dQnc/dv`.
     hq: Vec<f64>,
     hv: Vec<f64>,
@@ -67,34 +87,39 @@ pub(super) struct SparseStage {
     pub(super) al: Vec<f64>,
     /// `Phi_q v` (scratch of the projection).
     pub(super) pv: Vec<f64>,
+    /// Scratch `gamma` of the rows' gather.
+    pub(super) gamma: Vec<f64>,
 }
 
-/// Coordinate of local entry `a` (0..6) of a row acting on `bodies`, if not ground.
-#[inline]
-fn coord(bodies: (Option<usize>, Option<usize>), a: usize) -> Option<usize> {
-    let b = if a < 3 { bodies.0 } else { bodies.1 };
-    b.map(|b| 3 * b + a % 3)
+/// `out += Phi_q^T y` from the element-local rows `vals` (the layout of `rows`).
+pub(super) fn add_transpose(rows: &BlockRows, vals: &[f64], y: &[f64], out: &mut [f64]) {
+    rows.add_transpose(vals, y, out);
 }
 
-/// `out += Phi_q^T y` from element-local rows.
-pub(super) fn add_transpose(
-    grads: &[[f64; 6]],
-    row_bodies: &[(Option<usize>, Option<usize>)],
-    y: &[f64],
-    out: &mut [f64],
-) {
-    for ((g, &(ba, bb)), &yr) in grads.iter().zip(row_bodies).zip(y) {
-        if let Some(b) = ba {
-            for l in 0..3 {
-                out[3 * b + l] += g[l] * yr;
-            }
+/// A greedy colouring of `adj`'s vertices (`skip`: vertices left uncoloured, `usize::MAX`) in
+/// which no vertex shares a colour with one for which `clash(v, colour)` holds.
+fn colour(
+    count: usize,
+    skip: impl Fn(usize) -> bool,
+    clash: impl Fn(usize, usize, &[usize]) -> bool,
+) -> (Vec<usize>, Vec<Vec<usize>>) {
+    let mut color = vec![usize::MAX; count];
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for b in 0..count {
+        if skip(b) {
+            continue;
         }
-        if let Some(b) = bb {
-            for l in 0..3 {
-                out[3 * b + l] += g[3 + l] * yr;
-            }
+        let mut k = 0;
+        while clash(b, k, &color) {
+            k += 1;
         }
+        color[b] = k;
+        if members.len() <= k {
+            members.resize(k + 1, Vec::new());
+        }
+        members[k].push(b);
     }
+    (color, members)
 }
 
 impl SparseStage {
@@ -102,9 +127,34 @@ impl SparseStage {
     /// (allocates; once per integrator).
     pub(super) fn new(sys: &System, s: usize) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let nb = n / 3;
+        let nblocks = sys.n_body_blocks();
+        let blocks: Vec<(usize, usize)> = (0..nblocks)
+            .map(|b| sys.body_block(b).unwrap_or((0, 0)))
+            .collect();
+        let max_width = blocks.iter().map(|b| b.1).max().unwrap_or(0);
         let dim = s * (n + m);
-        let row_bodies = RowIncidence::new(sys).row_bodies;
+        let rows = BlockRows::new(sys, |_| true)?;
+        let nv = rows.n_values();
+        // each row's local values and their coordinates
+        let mut vcol = vec![0; nv];
+        let mut rstart = Vec::with_capacity(m + 1);
+        let mut at = 0;
+        for sides in rows.sides() {
+            rstart.push(at);
+            for side in sides.iter().flatten() {
+                if side.off != at {
+                    return Err(SolveError::Unsupported(
+                        "sparse stage: row sides not stored in order".into(),
+                    ));
+                }
+                for l in 0..side.width {
+                    vcol[at + l] = side.col + l;
+                }
+                at += side.width;
+            }
+        }
+        rstart.push(at);
+        let row_vals = |r: usize| rstart[r]..rstart[r + 1];
         let mut entries: Vec<(usize, usize)> = Vec::new();
         for nu in 0..s {
             for mu in 1..=s {
@@ -112,45 +162,49 @@ impl SparseStage {
                     entries.push((nu * n + i, (mu - 1) * n + i));
                 }
             }
-            for (r, &rb) in row_bodies.iter().enumerate() {
-                for a in 0..6 {
-                    if let Some(i) = coord(rb, a) {
-                        entries.push((nu * n + i, s * n + nu * m + r));
-                    }
+            for r in 0..m {
+                for k in row_vals(r) {
+                    entries.push((nu * n + vcol[k], s * n + nu * m + r));
                 }
             }
         }
         for nu in 1..=s {
-            for (r, &rb) in row_bodies.iter().enumerate() {
-                for c in 0..6 {
-                    if let Some(l) = coord(rb, c) {
-                        entries.push((s * n + (nu - 1) * m + r, (nu - 1) * n + l));
-                        if nu < s {
-                            for a in 0..6 {
-                                if let Some(i) = coord(rb, a) {
-                                    entries.push((nu * n + i, (nu - 1) * n + l));
-                                }
-                            }
+            for r in 0..m {
+                for c in row_vals(r) {
+                    let l = vcol[c];
+                    entries.push((s * n + (nu - 1) * m + r, (nu - 1) * n + l));
+                    if nu < s {
+                        for a in row_vals(r) {
+                            entries.push((nu * n + vcol[a], (nu - 1) * n + l));
                         }
                     }
                 }
             }
         }
-        // force graph: closed neighbourhoods of the bodies with a force element
-        let mut fnbr: Vec<Vec<usize>> = vec![Vec::new(); nb];
-        for f in sys.forces() {
-            let idx = |r: BodyRef| match r {
-                BodyRef::Body(h) if h.index() < nb => Some(h.index()),
-                _ => None,
-            };
-            let (a, b) = f.bodies();
-            let (a, b) = (idx(a), idx(b));
+        // force graph over blocks: closed neighbourhoods of the blocks with a force element
+        let planar = nblocks - sys.spatial_bodies().len();
+        let mut fnbr: Vec<Vec<usize>> = vec![Vec::new(); nblocks];
+        let mut link = |a: Option<usize>, b: Option<usize>| {
             for x in [a, b].into_iter().flatten() {
                 fnbr[x].push(x);
                 for y in [a, b].into_iter().flatten() {
                     fnbr[x].push(y);
                 }
             }
+        };
+        for f in sys.forces() {
+            let idx = |r: BodyRef| match r {
+                BodyRef::Body(h) if h.index() < planar => Some(h.index()),
+                _ => None,
+            };
+            let (a, b) = f.bodies();
+            link(idx(a), idx(b));
+        }
+        for f in sys.spatial_forces() {
+            link(
+                f.a.index().map(|k| planar + k),
+                f.b.index().map(|k| planar + k),
+            );
         }
         for v in &mut fnbr {
             v.sort_unstable();
@@ -158,10 +212,12 @@ impl SparseStage {
         }
         let mut fent = Vec::new();
         for (a, nbrs) in fnbr.iter().enumerate() {
+            let (ca, wa) = blocks[a];
             for &b in nbrs {
-                for r in 0..3 {
-                    for c in 0..3 {
-                        fent.push((3 * a + r, 3 * b + c));
+                let (cb, wb) = blocks[b];
+                for r in 0..wa {
+                    for c in 0..wb {
+                        fent.push((ca + r, cb + c));
                     }
                 }
             }
@@ -194,55 +250,50 @@ impl SparseStage {
                 }
             }
         }
-        let mut lam_slot = vec![[NONE; 6]; s * m];
-        let mut con_slot = vec![[NONE; 6]; s * m];
-        let mut curv_slot = vec![[[NONE; 6]; 6]; s.saturating_sub(1) * m];
-        for (r, &rb) in row_bodies.iter().enumerate() {
-            for nu in 0..s {
-                for a in 0..6 {
-                    if let Some(i) = coord(rb, a) {
-                        lam_slot[nu * m + r][a] = slot(nu * n + i, s * n + nu * m + r);
-                    }
+        let mut lam_slot = vec![NONE; s * nv];
+        let mut con_slot = vec![NONE; s * nv];
+        let mut cstart = Vec::with_capacity(m + 1);
+        let mut nc = 0;
+        for r in 0..m {
+            cstart.push(nc);
+            nc += row_vals(r).len().pow(2);
+        }
+        cstart.push(nc);
+        let mut curv_slot = vec![NONE; s.saturating_sub(1) * nc];
+        for r in 0..m {
+            let vals = row_vals(r);
+            let len = vals.len();
+            for k in vals.clone() {
+                for nu in 0..s {
+                    lam_slot[nu * nv + k] = slot(nu * n + vcol[k], s * n + nu * m + r);
                 }
             }
             for nu in 1..=s {
-                for c in 0..6 {
-                    if let Some(l) = coord(rb, c) {
-                        con_slot[(nu - 1) * m + r][c] =
-                            slot(s * n + (nu - 1) * m + r, (nu - 1) * n + l);
-                        if nu < s {
-                            for a in 0..6 {
-                                if let Some(i) = coord(rb, a) {
-                                    curv_slot[(nu - 1) * m + r][a][c] =
-                                        slot(nu * n + i, (nu - 1) * n + l);
-                                }
-                            }
+                for (c, kc) in vals.clone().enumerate() {
+                    let l = vcol[kc];
+                    con_slot[(nu - 1) * nv + kc] = slot(s * n + (nu - 1) * m + r, (nu - 1) * n + l);
+                    if nu < s {
+                        for (a, ka) in vals.clone().enumerate() {
+                            curv_slot[(nu - 1) * nc + cstart[r] + a * len + c] =
+                                slot(nu * n + vcol[ka], (nu - 1) * n + l);
                         }
                     }
                 }
             }
         }
-        // greedy colouring of the bodies: two bodies sharing a joint differ
-        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); nb];
-        for &(a, b) in &row_bodies {
-            if let (Some(a), Some(b)) = (a, b) {
-                adj[a].push(b);
-                adj[b].push(a);
+        // greedy colouring of the blocks: two blocks sharing a row differ
+        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); nblocks];
+        for sides in rows.sides() {
+            if let [Some(a), Some(b)] = sides {
+                adj[a.block].push(b.block);
+                adj[b.block].push(a.block);
             }
         }
-        let mut color = vec![usize::MAX; nb];
-        let mut color_bodies: Vec<Vec<usize>> = Vec::new();
-        for b in 0..nb {
-            let mut k = 0;
-            while adj[b].iter().any(|&o| color[o] == k) {
-                k += 1;
-            }
-            color[b] = k;
-            if color_bodies.len() <= k {
-                color_bodies.resize(k + 1, Vec::new());
-            }
-            color_bodies[k].push(b);
-        }
+        let (color, color_blocks) = colour(
+            nblocks,
+            |_| false,
+            |b, k, color| adj[b].iter().any(|&o| color[o] == k),
+        );
         let mut fent_slot = vec![NONE; s * s * fent.len()];
         for nu in 0..s {
             for mu in 1..=s {
@@ -252,31 +303,27 @@ impl SparseStage {
                 }
             }
         }
-        // distance-2 colouring of the bodies with force elements
-        let mut fcolor = vec![usize::MAX; nb];
-        let mut fcolor_bodies: Vec<Vec<usize>> = Vec::new();
-        for b in 0..nb {
-            if fnbr[b].is_empty() {
-                continue;
-            }
-            let mut k = 0;
-            let clash = |k: usize| {
+        // distance-2 colouring of the blocks with force elements
+        let (fcolor, fcolor_blocks) = colour(
+            nblocks,
+            |b| fnbr[b].is_empty(),
+            |b, k, color| {
                 fnbr[b]
                     .iter()
-                    .any(|&x| fcolor[x] == k || fnbr[x].iter().any(|&y| fcolor[y] == k))
-            };
-            while clash(k) {
-                k += 1;
+                    .any(|&x| color[x] == k || fnbr[x].iter().any(|&y| color[y] == k))
+            },
+        );
+        // the block of each coordinate, for the seeds
+        let mut block_of = vec![0; n];
+        for (b, &(c0, w)) in blocks.iter().enumerate() {
+            for x in &mut block_of[c0..c0 + w] {
+                *x = b;
             }
-            fcolor[b] = k;
-            if fcolor_bodies.len() <= k {
-                fcolor_bodies.resize(k + 1, Vec::new());
-            }
-            fcolor_bodies[k].push(b);
         }
-        let mut fseed = vec![Vec::new(); 3 * fcolor_bodies.len()];
+        let mut fseed = vec![Vec::new(); max_width * fcolor_blocks.len()];
         for (e, &(_, l)) in fent.iter().enumerate() {
-            fseed[3 * fcolor[l / 3] + l % 3].push(e);
+            let b = block_of[l];
+            fseed[max_width * fcolor[b] + (l - blocks[b].0)].push(e);
         }
         let ne = fent.len();
         let diag_slot = if redundant {
@@ -284,25 +331,36 @@ impl SparseStage {
         } else {
             Vec::new()
         };
+        let schur = if sys.has_spatial() {
+            None
+        } else {
+            Some(ConstraintSchur::new(sys)?)
+        };
         Ok(SparseStage {
             diag_slot,
             lu,
-            row_bodies,
-            schur: ConstraintSchur::new(sys)?,
+            vcol,
+            rstart,
+            schur,
             acc: SparseAccelerationSolver::new(sys)?,
             k_slot,
             lam_slot,
             con_slot,
             curv_slot,
+            cstart,
             color,
-            color_bodies,
+            color_blocks,
+            max_width,
+            blocks,
             vdir: vec![0.0; n],
-            gscratch: vec![[0.0; 6]; m],
-            dgrads: vec![[0.0; 6]; m],
+            zero: vec![0.0; n],
+            gscratch: vec![0.0; nv],
+            dgrads: vec![0.0; nv],
+            dtime: vec![0.0; nv],
             fent,
             fent_slot,
             fseed,
-            fcolor_bodies,
+            fcolor_blocks,
             hq: vec![0.0; ne],
             hv: vec![0.0; ne],
             qp: vec![0.0; n],
@@ -311,7 +369,14 @@ impl SparseStage {
             gm: vec![0.0; n],
             al: vec![0.0; n],
             pv: vec![0.0; m],
+            gamma: vec![0.0; m],
+            rows,
         })
+    }
+
+    /// The local gradients of every row at `(q, t)` into `vals` (the layout of `rows`).
+    pub(super) fn gather(&mut self, sys: &System, q: &[f64], t: f64, vals: &mut [f64]) {
+        self.rows.gather(sys, q, None, t, vals, &mut self.gamma);
     }
 }
 
@@ -319,10 +384,10 @@ impl Galerkin {
     /// The sparse Jacobian of the stage equations at `self.x` (after `residual` at the same
     /// point), factored. Same entries as the dense `jacobian`, written into the slots of the
     /// fixed pattern; the constraint curvature `sum_r lt_r Hess(Phi_r)` at the interior control
-    /// points comes from `System::phi_q_dot_local` along coloured seed directions (one per
-    /// colour and body coordinate: `v^T Hess(Phi_r)` for `v` the unit vector of that
-    /// coordinate of every body of one colour, which a row of a joint between two bodies of
-    /// different colours sees for one body only).
+    /// points comes from `System::local_rows_tan` along coloured seed directions (one per
+    /// colour and block coordinate: `v^T Hess(Phi_r)` for `v` the unit vector of that
+    /// coordinate of every block of one colour, which a row between two blocks of different
+    /// colours sees for one block only).
     pub(super) fn jacobian_sparse(
         &mut self,
         sys: &System,
@@ -334,10 +399,12 @@ impl Galerkin {
         let Some(sp) = self.sparse.as_deref_mut() else {
             return Ok(());
         };
-        sys.phi_q_local(&self.qn[s * n..(s + 1) * n], &mut self.grads[s]);
+        let ts = t + self.tab.tau[s] * h;
+        sp.gather(sys, &self.qn[s * n..(s + 1) * n], ts, &mut self.grads[s]);
         let h2 = h * h;
         let tab = &self.tab;
-        let minv = &self.minv;
+        let (minv, unit) = (&self.minv, &self.unit);
+        let nv = sp.rows.n_values();
         sp.lu.clear();
         {
             let vals = sp.lu.values_mut();
@@ -345,34 +412,28 @@ impl Galerkin {
                 for mu in 1..=s {
                     let kk = tab.k[nu * s1 + mu];
                     let ks = &sp.k_slot[(nu * s + mu - 1) * n..(nu * s + mu) * n];
-                    for &k in ks {
-                        vals[k] += kk;
+                    for (&k, &u) in ks.iter().zip(unit) {
+                        vals[k] += kk * u;
                     }
                 }
-                for (r, &rb) in sp.row_bodies.iter().enumerate() {
-                    let g = &self.grads[nu][r];
-                    let sl = &sp.lam_slot[nu * m + r];
-                    for a in 0..6 {
-                        if let Some(i) = coord(rb, a) {
-                            vals[sl[a]] = -h2 * minv[i] * g[a];
-                        }
-                    }
+                let g = &self.grads[nu];
+                let sl = &sp.lam_slot[nu * nv..(nu + 1) * nv];
+                for (k, (&slot, &gk)) in sl.iter().zip(g).enumerate() {
+                    vals[slot] = -h2 * minv[sp.vcol[k]] * gk;
                 }
             }
             for nu in 1..=s {
-                for r in 0..m {
-                    let g = &self.grads[nu][r];
-                    for (&k, &v) in sp.con_slot[(nu - 1) * m + r].iter().zip(g) {
-                        if k != NONE {
-                            vals[k] = v;
-                        }
-                    }
+                let g = &self.grads[nu];
+                let sl = &sp.con_slot[(nu - 1) * nv..nu * nv];
+                for (&slot, &gk) in sl.iter().zip(g) {
+                    vals[slot] = gk;
                 }
             }
         }
         // force Hessians at the Gauss points (coloured central differences)
         if !sp.fent.is_empty() {
             let nonconservative = self.nonconservative;
+            let wmax = sp.max_width;
             for j in 0..s {
                 let qj = &self.qj[j * n..(j + 1) * n];
                 let tj = t + tab.c[j] * h;
@@ -390,47 +451,47 @@ impl Galerkin {
                         }
                     }
                 };
-                for (k, bodies) in sp.fcolor_bodies.iter().enumerate() {
-                    for l in 0..3 {
-                        let seeds = &sp.fseed[3 * k + l];
+                for (k, blocks) in sp.fcolor_blocks.iter().enumerate() {
+                    for l in 0..wmax {
+                        let seeds = &sp.fseed[wmax * k + l];
+                        if seeds.is_empty() {
+                            continue;
+                        }
                         for (wrt_v, active) in [(false, true), (true, nonconservative)] {
                             if !active {
                                 continue;
                             }
+                            let base = |c: usize| {
+                                if wrt_v {
+                                    self.hvj[j * n + c] / h
+                                } else {
+                                    qj[c]
+                                }
+                            };
+                            let cols = blocks
+                                .iter()
+                                .map(|&b| sp.blocks[b])
+                                .filter(|&(_, w)| l < w)
+                                .map(|(c0, _)| c0 + l);
                             let x = if wrt_v { &mut sp.vp } else { &mut sp.qp };
-                            for &b in bodies {
-                                let c = 3 * b + l;
+                            for c in cols.clone() {
                                 x[c] += 1e-6 * (1.0 + x[c].abs());
                             }
                             grad(&sp.qp, &sp.vp, &mut sp.gp, &mut sp.al);
                             let x = if wrt_v { &mut sp.vp } else { &mut sp.qp };
-                            for &b in bodies {
-                                let c = 3 * b + l;
-                                let x0 = if wrt_v {
-                                    self.hvj[j * n + c] / h
-                                } else {
-                                    qj[c]
-                                };
+                            for c in cols.clone() {
+                                let x0 = base(c);
                                 x[c] = x0 - 1e-6 * (1.0 + x0.abs());
                             }
                             grad(&sp.qp, &sp.vp, &mut sp.gm, &mut sp.al);
                             let x = if wrt_v { &mut sp.vp } else { &mut sp.qp };
-                            for &b in bodies {
-                                let c = 3 * b + l;
-                                x[c] = if wrt_v {
-                                    self.hvj[j * n + c] / h
-                                } else {
-                                    qj[c]
-                                };
+                            for c in cols {
+                                x[c] = base(c);
                             }
                             let out = if wrt_v { &mut sp.hv } else { &mut sp.hq };
                             for &e in seeds {
                                 let (i, c) = sp.fent[e];
-                                let x0 = if wrt_v {
-                                    self.hvj[j * n + c] / h
-                                } else {
-                                    qj[c]
-                                };
+                                let x0 = base(c);
                                 let d = 1e-6 * (1.0 + x0.abs());
                                 out[e] = (sp.gp[i] - sp.gm[i]) / ((x0 + d) - (x0 - d));
                             }
@@ -456,33 +517,59 @@ impl Galerkin {
             }
         }
         // constraint curvature at the interior control points
+        let rheonomic = sys.is_rheonomic();
+        let nc = sp.cstart.last().copied().unwrap_or(0);
         for nu in 1..s {
             let q = &self.qn[nu * n..(nu + 1) * n];
+            let tn = t + tab.tau[nu] * h;
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
-            for (k, bodies) in sp.color_bodies.iter().enumerate() {
-                for l in 0..3 {
-                    for &b in bodies {
-                        sp.vdir[3 * b + l] = 1.0;
+            if rheonomic {
+                // (Phi_q 0 + Phi_t)_q = Phi_tq: not curvature, subtracted below
+                sp.rows
+                    .gather_tan(sys, q, &sp.zero, tn, &mut sp.gscratch, &mut sp.dtime);
+            }
+            for (k, blocks) in sp.color_blocks.iter().enumerate() {
+                for l in 0..sp.max_width {
+                    let mut any = false;
+                    for &b in blocks {
+                        let (c0, w) = sp.blocks[b];
+                        if l < w {
+                            sp.vdir[c0 + l] = 1.0;
+                            any = true;
+                        }
                     }
-                    sys.phi_q_dot_local(q, &sp.vdir, &mut sp.gscratch, &mut sp.dgrads);
-                    for &b in bodies {
-                        sp.vdir[3 * b + l] = 0.0;
+                    if !any {
+                        continue;
+                    }
+                    sp.rows
+                        .gather_tan(sys, q, &sp.vdir, tn, &mut sp.gscratch, &mut sp.dgrads);
+                    for &b in blocks {
+                        let (c0, w) = sp.blocks[b];
+                        if l < w {
+                            sp.vdir[c0 + l] = 0.0;
+                        }
+                    }
+                    if rheonomic {
+                        for (d, z) in sp.dgrads.iter_mut().zip(&sp.dtime) {
+                            *d -= z;
+                        }
                     }
                     let vals = sp.lu.values_mut();
-                    for (r, &(ba, bb)) in sp.row_bodies.iter().enumerate() {
+                    for (r, sides) in sp.rows.sides().iter().enumerate() {
                         let lr = lam[r];
                         if lr == 0.0 {
                             continue;
                         }
-                        for (p, body) in [(0, ba), (1, bb)] {
-                            let Some(b) = body else { continue };
-                            if sp.color[b] != k {
+                        let (r0, len) = (sp.rstart[r], sp.rstart[r + 1] - sp.rstart[r]);
+                        for side in sides.iter().flatten() {
+                            if sp.color[side.block] != k || l >= side.width {
                                 continue;
                             }
-                            let a = 3 * p + l;
-                            let f = -h2 * minv[3 * b + l] * lr;
-                            let sl = &sp.curv_slot[(nu - 1) * m + r][a];
-                            for (&slot, &d) in sl.iter().zip(&sp.dgrads[r]) {
+                            let a = side.off - r0 + l;
+                            let f = -h2 * minv[side.col + l] * lr;
+                            let base = (nu - 1) * nc + sp.cstart[r] + a * len;
+                            let sl = &sp.curv_slot[base..base + len];
+                            for (&slot, &d) in sl.iter().zip(&sp.dgrads[r0..r0 + len]) {
                                 if slot != NONE {
                                     vals[slot] += f * d;
                                 }
@@ -505,29 +592,28 @@ impl Galerkin {
                 vals[sp.k_slot[i]] += minv[i] * (cw * 2.0 * wd[i] + ch * ad[i]);
             }
         }
-        if !sp.diag_slot.is_empty() {
+        if let (false, Some(schur)) = (sp.diag_slot.is_empty(), sp.schur.as_mut()) {
             // the equations dependent at the step's end configuration are left out: their
             // rows become the identity on their multipliers, which then stay put (Newton
             // moves them by the residual of an equation the others imply)
-            sp.schur.update(sys, &self.qn[s * n..(s + 1) * n]);
-            sp.schur
-                .factor(&self.minv)
-                .map_err(|_| SolveError::Singular {
-                    t: t + h,
-                    what: "constraint matrix Phi_q M^-1 Phi_q^T of the stage equations",
-                    detail: "more dependent equations than the model's redundant ones".into(),
-                })?;
+            schur.update(sys, &self.qn[s * n..(s + 1) * n]);
+            schur.factor(&self.minv).map_err(|_| SolveError::Singular {
+                t: t + h,
+                what: "constraint matrix Phi_q M^-1 Phi_q^T of the stage equations",
+                detail: "more dependent equations than the model's redundant ones".into(),
+            })?;
             let vals = sp.lu.values_mut();
-            for &r in sp.schur.dependent() {
+            for &r in schur.dependent() {
+                let rv = sp.rstart[r]..sp.rstart[r + 1];
                 for nu in 1..=s {
-                    for &k in &sp.con_slot[(nu - 1) * m + r] {
-                        if k != NONE {
-                            vals[k] = 0.0;
-                        }
-                    }
-                    for &k in &sp.lam_slot[(nu - 1) * m + r] {
-                        if k != NONE {
-                            vals[k] = 0.0;
+                    for k in rv.clone() {
+                        for slot in [
+                            sp.con_slot[(nu - 1) * nv + k],
+                            sp.lam_slot[(nu - 1) * nv + k],
+                        ] {
+                            if slot != NONE {
+                                vals[slot] = 0.0;
+                            }
                         }
                     }
                     vals[sp.diag_slot[(nu - 1) * m + r]] = 1.0;

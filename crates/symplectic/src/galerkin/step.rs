@@ -102,7 +102,7 @@ impl Integrator for Galerkin {
         if let Some(sp) = &self.sparse {
             let lts = self.x[s * n..].chunks_exact(m);
             for (grads, lt) in self.grads[..s].iter().zip(lts) {
-                add_transpose(grads, &sp.row_bodies, lt, f);
+                add_transpose(&sp.rows, grads, lt, f);
             }
         } else if m > 0 {
             let lts = self.x[s * n..].chunks_exact(m);
@@ -124,26 +124,26 @@ impl Integrator for Galerkin {
         }
         let qn1 = &self.qn[s * n..(s + 1) * n];
         let t1 = t + h;
-        if let Some(sp) = &mut self.sparse {
+        let planar_sparse = self.sparse.as_deref_mut().and_then(|sp| {
+            let schur = sp.schur.as_mut()?;
+            Some((schur, &mut sp.pv))
+        });
+        if let Some((schur, pv)) = planar_sparse {
             // M^-1-orthogonal projection onto Phi_q v + Phi_t = 0, O(N) (docs/symplectic.md)
-            sp.schur.update(sys, qn1);
-            self.grads[s].copy_from_slice(sp.schur.grads());
-            self.end_phiq_valid = true;
-            sp.schur
-                .factor(&self.minv)
-                .map_err(|_| SolveError::Singular {
-                    t: t1,
-                    what: "momentum projection matrix Phi_q M^-1 Phi_q^T",
-                    detail: "redundant constraints or a singular configuration".into(),
-                })?;
+            schur.update(sys, qn1);
+            self.end_phiq_valid = false;
+            schur.factor(&self.minv).map_err(|_| SolveError::Singular {
+                t: t1,
+                what: "momentum projection matrix Phi_q M^-1 Phi_q^T",
+                detail: "redundant constraints or a singular configuration".into(),
+            })?;
             sys.phi_t(qn1, t1, &mut self.mu);
-            sp.schur.apply(&self.vm, &mut sp.pv);
-            for (mu, &pv) in self.mu.iter_mut().zip(&sp.pv) {
+            schur.apply(&self.vm, pv);
+            for (mu, &pv) in self.mu.iter_mut().zip(pv.iter()) {
                 *mu += pv;
             }
-            sp.schur.solve_in_place(&mut self.mu);
-            sp.schur
-                .add_weighted_transpose(-1.0, &self.minv, &self.mu, &mut self.vm);
+            schur.solve_in_place(&mut self.mu);
+            schur.add_weighted_transpose(-1.0, &self.minv, &self.mu, &mut self.vm);
         } else if let Some(es) = self.end_solve.as_deref_mut() {
             // singular mass matrices: M v + Phi_q^T mu = M v_k - h f, Phi_q v = -Phi_t
             for (i, p) in es.p.iter_mut().enumerate() {
@@ -155,7 +155,11 @@ impl Integrator for Galerkin {
             }
             es.solve.factor(sys, qn1, t1)?;
             es.solve.solve(&es.p, &es.r, &mut self.vm, &mut self.mu)?;
-            sys.phi_q(qn1, t1, &mut self.phiq[s]);
+            if let Some(sp) = self.sparse.as_deref_mut() {
+                sp.gather(sys, qn1, t1, &mut self.grads[s]);
+            } else {
+                sys.phi_q(qn1, t1, &mut self.phiq[s]);
+            }
             self.end_phiq_valid = true;
         } else if m > 0 {
             sys.phi_q(qn1, t1, &mut self.phiq[s]);

@@ -76,13 +76,6 @@ pub struct SparseChart {
     redundant: usize,
     /// Every equation over body blocks.
     rows: BlockRows,
-    /// Every row side in the order of the value arrays: its first coordinate, row and value
-    /// offset (`side_off` has one more entry, the total), and the common width of all sides
-    /// (`None`: mixed widths, e.g. planar and spatial bodies in one model).
-    side_col: Vec<usize>,
-    side_row: Vec<usize>,
-    side_off: Vec<usize>,
-    uniform: Option<usize>,
     /// Element-local rows of `Phi_q` and `(Phi_q v)_q` at the centre (the layout of `rows`).
     grads: Vec<f64>,
     dgrads: Vec<f64>,
@@ -166,39 +159,10 @@ impl SparseChart {
             });
         }
         let nv = rows.n_values();
-        let (mut side_col, mut side_row, mut side_off) = (Vec::new(), Vec::new(), Vec::new());
-        let mut widths = Vec::new();
-        for (r, sides) in rows.sides().iter().enumerate() {
-            for s in sides.iter().flatten() {
-                side_col.push(s.col);
-                side_row.push(r);
-                side_off.push(s.off);
-                widths.push(s.width);
-            }
-        }
-        side_off.push(nv);
-        // (the values are stored side after side in this order: BlockRows' layout)
-        if side_off
-            .windows(2)
-            .zip(&widths)
-            .any(|(o, &w)| o[1] - o[0] != w)
-        {
-            return Err(SolveError::Unsupported(
-                "sparse chart: row sides not stored in order".into(),
-            ));
-        }
-        let uniform = match widths.first() {
-            Some(&w) if widths.iter().all(|&x| x == w) => Some(w),
-            _ => None,
-        };
         Ok(SparseChart {
             n,
             m,
             redundant: k,
-            side_col,
-            side_row,
-            side_off,
-            uniform,
             rows,
             grads: vec![0.0; nv],
             dgrads: vec![0.0; nv],
@@ -353,6 +317,15 @@ impl SparseChart {
         Ok(())
     }
 
+    /// Every row side with its row, in storage order.
+    fn sides(&self) -> impl Iterator<Item = (usize, mbd_solve::sparse::RowSide)> + '_ {
+        self.rows
+            .sides()
+            .iter()
+            .enumerate()
+            .flat_map(|(r, s)| s.iter().flatten().map(move |&side| (r, side)))
+    }
+
     /// `out = Df(x_c) z` for `z` of length `2n` (`out` of length `2m`).
     pub fn apply_df(&self, z: &[f64], out: &mut [f64]) {
         let (n, m) = (self.n, self.m);
@@ -360,12 +333,12 @@ impl SparseChart {
         let (op, ov) = out[..2 * m].split_at_mut(m);
         op.fill(0.0);
         ov.fill(0.0);
-        match self.uniform {
+        match self.rows.side_order().2 {
             Some(3) => self.apply_df_w::<3>(zq, zv, op, ov),
             Some(12) => self.apply_df_w::<12>(zq, zv, op, ov),
             _ => {
-                for (k, (&c, &r)) in self.side_col.iter().zip(&self.side_row).enumerate() {
-                    let (o, w) = (self.side_off[k], self.side_off[k + 1] - self.side_off[k]);
+                for (r, side) in self.sides() {
+                    let (o, w, c) = (side.off, side.width, side.col);
                     let (a, x) = (&self.grads[o..o + w], &self.dgrads[o..o + w]);
                     let (zq, zv) = (&zq[c..c + w], &zv[c..c + w]);
                     for l in 0..w {
@@ -380,7 +353,8 @@ impl SparseChart {
     /// [`SparseChart::apply_df`] when every side has width `W` (the loops unrolled).
     fn apply_df_w<const W: usize>(&self, zq: &[f64], zv: &[f64], op: &mut [f64], ov: &mut [f64]) {
         let (a, x) = (self.grads.chunks_exact(W), self.dgrads.chunks_exact(W));
-        for ((a, x), (&c, &r)) in a.zip(x).zip(self.side_col.iter().zip(&self.side_row)) {
+        let (cols, rows, _) = self.rows.side_order();
+        for ((a, x), (&c, &r)) in a.zip(x).zip(cols.iter().zip(rows)) {
             let (Some(a), Some(x), Some(zq), Some(zv)) = (
                 a.first_chunk::<W>(),
                 x.first_chunk::<W>(),
@@ -404,12 +378,12 @@ impl SparseChart {
         let (n, m) = (self.n, self.m);
         let (oq, ov) = out.split_at_mut(n);
         let (ep, ev) = e[..2 * m].split_at(m);
-        match self.uniform {
+        match self.rows.side_order().2 {
             Some(3) => self.add_df_t_w::<3>(alpha, ep, ev, oq, ov),
             Some(12) => self.add_df_t_w::<12>(alpha, ep, ev, oq, ov),
             _ => {
-                for (k, (&c, &r)) in self.side_col.iter().zip(&self.side_row).enumerate() {
-                    let (o, w) = (self.side_off[k], self.side_off[k + 1] - self.side_off[k]);
+                for (r, side) in self.sides() {
+                    let (o, w, c) = (side.off, side.width, side.col);
                     let (a, x) = (&self.grads[o..o + w], &self.dgrads[o..o + w]);
                     let (p, v) = (alpha * ep[r], alpha * ev[r]);
                     for l in 0..w {
@@ -431,7 +405,8 @@ impl SparseChart {
         ov: &mut [f64],
     ) {
         let (a, x) = (self.grads.chunks_exact(W), self.dgrads.chunks_exact(W));
-        for ((a, x), (&c, &r)) in a.zip(x).zip(self.side_col.iter().zip(&self.side_row)) {
+        let (cols, rows, _) = self.rows.side_order();
+        for ((a, x), (&c, &r)) in a.zip(x).zip(cols.iter().zip(rows)) {
             let (p, v) = (alpha * ep[r], alpha * ev[r]);
             let (Some(a), Some(x), Some(oq), Some(ov)) = (
                 a.first_chunk::<W>(),
