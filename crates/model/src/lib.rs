@@ -81,8 +81,9 @@ pub use element_hessians::ElementHessian;
 pub use error::{num as format_number, ModelError};
 pub use file::{
     read_text, BodyKind, BodySpec, EulerSpec, ForceSpec, InitialInput, JointSpec, ModelFile,
-    OrientationSpec, SpatialBodySpec, SpatialForceSpec, SpatialJointSpec, SpatialJointType,
-    SpatialPointForceSpec, SpatialSpringDamperSpec, SpatialTorqueSpec, MAX_MODEL_FILE_BYTES,
+    OrientationSpec, SpatialBodyKind, SpatialBodySpec, SpatialForceSpec, SpatialJointSpec,
+    SpatialJointType, SpatialPointForceSpec, SpatialSpringDamperSpec, SpatialTorqueSpec,
+    MAX_MODEL_FILE_BYTES,
 };
 pub use forces::{Force, ForceKind};
 pub use init::{RedundantConstraints, RedundantEquation, SPARSE_RANK_THRESHOLD};

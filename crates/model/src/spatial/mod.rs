@@ -32,6 +32,7 @@ mod forces;
 mod inertia;
 mod joints;
 mod orientation;
+mod point_mass;
 mod reactions;
 mod rigid;
 pub(crate) mod system;
@@ -41,6 +42,7 @@ pub use forces::{Axes, SpatialForce, SpatialForceKind, SpatialLoad, SpatialSprin
 pub use inertia::{SpatialInertia, SpatialInertiaError};
 pub use joints::{Marker, SpatialFrame, SpatialJoint, SpatialJointError, SpatialJointKind};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};
+pub use point_mass::{SpatialPointMass, SpatialPointMassHandle};
 pub use reactions::SpatialJointReaction;
 pub use rigid::{internal_gamma, RigidSolve};
 pub use system::SpatialJointEntry;
