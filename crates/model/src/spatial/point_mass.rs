@@ -135,3 +135,7 @@ impl super::system::SpatialPart {
 pub(crate) fn as_side(l: &Option<([f64; 12], [f64; 12])>) -> Option<(&[f64], &[f64])> {
     l.as_ref().map(|(q, v)| (&q[..], &v[..]))
 }
+
+#[cfg(test)]
+#[path = "point_mass_tests.rs"]
+mod tests;
