@@ -345,7 +345,8 @@ impl System {
         if bodies.is_empty() && spatial.bodies.is_empty() && spatial.points.is_empty() {
             return Err(ModelError::Empty);
         }
-        if !joint_initials.is_empty() && !(spatial.bodies.is_empty() && spatial.points.is_empty()) {
+        let has_spatial = !spatial.bodies.is_empty() || !spatial.points.is_empty();
+        if !joint_initials.is_empty() && has_spatial {
             return Err(invalid(
                 "assembly".to_string(),
                 "assembly from joint coordinates takes planar models only; place spatial \
