@@ -339,6 +339,39 @@ fn a_chain_of_point_masses_runs_alike_on_the_sparse_and_dense_paths() {
     assert!((&k.end.q - &s.q).amax() < 1e-12);
 }
 
+/// A `spatial_point` sensor on the bob reads its coordinates, velocities and accelerations, and
+/// a reaction sensor on the rod the joint's reaction (force only).
+#[test]
+fn sensors_read_a_point_mass() {
+    let mut b = SystemBuilder::new();
+    b.set_spatial_gravity([0.0, 0.0, -G]);
+    let (l, th): (f64, f64) = (1.2, 0.6);
+    let bob = b.add_spatial_point_mass(
+        "bob",
+        1.5,
+        [l * th.sin(), 0.0, -l * th.cos()],
+        [0.0, 1.9, 0.0],
+    );
+    let rod = b.add_spatial_joint("rod", SpatialBodyRef::Ground, bob, distance(l, [0.0; 3]));
+    b.add_sensor(mbd::model::Sensor::spatial_point("tip", bob, [0.0; 3]));
+    b.add_sensor(mbd::model::Sensor::spatial_reaction("pull", rod));
+    let sys = b.build().unwrap();
+    let mut ss = mbd::solve::SensorSolver::new(&sys).unwrap();
+    let mut out = Vec::new();
+    let s = State::consistent(&sys, 0.0).unwrap();
+    ss.evaluate(&sys, &s, &mut out).unwrap();
+    let mut os = mbd::solve::OutputSolve::new(&sys).unwrap();
+    let (a, lambda) = os.at(&sys, &s).unwrap();
+    let (a, lambda) = (a.to_vec(), lambda.to_vec());
+    let want: Vec<f64> = s.q.iter().chain(s.v.iter()).chain(&a).copied().collect();
+    assert_eq!(out[..9], want[..]);
+    let r = sys
+        .spatial_joint_reactions(s.q.as_slice(), &lambda)
+        .unwrap()[0];
+    assert_eq!(out[9..12], r.force);
+    assert_eq!(out[12..15], [0.0; 3]);
+}
+
 /// The rod's reaction on the bob is `m a - m g` (a force along the rod, no moment), at the
 /// bob's position; its momentum balance holds to round-off.
 #[test]
