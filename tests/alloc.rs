@@ -77,15 +77,15 @@ fn spatial_steps_allocate_nothing() {
     let lambda = vec![0.5; chain.n_constraints()];
     let mut out = vec![Default::default(); chain.spatial_joints().len()];
     chain
-        .spatial_joint_reactions_into(s.q.as_slice(), &lambda, &mut out)
+        .spatial_joint_reactions_into(s.q.as_slice(), s.t, &lambda, &mut out)
         .unwrap();
     let before = allocations();
     chain
-        .spatial_joint_reactions_into(s.q.as_slice(), &lambda, &mut out)
+        .spatial_joint_reactions_into(s.q.as_slice(), s.t, &lambda, &mut out)
         .unwrap();
     assert_eq!(allocations() - before, 0, "spatial reactions");
     assert!(chain
-        .spatial_joint_reactions_into(s.q.as_slice(), &lambda, &mut out[..2])
+        .spatial_joint_reactions_into(s.q.as_slice(), s.t, &lambda, &mut out[..2])
         .is_err());
 }
 

@@ -517,7 +517,9 @@ fn spatial_joint_reactions_obey_newton_and_the_ball_joint_carries_no_moment() {
         for _ in 0..3 {
             let s = sim.state().clone();
             let (a, lambda) = out.at(&sys, &s).unwrap();
-            let r = sys.spatial_joint_reactions(s.q.as_slice(), lambda).unwrap();
+            let r = sys
+                .spatial_joint_reactions(s.q.as_slice(), s.t, lambda)
+                .unwrap();
             assert_eq!(r.len(), 1);
             let want = Vector3::new(a[0], a[1], a[2] + 9.81);
             let f = Vector3::from(r[0].force);
@@ -537,7 +539,7 @@ fn spatial_joint_reactions_obey_newton_and_the_ball_joint_carries_no_moment() {
             sim.run(RunConfig::new(sim.state().t + 0.1, 1e-3)).unwrap();
         }
         let e = sys
-            .spatial_joint_reactions(&[0.0; 3], &[0.0; 9])
+            .spatial_joint_reactions(&[0.0; 3], 0.0, &[0.0; 9])
             .unwrap_err()
             .to_string();
         assert!(e.contains('q'), "{e}");
@@ -562,7 +564,8 @@ fn spatial_joint_reactions_obey_newton_and_the_ball_joint_carries_no_moment() {
         let s = State::consistent(sys, 0.0).unwrap();
         let mut out = OutputSolve::new(sys).unwrap();
         let (_, lambda) = out.at(sys, &s).unwrap();
-        sys.spatial_joint_reactions(s.q.as_slice(), lambda).unwrap()[0]
+        sys.spatial_joint_reactions(s.q.as_slice(), s.t, lambda)
+            .unwrap()[0]
     };
     let (a, b) = (load(&fwd), load(&rev));
     for c in 0..3 {

@@ -220,7 +220,8 @@ fn the_angle_drivers_derivatives_match_differences() {
 /// rod's angle within 1e-9 of `theta` at t = 1.2 s, h = 1e-3; the tangent chart also on its
 /// sparse path; FA-DAE refuses a model without a degree of freedom), and the driver's multiplier is the torque Euler's law about the hinge needs:
 /// `lambda = m g (L/2) cos theta - J_hinge theta''` (`J_hinge = m L^2 / 3`; the driver's
-/// equation is `sin(phi - theta)`, slope 1 in the rod's angle `phi`), to 1e-8.
+/// equation is `sin(phi - theta)`, slope 1 in the rod's angle `phi`), to 1e-8; the motor's
+/// reaction on the rod is the moment `-lambda` about the hinge axis and nothing else.
 #[test]
 fn a_motor_turns_a_rod_through_its_angle_with_every_solver() {
     let sys = motor_rod();
@@ -244,9 +245,20 @@ fn a_motor_turns_a_rod_through_its_angle_with_every_solver() {
         let mut os = mbd::solve::OutputSolve::new(&sys).unwrap();
         let (_, lambda) = os.at(&sys, st).unwrap();
         let dl = (lambda[sys.n_constraints() - 1] - torque).abs();
-        eprintln!("{spec}: angle off by {err:.1e}, motor torque off by {dl:.1e}");
+        // the motor's reaction on the rod: a moment about the hinge axis (global y, the
+        // direction theta turns) of -lambda, and no force
+        let r = sys
+            .spatial_joint_reactions(st.q.as_slice(), st.t, lambda)
+            .unwrap()[1];
+        let dm = (r.moment[1] + lambda[sys.n_constraints() - 1]).abs();
+        let off = r.force.iter().chain(&r.moment[..1]).chain(&r.moment[2..]);
+        let off = off.fold(0.0f64, |m, x| m.max(x.abs()));
+        eprintln!(
+            "{spec}: angle off by {err:.1e}, motor torque off by {dl:.1e}, its reaction by {dm:.1e}"
+        );
         assert!(err < 1e-9, "{spec}: {err:e}");
         assert!(dl < 1e-8, "{spec}: {dl:e}");
+        assert!(dm < 1e-9 && off < 1e-9, "{spec}: {dm:e} {off:e}");
     }
     // the motor leaves no degree of freedom, which FA-DAE's optimisation needs
     let e = Simulation::new(sys.clone(), "firefly-gauss")

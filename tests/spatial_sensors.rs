@@ -104,7 +104,7 @@ fn spatial_sensor_values_are_consistent_along_a_run() {
                 let mut os = mbd::solve::OutputSolve::new(&sys).unwrap();
                 os.at(&sys, &cur.0).unwrap().1.to_vec()
             };
-            let r = sys.spatial_joint_reactions(q, &lambda).unwrap()[0];
+            let r = sys.spatial_joint_reactions(q, cur.0.t, &lambda).unwrap()[0];
             assert_eq!(o[24..27], r.force);
             assert_eq!(o[27..30], r.moment);
             let (t, u) = (sys.kinetic(v), sys.potential(q));

@@ -93,6 +93,15 @@ impl CoreModel {
             names(s.spatial_bodies().iter().map(|b| b.name.as_str()).collect()),
         )?;
         d.set_item(
+            "spatial_point_masses",
+            names(
+                s.spatial_point_masses()
+                    .iter()
+                    .map(|p| p.name.as_str())
+                    .collect(),
+            ),
+        )?;
+        d.set_item(
             "spatial_joints",
             names(s.spatial_joints().iter().map(|j| j.name.as_str()).collect()),
         )?;

@@ -281,6 +281,7 @@ impl<W: Write> CsvObserver<W> {
                     .resize(sys.spatial_joints().len(), Default::default());
                 sys.spatial_joint_reactions_into(
                     s.q.as_slice(),
+                    s.t,
                     lambda,
                     &mut self.spatial_reactions,
                 )?;

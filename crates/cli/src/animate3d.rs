@@ -8,6 +8,8 @@
 //!   with the body's mass and principal moments, centred at the centre of mass, its edges along
 //!   the directors `d_1, d_2, d_3` (a zero half-extent, a flat plate or a thin rod, is drawn
 //!   with a small thickness: 0.6 % of the scene's half diagonal);
+//! * each spatial point mass as a small sphere (radius 2 % of the scene's half diagonal) at its
+//!   position (`class="point-mass"`, after the spatial bodies in the page's body list);
 //! * a dot at every centre of mass, every joint's marker points (a square for a point on
 //!   ground), lines from each centre of mass to its body's joint points (chains read as
 //!   chains), lines for distance joints and spring-dampers;
@@ -71,11 +73,17 @@ pub fn equivalent_box(mass: f64, moments: [f64; 3]) -> [f64; 3] {
 /// of a flat plate's box.
 const THIN: f64 = 0.006;
 
+/// A point mass's drawn radius, as a fraction of the scene's half diagonal.
+const POINT: f64 = 0.02;
+
 #[derive(Serialize)]
 struct Body3 {
     name: String,
-    /// Index of the centre of mass's `x` in a frame's coordinates (directors follow).
+    /// Index of the centre of mass's `x` in a frame's coordinates (directors follow, but for a
+    /// point mass).
     off: usize,
+    /// A spatial point mass (3 coordinates, drawn as a sphere of radius `drawn[0]`).
+    point: bool,
     /// The equivalent box's half-extents along `d_1, d_2, d_3`.
     half: [f64; 3],
     /// The drawn half-extents: `half`, none below `THIN` times the scene's half diagonal.
@@ -131,17 +139,20 @@ struct Page3<'a> {
     q: Vec<Vec<f64>>,
 }
 
-/// `p` (body frame) in spatial body `k`'s principal frame, `A^T p` (ground: unchanged), and
-/// the body's index (-1: ground).
-fn lower(sys: &System, k: Option<usize>, p: [f64; 3]) -> (i64, [f64; 3]) {
-    match k {
-        None => (-1, p),
-        Some(k) => {
-            let a = sys.spatial_bodies()[k].inertia.axes();
-            let v = std::array::from_fn(|i| (0..3).map(|j| a[(j, i)] * p[j]).sum());
-            (k as i64, v)
-        }
+/// `p` (body frame) in spatial body `k`'s principal frame, `A^T p` (ground, a point mass:
+/// unchanged), and the page's body index (-1: ground; point masses after the bodies).
+fn lower(sys: &System, r: SpatialBodyRef, p: [f64; 3]) -> (i64, [f64; 3]) {
+    match r {
+        SpatialBodyRef::Ground => (-1, p),
+        SpatialBodyRef::PointMass(h) => ((sys.spatial_bodies().len() + h.index()) as i64, p),
+        SpatialBodyRef::Body(h) => (h.index() as i64, to_principal(sys, h.index(), p)),
     }
+}
+
+/// `p` (body frame of spatial body `k`) in its principal frame, `A^T p`.
+fn to_principal(sys: &System, k: usize, p: [f64; 3]) -> [f64; 3] {
+    let a = sys.spatial_bodies()[k].inertia.axes();
+    std::array::from_fn(|i| (0..3).map(|j| a[(j, i)] * p[j]).sum())
 }
 
 fn link(
@@ -153,8 +164,8 @@ fn link(
     b: SpatialBodyRef,
     pb: [f64; 3],
 ) -> Link {
-    let (a, pa) = lower(sys, a.index(), pa);
-    let (b, pb) = lower(sys, b.index(), pb);
+    let (a, pa) = lower(sys, a, pa);
+    let (b, pb) = lower(sys, b, pb);
     Link {
         name: name.to_string(),
         kind,
@@ -189,22 +200,30 @@ fn links(sys: &System) -> (Vec<Link>, Vec<Link>) {
     (joints, springs)
 }
 
-/// Resolves `--trace` against the model (default: the last spatial body's centre of mass): the
-/// spatial body's index, the point in its principal frame and the legend's label. An unknown
-/// or planar body is an error naming it and listing the spatial bodies.
+/// Resolves `--trace` against the model (default: the last spatial body's centre of mass, or
+/// the last point mass): the page's body index (point masses after the spatial bodies), the
+/// point in its principal frame and the legend's label. An unknown or planar body is an error
+/// naming it and listing the spatial bodies.
 fn resolve_trace(sys: &System, spec: Option<&TraceSpec>) -> Result<Trace, CliError> {
     let bodies = sys.spatial_bodies();
+    let names: Vec<&str> = bodies
+        .iter()
+        .map(|b| b.name.as_str())
+        .chain(sys.spatial_point_masses().iter().map(|p| p.name.as_str()))
+        .collect();
     let Some(spec) = spec else {
-        let k = bodies.len().checked_sub(1).ok_or_else(|| {
-            CliError::Usage("--trace: the model has no spatial bodies".to_string())
-        })?;
+        let k = match bodies.len() {
+            0 => names.len().checked_sub(1).ok_or_else(|| {
+                CliError::Usage("--trace: the model has no spatial bodies".to_string())
+            })?,
+            nb => nb - 1,
+        };
         return Ok(Trace {
             body: k,
             point: [0.0; 3],
-            label: format!("{} (centre of mass)", bodies[k].name),
+            label: format!("{} (centre of mass)", names[k]),
         });
     };
-    let names: Vec<&str> = bodies.iter().map(|b| b.name.as_str()).collect();
     let Some(k) = names.iter().position(|n| *n == spec.body) else {
         let planar = sys.bodies().iter().any(|b| b.name == spec.body);
         return Err(CliError::Usage(format!(
@@ -218,7 +237,11 @@ fn resolve_trace(sys: &System, spec: Option<&TraceSpec>) -> Result<Trace, CliErr
             names.join(", ")
         )));
     };
-    let (_, point) = lower(sys, Some(k), spec.point.unwrap_or([0.0; 3]));
+    // a point mass's trace is its position
+    let point = match bodies.get(k) {
+        Some(_) => to_principal(sys, k, spec.point.unwrap_or([0.0; 3])),
+        None => [0.0; 3],
+    };
     let label = match spec.point {
         None => format!("{} (centre of mass)", spec.body),
         Some(p) => format!("{} point ({}, {}, {}) m", spec.body, p[0], p[1], p[2]),
@@ -235,13 +258,16 @@ pub fn check_trace(sys: &System, spec: Option<&TraceSpec>) -> Result<(), CliErro
     resolve_trace(sys, spec).map(|_| ())
 }
 
-/// World position of `p` (principal frame of spatial body `k`, or global when `k < 0`) in the
-/// frame `q` (all coordinates), with the spatial bodies' coordinates from `q0`.
-fn world(q: &[f64], q0: usize, k: i64, p: [f64; 3]) -> [f64; 3] {
-    if k < 0 {
+/// World position of `p` (principal frame of the page's body `k`, or global when `k < 0`; a
+/// point mass: its position) in the frame `q` (all coordinates).
+fn world(q: &[f64], bodies: &[Body3], k: i64, p: [f64; 3]) -> [f64; 3] {
+    let Some(b) = usize::try_from(k).ok().and_then(|k| bodies.get(k)) else {
         return p;
+    };
+    let o = b.off;
+    if b.point {
+        return [q[o], q[o + 1], q[o + 2]];
     }
-    let o = q0 + 12 * k as usize;
     std::array::from_fn(|c| q[o + c] + (0..3).map(|i| p[i] * q[o + 3 + 3 * i + c]).sum::<f64>())
 }
 
@@ -253,7 +279,6 @@ fn corners(h: [f64; 3]) -> impl Iterator<Item = [f64; 3]> {
 /// The box holding every box corner, joint and spring point, trace point and planar centre of
 /// mass of every frame (a unit box around the origin when there is none or it is not finite).
 fn scene(
-    q0: usize,
     frames: &[Vec<f64>],
     bodies: &[Body3],
     planar: &[Planar],
@@ -272,14 +297,14 @@ fn scene(
     for q in frames {
         for (k, b) in bodies.iter().enumerate() {
             for c in corners(b.half) {
-                grow(world(q, q0, k as i64, c));
+                grow(world(q, bodies, k as i64, c));
             }
         }
         for l in links {
-            grow(world(q, q0, l.a, l.pa));
-            grow(world(q, q0, l.b, l.pb));
+            grow(world(q, bodies, l.a, l.pa));
+            grow(world(q, bodies, l.b, l.pb));
         }
-        grow(world(q, q0, trace.body as i64, trace.point));
+        grow(world(q, bodies, trace.body as i64, trace.point));
         for p in planar {
             grow([q[p.off], q[p.off + 1], 0.0]);
         }
@@ -300,6 +325,41 @@ fn html_escape(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// The page's bodies: the spatial bodies (boxes), then the point masses (spheres), their drawn
+/// sizes still to be set against the scene.
+fn page_bodies(sys: &System) -> Vec<Body3> {
+    let q0 = sys.spatial_offset();
+    let mut bodies: Vec<Body3> = sys
+        .spatial_bodies()
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            let half = equivalent_box(b.inertia.mass(), b.inertia.moments());
+            Body3 {
+                name: b.name.clone(),
+                off: q0 + 12 * k,
+                point: false,
+                half,
+                drawn: half,
+            }
+        })
+        .collect();
+    let qp = sys.spatial_point_mass_offset();
+    bodies.extend(
+        sys.spatial_point_masses()
+            .iter()
+            .enumerate()
+            .map(|(k, p)| Body3 {
+                name: p.name.clone(),
+                off: qp + 3 * k,
+                point: true,
+                half: [0.0; 3],
+                drawn: [0.0; 3],
+            }),
+    );
+    bodies
+}
+
 /// Builds the 3D page for a trajectory of `sys` (`t` and, per frame, all coordinates in the
 /// order of [`System::coordinate_names`]) with the path of the `trace` point.
 pub fn page(
@@ -317,21 +377,7 @@ pub fn page(
             r.len()
         )));
     }
-    let q0 = sys.spatial_offset();
-    let mut bodies: Vec<Body3> = sys
-        .spatial_bodies()
-        .iter()
-        .enumerate()
-        .map(|(k, b)| {
-            let half = equivalent_box(b.inertia.mass(), b.inertia.moments());
-            Body3 {
-                name: b.name.clone(),
-                off: q0 + 12 * k,
-                half,
-                drawn: half,
-            }
-        })
-        .collect();
+    let mut bodies = page_bodies(sys);
     let planar = sys
         .bodies()
         .iter()
@@ -343,7 +389,7 @@ pub fn page(
         .collect::<Vec<_>>();
     let (joints, springs) = links(sys);
     let all: Vec<&Link> = joints.iter().chain(&springs).collect();
-    let scene = scene(q0, &q, &bodies, &planar, &all, &trace);
+    let scene = scene(&q, &bodies, &planar, &all, &trace);
     let radius = (0..3)
         .map(|k| (scene.hi[k] - scene.lo[k]).powi(2))
         .sum::<f64>()
@@ -351,7 +397,11 @@ pub fn page(
         * 0.5;
     let thin = THIN * if radius > 0.0 { radius } else { 1.0 };
     for b in &mut bodies {
-        b.drawn = b.half.map(|h| h.max(thin));
+        b.drawn = if b.point {
+            [POINT * if radius > 0.0 { radius } else { 1.0 }; 3]
+        } else {
+            b.half.map(|h| h.max(thin))
+        };
     }
     let data = Page3 {
         model: title,

@@ -90,11 +90,11 @@ fn joint_points_are_lowered_to_the_principal_frames() {
         assert!((got - want).abs() < 1e-15, "{:?}", hinge.pb);
     }
     let (q, _) = sys.initial_guess();
-    let w = world(q.as_slice(), sys.spatial_offset(), 1, hinge.pb);
+    let w = world(q.as_slice(), &page_bodies(&sys), 1, hinge.pb);
     for (got, want) in w.iter().zip([0.1, 0.0, -0.8]) {
         assert!((got - want).abs() < 1e-12, "{w:?}");
     }
-    let pivot = world(q.as_slice(), sys.spatial_offset(), 0, joints[0].pb);
+    let pivot = world(q.as_slice(), &page_bodies(&sys), 0, joints[0].pb);
     assert!(pivot.iter().all(|x| x.abs() < 1e-12), "{pivot:?}");
 }
 
@@ -163,7 +163,7 @@ fn the_page_holds_every_box_corner_and_draws_flat_bodies_thin() {
         }
         for f in &frames {
             for c in corners([half[0], half[1], half[2]]) {
-                let w = world(f, sys.spatial_offset(), k as i64, c);
+                let w = world(f, &page_bodies(&sys), k as i64, c);
                 assert!((0..3).all(|i| lo[i] <= w[i] && w[i] <= hi[i]), "{w:?}");
             }
         }
@@ -211,4 +211,51 @@ fn planar_bodies_of_a_mixed_model_are_centres_of_mass_at_z_0() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("'crank' is a planar body"), "{e}");
+}
+
+#[test]
+fn point_masses_are_spheres_after_the_bodies_and_joints_reach_them() {
+    let model = format!(
+        "{CHAIN}\n[[spatial_bodies]]\nname = \"bob\"\nkind = \"point_mass\"\nmass = 0.5\n\
+         position = [2.0, -1.0, -3.0]\n\n[[spatial_joints]]\ntype = \"distance\"\n\
+         name = \"tether\"\nbody_a = \"ground\"\nbody_b = \"bob\"\nlength = 3.741657386773941\n"
+    );
+    let sys = System::from_toml(&model).unwrap();
+    let (q, _) = sys.initial_guess();
+    let html = page("m", &sys, None, vec![0.0], vec![q.as_slice().to_vec()]).unwrap();
+    let start = html.find("type=\"application/json\">").unwrap() + 24;
+    let end = start + html[start..].find("</script>").unwrap();
+    let v: serde_json::Value = serde_json::from_str(&html[start..end]).unwrap();
+    let nb = sys.spatial_bodies().len();
+    let bob = &v["bodies"][nb];
+    assert_eq!(bob["name"], "bob");
+    assert_eq!(bob["point"], true);
+    assert_eq!(bob["off"], 12 * nb);
+    assert!(bob["drawn"][0].as_f64().unwrap() > 0.0);
+    assert_eq!(v["bodies"][0]["point"], false);
+    let tether = v["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|j| j["name"] == "tether")
+        .unwrap();
+    assert_eq!(tether["b"], nb);
+    // the scene reaches the point mass, and a trace on it is its position
+    assert_eq!(v["scene"]["lo"][2], -3.0);
+    let spec = TraceSpec {
+        body: "bob".into(),
+        point: None,
+    };
+    let html = page(
+        "m",
+        &sys,
+        Some(&spec),
+        vec![0.0],
+        vec![q.as_slice().to_vec()],
+    )
+    .unwrap();
+    assert!(
+        html.contains("\"trace\":{\"body\":2,\"point\":[0.0,0.0,0.0]"),
+        "trace"
+    );
 }

@@ -80,11 +80,20 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
                 }
             );
         }
+        let points = sys.spatial_point_masses();
+        if !points.is_empty() {
+            let _ = writeln!(s, "spatial point masses ({}):", points.len());
+            for p in points {
+                let _ = writeln!(s, "  {:<16} mass {}", p.name, num(p.mass));
+            }
+        }
         let _ = writeln!(s, "spatial joints ({}):", sys.spatial_joints().len());
-        let name = |r: mbd_model::spatial::SpatialBodyRef| {
-            r.index()
-                .and_then(|k| sys.spatial_bodies().get(k))
-                .map_or_else(|| "ground".to_string(), |b| b.name.clone())
+        let name = |r: mbd_model::spatial::SpatialBodyRef| match r {
+            mbd_model::spatial::SpatialBodyRef::Body(h) => {
+                sys.spatial_bodies()[h.index()].name.clone()
+            }
+            mbd_model::spatial::SpatialBodyRef::PointMass(h) => points[h.index()].name.clone(),
+            mbd_model::spatial::SpatialBodyRef::Ground => "ground".to_string(),
         };
         for j in sys.spatial_joints() {
             let n = j.joint.n_equations();

@@ -564,3 +564,39 @@ fn chain_page_follows_the_camera_set_in_the_url() {
         "the screenshots from two cameras are identical"
     );
 }
+
+/// The spherical pendulum's point mass is a sphere (`circle.point-mass`) centred on the
+/// projection of its position in the CSV, its rod a line from the ground point to it.
+#[test]
+fn spherical_pendulum_page_draws_the_point_mass_where_the_csv_puts_it() {
+    let Some(bin) = browser() else { return };
+    let d = scratch("anim3d-point-mass");
+    let (csv, html) = (d.join("pm.csv"), d.join("pm.html"));
+    let model = repo().join("examples/models/spherical_pendulum.toml");
+    run_and_animate(&model, &csv, &html, "1e-3", &[]);
+    let (head, rows) = read_csv(&csv);
+    let dom = dom_at_1000x700(&bin, &d.join("dom"), &url(&html, "t=0.5"));
+    let cam = Camera::of(by_id(&elements(&dom, "svg"), "stage"));
+    let t = by_id(&elements(&dom, "svg"), "stage").num("data-t");
+    let row = rows.iter().find(|r| r[0] == t).expect("a CSV row");
+    let col = |n: &str| row[head.iter().position(|h| h == n).unwrap()];
+    let at = cam.project([col("bob.x"), col("bob.y"), col("bob.z")]);
+    let circles = elements(&dom, "circle");
+    let s = circles
+        .iter()
+        .find(|c| c.has_class("point-mass") && c.get("data-body") == Some("bob"))
+        .expect("the point mass's sphere");
+    let got = (s.num("cx"), s.num("cy"));
+    eprintln!(
+        "point mass at t = {t}: {got:?}, CSV {at:?}, radius {}",
+        s.num("r")
+    );
+    assert!(dist(got, at) <= 1e-3, "{got:?} vs {at:?}");
+    assert!(s.num("r") >= 2.0);
+    let rod = elements(&dom, "line")
+        .into_iter()
+        .find(|l| l.has_class("rod") && l.get("data-joint") == Some("rod"))
+        .expect("the rod");
+    assert!(dist((rod.num("x2"), rod.num("y2")), at) <= 1e-3);
+    assert!(dist((rod.num("x1"), rod.num("y1")), cam.project([0.0; 3])) <= 1e-3);
+}

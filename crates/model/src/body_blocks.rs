@@ -12,7 +12,9 @@ impl System {
     /// `None`: ground) as `(block, local gradient)`. Block `b` is planar body `b` (3
     /// coordinates at `3 b`) for `b` below the planar body count, else spatial body
     /// `b - nb` (12 coordinates at [`System::spatial_offset`] `+ 12 (b - nb)`); see
-    /// [`System::body_block`]. What the sparse solves over bodies of any kind are built from.
+    /// [`System::body_block`]; then spatial point mass `p` is block `nb + ns + p` (3
+    /// coordinates, its position). What the sparse solves over bodies of any kind are built
+    /// from.
     pub fn local_rows_gamma(
         &self,
         q: &[f64],
@@ -30,12 +32,13 @@ impl System {
             );
         });
         let nb = self.bodies.len();
+        let width = |k: usize| self.spatial.slot_block(k).1;
         self.spatial.rows(q, v, t, |r, sides, jet| {
             visit(
                 r,
                 [
-                    sides[0].map(|k| (nb + k, &jet.g[0..12])),
-                    sides[1].map(|k| (nb + k, &jet.g[12..24])),
+                    sides[0].map(|k| (nb + k, &jet.g[0..width(k)])),
+                    sides[1].map(|k| (nb + k, &jet.g[12..12 + width(k)])),
                 ],
                 -jet.d2,
             );
@@ -65,30 +68,32 @@ impl System {
             );
         });
         let nb = self.bodies.len();
+        let width = |k: usize| self.spatial.slot_block(k).1;
         self.spatial.rows_tan(q, v, t, |r, sides, g, dg| {
             visit(
                 r,
                 [
-                    sides[0].map(|k| (nb + k, &g[0..12], &dg[0..12])),
-                    sides[1].map(|k| (nb + k, &g[12..24], &dg[12..24])),
+                    sides[0].map(|k| (nb + k, &g[0..width(k)], &dg[0..width(k)])),
+                    sides[1].map(|k| (nb + k, &g[12..12 + width(k)], &dg[12..12 + width(k)])),
                 ],
             );
         });
     }
 
-    /// The number of body blocks (planar and spatial bodies) of [`System::local_rows_gamma`].
+    /// The number of body blocks (planar bodies, spatial bodies and spatial point masses) of
+    /// [`System::local_rows_gamma`].
     pub fn n_body_blocks(&self) -> usize {
-        self.bodies.len() + self.spatial.bodies.len()
+        self.bodies.len() + self.spatial.n_slots()
     }
 
-    /// Body block `b`'s first coordinate and width (3 planar, 12 spatial), or `None` past the
-    /// last block.
+    /// Body block `b`'s first coordinate and width (3 planar, 12 spatial, 3 spatial point
+    /// mass), or `None` past the last block.
     pub fn body_block(&self, b: usize) -> Option<(usize, usize)> {
         let nb = self.bodies.len();
         if b < nb {
             Some((3 * b, 3))
         } else if b < self.n_body_blocks() {
-            Some((self.spatial.q0 + 12 * (b - nb), 12))
+            Some(self.spatial.slot_block(b - nb))
         } else {
             None
         }

@@ -342,10 +342,11 @@ impl System {
             joint_initials,
             spatial,
         } = b;
-        if bodies.is_empty() && spatial.bodies.is_empty() {
+        if bodies.is_empty() && spatial.bodies.is_empty() && spatial.points.is_empty() {
             return Err(ModelError::Empty);
         }
-        if !joint_initials.is_empty() && !spatial.bodies.is_empty() {
+        let has_spatial = !spatial.bodies.is_empty() || !spatial.points.is_empty();
+        if !joint_initials.is_empty() && has_spatial {
             return Err(invalid(
                 "assembly".to_string(),
                 "assembly from joint coordinates takes planar models only; place spatial \
@@ -484,7 +485,7 @@ impl System {
                 }
             }
             sensor.validate()?;
-            sensor.check_spatial(spatial.bodies.len(), spatial.joints.len())?;
+            sensor.check_spatial(&spatial.bodies, &spatial.points, spatial.joints.len())?;
         }
 
         let n = 3 * nb;
@@ -499,7 +500,7 @@ impl System {
             m += j.n_equations();
         }
         let spatial = spatial.build(n, m, &mut names, &mut jnames, &mut fnames)?;
-        let n = n + 12 * spatial.bodies.len();
+        let n = n + 12 * spatial.bodies.len() + 3 * spatial.points.len();
         let m = m + spatial.m;
         let mass = DVector::from_iterator(
             n,
@@ -510,7 +511,8 @@ impl System {
                     spatial
                         .bodies
                         .iter()
-                        .flat_map(|b| b.inertia.mass_diagonal()),
+                        .flat_map(|b| b.inertia.mass_diagonal())
+                        .chain(spatial.points.iter().flat_map(|p| [p.mass; 3])),
                 ),
         );
         let inv_mass = mass.map(|x| 1.0 / x);

@@ -95,6 +95,45 @@ pub enum ModelError {
         /// What is wrong, naming the field and the body.
         message: String,
     },
+    /// A spatial joint needs axes on a spatial point mass, which has none.
+    #[error(
+        "spatial joint '{joint}' ({kind}) needs axes on point mass '{point_mass}', which has \
+         none: a point mass takes spherical, distance and distance_driver joints on either \
+         side, and a slide_driver as its second body"
+    )]
+    PointMassJoint {
+        /// The joint.
+        joint: String,
+        /// The joint's kind (its model-file `type`).
+        kind: &'static str,
+        /// The point mass.
+        point_mass: String,
+    },
+    /// A joint marker, spring point or load point on a spatial point mass is off its
+    /// position.
+    #[error(
+        "{element}: its point {point:?} on point mass '{point_mass}' must be zero (a point \
+         mass has one point, its position)"
+    )]
+    PointMassOffset {
+        /// The joint, force or sensor, e.g. `spatial joint 'rod'`.
+        element: String,
+        /// The point mass.
+        point_mass: String,
+        /// The point given (from the point mass's position).
+        point: [f64; 3],
+    },
+    /// A load a spatial point mass cannot take: a torque or a load in body axes (it has no
+    /// rotation and no axes).
+    #[error("{element}: point mass '{point_mass}' takes no {what} (it has no rotation or axes)")]
+    PointMassLoad {
+        /// The force element or sensor.
+        element: String,
+        /// The point mass.
+        point_mass: String,
+        /// What it cannot take: `torque`, `body axes`, `angular velocity`.
+        what: &'static str,
+    },
     /// A model file could not be read or parsed.
     #[error("model file ({format}): {message}")]
     Parse {

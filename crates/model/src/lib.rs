@@ -3,7 +3,10 @@
 //! Planar rigid multibody systems in absolute Cartesian coordinates, ready for DAE solvers.
 //!
 //! Body `i` has coordinates `q_i = (x_i, y_i, theta_i)` (centre of mass and rotation); spatial
-//! bodies ([`spatial`]) follow the planar ones with 12 natural coordinates each. A
+//! bodies ([`spatial`]) follow the planar ones with 12 natural coordinates each
+//! ([`SystemBuilder::add_spatial_body`]), then spatial point masses with 3 each, their position
+//! ([`SystemBuilder::add_spatial_point_mass`], [`spatial::SpatialPointMass`]: mass matrix
+//! `m I3`, no internal constraint, joints and forces at their point only). A
 //! [`System`] is built from [`Body`]s, [`Joint`]s and [`Force`]s with a [`SystemBuilder`] or read
 //! from a JSON/TOML [`ModelFile`], and validated on the way. It then evaluates everything a solver
 //! of the index-3 equations
@@ -81,8 +84,9 @@ pub use element_hessians::ElementHessian;
 pub use error::{num as format_number, ModelError};
 pub use file::{
     read_text, BodyKind, BodySpec, EulerSpec, ForceSpec, InitialInput, JointSpec, ModelFile,
-    OrientationSpec, SpatialBodySpec, SpatialForceSpec, SpatialJointSpec, SpatialJointType,
-    SpatialPointForceSpec, SpatialSpringDamperSpec, SpatialTorqueSpec, MAX_MODEL_FILE_BYTES,
+    OrientationSpec, SpatialBodyKind, SpatialBodySpec, SpatialForceSpec, SpatialJointSpec,
+    SpatialJointType, SpatialPointForceSpec, SpatialSpringDamperSpec, SpatialTorqueSpec,
+    MAX_MODEL_FILE_BYTES,
 };
 pub use forces::{Force, ForceKind};
 pub use init::{RedundantConstraints, RedundantEquation, SPARSE_RANK_THRESHOLD};

@@ -55,8 +55,9 @@ pub enum SensorKind {
         body: Option<BodyRef>,
     },
     /// A point of a spatial body (body frame, from the centre of mass; ground: a global fixed
-    /// point): its position, velocity and acceleration in global axes, columns `NAME.x`, `.y`,
-    /// `.z`, `.vx`, `.vy`, `.vz`, `.ax`, `.ay`, `.az`.
+    /// point; a spatial point mass: its position, the point zero): its position, velocity and
+    /// acceleration in global axes, columns `NAME.x`, `.y`, `.z`, `.vx`, `.vy`, `.vz`, `.ax`,
+    /// `.ay`, `.az`.
     SpatialPoint {
         /// The body.
         body: SpatialBodyRef,
@@ -184,10 +185,30 @@ impl Sensor {
         Ok(())
     }
 
-    /// Checks the spatial body or joint a sensor reads against the model's `bodies` and
-    /// `joints` spatial counts; errors name the sensor.
-    pub(crate) fn check_spatial(&self, bodies: usize, joints: usize) -> Result<(), ModelError> {
+    /// Checks the spatial body, point mass or joint a sensor reads against the model's spatial
+    /// `bodies`, `points` and joint count; errors name the sensor (and a point mass whose
+    /// sensor point is off its position).
+    pub(crate) fn check_spatial(
+        &self,
+        bodies: &[crate::spatial::SpatialBody],
+        points: &[crate::spatial::SpatialPointMass],
+        joints: usize,
+    ) -> Result<(), ModelError> {
+        let bodies = bodies.len();
         let (what, k, n) = match self.kind {
+            SensorKind::SpatialPoint {
+                body: SpatialBodyRef::PointMass(h),
+                point,
+            } => match points.get(h.0) {
+                Some(p) if point != [0.0; 3] => {
+                    return Err(ModelError::PointMassOffset {
+                        element: format!("sensor '{}'", self.name),
+                        point_mass: p.name.clone(),
+                        point,
+                    })
+                }
+                _ => ("spatial point mass", h.0, points.len()),
+            },
             SensorKind::SpatialPoint { body, .. } => match body.index() {
                 Some(k) => ("spatial body", k, bodies),
                 None => return Ok(()),

@@ -160,6 +160,16 @@ impl System {
     pub fn spatial_bodies(&self) -> &[crate::spatial::SpatialBody] {
         &self.spatial.bodies
     }
+    /// The spatial point masses, in handle order; point mass `p`'s position is
+    /// `q[s + 3 p..s + 3 p + 3]` with `s` = [`System::spatial_point_mass_offset`].
+    pub fn spatial_point_masses(&self) -> &[crate::spatial::SpatialPointMass] {
+        &self.spatial.points
+    }
+    /// The first coordinate of the spatial point masses: after the planar bodies' and the
+    /// spatial bodies' coordinates.
+    pub fn spatial_point_mass_offset(&self) -> usize {
+        self.spatial.point_offset()
+    }
     /// The spatial force elements (points and load axes in the bodies' frames, as given).
     pub fn spatial_forces(&self) -> &[crate::spatial::SpatialForce] {
         &self.spatial.forces

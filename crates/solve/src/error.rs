@@ -247,15 +247,19 @@ pub fn refuse_redundant(sys: &mbd_model::System, solver: &str) -> Result<(), Sol
 }
 
 /// The refusal of a solver that does not run spatial bodies yet: `Ok` for a planar model,
-/// else [`SolveError::Unsupported`] naming `solver` and the first spatial body.
+/// else [`SolveError::Unsupported`] naming `solver` and the first spatial body (or point mass).
 pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), SolveError> {
-    match sys.spatial_bodies().first() {
+    let first = sys
+        .spatial_bodies()
+        .first()
+        .map(|b| b.name.as_str())
+        .or_else(|| sys.spatial_point_masses().first().map(|p| p.name.as_str()));
+    match first {
         None => Ok(()),
-        Some(b) => Err(SolveError::Unsupported(format!(
-            "{solver} does not run spatial bodies yet (body '{}'); the index-1 solvers (rk4, \
+        Some(name) => Err(SolveError::Unsupported(format!(
+            "{solver} does not run spatial bodies yet (body '{name}'); the index-1 solvers (rk4, \
              rk4-projected, index1:dopri5), the plain symplectic, the tangent and the \
-             firefly-gauss solvers do",
-            b.name
+             firefly-gauss solvers do"
         ))),
     }
 }

@@ -206,7 +206,7 @@ fn values(
         joint_reactions(grads, sys, state, lambda, loads)?;
     }
     if let Some(loads) = spatial_reactions {
-        sys.spatial_joint_reactions_into(q, lambda, loads)?;
+        sys.spatial_joint_reactions_into(q, state.t, lambda, loads)?;
     }
     // a body point's position, velocity and acceleration (ground: fixed)
     let kinematics = |i: Option<usize>, p: [f64; 2]| -> [[f64; 2]; 3] {
@@ -270,7 +270,7 @@ fn values(
                 out.extend([t, u, t + u]);
             }
             SensorKind::SpatialPoint { body, point } => {
-                spatial_point(sys, body.index(), *point, [q, v, a], out);
+                spatial_point(sys, *body, *point, [q, v, a], out);
             }
             SensorKind::AngularVelocity { body } => {
                 let k = body.index();
@@ -324,14 +324,23 @@ fn directors(sys: &System, k: usize, q: &[f64]) -> [[f64; 3]; 3] {
 }
 
 /// A spatial body point's position, velocity and acceleration (linear in the natural
-/// coordinates: `P = x + sum_i p_i d_i` with `p` in the principal frame), or a fixed point.
+/// coordinates: `P = x + sum_i p_i d_i` with `p` in the principal frame), a point mass's
+/// (its coordinates), or a fixed point.
 fn spatial_point(
     sys: &System,
-    body: Option<usize>,
+    body: mbd_model::spatial::SpatialBodyRef,
     point: [f64; 3],
     [q, v, a]: [&[f64]; 3],
     out: &mut Vec<f64>,
 ) {
+    if let Some(p) = body.point_mass() {
+        let o = sys.spatial_point_mass_offset() + 3 * p;
+        for y in [q, v, a] {
+            out.extend_from_slice(&y[o..o + 3]);
+        }
+        return;
+    }
+    let body = body.index();
     let Some((k, b)) = body.and_then(|k| sys.spatial_bodies().get(k).map(|b| (k, b))) else {
         out.extend(point);
         out.extend([0.0; 6]);

@@ -107,6 +107,11 @@ class Model:
         return list(self._describe()["spatial_bodies"])
 
     @property
+    def spatial_point_masses(self) -> List[str]:
+        """The spatial point masses' names (``kind = "point_mass"`` in ``spatial_bodies``)."""
+        return list(self._describe()["spatial_point_masses"])
+
+    @property
     def spatial_joints(self) -> List[str]:
         """The spatial joints' names."""
         return list(self._describe()["spatial_joints"])

@@ -25,7 +25,8 @@ mod spatial_forces;
 mod spec;
 
 pub use spatial::{
-    EulerSpec, OrientationSpec, SpatialBodySpec, SpatialJointSpec, SpatialJointType,
+    EulerSpec, OrientationSpec, SpatialBodyKind, SpatialBodySpec, SpatialJointSpec,
+    SpatialJointType,
 };
 pub use spatial_forces::{
     SpatialForceSpec, SpatialPointForceSpec, SpatialSpringDamperSpec, SpatialTorqueSpec,

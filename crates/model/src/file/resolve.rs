@@ -171,13 +171,20 @@ impl ModelFile {
                 )
             })
         };
-        // spatial bodies and joints by name: their handles are their places in the file
-        // (`add_spatial` adds them in order)
-        let spatial_body = |name: &str| {
+        // spatial bodies, point masses and joints by name: their handles are their places in
+        // the file among their kind (`add_spatial` adds them in order)
+        let place = |kind, name: &str| {
             self.spatial_bodies
                 .iter()
+                .filter(|b| b.kind == kind)
                 .position(|b| b.name == name)
-                .map(crate::spatial::SpatialBodyHandle)
+        };
+        let spatial_body = |name: &str| {
+            place(super::SpatialBodyKind::Rigid, name).map(crate::spatial::SpatialBodyHandle)
+        };
+        let spatial_point = |name: &str| {
+            place(super::SpatialBodyKind::PointMass, name)
+                .map(crate::spatial::SpatialPointMassHandle)
         };
         let spatial_joint = |name: &str| self.spatial_joints.iter().position(|j| j.name == name);
         let unknown_spatial = |sensor: &str, body: &str| {
@@ -211,12 +218,21 @@ impl ModelFile {
                 SensorSpec::SpatialPoint { name, body, point } => {
                     let r = if body.eq_ignore_ascii_case("ground") {
                         crate::spatial::SpatialBodyRef::Ground
+                    } else if let Some(p) = spatial_point(body) {
+                        p.into()
                     } else {
                         spatial_body(body)
                             .ok_or_else(|| unknown_spatial(name, body))?
                             .into()
                     };
                     Sensor::spatial_point(name, r, *point)
+                }
+                SensorSpec::AngularVelocity { name, body } if spatial_point(body).is_some() => {
+                    return Err(ModelError::PointMassLoad {
+                        element: format!("sensor '{name}'"),
+                        point_mass: body.clone(),
+                        what: "angular velocity",
+                    })
                 }
                 SensorSpec::AngularVelocity { name, body } => Sensor::angular_velocity(
                     name,
@@ -249,9 +265,10 @@ impl System {
         };
         let joints = self.joints.iter().map(|j| j.to_spec(&name)).collect();
         let forces = self.forces.iter().map(|f| f.to_spec(&name)).collect();
-        let spatial_name = |r: crate::spatial::SpatialBodyRef| match r.index() {
-            Some(k) => self.spatial.bodies[k].name.clone(),
-            None => "ground".to_string(),
+        let spatial_name = |r: crate::spatial::SpatialBodyRef| match r {
+            crate::spatial::SpatialBodyRef::Body(h) => self.spatial.bodies[h.0].name.clone(),
+            crate::spatial::SpatialBodyRef::PointMass(h) => self.spatial.points[h.0].name.clone(),
+            crate::spatial::SpatialBodyRef::Ground => "ground".to_string(),
         };
         let sensors = self
             .sensors
@@ -313,6 +330,12 @@ impl System {
                 .bodies
                 .iter()
                 .map(super::spatial::SpatialBodySpec::from_body)
+                .chain(
+                    self.spatial
+                        .points
+                        .iter()
+                        .map(super::spatial::SpatialBodySpec::from_point_mass),
+                )
                 .collect(),
             spatial_joints: self
                 .spatial

@@ -6,18 +6,39 @@ use crate::check::invalid;
 use crate::error::ModelError;
 use crate::spatial::{
     Axes, EulerSequence, Marker, Orientation, SpatialBody, SpatialBodyRef, SpatialInertia,
-    SpatialJoint, SpatialJointEntry, SpatialJointKind,
+    SpatialJoint, SpatialJointEntry, SpatialJointKind, SpatialPointMass,
 };
 use nalgebra::{Matrix3, Vector3};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-/// A spatial rigid body in a model file.
+/// How a spatial body moves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum SpatialBodyKind {
+    /// A rigid body: 12 natural coordinates (centre of mass and principal axes).
+    #[default]
+    Rigid,
+    /// A particle: 3 coordinates (its position), `mass`, `position` and `velocity` only; joints
+    /// and forces attach at its position, and joints that need axes on it are rejected.
+    PointMass,
+}
+
+impl SpatialBodyKind {
+    fn is_rigid(&self) -> bool {
+        *self == SpatialBodyKind::Rigid
+    }
+}
+
+/// A spatial rigid body or point mass in a model file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SpatialBodySpec {
     /// Unique name (among all bodies).
     pub name: String,
+    /// `rigid` (default) or `point_mass`.
+    #[serde(default, skip_serializing_if = "SpatialBodyKind::is_rigid")]
+    pub kind: SpatialBodyKind,
     /// Mass, kg (> 0).
     pub mass: f64,
     /// Principal moments of inertia about the centre of mass, kg m^2, along `axes` (give these
@@ -157,6 +178,53 @@ pub struct SpatialJointSpec {
 }
 
 impl SpatialBodySpec {
+    /// A point mass's body: only `mass`, `position` and `velocity`; any field of a rigid body
+    /// is an error naming the body and the field.
+    fn to_point_mass(&self) -> Result<SpatialPointMass, ModelError> {
+        let given = [
+            ("moments", self.moments.is_some()),
+            ("axes", self.axes.is_some()),
+            ("tensor", self.tensor.is_some()),
+            ("tensor_about", self.tensor_about.is_some()),
+            ("orientation", self.orientation.is_some()),
+            ("angular_velocity", self.angular_velocity != [0.0; 3]),
+            (
+                "angular_velocity_body",
+                self.angular_velocity_body.is_some(),
+            ),
+        ];
+        if let Some((field, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(invalid(
+                format!("spatial body '{}'", self.name),
+                format!(
+                    "`{field}` is not allowed for a point mass (kind = \"point_mass\": mass, \
+                     position and velocity only)"
+                ),
+            ));
+        }
+        Ok(SpatialPointMass::new(self.name.clone(), self.mass)
+            .position(self.position)
+            .velocity(self.velocity))
+    }
+
+    /// The file form of a model's point mass.
+    pub(crate) fn from_point_mass(p: &SpatialPointMass) -> Self {
+        SpatialBodySpec {
+            name: p.name.clone(),
+            kind: SpatialBodyKind::PointMass,
+            mass: p.mass,
+            moments: None,
+            axes: None,
+            tensor: None,
+            tensor_about: None,
+            position: p.position,
+            orientation: None,
+            velocity: p.velocity,
+            angular_velocity: [0.0; 3],
+            angular_velocity_body: None,
+        }
+    }
+
     fn to_body(&self) -> Result<SpatialBody, ModelError> {
         let element = format!("spatial body '{}'", self.name);
         let bad = |e: String| invalid(element.clone(), e);
@@ -221,6 +289,7 @@ impl SpatialBodySpec {
             .map_or(None, |m| Some(OrientationSpec::Matrix(rows(&m))));
         SpatialBodySpec {
             name: b.name.clone(),
+            kind: SpatialBodyKind::Rigid,
             mass: b.inertia.mass(),
             moments: Some(b.inertia.moments()),
             axes: (axes != Matrix3::identity()).then(|| vectors(&axes)),
@@ -363,7 +432,10 @@ pub(crate) fn add_spatial(
     b.set_spatial_gravity(gravity);
     let mut handles = std::collections::HashMap::new();
     for s in bodies {
-        let h = b.add_spatial_body(s.to_body()?);
+        let h: SpatialBodyRef = match s.kind {
+            SpatialBodyKind::Rigid => b.add_spatial_body(s.to_body()?).into(),
+            SpatialBodyKind::PointMass => b.add_spatial_point(s.to_point_mass()?).into(),
+        };
         handles.entry(s.name.as_str()).or_insert(h);
     }
     let find = |element: &str, name: &str| -> Result<SpatialBodyRef, ModelError> {
@@ -371,7 +443,7 @@ pub(crate) fn add_spatial(
             return Ok(SpatialBodyRef::Ground);
         }
         match handles.get(name) {
-            Some(&h) => Ok(SpatialBodyRef::Body(h)),
+            Some(&h) => Ok(h),
             None if planar(name) => Err(invalid(
                 element.to_string(),
                 format!("'{name}' is a planar body: spatial elements join spatial bodies"),

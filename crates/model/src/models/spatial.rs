@@ -145,7 +145,9 @@ pub fn spatial_double_pendulum() -> Result<System, ModelError> {
         let upper = Marker::at([0.0, 0.0, 0.5 * l]);
         let (jname, a) = match prev {
             SpatialBodyRef::Ground => ("shoulder", Marker::at([0.0; 3])),
-            SpatialBodyRef::Body(_) => ("elbow", Marker::at([0.0, 0.0, -0.5 * l])),
+            SpatialBodyRef::Body(_) | SpatialBodyRef::PointMass(_) => {
+                ("elbow", Marker::at([0.0, 0.0, -0.5 * l]))
+            }
         };
         b.add_spatial_joint(
             jname,

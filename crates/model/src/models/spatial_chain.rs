@@ -56,7 +56,7 @@ pub fn spatial_chain(n: usize) -> Result<System, ModelError> {
             SpatialBodyRef::Ground => {
                 SpatialJoint::new(SpatialJointKind::Spherical, Marker::at([0.0; 3]), top)
             }
-            SpatialBodyRef::Body(_) => SpatialJoint::new(
+            SpatialBodyRef::Body(_) | SpatialBodyRef::PointMass(_) => SpatialJoint::new(
                 SpatialJointKind::Spherical,
                 Marker::at([0.0, 0.0, -0.5 * l]),
                 top,

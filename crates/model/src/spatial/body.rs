@@ -17,13 +17,22 @@ impl SpatialBodyHandle {
     }
 }
 
-/// What a spatial joint attaches to: the fixed ground frame or a spatial body.
+/// What a spatial joint, force or sensor attaches to: the fixed ground frame, a spatial rigid
+/// body or a spatial point mass.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SpatialBodyRef {
     /// The inertial frame: marker points and axes on ground are global.
     Ground,
-    /// A spatial body.
+    /// A spatial rigid body.
     Body(SpatialBodyHandle),
+    /// A spatial point mass (a point, no axes: see [`super::SpatialPointMass`]).
+    PointMass(super::SpatialPointMassHandle),
+}
+
+impl From<super::SpatialPointMassHandle> for SpatialBodyRef {
+    fn from(h: super::SpatialPointMassHandle) -> Self {
+        SpatialBodyRef::PointMass(h)
+    }
 }
 
 impl From<SpatialBodyHandle> for SpatialBodyRef {
@@ -33,11 +42,33 @@ impl From<SpatialBodyHandle> for SpatialBodyRef {
 }
 
 impl SpatialBodyRef {
-    /// The body's index among the spatial bodies, or `None` for ground.
+    /// The rigid body's index among the spatial bodies, or `None` for ground and for a point
+    /// mass ([`SpatialBodyRef::point_mass`]).
     pub fn index(self) -> Option<usize> {
+        match self {
+            SpatialBodyRef::Body(h) => Some(h.0),
+            SpatialBodyRef::Ground | SpatialBodyRef::PointMass(_) => None,
+        }
+    }
+    /// The point mass's index among the spatial point masses, or `None` for ground and for a
+    /// rigid body.
+    pub fn point_mass(self) -> Option<usize> {
+        match self {
+            SpatialBodyRef::PointMass(h) => Some(h.0),
+            SpatialBodyRef::Ground | SpatialBodyRef::Body(_) => None,
+        }
+    }
+    /// Whether this is the ground.
+    pub fn is_ground(self) -> bool {
+        self == SpatialBodyRef::Ground
+    }
+    /// The element slot of a model with `nb` spatial rigid bodies: rigid body `k` is slot `k`,
+    /// point mass `p` slot `nb + p`, ground `None` (what the model's element attachments hold).
+    pub(crate) fn slot(self, nb: usize) -> Option<usize> {
         match self {
             SpatialBodyRef::Ground => None,
             SpatialBodyRef::Body(h) => Some(h.0),
+            SpatialBodyRef::PointMass(h) => Some(nb + h.0),
         }
     }
 }

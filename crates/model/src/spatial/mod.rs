@@ -25,6 +25,15 @@
 //! and plates, the heavy symmetric top `J = diag(a, 2a, a)`); it is definite on the tangent
 //! space of the internal constraints all the same (`d_i'` with `E_i = 0` is fixed by the other
 //! two directors' velocities through `d_i . d_j = 0`), which is what the solvers need.
+//!
+//! A third body kind, the spatial point mass ([`SpatialPointMass`], added by
+//! [`crate::SystemBuilder::add_spatial_point_mass`], referred to by
+//! [`SpatialBodyRef::PointMass`]), has 3 coordinates (its position, after every spatial body's
+//! 12), the mass matrix `m I3` and no internal constraint. It has a point but no axes: the joints
+//! whose equations use only a point on its side ([`SpatialJoint::needs_axes`]: spherical,
+//! distance, distance driver, and the slide driver's second side) take it, with its marker at
+//! its position; spring-dampers and forces act at its position; torques do not. Elements see
+//! its directors as the constant global axes, so the joints' equations stay written once.
 
 mod body;
 pub(crate) mod build;
@@ -32,6 +41,7 @@ mod forces;
 mod inertia;
 mod joints;
 mod orientation;
+mod point_mass;
 mod reactions;
 mod rigid;
 pub(crate) mod system;
@@ -41,6 +51,7 @@ pub use forces::{Axes, SpatialForce, SpatialForceKind, SpatialLoad, SpatialSprin
 pub use inertia::{SpatialInertia, SpatialInertiaError};
 pub use joints::{Marker, SpatialFrame, SpatialJoint, SpatialJointError, SpatialJointKind};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};
+pub use point_mass::{SpatialPointMass, SpatialPointMassHandle};
 pub use reactions::SpatialJointReaction;
 pub use rigid::{internal_gamma, RigidSolve};
 pub use system::SpatialJointEntry;

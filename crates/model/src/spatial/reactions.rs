@@ -1,5 +1,6 @@
 //! The loads spatial joints exert on their bodies, from the index-1 multipliers.
 
+use super::point_mass::as_side;
 use super::system::SW;
 use mbd_jet::Scalar;
 
@@ -18,7 +19,8 @@ pub struct SpatialJointReaction {
 
 impl crate::System {
     /// The load each spatial joint (in the order of [`crate::System::spatial_joints`]) exerts
-    /// on its second body at `q`, from the multipliers `lambda` of the index-1 equations
+    /// on its second body at `q` and time `t` (an angle driver's rows turn with its angle),
+    /// from the multipliers `lambda` of the index-1 equations
     /// (`M a = Q - Phi_q^T lambda`; for example `mbd_solve::OutputSolve`). The joint's share of
     /// the constraint force on body `b`'s natural coordinates is `g = -Phi_q,j^T lambda_j`
     /// (12 entries): its centre-of-mass entries are the force `F`, and its director entries
@@ -30,10 +32,11 @@ impl crate::System {
     pub fn spatial_joint_reactions(
         &self,
         q: &[f64],
+        t: f64,
         lambda: &[f64],
     ) -> Result<Vec<SpatialJointReaction>, crate::ModelError> {
         let mut out = vec![SpatialJointReaction::default(); self.spatial.joints.len()];
-        self.spatial_joint_reactions_into(q, lambda, &mut out)?;
+        self.spatial_joint_reactions_into(q, t, lambda, &mut out)?;
         Ok(out)
     }
 
@@ -43,6 +46,7 @@ impl crate::System {
     pub fn spatial_joint_reactions_into(
         &self,
         q: &[f64],
+        t: f64,
         lambda: &[f64],
         out: &mut [SpatialJointReaction],
     ) -> Result<(), crate::ModelError> {
@@ -56,22 +60,19 @@ impl crate::System {
                 got: out.len(),
             });
         }
-        const ZERO: [f64; 12] = [0.0; 12];
+        // a side's centre and directors (a point mass: its position, the constant global axes,
+        // on which the joint's rows have no gradient, so its moment is zero)
         let frame = |k: usize| {
-            let o = sp.q0 + 12 * k;
-            let v = |i: usize| nalgebra::Vector3::new(q[o + i], q[o + i + 1], q[o + i + 2]);
+            let (ql, _) = sp.local_state(k, q, None);
+            let v = |i: usize| nalgebra::Vector3::new(ql[i], ql[i + 1], ql[i + 2]);
             (v(0), [v(3), v(6), v(9)])
         };
         for (j, slot) in out.iter_mut().enumerate() {
             // the joint's share of the constraint force: g = -Phi_q,j^T lambda_j
-            let local = |s: usize| {
-                sp.attach[j][s].map(|k| {
-                    let o = sp.q0 + 12 * k;
-                    (&q[o..o + 12], &ZERO[..])
-                })
-            };
+            let [la, lb] = sp.attach[j].map(|k| k.map(|k| sp.local_state(k, q, None)));
             let mut e = [mbd_jet::DirJetN::<SW>::cst(0.0); 6];
-            sp.lowered[j].eval_jets(local(0), local(1), &mut e);
+            sp.lowered[j].eval_jets(as_side(&la), as_side(&lb), &mut e);
+            sp.combine_angle(j, t, &mut e);
             let mut g = [0.0; SW];
             let row0 = sp.joint_row[j];
             for (k, ek) in e.iter().enumerate().take(sp.lowered[j].n_equations()) {

@@ -2,20 +2,28 @@
 //! their rows of the constraint functions, written over the jets of 24 variables.
 //!
 //! Coordinates: after the planar bodies' `3 nb`, spatial body `k` holds
-//! `q[q0 + 12 k .. q0 + 12 k + 12] = (x, d_1, d_2, d_3)`. Rows: after the planar joints' rows,
-//! body `k`'s six internal constraints, then each spatial joint's equations. Every row is an
-//! element of one or two bodies (local variables `0..12` the first side's coordinates,
-//! `12..24` the second's; ground has none), evaluated with `f64`, `DirJetN<24>` (gradient,
-//! `Phi_q v`, `v^T H v`), `TanJetN<24>` (`H v`) or `HessJetN<24>` (the Hessian).
+//! `q[q0 + 12 k .. q0 + 12 k + 12] = (x, d_1, d_2, d_3)`, then point mass `p` holds
+//! `q[q0 + 12 ns + 3 p ..][..3] = x`. Rows: after the planar joints' rows, body `k`'s six
+//! internal constraints, then each spatial joint's equations. Every row is an element of one
+//! or two sides (local variables `0..12` the first side's coordinates, `12..24` the second's;
+//! ground has none, a point mass only its first three, its directors being the constant global
+//! axes), evaluated with `f64`, `DirJetN<24>` (gradient, `Phi_q v`, `v^T H v`), `TanJetN<24>`
+//! (`H v`) or `HessJetN<24>` (the Hessian). A side is a slot: rigid body `k` is slot `k`, point
+//! mass `p` slot `ns + p`.
 
 use super::body::{SpatialBody, SpatialBodyRef};
 use super::forces::SpatialForce;
 use super::joints::{SpatialFrame, SpatialJoint};
+use super::point_mass::{as_side, SpatialPointMass};
 use mbd_jet::{DirJetN, HessJetN, Scalar, TanJetN};
 use nalgebra::DMatrix;
 
 /// The local width of a spatial element: two bodies' natural coordinates.
 pub(crate) const SW: usize = 24;
+
+/// A side's 12 local coordinates at the origin with the global axes as directors (what a point
+/// mass's constant directors take).
+pub(crate) const IDENTITY: [f64; 12] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
 
 /// A spatial joint of a model: its name, the bodies its markers sit on, and the joint (markers
 /// in each body's frame, as given).
@@ -47,10 +55,12 @@ enum Item {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SpatialPart {
     pub(crate) bodies: Vec<SpatialBody>,
+    /// The point masses (coordinates after the bodies').
+    pub(crate) points: Vec<SpatialPointMass>,
     pub(crate) joints: Vec<SpatialJointEntry>,
     /// The joints with their markers in the principal frames (what the equations use).
     pub(crate) lowered: Vec<SpatialJoint>,
-    /// Each joint's bodies (spatial indices; `None`: ground).
+    /// Each joint's sides (slots; `None`: ground).
     pub(crate) attach: Vec<[Option<usize>; 2]>,
     /// Each joint's first row.
     pub(crate) joint_row: Vec<usize>,
@@ -64,20 +74,22 @@ pub(crate) struct SpatialPart {
     /// The force elements as given, and with their points and axes in the principal frames.
     pub(crate) forces: Vec<SpatialForce>,
     pub(crate) lowered_forces: Vec<SpatialForce>,
-    /// Each force element's bodies (spatial indices; `None`: ground).
+    /// Each force element's sides (slots; `None`: ground).
     pub(crate) force_attach: Vec<[Option<usize>; 2]>,
-    /// The initial natural coordinates and velocities, body after body.
+    /// The initial natural coordinates and velocities, body after body, then the point
+    /// masses' positions and velocities.
     pub(crate) q_init: Vec<f64>,
     pub(crate) v_init: Vec<f64>,
 }
 
 impl SpatialPart {
-    /// The part for `bodies` (valid: natural states `q_init`, `v_init`) and `joints` (their
-    /// markers lowered to the principal frames in `lowered`, attachments resolved), after
-    /// `q0` planar coordinates and `r0` planar rows.
+    /// The part for `bodies` and `points` (valid: natural states `q_init`, `v_init`) and
+    /// `joints` (their markers lowered to the principal frames in `lowered`, attachments
+    /// resolved), after `q0` planar coordinates and `r0` planar rows.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
         bodies: Vec<SpatialBody>,
+        points: Vec<SpatialPointMass>,
         joints: Vec<SpatialJointEntry>,
         lowered: Vec<SpatialJoint>,
         gravity: [f64; 3],
@@ -86,7 +98,11 @@ impl SpatialPart {
         q_init: Vec<f64>,
         v_init: Vec<f64>,
     ) -> Self {
-        let attach = joints.iter().map(|j| [j.a.index(), j.b.index()]).collect();
+        let ns = bodies.len();
+        let attach = joints
+            .iter()
+            .map(|j| [j.a.slot(ns), j.b.slot(ns)])
+            .collect();
         let mut joint_row = Vec::with_capacity(joints.len());
         let mut m = 6 * bodies.len();
         for j in &lowered {
@@ -95,6 +111,7 @@ impl SpatialPart {
         }
         SpatialPart {
             bodies,
+            points,
             joints,
             lowered,
             attach,
@@ -111,9 +128,9 @@ impl SpatialPart {
         }
     }
 
-    /// Whether the model has no spatial body.
+    /// Whether the model has no spatial body and no spatial point mass.
     pub(crate) fn is_empty(&self) -> bool {
-        self.bodies.is_empty()
+        self.bodies.is_empty() && self.points.is_empty()
     }
 
     /// Every element: its sides, first row and row count.
@@ -131,9 +148,11 @@ impl SpatialPart {
         internal.chain(joints)
     }
 
-    /// The global column of local variable `l` (side `l / 12`) of an element with `sides`.
+    /// The global column of local variable `l` (side `l / 12`) of an element with `sides`
+    /// (`None` on ground and on a point mass's directors, which are constants).
     pub(crate) fn col(&self, sides: [Option<usize>; 2], l: usize) -> Option<usize> {
-        sides[l / 12].map(|k| self.q0 + 12 * k + l % 12)
+        let (o, w) = self.slot_block(sides[l / 12]?);
+        (l % 12 < w).then_some(o + l % 12)
     }
 
     /// An element's equations at the frames of its sides at time `t`, a driver's without the
@@ -157,6 +176,14 @@ impl SpatialPart {
             }
         }
         out
+    }
+
+    /// An angle driver's equation at `t` in `e[0]` (and its derivative in `theta` in `e[1]`)
+    /// from the components [`SpatialJoint::eval`] writes; nothing for every other joint.
+    pub(crate) fn combine_angle<T: Scalar>(&self, j: usize, t: f64, e: &mut [T; 6]) {
+        if let Some([theta, ..]) = self.angle(j, t) {
+            (e[0], e[1]) = angle_combine(theta, e[0], e[1]);
+        }
     }
 
     /// An angle driver's `theta`, `theta'`, `theta''` at `t` (`None` for every other joint).
@@ -188,9 +215,13 @@ impl SpatialPart {
         var: impl Fn(usize, usize) -> T,
     ) -> [SpatialFrame<T>; 2] {
         std::array::from_fn(|s| match sides[s] {
+            // a point mass's directors are the constant global axes
             Some(_) => SpatialFrame::new(&std::array::from_fn(|k| {
                 let l = 12 * s + k;
-                var(l, self.col(sides, l).unwrap_or(0))
+                match self.col(sides, l) {
+                    Some(c) => var(l, c),
+                    None => T::cst(IDENTITY[k]),
+                }
             })),
             None => SpatialFrame::ground(),
         })
@@ -266,15 +297,9 @@ impl SpatialPart {
             let Item::Joint(j) = item else {
                 continue;
             };
-            const ZERO: [f64; 12] = [0.0; 12];
-            let local = |s: usize| {
-                sides[s].map(|k| {
-                    let o = self.q0 + 12 * k;
-                    (&q[o..o + 12], v.map_or(&ZERO[..], |v| &v[o..o + 12]))
-                })
-            };
+            let [la, lb] = sides.map(|k| k.map(|k| self.local_state(k, q, v)));
             let mut e = [DirJetN::<SW>::cst(0.0); 6];
-            self.lowered[j].eval_jets(local(0), local(1), &mut e);
+            self.lowered[j].eval_jets(as_side(&la), as_side(&lb), &mut e);
             if let Some([theta, dth, ddth]) = self.angle(j, t) {
                 // Phi = E(q, theta(t)): d/dt = E_q v + E_theta theta', and the second
                 // derivative v^T E_qq v + 2 theta' E_theta,q v + theta'^2 E_theta,theta +
@@ -433,25 +458,28 @@ impl SpatialPart {
         }
     }
 
-    /// The potential of gravity on the spatial bodies, `-sum_k m_k g . x_k`.
+    /// The potential of gravity on the spatial bodies and point masses, `-sum_k m_k g . x_k`.
     pub(crate) fn potential(&self, q: &[f64]) -> f64 {
         let g = self.gravity;
-        self.bodies
-            .iter()
-            .enumerate()
-            .map(|(k, b)| {
-                let x = &q[self.q0 + 12 * k..self.q0 + 12 * k + 3];
-                -b.inertia.mass() * (g[0] * x[0] + g[1] * x[1] + g[2] * x[2])
+        (0..self.n_slots())
+            .map(|k| {
+                let o = self.slot_block(k).0;
+                let x = &q[o..o + 3];
+                -self.slot_mass(k) * (g[0] * x[0] + g[1] * x[1] + g[2] * x[2])
             })
             .sum()
     }
 
-    /// Gravity's generalised forces `(m g, 0, 0, 0)` per spatial body, appended to `out`.
+    /// Gravity's generalised forces `(m g, 0, 0, 0)` per spatial body, then `m g` per point
+    /// mass, appended to `out`.
     pub(crate) fn gravity_forces(&self, out: &mut Vec<f64>) {
         for b in &self.bodies {
             let m = b.inertia.mass();
             out.extend(self.gravity.map(|g| m * g));
             out.extend([0.0; 9]);
+        }
+        for p in &self.points {
+            out.extend(self.gravity.map(|g| p.mass * g));
         }
     }
 
@@ -466,6 +494,11 @@ impl SpatialPart {
                 for c in ["x", "y", "z"] {
                     out.push(format!("{}.d{i}{c}", b.name));
                 }
+            }
+        }
+        for p in &self.points {
+            for c in ["x", "y", "z"] {
+                out.push(format!("{}.{c}", p.name));
             }
         }
     }
@@ -524,9 +557,9 @@ impl SpatialPart {
 }
 
 impl crate::System {
-    /// The angular momentum of the spatial bodies about the origin, global axes:
-    /// `sum_k (m_k x_k x x_k' + sum_i E_ik d_ik x d_ik')` (the spin part is the body's
-    /// `R J omega` on rigid motions).
+    /// The angular momentum of the spatial bodies and point masses about the origin, global
+    /// axes: `sum_k (m_k x_k x x_k' + sum_i E_ik d_ik x d_ik')` (the spin part is the body's
+    /// `R J omega` on rigid motions; a point mass has only `m x x x'`).
     pub fn spatial_angular_momentum(&self, q: &[f64], v: &[f64]) -> [f64; 3] {
         let o = self.spatial.q0;
         let mut l = [0.0; 3];
@@ -539,6 +572,15 @@ impl crate::System {
             for (i, e) in b.inertia.second_moments().iter().enumerate() {
                 lk += at(q, 3 + 3 * i).cross(&at(v, 3 + 3 * i)) * *e;
             }
+            for c in 0..3 {
+                l[c] += lk[c];
+            }
+        }
+        for (k, p) in self.spatial.points.iter().enumerate() {
+            let o = self.spatial.point_offset() + 3 * k;
+            let x = nalgebra::Vector3::new(q[o], q[o + 1], q[o + 2]);
+            let u = nalgebra::Vector3::new(v[o], v[o + 1], v[o + 2]);
+            let lk = x.cross(&u) * p.mass;
             for c in 0..3 {
                 l[c] += lk[c];
             }

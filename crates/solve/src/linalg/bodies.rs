@@ -3,8 +3,9 @@
 //! projections for any mass matrix that is definite on the constraints' tangent space (thin
 //! discs and plates included), from the whole dense `Phi_q`.
 //!
-//! With `C` the block-diagonal constrained inverse mass (a planar body's block its diagonal
-//! `M^-1`, or the projection's weights; a spatial body's block `RigidSolve`'s) and `Phi_e` the
+//! With `C` the block-diagonal constrained inverse mass (a planar body's or a spatial point
+//! mass's block its diagonal `M^-1`, `I/m` for a point mass, or the projection's weights; a
+//! spatial body's block `RigidSolve`'s) and `Phi_e` the
 //! rows other than the internal constraints, the solution of
 //! `M a + Phi^T lambda = f`, `Phi a = r` is
 //!
@@ -30,9 +31,11 @@ pub(crate) struct BodySchur {
     pub(crate) phi_q: DMatrix<f64>,
     /// The external rows (all but the spatial internal constraints).
     rows: Vec<usize>,
-    /// The internal constraints' rows `r0..r0 + 6 ns` and the spatial coordinates `q0..`.
+    /// The internal constraints' rows `r0..r0 + 6 ns`, the spatial bodies' coordinates
+    /// `q0..qp` and the point masses' `qp..n`.
     r0: usize,
     q0: usize,
+    qp: usize,
     /// Each spatial body's elimination at the last factorisation.
     rigid: Vec<RigidSolve>,
     /// `C Phi_e^T` (column `e`: `C` applied to external row `e`).
@@ -61,6 +64,7 @@ impl BodySchur {
             rows,
             r0: internal.start,
             q0: sys.spatial_offset(),
+            qp: sys.spatial_point_mass_offset(),
             rigid: Vec::with_capacity(sys.spatial_bodies().len()),
             chol,
             x: vec![0.0; n],
@@ -68,10 +72,10 @@ impl BodySchur {
         }
     }
 
-    /// `out = C f` (`w` the planar coordinates' weights, e.g. `M^-1`).
+    /// `out = C f` (`w` the planar and point-mass coordinates' weights, e.g. `M^-1`).
     fn apply_c(&self, w: &[f64], f: &[f64], out: &mut [f64]) {
         let q0 = self.q0;
-        for k in 0..q0 {
+        for k in (0..q0).chain(self.qp..self.n) {
             out[k] = w[k] * f[k];
         }
         for (b, rigid) in self.rigid.iter().enumerate() {

@@ -1,10 +1,11 @@
 //! The body-eliminated constrained solve of [`crate::linalg::BodySchur`] on the sparse path:
-//! bodies of any kind (planar, 3 coordinates; spatial, 12 with six internal constraints) as
-//! blocks, constraint rows in element-local form (each acts on at most two blocks), and
+//! bodies of any kind (planar, 3 coordinates; spatial, 12 with six internal constraints;
+//! spatial point masses, 3) as blocks, constraint rows in element-local form (each acts on at most two blocks), and
 //! `S = Phi_e C Phi_e^T` over the external rows (all but the spatial internal constraints)
 //! assembled on its sparse pattern and factored by the sparse Cholesky kernel.
 //!
-//! `C` is block diagonal: a planar block is its diagonal weight (`M^-1`), a spatial block the
+//! `C` is block diagonal: a planar or point-mass block is its diagonal weight (`M^-1`, `I/m`
+//! for a point mass), a spatial block the
 //! body's constrained inverse mass (`mbd_model::spatial::RigidSolve`), applied to each row's
 //! gradient on the block once per factorisation (`C_b g`, kept for the products with `S` and
 //! the solve). `S` couples two rows only when they share a block, so for
@@ -44,6 +45,10 @@ pub(crate) struct SparseBodySchur {
     planar: usize,
     q0: usize,
     r0: usize,
+    /// The first block and the first coordinate of the spatial point masses (diagonal weights,
+    /// like the planar blocks).
+    point_block: usize,
+    qp: usize,
     /// The spatial coordinates at the last [`SparseBodySchur::update`].
     qs: Vec<f64>,
     /// Each spatial body's elimination at the last factorisation.
@@ -90,7 +95,9 @@ impl SparseBodySchur {
             cg: vec![0.0; rows.n_values()],
             rows,
             contributions,
-            planar: nblocks - ns,
+            planar: nblocks - ns - sys.spatial_point_masses().len(),
+            point_block: nblocks - sys.spatial_point_masses().len(),
+            qp: sys.spatial_point_mass_offset(),
             q0: sys.spatial_offset(),
             r0: internal.start,
             qs: vec![0.0; 12 * ns],
@@ -111,13 +118,13 @@ impl SparseBodySchur {
         t: f64,
         gamma: &mut [f64],
     ) {
-        self.qs.copy_from_slice(&q[self.q0..]);
+        self.qs.copy_from_slice(&q[self.q0..self.qp]);
         self.rows.gather(sys, q, v, t, &mut self.grads, gamma);
     }
 
-    /// `out = C_b f` on block `b` (`w` the planar weights).
+    /// `out = C_b f` on block `b` (`w` the planar and point-mass weights).
     fn apply_block(&self, b: usize, col: usize, w: &[f64], f: &[f64], out: &mut [f64]) {
-        if b < self.planar {
+        if b < self.planar || b >= self.point_block {
             for l in 0..3 {
                 out[l] = w[col + l] * f[l];
             }
@@ -195,7 +202,7 @@ impl SparseBodySchur {
     ) {
         debug_assert!(a.len() == self.n && lambda.len() == self.m);
         let mut x = std::mem::take(&mut self.x);
-        for k in 0..self.q0 {
+        for k in (0..self.q0).chain(self.qp..self.n) {
             x[k] = w[k] * f[k];
         }
         for (b, rigid) in self.rigid.iter().enumerate() {

@@ -392,6 +392,17 @@ impl SpatialJoint {
         self.eval_at(&ma, &mb, out);
     }
 
+    /// Whether the equations use the axes of the marker on side `side` (0: `a`, 1: `b`):
+    /// never for the ball, distance and distance-driver joints, only on `a` for the slide
+    /// driver (`(P_b - P_a) . Z_a`), on both sides for every other kind. A spatial point mass
+    /// (a point without axes) takes a joint on the sides where this is `false`.
+    pub fn needs_axes(&self, side: usize) -> bool {
+        match self.kind {
+            SpatialJointKind::SlideDriver => side == 0,
+            _ => self.uses_axes(),
+        }
+    }
+
     /// Whether the equations use the markers' axes (all but the ball and distance joints).
     fn uses_axes(&self) -> bool {
         !matches!(
