@@ -7,15 +7,15 @@
 //! internal constraints, then each spatial joint's equations. Every row is an element of one
 //! or two sides (local variables `0..12` the first side's coordinates, `12..24` the second's;
 //! ground has none, a point mass only its first three, its directors being the constant global
-//! axes), evaluated with `f64`, `DirJetN<24>` (gradient, `Phi_q v`, `v^T H v`), `TanJetN<24>`
-//! (`H v`) or `HessJetN<24>` (the Hessian). A side is a slot: rigid body `k` is slot `k`, point
-//! mass `p` slot `ns + p`.
+//! axes), evaluated with `f64`, `DirJetN<24>` (gradient, `Phi_q v`, `v^T H v`; `H v` as the
+//! difference of two gradients, every equation being quadratic) or `HessJetN<24>` (the
+//! Hessian). A side is a slot: rigid body `k` is slot `k`, point mass `p` slot `ns + p`.
 
 use super::body::{SpatialBody, SpatialBodyRef};
 use super::forces::SpatialForce;
 use super::joints::{SpatialFrame, SpatialJoint};
 use super::point_mass::{as_side, SpatialPointMass};
-use mbd_jet::{DirJetN, HessJetN, Scalar, TanJetN};
+use mbd_jet::{DirJetN, HessJetN, Scalar};
 use nalgebra::DMatrix;
 
 /// The local width of a spatial element: two bodies' natural coordinates.
@@ -384,17 +384,31 @@ impl SpatialPart {
                 }
                 continue;
             }
-            let mut e = self.eval_jets(item, sides, t, |l, c| TanJetN::<SW>::var(l, q[c], v[c]));
-            if let (Item::Joint(j), true) = (item, n == 1) {
-                if let Some([_, dth, _]) = self.angle(j, t) {
-                    let et = e[1];
-                    for (d, g) in e[0].dg.iter_mut().zip(&et.g) {
+            let Item::Joint(j) = item else {
+                continue;
+            };
+            // every joint equation is quadratic in q (at a fixed t), so its gradient is affine
+            // and H v = g(q + v) - g(q) exactly: two passes of the closed-form marker jets
+            let [la, lb] = sides.map(|k| k.map(|k| self.local_state(k, q, Some(v))));
+            let shift = |l: &Option<([f64; 12], [f64; 12])>| {
+                l.map(|(ql, vl)| (std::array::from_fn(|i| ql[i] + vl[i]), [0.0; 12]))
+            };
+            let (sa, sb) = (shift(&la), shift(&lb));
+            let (mut e, mut es) = ([DirJetN::<SW>::cst(0.0); 6], [DirJetN::<SW>::cst(0.0); 6]);
+            self.lowered[j].eval_jets(as_side(&la), as_side(&lb), &mut e);
+            self.lowered[j].eval_jets(as_side(&sa), as_side(&sb), &mut es);
+            self.combine_angle(j, t, &mut e);
+            self.combine_angle(j, t, &mut es);
+            // an angle driver's Phi_tq = theta' E_theta,q (e[1] after the combination)
+            let dth = self.angle(j, t).map_or(0.0, |[_, d, _]| d);
+            for (k, (ek, sk)) in e.iter().zip(&es).enumerate().take(n) {
+                let mut dg: [f64; SW] = std::array::from_fn(|l| sk.g[l] - ek.g[l]);
+                if dth != 0.0 && n == 1 {
+                    for (d, g) in dg.iter_mut().zip(&e[1].g) {
                         *d += dth * g;
                     }
                 }
-            }
-            for (k, ek) in e.iter().enumerate().take(n) {
-                visit(row + k, sides, &ek.g, &ek.dg);
+                visit(row + k, sides, &ek.g, &dg);
             }
         }
     }
