@@ -342,14 +342,10 @@ fn matrix_api_transpose_solve_and_determinant() {
     assert!(lu.factor_lu().is_err());
 }
 
-/// A saddle-point matrix `[[M, G^T], [G, 0]]` whose constraint rows 1 and 2 of `G` are equal
-/// (a redundant equation): singular as it is; with one droppable multiplier pivot the LU drops
-/// the second of the two, gives it a zero unknown, and solves a consistent system exactly.
-#[test]
-fn a_dependent_multiplier_pivot_is_dropped_on_request() {
-    // unknowns: x0, x1, x2 (M = diag(2, 1, 4)), then multipliers l0, l1, l2
+/// The 6 x 6 saddle-point matrix `[[diag(m), G^T], [G, 0]]` (row-major) whose constraint rows 1
+/// and 2 of `G` are equal (a redundant equation).
+fn redundant_saddle(m: [f64; 3]) -> Vec<f64> {
     let g = [[1.0, 0.0, 1.0], [0.0, 1.0, -1.0], [0.0, 1.0, -1.0]];
-    let m = [2.0, 1.0, 4.0];
     let n = 6;
     let mut a = vec![0.0; n * n];
     for i in 0..3 {
@@ -359,6 +355,16 @@ fn a_dependent_multiplier_pivot_is_dropped_on_request() {
             a[(3 + r) * n + i] = g[r][i];
         }
     }
+    a
+}
+
+/// A saddle-point matrix `[[M, G^T], [G, 0]]` whose constraint rows 1 and 2 of `G` are equal
+/// (a redundant equation): singular as it is; with one droppable multiplier pivot the LU drops
+/// the second of the two, gives it a zero unknown, and solves a consistent system exactly.
+#[test]
+fn a_dependent_multiplier_pivot_is_dropped_on_request() {
+    // unknowns: x0, x1, x2 (M = diag(2, 1, 4)), then multipliers l0, l1, l2
+    let (n, a) = (6, redundant_saddle([2.0, 1.0, 4.0]));
     let mut lu = DenseLu::new(n);
     fill(&mut lu, &a);
     assert!(lu.factor_lu().is_err());
@@ -384,17 +390,7 @@ fn a_dependent_multiplier_pivot_is_dropped_on_request() {
 /// system is solved exactly, by both the direct and the transposed solve.
 #[test]
 fn the_pivoting_fallback_drops_a_dependent_multiplier_too() {
-    let g = [[1.0, 0.0, 1.0], [0.0, 1.0, -1.0], [0.0, 1.0, -1.0]];
-    let m = [1e-6, 1.0, 4.0];
-    let n = 6;
-    let mut a = vec![0.0; n * n];
-    for i in 0..3 {
-        a[i * n + i] = m[i];
-        for r in 0..3 {
-            a[i * n + 3 + r] = g[r][i];
-            a[(3 + r) * n + i] = g[r][i];
-        }
-    }
+    let (n, a) = (6, redundant_saddle([1e-6, 1.0, 4.0]));
     let mut lu = DenseLu::new(n);
     lu.set_droppable(3, 1);
     fill(&mut lu, &a);
