@@ -226,6 +226,7 @@ fn the_angle_drivers_derivatives_match_differences() {
 fn a_motor_turns_a_rod_through_its_angle_with_every_solver() {
     let sys = motor_rod();
     assert!(sys.is_rheonomic() && sys.dof() == 0);
+    assert!(sys.jacobian_depends_on_time());
     let t = 1.2;
     let [theta, _, ddtheta] = motion().eval(t);
     let torque = MASS * G * 0.5 * LENGTH * theta.cos() - MASS * LENGTH * LENGTH / 3.0 * ddtheta;

@@ -314,6 +314,12 @@ impl System {
     pub fn is_rheonomic(&self) -> bool {
         self.joints.iter().any(|j| j.is_rheonomic()) || self.spatial.is_rheonomic()
     }
+
+    /// Whether `Phi_q` depends on time (`Phi_qt != 0`): only with a spatial angle driver
+    /// (docs/spatial.md, "Drivers"); every other driver subtracts a function of time.
+    pub fn jacobian_depends_on_time(&self) -> bool {
+        self.spatial.has_angle_driver()
+    }
     /// Whether all applied forces derive from the potential [`System::potential`] (no damping, no
     /// time-dependent loads).
     pub fn is_conservative(&self) -> bool {

@@ -170,9 +170,7 @@ impl SpatialPart {
             Item::Internal => out = super::internal_eval(fa),
             Item::Joint(j) => {
                 self.lowered[j].eval(fa, fb, &mut out);
-                if let Some([theta, ..]) = self.angle(j, t) {
-                    (out[0], out[1]) = angle_combine(theta, out[0], out[1]);
-                }
+                self.combine_angle(j, t, &mut out);
             }
         }
         out
@@ -268,6 +266,12 @@ impl SpatialPart {
                 None => -self.drive(j, t)[1],
             };
         }
+    }
+
+    /// Whether an angle driver makes `Phi_q` depend on time.
+    pub(crate) fn has_angle_driver(&self) -> bool {
+        (0..self.lowered.len())
+            .any(|j| self.lowered[j].kind() == super::joints::SpatialJointKind::AngleDriver)
     }
 
     /// Whether a spatial joint is a driver.

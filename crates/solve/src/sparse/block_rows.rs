@@ -235,8 +235,8 @@ impl BlockRows {
     }
 
     /// The kept rows' local gradients at `(q, v, t)` into `vals` (length
-    /// [`BlockRows::n_values`]), and `gamma` for every row (length m; `v = None`: zero
-    /// velocities).
+    /// [`BlockRows::n_values`]), and, if asked for, `gamma` for every row (length m; `v = None`:
+    /// zero velocities).
     pub fn gather(
         &self,
         sys: &System,
@@ -244,10 +244,12 @@ impl BlockRows {
         v: Option<&[f64]>,
         t: f64,
         vals: &mut [f64],
-        gamma: &mut [f64],
+        mut gamma: Option<&mut [f64]>,
     ) {
         sys.local_rows_gamma(q, v, t, |r, s, gm| {
-            gamma[r] = gm;
+            if let Some(g) = gamma.as_deref_mut() {
+                g[r] = gm;
+            }
             let Some(e) = self.index(r) else {
                 return;
             };

@@ -119,7 +119,7 @@ impl SparseBodySchur {
         gamma: &mut [f64],
     ) {
         self.qs.copy_from_slice(&q[self.q0..self.qp]);
-        self.rows.gather(sys, q, v, t, &mut self.grads, gamma);
+        self.rows.gather(sys, q, v, t, &mut self.grads, Some(gamma));
     }
 
     /// `out = C_b f` on block `b` (`w` the planar and point-mass weights).

@@ -87,8 +87,6 @@ pub(super) struct SparseStage {
     pub(super) al: Vec<f64>,
     /// `Phi_q v` (scratch of the projection).
     pub(super) pv: Vec<f64>,
-    /// Scratch `gamma` of the rows' gather.
-    pub(super) gamma: Vec<f64>,
 }
 
 /// `out += Phi_q^T y` from the element-local rows `vals` (the layout of `rows`).
@@ -369,14 +367,13 @@ impl SparseStage {
             gm: vec![0.0; n],
             al: vec![0.0; n],
             pv: vec![0.0; m],
-            gamma: vec![0.0; m],
             rows,
         })
     }
 
     /// The local gradients of every row at `(q, t)` into `vals` (the layout of `rows`).
-    pub(super) fn gather(&mut self, sys: &System, q: &[f64], t: f64, vals: &mut [f64]) {
-        self.rows.gather(sys, q, None, t, vals, &mut self.gamma);
+    pub(super) fn gather(&self, sys: &System, q: &[f64], t: f64, vals: &mut [f64]) {
+        self.rows.gather(sys, q, None, t, vals, None);
     }
 }
 
@@ -517,7 +514,7 @@ impl Galerkin {
             }
         }
         // constraint curvature at the interior control points
-        let rheonomic = sys.is_rheonomic();
+        let rheonomic = sys.jacobian_depends_on_time();
         let nc = sp.cstart.last().copied().unwrap_or(0);
         for nu in 1..s {
             let q = &self.qn[nu * n..(nu + 1) * n];

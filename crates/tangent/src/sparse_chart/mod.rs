@@ -86,8 +86,6 @@ pub struct SparseChart {
     pos_chol: SparseCholesky,
     pos_contributions: Vec<PosContribution>,
     grads_x: Vec<f64>,
-    /// `gamma` of the rank report's pass (unused; length m).
-    gamma_x: Vec<f64>,
     /// The centre `(q_c, v_c)` and its time.
     xc: Vec<f64>,
     tc: f64,
@@ -171,7 +169,6 @@ impl SparseChart {
             pos_chol,
             pos_contributions,
             grads_x: vec![0.0; nv],
-            gamma_x: vec![0.0; m],
             xc: vec![0.0; 2 * n],
             tc: 0.0,
             f: vec![0.0; 2 * m],

@@ -30,8 +30,7 @@ impl SparseChart {
         if self.m == 0 || self.independent() > self.n || q.len() != self.n {
             return None;
         }
-        self.rows
-            .gather(sys, q, None, t, &mut self.grads_x, &mut self.gamma_x);
+        self.rows.gather(sys, q, None, t, &mut self.grads_x, None);
         self.pos_report(sys, t, rel_tol)
     }
 
