@@ -86,6 +86,13 @@ impl System {
         self.bodies.len() + self.spatial.n_slots()
     }
 
+    /// The body block of a spatial rigid body or point mass (`None` for ground): planar bodies
+    /// come first, then the spatial rigid bodies, then the point masses.
+    pub fn spatial_block(&self, r: crate::spatial::SpatialBodyRef) -> Option<usize> {
+        r.slot(self.spatial.bodies.len())
+            .map(|k| self.bodies.len() + k)
+    }
+
     /// Body block `b`'s first coordinate and width (3 planar, 12 spatial, 3 spatial point
     /// mass), or `None` past the last block.
     pub fn body_block(&self, b: usize) -> Option<(usize, usize)> {

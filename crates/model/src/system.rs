@@ -320,6 +320,17 @@ impl System {
     pub fn jacobian_depends_on_time(&self) -> bool {
         self.spatial.has_angle_driver()
     }
+
+    /// For every constraint row, whether its Hessian `Hess Phi_r` is constant (the same at every
+    /// `q` and `t`): the rows of spatial joints and internal constraints, which are quadratic
+    /// in the coordinates (docs/spatial.md), except an angle driver's, which turns with
+    /// `theta(t)`. Planar rows are not (rotations of angles). A solver may compute such a
+    /// row's Hessian once.
+    pub fn constant_hessian_rows(&self) -> Vec<bool> {
+        let mut out = vec![false; self.n_constraints()];
+        self.spatial.mark_constant_hessian_rows(&mut out);
+        out
+    }
     /// Whether all applied forces derive from the potential [`System::potential`] (no damping, no
     /// time-dependent loads).
     pub fn is_conservative(&self) -> bool {

@@ -60,7 +60,7 @@ mod tables;
 pub use calibrate::{calibrate_gamma, Calibration, CalibrationSettings};
 pub use error::SymplecticError;
 pub use galerkin::Galerkin;
-pub use options::{kappa, phase_constant, Nodes, PreadjustMode, SymplecticOptions};
+pub use options::{kappa, phase_constant, JacobianReuse, Nodes, PreadjustMode, SymplecticOptions};
 pub use preadjust::Preadjustment;
 pub use registry::SOLVERS;
 pub use tables::lobatto_nodes;

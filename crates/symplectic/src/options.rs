@@ -64,11 +64,13 @@ pub struct SymplecticOptions {
     /// modified-Lagrangian gradient are exact (`passes::potential_third`,
     /// `constraint_third`). Still validated (finite, in `(0, 1)`).
     pub fd_step: f64,
-    /// Start a step with the factored Jacobian of the previous step (same `h`) instead of a new
-    /// one; it is recomputed as soon as the simplified Newton iteration contracts by less than
-    /// 4x per iteration. Default off (one Jacobian per step, at the predictor). The converged solution does not depend on it (to the
+    /// Whether a step starts with the factored Jacobian of the previous step (same `h`) instead
+    /// of a new one; a kept factorisation is recomputed as soon as the simplified Newton
+    /// iteration contracts by less than 4x per iteration. Default [`JacobianReuse::Auto`]: kept
+    /// on the sparse stage path of the plain scheme, where one factorisation costs as much as
+    /// many residuals, new at every step otherwise. The converged solution does not depend on it (to the
     /// Newton tolerance).
-    pub reuse_jacobian: bool,
+    pub reuse_jacobian: JacobianReuse,
     /// Order `p` of the multistep predictor: once `p + 1` consecutive steps of the same `h` have
     /// been taken, the unknowns of the next step (control-point displacements and multipliers)
     /// are extrapolated by the degree-`p` polynomial through the last `p + 1` solutions
@@ -103,7 +105,7 @@ impl Default for SymplecticOptions {
                 jacobian_every: 6,
             },
             fd_step: 2e-3,
-            reuse_jacobian: false,
+            reuse_jacobian: JacobianReuse::Auto,
             predictor_order: 3,
             linear_solver: LinearSolver::Auto,
         }
@@ -131,6 +133,11 @@ impl SymplecticOptions {
     /// Sets the control-point placement.
     pub fn with_nodes(mut self, nodes: Nodes) -> Self {
         self.nodes = nodes;
+        self
+    }
+    /// Sets when the factored stage Jacobian is kept from one step to the next.
+    pub fn with_jacobian_reuse(mut self, reuse: JacobianReuse) -> Self {
+        self.reuse_jacobian = reuse;
         self
     }
     /// Sets the Newton settings.
@@ -233,5 +240,34 @@ mod tests {
         assert!((kappa(3) + 1.0 / 302400.0).abs() < 1e-20);
         assert!((kappa(4) + 1.0 / 101606400.0).abs() < 1e-22);
         assert!(kappa(0).is_nan());
+    }
+}
+
+/// When the symplectic scheme keeps the factored stage Jacobian from one step to the next
+/// ([`SymplecticOptions::reuse_jacobian`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum JacobianReuse {
+    /// Kept on the sparse stage path of the plain scheme (large models, where one sparse
+    /// factorisation costs as much as many residuals and triangular solves); a new one at every
+    /// step on the dense path and with a preadjustment (whose residuals cost more than the
+    /// factorisation they would save). Measured in docs/symplectic.md, "Large mechanisms".
+    #[default]
+    Auto,
+    /// Always kept while Newton contracts.
+    Always,
+    /// A new Jacobian at the predictor of every step.
+    Never,
+}
+
+impl JacobianReuse {
+    /// Whether a step on the given stage path (`sparse`) of a plain or preadjusted scheme
+    /// starts from the kept factorisation.
+    pub(crate) fn keeps(self, sparse: bool, preadjusted: bool) -> bool {
+        match self {
+            JacobianReuse::Auto => sparse && !preadjusted,
+            JacobianReuse::Always => true,
+            JacobianReuse::Never => false,
+        }
     }
 }

@@ -2,7 +2,7 @@
 //! preadjustment on, on the dense and on the sparse path.
 use mbd_model::models;
 use mbd_solve::{Integrator, LinearSolver, State};
-use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions};
+use mbd_symplectic::{Galerkin, JacobianReuse, PreadjustMode, SymplecticOptions};
 
 #[global_allocator]
 static GLOBAL: mbd_testkit::CountingAlloc = mbd_testkit::CountingAlloc;
@@ -59,7 +59,11 @@ fn sparse_steps_allocate_nothing() {
     ] {
         let mut opts = SymplecticOptions {
             linear_solver: LinearSolver::Sparse,
-            reuse_jacobian: reuse,
+            reuse_jacobian: if reuse {
+                JacobianReuse::Always
+            } else {
+                JacobianReuse::Never
+            },
             ..SymplecticOptions::new(s)
         };
         if modified {

@@ -2,7 +2,8 @@
 //! 2N steps is the cost of N steps without the set-up), and prints the time per step.
 //!
 //! `cargo run --release -p mbd-tools --bin bench_solver_steps -- SOLVER [N] [MODEL]` with SOLVER
-//! one of `rk4` (plain RK4), `rk4-projected`, `tangent-rk4`, `symplectic2` (`symplectic:2`), `dopri5` (index-1
+//! one of `rk4` (plain RK4), `rk4-projected`, `tangent-rk4`, `symplectic2` (`symplectic:2`; `symplecticS`, `modifiedS` for the (s,s) scheme, plain or with
+//! the modified Lagrangian, and a `-never` suffix for a new stage Jacobian at every step), `dopri5` (index-1
 //! DOPRI5, fixed steps), `fadae` (firefly-Gauss, default options), and MODEL one of
 //! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
 //! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
@@ -40,10 +41,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "rk4" => (Box::new(Rk4::new(&sys, Rk4Options::plain())?), 1e-3),
         "rk4-projected" => (Box::new(Rk4::new(&sys, Rk4Options::projected())?), 1e-3),
         "tangent-rk4" => (Box::new(TangentRk::rk4(&sys)?), 1e-3),
-        "symplectic2" => (
-            Box::new(Galerkin::new(&sys, SymplecticOptions::new(2))?),
-            1e-2,
-        ),
+        other if other.starts_with("symplectic") || other.starts_with("modified") => {
+            // symplecticS / modifiedS, `-never`: a new stage Jacobian at every step
+            let (name, never) = match other.strip_suffix("-never") {
+                Some(n) => (n, true),
+                None => (other, false),
+            };
+            let (s, modified) = match (
+                name.strip_prefix("symplectic").and_then(|k| k.parse().ok()),
+                name.strip_prefix("modified").and_then(|k| k.parse().ok()),
+            ) {
+                (Some(s), _) => (s, false),
+                (None, Some(s)) => (s, true),
+                _ => return Err(format!("unknown solver '{other}'").into()),
+            };
+            let mut o = SymplecticOptions::new(s);
+            if modified {
+                o = o.with_preadjust(mbd::symplectic::PreadjustMode::ModifiedLagrangian);
+            }
+            if never {
+                o = o.with_jacobian_reuse(mbd::symplectic::JacobianReuse::Never);
+            }
+            (Box::new(Galerkin::new(&sys, o)?), 1e-2)
+        }
         "dopri5" => (
             Box::new(Index1Rk::new(
                 &sys,

@@ -274,6 +274,23 @@ impl SpatialPart {
             .any(|j| self.lowered[j].kind() == super::joints::SpatialJointKind::AngleDriver)
     }
 
+    /// Marks in `out` (indexed by global row) the spatial rows whose Hessian is constant: every
+    /// spatial equation is quadratic in `q`, and only an angle driver's Hessian moves with
+    /// `theta(t)`.
+    pub(crate) fn mark_constant_hessian_rows(&self, out: &mut [bool]) {
+        for (item, _, row, n) in self.items() {
+            let constant = match item {
+                Item::Internal => true,
+                Item::Joint(j) => {
+                    self.lowered[j].kind() != super::joints::SpatialJointKind::AngleDriver
+                }
+            };
+            for x in &mut out[row..row + n] {
+                *x = constant;
+            }
+        }
+    }
+
     /// Whether a spatial joint is a driver.
     pub(crate) fn is_rheonomic(&self) -> bool {
         self.joints.iter().any(|j| j.motion.is_some())

@@ -48,6 +48,14 @@ pub(super) struct SparseStage {
     /// curvature; `nc = cstart[m]`.
     curv_slot: Vec<usize>,
     cstart: Vec<usize>,
+    /// Rows whose Hessian is constant ([`System::constant_hessian_rows`]), their local
+    /// Hessians in the layout of `curv_slot` (`hess[cstart[r] + a len_r + c]`) once
+    /// `hess_ready`, and whether some row's Hessian varies (then the seed passes run at every
+    /// Jacobian, for those rows).
+    hess_const: Vec<bool>,
+    hess: Vec<f64>,
+    hess_ready: bool,
+    hess_varies: bool,
     /// Colour of each block: blocks sharing a row have different colours.
     color: Vec<usize>,
     /// Blocks of each colour, and the widest block.
@@ -180,7 +188,7 @@ impl SparseStage {
             }
         }
         // force graph over blocks: closed neighbourhoods of the blocks with a force element
-        let planar = nblocks - sys.spatial_bodies().len();
+        let planar = sys.bodies().len();
         let mut fnbr: Vec<Vec<usize>> = vec![Vec::new(); nblocks];
         let mut link = |a: Option<usize>, b: Option<usize>| {
             for x in [a, b].into_iter().flatten() {
@@ -199,10 +207,7 @@ impl SparseStage {
             link(idx(a), idx(b));
         }
         for f in sys.spatial_forces() {
-            link(
-                f.a.index().map(|k| planar + k),
-                f.b.index().map(|k| planar + k),
-            );
+            link(sys.spatial_block(f.a), sys.spatial_block(f.b));
         }
         for v in &mut fnbr {
             v.sort_unstable();
@@ -334,7 +339,13 @@ impl SparseStage {
         } else {
             Some(ConstraintSchur::new(sys)?)
         };
+        let hess_const = sys.constant_hessian_rows();
+        let hess_varies = hess_const.iter().any(|c| !c);
         Ok(SparseStage {
+            hess: vec![0.0; nc],
+            hess_const,
+            hess_ready: false,
+            hess_varies,
             diag_slot,
             lu,
             vcol,
@@ -513,19 +524,25 @@ impl Galerkin {
                 }
             }
         }
-        // constraint curvature at the interior control points
+        // constraint curvature at the interior control points: `lambda_r Hess Phi_r` row by
+        // row, from the seed passes (rows whose Hessian varies, and every row at the first
+        // Jacobian, which keeps the constant ones) or from the kept constant Hessians
         let rheonomic = sys.jacobian_depends_on_time();
         let nc = sp.cstart.last().copied().unwrap_or(0);
+        let cached = sp.hess_ready;
         for nu in 1..s {
             let q = &self.qn[nu * n..(nu + 1) * n];
             let tn = t + tab.tau[nu] * h;
             let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
-            if rheonomic {
+            if rheonomic && (!cached || sp.hess_varies) {
                 // (Phi_q 0 + Phi_t)_q = Phi_tq: not curvature, subtracted below
                 sp.rows
                     .gather_tan(sys, q, &sp.zero, tn, &mut sp.gscratch, &mut sp.dtime);
             }
             for (k, blocks) in sp.color_blocks.iter().enumerate() {
+                if cached && !sp.hess_varies {
+                    break;
+                }
                 for l in 0..sp.max_width {
                     let mut any = false;
                     for &b in blocks {
@@ -553,8 +570,8 @@ impl Galerkin {
                     }
                     let vals = sp.lu.values_mut();
                     for (r, sides) in sp.rows.sides().iter().enumerate() {
-                        let lr = lam[r];
-                        if lr == 0.0 {
+                        let constant = sp.hess_const[r];
+                        if cached && constant {
                             continue;
                         }
                         let (r0, len) = (sp.rstart[r], sp.rstart[r + 1] - sp.rstart[r]);
@@ -563,9 +580,16 @@ impl Galerkin {
                                 continue;
                             }
                             let a = side.off - r0 + l;
+                            let at = sp.cstart[r] + a * len;
+                            if constant {
+                                sp.hess[at..at + len].copy_from_slice(&sp.dgrads[r0..r0 + len]);
+                            }
+                            let lr = lam[r];
+                            if lr == 0.0 {
+                                continue;
+                            }
                             let f = -h2 * minv[side.col + l] * lr;
-                            let base = (nu - 1) * nc + sp.cstart[r] + a * len;
-                            let sl = &sp.curv_slot[base..base + len];
+                            let sl = &sp.curv_slot[(nu - 1) * nc + at..(nu - 1) * nc + at + len];
                             for (&slot, &d) in sl.iter().zip(&sp.dgrads[r0..r0 + len]) {
                                 if slot != NONE {
                                     vals[slot] += f * d;
@@ -575,6 +599,31 @@ impl Galerkin {
                     }
                 }
             }
+            if cached {
+                let vals = sp.lu.values_mut();
+                for (r, sides) in sp.rows.sides().iter().enumerate() {
+                    let lr = lam[r];
+                    if !sp.hess_const[r] || lr == 0.0 {
+                        continue;
+                    }
+                    let (r0, len) = (sp.rstart[r], sp.rstart[r + 1] - sp.rstart[r]);
+                    for side in sides.iter().flatten() {
+                        for l in 0..side.width {
+                            let at = sp.cstart[r] + (side.off - r0 + l) * len;
+                            let f = -h2 * minv[side.col + l] * lr;
+                            let sl = &sp.curv_slot[(nu - 1) * nc + at..(nu - 1) * nc + at + len];
+                            for (&slot, &d) in sl.iter().zip(&sp.hess[at..at + len]) {
+                                if slot != NONE {
+                                    vals[slot] += f * d;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if s > 1 {
+            sp.hess_ready = true;
         }
         if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
             // the s = 1 modified Lagrangian: the diagonals of the blocks of galerkin/dense.rs,
