@@ -36,16 +36,16 @@ const SKIP_ABOVE_S: f64 = 1.0;
 fn timed_run(
     integ: &mut dyn Integrator,
     sys: &System,
-    s0: &State,
+    st: &mut State,
     steps: usize,
 ) -> Result<f64, String> {
-    let mut st = s0.clone();
+    let t_end = st.t + steps as f64 * H;
     let t = Instant::now();
     run(
         &mut *integ,
         sys,
-        &mut st,
-        RunConfig::new(steps as f64 * H, H),
+        st,
+        RunConfig::new(t_end, H),
         &mut NoObserver,
     )
     .map_err(|e| e.to_string())?;
@@ -60,7 +60,10 @@ struct Cell {
     peer: f64,
 }
 
-/// Best-of-blocks time per step of `integ` and of the plain RK4 peer, blocks interleaved.
+/// Best-of-blocks time per step of `integ` and of the plain RK4 peer, blocks of about
+/// `block_s` seconds interleaved. With `continuing`, a block is the second half of a run of
+/// twice its steps (what a long run costs per step, for a solver that keeps a factorisation
+/// across steps); otherwise each block is a run from `s0`.
 pub(crate) fn measure(
     sys: &System,
     s0: &State,
@@ -68,18 +71,61 @@ pub(crate) fn measure(
     peer: &mut dyn Integrator,
     blocks: usize,
     block_s: f64,
+    continuing: bool,
 ) -> Result<(f64, f64), String> {
     // warm-up and a first estimate of the step cost (one step each)
-    let one = timed_run(integ, sys, s0, 1)?;
-    let one_peer = timed_run(peer, sys, s0, 1)?;
+    let (mut st, mut st_peer) = (s0.clone(), s0.clone());
+    // (a run's first steps cost more: the first step's Taylor predictor and, for a solver
+    // that keeps its factorisation, the first factorisation; `continuing` times a stretch of
+    // a run after them)
+    let one = timed_run(integ, sys, &mut st, 1)?;
+    let one_peer = timed_run(peer, sys, &mut st_peer, 1)?;
     let steps = ((block_s / one.max(1e-9)) as usize).clamp(2, 2000);
     let peer_steps = ((block_s / one_peer.max(1e-9)) as usize).clamp(2, 2000);
     let (mut best, mut best_peer) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..blocks {
-        best = best.min(timed_run(integ, sys, s0, steps)?);
-        best_peer = best_peer.min(timed_run(peer, sys, s0, peer_steps)?);
+        if continuing {
+            best = best.min(second_stretch(integ, sys, s0, steps)?);
+            best_peer = best_peer.min(second_stretch(peer, sys, s0, peer_steps)?);
+        } else {
+            st.clone_from(s0);
+            st_peer.clone_from(s0);
+            best = best.min(timed_run(integ, sys, &mut st, steps)?);
+            best_peer = best_peer.min(timed_run(peer, sys, &mut st_peer, peer_steps)?);
+        }
     }
     Ok((best, best_peer))
+}
+
+/// The time per step of the second of two stretches of `steps` steps of one run from `s0`
+/// through the public run loop (an observer notes the time where the second begins and ends):
+/// the first stretch carries the run's start-up.
+fn second_stretch(
+    integ: &mut dyn Integrator,
+    sys: &System,
+    s0: &State,
+    steps: usize,
+) -> Result<f64, String> {
+    let mut st = s0.clone();
+    let mut marks = Vec::with_capacity(3);
+    let mut mark = |_: &System, _: &State, k: usize| {
+        if k == marks.len() * steps {
+            marks.push(Instant::now());
+        }
+        Ok(mbd::solve::Flow::Continue)
+    };
+    run(
+        &mut *integ,
+        sys,
+        &mut st,
+        RunConfig::new((2 * steps) as f64 * H, H),
+        &mut mark,
+    )
+    .map_err(|e| e.to_string())?;
+    match marks.as_slice() {
+        [_, a, b] => Ok((*b - *a).as_secs_f64() / steps as f64),
+        _ => Err(format!("timed run: {} marks, 3 expected", marks.len())),
+    }
 }
 
 /// The experiment.
@@ -134,7 +180,7 @@ pub fn scaling(ctx: &Ctx) -> Result<Section, String> {
                 .make(&sys)
                 .map_err(|e| e.to_string())
                 .and_then(|mut integ| {
-                    measure(&sys, &s0, integ.as_mut(), &mut peer, blocks, block_s)
+                    measure(&sys, &s0, integ.as_mut(), &mut peer, blocks, block_s, false)
                 });
             let (per, peer_per) = match measured {
                 Ok(x) => x,

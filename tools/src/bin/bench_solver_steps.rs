@@ -8,7 +8,8 @@
 //! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
 //! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
 //! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
-//! state in full (for comparing trajectories between builds).
+//! state in full (for comparing trajectories between builds). The environment variable `MBD_H`
+//! overrides the step.
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
 use mbd::rk4::{Rk4, Rk4Options};
@@ -83,19 +84,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .into())
         }
     };
+    // MBD_H overrides the step
+    let h = std::env::var("MBD_H")
+        .ok()
+        .and_then(|x| x.parse().ok())
+        .unwrap_or(h);
     let mut s = s0.clone();
+    let mut its = 0usize;
     let t = std::time::Instant::now();
     for _ in 0..n {
         // restart every 10 s of model time so that long runs stay in the same regime
         if s.t > 10.0 {
             s = s0.clone();
         }
-        integ.step(&sys, &mut s, h)?;
+        its += integ.step(&sys, &mut s, h)?.newton_iterations;
     }
     let dt = t.elapsed().as_secs_f64();
     println!(
-        "{solver} on {model}: {n} steps, {:.1} ns/step (q0 = {:.6})",
+        "{solver} on {model}: {n} steps, {:.1} ns/step, {:.2} Newton iterations/step (q0 = {:.6})",
         dt / n as f64 * 1e9,
+        its as f64 / n as f64,
         s.q[0]
     );
     if print_state {
