@@ -397,6 +397,54 @@ impl System {
         self.spatial.add_hessian(q, t, lambda, scale, out);
     }
 
+    /// The spatial rows' part of `out += scale sum_r w_r Hess(Phi_r) x` (`out` and `x` of
+    /// length n, `weights` of length m) at time `t`: what a pass over the planar elements
+    /// ([`System::joint_elements`], which hands out planar joints only) leaves out. Every
+    /// spatial equation is quadratic, so `Hess(Phi_r) x` is the row of `(Phi_q x)_q`
+    /// (an angle driver's row adds its `Phi_tq`, which a preadjustment refuses).
+    pub fn add_spatial_hessian_vector(
+        &self,
+        q: &[f64],
+        t: f64,
+        x: &[f64],
+        weights: &[f64],
+        scale: f64,
+        out: &mut [f64],
+    ) {
+        self.spatial.rows_tan(q, x, t, |r, sides, _, dg| {
+            let w = scale * weights[r];
+            if w == 0.0 {
+                return;
+            }
+            for (l, &d) in dg.iter().enumerate() {
+                if let Some(c) = self.spatial.col(sides, l) {
+                    out[c] += w * d;
+                }
+            }
+        });
+    }
+
+    /// The spatial rows' part of [`System::add_constraint_hessian`]: `out += scale
+    /// sum_r lambda_r Hess(Phi_r)` over the spatial rows only (`n x n`).
+    pub fn add_spatial_constraint_hessian(
+        &self,
+        q: &[f64],
+        t: f64,
+        lambda: &[f64],
+        scale: f64,
+        out: &mut DMatrix<f64>,
+    ) {
+        self.spatial.add_hessian(q, t, lambda, scale, out);
+    }
+
+    /// The spatial rows of `(Phi_q v + Phi_t)_q` added into the same rows of `out` (`m x n`):
+    /// the spatial part of [`System::phi_q_dot_jacobian`]'s second output.
+    pub fn add_spatial_phi_q_dot(&self, q: &[f64], v: &[f64], t: f64, out: &mut DMatrix<f64>) {
+        self.spatial.rows_tan(q, v, t, |r, sides, _, dg| {
+            self.spatial.scatter_row(r, sides, dg, out);
+        });
+    }
+
     pub(crate) fn scatter_hess(at: Attach, h: &[[f64; NV]; NV], out: &mut DMatrix<f64>) {
         at.scatter_hess(h, out);
     }

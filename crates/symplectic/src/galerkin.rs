@@ -131,7 +131,7 @@ impl Galerkin {
         let tab = Tables::new(s, options.nodes);
         let modlag = options.preadjust == PreadjustMode::ModifiedLagrangian;
         if sys.has_spatial() {
-            spatial_support(sys, modlag, options.gamma)?;
+            spatial_support(sys, s, modlag, options.gamma, options.linear_solver)?;
         }
         if modlag && !sys.is_conservative() {
             let elements: Vec<String> = sys
@@ -150,7 +150,9 @@ impl Galerkin {
         }
         // (W_s adds a dense block to the Newton matrix; the modified Lagrangian's blocks are
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
-        let sparse_ok = options.gamma == 0.0;
+        // (a preadjustment on spatial bodies takes the dense path: its passes over spatial rows
+        // fill dense Hessians and Phi_q)
+        let sparse_ok = options.gamma == 0.0 && !(modlag && sys.has_spatial());
         // spatial bodies with redundant equations take the dense path (the sparse path finds
         // the dependent rows through the planar Schur complement): up to the dense limit
         let spatial_redundant = sys.has_spatial() && sys.n_redundant() > 0;

@@ -71,6 +71,20 @@ fn gradient_matches_finite_differences() {
     let sys = b.build().unwrap();
     let st = State::consistent(&sys, 0.0).unwrap();
     check_gradient(&sys, st.q.as_slice(), "spring pendulum");
+    // spatial bodies: natural coordinates, internal constraints among the rows
+    for (sys, label) in [
+        (
+            models::heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap(),
+            "heavy top",
+        ),
+        (
+            models::spatial_double_pendulum().unwrap(),
+            "spatial double pendulum",
+        ),
+    ] {
+        let st = State::consistent(&sys, 0.0).unwrap();
+        check_gradient(&sys, st.q.as_slice(), label);
+    }
 }
 
 /// About the hanging equilibrium W_s = 1/2 omega^(2s+2) eta^2 for the rod pendulum, with
@@ -121,4 +135,13 @@ fn gamma_zero_is_the_plain_scheme_bit_for_bit() {
         }
         assert_ne!(bits(&sa), bits(&sc));
     }
+}
+
+/// The preadjustment's metric needs `M^-1`: on a spatial body with a zero second moment (the
+/// disc top, `E_3 = 0`) the workspace is refused, naming a massless coordinate.
+#[test]
+fn a_singular_mass_matrix_is_refused_by_name() {
+    let sys = models::heavy_top([0.25, 0.25, 0.5], 0.3, 20.0).unwrap();
+    let e = Preadjustment::new(&sys, 1).unwrap_err().to_string();
+    assert!(e.contains("M^-1") && e.contains("top."), "{e}");
 }

@@ -1,22 +1,75 @@
-//! Spatial bodies in the symplectic scheme: what it runs, the momentum rows' scale on massless
+//! Spatial bodies in the symplectic scheme: what it runs (the preadjusted schemes with their
+//! limits), the momentum rows' scale on massless
 //! coordinates and the end velocity by the constrained solve (docs/spatial.md, "The symplectic
 //! scheme with a singular mass matrix").
 
 use mbd_model::System;
-use mbd_solve::{ConstrainedSolve, SolveError};
+use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 
-/// What the symplectic scheme runs with spatial bodies: the plain (s,s) scheme on the dense
+/// What the symplectic scheme runs with spatial bodies: the plain (s,s) scheme on either
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
-/// balances, and the end velocity comes from the constrained solve). The preadjustments'
-/// derivative passes are planar.
-pub(super) fn spatial_support(sys: &System, modlag: bool, gamma: f64) -> Result<(), SolveError> {
-    if modlag || gamma != 0.0 {
-        return mbd_solve::refuse_spatial(
-            sys,
-            "the preadjusted symplectic scheme (gamma or :modified)",
+/// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
+/// and the s = 1 modified Lagrangian on the dense path, for models whose mass matrix is
+/// regular, whose potential is gravity's and whose Jacobian does not depend on time
+/// (docs/spatial.md, "The preadjusted schemes"). Each refusal names what stands in the way.
+pub(super) fn spatial_support(
+    sys: &System,
+    s: usize,
+    modlag: bool,
+    gamma: f64,
+    linear: LinearSolver,
+) -> Result<(), SolveError> {
+    if !modlag && gamma == 0.0 {
+        return Ok(());
+    }
+    let scheme = if modlag {
+        format!("the ({s},{s}) modified-Lagrangian preadjustment (:modified)")
+    } else {
+        "paper A's preadjustment W_s (gamma != 0)".to_string()
+    };
+    let refuse = |why: String| {
+        Err(SolveError::Unsupported(format!(
+            "{scheme} on spatial bodies: {why}; the plain symplectic:{s} runs this model"
+        )))
+    };
+    if modlag && s == 2 {
+        let first = sys
+            .spatial_bodies()
+            .first()
+            .map(|b| b.name.as_str())
+            .or_else(|| sys.spatial_point_masses().first().map(|p| p.name.as_str()))
+            .unwrap_or_default();
+        return refuse(format!(
+            "the s = 2 term's jet passes take planar elements only, not body '{first}' (the \
+             s = 1 term and W_s take spatial bodies)"
+        ));
+    }
+    if let Some(b) = sys
+        .spatial_bodies()
+        .iter()
+        .find(|b| b.inertia.second_moments().iter().any(|&e| e <= 0.0))
+    {
+        return refuse(format!(
+            "body '{}' has a zero second moment E_i (a thin disc or plate: a singular mass \
+             matrix), and the preadjustment's projected metric Phi_q M^-1 Phi_q^T needs M^-1",
+            b.name
+        ));
+    }
+    if let Some(f) = sys.spatial_forces().first() {
+        return refuse(format!(
+            "its derivative passes take gravity as the spatial potential, not force element \
+             '{}' ({})",
+            f.name,
+            f.kind_name()
+        ));
+    }
+    if sys.jacobian_depends_on_time() {
+        return refuse(
+            "an angle driver makes Phi_q depend on time, which the derivation does not cover"
+                .into(),
         );
     }
-    Ok(())
+    mbd_solve::refuse_large_spatial(sys, &scheme, linear)
 }
 
 /// The momentum rows' scale ([`Galerkin`]'s `minv`): `M^-1`, and on a massless coordinate of

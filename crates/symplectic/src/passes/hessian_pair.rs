@@ -74,6 +74,12 @@ pub(crate) fn add_lagrangian_hessian_pair(
         at.scatter_hess(&ha, out_a);
         at.scatter_hess(&hb, out_b);
     });
+    if sys.has_spatial() {
+        // the spatial rows (the element pass hands out planar joints only)
+        sys.add_spatial_constraint_hessian(q, 0.0, a.constraints, 1.0, out_a);
+        sys.add_spatial_constraint_hessian(q, 0.0, b.constraints, 1.0, out_b);
+        sys.add_spatial_phi_q_dot(q, v, 0.0, ct);
+    }
 }
 
 /// The diagonals of the two weighted Lagrangian Hessians of

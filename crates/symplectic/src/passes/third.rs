@@ -85,7 +85,7 @@ pub(crate) fn constraint_third(
 }
 
 /// Adds `scale * sum_k weights_k D^3 Phi_k(q)(v, v, .)` into `out` (see
-/// [`constraint_third`]).
+/// [`constraint_third`]). Spatial rows are quadratic and add nothing.
 pub(crate) fn add_constraint_third(
     sys: &System,
     q: &[f64],
@@ -123,7 +123,8 @@ pub(crate) fn add_constraint_third(
 }
 /// `L = potential * V + sum_k weights_k Phi_k`: its Hessian-vector product
 /// `Hess L(q) w` (length n) into `out` (overwritten), one forward pass per element without
-/// forming a Hessian (`potential = 0` for the constraints alone).
+/// forming a Hessian (`potential = 0` for the constraints alone). Spatial rows included;
+/// spatial force elements are not (the preadjustments refuse them).
 pub(crate) fn lagrangian_hessian_vector(
     sys: &System,
     q: &[f64],
@@ -204,6 +205,10 @@ fn lagrangian_hessian_vector_impl(
             }
         }
         scatter_grad(at, &g, 1.0, out);
+    }
+    if sys.has_spatial() {
+        // the spatial rows (quadratic: constant Hessians); their forces are refused
+        sys.add_spatial_hessian_vector(q, 0.0, w, weights, 1.0, out);
     }
 }
 
@@ -289,6 +294,10 @@ fn lagrangian_third_impl(
         }
         scatter_grad(at, &g1, 1.0, hv);
         scatter_grad(at, &g2, 1.0, d3);
+    }
+    if sys.has_spatial() {
+        // the spatial rows are quadratic: a Hessian-vector product and no third derivative
+        sys.add_spatial_hessian_vector(q, 0.0, v, weights, 1.0, hv);
     }
 }
 

@@ -37,6 +37,9 @@ pub(crate) struct ProjectedMetric {
     mass: Vec<f64>,
     minv: Vec<f64>,
     rheonomic: bool,
+    /// Whether the element-local rows along a velocity come from one fused pass with `Phi_q`
+    /// (planar scleronomic models; the pass takes planar joints only).
+    fused: bool,
     /// `grad V`.
     g: Vec<f64>,
     /// Dense layout: `Phi_q` (`m x n`) and the Cholesky factor of `S` (empty on the sparse
@@ -106,6 +109,7 @@ impl ProjectedMetric {
             mass: sys.mass_diag().as_slice().to_vec(),
             minv: sys.inv_mass_diag().as_slice().to_vec(),
             rheonomic: sys.is_rheonomic(),
+            fused: !sys.is_rheonomic() && !sys.has_spatial(),
             g: vec![0.0; n],
             gq: DMatrix::zeros(md, nd),
             chol,
@@ -354,7 +358,7 @@ impl ProjectedMetric {
         sys.potential_gradient(q, &mut self.g);
         if m > 0 {
             match along {
-                Some((v, rows)) if !self.rheonomic => {
+                Some((v, rows)) if self.fused => {
                     passes::constraint_third_local(
                         sys,
                         q,

@@ -92,6 +92,19 @@ impl Preadjustment {
                 reason: "W_s needs s >= 1",
             });
         }
+        if let Some(k) = sys.inv_mass_diag().iter().position(|x| !x.is_finite()) {
+            // (an error path: the names allocate)
+            let name = sys
+                .coordinate_names()
+                .get(k)
+                .cloned()
+                .unwrap_or_else(|| format!("#{k}"));
+            return Err(SolveError::Unsupported(format!(
+                "the preadjustment's projected metric Phi_q M^-1 Phi_q^T needs M^-1, and \
+                 coordinate '{name}' has no mass (a spatial body with a zero second moment: a \
+                 thin disc or plate)"
+            )));
+        }
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         Ok(Preadjustment {
             metric: ProjectedMetric::new(sys, sparse)?,

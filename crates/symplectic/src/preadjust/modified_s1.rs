@@ -421,13 +421,16 @@ pub(crate) mod modlag_tests {
 
     /// The analytic gradients of the modified-Lagrangian term against central differences of
     /// the term itself, away from equilibrium and with a generic velocity: on the double
-    /// pendulum (gravity) and on a rod with a spring (where the `-1/8 v^T Hess V v` term and its
-    /// third derivatives matter).
+    /// pendulum (gravity), on a rod with a spring (where the `-1/8 v^T Hess V v` term and its
+    /// third derivatives matter), and on spatial models (12 natural coordinates per body, the
+    /// internal constraints among the rows: the heavy top and the spatial double pendulum).
     #[test]
     fn modified_gradient_matches_differences() {
         for sys in [
             models::paper_a_double_pendulum().unwrap(),
             rod_with_spring(),
+            models::heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap(),
+            models::spatial_double_pendulum().unwrap(),
         ] {
             let st = mbd_solve::State::consistent(&sys, 0.0).unwrap();
             let n = sys.n_coords();
