@@ -124,7 +124,7 @@ fn orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     }
     sec.tables.push(table);
     sec.notes.push(format!(
-        "Refused by name (their derivative passes or residual scaling are planar or need a regular mass matrix): {}.",
+        "Refused by name (the s = 2 modified Lagrangian's jet passes are planar): {}.",
         refused.join(", ")
     ));
     sec.summary = json!({ "spatial_orders": rows });

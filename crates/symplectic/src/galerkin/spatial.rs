@@ -9,8 +9,9 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// What the symplectic scheme runs with spatial bodies: the plain (s,s) scheme on either
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
-/// and the s = 1 modified Lagrangian on the dense path, for models whose mass matrix is
-/// regular, whose potential is gravity's and whose Jacobian does not depend on time
+/// and the s = 1 modified Lagrangian on the dense path (a singular mass matrix included: their
+/// metric uses the augmented `M_W^-1`), for models whose potential is gravity's and whose
+/// Jacobian does not depend on time
 /// (docs/spatial.md, "The preadjusted schemes"). Each refusal names what stands in the way.
 pub(super) fn spatial_support(
     sys: &System,
@@ -42,17 +43,6 @@ pub(super) fn spatial_support(
         return refuse(format!(
             "the s = 2 term's jet passes take planar elements only, not body '{first}' (the \
              s = 1 term and W_s take spatial bodies)"
-        ));
-    }
-    if let Some(b) = sys
-        .spatial_bodies()
-        .iter()
-        .find(|b| b.inertia.second_moments().iter().any(|&e| e <= 0.0))
-    {
-        return refuse(format!(
-            "body '{}' has a zero second moment E_i (a thin disc or plate: a singular mass \
-             matrix), and the preadjustment's projected metric Phi_q M^-1 Phi_q^T needs M^-1",
-            b.name
         ));
     }
     if let Some(f) = sys.spatial_forces().first() {

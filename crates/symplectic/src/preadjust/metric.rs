@@ -17,6 +17,7 @@
 //! new point gets a new [`Stamp`], by which the terms tell whether what they keep is still of
 //! this point.
 
+use super::augmented::Augmented;
 use super::{dot, LocalRow, ZERO_ROW};
 use crate::passes;
 use mbd_model::System;
@@ -35,7 +36,12 @@ pub(crate) struct ProjectedMetric {
     n: usize,
     m: usize,
     mass: Vec<f64>,
+    /// The diagonal of `M^-1` (with spatial bodies: that of the augmented `M_W^-1`, a finite
+    /// stand-in on massless coordinates, for bounds and the sparse layout only).
     minv: Vec<f64>,
+    /// With spatial bodies (dense layout): the augmented `M_W^-1`, used wherever `M^-1` acts
+    /// (module `augmented`).
+    aug: Option<Box<Augmented>>,
     rheonomic: bool,
     /// Whether the element-local rows along a velocity come from one fused pass with `Phi_q`
     /// (planar scleronomic models; the pass takes planar joints only).
@@ -108,6 +114,11 @@ impl ProjectedMetric {
             m,
             mass: sys.mass_diag().as_slice().to_vec(),
             minv: sys.inv_mass_diag().as_slice().to_vec(),
+            aug: if sparse {
+                None
+            } else {
+                Augmented::new(sys).map(Box::new)
+            },
             rheonomic: sys.is_rheonomic(),
             fused: !sys.is_rheonomic() && !sys.has_spatial(),
             g: vec![0.0; n],
@@ -247,10 +258,64 @@ impl ProjectedMetric {
     /// `out += c M^-1 G^T x` (x of length m).
     #[inline]
     pub(super) fn add_dgt_to(&self, x: &[f64], c: f64, out: &mut [f64]) {
-        match &self.schur {
-            Some(sc) => sc.add_weighted_transpose(c, &self.minv, x, out),
-            None => add_dgt(&self.gq, &self.minv, x, c, out),
+        match (&self.schur, &self.aug) {
+            (Some(sc), _) => sc.add_weighted_transpose(c, &self.minv, x, out),
+            (None, Some(aug)) => {
+                if self.m > 0 {
+                    aug.add_apply(c, |k| self.g_col_dot(k, x), out);
+                }
+            }
+            (None, None) => add_dgt(&self.gq, &self.minv, x, c, out),
         }
+    }
+
+    /// `out = M^-1 x` (`M_W^-1 x` with spatial bodies).
+    pub(super) fn minv_mul(&self, x: &[f64], out: &mut [f64]) {
+        match &self.aug {
+            Some(aug) => aug.apply(x, out),
+            None => {
+                for ((o, xi), mi) in out.iter_mut().zip(x).zip(&self.minv) {
+                    *o = mi * xi;
+                }
+            }
+        }
+    }
+
+    /// Whether `M^-1` is the augmented `M_W^-1` (spatial bodies, dense layout).
+    pub(super) fn is_augmented(&self) -> bool {
+        self.aug.is_some()
+    }
+
+    /// The entry `(i, j)` of `M^-1` (of `M_W^-1` with spatial bodies).
+    pub(super) fn minv_entry(&self, i: usize, j: usize) -> f64 {
+        match &self.aug {
+            Some(aug) => aug.entry(i, j),
+            None if i == j => self.minv[i],
+            None => 0.0,
+        }
+    }
+
+    /// The coordinates `j` with `M^-1_kj` possibly nonzero (a spatial body's directors share
+    /// a block of `M_W^-1`).
+    pub(super) fn minv_partners(&self, k: usize) -> std::ops::Range<usize> {
+        match &self.aug {
+            Some(aug) => aug.partners(k),
+            None => k..k + 1,
+        }
+    }
+
+    /// The multipliers of `M` from `S^-1 c` of a solve whose constraint part is `c` (the
+    /// augmented metric's correction; nothing without spatial bodies), in place.
+    pub(super) fn correct_multipliers(&self, c: &[f64], mult: &mut [f64]) {
+        if let Some(aug) = &self.aug {
+            aug.correct(c, mult);
+        }
+    }
+
+    /// What `c^T S^-1 c` computed with the augmented metric exceeds that of `M` by (0 without
+    /// spatial bodies).
+    pub(super) fn penalty(&self, c: &[f64]) -> f64 {
+        self.aug.as_ref().map_or(0.0, |aug| aug.penalty(c))
     }
 
     /// `out = M^-1 G^T x` (x of length m).
@@ -270,8 +335,12 @@ impl ProjectedMetric {
     /// `out = Pi x`.
     pub(super) fn apply_pi(&mut self, x: &[f64], out: &mut [f64]) {
         let (n, m) = (self.n, self.m);
-        for i in 0..n {
-            out[i] = self.minv[i] * x[i];
+        if self.aug.is_some() {
+            self.minv_mul(x, out);
+        } else {
+            for i in 0..n {
+                out[i] = self.minv[i] * x[i];
+            }
         }
         if m == 0 {
             return;
@@ -287,8 +356,12 @@ impl ProjectedMetric {
     pub(super) fn sgm(&mut self, x: &[f64], out: &mut [f64]) {
         let n = self.n;
         let mut t = std::mem::take(&mut self.tmp_n);
-        for k in 0..n {
-            t[k] = self.minv[k] * x[k];
+        if self.aug.is_some() {
+            self.minv_mul(x, &mut t);
+        } else {
+            for k in 0..n {
+                t[k] = self.minv[k] * x[k];
+            }
         }
         self.g_times(&t, out);
         self.s_solve(out);
@@ -298,8 +371,12 @@ impl ProjectedMetric {
     /// `pi = Pi x` (bit for bit [`ProjectedMetric::apply_pi`]) and `sg = S^-1 G M^-1 x`
     /// ([`ProjectedMetric::sgm`], the solve inside `Pi x`), by one solve.
     pub(super) fn pi_sgm(&mut self, x: &[f64], pi: &mut [f64], sg: &mut [f64]) {
-        for ((p, xi), mi) in pi.iter_mut().zip(x).zip(&self.minv) {
-            *p = mi * xi;
+        if self.aug.is_some() {
+            self.minv_mul(x, pi);
+        } else {
+            for ((p, xi), mi) in pi.iter_mut().zip(x).zip(&self.minv) {
+                *p = mi * xi;
+            }
         }
         if self.m == 0 {
             return;
@@ -355,6 +432,10 @@ impl ProjectedMetric {
         }
         self.at_valid = false;
         self.stamp += 1;
+        if let Some(aug) = &mut self.aug {
+            aug.update(q)?;
+            aug.diagonal(&mut self.minv);
+        }
         sys.potential_gradient(q, &mut self.g);
         if m > 0 {
             match along {
@@ -394,8 +475,13 @@ impl ProjectedMetric {
                 let rows = &mut self.nz_rows;
                 let chol = &mut self.chol;
                 chol.clear();
-                // S = sum_k minv_k G_:k G_:k^T over the few nonzero rows of each column
+                // S = sum_k minv_k G_:k G_:k^T over the few nonzero rows of each column (with
+                // spatial bodies: their directors' columns by blocks of M_W^-1, below)
+                let aug = self.aug.as_deref();
                 for (k, col) in gq.as_slice().chunks_exact(m).enumerate() {
+                    if aug.is_some_and(|a| a.in_block(k)) {
+                        continue;
+                    }
                     rows.clear();
                     rows.extend((0..m).filter(|&r| col[r] != 0.0));
                     for (i, &c) in rows.iter().enumerate() {
@@ -405,6 +491,9 @@ impl ProjectedMetric {
                             chol.add(r, c, col[r] * gc);
                         }
                     }
+                }
+                if let Some(aug) = aug {
+                    aug.add_to_schur(gq, rows, chol);
                 }
                 self.chol.factor_in_place().map_err(|_| singular())?;
             }
@@ -422,6 +511,19 @@ impl ProjectedMetric {
             let mut u = std::mem::take(&mut self.u);
             self.add_dgt_to(&self.mu0, 1.0, &mut u);
             self.u = u;
+        } else if let Some(aug) = &self.aug {
+            // u = M_W^-1 (G^T mu0 - g)
+            let mut t = std::mem::take(&mut self.tmp_n);
+            for (k, tk) in t.iter_mut().enumerate() {
+                let acc = if m > 0 {
+                    self.g_col_dot(k, &self.mu0)
+                } else {
+                    0.0
+                };
+                *tk = acc - self.g[k];
+            }
+            aug.apply(&t, &mut self.u);
+            self.tmp_n = t;
         } else {
             for k in 0..n {
                 let acc = if m > 0 {

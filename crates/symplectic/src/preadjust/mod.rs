@@ -28,6 +28,7 @@ use mbd_solve::linalg::dot;
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
+mod augmented;
 mod metric;
 mod modified_s1;
 mod modified_s2;
@@ -92,18 +93,12 @@ impl Preadjustment {
                 reason: "W_s needs s >= 1",
             });
         }
-        if let Some(k) = sys.inv_mass_diag().iter().position(|x| !x.is_finite()) {
-            // (an error path: the names allocate)
-            let name = sys
-                .coordinate_names()
-                .get(k)
-                .cloned()
-                .unwrap_or_else(|| format!("#{k}"));
-            return Err(SolveError::Unsupported(format!(
-                "the preadjustment's projected metric Phi_q M^-1 Phi_q^T needs M^-1, and \
-                 coordinate '{name}' has no mass (a spatial body with a zero second moment: a \
-                 thin disc or plate)"
-            )));
+        if sparse && sys.has_spatial() {
+            return Err(SolveError::Unsupported(
+                "the preadjustment's sparse layout (Preadjustment::new_sparse) takes planar \
+                 models; spatial bodies take the dense one (Preadjustment::new)"
+                    .into(),
+            ));
         }
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         Ok(Preadjustment {

@@ -36,6 +36,9 @@ pub(crate) struct ModifiedS1 {
     /// `B = A + H_sigma - 3/2 Hess V`, and `D^3 (POTENTIAL_WEIGHT V + (sigma - mu0) . Phi)(v, v, .)`
     /// (`d3`).
     sigma: Vec<f64>,
+    /// `S^-1 gamma_c` of the metric's `S` (with spatial bodies the augmented metric's, whose
+    /// `M_W^-1 G^T` times it is the minimum-norm `w`; `sigma` is then corrected from it).
+    sigma_w: Vec<f64>,
     cm: Vec<f64>,
     hv: Vec<f64>,
     d3: Vec<f64>,
@@ -64,6 +67,7 @@ impl ModifiedS1 {
         ModifiedS1 {
             along: RowsAlong::new(n, m),
             sigma: vec![0.0; m],
+            sigma_w: vec![0.0; m],
             cm: vec![0.0; m],
             hv: vec![0.0; n],
             d3: vec![0.0; n],
@@ -132,6 +136,13 @@ impl ModifiedS1 {
             self.sigma.copy_from_slice(gc);
             metric.s_solve(&mut self.sigma);
             gg = dot(gc, &self.sigma);
+            if metric.is_augmented() {
+                // the augmented metric's S^-1 gamma_c and gamma_c^T S^-1 gamma_c exceed those
+                // of M by W gamma_int and gamma_int^T W gamma_int (module `augmented`)
+                self.sigma_w.copy_from_slice(&self.sigma);
+                metric.correct_multipliers(gc, &mut self.sigma);
+                gg -= metric.penalty(gc);
+            }
         }
         let mu0 = metric.mu0();
         for r in 0..m {
@@ -212,6 +223,12 @@ impl ModifiedS1 {
         if metric.is_sparse() {
             uw.copy_from_slice(metric.u());
             metric.add_dgt_to(&self.sigma, -1.0, uw);
+        } else if metric.is_augmented() {
+            // w = M_W^-1 G^T S_W^-1 gamma_c, the minimum-norm solution of G w = gamma_c
+            uw.copy_from_slice(metric.u());
+            if metric.m() > 0 {
+                metric.add_dgt_to(&self.sigma_w, -1.0, uw);
+            }
         } else {
             let (minv, u) = (metric.minv(), metric.u());
             for k in 0..n {

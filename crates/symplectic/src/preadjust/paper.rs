@@ -159,14 +159,28 @@ impl PaperTerm {
                     h[r] += 0.125 * g1[r];
                 }
             }
-            // rho (S is factored densely: the W_s methods need the dense layout)
+            // rho (S is factored densely: the W_s methods need the dense layout); with spatial
+            // bodies the augmented metric's, and h kept for its correction below
+            if metric.is_augmented() {
+                self.gam.copy_from_slice(h);
+            }
             metric.s_solve(h);
         }
         // (1)+(2b'): -A (a_{l+1} + M^-1 G^T rho)
-        let minv = metric.minv();
-        for k in 0..n {
-            let acc = metric.g_col_dot(k, h);
-            self.arg[k] = self.av[l + 1][k] + minv[k] * acc;
+        if metric.is_augmented() {
+            // M_W^-1 G^T S_W^-1 h: the minimum-norm solution of G x = h (that of M)
+            self.arg.copy_from_slice(&self.av[l + 1]);
+            if m > 0 {
+                metric.add_dgt_to(h, 1.0, &mut self.arg);
+                // rho of M from the augmented metric's
+                metric.correct_multipliers(&self.gam, h);
+            }
+        } else {
+            let minv = metric.minv();
+            for k in 0..n {
+                let acc = metric.g_col_dot(k, h);
+                self.arg[k] = self.av[l + 1][k] + minv[k] * acc;
+            }
         }
         metric.a_times(sys, q, &self.arg, out);
         out.iter_mut().for_each(|x| *x = -*x);

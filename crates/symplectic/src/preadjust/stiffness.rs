@@ -98,8 +98,19 @@ impl TangentStiffness {
         let k = self.kset.len();
         for (cj, &c) in self.kset.iter().enumerate() {
             let y = &mut self.ky[cj * m..(cj + 1) * m];
-            for r in 0..m {
-                y[r] = gq[(r, c)] * minv[c];
+            if metric.is_augmented() {
+                // (G M_W^-1)_:c over the coordinates sharing c's block of M_W^-1
+                y.fill(0.0);
+                for j in metric.minv_partners(c) {
+                    let w = metric.minv_entry(j, c);
+                    for r in 0..m {
+                        y[r] += gq[(r, j)] * w;
+                    }
+                }
+            } else {
+                for r in 0..m {
+                    y[r] = gq[(r, c)] * minv[c];
+                }
             }
             metric.chol().forward_in_place(y);
             for (ri, &r) in self.kset.iter().enumerate() {
@@ -127,7 +138,13 @@ impl TangentStiffness {
                     &self.ky[ri * m..(ri + 1) * m],
                     &self.ky[cj * m..(cj + 1) * m],
                 );
-                let d = if ri == cj { minv[self.kset[cj]] } else { 0.0 };
+                let d = if metric.is_augmented() {
+                    metric.minv_entry(self.kset[ri], self.kset[cj])
+                } else if ri == cj {
+                    minv[self.kset[cj]]
+                } else {
+                    0.0
+                };
                 self.kpi[cj * k + ri] = d - yy;
             }
         }
@@ -175,6 +192,19 @@ impl TangentStiffness {
                 }
             }
         }
+        if metric.is_augmented() {
+            // W = M_W^-1_KK A_KK into kpi (free here), by the blocks of M_W^-1
+            for cj in 0..k {
+                for (ri, &r) in self.kset.iter().enumerate() {
+                    let p = metric.minv_partners(r);
+                    let lo = self.kset.partition_point(|&x| x < p.start);
+                    let hi = self.kset.partition_point(|&x| x < p.end);
+                    self.kpi[cj * k + ri] = (lo..hi)
+                        .map(|l| metric.minv_entry(r, self.kset[l]) * self.ka[cj * k + l])
+                        .sum();
+                }
+            }
+        }
         let o = out.as_mut_slice();
         o.fill(0.0);
         for (cj, &c) in self.kset.iter().enumerate() {
@@ -183,12 +213,15 @@ impl TangentStiffness {
             for (ri, &r) in self.kset.iter().enumerate().take(cj + 1) {
                 // (A symmetric: row ri of A_KK is its column ri)
                 let ar = &self.ka[ri * k..(ri + 1) * k];
-                let am: f64 = ar
-                    .iter()
-                    .zip(ac)
-                    .zip(&self.kset)
-                    .map(|((&x, &y), &l)| x * minv[l] * y)
-                    .sum();
+                let am: f64 = if metric.is_augmented() {
+                    dot(ar, &self.kpi[cj * k..(cj + 1) * k])
+                } else {
+                    ar.iter()
+                        .zip(ac)
+                        .zip(&self.kset)
+                        .map(|((&x, &y), &l)| x * minv[l] * y)
+                        .sum()
+                };
                 let x = am - dot(&z[ri * m..(ri + 1) * m], zc);
                 o[c * n + r] = x;
                 o[r * n + c] = x;
