@@ -129,7 +129,7 @@ pub use hess::{HessJet, HessJetN};
 pub use poly::{Basis, PolyJet, MAX_DIRS};
 pub use tan::{TanJet, TanJetN};
 pub use taylor::{Taylor4, TAYLOR_DEGREE};
-pub use third::ThirdJet;
+pub use third::{ThirdJet, ThirdJetN};
 
 /// Number of independent variables every gradient of a jet has (in `mbd-model`: the local
 /// coordinates `(x, y, theta)` of the first body of a joint or force, then of the second).

@@ -7,24 +7,27 @@ use super::{Scalar, NV};
 use std::ops::{Add, Mul, Sub};
 
 /// Value `f`, gradient, `d1 = f' w`, `g1 = grad d1 = H w`, `d2 = w^T H w` and
-/// `g2 = grad d2 = D^3 f(w, w, .)`, with respect to the 6 local variables.
+/// `g2 = grad d2 = D^3 f(w, w, .)`, with respect to the `N` local variables.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ThirdJet {
+pub struct ThirdJetN<const N: usize> {
     /// Value.
     pub v: f64,
     /// Gradient.
-    pub g: [f64; NV],
+    pub g: [f64; N],
     /// First derivative along the seeded direction (`g . w`).
     pub d1: f64,
     /// Gradient of `d1` (`H w`).
-    pub g1: [f64; NV],
+    pub g1: [f64; N],
     /// Second derivative along the seeded direction (`w^T H w`).
     pub d2: f64,
     /// Gradient of `d2` (`D^3 f(w, w, .)`).
-    pub g2: [f64; NV],
+    pub g2: [f64; N],
 }
 
-impl ThirdJet {
+/// The planar jet: gradients over the [`NV`] local coordinates of a planar element.
+pub type ThirdJet = ThirdJetN<NV>;
+
+impl<const N: usize> ThirdJetN<N> {
     /// Independent variable number `i` with value `x` and direction component `w`.
     #[inline(always)]
     pub fn var(i: usize, x: f64, w: f64) -> Self {
@@ -38,18 +41,18 @@ impl ThirdJet {
     fn chain(self, f: [f64; 4]) -> Self {
         let [f0, f1, f2, f3] = f;
         let (d1, d2) = (self.d1, self.d2);
-        let mut out = ThirdJet {
+        let mut out = ThirdJetN {
             v: f0,
-            g: [0.0; NV],
+            g: [0.0; N],
             d1: f1 * d1,
-            g1: [0.0; NV],
+            g1: [0.0; N],
             d2: f2 * d1 * d1 + f1 * d2,
-            g2: [0.0; NV],
+            g2: [0.0; N],
         };
         let c1 = f2 * d1;
         let c2 = f3 * d1 * d1 + f2 * d2;
         let c3 = 2.0 * f2 * d1;
-        for i in 0..NV {
+        for i in 0..N {
             out.g[i] = f1 * self.g[i];
             out.g1[i] = c1 * self.g[i] + f1 * self.g1[i];
             out.g2[i] = c2 * self.g[i] + c3 * self.g1[i] + f1 * self.g2[i];
@@ -58,14 +61,14 @@ impl ThirdJet {
     }
 }
 
-impl Add for ThirdJet {
+impl<const N: usize> Add for ThirdJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn add(mut self, o: Self) -> Self {
         self.v += o.v;
         self.d1 += o.d1;
         self.d2 += o.d2;
-        for i in 0..NV {
+        for i in 0..N {
             self.g[i] += o.g[i];
             self.g1[i] += o.g1[i];
             self.g2[i] += o.g2[i];
@@ -73,14 +76,14 @@ impl Add for ThirdJet {
         self
     }
 }
-impl Sub for ThirdJet {
+impl<const N: usize> Sub for ThirdJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn sub(mut self, o: Self) -> Self {
         self.v -= o.v;
         self.d1 -= o.d1;
         self.d2 -= o.d2;
-        for i in 0..NV {
+        for i in 0..N {
             self.g[i] -= o.g[i];
             self.g1[i] -= o.g1[i];
             self.g2[i] -= o.g2[i];
@@ -88,20 +91,20 @@ impl Sub for ThirdJet {
         self
     }
 }
-impl Mul for ThirdJet {
+impl<const N: usize> Mul for ThirdJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn mul(self, o: Self) -> Self {
         let (a, b) = (self, o);
-        let mut out = ThirdJet {
+        let mut out = ThirdJetN {
             v: a.v * b.v,
-            g: [0.0; NV],
+            g: [0.0; N],
             d1: a.d1 * b.v + a.v * b.d1,
-            g1: [0.0; NV],
+            g1: [0.0; N],
             d2: a.d2 * b.v + 2.0 * a.d1 * b.d1 + a.v * b.d2,
-            g2: [0.0; NV],
+            g2: [0.0; N],
         };
-        for i in 0..NV {
+        for i in 0..N {
             out.g[i] = a.g[i] * b.v + a.v * b.g[i];
             out.g1[i] = a.g1[i] * b.v + a.d1 * b.g[i] + a.g[i] * b.d1 + a.v * b.g1[i];
             out.g2[i] = a.g2[i] * b.v
@@ -113,14 +116,14 @@ impl Mul for ThirdJet {
         out
     }
 }
-impl Mul<f64> for ThirdJet {
+impl<const N: usize> Mul<f64> for ThirdJetN<N> {
     type Output = Self;
     #[inline(always)]
     fn mul(mut self, c: f64) -> Self {
         self.v *= c;
         self.d1 *= c;
         self.d2 *= c;
-        for i in 0..NV {
+        for i in 0..N {
             self.g[i] *= c;
             self.g1[i] *= c;
             self.g2[i] *= c;
@@ -128,17 +131,17 @@ impl Mul<f64> for ThirdJet {
         self
     }
 }
-super::scalar_shift_ops!(ThirdJet);
-impl Scalar for ThirdJet {
+super::scalar_shift_ops!(const ThirdJetN);
+impl<const N: usize> Scalar for ThirdJetN<N> {
     #[inline(always)]
     fn cst(v: f64) -> Self {
-        ThirdJet {
+        ThirdJetN {
             v,
-            g: [0.0; NV],
+            g: [0.0; N],
             d1: 0.0,
-            g1: [0.0; NV],
+            g1: [0.0; N],
             d2: 0.0,
-            g2: [0.0; NV],
+            g2: [0.0; N],
         }
     }
     #[inline(always)]

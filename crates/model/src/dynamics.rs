@@ -72,6 +72,30 @@ impl System {
         self.add_potential_hessian(q, 1.0, out);
     }
 
+    /// The spatial force elements' part of `scale Hess V v` (into `hv`) and of
+    /// `scale D^3 V(v, v, .)` (into `d3`), each if given, added: what a pass over the planar force elements
+    /// ([`System::force_elements`], which hands out planar ones only) leaves out.
+    pub fn add_spatial_force_third(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        scale: f64,
+        hv: Option<&mut [f64]>,
+        d3: Option<&mut [f64]>,
+    ) {
+        if self.spatial.has_forces() {
+            self.spatial.add_force_third(q, v, scale, hv, d3);
+        }
+    }
+
+    /// The spatial force elements' part of [`System::add_potential_hessian`]: `out += scale
+    /// d^2 V_forces / dq^2` over the spatial force elements only.
+    pub fn add_spatial_force_hessian(&self, q: &[f64], scale: f64, out: &mut DMatrix<f64>) {
+        if self.spatial.has_forces() {
+            self.spatial.add_force_hessian(q, scale, out);
+        }
+    }
+
     /// Adds `scale * d^2 V / dq^2` into `out`.
     pub fn add_potential_hessian(&self, q: &[f64], scale: f64, out: &mut DMatrix<f64>) {
         if self.spatial.has_forces() {

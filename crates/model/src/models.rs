@@ -491,8 +491,8 @@ mod exact;
 pub use exact::{CrankMotion, Regime};
 mod spatial;
 pub use spatial::{
-    bricard, free_body, heavy_top, spatial_double_pendulum, spatial_slider_crank, BRICARD_POINTS,
-    DOUBLE_PENDULUM_ROD, TOP_LENGTH,
+    bricard, free_body, heavy_top, spatial_double_pendulum, spatial_slider_crank, sprung_rod,
+    BRICARD_POINTS, DOUBLE_PENDULUM_ROD, TOP_LENGTH,
 };
 mod tumbling;
 pub use tumbling::{TorqueFreeBody, TorqueFreeMotion};

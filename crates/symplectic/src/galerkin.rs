@@ -139,6 +139,12 @@ impl Galerkin {
                 .iter()
                 .filter(|f| f.is_nonconservative())
                 .map(|f| format!("'{}' ({})", f.name, f.kind_name()))
+                .chain(
+                    sys.spatial_forces()
+                        .iter()
+                        .filter(|f| f.is_nonconservative())
+                        .map(|f| format!("'{}' ({})", f.name, f.kind_name())),
+                )
                 .collect();
             return Err(SolveError::Unsupported(format!(
                 "the modified-Lagrangian preadjustment (:modified) is derived for a conservative \

@@ -24,7 +24,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 3.0,
-            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only); with gamma=G also spatial force elements, angle drivers and spatial models of more than 600 equations",
+            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only); with gamma=G also angle drivers and spatial models of more than 600 equations",
             compared: true,
         },
         SolverVariant {
@@ -35,7 +35,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only); with gamma=G also spatial force elements, angle drivers and spatial models of more than 600 equations",
+            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only); with gamma=G also angle drivers and spatial models of more than 600 equations",
             compared: true,
         },
         SolverVariant {
@@ -46,7 +46,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads); spatial force elements, angle drivers; spatial models above 600 equations",
+            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers; spatial models above 600 equations",
             compared: true,
         },
         SolverVariant {

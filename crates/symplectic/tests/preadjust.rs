@@ -81,6 +81,10 @@ fn gradient_matches_finite_differences() {
             models::spatial_double_pendulum().unwrap(),
             "spatial double pendulum",
         ),
+        (
+            models::sprung_rod([0.05, 0.05, 0.002]).unwrap(),
+            "sprung rod",
+        ),
     ] {
         let st = State::consistent(&sys, 0.0).unwrap();
         check_gradient(&sys, st.q.as_slice(), label);

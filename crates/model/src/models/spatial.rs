@@ -3,7 +3,7 @@
 use crate::builder::SystemBuilder;
 use crate::error::ModelError;
 use crate::spatial::{
-    Marker, Orientation, SpatialBody, SpatialBodyRef, SpatialInertia, SpatialJoint,
+    Marker, Orientation, SpatialBody, SpatialBodyRef, SpatialForce, SpatialInertia, SpatialJoint,
     SpatialJointKind,
 };
 use crate::system::System;
@@ -396,5 +396,57 @@ pub fn bricard() -> Result<System, ModelError> {
             joint(&name, SpatialJointKind::Revolute, a.1, b_.1)?,
         );
     }
+    b.build()
+}
+
+/// A conservative spatial pendulum with a non-linear potential: a 1 kg rod with principal
+/// moments `moments` (axis along its body `z`) hung by a spherical joint at its upper end
+/// (0.4 m above its centre of mass) from the origin, pulled sideways by an undamped spring
+/// (40 N/m, rest length 0.3 m) from the ground point `(0.5, 0.3, -0.3)` to its lower end,
+/// gravity 9.81 m/s^2 along `-z`; it starts hanging straight down, moving with angular velocity
+/// `(0.5, -1.25, 2)` rad/s about its pivot. The damped and driven variant is
+/// `examples/models/spatial_spring_pendulum.toml`.
+///
+/// ```
+/// let p = mbd_model::models::sprung_rod([0.05, 0.05, 0.002])?;
+/// assert_eq!((p.n_coords(), p.n_constraints(), p.dof()), (12, 9, 3));
+/// assert!(p.is_conservative());
+/// # Ok::<(), mbd_model::ModelError>(())
+/// ```
+pub fn sprung_rod(moments: [f64; 3]) -> Result<System, ModelError> {
+    let mut b = SystemBuilder::new();
+    b.set_spatial_gravity([0.0, 0.0, -9.81]);
+    let inertia = SpatialInertia::principal(1.0, moments)
+        .map_err(|e| crate::check::invalid("spatial body 'rod'".into(), e.to_string()))?;
+    let omega = Vector3::new(0.5, -1.25, 2.0);
+    // the pivot at rest: v = omega x (x - pivot)
+    let v = omega.cross(&Vector3::new(0.0, 0.0, -0.4));
+    let rod = b.add_spatial_body(
+        SpatialBody::new("rod", inertia)
+            .position([0.0, 0.0, -0.4])
+            .velocity(v.into())
+            .angular_velocity(omega.into()),
+    );
+    b.add_spatial_joint(
+        "pivot",
+        SpatialBodyRef::Ground,
+        rod,
+        joint(
+            "pivot",
+            SpatialJointKind::Spherical,
+            Marker::at([0.0; 3]),
+            Marker::at([0.0, 0.0, 0.4]),
+        )?,
+    );
+    b.add_spatial_force(SpatialForce::spring_damper(
+        "spring",
+        SpatialBodyRef::Ground,
+        [0.5, 0.3, -0.3],
+        rod,
+        [0.0, 0.0, -0.4],
+        40.0,
+        0.0,
+        0.3,
+    ));
     b.build()
 }

@@ -10,8 +10,7 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
 /// and the s = 1 modified Lagrangian on the dense path (a singular mass matrix included: their
-/// metric uses the augmented `M_W^-1`), for models whose potential is gravity's and whose
-/// Jacobian does not depend on time
+/// metric uses the augmented `M_W^-1`), for models whose Jacobian does not depend on time
 /// (docs/spatial.md, "The preadjusted schemes"). Each refusal names what stands in the way.
 pub(super) fn spatial_support(
     sys: &System,
@@ -43,14 +42,6 @@ pub(super) fn spatial_support(
         return refuse(format!(
             "the s = 2 term's jet passes take planar elements only, not body '{first}' (the \
              s = 1 term and W_s take spatial bodies)"
-        ));
-    }
-    if let Some(f) = sys.spatial_forces().first() {
-        return refuse(format!(
-            "its derivative passes take gravity as the spatial potential, not force element \
-             '{}' ({})",
-            f.name,
-            f.kind_name()
         ));
     }
     if sys.jacobian_depends_on_time() {

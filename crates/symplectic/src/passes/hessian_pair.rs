@@ -75,7 +75,9 @@ pub(crate) fn add_lagrangian_hessian_pair(
         at.scatter_hess(&hb, out_b);
     });
     if sys.has_spatial() {
-        // the spatial rows (the element pass hands out planar joints only)
+        // the spatial force elements and rows (the element pass hands out planar ones only)
+        sys.add_spatial_force_hessian(q, a.potential, out_a);
+        sys.add_spatial_force_hessian(q, b.potential, out_b);
         sys.add_spatial_constraint_hessian(q, 0.0, a.constraints, 1.0, out_a);
         sys.add_spatial_constraint_hessian(q, 0.0, b.constraints, 1.0, out_b);
         sys.add_spatial_phi_q_dot(q, v, 0.0, ct);

@@ -66,6 +66,9 @@ pub(crate) fn add_potential_third(sys: &System, q: &[f64], v: &[f64], scale: f64
         );
         scatter_grad(at, &e.g2, scale, out);
     }
+    if sys.has_spatial() {
+        sys.add_spatial_force_third(q, v, scale, None, Some(out));
+    }
 }
 
 /// The weighted third derivative of the constraints contracted twice with `v`,
@@ -123,8 +126,8 @@ pub(crate) fn add_constraint_third(
 }
 /// `L = potential * V + sum_k weights_k Phi_k`: its Hessian-vector product
 /// `Hess L(q) w` (length n) into `out` (overwritten), one forward pass per element without
-/// forming a Hessian (`potential = 0` for the constraints alone). Spatial rows included;
-/// spatial force elements are not (the preadjustments refuse them).
+/// forming a Hessian (`potential = 0` for the constraints alone). Spatial rows and force
+/// elements included.
 pub(crate) fn lagrangian_hessian_vector(
     sys: &System,
     q: &[f64],
@@ -207,7 +210,10 @@ fn lagrangian_hessian_vector_impl(
         scatter_grad(at, &g, 1.0, out);
     }
     if sys.has_spatial() {
-        // the spatial rows (quadratic: constant Hessians); their forces are refused
+        // the spatial rows (quadratic: constant Hessians) and force elements
+        if potential != 0.0 {
+            sys.add_spatial_force_third(q, w, potential, Some(out), None);
+        }
         sys.add_spatial_hessian_vector(q, 0.0, w, weights, 1.0, out);
     }
 }
@@ -296,7 +302,11 @@ fn lagrangian_third_impl(
         scatter_grad(at, &g2, 1.0, d3);
     }
     if sys.has_spatial() {
-        // the spatial rows are quadratic: a Hessian-vector product and no third derivative
+        // the spatial force elements; the spatial rows are quadratic: a Hessian-vector product
+        // and no third derivative
+        if potential != 0.0 {
+            sys.add_spatial_force_third(q, v, potential, Some(hv), Some(d3));
+        }
         sys.add_spatial_hessian_vector(q, 0.0, v, weights, 1.0, hv);
     }
 }

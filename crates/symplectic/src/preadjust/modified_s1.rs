@@ -440,7 +440,9 @@ pub(crate) mod modlag_tests {
     /// the term itself, away from equilibrium and with a generic velocity: on the double
     /// pendulum (gravity), on a rod with a spring (where the `-1/8 v^T Hess V v` term and its
     /// third derivatives matter), and on spatial models (12 natural coordinates per body, the
-    /// internal constraints among the rows: the heavy top and the spatial double pendulum).
+    /// internal constraints among the rows: the heavy top, the spatial double pendulum, a rod on
+    /// a spring (a spatial force element's third derivatives) and the disc top, whose singular
+    /// mass matrix takes the augmented metric).
     #[test]
     fn modified_gradient_matches_differences() {
         for sys in [
@@ -448,6 +450,8 @@ pub(crate) mod modlag_tests {
             rod_with_spring(),
             models::heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap(),
             models::spatial_double_pendulum().unwrap(),
+            models::sprung_rod([0.05, 0.05, 0.002]).unwrap(),
+            models::heavy_top([0.25, 0.25, 0.5], 0.3, 20.0).unwrap(),
         ] {
             let st = mbd_solve::State::consistent(&sys, 0.0).unwrap();
             let n = sys.n_coords();

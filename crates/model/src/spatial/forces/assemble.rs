@@ -4,7 +4,7 @@
 
 use super::SW;
 use crate::spatial::system::SpatialPart;
-use mbd_jet::{DirJetN, HessJetN};
+use mbd_jet::{DirJetN, HessJetN, ThirdJetN};
 use nalgebra::DMatrix;
 
 impl SpatialPart {
@@ -36,6 +36,38 @@ impl SpatialPart {
             for (l, &g) in e.g.iter().enumerate() {
                 if let Some(c) = self.col(sides, l) {
                     out[c] += sign * g;
+                }
+            }
+        }
+    }
+
+    /// Along `v`: `hv += scale (d^2 V_forces / dq^2) v` and `d3 += scale D^3 V_forces(v, v, .)`
+    /// (each if given),
+    /// one third-order jet pass per element (torques have no potential and are skipped, as in
+    /// [`SpatialPart::add_force_hessian`]).
+    pub(crate) fn add_force_third(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        scale: f64,
+        hv: Option<&mut [f64]>,
+        d3: Option<&mut [f64]>,
+    ) {
+        let (mut hv, mut d3) = (hv, d3);
+        for (f, &sides) in self.lowered_forces.iter().zip(&self.force_attach) {
+            if matches!(f.kind, super::SpatialForceKind::Torque(_)) {
+                continue;
+            }
+            let [fa, fb] = self.frames(sides, |l, c| ThirdJetN::<SW>::var(l, q[c], v[c]));
+            let e = f.potential(&fa, &fb);
+            for l in 0..SW {
+                if let Some(c) = self.col(sides, l) {
+                    if let Some(hv) = hv.as_deref_mut() {
+                        hv[c] += scale * e.g1[l];
+                    }
+                    if let Some(d3) = d3.as_deref_mut() {
+                        d3[c] += scale * e.g2[l];
+                    }
                 }
             }
         }
