@@ -311,6 +311,13 @@ impl Galerkin {
                 if res <= 1e-8 * qscale {
                     break;
                 }
+                if chord {
+                    // with a Jacobian kept from an earlier step (near a singular
+                    // configuration it can stop Newton short of the solution): a new one here
+                    need_jacobian = true;
+                    prev_step = f64::INFINITY;
+                    continue;
+                }
                 return Err(fail(res, it, self.tab.s, &self.qk, &self.hvk));
             }
         }
