@@ -211,6 +211,29 @@ fn sprung_chain(n: usize) -> System {
     b.build().unwrap()
 }
 
+/// `steps` steps of 1e-3 of symplectic (2,2) on the sparse and on the dense stage solve (a new
+/// Jacobian at every step on both, so that they differ by their linear algebra alone): the
+/// end states and the Newton iterations, sparse first.
+fn symplectic_paths(sys: &System, steps: usize) -> ([State; 2], [usize; 2]) {
+    let run = |linear_solver| {
+        let opts = mbd::symplectic::SymplecticOptions {
+            linear_solver,
+            ..mbd::symplectic::SymplecticOptions::new(2)
+        }
+        .with_jacobian_reuse(mbd::symplectic::JacobianReuse::Never);
+        let mut integ = mbd::symplectic::Galerkin::new(sys, opts).unwrap();
+        let mut s = State::consistent(sys, 0.0).unwrap();
+        let mut its = 0;
+        for _ in 0..steps {
+            its += integ.step(sys, &mut s, 1e-3).unwrap().newton_iterations;
+        }
+        (s, its)
+    };
+    let (a, ia) = run(mbd::solve::LinearSolver::Sparse);
+    let (b, ib) = run(mbd::solve::LinearSolver::Dense);
+    ([a, b], [ia, ib])
+}
+
 /// With spring-dampers and a body-frame torque (force Hessians by coloured differences over
 /// 12-coordinate blocks, the non-conservative Jacobian included), the sparse and the dense
 /// stage solve of symplectic (2,2) agree to 1e-9 over 0.2 s on a 6-rod chain (54 equations).
@@ -218,22 +241,7 @@ fn sprung_chain(n: usize) -> System {
 fn the_sparse_symplectic_stage_takes_spatial_forces() {
     let sys = sprung_chain(6);
     assert!(sys.n_constraints() > mbd::solve::SPARSE_THRESHOLD);
-    let mut ends = Vec::new();
-    for linear_solver in [
-        mbd::solve::LinearSolver::Sparse,
-        mbd::solve::LinearSolver::Dense,
-    ] {
-        let opts = mbd::symplectic::SymplecticOptions {
-            linear_solver,
-            ..mbd::symplectic::SymplecticOptions::new(2)
-        };
-        let mut integ = mbd::symplectic::Galerkin::new(&sys, opts).unwrap();
-        let mut s = State::consistent(&sys, 0.0).unwrap();
-        for _ in 0..200 {
-            integ.step(&sys, &mut s, 1e-3).unwrap();
-        }
-        ends.push(s);
-    }
+    let (ends, _) = symplectic_paths(&sys, 200);
     let moved = (&ends[1].q - sys.initial_guess().0).amax();
     let d = (&ends[0].q - &ends[1].q)
         .amax()
@@ -285,26 +293,7 @@ fn the_sparse_symplectic_stage_carries_point_mass_force_hessians() {
     }
     let sys = b.build().unwrap();
     assert!(sys.n_constraints() > mbd::solve::SPARSE_THRESHOLD);
-    let mut ends = Vec::new();
-    let mut iterations = Vec::new();
-    for linear_solver in [
-        mbd::solve::LinearSolver::Sparse,
-        mbd::solve::LinearSolver::Dense,
-    ] {
-        let opts = mbd::symplectic::SymplecticOptions {
-            linear_solver,
-            ..mbd::symplectic::SymplecticOptions::new(2)
-        }
-        .with_jacobian_reuse(mbd::symplectic::JacobianReuse::Never);
-        let mut integ = mbd::symplectic::Galerkin::new(&sys, opts).unwrap();
-        let mut s = State::consistent(&sys, 0.0).unwrap();
-        let mut its = 0;
-        for _ in 0..100 {
-            its += integ.step(&sys, &mut s, 1e-3).unwrap().newton_iterations;
-        }
-        iterations.push(its);
-        ends.push(s);
-    }
+    let (ends, iterations) = symplectic_paths(&sys, 100);
     let d = (&ends[0].q - &ends[1].q).amax();
     eprintln!("sprung point masses: Newton iterations sparse / dense {iterations:?}, end states {d:.1e} apart");
     assert!(iterations[0] <= iterations[1] + 10, "{iterations:?}");
