@@ -244,9 +244,11 @@ fn the_slider_crank_keeps_constraints_and_energy_with_every_solver() -> Result<(
 /// The Bricard linkage with every spatial solver: all 60 equations, the redundant one
 /// included, and the energy (relative to `m g L` for the five bars, 49 J) kept over 3 s.
 /// Measured: max |Phi| 5.6e-12 (RK4), 1.0e-14 (projected RK4), 1.6e-8 (index-1 DOPRI5 at
-/// tolerance 1e-8), 7.1e-14 / 2.1e-13 (tangent RK4 / DOPRI5), 6.7e-16 / 6.7e-16 (symplectic
-/// (1,1) / (2,2)), 5.2e-16 (FA-DAE); energy 1.6e-12, 2.3e-14, 2.5e-9, 2.0e-14 / 2.5e-14,
-/// 7.9e-8 / 2.2e-15, 1.3e-11. (Symplectic (2,2) needs the stage LU's pivoting fallback to drop
+/// tolerance 1e-8), 7.1e-14 / 2.1e-13 (tangent RK4 / DOPRI5), 1.6e-15 / 1.6e-15 (symplectic
+/// (1,1) / (2,2), on the sparse path, whose stage Jacobian leaves out the equation the
+/// body-eliminated Schur complement finds dependent; 6.7e-16 / 6.7e-16 on the dense path),
+/// 5.2e-16 (FA-DAE); energy 1.6e-12, 2.3e-14, 2.5e-9, 2.0e-14 / 2.5e-14, 7.9e-8 / 3.0e-15,
+/// 1.3e-11. (On the dense path symplectic (2,2) needs the stage LU's pivoting fallback to drop
 /// the redundant multiplier: without it the run stopped at t = 0.173.)
 #[test]
 fn the_bricard_linkage_keeps_constraints_and_energy() -> Result<()> {

@@ -110,6 +110,17 @@ impl ConstrainedSolve {
         res.map_err(|e| crate::projection::bodies_error(sys, t, e))
     }
 
+    /// The equations the last factorisation dropped as dependent on earlier ones (a model
+    /// with redundant equations: their multipliers are zero, the basic solution), into `out`
+    /// (cleared first; no allocation once `out` has the capacity).
+    pub fn dependent_rows(&self, out: &mut Vec<usize>) {
+        out.clear();
+        match &self.kernel {
+            Kernel::Dense(schur) => schur.dependent_rows(out),
+            Kernel::Sparse(schur) => schur.dependent_rows(out),
+        }
+    }
+
     /// The solution `x` of `M x + Phi_q^T lambda = f`, `Phi_q x = r` and its multipliers at the
     /// last factorisation.
     pub fn solve(

@@ -159,18 +159,7 @@ impl Galerkin {
         // (a preadjustment on spatial bodies takes the dense path: its passes over spatial rows
         // fill dense Hessians and Phi_q)
         let sparse_ok = options.gamma == 0.0 && !(modlag && sys.has_spatial());
-        // spatial bodies with redundant equations take the dense path (the sparse path finds
-        // the dependent rows through the planar Schur complement): up to the dense limit
-        let spatial_redundant = sys.has_spatial() && sys.n_redundant() > 0;
-        if spatial_redundant {
-            mbd_solve::refuse_large_spatial(
-                sys,
-                "the symplectic scheme (spatial bodies with redundant equations)",
-                options.linear_solver,
-            )?;
-        }
-        let use_sparse =
-            options.linear_solver.use_sparse(m) && m > 0 && sparse_ok && !spatial_redundant;
+        let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(
                 "the sparse symplectic stage solve needs gamma = 0 (the Hessian of the paper's \

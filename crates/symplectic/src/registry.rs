@@ -24,7 +24,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 3.0,
-            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only); with gamma=G also angle drivers and spatial models of more than 600 equations",
+            refuses: "with gamma=G: spatial angle drivers and spatial models of more than 600 equations",
             compared: true,
         },
         SolverVariant {
@@ -35,7 +35,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "spatial models with redundant equations above 600 equations (its sparse path finds the dependent rows of planar models only); with gamma=G also angle drivers and spatial models of more than 600 equations",
+            refuses: "with gamma=G: spatial angle drivers and spatial models of more than 600 equations",
             compared: true,
         },
         SolverVariant {

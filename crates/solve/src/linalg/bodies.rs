@@ -132,6 +132,12 @@ impl BodySchur {
         })
     }
 
+    /// The model rows (equations) the last factorisation dropped as dependent on earlier
+    /// ones, appended to `out` (none for a model without redundant equations).
+    pub(crate) fn dependent_rows(&self, out: &mut Vec<usize>) {
+        out.extend(self.chol.dependent().iter().map(|&e| self.rows[e]));
+    }
+
     /// The solution `a` of `M a + Phi^T lambda = f`, `Phi a = r` at the last factorisation
     /// (see the module documentation), with its multipliers `lambda` (length m).
     pub(crate) fn solve(

@@ -63,6 +63,8 @@ pub(super) struct SparseStage {
     max_width: usize,
     /// Each block's first coordinate and width.
     blocks: Vec<(usize, usize)>,
+    /// The equations dependent at the last Jacobian's end configuration (a redundant model).
+    dep: Vec<usize>,
     /// Workspaces of the curvature: a seed direction, the rows of `Phi_q` and of
     /// `(Phi_q v + Phi_t)_q` along it, and (rheonomic models) the rows of `Phi_tq` alone,
     /// which the curvature leaves out.
@@ -361,6 +363,7 @@ impl SparseStage {
             color_blocks,
             max_width,
             blocks,
+            dep: Vec::with_capacity(sys.n_redundant()),
             vdir: vec![0.0; n],
             zero: vec![0.0; n],
             gscratch: vec![0.0; nv],
@@ -638,18 +641,33 @@ impl Galerkin {
                 vals[sp.k_slot[i]] += minv[i] * (cw * 2.0 * wd[i] + ch * ad[i]);
             }
         }
-        if let (false, Some(schur)) = (sp.diag_slot.is_empty(), sp.schur.as_mut()) {
+        if !sp.diag_slot.is_empty() {
             // the equations dependent at the step's end configuration are left out: their
             // rows become the identity on their multipliers, which then stay put (Newton
-            // moves them by the residual of an equation the others imply)
-            schur.update(sys, &self.qn[s * n..(s + 1) * n]);
-            schur.factor(&self.minv).map_err(|_| SolveError::Singular {
+            // moves them by the residual of an equation the others imply); found by the
+            // planar Schur complement, or with spatial bodies by the body-eliminated one of
+            // the end velocity's constrained solve
+            let q_end = &self.qn[s * n..(s + 1) * n];
+            let more = || SolveError::Singular {
                 t: t + h,
                 what: "constraint matrix Phi_q M^-1 Phi_q^T of the stage equations",
                 detail: "more dependent equations than the model's redundant ones".into(),
-            })?;
+            };
+            match (sp.schur.as_mut(), self.end_solve.as_deref_mut()) {
+                (Some(schur), _) => {
+                    schur.update(sys, q_end);
+                    schur.factor(&self.minv).map_err(|_| more())?;
+                    sp.dep.clear();
+                    sp.dep.extend_from_slice(schur.dependent());
+                }
+                (None, Some(es)) => {
+                    es.solve.factor(sys, q_end, t + h)?;
+                    es.solve.dependent_rows(&mut sp.dep);
+                }
+                (None, None) => {}
+            }
             let vals = sp.lu.values_mut();
-            for &r in schur.dependent() {
+            for &r in &sp.dep {
                 let rv = sp.rstart[r]..sp.rstart[r + 1];
                 for nu in 1..=s {
                     for k in rv.clone() {
