@@ -7,6 +7,8 @@
 //! bodies (see `docs/symplectic.md`, "Sparse stage solve").
 
 use super::{with_time, Galerkin};
+
+mod curvature;
 use mbd_model::{BodyRef, System};
 use mbd_solve::linalg::LuError;
 use mbd_solve::sparse::{BlockRows, ConstraintSchur, SparseLu};
@@ -527,107 +529,7 @@ impl Galerkin {
                 }
             }
         }
-        // constraint curvature at the interior control points: `lambda_r Hess Phi_r` row by
-        // row, from the seed passes (rows whose Hessian varies, and every row at the first
-        // Jacobian, which keeps the constant ones) or from the kept constant Hessians
-        let rheonomic = sys.jacobian_depends_on_time();
-        let nc = sp.cstart.last().copied().unwrap_or(0);
-        let cached = sp.hess_ready;
-        for nu in 1..s {
-            let q = &self.qn[nu * n..(nu + 1) * n];
-            let tn = t + tab.tau[nu] * h;
-            let lam = &self.x[s * n + nu * m..s * n + (nu + 1) * m];
-            if rheonomic && (!cached || sp.hess_varies) {
-                // (Phi_q 0 + Phi_t)_q = Phi_tq: not curvature, subtracted below
-                sp.rows
-                    .gather_tan(sys, q, &sp.zero, tn, &mut sp.gscratch, &mut sp.dtime);
-            }
-            for (k, blocks) in sp.color_blocks.iter().enumerate() {
-                if cached && !sp.hess_varies {
-                    break;
-                }
-                for l in 0..sp.max_width {
-                    let mut any = false;
-                    for &b in blocks {
-                        let (c0, w) = sp.blocks[b];
-                        if l < w {
-                            sp.vdir[c0 + l] = 1.0;
-                            any = true;
-                        }
-                    }
-                    if !any {
-                        continue;
-                    }
-                    sp.rows
-                        .gather_tan(sys, q, &sp.vdir, tn, &mut sp.gscratch, &mut sp.dgrads);
-                    for &b in blocks {
-                        let (c0, w) = sp.blocks[b];
-                        if l < w {
-                            sp.vdir[c0 + l] = 0.0;
-                        }
-                    }
-                    if rheonomic {
-                        for (d, z) in sp.dgrads.iter_mut().zip(&sp.dtime) {
-                            *d -= z;
-                        }
-                    }
-                    let vals = sp.lu.values_mut();
-                    for (r, sides) in sp.rows.sides().iter().enumerate() {
-                        let constant = sp.hess_const[r];
-                        if cached && constant {
-                            continue;
-                        }
-                        let (r0, len) = (sp.rstart[r], sp.rstart[r + 1] - sp.rstart[r]);
-                        for side in sides.iter().flatten() {
-                            if sp.color[side.block] != k || l >= side.width {
-                                continue;
-                            }
-                            let a = side.off - r0 + l;
-                            let at = sp.cstart[r] + a * len;
-                            if constant {
-                                sp.hess[at..at + len].copy_from_slice(&sp.dgrads[r0..r0 + len]);
-                            }
-                            let lr = lam[r];
-                            if lr == 0.0 {
-                                continue;
-                            }
-                            let f = -h2 * minv[side.col + l] * lr;
-                            let sl = &sp.curv_slot[(nu - 1) * nc + at..(nu - 1) * nc + at + len];
-                            for (&slot, &d) in sl.iter().zip(&sp.dgrads[r0..r0 + len]) {
-                                if slot != NONE {
-                                    vals[slot] += f * d;
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            if cached {
-                let vals = sp.lu.values_mut();
-                for (r, sides) in sp.rows.sides().iter().enumerate() {
-                    let lr = lam[r];
-                    if !sp.hess_const[r] || lr == 0.0 {
-                        continue;
-                    }
-                    let (r0, len) = (sp.rstart[r], sp.rstart[r + 1] - sp.rstart[r]);
-                    for side in sides.iter().flatten() {
-                        for l in 0..side.width {
-                            let at = sp.cstart[r] + (side.off - r0 + l) * len;
-                            let f = -h2 * minv[side.col + l] * lr;
-                            let sl = &sp.curv_slot[(nu - 1) * nc + at..(nu - 1) * nc + at + len];
-                            for (&slot, &d) in sl.iter().zip(&sp.hess[at..at + len]) {
-                                if slot != NONE {
-                                    vals[slot] += f * d;
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        if s > 1 {
-            sp.hess_ready = true;
-        }
+        curvature::add(sp, sys, &self.qn, &self.x, tab, minv, (n, m), (t, h));
         if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
             // the s = 1 modified Lagrangian: the diagonals of the blocks of galerkin/dense.rs,
             // -h^2/12 (2 B) and -h^4/48 A M^-1 A, on the entries (i, Z_1,i) (docs/symplectic.md
