@@ -248,6 +248,16 @@ pub fn refuse_redundant(sys: &mbd_model::System, solver: &str) -> Result<(), Sol
 
 /// The refusal of a solver that does not run spatial bodies yet: `Ok` for a planar model,
 /// else [`SolveError::Unsupported`] naming `solver` and the first spatial body (or point mass).
+/// Every registered solver runs spatial models now; this is for a solver crate of one's own.
+///
+/// ```
+/// use mbd_model::models::{heavy_top, pendulum};
+/// let top = heavy_top([0.3, 0.3, 0.1], 0.3, 20.0)?;
+/// let e = mbd_solve::refuse_spatial(&top, "my solver").unwrap_err().to_string();
+/// assert!(e.contains("my solver") && e.contains("'top'"), "{e}");
+/// assert!(mbd_solve::refuse_spatial(&pendulum(1.0, 1.0, 0.5, 9.81)?, "my solver").is_ok());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), SolveError> {
     let first = sys
         .spatial_bodies()
@@ -257,9 +267,8 @@ pub fn refuse_spatial(sys: &mbd_model::System, solver: &str) -> Result<(), Solve
     match first {
         None => Ok(()),
         Some(name) => Err(SolveError::Unsupported(format!(
-            "{solver} does not run spatial bodies yet (body '{name}'); the index-1 solvers (rk4, \
-             rk4-projected, index1:dopri5), the plain symplectic, the tangent and the \
-             firefly-gauss solvers do"
+            "{solver} does not run spatial bodies yet (body '{name}'); `mbd solvers` lists the \
+             solvers that do"
         ))),
     }
 }
