@@ -2,6 +2,7 @@
 //! index-1 solvers (energy, the conserved angular momentum, constraints, convergence order),
 //! and a clear refusal from the solvers that do not run spatial bodies yet.
 
+mod common;
 use mbd::model::models::{free_body, heavy_top};
 use mbd::prelude::*;
 use mbd::Simulation;
@@ -10,19 +11,6 @@ use nalgebra::{DVector, Vector3};
 /// Angular momentum about the origin (`System::spatial_angular_momentum`).
 fn angular_momentum(sys: &System, s: &State) -> Vector3<f64> {
     Vector3::from(sys.spatial_angular_momentum(s.q.as_slice(), s.v.as_slice()))
-}
-
-/// The state of `sys` after a run with `spec` (fixed steps or adaptive).
-fn end_state(sys: &System, spec: &str, plan: impl Into<Plan>) -> State {
-    let mut sim = Simulation::new(sys.clone(), spec).unwrap();
-    sim.run(plan).unwrap();
-    sim.state().clone()
-}
-
-fn max_phi(sys: &System, s: &State) -> f64 {
-    let mut phi = vec![0.0; sys.n_constraints()];
-    sys.phi(s.q.as_slice(), s.t, &mut phi);
-    phi.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// The heavy top (a solid body, 20 rad/s) with projected RK4 at h = 1e-3 over 2 s: energy to
@@ -58,7 +46,11 @@ fn top_keeps_its_invariants(moments: [f64; 3]) {
         l0[2],
         l1[2]
     );
-    assert!(max_phi(&sys, s) < 1e-12, "{}", max_phi(&sys, s));
+    assert!(
+        common::max_phi_at(&sys, s) < 1e-12,
+        "{}",
+        common::max_phi_at(&sys, s)
+    );
     // the top precesses: its centre of mass has moved round the vertical
     let o = sys.spatial_offset();
     let x0 = sys.initial_guess().0;
@@ -71,7 +63,7 @@ fn top_keeps_its_invariants(moments: [f64; 3]) {
 #[test]
 fn rk4_converges_with_order_four_on_the_heavy_top() {
     let sys = heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap();
-    let end = |spec: &str, plan: Plan| -> DVector<f64> { end_state(&sys, spec, plan).q };
+    let end = |spec: &str, plan: Plan| -> DVector<f64> { common::end_state(&sys, spec, plan).q };
     let reference = end("rk4", RunConfig::new(0.5, 1.25e-4).into());
     let errs: Vec<f64> = [4e-3, 2e-3, 1e-3]
         .iter()
@@ -221,16 +213,16 @@ fn flips_of_a_tumbling_plate_match_the_exact_solution() {
 fn firefly_gauss_runs_spatial_tops() {
     for moments in [[0.3, 0.3, 0.1], [0.25, 0.25, 0.5]] {
         let sys = heavy_top(moments, 0.3, 20.0).unwrap();
-        let end = |spec: &str, h: f64| end_state(&sys, spec, RunConfig::new(0.1, h));
+        let end = |spec: &str, h: f64| common::end_state(&sys, spec, RunConfig::new(0.1, h));
         let reference = end("rk4", 1e-4);
         let s = end("firefly-gauss:polish", 1e-3);
         let d = (&s.q - &reference.q).amax();
         eprintln!(
             "{moments:?}: firefly-gauss:polish off by {d:.1e}, |Phi| {:.1e}",
-            max_phi(&sys, &s)
+            common::max_phi_at(&sys, &s)
         );
         assert!(d < 1e-7, "{moments:?}: {d:e}");
-        assert!(max_phi(&sys, &s) < 1e-10, "{moments:?}");
+        assert!(common::max_phi_at(&sys, &s) < 1e-10, "{moments:?}");
     }
 }
 
@@ -241,14 +233,18 @@ fn firefly_gauss_runs_spatial_tops() {
 fn the_tangent_solvers_reach_their_orders_on_spatial_tops() {
     for moments in [[0.3, 0.3, 0.1], [0.25, 0.25, 0.5]] {
         let sys = heavy_top(moments, 0.3, 20.0).unwrap();
-        let end = |spec: &str, h: f64| end_state(&sys, spec, RunConfig::new(0.5, h));
+        let end = |spec: &str, h: f64| common::end_state(&sys, spec, RunConfig::new(0.5, h));
         let reference = end("rk4", 1.25e-4);
         for (spec, order) in [("tangent:rk4", 4.0), ("tangent:dopri5", 5.0)] {
             let mut errs = Vec::new();
             for h in [4e-3, 2e-3, 1e-3] {
                 let s = end(spec, h);
                 errs.push((&s.q - &reference.q).amax());
-                assert!(max_phi(&sys, &s) < 1e-12, "{spec}: {}", max_phi(&sys, &s));
+                assert!(
+                    common::max_phi_at(&sys, &s) < 1e-12,
+                    "{spec}: {}",
+                    common::max_phi_at(&sys, &s)
+                );
             }
             let orders: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
             eprintln!("{moments:?} {spec}: errors {errs:?}, orders {orders:?}");
@@ -271,7 +267,7 @@ fn the_tangent_solvers_reach_their_orders_on_spatial_tops() {
 fn the_plain_symplectic_scheme_reaches_its_orders_on_both_tops() {
     for moments in [[0.3, 0.3, 0.1], [0.25, 0.25, 0.5]] {
         let sys = heavy_top(moments, 0.3, 20.0).unwrap();
-        let end = |spec: &str, h: f64| end_state(&sys, spec, RunConfig::new(0.5, h));
+        let end = |spec: &str, h: f64| common::end_state(&sys, spec, RunConfig::new(0.5, h));
         let reference = end("rk4", 1.25e-4);
         for (spec, order) in [("symplectic:1", 2.0), ("symplectic:2", 4.0)] {
             let errs: Vec<f64> = [4e-3, 2e-3, 1e-3]
@@ -291,10 +287,10 @@ fn the_plain_symplectic_scheme_reaches_its_orders_on_both_tops() {
         let d = (&s3.q - &reference.q).amax();
         eprintln!(
             "{moments:?} symplectic:3: {d:.1e} from the reference, |Phi| {:.1e}",
-            max_phi(&sys, &s3)
+            common::max_phi_at(&sys, &s3)
         );
         assert!(d < 1e-10, "{moments:?} symplectic:3: {d:e}");
-        assert!(max_phi(&sys, &s3) < 1e-12);
+        assert!(common::max_phi_at(&sys, &s3) < 1e-12);
         // the s = 2 modified Lagrangian's passes are planar: refused, naming the body
         let e = Simulation::new(sys.clone(), "symplectic:2:modified")
             .unwrap_err()
@@ -324,7 +320,7 @@ fn symplectic_keeps_the_angular_momentum_of_a_tumbling_body() {
         worst = (
             worst.0.max(e),
             worst.1.max(l),
-            worst.2.max(max_phi(&sys, s)),
+            worst.2.max(common::max_phi_at(&sys, s)),
         );
         Ok(Flow::Continue)
     };
@@ -398,7 +394,8 @@ fn a_spatial_hinge_swings_like_the_planar_pendulum() {
         [-0.5 * l, 0.0],
     ));
     let planar = p.build().unwrap();
-    let end = |sys: &System| end_state(sys, "index1:dopri5", AdaptiveConfig::new(2.0, 1e-12));
+    let end =
+        |sys: &System| common::end_state(sys, "index1:dopri5", AdaptiveConfig::new(2.0, 1e-12));
     let (s, pl) = (end(&spatial), end(&planar));
     // the rod's direction: body x = d_1; its angle from the downward vertical in x-z
     let d1 = Vector3::new(s.q[3], s.q[4], s.q[5]);
@@ -500,7 +497,7 @@ fn a_spatial_double_pendulum_conserves_energy() {
     let s = sim.state();
     let h1 = sys.energy(s.q.as_slice(), s.v.as_slice());
     assert!((h1 - h0).abs() < 1e-7 * scale, "H {h0} -> {h1}");
-    assert!(max_phi(&sys, s) < 1e-12);
+    assert!(common::max_phi_at(&sys, s) < 1e-12);
     // it fell
     assert!(s.q[12 + 2] < -0.5, "{}", s.q[14]);
 }

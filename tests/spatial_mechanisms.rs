@@ -5,6 +5,7 @@
 //! that runs spatial bodies keeps the constraints and the energy; two independent solvers
 //! agree at fine settings; the Bricard linkage moves with one degree of freedom.
 
+mod common;
 use mbd::model::models::{bricard, spatial_double_pendulum, spatial_slider_crank};
 use mbd::prelude::*;
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -34,12 +35,6 @@ fn mechanisms() -> Vec<(&'static str, System, &'static str)> {
     ]
 }
 
-fn max_phi(sys: &System, q: &[f64], t: f64) -> f64 {
-    let mut phi = vec![0.0; sys.n_constraints()];
-    sys.phi(q, t, &mut phi);
-    phi.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
 /// What a run kept: the largest `|Phi|` over its steps, the largest energy change relative to
 /// `scale`, and the end state.
 struct Kept {
@@ -54,9 +49,9 @@ fn run_watched(sys: &System, spec: &str, t_end: f64, h: f64, scale: f64) -> Resu
     let mut sim = Simulation::new(sys.clone(), spec)?;
     let s0 = sim.state().clone();
     let h0 = sys.energy(s0.q.as_slice(), s0.v.as_slice());
-    let (mut phi, mut energy) = (max_phi(sys, s0.q.as_slice(), 0.0), 0.0f64);
+    let (mut phi, mut energy) = (common::max_phi(sys, s0.q.as_slice(), 0.0), 0.0f64);
     let mut watch = |sys: &System, s: &State, _: usize| -> std::result::Result<Flow, SolveError> {
-        phi = phi.max(max_phi(sys, s.q.as_slice(), s.t));
+        phi = phi.max(common::max_phi(sys, s.q.as_slice(), s.t));
         let e = sys.energy(s.q.as_slice(), s.v.as_slice());
         energy = energy.max((e - h0).abs() / scale);
         Ok(Flow::Continue)

@@ -4,6 +4,7 @@
 //! against a spatial body whose inertia cannot matter, every spatial solver on the spherical
 //! pendulum, the sparse path against the dense one on a chain, and the joint's reaction.
 
+mod common;
 use mbd::model::spatial::{
     Marker, SpatialBody, SpatialBodyRef, SpatialInertia, SpatialJoint, SpatialJointKind,
 };
@@ -39,12 +40,6 @@ fn precessing() -> System {
     spherical_pendulum(1.5, l, [l * th.sin(), 0.0, -l * th.cos()], [0.0, 1.9, 0.0])
 }
 
-fn max_phi(sys: &System, q: &[f64], t: f64) -> f64 {
-    let mut phi = vec![0.0; sys.n_constraints()];
-    sys.phi(q, t, &mut phi);
-    phi.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
 /// The largest `|Phi|` and the largest energy and `L_z` changes (relative to the energy scale
 /// and to `|L_z(0)|`) along a run of `spec`, and the end state.
 struct Kept {
@@ -63,7 +58,7 @@ fn run_watched(sys: &System, spec: &str, t_end: f64, h: f64) -> Kept {
     let (mut phi, mut energy, mut lz) = (0.0f64, 0.0f64, 0.0f64);
     let mut watch = |sys: &System, s: &State, _: usize| -> Result<Flow, SolveError> {
         let (q, v) = (s.q.as_slice(), s.v.as_slice());
-        phi = phi.max(max_phi(sys, q, s.t));
+        phi = phi.max(common::max_phi(sys, q, s.t));
         energy = energy.max((sys.energy(q, v) - h0).abs() / scale);
         lz = lz.max((sys.spatial_angular_momentum(q, v)[2] - lz0).abs() / lz0.abs());
         Ok(Flow::Continue)

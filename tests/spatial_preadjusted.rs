@@ -4,32 +4,21 @@
 //! pendulum, their orders against an RK4 reference, the modified Lagrangian's gain over the
 //! plain (1,1) scheme in the trajectory and in the energy of a torque-free body.
 
+mod common;
 use mbd::model::models::{free_body, heavy_top, spatial_double_pendulum, sprung_rod};
 use mbd::prelude::*;
 use mbd::Simulation;
-
-fn end_state(sys: &System, spec: &str, t: f64, h: f64) -> State {
-    let mut sim = Simulation::new(sys.clone(), spec).unwrap();
-    sim.run(RunConfig::new(t, h)).unwrap();
-    sim.state().clone()
-}
-
-fn max_phi(sys: &System, s: &State) -> f64 {
-    let mut phi = vec![0.0; sys.n_constraints()];
-    sys.phi(s.q.as_slice(), s.t, &mut phi);
-    phi.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
 
 /// Errors at t against the reference for h, h/2, h/4, and the two fitted orders.
 fn errors(sys: &System, spec: &str, t: f64, h: f64, reference: &State) -> (Vec<f64>, Vec<f64>) {
     let errs: Vec<f64> = [h, h / 2.0, h / 4.0]
         .iter()
         .map(|&h| {
-            let s = end_state(sys, spec, t, h);
+            let s = common::end_state(sys, spec, RunConfig::new(t, h));
             assert!(
-                max_phi(sys, &s) < 1e-12,
+                common::max_phi_at(sys, &s) < 1e-12,
                 "{spec} h = {h}: |Phi| {:e}",
-                max_phi(sys, &s)
+                common::max_phi_at(sys, &s)
             );
             (&s.q - &reference.q).amax()
         })
@@ -80,7 +69,7 @@ fn the_modified_lagrangian_reaches_order_four_on_spatial_models() {
             1e-2,
         ),
     ] {
-        let reference = end_state(&sys, "rk4", t, h / 32.0);
+        let reference = common::end_state(&sys, "rk4", RunConfig::new(t, h / 32.0));
         let (plain, po) = errors(&sys, "symplectic:1", t, h, &reference);
         let (modified, mo) = errors(&sys, "symplectic:1:modified", t, h, &reference);
         eprintln!(
@@ -105,7 +94,7 @@ fn the_modified_lagrangian_reaches_order_four_on_spatial_models() {
 fn a_thin_disc_takes_the_preadjusted_schemes_at_their_orders() {
     let sys = heavy_top([0.25, 0.25, 0.5], 0.3, 20.0).unwrap();
     let (t, h) = (0.5, 4e-3);
-    let reference = end_state(&sys, "rk4", t, h / 32.0);
+    let reference = common::end_state(&sys, "rk4", RunConfig::new(t, h / 32.0));
     let (plain, po) = errors(&sys, "symplectic:1", t, h, &reference);
     let (modified, mo) = errors(&sys, "symplectic:1:modified", t, h, &reference);
     let (paper, pa) = errors(&sys, "symplectic:2:gamma=1", t, h, &reference);
@@ -126,7 +115,7 @@ fn a_thin_disc_takes_the_preadjusted_schemes_at_their_orders() {
 fn paper_w_s_keeps_the_orders_on_spatial_models() {
     let sys = spatial_double_pendulum().unwrap();
     let (t, h) = (1.0, 1e-2);
-    let reference = end_state(&sys, "rk4", t, h / 32.0);
+    let reference = common::end_state(&sys, "rk4", RunConfig::new(t, h / 32.0));
     for s in [1usize, 2] {
         let (plain, _) = errors(&sys, &format!("symplectic:{s}"), t, h, &reference);
         let (paper, po) = errors(&sys, &format!("symplectic:{s}:gamma=1"), t, h, &reference);

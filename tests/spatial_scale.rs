@@ -4,15 +4,10 @@
 //! whose solves are dense, refuses a chain past the dense limit by name instead of allocating
 //! dense matrices of the model's size.
 
+mod common;
 use mbd::model::models::spatial_chain;
 use mbd::prelude::*;
 use mbd::Simulation;
-
-fn max_phi(sys: &System, s: &State) -> f64 {
-    let mut phi = vec![0.0; sys.n_constraints()];
-    sys.phi(s.q.as_slice(), s.t, &mut phi);
-    phi.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
 
 /// A 12-rod chain (108 equations: the sparse path) for 0.5 s at h = 1e-3: projected RK4 keeps
 /// the energy to 1e-9 of its scale and the constraints to 1e-12; plain RK4 and index-1
@@ -36,10 +31,10 @@ fn a_spatial_chain_runs_on_the_sparse_path() {
     let dh = (sys.energy(p.q.as_slice(), p.v.as_slice()) - h0).abs() / scale;
     eprintln!(
         "rk4-projected: energy {dh:.1e} of its scale, |Phi| {:.1e}",
-        max_phi(&sys, &p)
+        common::max_phi_at(&sys, &p)
     );
     assert!(dh < 1e-9, "{dh:e}");
-    assert!(max_phi(&sys, &p) < 1e-12);
+    assert!(common::max_phi_at(&sys, &p) < 1e-12);
     for spec in ["rk4", "index1:dopri5"] {
         let s = end(spec);
         let d = (&s.q - &p.q).amax();
@@ -72,10 +67,10 @@ fn sparse_against_dense(
         let d = (&s.q - &reference.q).amax();
         eprintln!(
             "{name} ({linear:?}): {d:.1e} from rk4-projected, |Phi| {:.1e}",
-            max_phi(&sys, &s)
+            common::max_phi_at(&sys, &s)
         );
         assert!(d < 1e-8, "{name} {linear:?}: {d:e}");
-        assert!(max_phi(&sys, &s) < 1e-12);
+        assert!(common::max_phi_at(&sys, &s) < 1e-12);
         ends.push(s);
     }
     let d = (&ends[0].q - &ends[1].q)
