@@ -27,7 +27,9 @@ const BRANCH_TOL: f64 = 1e-2;
 /// mechanism; the free one (released at 6 rad/s, turning over) shows where solvers still lose
 /// accuracy or stop with an untyped error at a singular passage.
 const FREE_MISS: &str = "the free N-four-bar goes beyond the driven target: projected RK4 \
-    loses accuracy at the smallest h and tangent DOPRI5's error does not fall with h (open work)";
+    loses accuracy at the smallest h and tangent DOPRI5's error does not fall with h: a stage \
+    that lands near a flat configuration gets an index-1 acceleration whose error grows like \
+    the inverse square of the distance (docs/report.md, own-singular; open work)";
 
 /// How a run ended.
 enum Outcome {
