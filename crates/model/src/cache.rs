@@ -117,9 +117,10 @@ impl BodyAngles {
         }
     }
 
-    /// Whether the table holds the angles of `q` (the `_at` passes check it in debug builds).
+    /// Whether the table holds the angles of `q` (the `_at` passes check it in debug builds):
+    /// those of its planar bodies, whose coordinates come first (spatial ones may follow).
     pub fn matches(&self, q: &[f64]) -> bool {
-        q.len() == 3 * self.sc.len()
+        q.len() >= 3 * self.sc.len()
             && self
                 .sc
                 .iter()

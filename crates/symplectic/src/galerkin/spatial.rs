@@ -10,7 +10,9 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
 /// and the s = 1 modified Lagrangian on the dense path (a singular mass matrix included: their
-/// metric uses the augmented `M_W^-1`), for models whose Jacobian does not depend on time
+/// metric uses the augmented `M_W^-1`), the s = 2 modified Lagrangian there for bodies with a
+/// definite mass matrix and no spatial force elements, for models whose Jacobian does not
+/// depend on time
 /// (docs/spatial.md, "The preadjusted schemes"). Each refusal names what stands in the way.
 pub(super) fn spatial_support(
     sys: &System,
@@ -33,16 +35,21 @@ pub(super) fn spatial_support(
         )))
     };
     if modlag && s == 2 {
-        let first = sys
-            .spatial_bodies()
-            .first()
-            .map(|b| b.name.as_str())
-            .or_else(|| sys.spatial_point_masses().first().map(|p| p.name.as_str()))
-            .unwrap_or_default();
-        return refuse(format!(
-            "the s = 2 term's jet passes take planar elements only, not body '{first}' (the \
-             s = 1 term and W_s take spatial bodies)"
-        ));
+        // the s = 2 term's passes take quadratic constraint rows and a linear potential, and
+        // its reverse pass the constant diagonal M^-1
+        if let Some(f) = sys.spatial_forces().first() {
+            return refuse(format!(
+                "the s = 2 term's passes take gravity as the only potential of spatial bodies, \
+                 not force element '{}' (the s = 1 term and W_s take it)",
+                f.name
+            ));
+        }
+        if let Some(b) = crate::preadjust::singular_body(sys) {
+            return refuse(format!(
+                "the s = 2 term needs a definite mass matrix, and body '{b}' has a zero second \
+                 moment E_i (a thin disc or plate; the s = 1 term and W_s take it)"
+            ));
+        }
     }
     if sys.jacobian_depends_on_time() {
         return refuse(

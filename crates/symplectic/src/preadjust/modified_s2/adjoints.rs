@@ -3,6 +3,7 @@
 
 use super::passes::{BasisR, Pass, NA, NB, NC, NR, R_OUTPUTS};
 use crate::preadjust::{LocalRow, ZERO_ROW};
+use mbd_model::System;
 
 /// The element-local columns of a constraint row: the first coordinate of the joint's body a
 /// (local columns 0..3) and of its body b (3..6), `None` for ground.
@@ -41,8 +42,10 @@ pub(super) struct Adjoints {
     pub(super) rpass: Pass<NR, BasisR>,
     pub(super) rw: Vec<[[f64; NR]; R_OUTPUTS]>,
 
-    /// `Gb` in element-local form.
+    /// `Gb` in element-local form (planar rows).
     pub(super) gbar: Vec<LocalRow>,
+    /// The spatial rows' share of `sum_r Hess Phi_r Gb_r` (length n), added as `Gb` grows.
+    pub(super) sgq: Vec<f64>,
     /// Scratch: n-vectors and m-vectors.
     pub(super) tn: [Vec<f64>; 8],
     pub(super) tm: [Vec<f64>; 4],
@@ -79,6 +82,7 @@ impl Adjoints {
             rw: vec![[[0.0; NR]; R_OUTPUTS]; m],
 
             gbar: vec![ZERO_ROW; m],
+            sgq: zn(),
             tn: std::array::from_fn(|_| zn()),
             tm: std::array::from_fn(|_| zm()),
         }
@@ -113,12 +117,46 @@ impl Adjoints {
         self.pa = [0.0; NA];
         self.pb = [0.0; NB];
         self.gbar.fill(ZERO_ROW);
+        self.sgq.fill(0.0);
     }
 }
 
-/// `Gb += c alpha beta^T` in element-local form.
-pub(super) fn gbar_add(gbar: &mut [LocalRow], cols: &[Cols], c: f64, al: &[f64], be: &[f64]) {
-    for ((g, cols), &a) in gbar.iter_mut().zip(cols).zip(al) {
+/// What `Gb += c alpha beta^T` needs: the planar rows' local columns, and for the spatial rows
+/// (whose Hessians are constant) the model and `q` at which their share
+/// `sum_r c alpha_r Hess Phi_r beta` is applied at once.
+#[derive(Clone, Copy)]
+pub(super) struct GbCtx<'a> {
+    sys: &'a System,
+    q: &'a [f64],
+    cols: &'a [Cols],
+    spatial: bool,
+}
+
+impl<'a> GbCtx<'a> {
+    pub(super) fn new(sys: &'a System, q: &'a [f64], cols: &'a [Cols]) -> Self {
+        GbCtx {
+            sys,
+            q,
+            cols,
+            spatial: sys.has_spatial(),
+        }
+    }
+}
+
+/// `Gb += c alpha beta^T`: in element-local form on the planar rows; on the spatial rows its
+/// contribution to `qb`, `c sum_r alpha_r Hess Phi_r beta`, into `sgq`.
+pub(super) fn gbar_add(
+    gbar: &mut [LocalRow],
+    sgq: &mut [f64],
+    cx: GbCtx,
+    c: f64,
+    al: &[f64],
+    be: &[f64],
+) {
+    if cx.spatial {
+        cx.sys.add_spatial_hessian_vector(cx.q, 0.0, be, al, c, sgq);
+    }
+    for ((g, cols), &a) in gbar.iter_mut().zip(cx.cols).zip(al) {
         if a == 0.0 {
             continue;
         }

@@ -184,15 +184,17 @@ impl ModifiedS2 {
             f.kap3u[r] = 2.0 * a[A_ETT] + 2.0 * c[C_AT] + b[B_ED];
             f.kap4[r] = 24.0 * a[A_T4] + 12.0 * b[B_ETT] + 6.0 * b[B_EE] + 4.0 * c[C_BT];
         }
-        // the constraint-weighted Hessian-vector products from the rows
-        for (out, rows, w) in [
-            (&mut f.hmu_v, &f.rhv_v, &f.mu0),
-            (&mut f.hsig_v, &f.rhv_v, &f.sig),
-            (&mut f.hmu_u, &f.rhv_u, &f.mu0),
-            (&mut f.hsig_u, &f.rhv_u, &f.sig),
+        // the constraint-weighted Hessian-vector products from the rows (pass A's direction
+        // 0 is v, 1 is u: the spatial rows' H_r v and H_r u)
+        for (out, rows, w, j) in [
+            (&mut f.hmu_v, &f.rhv_v, &f.mu0, 0),
+            (&mut f.hsig_v, &f.rhv_v, &f.sig, 0),
+            (&mut f.hmu_u, &f.rhv_u, &f.mu0, 1),
+            (&mut f.hsig_u, &f.rhv_u, &f.sig, 1),
         ] {
             out.fill(0.0);
             passes::add_local_rows(sys, rows, w, out);
+            f.pa.sp.add_hessian_direction(j, w, out);
         }
         metric.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
         if sys.forces().is_empty() {

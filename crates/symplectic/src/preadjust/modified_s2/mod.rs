@@ -33,6 +33,7 @@ mod adjoints;
 mod forward;
 mod passes;
 mod reverse;
+mod spatial;
 
 /// The invariants of `e4` (module doc for the symbols), in the order of [`E4_TERMS`]: the
 /// term values ([`PerInvariant`]) and the public arrays of

@@ -6,6 +6,7 @@
 //! exponents; `t` stands for the velocity `v` throughout. Its size, its number of directions
 //! and the positions of the monomials the term reads are derived from the list.
 
+use super::spatial::SpatialRows;
 use crate::passes;
 use crate::passes::PolyWorkspace;
 use crate::preadjust::{LocalRow, ZERO_ROW};
@@ -192,13 +193,16 @@ pub(super) const R_XY: [usize; R_PRODUCTS] = [
 ];
 
 /// One pass's coefficients per constraint row and of the potential, with their element-local
-/// gradients (per row, and per force element), and its jets' workspace.
+/// gradients (per planar row, and per force element; the spatial rows' in [`SpatialRows`]),
+/// and its jets' workspace.
 #[derive(Debug)]
 pub(super) struct Pass<const K: usize, B> {
     pub(super) vals: Vec<[f64; K]>,
     pub(super) grads: Vec<[LocalRow; K]>,
     pub(super) pot: [f64; K],
     pub(super) pgrads: Vec<[LocalRow; K]>,
+    /// The spatial rows (none on a planar model).
+    pub(super) sp: SpatialRows,
     ws: Box<PolyWorkspace<K, B>>,
 }
 
@@ -209,6 +213,7 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
             grads: vec![[ZERO_ROW; K]; m],
             pot: [0.0; K],
             pgrads: vec![[ZERO_ROW; K]; nf],
+            sp: SpatialRows::default(),
             ws: PolyWorkspace::new(),
         }
     }
@@ -218,6 +223,16 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         let ws = &mut self.ws;
         passes::constraint_poly_series(sys, ws, q, a, dirs, &mut self.vals, &mut self.grads);
         self.pot = passes::potential_poly_series(sys, ws, q, a, dirs, &mut self.pgrads);
+        self.eval_spatial(sys, q, dirs);
+    }
+
+    /// The spatial rows' coefficients and gradients (the potential of a spatial model is
+    /// gravity alone, linear: the s = 2 term refuses spatial force elements).
+    fn eval_spatial(&mut self, sys: &System, q: &[f64], dirs: &[&[f64]]) {
+        if sys.has_spatial() {
+            self.sp.gather(sys, q, dirs);
+            self.sp.coefficients::<K, B>(dirs, &mut self.vals);
+        }
     }
 
     /// The pass along `dirs` at `q`, constraints only.
@@ -237,6 +252,7 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
             &mut self.vals,
             &mut self.grads,
         );
+        self.eval_spatial(sys, q, dirs);
     }
 
     /// `out = sum_f grad_q` of the potential's coefficient `k` (length n; zero without force

@@ -35,11 +35,11 @@
 //!   `Gb -= a (D G^T z)^T + z (D G^T a)^T` with `a = S^-1 zb`;
 //! * `u = -D g + D G^T mu0`, `mu0 = S^-1 G D g` (`g = grad V`), and `gb` to `qb` by `Hess V`.
 
-use super::adjoints::{gbar_add, Adjoints, Cols};
+use super::adjoints::{gbar_add, Adjoints, GbCtx};
 use super::forward::E4Forward;
 use super::passes::{
-    BasisA, BasisB, BasisC, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE, B_ET, B_ETT, C_AT,
-    C_BT, NA, NB, NC, NR, R_DIRS, R_OUTPUTS, R_XY, R_Y,
+    BasisA, BasisB, BasisC, BasisR, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE, B_ET, B_ETT,
+    C_AT, C_BT, NA, NB, NC, NR, R_DIRS, R_OUTPUTS, R_XY, R_Y,
 };
 use super::{e4_value, Invariant, ModifiedS2, PerInvariant};
 use crate::passes;
@@ -57,19 +57,19 @@ fn comb_into(a: &[f64], ca: f64, b: &[f64], cb: f64, out: &mut [f64]) {
 
 /// `y = -D G^T z` with `z = S^-1 x`: leaves the increment of `xb` in `w.tm[0]` for the
 /// adjoint `yb`; `Gb` updated.
-fn adj_neg_e(metric: &mut ProjectedMetric, w: &mut Adjoints, cols: &[Cols], z: &[f64], yb: &[f64]) {
+fn adj_neg_e(metric: &mut ProjectedMetric, w: &mut Adjoints, cx: GbCtx, z: &[f64], yb: &[f64]) {
     let [dyb, dz, da, ..] = &mut w.tn;
     for ((d, y), mi) in dyb.iter_mut().zip(yb).zip(metric.minv()) {
         *d = mi * y;
     }
-    gbar_add(&mut w.gbar, cols, -1.0, z, dyb);
+    gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, z, dyb);
     let a = &mut w.tm[0];
     metric.sgm(yb, a);
     a.iter_mut().for_each(|x| *x = -*x);
     metric.dgt_into(z, dz);
     metric.dgt_into(a, da);
-    gbar_add(&mut w.gbar, cols, -1.0, a, dz);
-    gbar_add(&mut w.gbar, cols, -1.0, z, da);
+    gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, a, dz);
+    gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, z, da);
 }
 
 impl ModifiedS2 {
@@ -103,7 +103,7 @@ impl ModifiedS2 {
         use Invariant::*;
         let m = metric.m();
         let ModifiedS2 { f, b: w, cols } = self;
-        let cols = cols.as_slice();
+        let cx = GbCtx::new(sys, q, cols);
         let e4 = e4_value(&f.terms().0);
         let c = PerInvariant::coefficients();
         gq.fill(0.0);
@@ -117,20 +117,20 @@ impl ModifiedS2 {
         let hsig_v = (f.pi_hsig_v.as_slice(), f.sg_hsig_v.as_slice());
         let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
         let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
-        adj_pi(&mut w.gbar, cols, c[VHsigPiHmuV], hsig_v, hmu_v);
+        adj_pi(&mut w.gbar, &mut w.sgq, cx, c[VHsigPiHmuV], hsig_v, hmu_v);
         axpy(c[VHsigPiHmuV], &f.pi_hmu_v, &mut w.hsig_vb);
         axpy(c[VHsigPiHmuV], &f.pi_hsig_v, &mut w.hmu_vb);
-        adj_pi(&mut w.gbar, cols, c[VHmuPiHmuV], hmu_v, hmu_v);
+        adj_pi(&mut w.gbar, &mut w.sgq, cx, c[VHmuPiHmuV], hmu_v, hmu_v);
         axpy(2.0 * c[VHmuPiHmuV], &f.pi_hmu_v, &mut w.hmu_vb);
         axpy(c[UHmuU], &f.hmu_u, &mut w.ub);
         axpy(c[UHmuU], &f.u, &mut w.hmu_ub);
         let beta = (f.s_beta.as_slice(), f.k2.as_slice());
         let kap3 = (f.s_kap3.as_slice(), f.k3.as_slice());
-        adj_s(&mut w.gbar, cols, c[BetaSBeta], beta, beta);
+        adj_s(&mut w.gbar, &mut w.sgq, cx, c[BetaSBeta], beta, beta);
         axpy(2.0 * c[BetaSBeta], &f.s_beta, &mut w.betab);
         axpy(c[UHsigU], &f.hsig_u, &mut w.ub);
         axpy(c[UHsigU], &f.u, &mut w.hsig_ub);
-        adj_s(&mut w.gbar, cols, c[Kappa3SBeta], kap3, beta);
+        adj_s(&mut w.gbar, &mut w.sgq, cx, c[Kappa3SBeta], kap3, beta);
         axpy(c[Kappa3SBeta], &f.s_beta, &mut w.kap3b);
         axpy(c[Kappa3SBeta], &f.s_kap3, &mut w.betab);
         axpy(c[Mu0Kappa3u], &f.kap3u, &mut w.mu0b);
@@ -139,14 +139,14 @@ impl ModifiedS2 {
         axpy(c[SigmaKappa3u], &f.sig, &mut w.kap3ub);
         axpy(c[Mu0Kappa4], &f.kap4, &mut w.mu0b);
         axpy(c[Mu0Kappa4], &f.mu0, &mut w.kap4b);
-        adj_pi(&mut w.gbar, cols, c[VHsigPiHsigV], hsig_v, hsig_v);
+        adj_pi(&mut w.gbar, &mut w.sgq, cx, c[VHsigPiHsigV], hsig_v, hsig_v);
         axpy(2.0 * c[VHsigPiHsigV], &f.pi_hsig_v, &mut w.hsig_vb);
         axpy(c[SigmaKappa4], &f.kap4, &mut w.sigb);
         axpy(c[SigmaKappa4], &f.sig, &mut w.kap4b);
-        adj_s(&mut w.gbar, cols, c[Kappa3SKappa3], kap3, kap3);
+        adj_s(&mut w.gbar, &mut w.sgq, cx, c[Kappa3SKappa3], kap3, kap3);
         axpy(2.0 * c[Kappa3SKappa3], &f.s_kap3, &mut w.kap3b);
         if pot {
-            adj_pi(&mut w.gbar, cols, c[VHmuPiHV], hmu_v, hv);
+            adj_pi(&mut w.gbar, &mut w.sgq, cx, c[VHmuPiHV], hmu_v, hv);
             axpy(c[VHmuPiHV], &f.pi_hv, &mut w.hmu_vb);
             axpy(c[VHmuPiHV], &f.pi_hmu_v, &mut w.hvb);
             axpy(c[VHK2], &f.k2, &mut w.hvb);
@@ -159,13 +159,13 @@ impl ModifiedS2 {
             w.pa[A_ETT] += 2.0 * c[D3VUVV];
             axpy(c[NHN], &f.hn, &mut w.nnb);
             axpy(c[NHN], &f.nn, &mut w.hnb);
-            adj_pi(&mut w.gbar, cols, c[VHPiHsigV], hv, hsig_v);
+            adj_pi(&mut w.gbar, &mut w.sgq, cx, c[VHPiHsigV], hv, hsig_v);
             axpy(c[VHPiHsigV], &f.pi_hsig_v, &mut w.hvb);
             axpy(c[VHPiHsigV], &f.pi_hv, &mut w.hsig_vb);
             axpy(c[VHK3], &f.k3, &mut w.hvb);
             axpy(c[VHK3], &f.hv, &mut w.k3b);
             w.pb[B_ETT] += 2.0 * c[D3VNVV];
-            adj_pi(&mut w.gbar, cols, c[VHPiHV], hv, hv);
+            adj_pi(&mut w.gbar, &mut w.sgq, cx, c[VHPiHV], hv, hv);
             axpy(2.0 * c[VHPiHV], &f.pi_hv, &mut w.hvb);
             w.pa[A_T4] += 24.0 * c[D4V];
         }
@@ -209,7 +209,7 @@ impl ModifiedS2 {
 
         // 5. k3 = -D G^T S^-1 kappa3, kappa3 = 6 A[t^3] + 3 B[e t]
         let k3b = std::mem::take(&mut w.k3b);
-        adj_neg_e(metric, w, cols, &f.s_kap3, &k3b);
+        adj_neg_e(metric, w, cx, &f.s_kap3, &k3b);
         w.k3b = k3b;
         axpy(1.0, &w.tm[0], &mut w.kap3b);
         for r in 0..m {
@@ -218,7 +218,7 @@ impl ModifiedS2 {
         }
         // 6. k2 = -D G^T S^-1 beta, beta = A[e t]
         let k2b = std::mem::take(&mut w.k2b);
-        adj_neg_e(metric, w, cols, &f.s_beta, &k2b);
+        adj_neg_e(metric, w, cx, &f.s_beta, &k2b);
         w.k2b = k2b;
         axpy(1.0, &w.tm[0], &mut w.betab);
         for r in 0..m {
@@ -241,13 +241,13 @@ impl ModifiedS2 {
                 *d = mi * x;
             }
             metric.g_times(dn, t);
-            gbar_add(&mut w.gbar, cols, -1.0, &f.sig, dn);
+            gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, &f.sig, dn);
             axpy(-1.0, t, &mut w.sigb);
             metric.s_inv_into(&w.sigb, a);
             metric.dgt_into(&f.sig, dsig);
             metric.dgt_into(a, da);
-            gbar_add(&mut w.gbar, cols, -1.0, a, dsig);
-            gbar_add(&mut w.gbar, cols, -1.0, &f.sig, da);
+            gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, a, dsig);
+            gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, &f.sig, da);
             for r in 0..m {
                 w.wa[r][A_TT] += 2.0 * a[r];
             }
@@ -270,23 +270,25 @@ impl ModifiedS2 {
             metric.g_times(dub, s);
             axpy(1.0, s, &mut w.mu0b);
             axpy(-1.0, dub, &mut w.gradb);
-            gbar_add(&mut w.gbar, cols, 1.0, &f.mu0, dub);
+            gbar_add(&mut w.gbar, &mut w.sgq, cx, 1.0, &f.mu0, dub);
             metric.s_inv_into(&w.mu0b, a);
             metric.dgt_into(a, da);
             axpy(1.0, da, &mut w.gradb);
             for ((d, x), mi) in dg.iter_mut().zip(metric.grad_v()).zip(metric.minv()) {
                 *d = mi * x;
             }
-            gbar_add(&mut w.gbar, cols, 1.0, a, dg);
+            gbar_add(&mut w.gbar, &mut w.sgq, cx, 1.0, a, dg);
             metric.dgt_into(&f.mu0, dmu);
-            gbar_add(&mut w.gbar, cols, -1.0, a, dmu);
-            gbar_add(&mut w.gbar, cols, -1.0, &f.mu0, da);
+            gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, a, dmu);
+            gbar_add(&mut w.gbar, &mut w.sgq, cx, -1.0, &f.mu0, da);
             passes::lagrangian_hessian_vector_at(sys, q, &f.angles, &w.gradb, 1.0, &f.zero_m, t);
             axpy(1.0, t, gq);
         }
 
-        // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r
+        // 10. G's adjoint: qb += sum_r Hess Phi_r Gb_r (the spatial rows' share was added
+        //     to `sgq` as Gb grew, `gbar_add`)
         passes::add_constraint_hessian_rows_at(sys, q, &f.angles, &w.gbar, gq);
+        axpy(1.0, &w.sgq, gq);
         e4
     }
 }
@@ -296,13 +298,14 @@ impl ModifiedS2 {
 /// `c Pi b` and `c Pi a`, are the caller's.
 fn adj_pi(
     gbar: &mut [LocalRow],
-    cols: &[Cols],
+    sgq: &mut [f64],
+    cx: GbCtx,
     c: f64,
     (pa, sa): (&[f64], &[f64]),
     (pb, sb): (&[f64], &[f64]),
 ) {
-    gbar_add(gbar, cols, -c, sb, pa);
-    gbar_add(gbar, cols, -c, sa, pb);
+    gbar_add(gbar, sgq, cx, -c, sb, pa);
+    gbar_add(gbar, sgq, cx, -c, sa, pb);
 }
 
 /// `c a^T S^-1 b` with `(S^-1 a, k_a)` and `(S^-1 b, k_b)`, `k_x = -D G^T S^-1 x`, from the
@@ -311,13 +314,14 @@ fn adj_pi(
 /// `c S^-1 a`, are the caller's.
 fn adj_s(
     gbar: &mut [LocalRow],
-    cols: &[Cols],
+    sgq: &mut [f64],
+    cx: GbCtx,
     c: f64,
     (al, ka): (&[f64], &[f64]),
     (be, kb): (&[f64], &[f64]),
 ) {
-    gbar_add(gbar, cols, c, al, kb);
-    gbar_add(gbar, cols, c, be, ka);
+    gbar_add(gbar, sgq, cx, c, al, kb);
+    gbar_add(gbar, sgq, cx, c, be, ka);
 }
 
 /// The adjoint of `y = H x`, `H = p Hess V + sum_r w_r Hess Phi_r` (`(p, w)`), for the adjoint
@@ -382,7 +386,11 @@ fn hvp_weighted_adj(
         }
         w.rw[r] = x;
     }
-    passes::add_constraint_poly_grads_many(sys, &w.rpass.grads, &w.rw, [gq, gv, &mut w.ub]);
+    let mut outs = [gq, gv, &mut w.ub];
+    w.rpass
+        .sp
+        .add_grads_many::<NR, R_OUTPUTS, BasisR>(&w.rw, &mut outs);
+    passes::add_constraint_poly_grads_many(sys, &w.rpass.grads, &w.rw, outs);
 }
 
 /// The adjoint of a pass ([`Pass`]) with the adjoint weights `wts` of its rows' coefficients
@@ -395,6 +403,7 @@ fn contract<const K: usize, B: Basis<K>>(
     dirs: &mut [&mut [f64]],
 ) {
     passes::add_constraint_poly_adjoint::<K, B>(sys, &p.grads, wts, qb, dirs);
+    p.sp.adjoint::<K, B>(wts, qb, dirs);
     if let Some(pw) = pot {
         passes::add_potential_poly_adjoint::<K, B>(sys, &p.pgrads, pw, qb, dirs);
     }
@@ -404,6 +413,67 @@ fn contract<const K: usize, B: Basis<K>>(
 mod tests {
     use crate::Preadjustment;
     use mbd_model::models;
+    use mbd_solve::State;
+
+    /// `e4`'s gradients by the reverse pass against fourth-order central differences of the
+    /// forward evaluation at `(q, v)`: the largest difference, relative to the largest
+    /// gradient entry.
+    fn gradient_error(sys: &mbd_model::System, q: &[f64], v: &[f64]) -> f64 {
+        let n = sys.n_coords();
+        let mut p = Preadjustment::new(sys, 2).unwrap();
+        let (mut gq, mut gv) = (vec![0.0; n], vec![0.0; n]);
+        let e4 = p
+            .modified_gradients_s2(sys, q, v, &mut gq, &mut gv)
+            .unwrap();
+        let e4b = p.modified_term_s2(sys, q, v).unwrap();
+        assert!((e4 - e4b).abs() <= 1e-13 * e4.abs().max(1.0));
+        let d = 1e-4;
+        let mut fd = |wrt_q: bool, l: usize| -> f64 {
+            let mut acc = 0.0;
+            for (cf, k) in [(8.0, 1.0), (-8.0, -1.0), (-1.0, 2.0), (1.0, -2.0)] {
+                let (mut y, mut w) = (q.to_vec(), v.to_vec());
+                if wrt_q {
+                    y[l] += k * d;
+                } else {
+                    w[l] += k * d;
+                }
+                acc += cf * p.modified_term_s2(sys, &y, &w).unwrap();
+            }
+            acc / (12.0 * d)
+        };
+        let scale = gq.iter().chain(&gv).fold(1e-30f64, |a, x| a.max(x.abs()));
+        let mut worst = 0.0f64;
+        for l in 0..n {
+            worst = worst
+                .max((fd(true, l) - gq[l]).abs())
+                .max((fd(false, l) - gv[l]).abs());
+        }
+        worst / scale
+    }
+
+    /// The spatial rows (quadratic, in natural coordinates) through the passes and the reverse
+    /// pass: gradients against differences on a heavy top, a torque-free body and a spatial
+    /// double pendulum, at the consistent state with a generic velocity added (`e4` is defined
+    /// off the tangent space too).
+    #[test]
+    fn spatial_gradients_match_differences() {
+        let systems = [
+            models::heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap(),
+            models::free_body([0.2, 0.3, 0.4], [0.4, 5.0, 0.3]).unwrap(),
+            models::spatial_double_pendulum().unwrap(),
+        ];
+        for sys in &systems {
+            let st = State::consistent(sys, 0.0).unwrap();
+            let v: Vec<f64> =
+                st.v.iter()
+                    .enumerate()
+                    .map(|(i, x)| x + 0.3 * (0.7 * i as f64).sin())
+                    .collect();
+            let err = gradient_error(sys, st.q.as_slice(), &v);
+            eprintln!("n = {}: gradient error {err:.2e}", sys.n_coords());
+            assert!(err < 1e-7, "n = {}: {err:.2e}", sys.n_coords());
+        }
+    }
 
     /// The reverse-pass gradients against fourth-order central differences of `e4`, on paper
     /// A's double pendulum, a rod with a spring, a 3-link chain and an elastic pendulum (`m = 0`),

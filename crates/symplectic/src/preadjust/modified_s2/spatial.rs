@@ -1,0 +1,233 @@
+//! The spatial rows of a pass of `e4` (docs/spatial.md, "The preadjusted symplectic
+//! schemes"): every spatial equation is quadratic in the natural coordinates, so along
+//! directions `d_1 .. d_D` the series of row `r` ends at degree two,
+//!
+//! `Phi_r(q + sum_j x_j d_j) = Phi_r(q) + sum_j x_j g_r . d_j + sum_(j<l) x_j x_l d_j . H_r d_l
+//! + sum_j x_j^2 d_j . H_r d_j / 2`,
+//!
+//! with `g_r` the row of `Phi_q` and `H_r` its constant Hessian. The coefficients' gradients
+//! with respect to `q` are `g_r` (degree 0), `H_r d_j` (the coefficient of `x_j`) and zero
+//! above, and the gradient of the coefficient of `x^e` with respect to direction `j` is the
+//! `q`-gradient of the coefficient of `x^e / x_j` (the planar passes' division table). So a
+//! pass keeps, per spatial row, `g_r` and `H_r d_j` for every direction, in the element-local
+//! columns of the row's two bodies, and forms everything from them. The spatial model's time
+//! does not enter: the preadjustments refuse constraints whose Jacobian depends on time, and no
+//! term reads a degree-0 coefficient (left zero).
+
+use mbd_model::{Basis, System, MAX_DIRS};
+
+/// The element-local width of a spatial row: twelve columns per side (a point mass uses three).
+const W: usize = 24;
+/// A local column that no coordinate fills.
+const NONE: usize = usize::MAX;
+
+/// One spatial row's data in a pass.
+#[derive(Clone, Debug)]
+struct Row {
+    /// The row's index in `Phi`.
+    r: usize,
+    /// The coordinate of each local column ([`NONE`] where the side is ground or narrower).
+    cols: [usize; W],
+    /// `g_r` and `H_r d_j` in local columns.
+    g: [f64; W],
+    hd: [[f64; W]; MAX_DIRS],
+}
+
+impl Row {
+    fn dot(&self, x: &[f64; W], d: &[f64]) -> f64 {
+        let mut s = 0.0;
+        for (l, &c) in self.cols.iter().enumerate() {
+            if c != NONE {
+                s += x[l] * d[c];
+            }
+        }
+        s
+    }
+
+    fn scatter(&self, c: f64, x: &[f64; W], out: &mut [f64]) {
+        if c == 0.0 {
+            return;
+        }
+        for (l, &k) in self.cols.iter().enumerate() {
+            if k != NONE {
+                out[k] += c * x[l];
+            }
+        }
+    }
+}
+
+/// The degree of a monomial and its directions (`(j, l)` with `j <= l` for degree two, `j`
+/// twice for a square).
+fn split(e: &[u8; MAX_DIRS]) -> (usize, usize, usize) {
+    let mut deg = 0usize;
+    let (mut a, mut b) = (0usize, 0usize);
+    for (j, &x) in e.iter().enumerate() {
+        for _ in 0..x {
+            if deg == 0 {
+                a = j;
+            }
+            b = j;
+            deg += 1;
+        }
+    }
+    (deg, a, b)
+}
+
+/// The spatial rows of one pass ([`super::passes::Pass`]): filled by [`SpatialRows::gather`]
+/// at every evaluation (the row list is built at the first and kept).
+#[derive(Debug, Default)]
+pub(super) struct SpatialRows {
+    rows: Vec<Row>,
+}
+
+impl SpatialRows {
+    /// `g_r` and `H_r d_j` of every spatial row at `q` for the directions `dirs`.
+    pub(super) fn gather(&mut self, sys: &System, q: &[f64], dirs: &[&[f64]]) {
+        let planar = sys.bodies().len();
+        for (j, d) in dirs.iter().enumerate() {
+            let mut k = 0;
+            let rows = &mut self.rows;
+            sys.local_rows_tan(q, d, 0.0, |r, sides| {
+                let spatial = sides.iter().flatten().any(|s| s.0 >= planar);
+                if !spatial {
+                    return;
+                }
+                if k == rows.len() {
+                    rows.push(Row {
+                        r,
+                        cols: [NONE; W],
+                        g: [0.0; W],
+                        hd: [[0.0; W]; MAX_DIRS],
+                    });
+                }
+                let row = &mut rows[k];
+                k += 1;
+                if j == 0 {
+                    row.r = r;
+                    row.cols = [NONE; W];
+                    row.g = [0.0; W];
+                }
+                row.hd[j] = [0.0; W];
+                for (s, side) in sides.iter().enumerate() {
+                    let Some((block, g, dg)) = side else {
+                        continue;
+                    };
+                    let Some((o, _)) = sys.body_block(*block) else {
+                        continue;
+                    };
+                    for l in 0..g.len().min(12) {
+                        if j == 0 {
+                            row.cols[12 * s + l] = o + l;
+                            row.g[12 * s + l] = g[l];
+                        }
+                        row.hd[j][12 * s + l] = dg[l];
+                    }
+                }
+            });
+            self.rows.truncate(k);
+        }
+    }
+
+    /// The coefficients of the spatial rows in the basis `B` into `vals` (module doc).
+    pub(super) fn coefficients<const K: usize, B: Basis<K>>(
+        &self,
+        dirs: &[&[f64]],
+        vals: &mut [[f64; K]],
+    ) {
+        for row in &self.rows {
+            let out = &mut vals[row.r];
+            for (k, e) in B::EXP.iter().enumerate() {
+                out[k] = match split(e) {
+                    (1, j, _) => row.dot(&row.g, dirs[j]),
+                    (2, j, l) if j == l => 0.5 * row.dot(&row.hd[j], dirs[j]),
+                    (2, j, l) => row.dot(&row.hd[l], dirs[j]),
+                    _ => 0.0,
+                };
+            }
+        }
+    }
+
+    /// `out += sum_r w_r H_r d_j` over the spatial rows.
+    pub(super) fn add_hessian_direction(&self, j: usize, w: &[f64], out: &mut [f64]) {
+        for row in &self.rows {
+            row.scatter(w[row.r], &row.hd[j], out);
+        }
+    }
+
+    /// The spatial rows' share of [`crate::passes::add_constraint_poly_adjoint`] with the
+    /// weights `w` of the coefficients: `qb += sum_k w_k grad_q c_k`, `dirs[j] += sum_k w_k
+    /// grad_q c_(k / x_j)`.
+    pub(super) fn adjoint<const K: usize, B: Basis<K>>(
+        &self,
+        w: &[[f64; K]],
+        qb: &mut [f64],
+        dirs: &mut [&mut [f64]],
+    ) {
+        let nd = dirs.len();
+        for row in &self.rows {
+            let wr = &w[row.r];
+            for (k, e) in B::EXP.iter().enumerate() {
+                let c = wr[k];
+                if c == 0.0 {
+                    continue;
+                }
+                match split(e) {
+                    (0, _, _) => row.scatter(c, &row.g, qb),
+                    (1, j, _) => {
+                        row.scatter(c, &row.hd[j], qb);
+                        if j < nd {
+                            row.scatter(c, &row.g, dirs[j]);
+                        }
+                    }
+                    (2, j, l) => {
+                        if j < nd {
+                            row.scatter(c, &row.hd[l], dirs[j]);
+                        }
+                        if l != j && l < nd {
+                            row.scatter(c, &row.hd[j], dirs[l]);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+
+    /// The spatial rows' share of [`crate::passes::add_constraint_poly_grads_many`]:
+    /// `outs[p] += sum_r sum_k w[r][p][k] grad_q c_k`.
+    pub(super) fn add_grads_many<const K: usize, const P: usize, B: Basis<K>>(
+        &self,
+        w: &[[[f64; K]; P]],
+        outs: &mut [&mut [f64]; P],
+    ) {
+        for row in &self.rows {
+            for (wp, out) in w[row.r].iter().zip(outs.iter_mut()) {
+                for (k, e) in B::EXP.iter().enumerate() {
+                    let c = wp[k];
+                    if c == 0.0 {
+                        continue;
+                    }
+                    match split(e) {
+                        (0, _, _) => row.scatter(c, &row.g, out),
+                        (1, j, _) => row.scatter(c, &row.hd[j], out),
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split;
+
+    #[test]
+    fn monomials_split_into_degree_and_directions() {
+        assert_eq!(split(&[0; 6]), (0, 0, 0));
+        assert_eq!(split(&[0, 1, 0, 0, 0, 0]), (1, 1, 1));
+        assert_eq!(split(&[2, 0, 0, 0, 0, 0]), (2, 0, 0));
+        assert_eq!(split(&[1, 0, 1, 0, 0, 0]), (2, 0, 2));
+        assert_eq!(split(&[2, 1, 0, 0, 0, 0]).0, 3);
+    }
+}
