@@ -77,11 +77,14 @@ pub enum SensorKind {
         /// The joint's index among the spatial joints.
         joint: usize,
     },
-    /// A spatial body's kinetic energy and the potential of gravity on it (J), columns
-    /// `NAME.kinetic`, `.potential`, `.total`.
+    /// A spatial body's or spatial point mass's kinetic energy and the potential of gravity on
+    /// it (J), columns `NAME.kinetic`, `.potential`, `.total`: for a rigid body
+    /// `m |v|^2 / 2 + omega . J omega / 2` and `-m g . x` (`x` its centre of mass), for a point
+    /// mass `m |x'|^2 / 2` and `-m g . x` (`x` its position); ground gives zeros, as for the
+    /// planar [`SensorKind::Energy`].
     SpatialEnergy {
-        /// The body.
-        body: SpatialBodyHandle,
+        /// The rigid body or point mass.
+        body: SpatialBodyRef,
     },
 }
 
@@ -154,11 +157,12 @@ impl Sensor {
         }
     }
 
-    /// A spatial body's energies (see [`SensorKind::SpatialEnergy`]).
-    pub fn spatial_energy(name: impl Into<String>, body: SpatialBodyHandle) -> Self {
+    /// A spatial body's or point mass's energies (see [`SensorKind::SpatialEnergy`]): `body` a
+    /// [`SpatialBodyHandle`] or a [`crate::spatial::SpatialPointMassHandle`].
+    pub fn spatial_energy(name: impl Into<String>, body: impl Into<SpatialBodyRef>) -> Self {
         Sensor {
             name: name.into(),
-            kind: SensorKind::SpatialEnergy { body },
+            kind: SensorKind::SpatialEnergy { body: body.into() },
         }
     }
 
@@ -213,9 +217,12 @@ impl Sensor {
                 Some(k) => ("spatial body", k, bodies),
                 None => return Ok(()),
             },
-            SensorKind::AngularVelocity { body } | SensorKind::SpatialEnergy { body } => {
-                ("spatial body", body.index(), bodies)
-            }
+            SensorKind::SpatialEnergy { body } => match body {
+                SpatialBodyRef::Body(h) => ("spatial body", h.0, bodies),
+                SpatialBodyRef::PointMass(h) => ("spatial point mass", h.0, points.len()),
+                SpatialBodyRef::Ground => return Ok(()),
+            },
+            SensorKind::AngularVelocity { body } => ("spatial body", body.index(), bodies),
             SensorKind::SpatialReaction { joint } => ("spatial joint", joint, joints),
             _ => return Ok(()),
         };
@@ -262,12 +269,12 @@ pub enum SensorSpec {
         joint: String,
     },
     /// Kinetic, potential and total energy (`NAME.kinetic`, `.potential`, `.total`) of the
-    /// model, or of one body, planar or spatial (its kinetic energy and the potential of
-    /// gravity on it).
+    /// model, or of one body, planar or spatial, or of a spatial point mass (its kinetic
+    /// energy and the potential of gravity on it).
     Energy {
         /// Unique sensor name.
         name: String,
-        /// The body; absent for the whole model.
+        /// The body (planar or spatial) or spatial point mass; absent for the whole model.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         body: Option<String>,
     },

@@ -11,7 +11,8 @@
 //! ([`System::joint_coordinates`], shared with assembly from joint coordinates).
 //! A reaction sensor reads its joint's [`JointReaction`] from the multipliers of the same
 //! index-1 solve; an energy sensor evaluates `T` and `V` at the state (for one body, its
-//! kinetic energy and the potential of gravity on it).
+//! kinetic energy and the potential of gravity on it; likewise for a spatial body or point
+//! mass).
 
 use crate::error::SolveError;
 use crate::output_solve::OutputSolve;
@@ -297,24 +298,45 @@ fn values(
                 out.extend(r.force.iter().chain(&r.moment));
             }
             SensorKind::SpatialEnergy { body } => {
-                let k = body.index();
-                let o = sys.spatial_offset() + 12 * k;
-                let g = sys.spatial_gravity();
-                let (t, u) = match sys.spatial_bodies().get(k) {
-                    Some(b) => (
-                        (o..o + 12)
-                            .map(|i| 0.5 * mass[i] * v[i] * v[i])
-                            .sum::<f64>(),
-                        -b.inertia.mass() * (0..3).map(|c| g[c] * q[o + c]).sum::<f64>(),
-                    ),
-                    None => (0.0, 0.0),
-                };
+                let (t, u) = spatial_energy(sys, *body, q, v);
                 out.extend([t, u, t + u]);
             }
             _ => {}
         }
     }
     Ok(())
+}
+
+/// A spatial rigid body's or point mass's kinetic energy (`sum_i m_ii v_i^2 / 2` over its
+/// coordinates, with the diagonal mass of the natural coordinates: `m |v|^2 / 2 +
+/// omega . J omega / 2` for a body, `m |x'|^2 / 2` for a point mass) and the potential of
+/// gravity on it, `-m g . x` with `x` its centre of mass or position; ground (and an index the
+/// model does not have, which its build refuses): zeros.
+fn spatial_energy(
+    sys: &System,
+    body: mbd_model::spatial::SpatialBodyRef,
+    q: &[f64],
+    v: &[f64],
+) -> (f64, f64) {
+    let (offset, width, m) = if let Some(p) = body.point_mass() {
+        match sys.spatial_point_masses().get(p) {
+            Some(pm) => (sys.spatial_point_mass_offset() + 3 * p, 3, pm.mass),
+            None => return (0.0, 0.0),
+        }
+    } else if let Some(k) = body.index() {
+        match sys.spatial_bodies().get(k) {
+            Some(b) => (sys.spatial_offset() + 12 * k, 12, b.inertia.mass()),
+            None => return (0.0, 0.0),
+        }
+    } else {
+        return (0.0, 0.0);
+    };
+    let (mass, g) = (sys.mass_diag(), sys.spatial_gravity());
+    let t = (offset..offset + width)
+        .map(|i| 0.5 * mass[i] * v[i] * v[i])
+        .sum::<f64>();
+    let u = -m * (0..3).map(|c| g[c] * q[offset + c]).sum::<f64>();
+    (t, u)
 }
 
 /// Spatial body `k`'s directors at `q`.

@@ -186,6 +186,12 @@ impl ModelFile {
             place(super::SpatialBodyKind::PointMass, name)
                 .map(crate::spatial::SpatialPointMassHandle)
         };
+        // a spatial point mass or rigid body (names are unique among all bodies)
+        let spatial_ref = |name: &str| -> Option<crate::spatial::SpatialBodyRef> {
+            spatial_point(name)
+                .map(Into::into)
+                .or_else(|| spatial_body(name).map(Into::into))
+        };
         let spatial_joint = |name: &str| self.spatial_joints.iter().position(|j| j.name == name);
         let unknown_spatial = |sensor: &str, body: &str| {
             invalid(
@@ -205,25 +211,21 @@ impl ModelFile {
                     Some(k) if !joints.contains_key(joint) => Sensor::spatial_reaction(name, k),
                     _ => Sensor::reaction(name, sensor_joint(name, joint)?),
                 },
-                SensorSpec::Energy { name, body } => match body.as_deref().map(spatial_body) {
-                    Some(Some(h)) => Sensor::spatial_energy(name, h),
-                    _ => Sensor::energy(
-                        name,
-                        match body {
-                            Some(body) => Some(find(&format!("sensor '{name}'"), body)?),
-                            None => None,
-                        },
-                    ),
+                // a spatial body or point mass, else a planar body (or ground)
+                SensorSpec::Energy { name, body } => match body.as_deref() {
+                    Some(body) => match spatial_ref(body) {
+                        Some(r) => Sensor::spatial_energy(name, r),
+                        None => {
+                            Sensor::energy(name, Some(find(&format!("sensor '{name}'"), body)?))
+                        }
+                    },
+                    None => Sensor::energy(name, None),
                 },
                 SensorSpec::SpatialPoint { name, body, point } => {
                     let r = if body.eq_ignore_ascii_case("ground") {
                         crate::spatial::SpatialBodyRef::Ground
-                    } else if let Some(p) = spatial_point(body) {
-                        p.into()
                     } else {
-                        spatial_body(body)
-                            .ok_or_else(|| unknown_spatial(name, body))?
-                            .into()
+                        spatial_ref(body).ok_or_else(|| unknown_spatial(name, body))?
                     };
                     Sensor::spatial_point(name, r, *point)
                 }
@@ -302,7 +304,7 @@ impl System {
                 }),
                 SensorKind::SpatialEnergy { body } => Some(SensorSpec::Energy {
                     name: s.name.clone(),
-                    body: Some(spatial_name((*body).into())),
+                    body: Some(spatial_name(*body)),
                 }),
                 SensorKind::Energy { body } => Some(SensorSpec::Energy {
                     name: s.name.clone(),
