@@ -137,10 +137,10 @@ fn orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
         );
     }
     sec.tables.push(table);
-    sec.notes.push(format!(
-        "Refused by name (the s = 2 modified Lagrangian needs a definite mass matrix): {}.",
-        refused.join(", ")
-    ));
+    if !refused.is_empty() {
+        sec.notes
+            .push(format!("Refused by name: {}.", refused.join(", ")));
+    }
     sec.summary = json!({ "spatial_orders": rows });
     Ok(())
 }

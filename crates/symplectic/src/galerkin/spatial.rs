@@ -10,8 +10,8 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
 /// and the s = 1 modified Lagrangian on the dense path (a singular mass matrix included: their
-/// metric uses the augmented `M_W^-1`), the s = 2 modified Lagrangian there for bodies with a
-/// definite mass matrix and no spatial force elements, for models whose Jacobian does not
+/// metric uses the augmented `M_W^-1`), the s = 2 modified Lagrangian there for models without
+/// spatial force elements (a massless director regularised), for models whose Jacobian does not
 /// depend on time
 /// (docs/spatial.md, "The preadjusted schemes"). Each refusal names what stands in the way.
 pub(super) fn spatial_support(
@@ -35,19 +35,12 @@ pub(super) fn spatial_support(
         )))
     };
     if modlag && s == 2 {
-        // the s = 2 term's passes take quadratic constraint rows and a linear potential, and
-        // its reverse pass the constant diagonal M^-1
+        // the s = 2 term's passes take quadratic constraint rows and a linear potential
         if let Some(f) = sys.spatial_forces().first() {
             return refuse(format!(
                 "the s = 2 term's passes take gravity as the only potential of spatial bodies, \
                  not force element '{}' (the s = 1 term and W_s take it)",
                 f.name
-            ));
-        }
-        if let Some(b) = crate::preadjust::singular_body(sys) {
-            return refuse(format!(
-                "the s = 2 term needs a definite mass matrix, and body '{b}' has a zero second \
-                 moment E_i (a thin disc or plate; the s = 1 term and W_s take it)"
             ));
         }
     }

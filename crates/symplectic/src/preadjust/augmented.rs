@@ -17,6 +17,9 @@
 //!   `c^T S_W^-1 c - c_int^T W c_int` ([`Augmented::penalty`]).
 //!
 //! So every quantity is that of `M`, also where `M` is singular and `M^-1` does not exist.
+//!
+//! The s = 2 term's reverse pass needs a constant diagonal inverse mass instead:
+//! [`regularised_inverse`].
 
 use mbd_model::System;
 use mbd_solve::linalg::DenseCholesky;
@@ -234,6 +237,58 @@ impl Augmented {
     pub(super) fn diagonal(&self, out: &mut [f64]) {
         for (k, o) in out.iter_mut().enumerate() {
             *o = self.entry(k, k);
+        }
+    }
+}
+
+/// The regularisation of a zero second moment in [`regularised_inverse`], relative to the
+/// body's largest second moment.
+pub(super) const MASSLESS_REGULARISATION: f64 = 1e-8;
+
+/// A constant diagonal inverse mass for the s = 2 term (docs/spatial.md, "The s = 2 modified
+/// Lagrangian"): `M^-1`, except on a director whose second moment is zero (a thin disc or
+/// plate), which takes the moment `MASSLESS_REGULARISATION E_max`. Every term of `e4` has a
+/// limit as that moment goes to zero (the KKT blocks stay regular), which the regularised value
+/// meets to `O(MASSLESS_REGULARISATION)` relative, while the cancellation in `Pi = D - D G^T
+/// S^-1 G D` costs about `eps / MASSLESS_REGULARISATION`: both near 1e-8.
+pub(super) fn regularised_inverse(sys: &System, minv: &mut [f64]) {
+    minv.copy_from_slice(sys.inv_mass_diag().as_slice());
+    let q0 = sys.spatial_offset();
+    for (k, b) in sys.spatial_bodies().iter().enumerate() {
+        let e = b.inertia.second_moments();
+        let e_max = e[0].max(e[1]).max(e[2]);
+        for (i, &ei) in e.iter().enumerate() {
+            if ei <= 0.0 || ei.is_nan() {
+                let c = q0 + 12 * k + 3 + 3 * i;
+                minv[c..c + 3].fill(1.0 / (MASSLESS_REGULARISATION * e_max));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The regularisation is the one docs/spatial.md states; it replaces exactly the massless
+    /// director's three entries of `M^-1` (the disc top: `E_3 = 0`, `E_max = 0.25`).
+    #[test]
+    fn the_regularised_inverse_touches_only_massless_directors() {
+        let doc = include_str!("../../../../docs/spatial.md");
+        let stated = format!("MASSLESS_REGULARISATION = {MASSLESS_REGULARISATION:e}");
+        assert!(doc.contains(&stated), "docs/spatial.md lacks '{stated}'");
+        let sys = mbd_model::models::heavy_top([0.25, 0.25, 0.5], 0.3, 20.0).unwrap();
+        let mut minv = vec![0.0; sys.n_coords()];
+        regularised_inverse(&sys, &mut minv);
+        let plain = sys.inv_mass_diag();
+        let d3 = sys.spatial_offset() + 9..sys.spatial_offset() + 12;
+        for (i, (&a, &b)) in minv.iter().zip(plain.iter()).enumerate() {
+            if d3.contains(&i) {
+                assert!(!b.is_finite(), "{i}: {b}");
+                assert_eq!(a, 1.0 / (MASSLESS_REGULARISATION * 0.25), "{i}");
+            } else {
+                assert_eq!(a, b, "{i}");
+            }
         }
     }
 }

@@ -281,24 +281,15 @@ impl ProjectedMetric {
         }
     }
 
-    /// Takes `M^-1` itself instead of the augmented `M_W^-1` (the s = 2 term's reverse pass is
-    /// derived with a constant diagonal `M^-1`); an error naming the first spatial body with a
-    /// zero second moment, whose `M` is singular. Nothing on a model without spatial bodies.
-    pub(super) fn use_plain_inverse(&mut self, sys: &System) -> Result<(), SolveError> {
-        if self.aug.is_none() {
-            return Ok(());
+    /// Takes a constant diagonal inverse mass instead of the augmented `M_W^-1` (the s = 2
+    /// term's reverse pass is derived with one): `M^-1`, regularised on massless directors
+    /// ([`super::augmented::regularised_inverse`]). Nothing on a model without spatial bodies.
+    pub(super) fn use_plain_inverse(&mut self, sys: &System) {
+        if self.aug.is_some() {
+            self.aug = None;
+            super::augmented::regularised_inverse(sys, &mut self.minv);
+            self.at_valid = false;
         }
-        if let Some(b) = singular_body(sys) {
-            return Err(SolveError::Unsupported(format!(
-                "the s = 2 modified Lagrangian needs a definite mass matrix: spatial body '{b}' \
-                 has a zero second moment E_i (a thin disc or plate); the s = 1 modified \
-                 Lagrangian and the plain scheme take it"
-            )));
-        }
-        self.aug = None;
-        self.minv.copy_from_slice(sys.inv_mass_diag().as_slice());
-        self.at_valid = false;
-        Ok(())
     }
 
     /// Whether `M^-1` is the augmented `M_W^-1` (spatial bodies, dense layout).
@@ -589,12 +580,4 @@ fn add_dgt(g: &DMatrix<f64>, minv: &[f64], x: &[f64], c: f64, out: &mut [f64]) {
     for ((o, col), mi) in out.iter_mut().zip(g.as_slice().chunks_exact(m)).zip(minv) {
         *o += c * mi * dot(col, x);
     }
-}
-
-/// The first spatial body of `sys` with a zero second moment (a singular `M`), by name.
-pub(crate) fn singular_body(sys: &System) -> Option<&str> {
-    sys.spatial_bodies()
-        .iter()
-        .find(|b| b.inertia.second_moments().iter().any(|&e| e <= 0.0 || e.is_nan()))
-        .map(|b| b.name.as_str())
 }

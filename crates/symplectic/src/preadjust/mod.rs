@@ -35,7 +35,6 @@ mod modified_s2;
 mod paper;
 mod stiffness;
 
-pub(crate) use metric::singular_body;
 use metric::ProjectedMetric;
 use modified_s1::ModifiedS1;
 use modified_s2::E4_TERM_COUNT;
@@ -327,7 +326,7 @@ impl Preadjustment {
         v: &[f64],
     ) -> Result<[f64; E4_TERM_COUNT], SolveError> {
         self.metric.check_v(v)?;
-        self.metric.use_plain_inverse(sys)?;
+        self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.forward(&mut self.metric, sys, q, v)?;
         Ok(term.terms())
@@ -367,7 +366,7 @@ impl Preadjustment {
                 });
             }
         }
-        self.metric.use_plain_inverse(sys)?;
+        self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.gradients(&mut self.metric, sys, q, v, gq, gv)
     }
