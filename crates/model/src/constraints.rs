@@ -411,17 +411,8 @@ impl System {
         scale: f64,
         out: &mut [f64],
     ) {
-        self.spatial.rows_tan(q, x, t, |r, sides, _, dg| {
-            let w = scale * weights[r];
-            if w == 0.0 {
-                return;
-            }
-            for (l, &d) in dg.iter().enumerate() {
-                if let Some(c) = self.spatial.col(sides, l) {
-                    out[c] += w * d;
-                }
-            }
-        });
+        self.spatial
+            .add_hessian_vector(q, t, x, weights, scale, out);
     }
 
     /// The spatial rows' part of [`System::add_constraint_hessian`]: `out += scale

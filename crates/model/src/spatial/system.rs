@@ -15,8 +15,11 @@ use super::body::{SpatialBody, SpatialBodyRef};
 use super::forces::SpatialForce;
 use super::joints::{SpatialFrame, SpatialJoint};
 use super::point_mass::{as_side, SpatialPointMass};
+use hessians::ConstantHessians;
 use mbd_jet::{DirJetN, HessJetN, Scalar};
 use nalgebra::DMatrix;
+
+mod hessians;
 
 /// The local width of a spatial element: two bodies' natural coordinates.
 pub(crate) const SW: usize = 24;
@@ -80,6 +83,8 @@ pub(crate) struct SpatialPart {
     /// masses' positions and velocities.
     pub(crate) q_init: Vec<f64>,
     pub(crate) v_init: Vec<f64>,
+    /// The rows' constant Hessians, evaluated at first use ([`ConstantHessians`]).
+    hessians: std::sync::OnceLock<ConstantHessians>,
 }
 
 impl SpatialPart {
@@ -125,6 +130,7 @@ impl SpatialPart {
             force_attach: Vec::new(),
             q_init,
             v_init,
+            hessians: std::sync::OnceLock::new(),
         }
     }
 
@@ -471,7 +477,20 @@ impl SpatialPart {
         scale: f64,
         out: &mut DMatrix<f64>,
     ) {
+        let cache = self.constant_hessians(q);
         for (item, sides, row, n) in self.items() {
+            if cache.row(self, row).is_some() {
+                for k in 0..n {
+                    let w = scale * lambda[row + k];
+                    if w == 0.0 {
+                        continue;
+                    }
+                    for &(r, c, h) in cache.row(self, row + k).unwrap_or_default() {
+                        out[(r, c)] += w * h;
+                    }
+                }
+                continue;
+            }
             let e = self.eval_jets(item, sides, t, |l, c| HessJetN::<SW>::var(l, q[c]));
             for (k, ek) in e.iter().enumerate().take(n) {
                 let w = scale * lambda[row + k];
@@ -491,6 +510,49 @@ impl SpatialPart {
                 }
             }
         }
+    }
+
+    /// `out += scale sum_r w_r Hess(Phi_r) x` over the spatial rows at time `t` (an angle
+    /// driver's row adds its `Phi_tq x`, as in [`SpatialPart::rows_tan`]): the constant Hessians
+    /// from the cache, the others by a tangent pass.
+    pub(crate) fn add_hessian_vector(
+        &self,
+        q: &[f64],
+        t: f64,
+        x: &[f64],
+        weights: &[f64],
+        scale: f64,
+        out: &mut [f64],
+    ) {
+        let cache = self.constant_hessians(q);
+        for r in self.r0..self.r0 + self.m {
+            let w = scale * weights[r];
+            if w == 0.0 {
+                continue;
+            }
+            for &(i, j, h) in cache.row(self, r).unwrap_or_default() {
+                out[i] += w * h * x[j];
+            }
+        }
+        if cache.all_constant() {
+            return;
+        }
+        self.rows_tan(q, x, t, |r, sides, _, dg| {
+            let w = scale * weights[r];
+            if w == 0.0 || cache.row(self, r).is_some() {
+                return;
+            }
+            for (l, &d) in dg.iter().enumerate() {
+                if let Some(c) = self.col(sides, l) {
+                    out[c] += w * d;
+                }
+            }
+        });
+    }
+
+    /// The constant Hessians of the rows (evaluated at `q` on first use).
+    fn constant_hessians(&self, q: &[f64]) -> &ConstantHessians {
+        self.hessians.get_or_init(|| ConstantHessians::new(self, q))
     }
 
     /// The potential of gravity on the spatial bodies and point masses, `-sum_k m_k g . x_k`.
