@@ -497,17 +497,7 @@ impl SpatialPart {
                 if w == 0.0 {
                     continue;
                 }
-                for r in 0..SW {
-                    let Some(gr) = self.col(sides, r) else {
-                        continue;
-                    };
-                    for c in 0..SW {
-                        let Some(gc) = self.col(sides, c) else {
-                            continue;
-                        };
-                        out[(gr, gc)] += w * ek.h[r][c];
-                    }
-                }
+                hessians::for_each_entry(self, sides, &ek.h, |r, c, h| out[(r, c)] += w * h);
             }
         }
     }

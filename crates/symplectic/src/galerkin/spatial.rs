@@ -36,11 +36,10 @@ pub(super) fn spatial_support(
     };
     if modlag && s == 2 {
         // the s = 2 term's passes take quadratic constraint rows and a linear potential
-        if let Some(f) = sys.spatial_forces().first() {
+        if let Some(f) = crate::preadjust::spatial_force_element(sys) {
             return refuse(format!(
                 "the s = 2 term's passes take gravity as the only potential of spatial bodies, \
-                 not force element '{}' (the s = 1 term and W_s take it)",
-                f.name
+                 not force element '{f}' (the s = 1 term and W_s take it)"
             ));
         }
     }

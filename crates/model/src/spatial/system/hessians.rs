@@ -16,6 +16,26 @@ pub(crate) struct ConstantHessians {
     rows: Vec<Option<Vec<(usize, usize, f64)>>>,
 }
 
+/// `f(row column, column, value)` for every entry of an element's local Hessian `h` whose
+/// local variables are coordinates (not ground, not a point mass's absent directors).
+pub(super) fn for_each_entry(
+    part: &SpatialPart,
+    sides: [Option<usize>; 2],
+    h: &[[f64; SW]; SW],
+    mut f: impl FnMut(usize, usize, f64),
+) {
+    for (r, hr) in h.iter().enumerate() {
+        let Some(gr) = part.col(sides, r) else {
+            continue;
+        };
+        for (c, &x) in hr.iter().enumerate() {
+            if let Some(gc) = part.col(sides, c) {
+                f(gr, gc, x);
+            }
+        }
+    }
+}
+
 impl ConstantHessians {
     /// The Hessians of `part`'s rows, evaluated at `q` (any configuration: they are constant).
     pub(super) fn new(part: &SpatialPart, q: &[f64]) -> Self {
@@ -29,19 +49,11 @@ impl ConstantHessians {
             let e = part.eval_jets(item, sides, 0.0, |l, c| HessJetN::<SW>::var(l, q[c]));
             for (k, ek) in e.iter().enumerate().take(n) {
                 let mut nz = Vec::new();
-                for r in 0..SW {
-                    let Some(gr) = part.col(sides, r) else {
-                        continue;
-                    };
-                    for c in 0..SW {
-                        let Some(gc) = part.col(sides, c) else {
-                            continue;
-                        };
-                        if ek.h[r][c] != 0.0 {
-                            nz.push((gr, gc, ek.h[r][c]));
-                        }
+                for_each_entry(part, sides, &ek.h, |r, c, h| {
+                    if h != 0.0 {
+                        nz.push((r, c, h));
                     }
-                }
+                });
                 rows[row - part.r0 + k] = Some(nz);
             }
         }

@@ -240,3 +240,9 @@ pub(super) fn ensure_s2<'a>(
     }
     w
 }
+
+/// The first spatial force element of `sys`, by name: the passes of `e4` take gravity as the
+/// only potential of spatial bodies (`spatial.rs`), so a model with one is refused.
+pub(crate) fn spatial_force_element(sys: &System) -> Option<&str> {
+    sys.spatial_forces().first().map(|f| f.name.as_str())
+}

@@ -451,6 +451,25 @@ mod tests {
         worst / scale
     }
 
+    /// A spatial spring is outside the passes (gravity is their only spatial potential): the
+    /// term and its gradients are an error naming it, not a value without its potential.
+    #[test]
+    fn a_spatial_force_element_is_refused_by_name() {
+        let sys = models::sprung_rod([0.05, 0.05, 0.002]).unwrap();
+        let st = State::consistent(&sys, 0.0).unwrap();
+        let (q, v) = (st.q.as_slice(), st.v.as_slice());
+        let mut p = Preadjustment::new(&sys, 2).unwrap();
+        let e = p.modified_term_s2(&sys, q, v).unwrap_err().to_string();
+        assert!(e.contains("'spring'"), "{e}");
+        let n = sys.n_coords();
+        let (mut gq, mut gv) = (vec![0.0; n], vec![0.0; n]);
+        let e = p
+            .modified_gradients_s2(&sys, q, v, &mut gq, &mut gv)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'spring'"), "{e}");
+    }
+
     /// The spatial rows (quadratic, in natural coordinates) through the passes and the reverse
     /// pass: gradients against differences on a heavy top, a torque-free body and a spatial
     /// double pendulum, at the consistent state with a generic velocity added (`e4` is defined
