@@ -120,6 +120,82 @@ pub fn generic_point(n: usize) -> (Vec<f64>, Vec<f64>) {
 
 pub use mbd_jet::fixtures::TwoDirections;
 
+/// Every kind of spatial potential on a spatial model: two bars on ball joints (the upper to
+/// ground) with gravity, a spring between the bars (rest length 0.2 m), one from the lower bar
+/// to ground (rest length 0), a free point mass on a spring from the lower bar, and a constant
+/// force in global axes on the lower bar. The fixture of the tests that check the spatial
+/// force elements' series and their gradients.
+pub fn spatial_springs() -> System {
+    use crate::spatial::{
+        Axes, Marker, SpatialBody, SpatialForce, SpatialInertia, SpatialJoint, SpatialJointKind,
+    };
+    let mut b = SystemBuilder::new();
+    b.set_spatial_gravity([0.0, 0.0, -9.81]);
+    let i1 = SpatialInertia::principal(1.0, [0.05, 0.06, 0.012]).expect("valid inertia");
+    let i2 = SpatialInertia::principal(0.7, [0.03, 0.025, 0.01]).expect("valid inertia");
+    let upper = b.add_spatial_body(
+        SpatialBody::new("upper", i1)
+            .position([0.1, 0.0, -0.3])
+            .angular_velocity([0.4, -0.8, 1.2]),
+    );
+    let lower = b.add_spatial_body(
+        SpatialBody::new("lower", i2)
+            .position([0.15, 0.2, -0.8])
+            .angular_velocity([-0.3, 0.5, 0.9]),
+    );
+    let ball = |a: [f64; 3], c: [f64; 3]| {
+        SpatialJoint::new(SpatialJointKind::Spherical, Marker::at(a), Marker::at(c))
+            .expect("valid joint")
+    };
+    let g = crate::spatial::SpatialBodyRef::Ground;
+    b.add_spatial_joint("shoulder", g, upper, ball([0.0; 3], [-0.1, 0.0, 0.3]));
+    b.add_spatial_joint(
+        "elbow",
+        upper,
+        lower,
+        ball([0.05, 0.1, -0.2], [0.0, -0.1, 0.3]),
+    );
+    let bob = b.add_spatial_point_mass("bob", 0.3, [0.4, 0.1, -1.2], [0.2, -0.1, 0.3]);
+    b.add_spatial_force(SpatialForce::spring_damper(
+        "between",
+        upper,
+        [0.1, 0.05, 0.0],
+        lower,
+        [-0.05, 0.1, 0.1],
+        30.0,
+        0.0,
+        0.2,
+    ));
+    b.add_spatial_force(SpatialForce::spring_damper(
+        "anchor",
+        lower,
+        [0.0, 0.0, -0.3],
+        g,
+        [0.3, -0.2, -1.0],
+        12.0,
+        0.0,
+        0.0,
+    ));
+    b.add_spatial_force(SpatialForce::spring_damper(
+        "bob_spring",
+        lower,
+        [0.05, 0.0, -0.2],
+        bob,
+        [0.0; 3],
+        20.0,
+        0.0,
+        0.35,
+    ));
+    b.add_spatial_force(SpatialForce::force(
+        "push",
+        lower,
+        [0.02, 0.0, -0.1],
+        [1.5, -0.7, 0.4].map(TimeFunction::constant),
+        Axes::Global,
+    ));
+    b.build().expect("the spatial-springs fixture is valid")
+}
+
 #[cfg(test)]
 mod tests {
     /// The fixture holds every joint kind, the slide driver among them, and goes through the

@@ -174,6 +174,15 @@ impl System {
     pub fn spatial_forces(&self) -> &[crate::spatial::SpatialForce] {
         &self.spatial.forces
     }
+    /// Every spatial force element with its local columns and its potential over a generic
+    /// scalar, in the order of [`System::spatial_forces`]: the hook of the potential's
+    /// derivative passes on spatial bodies.
+    pub fn spatial_force_elements(
+        &self,
+    ) -> impl ExactSizeIterator<Item = crate::spatial::SpatialForceElement<'_>> + '_ {
+        (0..self.spatial.forces.len())
+            .map(|k| crate::spatial::SpatialForceElement::new(&self.spatial, k))
+    }
     /// The spatial joints (markers in the bodies' frames, as given).
     pub fn spatial_joints(&self) -> &[crate::spatial::SpatialJointEntry] {
         &self.spatial.joints

@@ -57,7 +57,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 20.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers; spatial force elements and spatial models above 600 equations",
+            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers; spatial models above 600 equations",
             compared: true,
         },
     ],

@@ -47,7 +47,10 @@ mod rigid;
 pub(crate) mod system;
 
 pub use body::{SpatialBody, SpatialBodyHandle, SpatialBodyRef};
-pub use forces::{Axes, SpatialForce, SpatialForceKind, SpatialLoad, SpatialSpringDamper};
+pub use forces::{
+    Axes, SpatialForce, SpatialForceElement, SpatialForceKind, SpatialLoad, SpatialSpringDamper,
+    SPATIAL_LOCAL_WIDTH,
+};
 pub use inertia::{SpatialInertia, SpatialInertiaError};
 pub use joints::{Marker, SpatialFrame, SpatialJoint, SpatialJointError, SpatialJointKind};
 pub use orientation::{global_angular_velocity, EulerSequence, Orientation};

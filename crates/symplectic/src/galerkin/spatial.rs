@@ -10,10 +10,9 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
 /// and the s = 1 modified Lagrangian on the dense path (a singular mass matrix included: their
-/// metric uses the augmented `M_W^-1`), the s = 2 modified Lagrangian there for models without
-/// spatial force elements (a massless director regularised), for models whose Jacobian does not
-/// depend on time
-/// (docs/spatial.md, "The preadjusted schemes"). Each refusal names what stands in the way.
+/// metric uses the augmented `M_W^-1`) and the s = 2 modified Lagrangian there (a massless
+/// director regularised), for models whose Jacobian does not depend on time (docs/spatial.md,
+/// "The preadjusted schemes"). Each refusal names what stands in the way.
 pub(super) fn spatial_support(
     sys: &System,
     s: usize,
@@ -34,15 +33,6 @@ pub(super) fn spatial_support(
             "{scheme} on spatial bodies: {why}; the plain symplectic:{s} runs this model"
         )))
     };
-    if modlag && s == 2 {
-        // the s = 2 term's passes take quadratic constraint rows and a linear potential
-        if let Some(f) = crate::preadjust::spatial_force_element(sys) {
-            return refuse(format!(
-                "the s = 2 term's passes take gravity as the only potential of spatial bodies, \
-                 not force element '{f}' (the s = 1 term and W_s take it)"
-            ));
-        }
-    }
     if sys.jacobian_depends_on_time() {
         return refuse(
             "an angle driver makes Phi_q depend on time, which the derivation does not cover"

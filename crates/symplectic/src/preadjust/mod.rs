@@ -37,7 +37,6 @@ mod stiffness;
 
 use metric::ProjectedMetric;
 use modified_s1::ModifiedS1;
-pub(crate) use modified_s2::spatial_force_element;
 use modified_s2::E4_TERM_COUNT;
 use paper::PaperTerm;
 use stiffness::TangentStiffness;
@@ -327,7 +326,6 @@ impl Preadjustment {
         v: &[f64],
     ) -> Result<[f64; E4_TERM_COUNT], SolveError> {
         self.metric.check_v(v)?;
-        s2_supports(sys)?;
         self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.forward(&mut self.metric, sys, q, v)?;
@@ -368,21 +366,8 @@ impl Preadjustment {
                 });
             }
         }
-        s2_supports(sys)?;
         self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.gradients(&mut self.metric, sys, q, v, gq, gv)
-    }
-}
-
-/// The s = 2 term's refusal of a spatial force element (named), for callers of the
-/// `Preadjustment` methods directly (the integrator refuses it at construction).
-fn s2_supports(sys: &System) -> Result<(), SolveError> {
-    match spatial_force_element(sys) {
-        Some(f) => Err(SolveError::Unsupported(format!(
-            "the s = 2 modified Lagrangian takes gravity as the only potential of spatial \
-             bodies, not force element '{f}'"
-        ))),
-        None => Ok(()),
     }
 }

@@ -16,9 +16,11 @@
 //!   multipliers).
 
 mod assemble;
+mod element;
 mod load;
 mod spring_damper;
 
+pub use element::{SpatialForceElement, SPATIAL_LOCAL_WIDTH};
 pub use load::{Axes, SpatialLoad};
 pub use spring_damper::SpatialSpringDamper;
 

@@ -197,7 +197,7 @@ impl ModifiedS2 {
             f.pa.sp.add_hessian_direction(j, w, out);
         }
         metric.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
-        if sys.forces().is_empty() {
+        if !super::has_potential(sys) {
             // (H v = 0: gravity is linear)
             f.pi_hv.fill(0.0);
             f.sg_hv.fill(0.0);

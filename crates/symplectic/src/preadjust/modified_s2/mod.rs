@@ -34,6 +34,7 @@ mod forward;
 mod passes;
 mod reverse;
 mod spatial;
+mod spatial_potential;
 
 /// The invariants of `e4` (module doc for the symbols), in the order of [`E4_TERMS`]: the
 /// term values ([`PerInvariant`]) and the public arrays of
@@ -241,8 +242,9 @@ pub(super) fn ensure_s2<'a>(
     w
 }
 
-/// The first spatial force element of `sys`, by name: the passes of `e4` take gravity as the
-/// only potential of spatial bodies (`spatial.rs`), so a model with one is refused.
-pub(crate) fn spatial_force_element(sys: &System) -> Option<&str> {
-    sys.spatial_forces().first().map(|f| f.name.as_str())
+/// Whether `sys` has force elements with a potential (planar ones, or spatial springs and
+/// constant global forces): without them `V` is gravity alone, linear, and every term with
+/// `Hess V` or a higher derivative of `V` vanishes.
+pub(super) fn has_potential(sys: &System) -> bool {
+    !sys.forces().is_empty() || sys.spatial_force_elements().any(|e| e.has_potential())
 }

@@ -7,6 +7,7 @@
 //! and the positions of the monomials the term reads are derived from the list.
 
 use super::spatial::SpatialRows;
+use super::spatial_potential::SpatialPotential;
 use crate::passes;
 use crate::passes::PolyWorkspace;
 use crate::preadjust::{LocalRow, ZERO_ROW};
@@ -203,6 +204,8 @@ pub(super) struct Pass<const K: usize, B> {
     pub(super) pgrads: Vec<[LocalRow; K]>,
     /// The spatial rows (none on a planar model).
     pub(super) sp: SpatialRows,
+    /// The spatial force elements with a potential (none on a planar model).
+    pub(super) spp: SpatialPotential<K>,
     ws: Box<PolyWorkspace<K, B>>,
 }
 
@@ -214,6 +217,7 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
             pot: [0.0; K],
             pgrads: vec![[ZERO_ROW; K]; nf],
             sp: SpatialRows::default(),
+            spp: SpatialPotential::default(),
             ws: PolyWorkspace::new(),
         }
     }
@@ -223,11 +227,12 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         let ws = &mut self.ws;
         passes::constraint_poly_series(sys, ws, q, a, dirs, &mut self.vals, &mut self.grads);
         self.pot = passes::potential_poly_series(sys, ws, q, a, dirs, &mut self.pgrads);
+        // (gravity, linear in q, enters through the metric's gradient of V alone)
+        self.spp.eval::<B>(sys, q, dirs, &mut self.pot);
         self.eval_spatial(sys, q, dirs);
     }
 
-    /// The spatial rows' coefficients and gradients (the potential of a spatial model is
-    /// gravity alone, linear: the s = 2 term refuses spatial force elements).
+    /// The spatial rows' coefficients and gradients.
     fn eval_spatial(&mut self, sys: &System, q: &[f64], dirs: &[&[f64]]) {
         if sys.has_spatial() {
             self.sp.gather(sys, q, dirs);
@@ -262,5 +267,6 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         let mut w = [0.0; K];
         w[k] = 1.0;
         passes::add_potential_poly_adjoint::<K, B>(sys, &self.pgrads, &w, out, &mut []);
+        self.spp.adjoint::<B>(&w, out, &mut []);
     }
 }

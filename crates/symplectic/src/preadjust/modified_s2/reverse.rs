@@ -110,10 +110,10 @@ impl ModifiedS2 {
         gv.fill(0.0);
         w.clear();
 
-        // 1. the terms (those with Hess V or D^k V only with force elements: gravity is
-        //    linear, so without them H v, H u, H n and the potential's derivatives are zero and
-        //    so is every contribution of those terms)
-        let pot = !sys.forces().is_empty();
+        // 1. the terms (those with Hess V or D^k V only with force elements with a potential:
+        //    gravity is linear, so without them H v, H u, H n and the potential's derivatives
+        //    are zero and so is every contribution of those terms)
+        let pot = super::has_potential(sys);
         let hsig_v = (f.pi_hsig_v.as_slice(), f.sg_hsig_v.as_slice());
         let hmu_v = (f.pi_hmu_v.as_slice(), f.sg_hmu_v.as_slice());
         let hv = (f.pi_hv.as_slice(), f.sg_hv.as_slice());
@@ -406,6 +406,7 @@ fn contract<const K: usize, B: Basis<K>>(
     p.sp.adjoint::<K, B>(wts, qb, dirs);
     if let Some(pw) = pot {
         passes::add_potential_poly_adjoint::<K, B>(sys, &p.pgrads, pw, qb, dirs);
+        p.spp.adjoint::<B>(pw, qb, dirs);
     }
 }
 
@@ -451,28 +452,10 @@ mod tests {
         worst / scale
     }
 
-    /// A spatial spring is outside the passes (gravity is their only spatial potential): the
-    /// term and its gradients are an error naming it, not a value without its potential.
-    #[test]
-    fn a_spatial_force_element_is_refused_by_name() {
-        let sys = models::sprung_rod([0.05, 0.05, 0.002]).unwrap();
-        let st = State::consistent(&sys, 0.0).unwrap();
-        let (q, v) = (st.q.as_slice(), st.v.as_slice());
-        let mut p = Preadjustment::new(&sys, 2).unwrap();
-        let e = p.modified_term_s2(&sys, q, v).unwrap_err().to_string();
-        assert!(e.contains("'spring'"), "{e}");
-        let n = sys.n_coords();
-        let (mut gq, mut gv) = (vec![0.0; n], vec![0.0; n]);
-        let e = p
-            .modified_gradients_s2(&sys, q, v, &mut gq, &mut gv)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("'spring'"), "{e}");
-    }
-
-    /// The spatial rows (quadratic, in natural coordinates) through the passes and the reverse
-    /// pass: gradients against differences on a heavy top, a torque-free body and a spatial
-    /// double pendulum, at the consistent state with a generic velocity added (`e4` is defined
+    /// The spatial rows (quadratic, in natural coordinates) and the spatial force elements'
+    /// potentials through the passes and the reverse pass: gradients against differences on a
+    /// heavy top, a torque-free body, a spatial double pendulum, a rod on a spring and the
+    /// fixture with every kind of spatial potential, at the consistent state with a generic velocity added (`e4` is defined
     /// off the tangent space too).
     #[test]
     fn spatial_gradients_match_differences() {
@@ -480,6 +463,8 @@ mod tests {
             models::heavy_top([0.3, 0.3, 0.1], 0.3, 20.0).unwrap(),
             models::free_body([0.2, 0.3, 0.4], [0.4, 5.0, 0.3]).unwrap(),
             models::spatial_double_pendulum().unwrap(),
+            models::sprung_rod([0.05, 0.05, 0.002]).unwrap(),
+            mbd_model::fixtures::spatial_springs(),
         ];
         for sys in &systems {
             let st = State::consistent(sys, 0.0).unwrap();
