@@ -102,9 +102,37 @@ impl System {
         phi_q: &mut DMatrix<f64>,
         out: &mut DMatrix<f64>,
     ) {
+        self.phi_q_dot_jacobian_impl(q, None, v, t, phi_q, out);
+    }
+
+    /// [`System::phi_q_dot_jacobian`] with the bodies' `sin`/`cos` from `angles` (a table at
+    /// this `q`, [`BodyAngles::matches`]; evaluated when it does not match).
+    pub fn phi_q_dot_jacobian_at(
+        &self,
+        q: &[f64],
+        angles: &BodyAngles,
+        v: &[f64],
+        t: f64,
+        phi_q: &mut DMatrix<f64>,
+        out: &mut DMatrix<f64>,
+    ) {
+        let table = angles.matches(q).then_some(angles);
+        self.phi_q_dot_jacobian_impl(q, table, v, t, phi_q, out);
+    }
+
+    #[inline(always)]
+    fn phi_q_dot_jacobian_impl(
+        &self,
+        q: &[f64],
+        angles: Option<&BodyAngles>,
+        v: &[f64],
+        t: f64,
+        phi_q: &mut DMatrix<f64>,
+        out: &mut DMatrix<f64>,
+    ) {
         phi_q.as_mut_slice().fill(0.0);
         out.fill(0.0);
-        let sc = SinCos::new(self, q, None);
+        let sc = SinCos::new(self, q, angles);
         self.for_each_row_tan(q, v, &sc, |ji, r, g, dg| {
             self.scatter_row(ji, r, g, phi_q);
             self.scatter_row(ji, r, dg, out);

@@ -108,6 +108,34 @@ impl AccelerationSolver {
         Ok(())
     }
 
+    /// As [`AccelerationSolver::solve`] without filling the dense [`AccelerationSolver::phi_q`]
+    /// (it keeps the value of an earlier solve), for callers that read only `a` and `lambda`
+    /// (the stages of a Runge-Kutta method), with the bodies' `sin`/`cos` from `angles` when
+    /// that table holds the angles of `q` ([`BodyAngles::matches`]; a caller's table kept
+    /// up to date by [`BodyAngles::update_near`] saves the `sin_cos` calls), else evaluated.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_accelerations(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        angles: Option<&BodyAngles>,
+        a: &mut [f64],
+        lambda: &mut [f64],
+    ) -> Result<(), SolveError> {
+        self.check_sizes(q, v, a, lambda)?;
+        sys.forces_into(q, v, t, &mut self.forces);
+        if self.m == 0 || self.bodies.is_some() {
+            return self.solve_with_forces(sys, q, v, t, a, lambda);
+        }
+        match angles {
+            Some(table) if table.matches(q) => self.rows_with(sys, q, table, v, t),
+            _ => self.rows(sys, q, v, t),
+        }
+        self.finish_rows(sys, t, a, lambda)
+    }
+
     /// As [`AccelerationSolver::solve`], with the applied forces already in
     /// [`AccelerationSolver::forces`] (lets a caller add its own terms, e.g. Baumgarte).
     pub fn solve_with_forces(
@@ -176,6 +204,12 @@ impl AccelerationSolver {
             &mut self.schur.grads,
             &mut self.gamma,
         );
+    }
+
+    /// [`AccelerationSolver::rows`] with the angles of `q` from `angles`.
+    #[inline]
+    fn rows_with(&mut self, sys: &System, q: &[f64], angles: &BodyAngles, v: &[f64], t: f64) {
+        sys.phi_q_local_gamma_at(q, angles, v, t, &mut self.schur.grads, &mut self.gamma);
     }
 
     /// Completes the solve from `phi_q`, `gamma` and `forces` already set (advanced use). With

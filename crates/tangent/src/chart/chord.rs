@@ -30,6 +30,7 @@ impl TangentChart {
         self.sel.jacobian(
             sys,
             &x_e[..n],
+            None,
             &x_e[n..],
             t_e,
             &mut self.pq_e,

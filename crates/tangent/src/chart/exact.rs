@@ -54,6 +54,7 @@ impl TangentChart {
         self.sel.jacobian(
             sys,
             &x[..n],
+            None,
             &x[n..],
             t,
             &mut self.pq_x,
@@ -91,6 +92,7 @@ impl TangentChart {
                 self.sel.jacobian(
                     sys,
                     &x[..n],
+                    None,
                     &x[n..],
                     t,
                     &mut self.pq_x,

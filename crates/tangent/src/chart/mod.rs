@@ -257,12 +257,6 @@ impl TangentChart {
         }
     }
 
-    /// Whether the chart drops rows of `Phi` (the model's redundant equations): its `Phi_q` is
-    /// then not the model's.
-    pub(crate) fn drops_rows(&self) -> bool {
-        self.sel.drops_rows()
-    }
-
     /// Dimension of the chart, `2 (n - m)`: twice the degrees of freedom.
     pub fn dim(&self) -> usize {
         2 * (self.n - self.m)
@@ -305,16 +299,6 @@ impl TangentChart {
     pub fn normal(&self, k: usize) -> &[f64] {
         debug_assert!(self.q_ready, "form_q first");
         self.col(k)
-    }
-
-    /// `Phi_q` at the centre (`m x n`), from the last [`TangentChart::centre`].
-    pub fn centre_phi_q(&self) -> &DMatrix<f64> {
-        &self.phi_q
-    }
-
-    /// `(Phi_q v)_q` at the centre (`m x n`), from the last [`TangentChart::centre`].
-    pub fn centre_phi_q_dot_jacobian(&self) -> &DMatrix<f64> {
-        &self.dphi
     }
 
     /// Entry `(i, j)` of the triangular factor `R` (`2m x 2m`) of `Df(x_c)^T = Q1 R`.
@@ -376,9 +360,18 @@ impl TangentChart {
             self.centred = true;
             return Ok(());
         }
-        let selected = self
-            .sel
-            .jacobian(sys, q, v, t, &mut self.phi_q, &mut self.dphi, true);
+        // (the end-point map's verified residual was evaluated at q: the rotation is empty)
+        self.angles.update_near(sys, q);
+        let selected = self.sel.jacobian(
+            sys,
+            q,
+            Some(&self.angles),
+            v,
+            t,
+            &mut self.phi_q,
+            &mut self.dphi,
+            true,
+        );
         if !all_finite(self.phi_q.as_slice()) || !all_finite(self.dphi.as_slice()) {
             return Err(SolveError::NonFinite {
                 t,
@@ -517,6 +510,14 @@ impl TangentChart {
             r = r.max(e.abs());
         }
         r
+    }
+
+    /// The chart's angle table brought to `q` by rotating it from its last evaluation
+    /// ([`mbd_model::BodyAngles::update_near`]): for the index-1 solve at a point the chart has
+    /// just mapped, whose angles moved by the last correction only.
+    pub(crate) fn angles_near(&mut self, sys: &System, q: &[f64]) -> &mbd_model::BodyAngles {
+        self.angles.update_near(sys, q);
+        &self.angles
     }
 
     /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous

@@ -56,12 +56,6 @@ impl RowSelection {
         }
     }
 
-    /// Whether rows are dropped (the model has redundant equations).
-    #[inline]
-    pub(crate) fn drops_rows(&self) -> bool {
-        self.k > 0
-    }
-
     /// The model's row of kept row `i`.
     #[inline]
     pub(crate) fn full_row(&self, i: usize) -> usize {
@@ -75,21 +69,27 @@ impl RowSelection {
     /// configuration), or fewer (the redundancy found at build time is gone).
     #[inline]
     #[allow(clippy::too_many_arguments)] // (the point (q, v, t), two outputs and a flag)
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn jacobian(
         &mut self,
         sys: &System,
         q: &[f64],
+        angles: Option<&BodyAngles>,
         v: &[f64],
         t: f64,
         pq: &mut DMatrix<f64>,
         dp: &mut DMatrix<f64>,
         select: bool,
     ) -> bool {
+        let eval = |pq: &mut DMatrix<f64>, dp: &mut DMatrix<f64>| match angles {
+            Some(a) => sys.phi_q_dot_jacobian_at(q, a, v, t, pq, dp),
+            None => sys.phi_q_dot_jacobian(q, v, t, pq, dp),
+        };
         if self.k == 0 {
-            sys.phi_q_dot_jacobian(q, v, t, pq, dp);
+            eval(pq, dp);
             return true;
         }
-        sys.phi_q_dot_jacobian(q, v, t, &mut self.pq, &mut self.dp);
+        eval(&mut self.pq, &mut self.dp);
         if select && !self.select() {
             return false;
         }

@@ -115,7 +115,7 @@ impl TangentRk {
             let (q, v) = self.cur.split_at(n);
             if let Err(e) = self
                 .path
-                .accel(sys, q, v, t, false, &mut self.acc_a, &mut self.lambda)
+                .accel(sys, q, v, t, &mut self.acc_a, &mut self.lambda)
             {
                 return Err(match e {
                     SolveError::Singular { .. } => self
@@ -145,7 +145,7 @@ impl TangentRk {
         {
             let (q, v) = self.x.split_at(n);
             self.path
-                .accel(sys, q, v, t + ha, false, &mut self.acc_a, &mut self.lambda)?;
+                .accel(sys, q, v, t + ha, &mut self.acc_a, &mut self.lambda)?;
         }
         self.stats.rhs_evals += 1;
         self.proj[..n].copy_from_slice(&self.x[n..]);

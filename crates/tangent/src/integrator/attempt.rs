@@ -47,7 +47,6 @@ impl TangentRk {
         // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
         let centre_ok = self.cur_ok && same_time(self.cur_t, t);
         let quadratic = !sys.is_rheonomic();
-        let scleronomic = quadratic && self.m > 0;
         if !follows {
             self.hist.clear();
         }
@@ -162,9 +161,7 @@ impl TangentRk {
                     }
                 }
                 let (q, v) = x.split_at(n);
-                // at the centre: Phi_q and (Phi_q v)_q are the chart's, so (dense path)
-                // gamma = -(Phi_q v)_q v needs no model evaluation
-                let solved = chart.accel(sys, q, v, ti, at_centre && scleronomic, acc_a, lambda);
+                let solved = chart.accel(sys, q, v, ti, acc_a, lambda);
                 if solved.is_ok() {
                     work.condition = work.condition.max(chart.condition_estimate());
                 }

@@ -146,10 +146,8 @@ impl Path {
         }
     }
 
-    /// The index-1 accelerations at `(q, v, t)`. `at_centre`: `(q, v)` is the chart's centre
-    /// and the constraints are scleronomic, so the dense path takes `Phi_q` and
-    /// `gamma = -(Phi_q v)_q v` from the chart instead of evaluating the model.
-    #[allow(clippy::too_many_arguments)]
+    /// The index-1 accelerations at `(q, v, t)`, a point the chart has just mapped (or its
+    /// centre): the dense path takes the bodies' `sin`/`cos` from the chart's last residual.
     #[inline]
     pub(super) fn accel(
         &mut self,
@@ -157,29 +155,15 @@ impl Path {
         q: &[f64],
         v: &[f64],
         t: f64,
-        at_centre: bool,
         a: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
         match self {
             Path::Dense { chart, acc } => {
-                // (with redundant equations the chart keeps only its rows of Phi_q; spatial
-                // bodies' solve needs the configuration for their elimination)
-                if at_centre && !chart.drops_rows() && !sys.has_spatial() {
-                    sys.forces_into(q, v, t, &mut acc.forces);
-                    acc.phi_q.copy_from(chart.centre_phi_q());
-                    let dphi = chart.centre_phi_q_dot_jacobian().as_slice();
-                    let m = acc.gamma.len();
-                    acc.gamma.fill(0.0);
-                    for (col, &vk) in dphi.chunks_exact(m.max(1)).zip(v) {
-                        for (gr, &d) in acc.gamma.iter_mut().zip(col) {
-                            *gr -= d * vk;
-                        }
-                    }
-                    acc.finish(sys, t, a, lambda)
-                } else {
-                    acc.solve(sys, q, v, t, a, lambda)
-                }
+                // the chart's sin/cos of its last residual, rotated to q (at the centre: the
+                // end-point map's verified residual was evaluated there)
+                let angles = chart.angles_near(sys, q);
+                acc.solve_accelerations(sys, q, v, t, Some(angles), a, lambda)
             }
             Path::Sparse(p) => p.acc.solve(sys, q, v, t, a, lambda),
         }
