@@ -21,28 +21,26 @@ const W: usize = SPATIAL_LOCAL_WIDTH;
 /// The blocks of [`NV`] local variables.
 const BLOCKS: usize = W.div_ceil(NV);
 
-/// One element's data in a pass: its index among the spatial force elements, its columns and
-/// the gradients of its coefficients in local variables.
+/// One element's data in a pass: its columns and the gradients of its coefficients in local
+/// variables.
 #[derive(Clone, Debug)]
 struct Element<const K: usize> {
-    k: usize,
     cols: [Option<usize>; W],
     g: [[f64; W]; K],
 }
 
 /// The spatial force elements with a potential, in one pass ([`super::passes::Pass`]): filled
-/// by [`SpatialPotential::eval`] at every evaluation (the element list is built at the first).
+/// by [`SpatialPotential::eval`] at every evaluation from the system it is given (the list
+/// allocates only when it grows).
 #[derive(Debug)]
 pub(super) struct SpatialPotential<const K: usize> {
     elements: Vec<Element<K>>,
-    built: bool,
 }
 
 impl<const K: usize> Default for SpatialPotential<K> {
     fn default() -> Self {
         SpatialPotential {
             elements: Vec::new(),
-            built: false,
         }
     }
 }
@@ -57,26 +55,15 @@ impl<const K: usize> SpatialPotential<K> {
         dirs: &[&[f64]],
         pot: &mut [f64; K],
     ) {
-        if !self.built {
-            self.elements = sys
-                .spatial_force_elements()
-                .enumerate()
-                .filter(|(_, e)| e.has_potential())
-                .map(|(k, e)| Element {
-                    k,
-                    cols: e.columns(),
-                    g: [[0.0; W]; K],
-                })
-                .collect();
-            self.built = true;
-        }
-        if self.elements.is_empty() {
-            return;
-        }
+        self.elements.clear();
         let nd = dirs.len().min(B::ND);
-        for el in &mut self.elements {
-            let Some(e) = sys.spatial_force_elements().nth(el.k) else {
+        for e in sys.spatial_force_elements() {
+            if !e.has_potential() {
                 continue;
+            }
+            let mut el = Element {
+                cols: e.columns(),
+                g: [[0.0; W]; K],
             };
             let mut first = true;
             for b in 0..BLOCKS {
@@ -105,6 +92,7 @@ impl<const K: usize> SpatialPotential<K> {
                     gk[block.clone()].copy_from_slice(&jg[..block.len()]);
                 }
             }
+            self.elements.push(el);
         }
     }
 
