@@ -105,8 +105,9 @@ impl System {
         self.phi_q_dot_jacobian_impl(q, None, v, t, phi_q, out);
     }
 
-    /// [`System::phi_q_dot_jacobian`] with the bodies' `sin`/`cos` from `angles` (a table at
-    /// this `q`, [`BodyAngles::matches`]; evaluated when it does not match).
+    /// [`System::phi_q_dot_jacobian`] with the bodies' `sin`/`cos` from `angles` (a
+    /// [`BodyAngles`] table at this `q`, as for [`System::phi_q_local_gamma_at`]): the same
+    /// values without a `sin_cos` per body.
     pub fn phi_q_dot_jacobian_at(
         &self,
         q: &[f64],
@@ -116,8 +117,8 @@ impl System {
         phi_q: &mut DMatrix<f64>,
         out: &mut DMatrix<f64>,
     ) {
-        let table = angles.matches(q).then_some(angles);
-        self.phi_q_dot_jacobian_impl(q, table, v, t, phi_q, out);
+        debug_assert!(angles.matches(q));
+        self.phi_q_dot_jacobian_impl(q, Some(angles), v, t, phi_q, out);
     }
 
     #[inline(always)]

@@ -110,9 +110,10 @@ impl AccelerationSolver {
 
     /// As [`AccelerationSolver::solve`] without filling the dense [`AccelerationSolver::phi_q`]
     /// (it keeps the value of an earlier solve), for callers that read only `a` and `lambda`
-    /// (the stages of a Runge-Kutta method), with the bodies' `sin`/`cos` from `angles` when
-    /// that table holds the angles of `q` ([`BodyAngles::matches`]; a caller's table kept
-    /// up to date by [`BodyAngles::update_near`] saves the `sin_cos` calls), else evaluated.
+    /// (the stages of a Runge-Kutta method). With `angles`, the bodies' `sin`/`cos` come from
+    /// the caller's table, brought to `q` by [`BodyAngles::update_near`] (rotated from the
+    /// angles it holds, a few units in the last place from the exact values; evaluated after
+    /// a larger move): a table the caller keeps near `q` saves the `sin_cos` calls.
     #[allow(clippy::too_many_arguments)]
     pub fn solve_accelerations(
         &mut self,
@@ -120,7 +121,7 @@ impl AccelerationSolver {
         q: &[f64],
         v: &[f64],
         t: f64,
-        angles: Option<&BodyAngles>,
+        angles: Option<&mut BodyAngles>,
         a: &mut [f64],
         lambda: &mut [f64],
     ) -> Result<(), SolveError> {
@@ -130,8 +131,11 @@ impl AccelerationSolver {
             return self.solve_with_forces(sys, q, v, t, a, lambda);
         }
         match angles {
-            Some(table) if table.matches(q) => self.rows_with(sys, q, table, v, t),
-            _ => self.rows(sys, q, v, t),
+            Some(table) => {
+                table.update_near(sys, q);
+                self.rows_with(sys, q, table, v, t);
+            }
+            None => self.rows(sys, q, v, t),
         }
         self.finish_rows(sys, t, a, lambda)
     }

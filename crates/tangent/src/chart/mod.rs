@@ -512,12 +512,11 @@ impl TangentChart {
         r
     }
 
-    /// The chart's angle table brought to `q` by rotating it from its last evaluation
-    /// ([`mbd_model::BodyAngles::update_near`]): for the index-1 solve at a point the chart has
-    /// just mapped, whose angles moved by the last correction only.
-    pub(crate) fn angles_near(&mut self, sys: &System, q: &[f64]) -> &mbd_model::BodyAngles {
-        self.angles.update_near(sys, q);
-        &self.angles
+    /// The chart's angle table, holding the angles of its last residual evaluation: for the
+    /// index-1 solve at a point the chart has just mapped, whose angles moved by the last
+    /// correction only (the solve rotates it there, [`mbd_model::BodyAngles::update_near`]).
+    pub(crate) fn angles_mut(&mut self) -> &mut mbd_model::BodyAngles {
+        &mut self.angles
     }
 
     /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous

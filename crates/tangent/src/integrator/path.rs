@@ -161,9 +161,8 @@ impl Path {
         match self {
             Path::Dense { chart, acc } => {
                 // the chart's sin/cos of its last residual, rotated to q (at the centre: the
-                // end-point map's verified residual was evaluated there)
-                let angles = chart.angles_near(sys, q);
-                acc.solve_accelerations(sys, q, v, t, Some(angles), a, lambda)
+                // end-point map's verified residual was evaluated there, nothing to rotate)
+                acc.solve_accelerations(sys, q, v, t, Some(chart.angles_mut()), a, lambda)
             }
             Path::Sparse(p) => p.acc.solve(sys, q, v, t, a, lambda),
         }
