@@ -39,6 +39,45 @@ fn run(sys: &System, spec: &str, t_end: f64, h: f64) -> Result<State, String> {
     Ok(sim.state().clone())
 }
 
+/// One solver's errors in `q` at `t_end` against `reference` for each step of `hs`, and their
+/// fitted order (errors below `floor` left out of the fit).
+fn order_study(
+    sys: &System,
+    spec: &str,
+    t_end: f64,
+    hs: &[f64],
+    reference: &State,
+    floor: f64,
+) -> Result<(Vec<f64>, f64), String> {
+    let mut errs = Vec::new();
+    for &h in hs {
+        let s = run(sys, spec, t_end, h)?;
+        errs.push(mbd_solve::linalg::max_abs_diff(
+            s.q.as_slice(),
+            reference.q.as_slice(),
+        ));
+    }
+    let fit = fit_order(hs, &errs, floor).map_err(|e| format!("{spec}: {e} ({errs:?})"))?;
+    Ok((errs, fit.order))
+}
+
+/// The claim that `spec` reaches its order `order` on `model` within [`ORDER_TOL`].
+fn order_claim(spec: &str, order: u32, model: &str, fitted: f64, errs: &[f64]) -> Claim {
+    Claim::check(
+        format!("{spec} reaches its order {order} on {model} within {ORDER_TOL}"),
+        (fitted - f64::from(order)).abs() <= ORDER_TOL,
+        format!("fitted {fitted:.3} from errors {errs:?}"),
+    )
+}
+
+/// Errors for a table cell.
+fn fmt_errors(errs: &[f64]) -> String {
+    errs.iter()
+        .map(|e| fmt_e(*e))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Angular momentum about the origin of the spatial bodies.
 fn angular_momentum(sys: &System, s: &State) -> Vector3<f64> {
     Vector3::from(sys.spatial_angular_momentum(s.q.as_slice(), s.v.as_slice()))
@@ -93,15 +132,7 @@ fn orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
             } else {
                 hs.clone()
             };
-            let mut errs = Vec::new();
-            for &h in &hs_v {
-                let s = run(&sys, v.spec, t_end, h)?;
-                errs.push(mbd_solve::linalg::max_abs_diff(
-                    s.q.as_slice(),
-                    reference.q.as_slice(),
-                ));
-            }
-            let fit = fit_order(&hs_v, &errs, FLOOR).map_err(|e| e.to_string())?;
+            let (errs, fitted) = order_study(&sys, v.spec, t_end, &hs_v, &reference, FLOOR)?;
             if let Some(&e) = errs.last() {
                 smallest_h_errors.push((v.spec, e));
             }
@@ -109,21 +140,17 @@ fn orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
                 v.spec.to_string(),
                 body.to_string(),
                 format!("{}", v.order),
-                format!("{:.2}", fit.order),
-                errs.iter()
-                    .map(|e| fmt_e(*e))
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                format!("{fitted:.2}"),
+                fmt_errors(&errs),
             ]);
-            sec.claims.push(Claim::check(
-                format!(
-                    "{} reaches its order {} on the heavy top ({body}) within {ORDER_TOL}",
-                    v.spec, v.order
-                ),
-                (fit.order - v.order as f64).abs() <= ORDER_TOL,
-                format!("fitted {:.3} from errors {errs:?}", fit.order),
+            sec.claims.push(order_claim(
+                v.spec,
+                v.order,
+                &format!("the heavy top ({body})"),
+                fitted,
+                &errs,
             ));
-            rows.push(json!({"solver": v.spec, "body": body, "order": num(fit.order), "errors": errs.iter().map(|e| num(*e)).collect::<Vec<_>>()}));
+            rows.push(json!({"solver": v.spec, "body": body, "order": num(fitted), "errors": errs.iter().map(|e| num(*e)).collect::<Vec<_>>()}));
         }
         modified_gain(
             sec,
@@ -177,35 +204,24 @@ fn tumbling_orders(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
             continue;
         }
         let hs = hs_for(order);
-        let mut errs = Vec::new();
-        for &h in &hs {
-            let s = run(&sys, &spec, t_end, h)?;
-            errs.push(mbd_solve::linalg::max_abs_diff(
-                s.q.as_slice(),
-                reference.q.as_slice(),
-            ));
-        }
-        let fit =
-            fit_order(&hs, &errs, TUMBLING_FLOOR).map_err(|e| format!("{spec}: {e} ({errs:?})"))?;
+        let (errs, fitted) = order_study(&sys, &spec, t_end, &hs, &reference, TUMBLING_FLOOR)?;
         if let Some(&e) = errs.last() {
             smallest_h_errors.push((spec.clone(), e));
         }
         table.row(vec![
             spec.clone(),
             format!("{order}"),
-            format!("{:.2}", fit.order),
-            errs.iter()
-                .map(|e| fmt_e(*e))
-                .collect::<Vec<_>>()
-                .join(", "),
+            format!("{fitted:.2}"),
+            fmt_errors(&errs),
         ]);
-        let claim = Claim::check(
-            format!("{spec} reaches its order {order} on a body tumbling about its intermediate axis within {ORDER_TOL}"),
-            (fit.order - f64::from(order)).abs() <= ORDER_TOL,
-            format!("fitted {:.3} from errors {errs:?}", fit.order),
-        );
-        sec.claims.push(claim);
-        rows.push(json!({"solver": spec, "order": num(fit.order), "errors": errs.iter().map(|e| num(*e)).collect::<Vec<_>>()}));
+        sec.claims.push(order_claim(
+            &spec,
+            order,
+            "a body tumbling about its intermediate axis",
+            fitted,
+            &errs,
+        ));
+        rows.push(json!({"solver": spec, "order": num(fitted), "errors": errs.iter().map(|e| num(*e)).collect::<Vec<_>>()}));
     }
     sec.tables.push(table);
     sec.summary["spatial_tumbling_orders"] = json!(rows);
@@ -302,30 +318,19 @@ fn spring_s2(sec: &mut Section) -> Result<(), String> {
     );
     let mut last = Vec::new();
     for (spec, order) in [("symplectic:2", 4u32), ("symplectic:2:modified", 6)] {
-        let mut errs = Vec::new();
-        for &h in &hs {
-            let s = run(&sys, spec, t_end, h)?;
-            errs.push(mbd_solve::linalg::max_abs_diff(
-                s.q.as_slice(),
-                reference.q.as_slice(),
-            ));
-        }
-        let fit = fit_order(&hs, &errs, FLOOR).map_err(|e| format!("{spec}: {e}"))?;
+        let (errs, fitted) = order_study(&sys, spec, t_end, &hs, &reference, FLOOR)?;
         table.row(vec![
             spec.to_string(),
             format!("{order}"),
-            format!("{:.2}", fit.order),
-            errs.iter()
-                .map(|e| fmt_e(*e))
-                .collect::<Vec<_>>()
-                .join(", "),
+            format!("{fitted:.2}"),
+            fmt_errors(&errs),
         ]);
-        sec.claims.push(Claim::check(
-            format!(
-                "{spec} reaches its order {order} on a rod on a spatial spring within {ORDER_TOL}"
-            ),
-            (fit.order - f64::from(order)).abs() <= ORDER_TOL,
-            format!("fitted {:.3} from errors {errs:?}", fit.order),
+        sec.claims.push(order_claim(
+            spec,
+            order,
+            "a rod on a spatial spring",
+            fitted,
+            &errs,
         ));
         last.push(errs[errs.len() - 1]);
     }
