@@ -426,6 +426,15 @@ impl System {
         self.spatial.add_hessian(q, t, lambda, scale, out);
     }
 
+    /// The nonzeros `(row column, column, value)` of row `r`'s Hessian in global columns, if
+    /// `r` is a spatial row whose Hessian is constant (every spatial equation is quadratic;
+    /// an angle driver's rows turn with time and give `None`, as every planar row does). The
+    /// Hessians are evaluated once, at the first call of this or of the other spatial Hessian
+    /// passes (`q` is only used then).
+    pub fn spatial_row_hessian(&self, q: &[f64], r: usize) -> Option<&[(usize, usize, f64)]> {
+        self.spatial.row_hessian(q, r)
+    }
+
     /// The spatial rows' part of `out += scale sum_r w_r Hess(Phi_r) x` (`out` and `x` of
     /// length n, `weights` of length m) at time `t`: what a pass over the planar elements
     /// ([`System::joint_elements`], which hands out planar joints only) leaves out. Every

@@ -545,6 +545,15 @@ impl SpatialPart {
         self.hessians.get_or_init(|| ConstantHessians::new(self, q))
     }
 
+    /// Row `r`'s constant Hessian as nonzeros in global columns (`None`: not a spatial row, or
+    /// an angle driver's).
+    pub(crate) fn row_hessian(&self, q: &[f64], r: usize) -> Option<&[(usize, usize, f64)]> {
+        if r < self.r0 || r >= self.r0 + self.m {
+            return None;
+        }
+        self.constant_hessians(q).row(self, r)
+    }
+
     /// The potential of gravity on the spatial bodies and point masses, `-sum_k m_k g . x_k`.
     pub(crate) fn potential(&self, q: &[f64]) -> f64 {
         let g = self.gravity;

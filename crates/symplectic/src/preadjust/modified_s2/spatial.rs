@@ -31,6 +31,8 @@ struct Row {
     /// `g_r` and `H_r d_j` in local columns.
     g: [f64; W],
     hd: [[f64; W]; MAX_DIRS],
+    /// `H_r`'s nonzeros `(local row column, global column, value)`.
+    nz: Vec<(usize, usize, f64)>,
 }
 
 impl Row {
@@ -81,51 +83,90 @@ pub(super) struct SpatialRows {
 }
 
 impl SpatialRows {
-    /// `g_r` and `H_r d_j` of every spatial row at `q` for the directions `dirs`.
+    /// `g_r` and `H_r d_j` of every spatial row at `q` for the directions `dirs`: one pass of
+    /// the rows along `d_1` gives the rows, their columns, `g_r` and `H_r d_1`; the other
+    /// directions' products come from the rows' constant Hessians
+    /// ([`System::spatial_row_hessian`]), or from a pass along each if a row's Hessian is not
+    /// constant.
     pub(super) fn gather(&mut self, sys: &System, q: &[f64], dirs: &[&[f64]]) {
-        let planar = sys.bodies().len();
-        for (j, d) in dirs.iter().enumerate() {
-            let mut k = 0;
-            let rows = &mut self.rows;
-            sys.local_rows_tan(q, d, 0.0, |r, sides| {
-                let spatial = sides.iter().flatten().any(|s| s.0 >= planar);
-                if !spatial {
-                    return;
+        let Some(&first) = dirs.first() else {
+            self.rows.clear();
+            return;
+        };
+        self.pass(sys, q, first, 0);
+        let mut constant = true;
+        for row in &mut self.rows {
+            row.nz.clear();
+            let Some(h) = sys.spatial_row_hessian(q, row.r) else {
+                constant = false;
+                continue;
+            };
+            for &(i, c, v) in h {
+                if let Some(l) = row.cols.iter().position(|&x| x == i) {
+                    row.nz.push((l, c, v));
                 }
-                if k == rows.len() {
-                    rows.push(Row {
-                        r,
-                        cols: [NONE; W],
-                        g: [0.0; W],
-                        hd: [[0.0; W]; MAX_DIRS],
-                    });
-                }
-                let row = &mut rows[k];
-                k += 1;
-                if j == 0 {
-                    row.r = r;
-                    row.cols = [NONE; W];
-                    row.g = [0.0; W];
-                }
-                row.hd[j] = [0.0; W];
-                for (s, side) in sides.iter().enumerate() {
-                    let Some((block, g, dg)) = side else {
-                        continue;
-                    };
-                    let Some((o, _)) = sys.body_block(*block) else {
-                        continue;
-                    };
-                    for l in 0..g.len().min(12) {
-                        if j == 0 {
-                            row.cols[12 * s + l] = o + l;
-                            row.g[12 * s + l] = g[l];
-                        }
-                        row.hd[j][12 * s + l] = dg[l];
-                    }
-                }
-            });
-            self.rows.truncate(k);
+            }
         }
+        for (j, d) in dirs.iter().enumerate().skip(1) {
+            if !constant {
+                self.pass(sys, q, d, j);
+                continue;
+            }
+            for row in &mut self.rows {
+                let hd = &mut row.hd[j];
+                *hd = [0.0; W];
+                for &(l, c, v) in &row.nz {
+                    hd[l] += v * d[c];
+                }
+            }
+        }
+    }
+
+    /// One pass of the rows along `d` (direction `j`): `H_r d` into each row's `hd[j]`, and for
+    /// `j = 0` the row list, the columns and `g_r`.
+    fn pass(&mut self, sys: &System, q: &[f64], d: &[f64], j: usize) {
+        let planar = sys.bodies().len();
+        let mut k = 0;
+        let rows = &mut self.rows;
+        sys.local_rows_tan(q, d, 0.0, |r, sides| {
+            let spatial = sides.iter().flatten().any(|s| s.0 >= planar);
+            if !spatial {
+                return;
+            }
+            if k == rows.len() {
+                rows.push(Row {
+                    r,
+                    cols: [NONE; W],
+                    g: [0.0; W],
+                    hd: [[0.0; W]; MAX_DIRS],
+                    nz: Vec::new(),
+                });
+            }
+            let row = &mut rows[k];
+            k += 1;
+            if j == 0 {
+                row.r = r;
+                row.cols = [NONE; W];
+                row.g = [0.0; W];
+            }
+            row.hd[j] = [0.0; W];
+            for (s, side) in sides.iter().enumerate() {
+                let Some((block, g, dg)) = side else {
+                    continue;
+                };
+                let Some((o, _)) = sys.body_block(*block) else {
+                    continue;
+                };
+                for l in 0..g.len().min(12) {
+                    if j == 0 {
+                        row.cols[12 * s + l] = o + l;
+                        row.g[12 * s + l] = g[l];
+                    }
+                    row.hd[j][12 * s + l] = dg[l];
+                }
+            }
+        });
+        self.rows.truncate(k);
     }
 
     /// The coefficients of the spatial rows in the basis `B` into `vals` (module doc).
