@@ -6,7 +6,7 @@
 //! agree at fine settings; the Bricard linkage moves with one degree of freedom.
 
 mod common;
-use mbd::model::models::{bricard, spatial_double_pendulum, spatial_slider_crank};
+use mbd::model::models::{bricard, spatial_double_pendulum, spatial_slider_crank, sprung_rod};
 use mbd::prelude::*;
 use nalgebra::{DMatrix, DVector, Vector3};
 use std::f64::consts::PI;
@@ -18,7 +18,8 @@ fn slider_crank() -> std::result::Result<System, mbd::model::ModelError> {
     spatial_slider_crank(-2.0 * PI)
 }
 
-/// The three mechanisms: name, the model in code, its example file.
+/// The three mechanisms and the rod on a spring (`models::sprung_rod`): name, the model in
+/// code, its example file.
 fn mechanisms() -> Vec<(&'static str, System, &'static str)> {
     vec![
         (
@@ -32,6 +33,11 @@ fn mechanisms() -> Vec<(&'static str, System, &'static str)> {
             "spatial_slider_crank.toml",
         ),
         ("Bricard", bricard().expect("Bricard"), "bricard.toml"),
+        (
+            "rod on a spring",
+            sprung_rod([0.05, 0.05, 0.002]).expect("rod on a spring"),
+            "sprung_rod.toml",
+        ),
     ]
 }
 
@@ -78,8 +84,8 @@ fn energy_scale(sys: &System, lift: f64) -> f64 {
 }
 
 /// Each example file builds the model's system: the same coordinates, equations, redundancy,
-/// joints, initial guess (to 1e-12) and constraint values at a configuration off the
-/// constraints (to 1e-12).
+/// joints, force elements, initial guess (to 1e-12) and constraint values at a configuration
+/// off the constraints (to 1e-12).
 #[test]
 fn the_example_files_are_the_models() -> Result<()> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
@@ -100,6 +106,7 @@ fn the_example_files_are_the_models() -> Result<()> {
             code.spatial_gravity(),
             "{name}"
         );
+        assert_eq!(from_file.spatial_forces(), code.spatial_forces(), "{name}");
         let (qf, vf) = from_file.initial_guess();
         let (qc, vc) = code.initial_guess();
         let (dq, dv) = ((&qf - &qc).amax(), (&vf - &vc).amax());

@@ -404,7 +404,8 @@ pub fn bricard() -> Result<System, ModelError> {
 /// (0.4 m above its centre of mass) from the origin, pulled sideways by an undamped spring
 /// (40 N/m, rest length 0.3 m) from the ground point `(0.5, 0.3, -0.3)` to its lower end,
 /// gravity 9.81 m/s^2 along `-z`; it starts hanging straight down, moving with angular velocity
-/// `(0.5, -1.25, 2)` rad/s about its pivot. The damped and driven variant is
+/// `(0.5, -1.25, 2)` rad/s about its pivot (with `moments = [0.05, 0.05, 0.002]`: the model
+/// file `examples/models/sprung_rod.toml`). The damped and driven variant is
 /// `examples/models/spatial_spring_pendulum.toml`.
 ///
 /// ```
