@@ -266,6 +266,7 @@ fn every_example_loads_with_its_dof_and_a_consistent_state() {
         ("spatial_slider_crank.toml", 1, false),
         ("spatial_spring_pendulum.toml", 3, false),
         ("spherical_pendulum.toml", 2, false),
+        ("sprung_rod.toml", 3, false),
         ("turning_arm.toml", 3, true),
     ];
     let files = examples();
