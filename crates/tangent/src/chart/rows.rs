@@ -63,13 +63,11 @@ impl RowSelection {
     }
 
     /// `Phi_q` and `(Phi_q v + Phi_t)_q` at `(q, v, t)`, kept rows (`m - k` x `n`), into `pq`,
-    /// `dp`; with
-    /// `select`, the rows are chosen afresh at this point first (a centre). `false` if the
+    /// `dp` (the bodies' `sin`/`cos` from `angles` if given, a table at `q`); with `select`, the rows are chosen afresh at this point first (a centre). `false` if the
     /// selection failed: `Phi_q` has more than `k` dependent rows here (a singular
     /// configuration), or fewer (the redundancy found at build time is gone).
     #[inline]
-    #[allow(clippy::too_many_arguments)] // (the point (q, v, t), two outputs and a flag)
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)] // (the point (q, v, t), its angles, two outputs, a flag)
     pub(crate) fn jacobian(
         &mut self,
         sys: &System,
