@@ -156,9 +156,7 @@ impl Galerkin {
         }
         // (W_s adds a dense block to the Newton matrix; the modified Lagrangian's blocks are
         // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
-        // (a preadjustment on spatial bodies takes the dense path: its passes over spatial rows
-        // fill dense Hessians and Phi_q)
-        let sparse_ok = options.gamma == 0.0 && !(modlag && sys.has_spatial());
+        let sparse_ok = options.gamma == 0.0;
         let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
         if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
             return Err(SolveError::Unsupported(

@@ -248,9 +248,10 @@ mod tests {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum JacobianReuse {
-    /// Kept on the sparse stage path of the plain scheme (large models, where one sparse
-    /// factorisation costs as much as many residuals and triangular solves); a new one at every
-    /// step on the dense path and with a preadjustment (whose residuals cost more than the
+    /// Kept on the sparse stage path of the plain scheme, and of the modified Lagrangian on
+    /// models with spatial bodies (large models, where one sparse factorisation costs as much
+    /// as many residuals and triangular solves); a new one at every step on the dense path and
+    /// for the modified Lagrangian on planar models (whose residuals can cost more than the
     /// factorisation they would save). Measured in docs/symplectic.md, "Large mechanisms".
     #[default]
     Auto,
@@ -261,11 +262,11 @@ pub enum JacobianReuse {
 }
 
 impl JacobianReuse {
-    /// Whether a step on the given stage path (`sparse`) of a plain or preadjusted scheme
-    /// starts from the kept factorisation.
-    pub(crate) fn keeps(self, sparse: bool, preadjusted: bool) -> bool {
+    /// Whether a step on the given stage path (`sparse`) starts from the kept factorisation
+    /// (`planar_modified`: the modified Lagrangian on a model without spatial bodies).
+    pub(crate) fn keeps(self, sparse: bool, planar_modified: bool) -> bool {
         match self {
-            JacobianReuse::Auto => sparse && !preadjusted,
+            JacobianReuse::Auto => sparse && !planar_modified,
             JacobianReuse::Always => true,
             JacobianReuse::Never => false,
         }

@@ -78,13 +78,28 @@ fn energy_error_falls_on_other_mechanisms() {
 /// 107 and 107. With the Newton tolerance at 1e-15 the s = 1 paths are 5.2e-14 apart in q.
 /// The modified term itself moves q by 2.0e-4 (s = 1) and 1.9e-7 (s = 2) from the plain
 /// scheme's, so a path that dropped it would fail.)
+///
+/// The same on a chain of six spatial rods (54 equations; `S` over body blocks, the inverse
+/// mass diagonal), with a new stage Jacobian at every step on both paths (by default the
+/// sparse path keeps it there, which takes more Newton iterations).
 #[test]
 fn sparse_path_matches_the_dense_path() {
+    for (name, sys) in [
+        ("30-link chain", models::n_link_chain(30).unwrap()),
+        ("6-rod spatial chain", models::spatial_chain(6).unwrap()),
+    ] {
+        sparse_path_matches_the_dense_path_on(name, &sys);
+    }
+}
+
+fn sparse_path_matches_the_dense_path_on(name: &str, sys: &System) {
     use mbd_solve::LinearSolver;
-    let sys = models::n_link_chain(30).unwrap();
+    use mbd_symplectic::JacobianReuse;
     assert!(sys.n_constraints() >= mbd_solve::SPARSE_THRESHOLD);
     for s in [1, 2] {
-        let o = SymplecticOptions::new(s).with_preadjust(PreadjustMode::ModifiedLagrangian);
+        let o = SymplecticOptions::new(s)
+            .with_preadjust(PreadjustMode::ModifiedLagrangian)
+            .with_jacobian_reuse(JacobianReuse::Never);
         let mut sparse = Galerkin::new(&sys, o).unwrap();
         let mut dense = Galerkin::new(
             &sys,
@@ -108,17 +123,17 @@ fn sparse_path_matches_the_dense_path() {
             off = off.max(max_abs_diff(sa.q.as_slice(), sc.q.as_slice()));
         }
         eprintln!(
-            "30-link chain, s = {s}, 40 steps: sparse - dense {wq:.2e} in q, {wv:.2e} in v ({} / \
+            "{name}, s = {s}, 40 steps: sparse - dense {wq:.2e} in q, {wv:.2e} in v ({} / \
              {} Newton iterations); modified - plain {off:.2e} in q",
             its[0], its[1]
         );
         // (Newton's tolerance is 1e-14 (1 + max |x, y|), about 3e-13 here, per step; the
         // velocities carry it divided by h)
-        assert!(wq < 1e-10 && wv < 1e-8, "s = {s}: {wq} in q, {wv} in v");
+        assert!(wq < 1e-10 && wv < 1e-8, "{name}, s = {s}: {wq} in q, {wv} in v");
         // (the comparison can see the term: it moves the steps far more than the tolerance)
-        assert!(off > 1e3 * wq.max(1e-14), "s = {s}: {off}");
+        assert!(off > 1e3 * wq.max(1e-14), "{name}, s = {s}: {off}");
         // the diagonal blocks cost at most about one Newton iteration per step
-        assert!(its[0] <= its[1] + 40, "s = {s}: {its:?}");
+        assert!(its[0] <= its[1] + 40, "{name}, s = {s}: {its:?}");
     }
 }
 
@@ -157,4 +172,38 @@ fn a_stall_at_a_singular_configuration_does_not_advise_a_smaller_h() {
     // the message is what this test checks: when the scheme learns to pass the flat
     // configurations, this count (4 today) falls and the test must move to a model that stalls
     assert!(stops > 0, "no run stopped: nothing was checked");
+}
+
+/// Above `DENSE_SPATIAL_LIMIT` equations a spatial model takes the modified Lagrangian on the
+/// sparse layout (a 70-rod chain, 630 equations: it builds, takes the sparse path and steps
+/// with the constraints at round-off), while paper A's `W_s`, whose Newton block is dense, and
+/// the modified Lagrangian forced onto the dense path are refused with the limit named.
+#[test]
+fn large_spatial_models_take_the_sparse_layout() {
+    use mbd_solve::LinearSolver;
+    let sys = models::spatial_chain(70).unwrap();
+    assert!(sys.n_constraints() > mbd_solve::DENSE_SPATIAL_LIMIT);
+    for s in [1, 2] {
+        let o = SymplecticOptions::new(s).with_preadjust(PreadjustMode::ModifiedLagrangian);
+        let mut g = Galerkin::new(&sys, o).unwrap();
+        assert!(g.is_sparse(), "s = {s}");
+        let mut st = State::consistent(&sys, 0.0).unwrap();
+        for _ in 0..2 {
+            g.step(&sys, &mut st, 1e-3).unwrap();
+        }
+        let mut phi = vec![0.0; sys.n_constraints()];
+        sys.phi(st.q.as_slice(), st.t, &mut phi);
+        let worst = phi.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        assert!(worst < 1e-12, "s = {s}: max |Phi| {worst}");
+        let dense = SymplecticOptions {
+            linear_solver: LinearSolver::Dense,
+            ..o
+        };
+        let e = Galerkin::new(&sys, dense).unwrap_err().to_string();
+        assert!(e.contains("600") && e.contains("dense"), "{e}");
+    }
+    let e = Galerkin::new(&sys, SymplecticOptions::new(2).with_gamma(1.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("600") && e.contains("W_s"), "{e}");
 }

@@ -8,7 +8,8 @@
 //! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
 //! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
 //! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
-//! state in full (for comparing trajectories between builds). The environment variable `MBD_H`
+//! state in full (for comparing trajectories between builds). `MBD_LINEAR=dense|sparse` picks the symplectic scheme's
+//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps. The environment variable `MBD_H`
 //! overrides the step.
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
@@ -62,6 +63,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             if never {
                 o = o.with_jacobian_reuse(mbd::symplectic::JacobianReuse::Never);
+            }
+            // MBD_REUSE=always keeps the stage Jacobian across steps
+            if std::env::var("MBD_REUSE").as_deref() == Ok("always") {
+                o = o.with_jacobian_reuse(mbd::symplectic::JacobianReuse::Always);
+            }
+            // MBD_LINEAR=dense|sparse picks the path (default: Auto)
+            match std::env::var("MBD_LINEAR").as_deref() {
+                Ok("dense") => o.linear_solver = mbd::solve::LinearSolver::Dense,
+                Ok("sparse") => o.linear_solver = mbd::solve::LinearSolver::Sparse,
+                _ => {}
             }
             (Box::new(Galerkin::new(&sys, o)?), 1e-2)
         }

@@ -7,6 +7,8 @@
 //! * [`ConstraintSchur`]: the constraint Jacobian `Phi_q` in element-local form (each equation
 //!   acts on at most two bodies) and the matrix `S = Phi_q W Phi_q^T` for a diagonal weight `W`
 //!   (the index-1 solve and the projections use `W = M^-1`);
+//! * [`BlockSchur`]: the same for bodies of any kind (rows over body blocks,
+//!   [`BlockRows`]), every row kept (the spatial internal ones too);
 //! * [`SparseLu`] (from [`mbd_linalg`]): a general square matrix on a fixed pattern (the symplectic stage
 //!   equations), analysed once and refactored into reused storage, with a scale-invariant
 //!   pivot test by power-of-two equilibration;
@@ -16,6 +18,7 @@
 
 mod accel;
 mod block_rows;
+mod block_schur;
 mod bodies;
 mod schur;
 
@@ -23,6 +26,7 @@ pub(crate) use bodies::SparseBodySchur;
 
 pub use accel::SparseAccelerationSolver;
 pub use block_rows::{BlockRows, RowSide};
+pub use block_schur::BlockSchur;
 pub use mbd_linalg::{SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};
 pub use schur::{ConstraintSchur, RowIncidence};
 

@@ -169,11 +169,11 @@ impl Galerkin {
         }
         // simplified Newton: one Jacobian per step (or the last step's, if reuse is on), kept
         // while it contracts by 4x per iteration, recomputed every `jacobian_every` iterations
-        let preadjusted = self.opts.gamma != 0.0 || !self.ml.is_empty();
+        let planar_modified = !self.ml.is_empty() && self.end_solve.is_none();
         let mut need_jacobian = !(self
             .opts
             .reuse_jacobian
-            .keeps(self.sparse.is_some(), preadjusted)
+            .keeps(self.sparse.is_some(), planar_modified)
             && self.jac_valid
             && (self.jac_h - h).abs() <= 1e-12 * h
             && self.jac_gk == self.gk);

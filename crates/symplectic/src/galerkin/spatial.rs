@@ -9,10 +9,11 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// What the symplectic scheme runs with spatial bodies: the plain (s,s) scheme on either
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
-/// and the s = 1 modified Lagrangian on the dense path (a singular mass matrix included: their
-/// metric uses the augmented `M_W^-1`) and the s = 2 modified Lagrangian there (a massless
-/// director regularised), for models whose Jacobian does not depend on time (docs/spatial.md,
-/// "The preadjusted schemes"). Each refusal names what stands in the way.
+/// on the dense path and the modified Lagrangian on either path (a singular mass matrix
+/// included: the dense metric of `W_s` and the s = 1 term uses the augmented `M_W^-1`, the
+/// s = 2 term and the sparse layout a regularised diagonal on a massless director), for
+/// models whose Jacobian does not depend on time (docs/spatial.md, "The preadjusted
+/// schemes"). Each refusal names what stands in the way.
 pub(super) fn spatial_support(
     sys: &System,
     s: usize,
@@ -38,6 +39,10 @@ pub(super) fn spatial_support(
             "an angle driver makes Phi_q depend on time, which the derivation does not cover"
                 .into(),
         );
+    }
+    if modlag && gamma == 0.0 && linear.use_sparse(sys.n_constraints()) {
+        // the modified Lagrangian's sparse layout: O(N), any size
+        return Ok(());
     }
     mbd_solve::refuse_large_spatial(sys, &scheme, linear)
 }

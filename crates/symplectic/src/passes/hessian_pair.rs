@@ -86,7 +86,8 @@ pub(crate) fn add_lagrangian_hessian_pair(
 
 /// The diagonals of the two weighted Lagrangian Hessians of
 /// [`add_lagrangian_hessian_pair`], added into `out_a` and `out_b` (length n), in
-/// `O(elements)` with nothing assembled (diagonal Newton blocks on a sparse path).
+/// `O(elements)` with nothing assembled (diagonal Newton blocks on a sparse path): every
+/// planar element and the spatial constraint rows (the spatial force elements are left out).
 pub(crate) fn add_lagrangian_hessian_pair_diagonals(
     sys: &System,
     q: &[f64],
@@ -121,6 +122,18 @@ pub(crate) fn add_lagrangian_hessian_pair_diagonals(
             }
         }
     });
+    if sys.has_spatial() {
+        // the spatial rows' constant Hessians (the spatial force elements' Hessians are left
+        // out: these diagonals only shape a Newton matrix)
+        for (r, (&wa, &wb)) in a.constraints.iter().zip(b.constraints).enumerate() {
+            for &(i, j, h) in sys.spatial_row_hessian(q, r).unwrap_or(&[]) {
+                if i == j {
+                    out_a[i] += wa * h;
+                    out_b[i] += wb * h;
+                }
+            }
+        }
+    }
 }
 
 fn scaled(h: &[[f64; NV]; NV], w: f64) -> [[f64; NV]; NV] {

@@ -11,7 +11,9 @@
 //!   `A = Hess V - mu0 . Hess Phi`.
 //!
 //! `S` is factored densely ([`DenseCholesky`], `G` an `m x n` matrix) or, on the sparse layout,
-//! held in element-local rows and factored sparsely ([`ConstraintSchur`]). The evaluation is kept
+//! held in element-local rows and factored sparsely ([`ConstraintSchur`] for planar models,
+//! [`BlockSchur`] over body blocks with spatial bodies, whose `M^-1` is then the regularised
+//! diagonal of [`super::augmented::regularised_inverse`]). The evaluation is kept
 //! while the point does not change bit for bit: the control point `q_1` of one step is `q_0` of
 //! the next, and the Newton Jacobian is evaluated where the residual was. Every evaluation at a
 //! new point gets a new [`Stamp`], by which the terms tell whether what they keep is still of
@@ -21,8 +23,8 @@ use super::augmented::Augmented;
 use super::{dot, LocalRow, ZERO_ROW};
 use crate::passes;
 use mbd_model::System;
-use mbd_solve::linalg::DenseCholesky;
-use mbd_solve::sparse::ConstraintSchur;
+use mbd_solve::linalg::{DenseCholesky, FactorError};
+use mbd_solve::sparse::{BlockSchur, ConstraintSchur};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -53,7 +55,7 @@ pub(crate) struct ProjectedMetric {
     gq: DMatrix<f64>,
     chol: DenseCholesky,
     /// Sparse layout: `Phi_q` in element-local rows and the sparse factor of `S`.
-    schur: Option<Box<ConstraintSchur>>,
+    schur: Option<Box<SparseS>>,
     mu0: Vec<f64>,
     /// `-mu0`: the constraint weights of `A`.
     nmu0: Vec<f64>,
@@ -101,11 +103,17 @@ impl ProjectedMetric {
     /// `n x n` or `m x n` matrix.
     pub(super) fn new(sys: &System, sparse: bool) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let schur = if sparse {
-            Some(Box::new(ConstraintSchur::new(sys)?))
-        } else {
-            None
+        let schur = match (sparse, sys.has_spatial()) {
+            (false, _) => None,
+            (true, false) => Some(Box::new(SparseS::Planar(ConstraintSchur::new(sys)?))),
+            (true, true) => Some(Box::new(SparseS::Blocks(BlockSchur::new(sys)?))),
         };
+        let mut minv = sys.inv_mass_diag().as_slice().to_vec();
+        if sparse {
+            // (the augmented M_W^-1 has 9 x 9 blocks; the sparse layout weights S by a
+            // diagonal, the regularised M^-1 that the s = 2 term takes on either layout)
+            super::augmented::regularised_inverse(sys, &mut minv);
+        }
         let (nd, md) = if sparse { (0, 0) } else { (n, m) };
         let mut chol = DenseCholesky::new(md);
         chol.set_max_dependent(sys.n_redundant());
@@ -113,7 +121,7 @@ impl ProjectedMetric {
             n,
             m,
             mass: sys.mass_diag().as_slice().to_vec(),
-            minv: sys.inv_mass_diag().as_slice().to_vec(),
+            minv,
             aug: if sparse {
                 None
             } else {
@@ -460,8 +468,12 @@ impl ProjectedMetric {
                         &mut rows.third_vv,
                         &mut rows.vhv,
                     );
-                    match &mut self.schur {
-                        Some(sc) => sc.grads_mut().copy_from_slice(&self.local_grads),
+                    match self.schur.as_deref_mut() {
+                        Some(SparseS::Planar(sc)) => {
+                            sc.grads_mut().copy_from_slice(&self.local_grads)
+                        }
+                        // (the fused pass takes planar models only)
+                        Some(sc @ SparseS::Blocks(_)) => sc.update(sys, q),
                         None => sys.local_rows_dense(&self.local_grads, &mut self.gq),
                     }
                     rows.v.copy_from_slice(v);
@@ -469,7 +481,7 @@ impl ProjectedMetric {
                 }
                 _ => match &mut self.schur {
                     Some(sc) => sc.update(sys, q),
-                    // (the preadjustments take planar models, whose Phi_q does not depend on t)
+                    // (the preadjustments take models whose Phi_q does not depend on t)
                     None => sys.phi_q(q, 0.0, &mut self.gq),
                 },
             }
@@ -579,5 +591,56 @@ fn add_dgt(g: &DMatrix<f64>, minv: &[f64], x: &[f64], c: f64, out: &mut [f64]) {
     }
     for ((o, col), mi) in out.iter_mut().zip(g.as_slice().chunks_exact(m)).zip(minv) {
         *o += c * mi * dot(col, x);
+    }
+}
+
+/// `S` held sparse (the sparse layout): planar models in the six-number rows that the fused
+/// pass fills, models with spatial bodies over body blocks.
+#[derive(Debug)]
+enum SparseS {
+    Planar(ConstraintSchur),
+    Blocks(BlockSchur),
+}
+
+impl SparseS {
+    /// Evaluates `Phi_q(q)` (time-independent: the preadjustments refuse a Jacobian that
+    /// depends on time).
+    fn update(&mut self, sys: &System, q: &[f64]) {
+        match self {
+            SparseS::Planar(s) => s.update(sys, q),
+            SparseS::Blocks(s) => s.update(sys, q, 0.0),
+        }
+    }
+
+    /// Assembles and factors `S = Phi_q W Phi_q^T` for the diagonal `w`.
+    fn factor(&mut self, w: &[f64]) -> Result<(), FactorError> {
+        match self {
+            SparseS::Planar(s) => s.factor(w),
+            SparseS::Blocks(s) => s.factor(w),
+        }
+    }
+
+    /// `b <- S^-1 b`.
+    fn solve_in_place(&mut self, b: &mut [f64]) {
+        match self {
+            SparseS::Planar(s) => s.solve_in_place(b),
+            SparseS::Blocks(s) => s.solve_in_place(b),
+        }
+    }
+
+    /// `out = Phi_q x`.
+    fn apply(&self, x: &[f64], out: &mut [f64]) {
+        match self {
+            SparseS::Planar(s) => s.apply(x, out),
+            SparseS::Blocks(s) => s.apply(x, out),
+        }
+    }
+
+    /// `out += alpha W Phi_q^T y`.
+    fn add_weighted_transpose(&self, alpha: f64, w: &[f64], y: &[f64], out: &mut [f64]) {
+        match self {
+            SparseS::Planar(s) => s.add_weighted_transpose(alpha, w, y, out),
+            SparseS::Blocks(s) => s.add_weighted_transpose(alpha, w, y, out),
+        }
     }
 }

@@ -76,8 +76,10 @@ impl Preadjustment {
     /// A workspace for the modified Lagrangian alone ([`Preadjustment::modified_term`],
     /// [`Preadjustment::modified_gradients`] for `s = 1`, [`Preadjustment::modified_term_s2`],
     /// [`Preadjustment::modified_gradients_s2`] for `s = 2`) with `S = Phi_q M^-1 Phi_q^T`
-    /// held sparse ([`mbd_solve::sparse::ConstraintSchur`]): `O(N)` storage and work per
-    /// evaluation on a chain of `N` bodies (the symplectic scheme's sparse stage solve). The
+    /// held sparse ([`mbd_solve::sparse::ConstraintSchur`], or [`mbd_solve::sparse::BlockSchur`]
+    /// with spatial bodies, whose `M^-1` is then regularised on a massless director as the
+    /// s = 2 term's is on either layout): `O(N)` storage and work per evaluation on a chain of
+    /// `N` bodies (the symplectic scheme's sparse stage solve). The
     /// `W_s` methods and the dense Hessians need the dense matrices and return
     /// [`SolveError::Unsupported`] on it.
     pub fn new_sparse(sys: &System) -> Result<Self, SolveError> {
@@ -92,13 +94,6 @@ impl Preadjustment {
                 value: 0.0,
                 reason: "W_s needs s >= 1",
             });
-        }
-        if sparse && sys.has_spatial() {
-            return Err(SolveError::Unsupported(
-                "the preadjustment's sparse layout (Preadjustment::new_sparse) takes planar \
-                 models; spatial bodies take the dense one (Preadjustment::new)"
-                    .into(),
-            ));
         }
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         Ok(Preadjustment {
