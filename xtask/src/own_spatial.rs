@@ -433,12 +433,14 @@ fn director_drift(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
 }
 
 /// The solvers timed on the spatial chain, and whether each is expected to run there.
-const SCALING_SOLVERS: [(&str, bool); 5] = [
+const SCALING_SOLVERS: [(&str, bool); 7] = [
     ("rk4-projected", true),
     ("index1:dopri5", true),
     ("tangent:rk4", true),
     ("symplectic:2", true),
     ("symplectic:1", true),
+    ("symplectic:1:modified", true),
+    ("symplectic:2:modified", true),
 ];
 /// The solvers of the 10x claim that every solver must meet.
 const INDEX1_AND_TANGENT: [&str; 3] = ["rk4-projected", "index1:dopri5", "tangent:rk4"];

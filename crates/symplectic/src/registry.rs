@@ -46,7 +46,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers; spatial models above 600 equations",
+            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers",
             compared: true,
         },
         SolverVariant {
@@ -57,7 +57,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 20.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers; spatial models above 600 equations",
+            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers",
             compared: true,
         },
     ],
