@@ -444,6 +444,10 @@ const SCALING_SOLVERS: [(&str, bool); 7] = [
 ];
 /// The solvers of the 10x claim that every solver must meet.
 const INDEX1_AND_TANGENT: [&str; 3] = ["rk4-projected", "index1:dopri5", "tangent:rk4"];
+/// The modified-Lagrangian schemes, whose misses of the scaling claims are documented.
+const MODIFIED: [&str; 2] = ["symplectic:1:modified", "symplectic:2:modified"];
+/// Why the modified-Lagrangian schemes miss the spatial chain's scaling claims.
+const MODIFIED_SCALING_MISS: &str = "the modified Lagrangian runs spatial chains above 600 equations since 2026-11-27 (sparse layout); from N = 100 to 1000 the s = 2 term's instructions per step grow 9x (callgrind: 117M to 1.06G) but its wall clock 27x (memory-bound at N = 1000: our reading), and the s = 1 scheme's Newton iterations grow from 2.0 to 8.8 per step (its diagonal Newton blocks leave out the S^-1-coupled parts, which grow with the chain's tension); see docs/report.md, own-spatial";
 
 /// Cost of a step on a chain of spatial rods against its length, as ratios to plain RK4.
 fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
@@ -451,7 +455,7 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     let (blocks, block_s) = if ctx.quick { (2, 0.03) } else { (3, 0.3) };
     sec.setting(
         "spatial chain",
-        format!("models::spatial_chain: rods of 0.5 m on ball joints, 12 coordinates and 9 equations per rod, h = 1e-3; best of {blocks} blocks of about {block_s} s, each block the second half of a run of twice its steps through the public run loop (symplectic (s,s) keeps its sparse stage factorisation across steps; the first half carries the run's start-up), interleaved with plain RK4's; N = {ns:?}"),
+        format!("models::spatial_chain: rods of 0.5 m on ball joints, 12 coordinates and 9 equations per rod, h = 1e-3; best of {blocks} blocks of about {block_s} s, each block the second half of a run of twice its steps through the public run loop (symplectic (s,s), plain and modified, keeps its sparse stage factorisation across steps; the first half carries the run's start-up), interleaved with plain RK4's; N = {ns:?}"),
     );
     let mut table = Table::new(
         "Spatial chain: cost of one step (microseconds, and ratio to plain RK4 in the same loop)",
@@ -466,6 +470,8 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     let mut worst_ratio = 0.0f64;
     let mut worst_all = 0.0f64;
     let mut worst_exp = 0.0f64;
+    // the solvers above the claims' bounds: the exponent, the 10x ratio
+    let (mut over_exp, mut over_ratio): (Vec<&str>, Vec<&str>) = (Vec::new(), Vec::new());
     let mut refused = Vec::new();
     for (spec, runs) in SCALING_SOLVERS {
         let mut row = vec![spec.to_string()];
@@ -504,11 +510,17 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
                     worst_ratio = worst_ratio.max(t / tp);
                 }
                 worst_all = worst_all.max(t / tp);
+                if t / tp > 10.0 {
+                    over_ratio.push(spec);
+                }
             }
         }
         let exp = (per[1] / per[0]).ln() / (ns[1] as f64 / ns[0] as f64).ln();
         if exp.is_finite() {
             worst_exp = worst_exp.max(exp);
+            if exp > 1.2 {
+                over_exp.push(spec);
+            }
         }
         row.push(if exp.is_finite() {
             format!("{exp:.2}")
@@ -535,27 +547,47 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
         .filter(|s| refused.iter().any(|r| r.starts_with(&format!("{s} at"))))
         .collect();
     refused_solvers.dedup();
-    sec.claims.push(Claim::timing(
-        "on a spatial chain, every timed solver's cost per step grows at most like N^1.2 (sparse paths)",
-        worst_exp.max(peer_exp) <= 1.2,
-        format!("largest fitted exponent {:.2} (plain RK4 {peer_exp:.2})", worst_exp.max(peer_exp)),
+    // a miss by the modified-Lagrangian schemes alone is the documented one
+    let only_modified = |over: &[&str]| over.iter().all(|s| MODIFIED.contains(s));
+    let expected = |c: Claim, over: &[&str]| {
+        if !over.is_empty() && only_modified(over) {
+            c.expected_miss(MODIFIED_SCALING_MISS)
+        } else {
+            c
+        }
+    };
+    sec.claims.push(expected(
+        Claim::timing(
+            "on a spatial chain, every timed solver's cost per step grows at most like N^1.2 (sparse paths)",
+            worst_exp.max(peer_exp) <= 1.2,
+            format!(
+                "largest fitted exponent {:.2} (plain RK4 {peer_exp:.2}); above 1.2: {}",
+                worst_exp.max(peer_exp),
+                if over_exp.is_empty() { "none".to_string() } else { over_exp.join(", ") }
+            ),
+        ),
+        &over_exp,
     ));
     sec.claims.push(Claim::timing(
         format!("on a {largest}-rod spatial chain, projected RK4, index-1 DOPRI5 and tangent RK4 cost within 10x plain RK4 per step"),
         worst_ratio <= 10.0,
         format!("largest ratio {worst_ratio:.2}"),
     ));
-    sec.claims.push(
-        Claim::timing(
-            format!("every solver but FA-DAE runs a {largest}-rod spatial chain within 10x plain RK4 per step"),
-            refused_solvers.is_empty() && worst_all <= 10.0,
-            format!(
-                "{} refused it ({}); largest ratio of those that ran {worst_all:.2}",
-                refused_solvers.len(),
-                refused_solvers.join(", ")
-            ),
+    let every = Claim::timing(
+        format!("every solver but FA-DAE runs a {largest}-rod spatial chain within 10x plain RK4 per step"),
+        refused_solvers.is_empty() && worst_all <= 10.0,
+        format!(
+            "{} refused it ({}); largest ratio of those that ran {worst_all:.2}; above 10x: {}",
+            refused_solvers.len(),
+            refused_solvers.join(", "),
+            if over_ratio.is_empty() { "none".to_string() } else { over_ratio.join(", ") }
         ),
     );
+    sec.claims.push(if refused_solvers.is_empty() {
+        expected(every, &over_ratio)
+    } else {
+        every
+    });
     sec.timings = json!({ "spatial_scaling": {
         "n": ns,
         "peer_s_per_step": peer_cost,
