@@ -232,7 +232,9 @@ fn the_modified_lagrangian_keeps_a_free_body_energy_to_order_four() {
 
 /// What the preadjusted schemes do not take on spatial bodies is refused at construction,
 /// naming it: a spatial damper and a load for the modified Lagrangian (non-conservative), an
-/// angle driver (a time-dependent `Phi_q`), and a forced sparse path.
+/// angle driver (a time-dependent `Phi_q`), and a forced sparse path for paper A's `W_s`
+/// (whose Newton block is dense); the modified Lagrangian takes the forced sparse path and
+/// steps on it.
 #[test]
 fn what_the_preadjusted_schemes_do_not_take_is_refused_by_name() {
     let example = |f: &str| {
@@ -260,13 +262,23 @@ fn what_the_preadjusted_schemes_do_not_take_is_refused_by_name() {
         assert!(e.contains(what), "{spec}: {e}");
     }
     let sys = spatial_double_pendulum().unwrap();
-    let opts = mbd::symplectic::SymplecticOptions {
+    let sparse = |o: mbd::symplectic::SymplecticOptions| mbd::symplectic::SymplecticOptions {
         linear_solver: mbd::solve::LinearSolver::Sparse,
-        ..mbd::symplectic::SymplecticOptions::new(1)
-            .with_preadjust(mbd::symplectic::PreadjustMode::ModifiedLagrangian)
+        ..o
     };
-    let e = mbd::symplectic::Galerkin::new(&sys, opts)
+    let gamma = sparse(mbd::symplectic::SymplecticOptions::new(1).with_gamma(1.0));
+    let e = mbd::symplectic::Galerkin::new(&sys, gamma)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("sparse"), "{e}");
+    assert!(e.contains("sparse") && e.contains("gamma"), "{e}");
+    let modified = sparse(
+        mbd::symplectic::SymplecticOptions::new(1)
+            .with_preadjust(mbd::symplectic::PreadjustMode::ModifiedLagrangian),
+    );
+    let mut g = mbd::symplectic::Galerkin::new(&sys, modified).unwrap();
+    assert!(g.is_sparse());
+    let mut st = State::consistent(&sys, 0.0).unwrap();
+    for _ in 0..10 {
+        g.step(&sys, &mut st, 1e-3).unwrap();
+    }
 }
