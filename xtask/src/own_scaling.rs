@@ -24,6 +24,9 @@ const TARGETS: [(&str, f64); 4] = [
     ("tangent:rk4", 8.0),
 ];
 
+/// The fewest steps in each half of a continuing block ([`measure`]).
+pub(crate) const CONTINUING_MIN_STEPS: usize = 8;
+
 /// Largest allowed cost exponent between N = 100 and N = 1000.
 const MAX_EXPONENT: f64 = 1.2;
 /// Step size of every run.
@@ -80,8 +83,13 @@ pub(crate) fn measure(
     // a run after them)
     let one = timed_run(integ, sys, &mut st, 1)?;
     let one_peer = timed_run(peer, sys, &mut st_peer, 1)?;
-    let steps = ((block_s / one.max(1e-9)) as usize).clamp(2, 2000);
-    let peer_steps = ((block_s / one_peer.max(1e-9)) as usize).clamp(2, 2000);
+    // (a continuing block is at least CONTINUING_MIN_STEPS steps: the first step's time,
+    // from which the count is estimated, carries the start-up, and a scheme that extrapolates
+    // from its last steps, like the s = 2 modified Lagrangian's gradients from four, reaches
+    // its steady cost only after them)
+    let least = if continuing { CONTINUING_MIN_STEPS } else { 2 };
+    let steps = ((block_s / one.max(1e-9)) as usize).clamp(least, 2000);
+    let peer_steps = ((block_s / one_peer.max(1e-9)) as usize).clamp(least, 2000);
     let (mut best, mut best_peer) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..blocks {
         if continuing {

@@ -447,7 +447,7 @@ const INDEX1_AND_TANGENT: [&str; 3] = ["rk4-projected", "index1:dopri5", "tangen
 /// The modified-Lagrangian schemes, whose misses of the scaling claims are documented.
 const MODIFIED: [&str; 2] = ["symplectic:1:modified", "symplectic:2:modified"];
 /// Why the modified-Lagrangian schemes miss the spatial chain's scaling claims.
-const MODIFIED_SCALING_MISS: &str = "the modified Lagrangian runs spatial chains above 600 equations since 2026-11-27 (sparse layout); from N = 100 to 1000 the s = 2 term's instructions per step grow 9x (callgrind: 117M to 1.06G) but its wall clock 27x (memory-bound at N = 1000: our reading), and the s = 1 scheme's Newton iterations grow from 2.0 to 8.8 per step (its diagonal Newton blocks leave out the S^-1-coupled parts, which grow with the chain's tension); see docs/report.md, own-spatial";
+const MODIFIED_SCALING_MISS: &str = "the modified Lagrangian runs spatial chains above 600 equations since 2026-11-27 (sparse layout); from N = 100 to 1000 the s = 2 scheme's instructions per step grow 11.6x (callgrind: 91.5M to 1.06G) but its wall clock 26.5x (its per-row pass data outgrow the caches: our reading), and the s = 1 scheme needs 8.5 Newton iterations per step at N = 1000 against 3.6 for plain (1,1) (its diagonal Newton blocks); see docs/report.md, own-spatial";
 
 /// Cost of a step on a chain of spatial rods against its length, as ratios to plain RK4.
 fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
@@ -455,7 +455,7 @@ fn scaling(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     let (blocks, block_s) = if ctx.quick { (2, 0.03) } else { (3, 0.3) };
     sec.setting(
         "spatial chain",
-        format!("models::spatial_chain: rods of 0.5 m on ball joints, 12 coordinates and 9 equations per rod, h = 1e-3; best of {blocks} blocks of about {block_s} s, each block the second half of a run of twice its steps through the public run loop (symplectic (s,s), plain and modified, keeps its sparse stage factorisation across steps; the first half carries the run's start-up), interleaved with plain RK4's; N = {ns:?}"),
+        format!("models::spatial_chain: rods of 0.5 m on ball joints, 12 coordinates and 9 equations per rod, h = 1e-3; best of {blocks} blocks of about {block_s} s, each block the second half of a run of twice its steps (at least {} each) through the public run loop (symplectic (s,s), plain and modified, keeps its sparse stage factorisation across steps; the first half carries the run's start-up), interleaved with plain RK4's; N = {ns:?}", crate::own_scaling::CONTINUING_MIN_STEPS),
     );
     let mut table = Table::new(
         "Spatial chain: cost of one step (microseconds, and ratio to plain RK4 in the same loop)",
