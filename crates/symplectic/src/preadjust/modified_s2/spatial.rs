@@ -9,8 +9,11 @@
 //! with respect to `q` are `g_r` (degree 0), `H_r d_j` (the coefficient of `x_j`) and zero
 //! above, and the gradient of the coefficient of `x^e` with respect to direction `j` is the
 //! `q`-gradient of the coefficient of `x^e / x_j` (the planar passes' division table). So a
-//! pass keeps, per spatial row, `g_r` and `H_r d_j` for every direction, in the element-local
-//! columns of the row's two bodies, and forms everything from them. The spatial model's time
+//! pass keeps, per spatial row, `g_r` in the element-local columns of the row's two bodies and
+//! the few nonzeros of `H_r` (a quadratic row's Hessian has at most a few dozen; a joint row
+//! that is linear in the coordinates has none), and the directions: every product `H_r d_j`
+//! is formed from them where it is used, so a pass's memory is `O(rows)` small records and
+//! not `O(rows x directions x 24)`. The spatial model's time
 //! does not enter: the preadjustments refuse constraints whose Jacobian depends on time, and no
 //! term reads a degree-0 coefficient (left zero).
 
@@ -28,11 +31,14 @@ struct Row {
     r: usize,
     /// The coordinate of each local column ([`NONE`] where the side is ground or narrower).
     cols: [usize; W],
-    /// `g_r` and `H_r d_j` in local columns.
+    /// `g_r` in local columns.
     g: [f64; W],
-    hd: [[f64; W]; MAX_DIRS],
-    /// `H_r`'s nonzeros `(local row column, global column, value)`.
+    /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)`, for a row whose Hessian
+    /// is constant (kept from the first evaluation).
     nz: Vec<(usize, usize, f64)>,
+    /// A row whose Hessian is not constant: `H_r d_j` in local columns for every direction,
+    /// from a pass along each (empty for a constant Hessian).
+    hd: Vec<[f64; W]>,
 }
 
 impl Row {
@@ -56,6 +62,31 @@ impl Row {
             }
         }
     }
+
+    /// `x . H_r d_j` (`d` the pass's directions).
+    fn hd_dot(&self, j: usize, d: &[Vec<f64>], x: &[f64]) -> f64 {
+        if self.hd.is_empty() {
+            let dj = &d[j];
+            self.nz.iter().map(|&(i, c, v)| x[i] * v * dj[c]).sum()
+        } else {
+            self.dot(&self.hd[j], x)
+        }
+    }
+
+    /// `out += c H_r d_j`.
+    fn hd_scatter(&self, c: f64, j: usize, d: &[Vec<f64>], out: &mut [f64]) {
+        if c == 0.0 {
+            return;
+        }
+        if self.hd.is_empty() {
+            let dj = &d[j];
+            for &(i, k, v) in &self.nz {
+                out[i] += c * v * dj[k];
+            }
+        } else {
+            self.scatter(c, &self.hd[j], out);
+        }
+    }
 }
 
 /// The degree of a monomial and its directions (`(j, l)` with `j <= l` for degree two, `j`
@@ -76,55 +107,82 @@ fn split(e: &[u8; MAX_DIRS]) -> (usize, usize, usize) {
 }
 
 /// The spatial rows of one pass ([`super::passes::Pass`]): filled by [`SpatialRows::gather`]
-/// at every evaluation (the row list is built at the first and kept).
+/// at every evaluation (the row list, the columns and the constant Hessians are built at the
+/// first and kept).
 #[derive(Debug, Default)]
 pub(super) struct SpatialRows {
     rows: Vec<Row>,
+    /// The pass's directions, copied at every evaluation (the products `H_r d_j` of the rows
+    /// with constant Hessians are formed from them where they are used, not kept per row).
+    dirs: Vec<Vec<f64>>,
+    /// Whether the row list is built and every row's Hessian constant (then an evaluation
+    /// only refreshes `g_r`).
+    constant: bool,
+    /// Each constraint row's place in `rows` ([`NONE`]: not a spatial row).
+    slot: Vec<usize>,
 }
 
 impl SpatialRows {
-    /// `g_r` and `H_r d_j` of every spatial row at `q` for the directions `dirs`: one pass of
-    /// the rows along `d_1` gives the rows, their columns, `g_r` and `H_r d_1`; the other
-    /// directions' products come from the rows' constant Hessians
-    /// ([`System::spatial_row_hessian`]), or from a pass along each if a row's Hessian is not
-    /// constant.
+    /// `g_r` of every spatial row at `q`, and the directions `dirs`. At the first evaluation
+    /// one pass of the rows along `d_1` gives the rows and their columns; each row keeps its
+    /// constant Hessian ([`System::spatial_row_hessian`]), or, if a row's Hessian is not
+    /// constant, `H_r d_j` from a pass along each direction at every evaluation.
     pub(super) fn gather(&mut self, sys: &System, q: &[f64], dirs: &[&[f64]]) {
-        let Some(&first) = dirs.first() else {
+        if dirs.is_empty() {
             self.rows.clear();
+            self.constant = false;
             return;
-        };
-        self.pass(sys, q, first, 0);
+        }
+        self.dirs.resize_with(dirs.len(), Vec::new);
+        for (kept, d) in self.dirs.iter_mut().zip(dirs) {
+            kept.clear();
+            kept.extend_from_slice(d);
+        }
+        if self.constant {
+            self.refresh_gradients(sys, q);
+            return;
+        }
+        for (j, d) in dirs.iter().enumerate() {
+            self.pass(sys, q, d, j, dirs.len());
+        }
         let mut constant = true;
         for row in &mut self.rows {
             row.nz.clear();
-            let Some(h) = sys.spatial_row_hessian(q, row.r) else {
-                constant = false;
-                continue;
-            };
-            for &(i, c, v) in h {
-                if let Some(l) = row.cols.iter().position(|&x| x == i) {
-                    row.nz.push((l, c, v));
-                }
+            match sys.spatial_row_hessian(q, row.r) {
+                Some(h) => row.nz.extend_from_slice(h),
+                None => constant = false,
             }
         }
-        for (j, d) in dirs.iter().enumerate().skip(1) {
-            if !constant {
-                self.pass(sys, q, d, j);
-                continue;
+        if constant {
+            self.slot.clear();
+            self.slot.resize(sys.n_constraints(), NONE);
+            for (k, row) in self.rows.iter_mut().enumerate() {
+                row.hd = Vec::new();
+                self.slot[row.r] = k;
             }
-            for row in &mut self.rows {
-                let hd = &mut row.hd[j];
-                *hd = [0.0; W];
-                for &(l, c, v) in &row.nz {
-                    hd[l] += v * d[c];
-                }
-            }
+            self.constant = true;
         }
     }
 
-    /// One pass of the rows along `d` (direction `j`): `H_r d` into each row's `hd[j]`, and for
-    /// `j = 0` the row list, the columns and `g_r`.
-    fn pass(&mut self, sys: &System, q: &[f64], d: &[f64], j: usize) {
+    /// `g_r` of every kept row at `q` (the rows and their columns do not change).
+    fn refresh_gradients(&mut self, sys: &System, q: &[f64]) {
+        let (rows, slot) = (&mut self.rows, &self.slot);
+        sys.local_rows_gamma(q, None, 0.0, |r, sides, _| {
+            let Some(row) = slot.get(r).and_then(|&k| rows.get_mut(k)) else {
+                return;
+            };
+            for (s, side) in sides.iter().enumerate() {
+                if let Some((_, g)) = side {
+                    let n = g.len().min(12);
+                    row.g[12 * s..12 * s + n].copy_from_slice(&g[..n]);
+                }
+            }
+        });
+    }
+
+    /// One pass of the rows along `d` (direction `j` of `nd`): `H_r d` into each row's
+    /// `hd[j]`, and for `j = 0` the row list, the columns and `g_r`.
+    fn pass(&mut self, sys: &System, q: &[f64], d: &[f64], j: usize, nd: usize) {
         let planar = sys.bodies().len();
         let mut k = 0;
         let rows = &mut self.rows;
@@ -138,8 +196,8 @@ impl SpatialRows {
                     r,
                     cols: [NONE; W],
                     g: [0.0; W],
-                    hd: [[0.0; W]; MAX_DIRS],
                     nz: Vec::new(),
+                    hd: Vec::new(),
                 });
             }
             let row = &mut rows[k];
@@ -148,6 +206,7 @@ impl SpatialRows {
                 row.r = r;
                 row.cols = [NONE; W];
                 row.g = [0.0; W];
+                row.hd.resize(nd, [0.0; W]);
             }
             row.hd[j] = [0.0; W];
             for (s, side) in sides.iter().enumerate() {
@@ -175,13 +234,14 @@ impl SpatialRows {
         dirs: &[&[f64]],
         vals: &mut [[f64; K]],
     ) {
+        let d = &self.dirs;
         for row in &self.rows {
             let out = &mut vals[row.r];
             for (k, e) in B::EXP.iter().enumerate() {
                 out[k] = match split(e) {
                     (1, j, _) => row.dot(&row.g, dirs[j]),
-                    (2, j, l) if j == l => 0.5 * row.dot(&row.hd[j], dirs[j]),
-                    (2, j, l) => row.dot(&row.hd[l], dirs[j]),
+                    (2, j, l) if j == l => 0.5 * row.hd_dot(j, d, dirs[j]),
+                    (2, j, l) => row.hd_dot(l, d, dirs[j]),
                     _ => 0.0,
                 };
             }
@@ -191,7 +251,7 @@ impl SpatialRows {
     /// `out += sum_r w_r H_r d_j` over the spatial rows.
     pub(super) fn add_hessian_direction(&self, j: usize, w: &[f64], out: &mut [f64]) {
         for row in &self.rows {
-            row.scatter(w[row.r], &row.hd[j], out);
+            row.hd_scatter(w[row.r], j, &self.dirs, out);
         }
     }
 
@@ -205,6 +265,7 @@ impl SpatialRows {
         dirs: &mut [&mut [f64]],
     ) {
         let nd = dirs.len();
+        let d = &self.dirs;
         for row in &self.rows {
             let wr = &w[row.r];
             for (k, e) in B::EXP.iter().enumerate() {
@@ -215,17 +276,17 @@ impl SpatialRows {
                 match split(e) {
                     (0, _, _) => row.scatter(c, &row.g, qb),
                     (1, j, _) => {
-                        row.scatter(c, &row.hd[j], qb);
+                        row.hd_scatter(c, j, d, qb);
                         if j < nd {
                             row.scatter(c, &row.g, dirs[j]);
                         }
                     }
                     (2, j, l) => {
                         if j < nd {
-                            row.scatter(c, &row.hd[l], dirs[j]);
+                            row.hd_scatter(c, l, d, dirs[j]);
                         }
                         if l != j && l < nd {
-                            row.scatter(c, &row.hd[j], dirs[l]);
+                            row.hd_scatter(c, j, d, dirs[l]);
                         }
                     }
                     _ => {}
@@ -241,6 +302,7 @@ impl SpatialRows {
         w: &[[[f64; K]; P]],
         outs: &mut [&mut [f64]; P],
     ) {
+        let d = &self.dirs;
         for row in &self.rows {
             for (wp, out) in w[row.r].iter().zip(outs.iter_mut()) {
                 for (k, e) in B::EXP.iter().enumerate() {
@@ -250,7 +312,7 @@ impl SpatialRows {
                     }
                     match split(e) {
                         (0, _, _) => row.scatter(c, &row.g, out),
-                        (1, j, _) => row.scatter(c, &row.hd[j], out),
+                        (1, j, _) => row.hd_scatter(c, j, d, out),
                         _ => {}
                     }
                 }
