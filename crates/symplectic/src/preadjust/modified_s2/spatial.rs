@@ -106,6 +106,11 @@ fn split(e: &[u8; MAX_DIRS]) -> (usize, usize, usize) {
     (deg, a, b)
 }
 
+/// [`split`] of every monomial of the basis `B`.
+fn splits<const K: usize, B: Basis<K>>() -> [(usize, usize, usize); K] {
+    std::array::from_fn(|k| split(&B::EXP[k]))
+}
+
 /// The spatial rows of one pass ([`super::passes::Pass`]): filled by [`SpatialRows::gather`]
 /// at every evaluation (the row list, the columns and the constant Hessians are built at the
 /// first and kept).
@@ -235,10 +240,11 @@ impl SpatialRows {
         vals: &mut [[f64; K]],
     ) {
         let d = &self.dirs;
+        let splits = splits::<K, B>();
         for row in &self.rows {
             let out = &mut vals[row.r];
-            for (k, e) in B::EXP.iter().enumerate() {
-                out[k] = match split(e) {
+            for (k, sp) in splits.iter().enumerate() {
+                out[k] = match *sp {
                     (1, j, _) => row.dot(&row.g, dirs[j]),
                     (2, j, l) if j == l => 0.5 * row.hd_dot(j, d, dirs[j]),
                     (2, j, l) => row.hd_dot(l, d, dirs[j]),
@@ -266,14 +272,14 @@ impl SpatialRows {
     ) {
         let nd = dirs.len();
         let d = &self.dirs;
+        let splits = splits::<K, B>();
         for row in &self.rows {
             let wr = &w[row.r];
-            for (k, e) in B::EXP.iter().enumerate() {
-                let c = wr[k];
+            for (&c, sp) in wr.iter().zip(&splits) {
                 if c == 0.0 {
                     continue;
                 }
-                match split(e) {
+                match *sp {
                     (0, _, _) => row.scatter(c, &row.g, qb),
                     (1, j, _) => {
                         row.hd_scatter(c, j, d, qb);
@@ -303,14 +309,14 @@ impl SpatialRows {
         outs: &mut [&mut [f64]; P],
     ) {
         let d = &self.dirs;
+        let splits = splits::<K, B>();
         for row in &self.rows {
             for (wp, out) in w[row.r].iter().zip(outs.iter_mut()) {
-                for (k, e) in B::EXP.iter().enumerate() {
-                    let c = wp[k];
+                for (&c, sp) in wp.iter().zip(&splits) {
                     if c == 0.0 {
                         continue;
                     }
-                    match split(e) {
+                    match *sp {
                         (0, _, _) => row.scatter(c, &row.g, out),
                         (1, j, _) => row.hd_scatter(c, j, d, out),
                         _ => {}
