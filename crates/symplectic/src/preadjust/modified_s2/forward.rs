@@ -5,6 +5,7 @@ use super::passes::{
     BasisA, BasisB, BasisC, Pass, A_E, A_ET, A_ETT, A_T, A_T4, A_TT, A_TTT, B_E, B_ED, B_EE, B_ET,
     B_ETT, C_AT, C_BT, NA, NB, NC,
 };
+use super::spatial::SpatialRowSet;
 use super::{Invariant, ModifiedS2, PerInvariant, E4_TERM_COUNT};
 use crate::passes;
 use crate::preadjust::metric::ProjectedMetric;
@@ -55,6 +56,8 @@ pub(super) struct E4Forward {
     pub(super) pc: Pass<NC, BasisC>,
     /// `sin`/`cos` of the body angles at `q`, shared by every pass.
     pub(super) angles: BodyAngles,
+    /// The spatial rows at `q`, shared by every pass.
+    pub(super) sprows: SpatialRowSet,
     /// Per constraint row, element-local `Hess Phi_r v` and `Hess Phi_r u` (the weighted
     /// Hessian-vector products `H_mu v`, `H_sigma v`, ...; pass A's gradients of `t` and `e`).
     pub(super) rhv_v: Vec<LocalRow>,
@@ -100,6 +103,7 @@ impl E4Forward {
             pb: Pass::new(m, nf),
             pc: Pass::new(m, nf),
             angles: BodyAngles::default(),
+            sprows: SpatialRowSet::default(),
             rhv_v: vec![ZERO_ROW; m],
             rhv_u: vec![ZERO_ROW; m],
             zero_m: zm(),
@@ -153,11 +157,12 @@ impl ModifiedS2 {
         let m = metric.m();
         let f = &mut self.f;
         f.angles.update(sys, q);
+        f.sprows.update(sys, q);
         f.u.copy_from_slice(metric.u());
         f.mu0.copy_from_slice(metric.mu0());
         // pass A along (v, u): gamma, beta, D^3 Phi(v^3), D^4 Phi(v^4), D^3 Phi(v, v, u), the
         // rows Hess Phi_r v and Hess Phi_r u, and of V: D^4 V(v^4), D^3 V(u, v, v), H v, H u
-        f.pa.eval(sys, q, &f.angles, &[v, &f.u]);
+        f.pa.eval(sys, q, (&f.angles, &f.sprows), &[v, &f.u]);
         for r in 0..m {
             let (c, g) = (&f.pa.vals[r], &f.pa.grads[r]);
             f.gam[r] = 2.0 * c[A_TT];
@@ -171,14 +176,14 @@ impl ModifiedS2 {
         metric.neg_e_into(&f.beta, &mut f.s_beta, &mut f.k2);
         // pass B along (v, n, u): D^2 Phi(n, v), D^3 Phi(v, v, n), D^2 Phi(n, n), D^2 Phi(n, u),
         // and of V: D^3 V(n, v, v), H n
-        f.pb.eval(sys, q, &f.angles, &[v, &f.nn, &f.u]);
+        f.pb.eval(sys, q, (&f.angles, &f.sprows), &[v, &f.nn, &f.u]);
         f.pb.pot_grad_into(sys, B_E, &mut f.hn);
         for r in 0..m {
             f.kap3[r] = 6.0 * f.pa.vals[r][A_TTT] + 3.0 * f.pb.vals[r][B_ET];
         }
         metric.neg_e_into(&f.kap3, &mut f.s_kap3, &mut f.k3);
         // pass C along (v, K2, K3): D^2 Phi(K2, v), D^2 Phi(K3, v)
-        f.pc.eval(sys, q, &f.angles, &[v, &f.k2, &f.k3]);
+        f.pc.eval(sys, q, (&f.angles, &f.sprows), &[v, &f.k2, &f.k3]);
         for r in 0..m {
             let (a, b, c) = (&f.pa.vals[r], &f.pb.vals[r], &f.pc.vals[r]);
             f.kap3u[r] = 2.0 * a[A_ETT] + 2.0 * c[C_AT] + b[B_ED];
@@ -194,7 +199,7 @@ impl ModifiedS2 {
         ] {
             out.fill(0.0);
             passes::add_local_rows(sys, rows, w, out);
-            f.pa.sp.add_hessian_direction(j, w, out);
+            f.pa.sp.add_hessian_direction(&f.sprows, j, w, out);
         }
         metric.pi_sgm(&f.hmu_v, &mut f.pi_hmu_v, &mut f.sg_hmu_v);
         if !super::has_potential(sys) {

@@ -6,7 +6,7 @@
 //! exponents; `t` stands for the velocity `v` throughout. Its size, its number of directions
 //! and the positions of the monomials the term reads are derived from the list.
 
-use super::spatial::SpatialRows;
+use super::spatial::{SpatialRowSet, SpatialRows};
 use super::spatial_potential::SpatialPotential;
 use crate::passes;
 use crate::passes::PolyWorkspace;
@@ -193,6 +193,9 @@ pub(super) const R_XY: [usize; R_PRODUCTS] = [
     position(R_LIST, mono([0, 1, 0, 0, 0, 1])),
 ];
 
+/// What the passes at one `q` share: the body angles' `sin`/`cos` and the spatial rows.
+pub(super) type AtQ<'a> = (&'a BodyAngles, &'a SpatialRowSet);
+
 /// One pass's coefficients per constraint row and of the potential, with their element-local
 /// gradients (per planar row, and per force element; the spatial rows' in [`SpatialRows`]),
 /// and its jets' workspace.
@@ -222,21 +225,23 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         }
     }
 
-    /// The pass along `dirs` at `q` (constraints and potential).
-    pub(super) fn eval(&mut self, sys: &System, q: &[f64], a: &BodyAngles, dirs: &[&[f64]]) {
+    /// The pass along `dirs` at `q` (constraints and potential), with the body angles and the
+    /// spatial rows at `q`, shared by the passes (`at`).
+    pub(super) fn eval(&mut self, sys: &System, q: &[f64], at: AtQ<'_>, dirs: &[&[f64]]) {
         let ws = &mut self.ws;
+        let a = at.0;
         passes::constraint_poly_series(sys, ws, q, a, dirs, &mut self.vals, &mut self.grads);
         self.pot = passes::potential_poly_series(sys, ws, q, a, dirs, &mut self.pgrads);
         // (gravity, linear in q, enters through the metric's gradient of V alone)
         self.spp.eval::<B>(sys, q, dirs, &mut self.pot);
-        self.eval_spatial(sys, q, dirs);
+        self.eval_spatial(sys, q, at.1, dirs);
     }
 
     /// The spatial rows' coefficients and gradients.
-    fn eval_spatial(&mut self, sys: &System, q: &[f64], dirs: &[&[f64]]) {
+    fn eval_spatial(&mut self, sys: &System, q: &[f64], set: &SpatialRowSet, dirs: &[&[f64]]) {
         if sys.has_spatial() {
-            self.sp.gather(sys, q, dirs);
-            self.sp.coefficients::<K, B>(dirs, &mut self.vals);
+            self.sp.gather(sys, q, set, dirs);
+            self.sp.coefficients::<K, B>(set, dirs, &mut self.vals);
         }
     }
 
@@ -245,9 +250,10 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         &mut self,
         sys: &System,
         q: &[f64],
-        a: &BodyAngles,
+        at: AtQ<'_>,
         dirs: &[&[f64]],
     ) {
+        let a = at.0;
         passes::constraint_poly_series(
             sys,
             &mut self.ws,
@@ -257,7 +263,7 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
             &mut self.vals,
             &mut self.grads,
         );
-        self.eval_spatial(sys, q, dirs);
+        self.eval_spatial(sys, q, at.1, dirs);
     }
 
     /// `out = sum_f grad_q` of the potential's coefficient `k` (length n; zero without force

@@ -37,6 +37,7 @@
 
 use super::adjoints::{gbar_add, Adjoints, GbCtx};
 use super::forward::E4Forward;
+use super::spatial::SpatialRowSet;
 use super::passes::{
     BasisA, BasisB, BasisC, BasisR, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE, B_ET, B_ETT,
     C_AT, C_BT, NA, NB, NC, NR, R_DIRS, R_OUTPUTS, R_XY, R_Y,
@@ -202,6 +203,7 @@ impl ModifiedS2 {
         // 4. pass C along (v, K2, K3)
         contract::<NC, BasisC>(
             sys,
+            &f.sprows,
             (&f.pc, &w.wc, None),
             gq,
             &mut [&mut *gv, w.k2b.as_mut_slice(), w.k3b.as_mut_slice()],
@@ -228,6 +230,7 @@ impl ModifiedS2 {
         // 7. pass B along (v, n, u)
         contract::<NB, BasisB>(
             sys,
+            &f.sprows,
             (&f.pb, &w.wb, Some(&w.pb)),
             gq,
             &mut [&mut *gv, w.nnb.as_mut_slice(), w.ub.as_mut_slice()],
@@ -255,6 +258,7 @@ impl ModifiedS2 {
         // pass A along (v, u)
         contract::<NA, BasisA>(
             sys,
+            &f.sprows,
             (&f.pa, &w.wa, Some(&w.pa)),
             gq,
             &mut [&mut *gv, w.ub.as_mut_slice()],
@@ -372,7 +376,7 @@ fn hvp_weighted_adj(
     gv: &mut [f64],
 ) {
     let dirs: [&[f64]; R_DIRS] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
-    w.rpass.eval_constraints(sys, q, &f.angles, &dirs);
+    w.rpass.eval_constraints(sys, q, (&f.angles, &f.sprows), &dirs);
     for r in 0..m {
         let (s, mu) = (f.sig[r], f.mu0[r]);
         let c = &w.rpass.vals[r];
@@ -389,7 +393,7 @@ fn hvp_weighted_adj(
     let mut outs = [gq, gv, &mut w.ub];
     w.rpass
         .sp
-        .add_grads_many::<NR, R_OUTPUTS, BasisR>(&w.rw, &mut outs);
+        .add_grads_many::<NR, R_OUTPUTS, BasisR>(&f.sprows, &w.rw, &mut outs);
     passes::add_constraint_poly_grads_many(sys, &w.rpass.grads, &w.rw, outs);
 }
 
@@ -398,12 +402,13 @@ fn hvp_weighted_adj(
 /// direction `j` to `dirs[j]`.
 fn contract<const K: usize, B: Basis<K>>(
     sys: &System,
+    set: &SpatialRowSet,
     (p, wts, pot): (&Pass<K, B>, &[[f64; K]], Option<&[f64; K]>),
     qb: &mut [f64],
     dirs: &mut [&mut [f64]],
 ) {
     passes::add_constraint_poly_adjoint::<K, B>(sys, &p.grads, wts, qb, dirs);
-    p.sp.adjoint::<K, B>(wts, qb, dirs);
+    p.sp.adjoint::<K, B>(set, wts, qb, dirs);
     if let Some(pw) = pot {
         passes::add_potential_poly_adjoint::<K, B>(sys, &p.pgrads, pw, qb, dirs);
         p.spp.adjoint::<B>(pw, qb, dirs);

@@ -1,4 +1,4 @@
-//! The spatial rows of a pass of `e4` (docs/spatial.md, "The preadjusted symplectic
+//! The spatial rows of the passes of `e4` (docs/spatial.md, "The preadjusted symplectic
 //! schemes"): every spatial equation is quadratic in the natural coordinates, so along
 //! directions `d_1 .. d_D` the series of row `r` ends at degree two,
 //!
@@ -8,12 +8,13 @@
 //! with `g_r` the row of `Phi_q` and `H_r` its constant Hessian. The coefficients' gradients
 //! with respect to `q` are `g_r` (degree 0), `H_r d_j` (the coefficient of `x_j`) and zero
 //! above, and the gradient of the coefficient of `x^e` with respect to direction `j` is the
-//! `q`-gradient of the coefficient of `x^e / x_j` (the planar passes' division table). So a
-//! pass keeps, per spatial row, `g_r` in the element-local columns of the row's two bodies and
-//! the few nonzeros of `H_r` (a quadratic row's Hessian has at most a few dozen; a joint row
-//! that is linear in the coordinates has none), and the directions: every product `H_r d_j`
-//! is formed from them where it is used, so a pass's memory is `O(rows)` small records and
-//! not `O(rows x directions x 24)`. The spatial model's time
+//! `q`-gradient of the coefficient of `x^e / x_j` (the planar passes' division table). So the
+//! passes at one `q` share, per spatial row, `g_r` in the element-local columns of the row's
+//! two bodies and the few nonzeros of `H_r` (a quadratic row's Hessian has a handful; a joint
+//! row that is linear in the coordinates has none): [`SpatialRowSet`], evaluated once per
+//! `q`. Each pass keeps its directions ([`SpatialRows`]), and every product `H_r d_j` is formed
+//! from them where it is used, so a pass's memory is its directions, not
+//! `O(rows x directions x 24)`. The spatial model's time
 //! does not enter: the preadjustments refuse constraints whose Jacobian depends on time, and no
 //! term reads a degree-0 coefficient (left zero).
 
@@ -24,7 +25,7 @@ const W: usize = 24;
 /// A local column that no coordinate fills.
 const NONE: usize = usize::MAX;
 
-/// One spatial row's data in a pass.
+/// One spatial row at the set's `q`.
 #[derive(Clone, Debug)]
 struct Row {
     /// The row's index in `Phi`.
@@ -33,12 +34,8 @@ struct Row {
     cols: [usize; W],
     /// `g_r` in local columns.
     g: [f64; W],
-    /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)`, for a row whose Hessian
-    /// is constant (kept from the first evaluation).
+    /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)` if it is constant.
     nz: Vec<(usize, usize, f64)>,
-    /// A row whose Hessian is not constant: `H_r d_j` in local columns for every direction,
-    /// from a pass along each (empty for a constant Hessian).
-    hd: Vec<[f64; W]>,
 }
 
 impl Row {
@@ -60,31 +57,6 @@ impl Row {
             if k != NONE {
                 out[k] += c * x[l];
             }
-        }
-    }
-
-    /// `x . H_r d_j` (`d` the pass's directions).
-    fn hd_dot(&self, j: usize, d: &[Vec<f64>], x: &[f64]) -> f64 {
-        if self.hd.is_empty() {
-            let dj = &d[j];
-            self.nz.iter().map(|&(i, c, v)| x[i] * v * dj[c]).sum()
-        } else {
-            self.dot(&self.hd[j], x)
-        }
-    }
-
-    /// `out += c H_r d_j`.
-    fn hd_scatter(&self, c: f64, j: usize, d: &[Vec<f64>], out: &mut [f64]) {
-        if c == 0.0 {
-            return;
-        }
-        if self.hd.is_empty() {
-            let dj = &d[j];
-            for &(i, k, v) in &self.nz {
-                out[i] += c * v * dj[k];
-            }
-        } else {
-            self.scatter(c, &self.hd[j], out);
         }
     }
 }
@@ -111,66 +83,30 @@ fn splits<const K: usize, B: Basis<K>>() -> [(usize, usize, usize); K] {
     std::array::from_fn(|k| split(&B::EXP[k]))
 }
 
-/// The spatial rows of one pass ([`super::passes::Pass`]): filled by [`SpatialRows::gather`]
-/// at every evaluation (the row list, the columns and the constant Hessians are built at the
-/// first and kept).
+/// The spatial rows at one `q`, shared by the passes of an evaluation (module doc): the row
+/// list, the columns and the constant Hessians are built at the first [`SpatialRowSet::update`]
+/// and kept; every update refreshes `g_r`.
 #[derive(Debug, Default)]
-pub(super) struct SpatialRows {
+pub(super) struct SpatialRowSet {
     rows: Vec<Row>,
-    /// The pass's directions, copied at every evaluation (the products `H_r d_j` of the rows
-    /// with constant Hessians are formed from them where they are used, not kept per row).
-    dirs: Vec<Vec<f64>>,
-    /// Whether the row list is built and every row's Hessian constant (then an evaluation
-    /// only refreshes `g_r`).
-    constant: bool,
     /// Each constraint row's place in `rows` ([`NONE`]: not a spatial row).
     slot: Vec<usize>,
+    /// Whether the rows are built, and whether every row's Hessian is constant (otherwise the
+    /// passes take `H_r d_j` from a pass of the rows along each direction).
+    built: bool,
+    constant: bool,
 }
 
-impl SpatialRows {
-    /// `g_r` of every spatial row at `q`, and the directions `dirs`. At the first evaluation
-    /// one pass of the rows along `d_1` gives the rows and their columns; each row keeps its
-    /// constant Hessian ([`System::spatial_row_hessian`]), or, if a row's Hessian is not
-    /// constant, `H_r d_j` from a pass along each direction at every evaluation.
-    pub(super) fn gather(&mut self, sys: &System, q: &[f64], dirs: &[&[f64]]) {
-        if dirs.is_empty() {
-            self.rows.clear();
-            self.constant = false;
+impl SpatialRowSet {
+    /// `g_r` of every spatial row at `q` (nothing on a planar model).
+    pub(super) fn update(&mut self, sys: &System, q: &[f64]) {
+        if !sys.has_spatial() {
             return;
         }
-        self.dirs.resize_with(dirs.len(), Vec::new);
-        for (kept, d) in self.dirs.iter_mut().zip(dirs) {
-            kept.clear();
-            kept.extend_from_slice(d);
-        }
-        if self.constant {
-            self.refresh_gradients(sys, q);
+        if !self.built {
+            self.build(sys, q);
             return;
         }
-        for (j, d) in dirs.iter().enumerate() {
-            self.pass(sys, q, d, j, dirs.len());
-        }
-        let mut constant = true;
-        for row in &mut self.rows {
-            row.nz.clear();
-            match sys.spatial_row_hessian(q, row.r) {
-                Some(h) => row.nz.extend_from_slice(h),
-                None => constant = false,
-            }
-        }
-        if constant {
-            self.slot.clear();
-            self.slot.resize(sys.n_constraints(), NONE);
-            for (k, row) in self.rows.iter_mut().enumerate() {
-                row.hd = Vec::new();
-                self.slot[row.r] = k;
-            }
-            self.constant = true;
-        }
-    }
-
-    /// `g_r` of every kept row at `q` (the rows and their columns do not change).
-    fn refresh_gradients(&mut self, sys: &System, q: &[f64]) {
         let (rows, slot) = (&mut self.rows, &self.slot);
         sys.local_rows_gamma(q, None, 0.0, |r, sides, _| {
             let Some(row) = slot.get(r).and_then(|&k| rows.get_mut(k)) else {
@@ -185,69 +121,141 @@ impl SpatialRows {
         });
     }
 
-    /// One pass of the rows along `d` (direction `j` of `nd`): `H_r d` into each row's
-    /// `hd[j]`, and for `j = 0` the row list, the columns and `g_r`.
-    fn pass(&mut self, sys: &System, q: &[f64], d: &[f64], j: usize, nd: usize) {
+    /// The row list, columns, `g_r` and constant Hessians at `q`.
+    fn build(&mut self, sys: &System, q: &[f64]) {
         let planar = sys.bodies().len();
-        let mut k = 0;
         let rows = &mut self.rows;
-        sys.local_rows_tan(q, d, 0.0, |r, sides| {
-            let spatial = sides.iter().flatten().any(|s| s.0 >= planar);
-            if !spatial {
+        rows.clear();
+        sys.local_rows_gamma(q, None, 0.0, |r, sides, _| {
+            if !sides.iter().flatten().any(|s| s.0 >= planar) {
                 return;
             }
-            if k == rows.len() {
-                rows.push(Row {
-                    r,
-                    cols: [NONE; W],
-                    g: [0.0; W],
-                    nz: Vec::new(),
-                    hd: Vec::new(),
-                });
-            }
-            let row = &mut rows[k];
-            k += 1;
-            if j == 0 {
-                row.r = r;
-                row.cols = [NONE; W];
-                row.g = [0.0; W];
-                row.hd.resize(nd, [0.0; W]);
-            }
-            row.hd[j] = [0.0; W];
+            let mut row = Row {
+                r,
+                cols: [NONE; W],
+                g: [0.0; W],
+                nz: Vec::new(),
+            };
             for (s, side) in sides.iter().enumerate() {
-                let Some((block, g, dg)) = side else {
+                let Some((block, g)) = side else {
                     continue;
                 };
                 let Some((o, _)) = sys.body_block(*block) else {
                     continue;
                 };
                 for l in 0..g.len().min(12) {
-                    if j == 0 {
-                        row.cols[12 * s + l] = o + l;
-                        row.g[12 * s + l] = g[l];
-                    }
-                    row.hd[j][12 * s + l] = dg[l];
+                    row.cols[12 * s + l] = o + l;
+                    row.g[12 * s + l] = g[l];
                 }
             }
+            rows.push(row);
         });
-        self.rows.truncate(k);
+        self.slot.clear();
+        self.slot.resize(sys.n_constraints(), NONE);
+        self.constant = true;
+        for (k, row) in self.rows.iter_mut().enumerate() {
+            self.slot[row.r] = k;
+            match sys.spatial_row_hessian(q, row.r) {
+                Some(h) => row.nz.extend_from_slice(h),
+                None => self.constant = false,
+            }
+        }
+        self.built = true;
+    }
+}
+
+/// One pass's share of the spatial rows ([`super::passes::Pass`]): its directions, copied at
+/// every evaluation, and, on a model with a row whose Hessian is not constant, `H_r d_j` of
+/// every row and direction from a pass along each.
+#[derive(Debug, Default)]
+pub(super) struct SpatialRows {
+    dirs: Vec<Vec<f64>>,
+    /// `hd[k * nd + j]`: `H_r d_j` of the set's row `k` in local columns (empty when every
+    /// Hessian is constant).
+    hd: Vec<[f64; W]>,
+}
+
+impl SpatialRows {
+    /// The directions `dirs` of a pass at the set's `q` (and `H_r d_j` if a row's Hessian is
+    /// not constant).
+    pub(super) fn gather(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        set: &SpatialRowSet,
+        dirs: &[&[f64]],
+    ) {
+        self.dirs.resize_with(dirs.len(), Vec::new);
+        for (kept, d) in self.dirs.iter_mut().zip(dirs) {
+            kept.clear();
+            kept.extend_from_slice(d);
+        }
+        if set.constant {
+            self.hd.clear();
+            return;
+        }
+        let nd = dirs.len();
+        self.hd.clear();
+        self.hd.resize(set.rows.len() * nd, [0.0; W]);
+        for (j, d) in dirs.iter().enumerate() {
+            let hd = &mut self.hd;
+            sys.local_rows_tan(q, d, 0.0, |r, sides| {
+                let Some(&k) = set.slot.get(r).filter(|&&k| k != NONE) else {
+                    return;
+                };
+                let out = &mut hd[k * nd + j];
+                for (s, side) in sides.iter().enumerate() {
+                    if let Some((_, g, dg)) = side {
+                        let n = g.len().min(12);
+                        out[12 * s..12 * s + n].copy_from_slice(&dg[..n]);
+                    }
+                }
+            });
+        }
+    }
+
+    /// `x . H_r d_j` of the set's row `k`.
+    fn hd_dot(&self, set: &SpatialRowSet, k: usize, j: usize, x: &[f64]) -> f64 {
+        let row = &set.rows[k];
+        if self.hd.is_empty() {
+            let dj = &self.dirs[j];
+            row.nz.iter().map(|&(i, c, v)| x[i] * v * dj[c]).sum()
+        } else {
+            row.dot(&self.hd[k * self.dirs.len() + j], x)
+        }
+    }
+
+    /// `out += c H_r d_j` of the set's row `k`.
+    fn hd_scatter(&self, set: &SpatialRowSet, k: usize, c: f64, j: usize, out: &mut [f64]) {
+        if c == 0.0 {
+            return;
+        }
+        let row = &set.rows[k];
+        if self.hd.is_empty() {
+            let dj = &self.dirs[j];
+            for &(i, col, v) in &row.nz {
+                out[i] += c * v * dj[col];
+            }
+        } else {
+            row.scatter(c, &self.hd[k * self.dirs.len() + j], out);
+        }
     }
 
     /// The coefficients of the spatial rows in the basis `B` into `vals` (module doc).
     pub(super) fn coefficients<const K: usize, B: Basis<K>>(
         &self,
+        set: &SpatialRowSet,
         dirs: &[&[f64]],
         vals: &mut [[f64; K]],
     ) {
-        let d = &self.dirs;
         let splits = splits::<K, B>();
-        for row in &self.rows {
+        for (k, row) in set.rows.iter().enumerate() {
             let out = &mut vals[row.r];
-            for (k, sp) in splits.iter().enumerate() {
-                out[k] = match *sp {
+            for (o, sp) in out.iter_mut().zip(&splits) {
+                *o = match *sp {
                     (1, j, _) => row.dot(&row.g, dirs[j]),
-                    (2, j, l) if j == l => 0.5 * row.hd_dot(j, d, dirs[j]),
-                    (2, j, l) => row.hd_dot(l, d, dirs[j]),
+                    (2, j, l) if j == l => 0.5 * self.hd_dot(set, k, j, dirs[j]),
+                    (2, j, l) => self.hd_dot(set, k, l, dirs[j]),
                     _ => 0.0,
                 };
             }
@@ -255,9 +263,15 @@ impl SpatialRows {
     }
 
     /// `out += sum_r w_r H_r d_j` over the spatial rows.
-    pub(super) fn add_hessian_direction(&self, j: usize, w: &[f64], out: &mut [f64]) {
-        for row in &self.rows {
-            row.hd_scatter(w[row.r], j, &self.dirs, out);
+    pub(super) fn add_hessian_direction(
+        &self,
+        set: &SpatialRowSet,
+        j: usize,
+        w: &[f64],
+        out: &mut [f64],
+    ) {
+        for (k, row) in set.rows.iter().enumerate() {
+            self.hd_scatter(set, k, w[row.r], j, out);
         }
     }
 
@@ -266,33 +280,32 @@ impl SpatialRows {
     /// grad_q c_(k / x_j)`.
     pub(super) fn adjoint<const K: usize, B: Basis<K>>(
         &self,
+        set: &SpatialRowSet,
         w: &[[f64; K]],
         qb: &mut [f64],
         dirs: &mut [&mut [f64]],
     ) {
         let nd = dirs.len();
-        let d = &self.dirs;
         let splits = splits::<K, B>();
-        for row in &self.rows {
-            let wr = &w[row.r];
-            for (&c, sp) in wr.iter().zip(&splits) {
+        for (k, row) in set.rows.iter().enumerate() {
+            for (&c, sp) in w[row.r].iter().zip(&splits) {
                 if c == 0.0 {
                     continue;
                 }
                 match *sp {
                     (0, _, _) => row.scatter(c, &row.g, qb),
                     (1, j, _) => {
-                        row.hd_scatter(c, j, d, qb);
+                        self.hd_scatter(set, k, c, j, qb);
                         if j < nd {
                             row.scatter(c, &row.g, dirs[j]);
                         }
                     }
                     (2, j, l) => {
                         if j < nd {
-                            row.hd_scatter(c, l, d, dirs[j]);
+                            self.hd_scatter(set, k, c, l, dirs[j]);
                         }
                         if l != j && l < nd {
-                            row.hd_scatter(c, j, d, dirs[l]);
+                            self.hd_scatter(set, k, c, j, dirs[l]);
                         }
                     }
                     _ => {}
@@ -305,12 +318,12 @@ impl SpatialRows {
     /// `outs[p] += sum_r sum_k w[r][p][k] grad_q c_k`.
     pub(super) fn add_grads_many<const K: usize, const P: usize, B: Basis<K>>(
         &self,
+        set: &SpatialRowSet,
         w: &[[[f64; K]; P]],
         outs: &mut [&mut [f64]; P],
     ) {
-        let d = &self.dirs;
         let splits = splits::<K, B>();
-        for row in &self.rows {
+        for (k, row) in set.rows.iter().enumerate() {
             for (wp, out) in w[row.r].iter().zip(outs.iter_mut()) {
                 for (&c, sp) in wp.iter().zip(&splits) {
                     if c == 0.0 {
@@ -318,7 +331,7 @@ impl SpatialRows {
                     }
                     match *sp {
                         (0, _, _) => row.scatter(c, &row.g, out),
-                        (1, j, _) => row.hd_scatter(c, j, d, out),
+                        (1, j, _) => self.hd_scatter(set, k, c, j, out),
                         _ => {}
                     }
                 }
