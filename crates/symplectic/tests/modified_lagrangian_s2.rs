@@ -122,7 +122,10 @@ fn sparse_workspace_matches_the_dense_one() {
              {de1:.1e}, its gradients {dg1:.1e}"
         );
         assert!(de < 1e-12 && dg < 1e-12, "{name}: e4 {de}, gradients {dg}");
-        assert!(de1 < 1e-12 && dg1 < 1e-12, "{name}: e {de1}, gradients {dg1}");
+        assert!(
+            de1 < 1e-12 && dg1 < 1e-12,
+            "{name}: e {de1}, gradients {dg1}"
+        );
         let mut sparse = Preadjustment::new_sparse(&sys).unwrap();
         let mut out = vec![0.0; q.len()];
         match sparse.gradient(&sys, &q, &mut out) {
@@ -186,8 +189,12 @@ fn sparse_minus_dense(sys: &mbd_model::System, q: &[f64], v: &[f64]) -> [f64; 4]
         .modified_gradients_s2(sys, q, v, &mut gqs, &mut gvs)
         .unwrap();
     let [de, dg] = rel(ed, es, (&gqd, &gvd), (&gqs, &gvs));
-    let e1d = dense.modified_gradients(sys, q, v, &mut gqd, &mut gvd).unwrap();
-    let e1s = sparse.modified_gradients(sys, q, v, &mut gqs, &mut gvs).unwrap();
+    let e1d = dense
+        .modified_gradients(sys, q, v, &mut gqd, &mut gvd)
+        .unwrap();
+    let e1s = sparse
+        .modified_gradients(sys, q, v, &mut gqs, &mut gvs)
+        .unwrap();
     let [de1, dg1] = rel(e1d, e1s, (&gqd, &gvd), (&gqs, &gvs));
     [de, dg, de1, dg1]
 }

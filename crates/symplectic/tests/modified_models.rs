@@ -129,7 +129,10 @@ fn sparse_path_matches_the_dense_path_on(name: &str, sys: &System) {
         );
         // (Newton's tolerance is 1e-14 (1 + max |x, y|), about 3e-13 here, per step; the
         // velocities carry it divided by h)
-        assert!(wq < 1e-10 && wv < 1e-8, "{name}, s = {s}: {wq} in q, {wv} in v");
+        assert!(
+            wq < 1e-10 && wv < 1e-8,
+            "{name}, s = {s}: {wq} in q, {wv} in v"
+        );
         // (the comparison can see the term: it moves the steps far more than the tolerance)
         assert!(off > 1e3 * wq.max(1e-14), "{name}, s = {s}: {off}");
         // the diagonal blocks cost at most about one Newton iteration per step

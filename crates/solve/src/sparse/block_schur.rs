@@ -194,7 +194,10 @@ mod tests {
         }
         for k in 0..n {
             let want = 1.0 + 2.0 * w[k] * wgy_ref[k];
-            assert!((wgy[k] - want).abs() <= 1e-14 * want.abs().max(1.0), "coordinate {k}");
+            assert!(
+                (wgy[k] - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "coordinate {k}"
+            );
         }
     }
 }

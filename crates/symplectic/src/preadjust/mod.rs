@@ -321,6 +321,7 @@ impl Preadjustment {
         v: &[f64],
     ) -> Result<[f64; E4_TERM_COUNT], SolveError> {
         self.metric.check_v(v)?;
+        refuse_spatial_time_jacobian(sys)?;
         self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.forward(&mut self.metric, sys, q, v)?;
@@ -361,8 +362,23 @@ impl Preadjustment {
                 });
             }
         }
+        refuse_spatial_time_jacobian(sys)?;
         self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.gradients(&mut self.metric, sys, q, v, gq, gv)
     }
+}
+
+/// [`SolveError::Unsupported`] for a model with spatial bodies whose `Phi_q` depends on time
+/// (an angle driver): the s = 2 term's spatial passes take every spatial row's Hessian as
+/// constant, and the derivation does not cover a time-dependent Jacobian.
+fn refuse_spatial_time_jacobian(sys: &System) -> Result<(), SolveError> {
+    if sys.has_spatial() && sys.jacobian_depends_on_time() {
+        return Err(SolveError::Unsupported(
+            "the s = 2 modified Lagrangian on spatial bodies: an angle driver makes Phi_q \
+             depend on time, which the derivation does not cover"
+                .into(),
+        ));
+    }
+    Ok(())
 }

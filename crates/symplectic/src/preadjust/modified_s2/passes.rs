@@ -234,13 +234,13 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
         self.pot = passes::potential_poly_series(sys, ws, q, a, dirs, &mut self.pgrads);
         // (gravity, linear in q, enters through the metric's gradient of V alone)
         self.spp.eval::<B>(sys, q, dirs, &mut self.pot);
-        self.eval_spatial(sys, q, at.1, dirs);
+        self.eval_spatial(sys, at.1, dirs);
     }
 
     /// The spatial rows' coefficients and gradients.
-    fn eval_spatial(&mut self, sys: &System, q: &[f64], set: &SpatialRowSet, dirs: &[&[f64]]) {
+    fn eval_spatial(&mut self, sys: &System, set: &SpatialRowSet, dirs: &[&[f64]]) {
         if sys.has_spatial() {
-            self.sp.gather(sys, q, set, dirs);
+            self.sp.gather(dirs);
             self.sp.coefficients::<K, B>(set, dirs, &mut self.vals);
         }
     }
@@ -263,7 +263,7 @@ impl<const K: usize, B: Basis<K>> Pass<K, B> {
             &mut self.vals,
             &mut self.grads,
         );
-        self.eval_spatial(sys, q, at.1, dirs);
+        self.eval_spatial(sys, at.1, dirs);
     }
 
     /// `out = sum_f grad_q` of the potential's coefficient `k` (length n; zero without force

@@ -37,11 +37,11 @@
 
 use super::adjoints::{gbar_add, Adjoints, GbCtx};
 use super::forward::E4Forward;
-use super::spatial::SpatialRowSet;
 use super::passes::{
     BasisA, BasisB, BasisC, BasisR, Pass, A_ET, A_ETT, A_T4, A_TT, A_TTT, B_ED, B_EE, B_ET, B_ETT,
     C_AT, C_BT, NA, NB, NC, NR, R_DIRS, R_OUTPUTS, R_XY, R_Y,
 };
+use super::spatial::SpatialRowSet;
 use super::{e4_value, Invariant, ModifiedS2, PerInvariant};
 use crate::passes;
 use crate::preadjust::metric::ProjectedMetric;
@@ -376,7 +376,8 @@ fn hvp_weighted_adj(
     gv: &mut [f64],
 ) {
     let dirs: [&[f64]; R_DIRS] = [v, &f.u, &w.hsig_vb, &w.hmu_vb, &w.hsig_ub, &w.hmu_ub];
-    w.rpass.eval_constraints(sys, q, (&f.angles, &f.sprows), &dirs);
+    w.rpass
+        .eval_constraints(sys, q, (&f.angles, &f.sprows), &dirs);
     for r in 0..m {
         let (s, mu) = (f.sig[r], f.mu0[r]);
         let c = &w.rpass.vals[r];
@@ -482,6 +483,29 @@ mod tests {
             eprintln!("n = {}: gradient error {err:.2e}", sys.n_coords());
             assert!(err < 1e-7, "n = {}: {err:.2e}", sys.n_coords());
         }
+    }
+
+    /// The s = 2 term refuses a spatial model whose `Phi_q` depends on time (an angle driver),
+    /// by name, in its value and its gradients.
+    #[test]
+    fn a_spatial_angle_driver_is_refused() {
+        let sys = mbd_model::System::from_path(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/models/turning_arm.toml"
+        ))
+        .unwrap();
+        let st = State::consistent(&sys, 0.0).unwrap();
+        let (q, v) = (st.q.as_slice(), st.v.as_slice());
+        let n = q.len();
+        let mut p = Preadjustment::new(&sys, 2).unwrap();
+        let e = p.modified_term_s2(&sys, q, v).unwrap_err().to_string();
+        assert!(e.contains("angle driver"), "{e}");
+        let (mut gq, mut gv) = (vec![0.0; n], vec![0.0; n]);
+        let e = p
+            .modified_gradients_s2(&sys, q, v, &mut gq, &mut gv)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("angle driver"), "{e}");
     }
 
     /// The reverse-pass gradients against fourth-order central differences of `e4`, on paper

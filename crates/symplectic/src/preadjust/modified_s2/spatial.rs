@@ -14,9 +14,9 @@
 //! row that is linear in the coordinates has none): [`SpatialRowSet`], evaluated once per
 //! `q`. Each pass keeps its directions ([`SpatialRows`]), and every product `H_r d_j` is formed
 //! from them where it is used, so a pass's memory is its directions, not
-//! `O(rows x directions x 24)`. The spatial model's time
-//! does not enter: the preadjustments refuse constraints whose Jacobian depends on time, and no
-//! term reads a degree-0 coefficient (left zero).
+//! `O(rows x directions x 24)`. The spatial model's time does not enter: the s = 2 term
+//! refuses spatial models whose Jacobian depends on time (an angle driver), and no term reads a
+//! degree-0 coefficient (left zero).
 
 use mbd_model::{Basis, System, MAX_DIRS};
 
@@ -34,7 +34,7 @@ struct Row {
     cols: [usize; W],
     /// `g_r` in local columns.
     g: [f64; W],
-    /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)` if it is constant.
+    /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)` (constant).
     nz: Vec<(usize, usize, f64)>,
 }
 
@@ -85,16 +85,15 @@ fn splits<const K: usize, B: Basis<K>>() -> [(usize, usize, usize); K] {
 
 /// The spatial rows at one `q`, shared by the passes of an evaluation (module doc): the row
 /// list, the columns and the constant Hessians are built at the first [`SpatialRowSet::update`]
-/// and kept; every update refreshes `g_r`.
+/// and kept; every update refreshes `g_r`. (A row whose Hessian is not constant, an angle
+/// driver's, is refused before: `Preadjustment`'s s = 2 methods.)
 #[derive(Debug, Default)]
 pub(super) struct SpatialRowSet {
     rows: Vec<Row>,
     /// Each constraint row's place in `rows` ([`NONE`]: not a spatial row).
     slot: Vec<usize>,
-    /// Whether the rows are built, and whether every row's Hessian is constant (otherwise the
-    /// passes take `H_r d_j` from a pass of the rows along each direction).
+    /// Whether the rows are built.
     built: bool,
-    constant: bool,
 }
 
 impl SpatialRowSet {
@@ -152,77 +151,42 @@ impl SpatialRowSet {
         });
         self.slot.clear();
         self.slot.resize(sys.n_constraints(), NONE);
-        self.constant = true;
         for (k, row) in self.rows.iter_mut().enumerate() {
             self.slot[row.r] = k;
-            match sys.spatial_row_hessian(q, row.r) {
-                Some(h) => row.nz.extend_from_slice(h),
-                None => self.constant = false,
-            }
+            // (every row but an angle driver's has a constant Hessian, and the s = 2 term
+            // refuses angle drivers on spatial bodies)
+            row.nz
+                .extend_from_slice(sys.spatial_row_hessian(q, row.r).unwrap_or(&[]));
         }
         self.built = true;
     }
 }
 
 /// One pass's share of the spatial rows ([`super::passes::Pass`]): its directions, copied at
-/// every evaluation, and, on a model with a row whose Hessian is not constant, `H_r d_j` of
-/// every row and direction from a pass along each.
+/// every evaluation.
 #[derive(Debug, Default)]
 pub(super) struct SpatialRows {
     dirs: Vec<Vec<f64>>,
-    /// `hd[k * nd + j]`: `H_r d_j` of the set's row `k` in local columns (empty when every
-    /// Hessian is constant).
-    hd: Vec<[f64; W]>,
 }
 
 impl SpatialRows {
-    /// The directions `dirs` of a pass at the set's `q` (and `H_r d_j` if a row's Hessian is
-    /// not constant).
-    pub(super) fn gather(
-        &mut self,
-        sys: &System,
-        q: &[f64],
-        set: &SpatialRowSet,
-        dirs: &[&[f64]],
-    ) {
+    /// The directions `dirs` of a pass.
+    pub(super) fn gather(&mut self, dirs: &[&[f64]]) {
         self.dirs.resize_with(dirs.len(), Vec::new);
         for (kept, d) in self.dirs.iter_mut().zip(dirs) {
             kept.clear();
             kept.extend_from_slice(d);
         }
-        if set.constant {
-            self.hd.clear();
-            return;
-        }
-        let nd = dirs.len();
-        self.hd.clear();
-        self.hd.resize(set.rows.len() * nd, [0.0; W]);
-        for (j, d) in dirs.iter().enumerate() {
-            let hd = &mut self.hd;
-            sys.local_rows_tan(q, d, 0.0, |r, sides| {
-                let Some(&k) = set.slot.get(r).filter(|&&k| k != NONE) else {
-                    return;
-                };
-                let out = &mut hd[k * nd + j];
-                for (s, side) in sides.iter().enumerate() {
-                    if let Some((_, g, dg)) = side {
-                        let n = g.len().min(12);
-                        out[12 * s..12 * s + n].copy_from_slice(&dg[..n]);
-                    }
-                }
-            });
-        }
     }
 
     /// `x . H_r d_j` of the set's row `k`.
     fn hd_dot(&self, set: &SpatialRowSet, k: usize, j: usize, x: &[f64]) -> f64 {
-        let row = &set.rows[k];
-        if self.hd.is_empty() {
-            let dj = &self.dirs[j];
-            row.nz.iter().map(|&(i, c, v)| x[i] * v * dj[c]).sum()
-        } else {
-            row.dot(&self.hd[k * self.dirs.len() + j], x)
-        }
+        let dj = &self.dirs[j];
+        set.rows[k]
+            .nz
+            .iter()
+            .map(|&(i, c, v)| x[i] * v * dj[c])
+            .sum()
     }
 
     /// `out += c H_r d_j` of the set's row `k`.
@@ -230,14 +194,9 @@ impl SpatialRows {
         if c == 0.0 {
             return;
         }
-        let row = &set.rows[k];
-        if self.hd.is_empty() {
-            let dj = &self.dirs[j];
-            for &(i, col, v) in &row.nz {
-                out[i] += c * v * dj[col];
-            }
-        } else {
-            row.scatter(c, &self.hd[k * self.dirs.len() + j], out);
+        let dj = &self.dirs[j];
+        for &(i, col, v) in &set.rows[k].nz {
+            out[i] += c * v * dj[col];
         }
     }
 
