@@ -100,9 +100,9 @@ fn sparse_path_matches_the_dense_path_on(name: &str, sys: &System) {
         let o = SymplecticOptions::new(s)
             .with_preadjust(PreadjustMode::ModifiedLagrangian)
             .with_jacobian_reuse(JacobianReuse::Never);
-        let mut sparse = Galerkin::new(&sys, o).unwrap();
+        let mut sparse = Galerkin::new(sys, o).unwrap();
         let mut dense = Galerkin::new(
-            &sys,
+            sys,
             SymplecticOptions {
                 linear_solver: LinearSolver::Dense,
                 ..o
@@ -110,14 +110,14 @@ fn sparse_path_matches_the_dense_path_on(name: &str, sys: &System) {
         )
         .unwrap();
         assert!(sparse.is_sparse() && !dense.is_sparse());
-        let mut plain = Galerkin::new(&sys, SymplecticOptions::new(s)).unwrap();
-        let mut sa = State::consistent(&sys, 0.0).unwrap();
+        let mut plain = Galerkin::new(sys, SymplecticOptions::new(s)).unwrap();
+        let mut sa = State::consistent(sys, 0.0).unwrap();
         let (mut sb, mut sc) = (sa.clone(), sa.clone());
         let (mut wq, mut wv, mut its, mut off) = (0.0f64, 0.0f64, [0usize; 2], 0.0f64);
         for _ in 0..40 {
-            its[0] += sparse.step(&sys, &mut sa, 0.01).unwrap().newton_iterations;
-            its[1] += dense.step(&sys, &mut sb, 0.01).unwrap().newton_iterations;
-            plain.step(&sys, &mut sc, 0.01).unwrap();
+            its[0] += sparse.step(sys, &mut sa, 0.01).unwrap().newton_iterations;
+            its[1] += dense.step(sys, &mut sb, 0.01).unwrap().newton_iterations;
+            plain.step(sys, &mut sc, 0.01).unwrap();
             wq = wq.max(max_abs_diff(sa.q.as_slice(), sb.q.as_slice()));
             wv = wv.max(max_abs_diff(sa.v.as_slice(), sb.v.as_slice()));
             off = off.max(max_abs_diff(sa.q.as_slice(), sc.q.as_slice()));
