@@ -9,10 +9,43 @@
 //! products with `Phi_q` and `W Phi_q^T` separately. `S` couples two rows only when they share
 //! a block, so for a chain it is banded and every operation is `O(N)`.
 
-use super::{BlockRows, SparseCholesky};
+use super::{BlockRows, RowSide, SparseCholesky};
 use crate::error::SolveError;
 use crate::linalg::FactorError;
 use mbd_model::System;
+
+/// Two row sides on a shared block and the value slot of their entry of `S`.
+pub(crate) type SharedPair = (RowSide, RowSide, usize);
+
+/// The sparse Cholesky kernel on the pattern of `S = Phi W Phi^T` over the kept `rows` (two
+/// rows couple where they share a block), allowed `max_dependent` dependent rows (a model's
+/// redundant equations), and every pair of row sides on a shared block with the value slot of
+/// their entry: what the block-row Schur complements ([`BlockSchur`],
+/// [`super::SparseBodySchur`]) assemble from.
+pub(crate) fn shared_pair_pattern(
+    rows: &BlockRows,
+    max_dependent: usize,
+) -> Result<(SparseCholesky, Vec<SharedPair>), SolveError> {
+    let mut pairs = Vec::new();
+    rows.shared_pairs(|s1, s2, e1, e2| pairs.push((s1, s2, e1, e2)));
+    let pattern: Vec<(usize, usize)> = pairs
+        .iter()
+        .filter(|p| p.2 > p.3)
+        .map(|p| (p.2, p.3))
+        .collect();
+    let mut chol = SparseCholesky::new(rows.len(), &pattern)?;
+    // a mechanism with redundant equations: each factorisation drops that many dependent rows
+    // (their multipliers zero), and no more
+    chol.set_max_dependent(max_dependent);
+    let mut slots = Vec::with_capacity(pairs.len());
+    for (s1, s2, e1, e2) in pairs {
+        let slot = chol.slot(e1, e2).ok_or_else(|| {
+            SolveError::Unsupported(format!("sparse Schur pattern lacks entry ({e1}, {e2})"))
+        })?;
+        slots.push((s1, s2, slot));
+    }
+    Ok((chol, slots))
+}
 
 /// One contribution to `S`: rows sharing a block (the offsets of their gradients on it, the
 /// block's first coordinate and width, and the value slot of the entry).
@@ -50,30 +83,17 @@ impl BlockSchur {
                 rows.len()
             )));
         }
-        let mut pairs = Vec::new();
-        rows.shared_pairs(|s1, s2, e1, e2| pairs.push((s1, s2, e1, e2)));
-        let pattern: Vec<(usize, usize)> = pairs
-            .iter()
-            .filter(|p| p.2 > p.3)
-            .map(|p| (p.2, p.3))
-            .collect();
-        let mut chol = SparseCholesky::new(m, &pattern)?;
-        // a mechanism with redundant equations: each factorisation drops that many dependent
-        // rows (their multipliers zero), and no more
-        chol.set_max_dependent(sys.n_redundant());
-        let mut contributions = Vec::with_capacity(pairs.len());
-        for (s1, s2, e1, e2) in pairs {
-            let slot = chol.slot(e1, e2).ok_or_else(|| {
-                SolveError::Unsupported(format!("sparse Schur pattern lacks entry ({e1}, {e2})"))
-            })?;
-            contributions.push(Contribution {
+        let (chol, pairs) = shared_pair_pattern(&rows, sys.n_redundant())?;
+        let contributions = pairs
+            .into_iter()
+            .map(|(s1, s2, slot)| Contribution {
                 g1: s1.off,
                 g2: s2.off,
                 col: s1.col,
                 width: s1.width,
                 slot,
-            });
-        }
+            })
+            .collect();
         Ok(BlockSchur {
             m,
             vals: vec![0.0; rows.n_values()],

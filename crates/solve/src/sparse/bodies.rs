@@ -66,27 +66,16 @@ impl SparseBodySchur {
         let nblocks = sys.n_body_blocks();
         let rows = BlockRows::new(sys, |r| !internal.contains(&r))?;
         let me = rows.len();
-        let mut pairs = Vec::new();
-        rows.shared_pairs(|s1, s2, e1, e2| pairs.push((s1, s2, e1, e2)));
-        let pattern: Vec<(usize, usize)> = pairs
-            .iter()
-            .filter(|p| p.2 > p.3)
-            .map(|p| (p.2, p.3))
-            .collect();
-        let mut chol = SparseCholesky::new(me, &pattern)?;
-        chol.set_max_dependent(sys.n_redundant());
-        let mut contributions = Vec::with_capacity(pairs.len());
-        for (s1, s2, e1, e2) in pairs {
-            let slot = chol.slot(e1, e2).ok_or_else(|| {
-                SolveError::Unsupported(format!("sparse Schur pattern lacks entry ({e1}, {e2})"))
-            })?;
-            contributions.push(Contribution {
+        let (chol, pairs) = super::block_schur::shared_pair_pattern(&rows, sys.n_redundant())?;
+        let contributions = pairs
+            .into_iter()
+            .map(|(s1, s2, slot)| Contribution {
                 g1: s1.off,
                 c2: s2.off,
                 width: s1.width,
                 slot,
-            });
-        }
+            })
+            .collect();
         let ns = sys.spatial_bodies().len();
         Ok(SparseBodySchur {
             n,
