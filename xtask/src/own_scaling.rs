@@ -28,7 +28,7 @@ const TARGETS: [(&str, f64); 4] = [
 pub(crate) const CONTINUING_MIN_STEPS: usize = 8;
 
 /// Largest allowed cost exponent between N = 100 and N = 1000.
-const MAX_EXPONENT: f64 = 1.2;
+pub(crate) const MAX_EXPONENT: f64 = 1.2;
 /// Step size of every run.
 const H: f64 = 1e-3;
 /// A solver whose step is predicted to take longer than this at the next N (extrapolated from

@@ -63,7 +63,8 @@ impl RowSelection {
     }
 
     /// `Phi_q` and `(Phi_q v + Phi_t)_q` at `(q, v, t)`, kept rows (`m - k` x `n`), into `pq`,
-    /// `dp` (the bodies' `sin`/`cos` from `angles` if given, a table at `q`); with `select`, the rows are chosen afresh at this point first (a centre). `false` if the
+    /// `dp` (the bodies' `sin`/`cos` from `angles` if given, a table at `q`); with `select`,
+    /// the rows are chosen afresh at this point first (a centre). `false` if the
     /// selection failed: `Phi_q` has more than `k` dependent rows here (a singular
     /// configuration), or fewer (the redundancy found at build time is gone).
     #[inline]
