@@ -10,6 +10,8 @@
 //!   threshold pivoting and a pivot test on the equilibrated matrix;
 //! * [`SparseCholesky`] and [`SparseLu`]: the same factorisations on a fixed sparsity pattern
 //!   (faer's simplicial factorisations), analysed once and refactored in place;
+//! * [`Anderson`]: Anderson acceleration of a linearly converging fixed-point iteration (the
+//!   simplified Newton iterations whose iteration matrix leaves out part of the Jacobian);
 //! * small kernels: [`max_abs`] and [`max_abs_diff`] (max-norms that never lose a NaN),
 //!   [`axpy`], [`dot`], [`pow2_inverse`].
 //!
@@ -47,6 +49,7 @@
 // the factors read like the textbook algorithms.
 #![allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)]
 
+mod anderson;
 mod cholesky;
 mod error;
 mod householder;
@@ -54,6 +57,7 @@ mod lu;
 mod semidefinite;
 mod sparse;
 
+pub use anderson::Anderson;
 pub use cholesky::{
     DenseCholesky, CHOLESKY_PIVOT_TOL, FIXED_CHOLESKY, SMALL_CHOLESKY, SMALL_CHOLESKY_SOLVE,
 };

@@ -5,7 +5,7 @@ use crate::preadjust::Preadjustment;
 use crate::tables::Tables;
 use dense::stage_lu;
 use mbd_model::System;
-use mbd_solve::linalg::{DenseCholesky, DenseLu};
+use mbd_solve::linalg::{Anderson, DenseCholesky, DenseLu};
 use mbd_solve::{
     AccelerationSolver, ConstrainedSolve, Integrator, LinearSolver, SolveError, State, StepStats,
 };
@@ -50,8 +50,14 @@ pub struct Galerkin {
     nonconservative: bool,
     x: Vec<f64>,
     dx: Vec<f64>,
+    /// The previous Newton update (swapped with `dx` at each iteration).
+    dx_prev: Vec<f64>,
     r: Vec<f64>,
     xt: Vec<f64>,
+    /// Anderson mixing of the Newton updates (`newton.rs`), and the plain contraction that
+    /// switched it on in the last step (0: off), which carries it over with the Jacobian.
+    aa: Anderson,
+    aa_theta: f64,
     lu: DenseLu,
     qk: Vec<f64>,
     hvk: Vec<f64>,
@@ -240,8 +246,11 @@ impl Galerkin {
             nonconservative: !sys.is_conservative(),
             x: vec![0.0; dim],
             dx: vec![0.0; dim],
+            dx_prev: vec![0.0; dim],
             r: vec![0.0; dim],
             xt: vec![0.0; dim],
+            aa: Anderson::new(dim, s * n, options.anderson_depth),
+            aa_theta: 0.0,
             lu: if use_sparse {
                 DenseLu::with_ordering(Vec::new(), Vec::new())
             } else {

@@ -60,7 +60,10 @@ mod tables;
 pub use calibrate::{calibrate_gamma, Calibration, CalibrationSettings};
 pub use error::SymplecticError;
 pub use galerkin::Galerkin;
-pub use options::{kappa, phase_constant, JacobianReuse, Nodes, PreadjustMode, SymplecticOptions};
+pub use options::{
+    kappa, phase_constant, JacobianReuse, Nodes, PreadjustMode, SymplecticOptions,
+    ANDERSON_START_CONTRACTION, DEFAULT_ANDERSON_DEPTH, MAX_ANDERSON_DEPTH,
+};
 pub use preadjust::Preadjustment;
 pub use registry::SOLVERS;
 pub use tables::lobatto_nodes;

@@ -88,7 +88,26 @@ pub struct SymplecticOptions {
     /// Forcing
     /// [`LinearSolver::Sparse`] where it is not available is an error of [`crate::Galerkin::new`].
     pub linear_solver: LinearSolver,
+    /// Difference pairs kept by the Anderson mixing of the Newton updates (0 turns it off;
+    /// default [`DEFAULT_ANDERSON_DEPTH`], at most [`MAX_ANDERSON_DEPTH`]). The mixing starts
+    /// once a plain simplified-Newton update is more than [`ANDERSON_START_CONTRACTION`] times
+    /// the one before it (an iteration matrix that leaves out part of the Jacobian, as the modified Lagrangian's diagonal
+    /// Newton blocks on a long spatial chain) and carries over to the next step with a kept
+    /// Jacobian; an iteration that contracts fast never starts it. Only the number of Newton
+    /// iterations depends on it, not the solution (to the Newton tolerance).
+    pub anderson_depth: usize,
 }
+
+/// Default [`SymplecticOptions::anderson_depth`].
+pub const DEFAULT_ANDERSON_DEPTH: usize = 4;
+
+/// Largest [`SymplecticOptions::anderson_depth`].
+pub const MAX_ANDERSON_DEPTH: usize = 16;
+
+/// The contraction of the plain simplified-Newton updates (the ratio of one update to the one
+/// before it) above which the Anderson mixing starts: below it the plain iteration reaches the
+/// tolerance within a few more updates anyway.
+pub const ANDERSON_START_CONTRACTION: f64 = 0.12;
 
 impl Default for SymplecticOptions {
     fn default() -> Self {
@@ -108,6 +127,7 @@ impl Default for SymplecticOptions {
             reuse_jacobian: JacobianReuse::Auto,
             predictor_order: 3,
             linear_solver: LinearSolver::Auto,
+            anderson_depth: DEFAULT_ANDERSON_DEPTH,
         }
     }
 }
@@ -192,6 +212,13 @@ impl SymplecticOptions {
                 parameter: "predictor_order",
                 value: self.predictor_order as f64,
                 reason: "must be at most 6",
+            });
+        }
+        if self.anderson_depth > MAX_ANDERSON_DEPTH {
+            return Err(SolveError::InvalidParameter {
+                parameter: "anderson_depth",
+                value: self.anderson_depth as f64,
+                reason: "must be at most MAX_ANDERSON_DEPTH = 16 (0 turns the mixing off)",
             });
         }
         self.newton.validate()

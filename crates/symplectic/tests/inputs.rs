@@ -19,11 +19,18 @@ fn invalid_options_are_rejected() {
             predictor_order: 7,
             ..SymplecticOptions::new(2)
         },
+        SymplecticOptions {
+            anderson_depth: mbd_symplectic::MAX_ANDERSON_DEPTH + 1,
+            ..SymplecticOptions::new(2)
+        },
     ];
     for o in bad {
         match Galerkin::new(&sys, o) {
             Err(SolveError::InvalidParameter { parameter, .. }) => {
-                assert!(["s", "gamma", "fd_step", "predictor_order"].contains(&parameter))
+                assert!(
+                    ["s", "gamma", "fd_step", "predictor_order", "anderson_depth"]
+                        .contains(&parameter)
+                )
             }
             other => panic!("expected InvalidParameter, got {other:?}"),
         }

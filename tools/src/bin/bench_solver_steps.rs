@@ -9,7 +9,7 @@
 //! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
 //! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
 //! state in full (for comparing trajectories between builds). `MBD_LINEAR=dense|sparse` picks the symplectic scheme's
-//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps. The environment variable `MBD_H`
+//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off). The environment variable `MBD_H`
 //! overrides the step.
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
@@ -67,6 +67,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // MBD_REUSE=always keeps the stage Jacobian across steps
             if std::env::var("MBD_REUSE").as_deref() == Ok("always") {
                 o = o.with_jacobian_reuse(mbd::symplectic::JacobianReuse::Always);
+            }
+            // MBD_ANDERSON=K sets the Anderson depth of the Newton iteration (0: off)
+            if let Some(k) = std::env::var("MBD_ANDERSON")
+                .ok()
+                .and_then(|k| k.parse().ok())
+            {
+                o.anderson_depth = k;
             }
             // MBD_LINEAR=dense|sparse picks the path (default: Auto)
             match std::env::var("MBD_LINEAR").as_deref() {

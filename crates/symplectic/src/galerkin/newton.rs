@@ -2,6 +2,7 @@
 //! (`docs/symplectic.md`, "Predictor and Newton").
 
 use super::Galerkin;
+use crate::options::ANDERSON_START_CONTRACTION;
 use mbd_model::System;
 use mbd_solve::linalg::max_abs as norm_inf;
 use mbd_solve::{SolveError, State, StepStats};
@@ -185,11 +186,26 @@ impl Galerkin {
         // its error is smooth in time and, accepted unchanged, accumulates coherently from step
         // to step (docs/symplectic.md, "Newton").
         let mut last_dz = f64::INFINITY;
+        // Anderson mixing of the updates (`mbd_linalg::Anderson`), switched on for the rest of
+        // this Jacobian's iterations once two plain updates show a contraction slower than
+        // `ANDERSON_START_CONTRACTION` (an iteration matrix that leaves out part of the Jacobian, e.g. the
+        // modified Lagrangian's couplings through `S^-1` on a long chain); `theta_chord` is
+        // that measured contraction, which the stopping rule keeps using. Until then nothing
+        // is recorded (a fast iteration pays nothing): the history starts from the last two
+        // plain updates
+        // (a stage Jacobian kept from the last step whose iteration needed the mixing: on from
+        // the first update, its contraction measured again by the second plain update)
+        let mut aa_on = chord && self.aa_theta > 0.0;
+        let mut aa_allowed = self.opts.anderson_depth > 0;
+        let mut theta_chord = self.aa_theta;
+        let mut lambda_prev = 1.0;
+        self.aa.reset();
         while !(res <= tol && last_dz <= tol) {
             if it >= o.max_iter {
                 return Err(fail(res, it, self.tab.s, &self.qk, &self.hvk));
             }
-            if need_jacobian || since_jacobian >= o.jacobian_every {
+            // (while the mixed updates contract, the iteration matrix is kept)
+            if need_jacobian || (since_jacobian >= o.jacobian_every && !aa_on) {
                 self.jacobian(sys, t, h)?;
                 self.jac_valid = true;
                 self.jac_h = h;
@@ -198,8 +214,12 @@ impl Galerkin {
                 need_jacobian = false;
                 chord = false;
                 prev_step = f64::INFINITY;
+                self.aa.reset();
+                aa_on = false;
             }
             since_jacobian += 1;
+            // the last update stays in `dx_prev` (the history mixing starts from)
+            std::mem::swap(&mut self.dx, &mut self.dx_prev);
             for i in 0..self.dim {
                 self.dx[i] = -self.r[i];
             }
@@ -232,8 +252,23 @@ impl Galerkin {
             // iterate, an error of their Hessians times this update and times h^(2s), far below
             // the tolerance; docs/symplectic.md sections 5, 5a and "Newton")
             let dz = norm_inf(&self.dx[..sn]);
+            if aa_on && self.aa.is_empty() && prev_step.is_finite() {
+                // the second update of a mixing carried over from the last step, still plain:
+                // the mixing goes on only if it still contracts slowly
+                theta_chord = dz / prev_step;
+                if theta_chord.is_nan() || theta_chord <= ANDERSON_START_CONTRACTION {
+                    aa_on = false;
+                    self.aa.reset();
+                }
+            }
             if prev_step.is_finite() && dz.is_finite() {
-                let theta = dz / prev_step;
+                // (with mixing on, the ratio of the updates understates the plain update's
+                // contraction, which sets the error this branch leaves)
+                let theta = if aa_on {
+                    theta_chord.max(dz / prev_step)
+                } else {
+                    dz / prev_step
+                };
                 let left = theta / (1.0 - theta) * dz;
                 if theta < 0.5 && left <= 0.1 * tol {
                     for (x, d) in self.x.iter_mut().zip(&self.dx) {
@@ -260,9 +295,12 @@ impl Galerkin {
                     self.momentum_rows(sys, t, h);
                     res = norm_inf(&self.r);
                     prev_step = dz;
+                    lambda_prev = 1.0;
                     continue;
                 }
             }
+            // once switched on, every update is recorded and mixed
+            let mut mixed = aa_on && self.aa.mix(&self.x, &mut self.dx, true) > 0;
             self.xt.copy_from_slice(&self.x);
             let mut lambda = 1.0;
             let mut halvings = 0;
@@ -277,6 +315,16 @@ impl Galerkin {
                 if (rn.is_finite() && rn < res) || halvings >= o.max_halvings {
                     res = rn;
                     break;
+                }
+                if mixed {
+                    // the mixed update did not lower the residual: the plain one, and no
+                    // more mixing with this Jacobian
+                    self.dx.copy_from_slice(self.aa.last_update());
+                    self.aa.reset();
+                    mixed = false;
+                    aa_on = false;
+                    aa_allowed = false;
+                    continue;
                 }
                 lambda *= 0.5;
                 halvings += 1;
@@ -301,7 +349,18 @@ impl Galerkin {
                 prev_step = f64::INFINITY;
                 continue;
             }
+            if aa_allowed && !aa_on && !mixed && prev_step.is_finite() {
+                let theta = step / prev_step;
+                if theta > ANDERSON_START_CONTRACTION {
+                    aa_on = true;
+                    theta_chord = theta;
+                    // the last two plain updates start the history
+                    self.aa
+                        .start(&self.xt, &self.dx_prev, lambda_prev, &self.dx);
+                }
+            }
             prev_step = step;
+            lambda_prev = lambda;
             last_dz = step;
             if !res.is_finite() {
                 return Err(fail(res, it, self.tab.s, &self.qk, &self.hvk));
@@ -321,6 +380,7 @@ impl Galerkin {
                 return Err(fail(res, it, self.tab.s, &self.qk, &self.hvk));
             }
         }
+        self.aa_theta = if aa_on { theta_chord } else { 0.0 };
         Ok(StepStats {
             newton_iterations: it,
             residual: res,

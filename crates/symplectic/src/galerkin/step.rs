@@ -40,6 +40,7 @@ impl Integrator for Galerkin {
         self.hist_len = 0;
         self.end_phiq_valid = false;
         self.jac_valid = false;
+        self.aa_theta = 0.0;
         self.w_skip_left = 0;
         self.mlhist.clear();
     }
