@@ -132,7 +132,7 @@ impl System {
         out: &mut DMatrix<f64>,
     ) {
         phi_q.as_mut_slice().fill(0.0);
-        out.fill(0.0);
+        out.as_mut_slice().fill(0.0);
         let sc = SinCos::new(self, q, angles);
         self.for_each_row_tan(q, v, &sc, |ji, r, g, dg| {
             self.scatter_row(ji, r, g, phi_q);
@@ -388,7 +388,7 @@ impl System {
     /// The lambda-weighted constraint Hessian `sum_k lambda_k d^2 Phi_k / dq^2` (n x n) at time
     /// `t` into `out` (overwritten).
     pub fn constraint_hessian(&self, q: &[f64], t: f64, lambda: &[f64], out: &mut DMatrix<f64>) {
-        out.fill(0.0);
+        out.as_mut_slice().fill(0.0);
         self.add_constraint_hessian(q, t, lambda, 1.0, out);
     }
 

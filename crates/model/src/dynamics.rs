@@ -68,7 +68,7 @@ impl System {
 
     /// The Hessian of the potential `d^2 V / dq^2` (the stiffness) into `out` (overwritten).
     pub fn potential_hessian(&self, q: &[f64], out: &mut DMatrix<f64>) {
-        out.fill(0.0);
+        out.as_mut_slice().fill(0.0);
         self.add_potential_hessian(q, 1.0, out);
     }
 

@@ -67,15 +67,24 @@ impl Attach {
 
     /// `out[row, .] += g` in the columns of the element's bodies (`g` a local row; `out` is
     /// `m x n`).
+    ///
+    /// # Panics
+    ///
+    /// If `row` or a body's columns lie outside `out`.
     pub fn scatter_row(&self, row: usize, g: &[f64; NV], out: &mut DMatrix<f64>) {
+        // column-major storage: entry (row, c) at row + nrows c (the slice index is checked;
+        // a row outside the matrix would land in another column, hence the row check)
+        let nr = out.nrows();
+        assert!(row < nr, "row {row} outside a matrix of {nr} rows");
+        let s = out.as_mut_slice();
         if let Some(i) = self.a {
             for l in 0..3 {
-                out[(row, 3 * i + l)] += g[l];
+                s[row + nr * (3 * i + l)] += g[l];
             }
         }
         if let Some(i) = self.b {
             for l in 0..3 {
-                out[(row, 3 * i + l)] += g[3 + l];
+                s[row + nr * (3 * i + l)] += g[3 + l];
             }
         }
     }
