@@ -71,6 +71,7 @@ pub struct Simulation {
     solver: String,
     integrator: BoxedIntegrator,
     state: State,
+    caveat: Option<String>,
 }
 
 impl std::fmt::Debug for Simulation {
@@ -102,6 +103,7 @@ impl Simulation {
             .map_err(|e| registry().with_advice(&system, e))?;
         let state = State::consistent(&system, 0.0)?;
         Ok(Simulation {
+            caveat: spec.caveat(&system),
             system,
             solver: spec.spec().to_string(),
             integrator,
@@ -121,6 +123,7 @@ impl Simulation {
             system,
             integrator: Box::new(integrator),
             state,
+            caveat: None,
         })
     }
 
@@ -139,7 +142,16 @@ impl Simulation {
             solver: solver.into(),
             integrator,
             state,
+            caveat: None,
         })
+    }
+
+    /// What the registry's solver does not deliver on this model of its nominal properties
+    /// ([`SolverSpec::caveat`], e.g. the modified-Lagrangian schemes on a model with drivers
+    /// keep the plain scheme's order), for a warning; `None` otherwise and for integrators
+    /// built outside the registry.
+    pub fn caveat(&self) -> Option<&str> {
+        self.caveat.as_deref()
     }
 
     /// The model.
@@ -250,6 +262,23 @@ mod tests {
             other => panic!("{other:?}"),
         }
         assert!(stats.stopped_early);
+    }
+
+    #[test]
+    fn a_solver_caveat_reaches_the_simulation() {
+        let free = models::pendulum(1.0, 1.0, 0.5, 9.81).expect("model");
+        let driven = models::ClosedLoop::n_four_bar(1, 1.0, 2.0)
+            .and_then(|l| l.system(1.0, 1.0, true))
+            .expect("model");
+        for (_, v) in registry().variants() {
+            let sim = Simulation::new(free.clone(), v.spec).expect(v.spec);
+            assert_eq!(sim.caveat(), None, "{}", v.spec);
+        }
+        let sim = Simulation::new(driven.clone(), "symplectic:1:modified").expect("sim");
+        let c = sim.caveat().expect("a caveat");
+        assert!(c.contains("order 2 (not 4)"), "{c}");
+        let sim = Simulation::new(driven, "symplectic:1").expect("sim");
+        assert_eq!(sim.caveat(), None);
     }
 
     #[test]

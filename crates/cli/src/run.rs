@@ -335,6 +335,9 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         .solver
         .build(&sys)
         .map_err(|e| solve_error(&args.solver, mbd::registry().with_advice(&sys, e)))?;
+    if let Some(c) = args.solver.caveat(&sys) {
+        eprintln!("warning: {c}");
+    }
     let every = usize::try_from(args.every).unwrap_or(usize::MAX);
     let why_not_conserved = not_conserved(&sys);
     let sink = open_sink(args, &sys, every)?;

@@ -125,6 +125,41 @@ fn modified_lagrangian_runs_on_a_conservative_model() {
     let out = run_model(&model, "symplectic:1:modified", &["--h", "0.01"], &csv);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert_eq!(read_csv(&csv).1.len(), 3);
+    // a conservative model without drivers gets the full order: no caveat
+    assert!(!out.stderr.contains("warning"), "{}", out.stderr);
+}
+
+/// On a model with drivers the modified-Lagrangian schemes run at the plain order, and `run`
+/// says so (the driven arm without its force elements, which the schemes refuse).
+#[test]
+fn modified_lagrangian_warns_about_drivers() {
+    let d = scratch("modified_driven");
+    let text =
+        std::fs::read_to_string(common::repo().join("examples/models/driven_three_link_arm.json"))
+            .unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    json["forces"] = serde_json::Value::Array(Vec::new());
+    let model = d.join("driven.json");
+    std::fs::write(&model, json.to_string()).unwrap();
+    let csv = d.join("m.csv");
+    for (s, order) in [(1, 2), (2, 4)] {
+        let out = run_model(
+            &model,
+            &format!("symplectic:{s}:modified"),
+            &["--h", "0.01"],
+            &csv,
+        );
+        assert_eq!(out.code, 0, "{}", out.stderr);
+        assert!(
+            out.stderr
+                .contains("warning: the modified-Lagrangian terms are derived")
+                && out
+                    .stderr
+                    .contains(&format!("order {order} (not {})", order + 2)),
+            "{}",
+            out.stderr
+        );
+    }
 }
 
 #[test]

@@ -179,7 +179,11 @@ pub struct SolverSpec {
     order: u32,
     adaptive: bool,
     build: Arc<BuildFn>,
+    caveat: Option<Arc<CaveatFn>>,
 }
+
+/// What a solver says about a model it runs with less than its nominal properties.
+type CaveatFn = dyn Fn(&System) -> Option<String> + Send + Sync;
 
 impl SolverSpec {
     /// A spec with its canonical string, report label, order, adaptivity and constructor.
@@ -196,7 +200,27 @@ impl SolverSpec {
             order,
             adaptive,
             build: Arc::new(build),
+            caveat: None,
         }
+    }
+
+    /// Adds the check behind [`SolverSpec::caveat`]: for a model the solver runs, but with
+    /// less than its nominal order or another stated limitation, a sentence saying what holds
+    /// instead.
+    pub fn with_caveat(
+        mut self,
+        caveat: impl Fn(&System) -> Option<String> + Send + Sync + 'static,
+    ) -> Self {
+        self.caveat = Some(Arc::new(caveat));
+        self
+    }
+
+    /// What this solver's results on `sys` do not have of its nominal properties (e.g. the
+    /// modified-Lagrangian schemes on a model with drivers keep the plain scheme's order), as
+    /// a sentence for a warning; `None` when the model gets everything [`SolverSpec::order`]
+    /// and the registry's description promise.
+    pub fn caveat(&self, sys: &System) -> Option<String> {
+        self.caveat.as_ref().and_then(|c| c(sys))
     }
 
     /// The canonical spec string (parses back to this solver).

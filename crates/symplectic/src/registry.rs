@@ -2,6 +2,7 @@
 //! `symplectic:S:modified`.
 
 use crate::{Galerkin, PreadjustMode, SymplecticOptions};
+use mbd_model::System;
 use mbd_solve::registry::{SolverFamily, SolverSpec, SolverVariant, SpecArgs};
 use mbd_solve::SolveError;
 
@@ -41,23 +42,23 @@ pub static SOLVERS: SolverFamily = SolverFamily {
         SolverVariant {
             spec: "symplectic:1:modified",
             label: "symplectic (1,1), modified Lagrangian",
-            description: "(1,1) with the parameter-free modified-Lagrangian preadjustment (order 4: the h^2 error term removed)",
+            description: "(1,1) with the parameter-free modified-Lagrangian preadjustment (order 4: the h^2 error term removed; order 2 with drivers)",
             order: 4,
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers",
+            refuses: "non-conservative force elements (dampers, time-varying loads); spatial angle drivers",
             compared: true,
         },
         SolverVariant {
             spec: "symplectic:2:modified",
             label: "symplectic (2,2), modified Lagrangian",
-            description: "(2,2) with the parameter-free modified-Lagrangian preadjustment (order 6: the h^4 error term removed)",
+            description: "(2,2) with the parameter-free modified-Lagrangian preadjustment (order 6: the h^4 error term removed; order 4 with drivers)",
             order: 6,
             adaptive: false,
             scales: true,
             relative_cost: 20.0,
-            refuses: "non-conservative force elements (dampers, time-varying loads); angle drivers",
+            refuses: "non-conservative force elements (dampers, time-varying loads); spatial angle drivers",
             compared: true,
         },
     ],
@@ -112,11 +113,32 @@ fn parse(args: &SpecArgs) -> Result<SolverSpec, SolveError> {
     };
     // the modified Lagrangian removes the leading error term of the (s,s) scheme
     let order = 2 * s as u32 + if modified { 2 } else { 0 };
-    Ok(SolverSpec::new(spec, label, order, false, move |sys| {
+    let spec = SolverSpec::new(spec, label, order, false, move |sys| {
         let mut o = SymplecticOptions::new(s).with_gamma(gamma);
         if modified {
             o = o.with_preadjust(PreadjustMode::ModifiedLagrangian);
         }
         Ok(Box::new(Galerkin::new(sys, o)?))
-    }))
+    });
+    Ok(if modified {
+        spec.with_caveat(move |sys| rheonomic_caveat(sys, s))
+    } else {
+        spec
+    })
+}
+
+/// The modified Lagrangian on a rheonomic model (drivers): its terms are derived for
+/// constraints that do not depend on time, and the scheme keeps the plain (s,s) order 2s there
+/// (measured: docs/symplectic.md section 5a, "Rheonomic constraints (drivers), measured").
+fn rheonomic_caveat(sys: &System, s: usize) -> Option<String> {
+    if !sys.is_rheonomic() {
+        return None;
+    }
+    Some(format!(
+        "the modified-Lagrangian terms are derived for constraints that do not depend on time, \
+         and this model has drivers: symplectic:{s}:modified runs it at the plain (s,s) \
+         scheme's order {} (not {}), with a smaller error constant",
+        2 * s,
+        2 * s + 2
+    ))
 }
