@@ -56,7 +56,7 @@ pub struct RunData {
     /// Where `H` is not conserved: the energy balance's largest residual relative to `max |H|`.
     pub balance: Option<f64>,
     /// Warnings `mbd run` prints (initial values the consistent state changed, redundant
-    /// equations).
+    /// equations, the solver's caveat for this model).
     pub warnings: Vec<String>,
 }
 
@@ -125,7 +125,9 @@ pub fn run_model(sys: &System, opts: &RunOptions) -> Result<RunData, Failure> {
         )));
     }
     let state = State::consistent(sys, 0.0)?;
-    let warnings = warnings(sys, &state);
+    let mut warnings = warnings(sys, &state);
+    // what the solver does not deliver on this model (e.g. the modified schemes with drivers)
+    warnings.extend(spec.caveat(sys));
     if opts.t_end.is_nan() || opts.t_end <= state.t {
         return Err(Failure::argument(format!(
             "t_end {} is not after the initial state's time {}",

@@ -161,3 +161,18 @@ def test_a_spatial_model_from_a_file_runs():
     # the centre of mass stays 0.5 m from the tip
     radius = (r["top.x"] ** 2 + r["top.y"] ** 2 + r["top.z"] ** 2) ** 0.5
     assert abs(radius - 0.5).max() < 1e-12
+
+
+def test_a_solver_caveat_is_a_warning():
+    # the driven arm without its force elements: the modified schemes run it at the plain order
+    d = mbd.Model.from_file(MODELS / "driven_three_link_arm.json").to_dict()
+    d["forces"] = []
+    m = mbd.Model.from_dict(d)
+    with pytest.warns(UserWarning, match=r"order 2 \(not 4\)"):
+        r = m.run("symplectic:1:modified", t_end=0.05, h=1e-2)
+    assert any("drivers" in w for w in r.stats.warnings)
+    # a model without drivers gets no caveat
+    r = mbd.Model.from_file(MODELS / "pendulum.toml").run(
+        "symplectic:1:modified", t_end=0.05, h=1e-2, warn=False
+    )
+    assert r.stats.warnings == []

@@ -180,7 +180,9 @@ class Model:
         ``every`` keeps every k-th step (and the last state); ``reactions`` adds the joint
         reactions; ``drift_tol`` / ``drift_guard=False`` loosen or turn off the drift guard;
         ``warn`` issues the warnings ``mbd run`` prints (initial values changed by the
-        consistent-state projection, redundant equations) as :class:`UserWarning`.
+        consistent-state projection, redundant equations, what the solver does not deliver on
+        this model, e.g. the modified-Lagrangian schemes' plain order with drivers) as
+        :class:`UserWarning`.
 
         Raises :class:`mbd.InvalidSolverSpec`, :class:`mbd.InvalidArgumentError`,
         :class:`mbd.SolveError` (or a subclass), :class:`mbd.ModelError`.
