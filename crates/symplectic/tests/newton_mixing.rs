@@ -8,7 +8,9 @@ mod common;
 use common::max_abs_diff;
 use mbd_model::{models, System};
 use mbd_solve::{Integrator, State};
-use mbd_symplectic::{Galerkin, PreadjustMode, SymplecticOptions, DEFAULT_ANDERSON_DEPTH};
+use mbd_symplectic::{
+    Galerkin, PreadjustMode, SymplecticOptions, ANDERSON_START_CONTRACTION, DEFAULT_ANDERSON_DEPTH,
+};
 
 /// The end state and the Newton iterations of `n` steps of `h`.
 fn run(sys: &System, o: SymplecticOptions, h: f64, n: usize) -> (State, usize) {
@@ -66,5 +68,19 @@ fn a_fast_iteration_never_starts_the_mixing() {
         let (b, its_off) = run(&sys, off, 0.01, 300);
         assert_eq!(its_on, its_off);
         assert!(a.q.as_slice() == b.q.as_slice() && a.v.as_slice() == b.v.as_slice());
+    }
+}
+
+#[test]
+fn the_guide_states_the_code_s_numbers() {
+    let guide = include_str!("../../../docs/symplectic.md");
+    for stated in [
+        format!("`ANDERSON_START_CONTRACTION = {ANDERSON_START_CONTRACTION}`"),
+        format!("(`SymplecticOptions::anderson_depth`, default {DEFAULT_ANDERSON_DEPTH};"),
+    ] {
+        assert!(
+            guide.contains(&stated),
+            "docs/symplectic.md should state {stated}"
+        );
     }
 }
