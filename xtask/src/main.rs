@@ -10,6 +10,7 @@ mod own;
 mod own_scaling;
 mod own_singular;
 mod own_spatial;
+mod own_spatial_mixing;
 mod paper_a;
 mod paper_b;
 mod paper_c;

@@ -5,7 +5,9 @@
 //! torque-free body with symplectic (2,2), plain and with the s = 2 modified Lagrangian, over a
 //! long time: energy and angular momentum. The s = 2 modified Lagrangian with a spatial spring:
 //! its order and gain on a rod on a spring. A
-//! chain of rods on ball joints: the cost of a step against its length on the sparse path.
+//! chain of rods on ball joints: the cost of a step against its length on the sparse path, and
+//! (`own_spatial_mixing.rs`) the Newton iterations of the (1,1) modified scheme there with and
+//! without the mixing of its updates.
 
 use crate::own_scaling::MAX_EXPONENT;
 use crate::report::{fmt_e, num, Claim, Ctx, Section, Table};
@@ -93,6 +95,7 @@ pub fn spatial(ctx: &Ctx) -> Result<Section, String> {
     spring_s2(&mut sec)?;
     director_drift(ctx, &mut sec)?;
     scaling(ctx, &mut sec)?;
+    crate::own_spatial_mixing::mixing(ctx, &mut sec)?;
     Ok(sec)
 }
 
