@@ -34,7 +34,7 @@
 /// let (mut x, mut d) = ([0.0, 0.0], [0.0, 0.0]);
 /// for _ in 0..4 {
 ///     update(&x, &mut d);
-///     aa.mix(&x, &mut d, true);
+///     aa.mix(&x, &mut d);
 ///     x[0] += d[0];
 ///     x[1] += d[1];
 /// }
@@ -136,9 +136,10 @@ impl Anderson {
     }
 
     /// Records the iterate `x` and its update `d` (both of length `dim`; other lengths reset
-    /// the history and leave `d` alone) and, if `apply`, overwrites `d` with the mixed update.
-    /// Returns the number of difference pairs the mixed update used (0: `d` unchanged).
-    pub fn mix(&mut self, x: &[f64], d: &mut [f64], apply: bool) -> usize {
+    /// the history and leave `d` alone) and overwrites `d` with the mixed update. Returns the
+    /// number of difference pairs the mixed update used (0: `d` unchanged, as on the first
+    /// call after a [`Anderson::reset`]).
+    pub fn mix(&mut self, x: &[f64], d: &mut [f64]) -> usize {
         let dim = self.dim;
         if x.len() != dim || d.len() != dim {
             self.reset();
@@ -162,7 +163,7 @@ impl Anderson {
         self.last_x.copy_from_slice(x);
         self.last_d.copy_from_slice(d);
         self.has_last = true;
-        if !apply || self.count == 0 {
+        if self.count == 0 {
             return 0;
         }
         // columns oldest first: k-th column in slot (head + k) % depth; drop the oldest until
@@ -281,7 +282,9 @@ mod tests {
                     d[i] += rho[k] * p * w[i];
                 }
             }
-            aa.mix(&x, &mut d, apply);
+            if apply {
+                aa.mix(&x, &mut d);
+            }
             x.iter_mut().zip(&d).for_each(|(a, b)| *a += b);
             let err = x
                 .iter()
@@ -309,17 +312,19 @@ mod tests {
     }
 
     #[test]
-    fn without_apply_the_update_is_untouched_and_mismatched_lengths_reset() {
+    fn the_first_update_is_untouched_and_mismatched_lengths_reset() {
         let mut aa = Anderson::new(3, 3, 2);
         let x = [1.0, 2.0, 3.0];
         let mut d = [0.5, -0.25, 0.125];
-        assert_eq!(aa.mix(&x, &mut d, false), 0);
+        assert_eq!(aa.mix(&x, &mut d), 0);
+        assert_eq!(d, [0.5, -0.25, 0.125]);
+        assert!(aa.is_empty());
         let mut d2 = [0.25, -0.125, 0.0625];
-        assert_eq!(aa.mix(&[1.5, 1.75, 3.125], &mut d2, false), 0);
-        assert_eq!(d2, [0.25, -0.125, 0.0625]);
+        assert_eq!(aa.mix(&[1.5, 1.75, 3.125], &mut d2), 1);
         assert_eq!(aa.len(), 1);
+        assert_eq!(aa.last_update(), &[0.25, -0.125, 0.0625]);
         let mut short = [0.0; 2];
-        assert_eq!(aa.mix(&[0.0; 2], &mut short, true), 0);
+        assert_eq!(aa.mix(&[0.0; 2], &mut short), 0);
         assert!(aa.is_empty());
     }
 
@@ -329,11 +334,11 @@ mod tests {
         // dropped and the update stays finite
         let mut aa = Anderson::new(2, 2, 3);
         let mut d = [1.0, 0.0];
-        aa.mix(&[0.0, 0.0], &mut d, true);
+        aa.mix(&[0.0, 0.0], &mut d);
         let mut d = [0.5, 0.0];
-        aa.mix(&[1.0, 0.0], &mut d, true);
+        aa.mix(&[1.0, 0.0], &mut d);
         let mut d = [0.0, 0.0];
-        let used = aa.mix(&[2.0, 0.0], &mut d, true);
+        let used = aa.mix(&[2.0, 0.0], &mut d);
         assert!(used >= 1 && d.iter().all(|v| v.is_finite()), "{used} {d:?}");
     }
 }

@@ -186,15 +186,15 @@ impl Galerkin {
         // its error is smooth in time and, accepted unchanged, accumulates coherently from step
         // to step (docs/symplectic.md, "Newton").
         let mut last_dz = f64::INFINITY;
-        // Anderson mixing of the updates (`mbd_linalg::Anderson`), switched on for the rest of
-        // this Jacobian's iterations once two plain updates show a contraction slower than
-        // `ANDERSON_START_CONTRACTION` (an iteration matrix that leaves out part of the Jacobian, e.g. the
-        // modified Lagrangian's couplings through `S^-1` on a long chain); `theta_chord` is
-        // that measured contraction, which the stopping rule keeps using. Until then nothing
-        // is recorded (a fast iteration pays nothing): the history starts from the last two
-        // plain updates
-        // (a stage Jacobian kept from the last step whose iteration needed the mixing: on from
-        // the first update, its contraction measured again by the second plain update)
+        // Anderson mixing of the updates (`mbd_linalg::Anderson`, docs/symplectic.md), switched
+        // on for the rest of this Jacobian's iterations once two plain updates contract more
+        // slowly than `ANDERSON_START_CONTRACTION` (an iteration matrix that leaves out part of
+        // the Jacobian, e.g. the modified Lagrangian's couplings through `S^-1` on a long
+        // chain). Until then nothing is recorded (a fast iteration pays nothing); the history
+        // starts from those two plain updates. `theta_chord` is their contraction, which the
+        // stopping rule keeps using. With a stage Jacobian kept from a step whose iteration
+        // needed the mixing, it is on from the first update and kept only if the second
+        // (plain) update again contracts slowly.
         let mut aa_on = chord && self.aa_theta > 0.0;
         let mut aa_allowed = self.opts.anderson_depth > 0;
         let mut theta_chord = self.aa_theta;
@@ -300,7 +300,7 @@ impl Galerkin {
                 }
             }
             // once switched on, every update is recorded and mixed
-            let mut mixed = aa_on && self.aa.mix(&self.x, &mut self.dx, true) > 0;
+            let mut mixed = aa_on && self.aa.mix(&self.x, &mut self.dx) > 0;
             self.xt.copy_from_slice(&self.x);
             let mut lambda = 1.0;
             let mut halvings = 0;
