@@ -10,6 +10,8 @@
 //!   threshold pivoting and a pivot test on the equilibrated matrix;
 //! * [`SparseCholesky`] and [`SparseLu`]: the same factorisations on a fixed sparsity pattern
 //!   (faer's simplicial factorisations), analysed once and refactored in place;
+//! * [`symmetric_eigen`]: the cyclic Jacobi eigen-decomposition of a small symmetric matrix
+//!   (its near-null space, accurately);
 //! * [`Anderson`]: Anderson acceleration of a linearly converging fixed-point iteration (the
 //!   simplified Newton iterations whose iteration matrix leaves out part of the Jacobian);
 //! * small kernels: [`max_abs`] and [`max_abs_diff`] (max-norms that never lose a NaN),
@@ -51,6 +53,7 @@
 
 mod anderson;
 mod cholesky;
+mod eigen;
 mod error;
 mod householder;
 mod lu;
@@ -61,6 +64,7 @@ pub use anderson::Anderson;
 pub use cholesky::{
     DenseCholesky, CHOLESKY_PIVOT_TOL, FIXED_CHOLESKY, SMALL_CHOLESKY, SMALL_CHOLESKY_SOLVE,
 };
+pub use eigen::{symmetric_eigen, JACOBI_MAX_SWEEPS};
 pub use error::{FactorError, LinalgError, LuError};
 pub use householder::{form_q_padded, mul_r, qr_padded, reflect, solve_r, solve_rt};
 pub use lu::{DenseLu, PIVOT_THRESHOLD, PIVOT_TOL};
