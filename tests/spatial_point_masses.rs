@@ -287,6 +287,7 @@ fn end_on(sys: &System, linear: LinearSolver, t_end: f64) -> State {
             baumgarte: None,
             projection: Some(ProjectionSettings::default()),
             linear,
+            ..Default::default()
         },
     )
     .unwrap();

@@ -35,7 +35,7 @@ use mbd_solve::{
 };
 
 /// Options of [`Rk4`]: both stabilisations off by default.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Rk4Options {
     /// Baumgarte `(alpha, beta)`.
     pub baumgarte: Option<(f64, f64)>,
@@ -43,6 +43,20 @@ pub struct Rk4Options {
     pub projection: Option<ProjectionSettings>,
     /// Dense or sparse index-1 solve (default: sparse for large systems).
     pub linear: LinearSolver,
+    /// Bridge the stage accelerations through singular configurations (default on; see
+    /// [`mbd_solve::SingularBridge`]).
+    pub bridge: bool,
+}
+
+impl Default for Rk4Options {
+    fn default() -> Self {
+        Rk4Options {
+            baumgarte: None,
+            projection: None,
+            linear: LinearSolver::default(),
+            bridge: true,
+        }
+    }
 }
 
 impl Rk4Options {
@@ -82,6 +96,7 @@ impl Rk4 {
                 baumgarte: options.baumgarte,
                 projection: options.projection,
                 linear: options.linear,
+                bridge: options.bridge,
             },
         )?;
         Ok(Rk4 { inner })

@@ -67,6 +67,16 @@ impl AccelerationSolver {
         }
     }
 
+    /// The element-local rows of the last solve (planar models).
+    pub(crate) fn schur_rows(&self) -> &DenseSchur {
+        &self.schur
+    }
+
+    /// Whether the solve eliminates spatial bodies' internal constraints (no plain rows).
+    pub(crate) fn has_body_blocks(&self) -> bool {
+        self.bodies.is_some()
+    }
+
     /// Solves for the accelerations `a` (length n) and multipliers `lambda` (length m) at
     /// `(q, v, t)`.
     pub fn solve(
@@ -363,6 +373,14 @@ impl Accel {
     /// Whether the sparse path was picked.
     pub(crate) fn is_sparse(&self) -> bool {
         matches!(self, Accel::Sparse(_))
+    }
+
+    /// The constraint rows of the last solve (for [`crate::SingularBridge`]).
+    pub(crate) fn rows(&self) -> &dyn crate::ConstraintRows {
+        match self {
+            Accel::Dense(acc) => acc,
+            Accel::Sparse(sp) => sp.as_ref(),
+        }
     }
 
     /// Condition estimate of the last index-1 matrix.

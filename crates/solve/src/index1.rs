@@ -5,6 +5,7 @@
 
 use crate::accel::Accel;
 use crate::adaptive::{AdaptiveIntegrator, StepAttempt};
+use crate::bridge::SingularBridge;
 use crate::error::SolveError;
 use crate::integrator::{Integrator, StepStats};
 use crate::projection::{ProjectionSettings, Projector};
@@ -14,7 +15,7 @@ use crate::tableau::{ButcherTableau, ExplicitRk, StepController};
 use mbd_model::System;
 
 /// Settings of [`Index1Rk`].
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Index1Options {
     /// Baumgarte parameters `(alpha, beta)`: the acceleration constraint becomes
     /// `Phi_q a = gamma - 2 alpha Phidot - beta^2 Phi`. `None` (default) = off.
@@ -24,6 +25,21 @@ pub struct Index1Options {
     /// Dense or sparse index-1 solve and projection (default: sparse above
     /// [`crate::SPARSE_THRESHOLD`] constraints).
     pub linear: LinearSolver,
+    /// Bridge the stage accelerations through singular configurations
+    /// ([`crate::SingularBridge`]; default on). Off, a stage near a singular configuration
+    /// takes the solve's accelerations as they are.
+    pub bridge: bool,
+}
+
+impl Default for Index1Options {
+    fn default() -> Self {
+        Index1Options {
+            baumgarte: None,
+            projection: None,
+            linear: LinearSolver::default(),
+            bridge: true,
+        }
+    }
 }
 
 /// Explicit RK on the index-1 equations, allocation-free per step.
@@ -42,6 +58,8 @@ pub struct Index1Rk {
     /// Start of an adaptive attempt (restored on rejection).
     y0: Vec<f64>,
     n: usize,
+    /// The accelerations of the last step starts, for stages near a singular configuration.
+    bridge: SingularBridge,
 }
 
 impl Index1Rk {
@@ -85,6 +103,7 @@ impl Index1Rk {
             phid: vec![0.0; m],
             y0: vec![0.0; 2 * n],
             n,
+            bridge: SingularBridge::new(sys),
         })
     }
 
@@ -145,12 +164,27 @@ impl Integrator for Index1Rk {
         let baum = self.options.baumgarte;
         let mut evals = 0usize;
         let mut condition = 0.0f64;
-        // the stage slope k_i = (v_i, a_i): the accelerations are solved into it directly
+        let mut bridged = 0usize;
+        let mut bridge = self.options.bridge.then_some(&mut self.bridge);
+        if let Some(b) = bridge.as_deref_mut() {
+            b.begin(state.t, state.q.as_slice());
+        }
+        // the stage slope k_i = (v_i, a_i): the accelerations are solved into it directly;
+        // near a singular configuration the bridge replaces their ill-determined components
         let mut f = |t: f64, y: &[f64], dy: &mut [f64]| -> Result<(), SolveError> {
             let (q, v) = y.split_at(n);
             let (dq, dv) = dy.split_at_mut(n);
             acc.stage(sys, q, v, t, baum, phi, phid, dv, lambda)?;
-            condition = condition.max(acc.condition());
+            let c = acc.condition();
+            condition = condition.max(c);
+            if let Some(b) = bridge.as_deref_mut() {
+                if b.correct(acc.rows(), sys, t, c, dv, lambda) {
+                    bridged += 1;
+                }
+                if evals == 0 {
+                    b.hold(t, c, dv);
+                }
+            }
             dq.copy_from_slice(v);
             evals += 1;
             Ok(())
@@ -164,6 +198,7 @@ impl Integrator for Index1Rk {
         let mut stats = StepStats {
             rhs_evals: evals,
             condition,
+            bridged_stages: bridged,
             ..Default::default()
         };
         if let Some(p) = &mut self.projector {
@@ -171,6 +206,7 @@ impl Integrator for Index1Rk {
             stats.newton_iterations = s.iterations;
             stats.residual = s.residual;
         }
+        self.bridge.accept(state.t, state.q.as_slice());
         Ok(stats)
     }
 }
@@ -215,6 +251,8 @@ impl AdaptiveIntegrator for Index1Rk {
             state.q.as_mut_slice().copy_from_slice(&self.y0[..n]);
             state.v.as_mut_slice().copy_from_slice(&self.y0[n..]);
             state.t = t;
+            // the retry starts where the rejected attempt did
+            self.bridge.retry_from(t, state.q.as_slice());
         }
         Ok(StepAttempt {
             accepted,

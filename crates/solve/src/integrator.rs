@@ -27,6 +27,9 @@ pub struct StepStats {
     /// report it; the symplectic scheme, which never forms the index-1 matrix (its stage system
     /// holds the constraints at the control points), reports 0.
     pub condition: f64,
+    /// Stages whose accelerations [`crate::SingularBridge`] bridged through a singular
+    /// configuration (RK4 and the tangent solver; 0 elsewhere).
+    pub bridged_stages: usize,
 }
 
 /// A one-step method for the constrained equations of motion.
@@ -390,6 +393,9 @@ pub struct RunStats {
     pub min_step: f64,
     /// Largest step taken (accepted steps of an adaptive run); 0 before the first step.
     pub max_step: f64,
+    /// Stages whose accelerations [`crate::SingularBridge`] bridged through a singular
+    /// configuration (summed over steps and attempts).
+    pub bridged_stages: usize,
 }
 
 impl RunStats {
@@ -405,16 +411,26 @@ impl RunStats {
         self.newton_iterations += s.newton_iterations;
         self.rhs_evals += s.rhs_evals;
         self.objective_evals += s.objective_evals;
+        self.bridged_stages += s.bridged_stages;
     }
 
     /// A warning to show the user when the run passed near a singular configuration, `None`
     /// otherwise.
     pub fn warning(&self) -> Option<String> {
         let t = self.first_near_singular?;
+        let bridged = if self.bridged_stages > 0 {
+            format!(
+                "; {} stage(s) took the ill-determined part of their accelerations from the \
+                 motion's extrapolation (SingularBridge)",
+                self.bridged_stages
+            )
+        } else {
+            String::new()
+        };
         Some(format!(
             "{} step(s) passed near a singular configuration (index-1 condition estimate up to \
              {:.1e}, first at t = {t}): accelerations and multipliers there may have lost digits; \
-             check the mechanism's geometry or take a smaller step",
+             check the mechanism's geometry or take a smaller step{bridged}",
             self.near_singular_steps, self.max_condition
         ))
     }

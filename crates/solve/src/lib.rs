@@ -51,6 +51,7 @@
 
 mod accel;
 mod adaptive;
+mod bridge;
 mod consistent;
 mod constrained;
 mod dense;
@@ -72,6 +73,10 @@ mod tableau;
 
 pub use accel::AccelerationSolver;
 pub use adaptive::{run_adaptive, AdaptiveConfig, AdaptiveIntegrator, StepAttempt};
+pub use bridge::{
+    ConstraintRows, SingularBridge, BRIDGE_CONDITION, BRIDGE_DISAGREEMENT, BRIDGE_MAX_CONSTRAINTS,
+    BRIDGE_MEMORY, BRIDGE_POINTS,
+};
 pub use consistent::{
     consistent_state, initial_changes, project_state, ConsistentOptions, ConsistentState,
     InitialChange, INITIAL_CHANGE_TOL,

@@ -112,6 +112,7 @@ fn rk4_runs_alike_on_both_paths() {
                 baumgarte: None,
                 projection: Some(ProjectionSettings::default()),
                 linear,
+                ..Default::default()
             },
         )
         .unwrap();

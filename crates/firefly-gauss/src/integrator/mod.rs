@@ -468,6 +468,7 @@ impl FireflyGauss {
             rhs_evals: 5,
             objective_evals: evals as usize,
             condition: self.end_acc.condition_estimate(),
+            bridged_stages: 0,
         })
     }
 }

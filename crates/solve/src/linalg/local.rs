@@ -136,6 +136,34 @@ impl DenseSchur {
         self.chol.factor_in_place()
     }
 
+    /// `out = Phi_q x` from the rows (`x`: n, `out`: m).
+    pub(crate) fn times(&self, x: &[f64], out: &mut [f64]) {
+        for ((o, g), c) in out.iter_mut().zip(&self.grads).zip(&self.cols) {
+            let mut acc = 0.0;
+            for (s, &col) in c.iter().enumerate() {
+                if col != GROUND {
+                    for l in 0..3 {
+                        acc += g[3 * s + l] * x[col + l];
+                    }
+                }
+            }
+            *o = acc;
+        }
+    }
+
+    /// `out += W Phi_q^T y` (`w` the diagonal of `W`, length n) from the rows.
+    pub(crate) fn add_weighted_transpose(&self, w: &[f64], y: &[f64], out: &mut [f64]) {
+        for ((g, c), &yr) in self.grads.iter().zip(&self.cols).zip(y) {
+            for (s, &col) in c.iter().enumerate() {
+                if col != GROUND {
+                    for l in 0..3 {
+                        out[col + l] += w[col + l] * g[3 * s + l] * yr;
+                    }
+                }
+            }
+        }
+    }
+
     /// `out -= W Phi_q^T y` with the `W` of the last [`DenseSchur::factor`].
     #[inline(always)]
     pub(crate) fn sub_weighted_transpose(&self, y: &[f64], out: &mut [f64]) {

@@ -37,11 +37,17 @@ impl TangentRk {
                     residual: w.residual,
                     rhs_evals: w.rhs_evals,
                     condition: w.condition,
+                    bridged_stages: w.bridged,
                     ..Default::default()
                 };
                 let accepted = error_norm <= 1.0;
+                if !accepted {
+                    // the retry starts where this attempt did
+                    self.bridge.retry_from(t, &self.cur[..self.n]);
+                }
                 if accepted {
                     std::mem::swap(&mut self.cur, &mut self.xnew);
+                    self.bridge.accept(t + h, &self.cur[..self.n]);
                     self.commit_history(h, t + h, w.end_initial_residual);
                     self.cur_t = t + h;
                     self.cur_ok = true;

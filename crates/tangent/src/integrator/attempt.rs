@@ -62,6 +62,10 @@ impl TangentRk {
         let mut singular_stage: Option<usize> = None;
         let mut stage = 0usize;
         self.xi.fill(0.0);
+        let mut bridge = self.options.bridge.then_some(&mut self.bridge);
+        if let Some(b) = bridge.as_deref_mut() {
+            b.begin(t, &self.cur[..n]);
+        }
         {
             let chart = &mut self.path;
             let zlast = &mut self.zeta;
@@ -163,7 +167,18 @@ impl TangentRk {
                 let (q, v) = x.split_at(n);
                 let solved = chart.accel(sys, q, v, ti, acc_a, lambda);
                 if solved.is_ok() {
-                    work.condition = work.condition.max(chart.condition_estimate());
+                    let c = chart.condition_estimate();
+                    work.condition = work.condition.max(c);
+                    if let Some(b) = bridge.as_deref_mut() {
+                        // near a singular configuration: the ill-determined components from
+                        // the accelerations of the last step starts
+                        if b.correct(chart.rows(), sys, ti, c, acc_a, lambda) {
+                            work.bridged += 1;
+                        }
+                        if i == 0 {
+                            b.hold(ti, c, acc_a);
+                        }
+                    }
                 }
                 if let Err(e) = solved {
                     if matches!(e, SolveError::Singular { .. }) {

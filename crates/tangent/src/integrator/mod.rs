@@ -6,8 +6,8 @@ use crate::sparse_chart::SparseChart;
 use mbd_model::System;
 use mbd_solve::linalg::axpy;
 use mbd_solve::{
-    AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Integrator, SolveError,
-    SparseAccelerationSolver, State, StepAttempt, StepController, StepStats,
+    AccelerationSolver, AdaptiveIntegrator, ButcherTableau, ExplicitRk, Integrator, SingularBridge,
+    SolveError, SparseAccelerationSolver, State, StepAttempt, StepController, StepStats,
 };
 mod adaptive;
 mod attempt;
@@ -113,6 +113,8 @@ pub struct TangentRk {
     /// Adaptive attempts in a row from the current point that failed for another reason than
     /// the error test.
     failures_here: usize,
+    /// The accelerations of the last step starts, for stages near a singular configuration.
+    bridge: SingularBridge,
 }
 
 /// Largest factor by which [`TangentChart::rcond`] may differ between the current chart and
@@ -136,6 +138,8 @@ struct AttemptWork {
     exact_maps: usize,
     /// Largest index-1 condition estimate of the attempt's stage solves.
     condition: f64,
+    /// Stages bridged through a singular configuration.
+    bridged: usize,
 }
 
 impl TangentRk {
@@ -223,6 +227,7 @@ impl TangentRk {
             stage_tol: options.newton.tol,
             centred_at: f64::NAN,
             failures_here: 0,
+            bridge: SingularBridge::new(sys),
         })
     }
 
@@ -367,6 +372,7 @@ impl TangentRk {
                 self.account(&w);
                 self.commit_history(h, t + h, w.end_initial_residual);
                 std::mem::swap(&mut self.cur, &mut self.xnew);
+                self.bridge.accept(t + h, &self.cur[..self.n]);
                 self.cur_t = t + h;
                 self.cur_ok = true;
                 self.stats.steps += 1;
@@ -375,6 +381,7 @@ impl TangentRk {
                 out.rhs_evals += w.rhs_evals;
                 out.residual = out.residual.max(w.residual);
                 out.condition = out.condition.max(w.condition);
+                out.bridged_stages += w.bridged;
                 Ok(())
             }
             Err(fail @ (Attempt::Chart(_) | Attempt::Stage(_))) => {
@@ -459,6 +466,7 @@ impl Integrator for TangentRk {
         self.hist.clear();
         self.centred_at = f64::NAN;
         self.failures_here = 0;
+        self.bridge.clear();
     }
 
     fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {

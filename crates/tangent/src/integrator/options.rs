@@ -74,6 +74,10 @@ pub struct TangentOptions {
     /// [`SolveError::RepeatedFailure`]. Default 8 (the step shrinks by `chart_shrink^8`,
     /// 1.5e-5 by default); at least 1.
     pub max_chart_failures: usize,
+    /// Bridge the stage accelerations through singular configurations
+    /// ([`mbd_solve::SingularBridge`]; default on). Off, a stage near a singular
+    /// configuration takes the index-1 solve's accelerations as they are.
+    pub bridge: bool,
 }
 
 impl Default for TangentOptions {
@@ -88,6 +92,7 @@ impl Default for TangentOptions {
             linear_solver: LinearSolver::Auto,
             chart_shrink: 0.25,
             max_chart_failures: 8,
+            bridge: true,
         }
     }
 }

@@ -7,7 +7,7 @@
 use crate::chart::{ChartFailure, MapStats, NewtonSettings, TangentChart};
 use crate::sparse_chart::SparseChart;
 use mbd_model::System;
-use mbd_solve::{AccelerationSolver, SolveError, SparseAccelerationSolver};
+use mbd_solve::{AccelerationSolver, ConstraintRows, SolveError, SparseAccelerationSolver};
 
 /// The chart and the index-1 solver of one path.
 // one `Path` per solver, built once: the size difference costs nothing, and the dense arm
@@ -165,6 +165,14 @@ impl Path {
                 acc.solve_accelerations(sys, q, v, t, Some(chart.angles_mut()), a, lambda)
             }
             Path::Sparse(p) => p.acc.solve(sys, q, v, t, a, lambda),
+        }
+    }
+
+    /// The constraint rows of the last index-1 solve (for the bridge).
+    pub(super) fn rows(&self) -> &dyn ConstraintRows {
+        match self {
+            Path::Dense { acc, .. } => acc,
+            Path::Sparse(p) => &p.acc,
         }
     }
 
