@@ -26,13 +26,13 @@ const BRANCH_TOL: f64 = 1e-2;
 /// The documented miss of the free N-four-bar's claims: the issue's target is the driven
 /// mechanism; the free one (released at 6 rad/s, turning over) shows where solvers still lose
 /// accuracy or stop with an untyped error at a singular passage.
-const FREE_MISS: &str = "the free N-four-bar goes beyond the driven target: projected RK4 \
-    loses accuracy at the smallest h and tangent DOPRI5's error does not fall with h: a stage \
-    that lands near a flat configuration gets an index-1 acceleration whose error grows like \
-    the inverse square of the distance; the (1,1) modified scheme at h = 1e-4 passes every flat \
-    configuration since its Newton updates are mixed (it stopped with the typed singular error \
-    before) and ends at an error floor of about 1e-9 over its 1e5 steps (docs/report.md, \
-    own-singular; open work)";
+const FREE_MISS: &str = "the free N-four-bar goes beyond the driven target: the (1,1) \
+    modified scheme, which never forms the index-1 solve and so is not bridged, ends the 2-four-bar \
+    at an error floor of about 1.2e-9 at h = 1e-4 (1.0e-9 at 1e-3) over its 1e5 steps; its cause \
+    is not measured (docs/singular.md, section 5; open work)";
+
+/// The rows with a documented miss on the free mechanism: (solver, loops).
+const FREE_MISS_ROWS: [(&str, usize); 1] = [("symplectic:1:modified", 2)];
 
 /// How a run ended.
 enum Outcome {
@@ -269,11 +269,12 @@ pub fn singular(ctx: &Ctx) -> Result<Section, String> {
                     reached.join(", ")
                 ),
             );
-            sec.claims.push(if driven {
-                claim
-            } else {
-                claim.expected_miss(FREE_MISS)
-            });
+            sec.claims
+                .push(if !driven && FREE_MISS_ROWS.contains(&(v.spec, n)) {
+                    claim.expected_miss(FREE_MISS)
+                } else {
+                    claim
+                });
         }
     }
     for driven in [true, false] {

@@ -10,6 +10,8 @@
 //!   and iterations.
 //! * [`AccelerationSolver`]: the index-1 solve `[[M, Phi_q^T], [Phi_q, 0]] [a; lambda] = [Q; gamma]`
 //!   (faer Cholesky of the Schur complement), and [`Projector`] for post-step projection.
+//! * [`SingularBridge`]: the stage accelerations of the index-1 solvers carried through
+//!   singular configurations (their ill-determined components from the motion's extrapolation).
 //! * [`ButcherTableau`] (methods as data) and [`ExplicitRk`], an allocation-free explicit
 //!   Runge-Kutta stepper with embedded error estimates and a [`StepController`].
 //! * [`quadrature`]: Gauss-Legendre rules and Lagrange bases for any number of points.
