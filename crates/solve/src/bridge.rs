@@ -245,9 +245,9 @@ impl SingularBridge {
     /// multipliers `lambda` (m) with condition estimate `condition` (see the module
     /// documentation). Does nothing (returns `false`) unless `condition` exceeds
     /// [`BRIDGE_CONDITION`] times the smallest condition estimate of the last
-    /// [`BRIDGE_MEMORY`] accepted step starts,
-    /// before [`BRIDGE_POINTS`] accepted steps, above [`BRIDGE_MAX_CONSTRAINTS`] constraints,
-    /// or when `rows` holds no rows; returns whether it changed `a`.
+    /// [`BRIDGE_MEMORY`] accepted step starts; nor before [`BRIDGE_POINTS`] accepted steps,
+    /// above [`BRIDGE_MAX_CONSTRAINTS`] constraints, or when `rows` holds no rows. Returns
+    /// whether it changed `a`.
     #[inline]
     pub fn correct(
         &mut self,
