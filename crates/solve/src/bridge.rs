@@ -72,13 +72,16 @@ impl ConstraintRows for AccelerationSolver {
     fn rows_times(&self, x: &[f64], out: &mut [f64]) {
         self.schur_rows().times(x, out);
     }
-    fn weighted_transpose(&self, sys: &System, y: &[f64], out: &mut [f64]) -> bool {
+    fn weighted_transpose(&self, _sys: &System, y: &[f64], out: &mut [f64]) -> bool {
         if self.has_body_blocks() {
             return false;
         }
+        // the last solve factored S with W = M^-1: out = -(0 - M^-1 Phi_q^T y)
         out.fill(0.0);
-        self.schur_rows()
-            .add_weighted_transpose(sys.inv_mass_diag().as_slice(), y, out);
+        self.schur_rows().sub_weighted_transpose(y, out);
+        for x in out.iter_mut() {
+            *x = -*x;
+        }
         true
     }
 }

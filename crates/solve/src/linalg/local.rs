@@ -151,19 +151,6 @@ impl DenseSchur {
         }
     }
 
-    /// `out += W Phi_q^T y` (`w` the diagonal of `W`, length n) from the rows.
-    pub(crate) fn add_weighted_transpose(&self, w: &[f64], y: &[f64], out: &mut [f64]) {
-        for ((g, c), &yr) in self.grads.iter().zip(&self.cols).zip(y) {
-            for (s, &col) in c.iter().enumerate() {
-                if col != GROUND {
-                    for l in 0..3 {
-                        out[col + l] += w[col + l] * g[3 * s + l] * yr;
-                    }
-                }
-            }
-        }
-    }
-
     /// `out -= W Phi_q^T y` with the `W` of the last [`DenseSchur::factor`].
     #[inline(always)]
     pub(crate) fn sub_weighted_transpose(&self, y: &[f64], out: &mut [f64]) {
