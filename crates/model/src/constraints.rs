@@ -435,11 +435,24 @@ impl System {
         self.spatial.row_hessian(q, r)
     }
 
+    /// `f(row column, column, value)` for the nonzeros of row `r`'s Hessian at time `t` in
+    /// global columns, for every spatial row, an angle driver's included (whose Hessian turns
+    /// with `theta(t)`: `cos theta H_0 - sin theta H_1` of its two bilinear components);
+    /// nothing for a planar row. From the same cache as [`System::spatial_row_hessian`].
+    pub fn spatial_row_hessian_at(
+        &self,
+        q: &[f64],
+        t: f64,
+        r: usize,
+        f: impl FnMut(usize, usize, f64),
+    ) {
+        self.spatial.row_hessian_at(q, t, r, f);
+    }
+
     /// The spatial rows' part of `out += scale sum_r w_r Hess(Phi_r) x` (`out` and `x` of
     /// length n, `weights` of length m) at time `t`: what a pass over the planar elements
-    /// ([`System::joint_elements`], which hands out planar joints only) leaves out. Every
-    /// spatial equation is quadratic, so `Hess(Phi_r) x` is the row of `(Phi_q x)_q`
-    /// (an angle driver's row adds its `Phi_tq`, which a preadjustment refuses).
+    /// ([`System::joint_elements`], which hands out planar joints only) leaves out. An angle
+    /// driver's row takes its Hessian at `t`.
     pub fn add_spatial_hessian_vector(
         &self,
         q: &[f64],

@@ -460,6 +460,7 @@ impl Galerkin {
             if let Some(pre) = self.pre.get_mut(j) {
                 let wg = &mut self.wgrad[j * n..(j + 1) * n];
                 if fresh_preadjustment {
+                    pre.set_time(t + tab.c[j] * h);
                     pre.gradient(sys, qj, wg).map_err(|e| with_time(e, t))?;
                 }
                 for i in 0..n {

@@ -16,7 +16,7 @@ use super::forces::SpatialForce;
 use super::joints::{SpatialFrame, SpatialJoint};
 use super::point_mass::{as_side, SpatialPointMass};
 use hessians::ConstantHessians;
-use mbd_jet::{DirJetN, HessJetN, Scalar};
+use mbd_jet::{DirJetN, Scalar};
 use nalgebra::DMatrix;
 
 mod hessians;
@@ -468,7 +468,8 @@ impl SpatialPart {
         });
     }
 
-    /// `out += scale sum_k lambda_k Hess(Phi_k)` over the spatial rows at time `t`.
+    /// `out += scale sum_k lambda_k Hess(Phi_k)` over the spatial rows at time `t`, from the
+    /// cached Hessians (an angle driver's turned to `theta(t)`).
     pub(crate) fn add_hessian(
         &self,
         q: &[f64],
@@ -478,33 +479,17 @@ impl SpatialPart {
         out: &mut DMatrix<f64>,
     ) {
         let cache = self.constant_hessians(q);
-        for (item, sides, row, n) in self.items() {
-            if cache.row(self, row).is_some() {
-                for k in 0..n {
-                    let w = scale * lambda[row + k];
-                    if w == 0.0 {
-                        continue;
-                    }
-                    for &(r, c, h) in cache.row(self, row + k).unwrap_or_default() {
-                        out[(r, c)] += w * h;
-                    }
-                }
+        for r in self.r0..self.r0 + self.m {
+            let w = scale * lambda[r];
+            if w == 0.0 {
                 continue;
             }
-            let e = self.eval_jets(item, sides, t, |l, c| HessJetN::<SW>::var(l, q[c]));
-            for (k, ek) in e.iter().enumerate().take(n) {
-                let w = scale * lambda[row + k];
-                if w == 0.0 {
-                    continue;
-                }
-                hessians::for_each_entry(self, sides, &ek.h, |r, c, h| out[(r, c)] += w * h);
-            }
+            cache.row_at(self, r, t, |i, j, h| out[(i, j)] += w * h);
         }
     }
 
-    /// `out += scale sum_r w_r Hess(Phi_r) x` over the spatial rows at time `t` (an angle
-    /// driver's row adds its `Phi_tq x`, as in [`SpatialPart::rows_tan`]): the constant Hessians
-    /// from the cache, the others by a tangent pass.
+    /// `out += scale sum_r w_r Hess(Phi_r) x` over the spatial rows at time `t`, from the
+    /// cached Hessians (an angle driver's turned to `theta(t)`).
     pub(crate) fn add_hessian_vector(
         &self,
         q: &[f64],
@@ -520,24 +505,14 @@ impl SpatialPart {
             if w == 0.0 {
                 continue;
             }
-            for &(i, j, h) in cache.row(self, r).unwrap_or_default() {
-                out[i] += w * h * x[j];
-            }
-        }
-        if cache.all_constant() {
-            return;
-        }
-        self.rows_tan(q, x, t, |r, sides, _, dg| {
-            let w = scale * weights[r];
-            if w == 0.0 || cache.row(self, r).is_some() {
-                return;
-            }
-            for (l, &d) in dg.iter().enumerate() {
-                if let Some(c) = self.col(sides, l) {
-                    out[c] += w * d;
+            if let Some(nz) = cache.row(self, r) {
+                for &(i, j, h) in nz {
+                    out[i] += w * h * x[j];
                 }
+            } else {
+                cache.row_at(self, r, t, |i, j, h| out[i] += w * h * x[j]);
             }
-        });
+        }
     }
 
     /// The constant Hessians of the rows (evaluated at `q` on first use).
@@ -552,6 +527,21 @@ impl SpatialPart {
             return None;
         }
         self.constant_hessians(q).row(self, r)
+    }
+
+    /// `f(row column, column, value)` for the nonzeros of row `r`'s Hessian at time `t`:
+    /// every spatial row's, an angle driver's included (nothing for a planar row).
+    pub(crate) fn row_hessian_at(
+        &self,
+        q: &[f64],
+        t: f64,
+        r: usize,
+        f: impl FnMut(usize, usize, f64),
+    ) {
+        if r < self.r0 || r >= self.r0 + self.m {
+            return;
+        }
+        self.constant_hessians(q).row_at(self, r, t, f);
     }
 
     /// The potential of gravity on the spatial bodies and point masses, `-sum_k m_k g . x_k`.

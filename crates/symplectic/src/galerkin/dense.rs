@@ -56,6 +56,7 @@ impl Galerkin {
             let mut worst = 0.0f64;
             for j in 0..s {
                 let qj = &self.qj[j * n..(j + 1) * n];
+                self.pre[j].set_time(t + self.tab.c[j] * h);
                 let rho = self.pre[j]
                     .hessian_bound(sys, qj)
                     .map_err(|e| with_time(e, t))?;
@@ -85,6 +86,7 @@ impl Galerkin {
             }
             if let Some(pre) = self.pre.get_mut(j) {
                 if !self.w_skip {
+                    pre.set_time(t + self.tab.c[j] * h);
                     pre.approximate_hessian(sys, qj, &mut self.wh)
                         .map_err(|e| with_time(e, t))?;
                     for (a, b) in self.hq[j].iter_mut().zip(self.wh.iter()) {
@@ -169,6 +171,7 @@ impl Galerkin {
             // (s = 2: the h^4 e4 term is left out of the Newton matrix)
             // (the slice's fill is a memset; the matrix's goes entry by entry)
             self.wh.as_mut_slice().fill(0.0);
+            ml.set_time(t + 0.5 * h);
             ml.add_modified_velocity_hessian(sys, &self.mlmid, &self.mlvel, 2.0, &mut self.wh)
                 .map_err(|e| with_time(e, t))?;
             // (s = 1 has no interior control point: hc is free)

@@ -87,6 +87,7 @@ impl Galerkin {
             // the step's constant velocity v = (Q_1 - Q_0) / h = hvj / h (one evaluation per
             // residual; docs/symplectic.md section 5a)
             let h2 = h * h;
+            ml.set_time(t + 0.5 * h);
             for i in 0..n {
                 self.mlvel[i] = self.hvj[i] / h;
                 self.mlmid[i] = 0.5 * (self.qn[i] + self.qn[n + i]);
@@ -116,6 +117,7 @@ impl Galerkin {
             self.mlmid[i] = 0.5 * (self.qn[i] + self.qn[s * n + i]);
             self.mlvel[i] = (self.qn[s * n + i] - self.qn[i]) / h;
         }
+        ml.set_time(t + 0.5 * h);
         ml.modified_gradients_s2(sys, &self.mlmid, &self.mlvel, &mut self.mlq, &mut self.mlv)
             .map_err(|e| with_time(e, t))?;
         let h4 = h.powi(4);

@@ -535,6 +535,7 @@ impl Galerkin {
             // -h^2/12 (2 B) and -h^4/48 A M^-1 A, on the entries (i, Z_1,i) (docs/symplectic.md
             // section 5a: the dense parts through S^-1 are left out)
             let [wd, ad] = &mut self.mldiag;
+            ml.set_time(t + 0.5 * h);
             ml.modified_newton_diagonals(sys, &self.mlmid, &self.mlvel, wd, ad)
                 .map_err(|e| with_time(e, t))?;
             let (cw, ch) = (-h2 / 12.0, -(h2 * h2) / 48.0);

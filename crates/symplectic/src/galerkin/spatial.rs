@@ -11,9 +11,9 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
 /// on the dense path and the modified Lagrangian on either path (a singular mass matrix
 /// included: the dense metric of `W_s` and the s = 1 term uses the augmented `M_W^-1`, the
-/// s = 2 term and the sparse layout a regularised diagonal on a massless director), for
-/// models whose Jacobian does not depend on time (docs/spatial.md, "The preadjusted
-/// schemes"). Each refusal names what stands in the way.
+/// s = 2 term and the sparse layout a regularised diagonal on a massless director), angle
+/// drivers included (each term evaluated with the constraints frozen at its point's time;
+/// docs/spatial.md, "The preadjusted schemes"). Each refusal names what stands in the way.
 pub(super) fn spatial_support(
     sys: &System,
     s: usize,
@@ -29,17 +29,6 @@ pub(super) fn spatial_support(
     } else {
         "paper A's preadjustment W_s (gamma != 0)".to_string()
     };
-    let refuse = |why: String| {
-        Err(SolveError::Unsupported(format!(
-            "{scheme} on spatial bodies: {why}; the plain symplectic:{s} runs this model"
-        )))
-    };
-    if sys.jacobian_depends_on_time() {
-        return refuse(
-            "an angle driver makes Phi_q depend on time, which the derivation does not cover"
-                .into(),
-        );
-    }
     if modlag && gamma == 0.0 && linear.use_sparse(sys.n_constraints()) {
         // the modified Lagrangian's sparse layout: O(N), any size
         return Ok(());

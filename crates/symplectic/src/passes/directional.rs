@@ -173,12 +173,12 @@ mod tests {
             let wts: Vec<f64> = (0..m).map(|r| 0.3 - 0.11 * r as f64).collect();
             for pot in [0.0, 1.0] {
                 let (mut h1, mut h2) = (vec![0.0; n], vec![0.0; n]);
-                lagrangian_hessian_vector(&sys, &q, &w, pot, &wts, &mut h1);
-                lagrangian_hessian_vector_at(&sys, &q, &ang, &w, pot, &wts, &mut h2);
+                lagrangian_hessian_vector(&sys, &q, 0.0, &w, pot, &wts, &mut h1);
+                lagrangian_hessian_vector_at(&sys, &q, 0.0, &ang, &w, pot, &wts, &mut h2);
                 same(&h1, &h2, "lagrangian_hessian_vector");
                 let (mut d1, mut d2) = (vec![0.0; n], vec![0.0; n]);
-                lagrangian_third(&sys, &q, &w, pot, &wts, &mut h1, &mut d1);
-                lagrangian_third_at(&sys, &q, &ang, &w, pot, &wts, &mut h2, &mut d2);
+                lagrangian_third(&sys, &q, 0.0, &w, pot, &wts, &mut h1, &mut d1);
+                lagrangian_third_at(&sys, &q, 0.0, &ang, &w, pot, &wts, &mut h2, &mut d2);
                 same(&h1, &h2, "lagrangian_third H w");
                 same(&d1, &d2, "lagrangian_third D3");
             }

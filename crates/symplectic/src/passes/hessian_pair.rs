@@ -26,6 +26,7 @@ pub(crate) struct LagrangianWeights<'a> {
 pub(crate) fn add_lagrangian_hessian_pair(
     sys: &System,
     q: &[f64],
+    t: f64,
     v: &[f64],
     (a, out_a): (LagrangianWeights<'_>, &mut DMatrix<f64>),
     (b, out_b): (LagrangianWeights<'_>, &mut DMatrix<f64>),
@@ -78,9 +79,17 @@ pub(crate) fn add_lagrangian_hessian_pair(
         // the spatial force elements and rows (the element pass hands out planar ones only)
         sys.add_spatial_force_hessian(q, a.potential, out_a);
         sys.add_spatial_force_hessian(q, b.potential, out_b);
-        sys.add_spatial_constraint_hessian(q, 0.0, a.constraints, 1.0, out_a);
-        sys.add_spatial_constraint_hessian(q, 0.0, b.constraints, 1.0, out_b);
-        sys.add_spatial_phi_q_dot(q, v, 0.0, ct);
+        sys.add_spatial_constraint_hessian(q, t, a.constraints, 1.0, out_a);
+        sys.add_spatial_constraint_hessian(q, t, b.constraints, 1.0, out_b);
+        if sys.jacobian_depends_on_time() {
+            // row k of ct is v^T Hess Phi_k, without the Phi_tq of an angle driver's row that
+            // (Phi_q v + Phi_t)_q holds
+            for r in 0..sys.n_constraints() {
+                sys.spatial_row_hessian_at(q, t, r, |i, j, h| ct[(r, j)] += h * v[i]);
+            }
+        } else {
+            sys.add_spatial_phi_q_dot(q, v, t, ct);
+        }
     }
 }
 
@@ -91,6 +100,7 @@ pub(crate) fn add_lagrangian_hessian_pair(
 pub(crate) fn add_lagrangian_hessian_pair_diagonals(
     sys: &System,
     q: &[f64],
+    t: f64,
     (a, out_a): (LagrangianWeights<'_>, &mut [f64]),
     (b, out_b): (LagrangianWeights<'_>, &mut [f64]),
 ) {
@@ -126,12 +136,12 @@ pub(crate) fn add_lagrangian_hessian_pair_diagonals(
         // the spatial rows' constant Hessians (the spatial force elements' Hessians are left
         // out: these diagonals only shape a Newton matrix)
         for (r, (&wa, &wb)) in a.constraints.iter().zip(b.constraints).enumerate() {
-            for &(i, j, h) in sys.spatial_row_hessian(q, r).unwrap_or(&[]) {
+            sys.spatial_row_hessian_at(q, t, r, |i, j, h| {
                 if i == j {
                     out_a[i] += wa * h;
                     out_b[i] += wb * h;
                 }
-            }
+            });
         }
     }
 }
@@ -169,6 +179,7 @@ mod tests {
             add_lagrangian_hessian_pair(
                 &sys,
                 &q,
+                0.0,
                 &v,
                 (
                     LagrangianWeights {
@@ -206,6 +217,7 @@ mod tests {
             add_lagrangian_hessian_pair_diagonals(
                 &sys,
                 &q,
+                0.0,
                 (
                     LagrangianWeights {
                         potential: 1.0,

@@ -131,19 +131,22 @@ pub(crate) fn add_constraint_third(
 pub(crate) fn lagrangian_hessian_vector(
     sys: &System,
     q: &[f64],
+    t: f64,
     w: &[f64],
     potential: f64,
     weights: &[f64],
     out: &mut [f64],
 ) {
-    lagrangian_hessian_vector_impl(sys, q, None, w, potential, weights, out);
+    lagrangian_hessian_vector_impl(sys, q, t, None, w, potential, weights, out);
 }
 
 /// [`lagrangian_hessian_vector`] with the body angles' `sin`/`cos` from `angles`
 /// (evaluated at this `q`, [`BodyAngles`]): bit for bit the same.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn lagrangian_hessian_vector_at(
     sys: &System,
     q: &[f64],
+    t: f64,
     angles: &BodyAngles,
     w: &[f64],
     potential: f64,
@@ -151,13 +154,15 @@ pub(crate) fn lagrangian_hessian_vector_at(
     out: &mut [f64],
 ) {
     debug_assert!(angles.matches(q));
-    lagrangian_hessian_vector_impl(sys, q, Some(angles), w, potential, weights, out);
+    lagrangian_hessian_vector_impl(sys, q, t, Some(angles), w, potential, weights, out);
 }
 
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn lagrangian_hessian_vector_impl(
     sys: &System,
     q: &[f64],
+    t: f64,
     ang: Option<&BodyAngles>,
     w: &[f64],
     potential: f64,
@@ -214,23 +219,25 @@ fn lagrangian_hessian_vector_impl(
         if potential != 0.0 {
             sys.add_spatial_force_third(q, w, potential, Some(out), None);
         }
-        sys.add_spatial_hessian_vector(q, 0.0, w, weights, 1.0, out);
+        sys.add_spatial_hessian_vector(q, t, w, weights, 1.0, out);
     }
 }
 
 /// `L = potential * V + sum_k weights_k Phi_k` along `v`: `Hess L(q) v` into `hv` and
 /// `D^3 L(q)(v, v, .)` into `d3` (both length n, overwritten), in one forward pass per
 /// element.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn lagrangian_third(
     sys: &System,
     q: &[f64],
+    t: f64,
     v: &[f64],
     potential: f64,
     weights: &[f64],
     hv: &mut [f64],
     d3: &mut [f64],
 ) {
-    lagrangian_third_impl(sys, q, None, v, potential, weights, hv, d3);
+    lagrangian_third_impl(sys, q, t, None, v, potential, weights, hv, d3);
 }
 
 /// [`lagrangian_third`] with the body angles' `sin`/`cos` from `angles` (evaluated
@@ -239,6 +246,7 @@ pub(crate) fn lagrangian_third(
 pub(crate) fn lagrangian_third_at(
     sys: &System,
     q: &[f64],
+    t: f64,
     angles: &BodyAngles,
     v: &[f64],
     potential: f64,
@@ -247,7 +255,7 @@ pub(crate) fn lagrangian_third_at(
     d3: &mut [f64],
 ) {
     debug_assert!(angles.matches(q));
-    lagrangian_third_impl(sys, q, Some(angles), v, potential, weights, hv, d3);
+    lagrangian_third_impl(sys, q, t, Some(angles), v, potential, weights, hv, d3);
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -255,6 +263,7 @@ pub(crate) fn lagrangian_third_at(
 fn lagrangian_third_impl(
     sys: &System,
     q: &[f64],
+    t: f64,
     ang: Option<&BodyAngles>,
     v: &[f64],
     potential: f64,
@@ -307,7 +316,7 @@ fn lagrangian_third_impl(
         if potential != 0.0 {
             sys.add_spatial_force_third(q, v, potential, Some(hv), Some(d3));
         }
-        sys.add_spatial_hessian_vector(q, 0.0, v, weights, 1.0, hv);
+        sys.add_spatial_hessian_vector(q, t, v, weights, 1.0, hv);
     }
 }
 

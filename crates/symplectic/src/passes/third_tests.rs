@@ -183,8 +183,8 @@ fn lagrangian_products_match_assembled_hessians() {
         sys.add_constraint_hessian(&q, 0.0, &w, 1.0, &mut hm);
         let dense = &hm * nalgebra::DVector::from_column_slice(&v);
         let (mut hv, mut hv2, mut d3) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-        lagrangian_hessian_vector(&sys, &q, &v, 0.5, &w, &mut hv);
-        lagrangian_third(&sys, &q, &v, 0.5, &w, &mut hv2, &mut d3);
+        lagrangian_hessian_vector(&sys, &q, 0.0, &v, 0.5, &w, &mut hv);
+        lagrangian_third(&sys, &q, 0.0, &v, 0.5, &w, &mut hv2, &mut d3);
         let (mut p3, mut c3) = (vec![0.0; n], vec![0.0; n]);
         potential_third(&sys, &q, &v, &mut p3);
         constraint_third(&sys, &q, &v, &w, &mut c3);
@@ -232,7 +232,7 @@ fn local_third_rows_match_the_dense_passes() {
         add_local_rows(&sys, &hv, &w, &mut a);
         add_local_rows(&sys, &d3, &w, &mut b);
         let (mut ea, mut eb) = (vec![0.0; n], vec![0.0; n]);
-        lagrangian_third(&sys, &q, &v, 0.0, &w, &mut ea, &mut eb);
+        lagrangian_third(&sys, &q, 0.0, &v, 0.0, &w, &mut ea, &mut eb);
         for i in 0..n {
             assert!(
                 (a[i] - ea[i]).abs() < 1e-13 * (1.0 + ea[i].abs()),

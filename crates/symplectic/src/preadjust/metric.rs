@@ -45,6 +45,11 @@ pub(crate) struct ProjectedMetric {
     /// (module `augmented`).
     aug: Option<Box<Augmented>>,
     rheonomic: bool,
+    /// Whether `Phi_q` depends on time (a spatial angle driver), and the time the evaluations
+    /// take (0 on every other model, whose `Phi_q`, constraint Hessians and `gamma_c` do not
+    /// depend on it).
+    time_jacobian: bool,
+    t: f64,
     /// Whether the element-local rows along a velocity come from one fused pass with `Phi_q`
     /// (planar scleronomic models; the pass takes planar joints only).
     fused: bool,
@@ -128,6 +133,8 @@ impl ProjectedMetric {
                 Augmented::new(sys).map(Box::new)
             },
             rheonomic: sys.is_rheonomic(),
+            time_jacobian: sys.jacobian_depends_on_time(),
+            t: 0.0,
             fused: !sys.is_rheonomic() && !sys.has_spatial(),
             g: vec![0.0; n],
             gq: DMatrix::zeros(md, nd),
@@ -169,6 +176,28 @@ impl ProjectedMetric {
     /// Whether the constraints depend on time.
     pub(super) fn rheonomic(&self) -> bool {
         self.rheonomic
+    }
+
+    /// Whether `Phi_q` depends on time (a spatial angle driver): the evaluations then take the
+    /// time of [`ProjectedMetric::set_time`].
+    pub(super) fn time_jacobian(&self) -> bool {
+        self.time_jacobian
+    }
+
+    /// The time the evaluations take: the last [`ProjectedMetric::set_time`] on a model whose
+    /// `Phi_q` depends on time, 0 on every other.
+    pub(super) fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Sets the time of the next evaluations on a model whose `Phi_q` depends on time (a new
+    /// time makes the prepared point stale); nothing on every other model, whose evaluations do
+    /// not depend on it (they keep t = 0, bit for bit as before).
+    pub(super) fn set_time(&mut self, t: f64) {
+        if self.time_jacobian && t.to_bits() != self.t.to_bits() {
+            self.t = t;
+            self.at_valid = false;
+        }
     }
 
     /// `grad V` at the prepared point.
@@ -406,7 +435,7 @@ impl ProjectedMetric {
 
     /// `out = A x` without assembling `A` (one Hessian-vector pass), after `prepare(q)`.
     pub(super) fn a_times(&self, sys: &System, q: &[f64], x: &[f64], out: &mut [f64]) {
-        passes::lagrangian_hessian_vector(sys, q, x, 1.0, &self.nmu0, out);
+        passes::lagrangian_hessian_vector(sys, q, self.t, x, 1.0, &self.nmu0, out);
     }
 
     /// Whether the workspace holds the evaluation at exactly `q` (bit for bit).
@@ -473,16 +502,15 @@ impl ProjectedMetric {
                             sc.grads_mut().copy_from_slice(&self.local_grads)
                         }
                         // (the fused pass takes planar models only)
-                        Some(sc @ SparseS::Blocks(_)) => sc.update(sys, q),
+                        Some(sc @ SparseS::Blocks(_)) => sc.update(sys, q, self.t),
                         None => sys.local_rows_dense(&self.local_grads, &mut self.gq),
                     }
                     rows.v.copy_from_slice(v);
                     rows.stamp = self.stamp;
                 }
                 _ => match &mut self.schur {
-                    Some(sc) => sc.update(sys, q),
-                    // (the preadjustments take models whose Phi_q does not depend on t)
-                    None => sys.phi_q(q, 0.0, &mut self.gq),
+                    Some(sc) => sc.update(sys, q, self.t),
+                    None => sys.phi_q(q, self.t, &mut self.gq),
                 },
             }
             let singular = || SolveError::Singular {
@@ -603,12 +631,11 @@ enum SparseS {
 }
 
 impl SparseS {
-    /// Evaluates `Phi_q(q)` (time-independent: the preadjustments refuse a Jacobian that
-    /// depends on time).
-    fn update(&mut self, sys: &System, q: &[f64]) {
+    /// Evaluates `Phi_q(q, t)` (a planar `Phi_q` does not depend on `t`).
+    fn update(&mut self, sys: &System, q: &[f64], t: f64) {
         match self {
             SparseS::Planar(s) => s.update(sys, q),
-            SparseS::Blocks(s) => s.update(sys, q, 0.0),
+            SparseS::Blocks(s) => s.update(sys, q, t),
         }
     }
 

@@ -106,6 +106,16 @@ impl Preadjustment {
         })
     }
 
+    /// Sets the time `t` at which the next evaluations take the model's constraints, on a
+    /// model whose `Phi_q` depends on time (a spatial angle driver, whose equation turns with
+    /// `theta(t)`: [`System::jacobian_depends_on_time`]); every term is then that of the
+    /// model frozen at `t`. Nothing on every other model, whose terms do not depend on the
+    /// time. The scheme sets it to the time of each evaluation point (the chord midpoint
+    /// `t + h/2` of the modified Lagrangian, the Gauss points of `W_s`); the default is 0.
+    pub fn set_time(&mut self, t: f64) {
+        self.metric.set_time(t);
+    }
+
     /// The degree `s`.
     pub fn s(&self) -> usize {
         self.paper.s()
@@ -321,7 +331,6 @@ impl Preadjustment {
         v: &[f64],
     ) -> Result<[f64; E4_TERM_COUNT], SolveError> {
         self.metric.check_v(v)?;
-        refuse_spatial_time_jacobian(sys)?;
         self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.forward(&mut self.metric, sys, q, v)?;
@@ -362,23 +371,8 @@ impl Preadjustment {
                 });
             }
         }
-        refuse_spatial_time_jacobian(sys)?;
         self.metric.use_plain_inverse(sys);
         let term = modified_s2::ensure_s2(&mut self.s2, &self.metric, sys);
         term.gradients(&mut self.metric, sys, q, v, gq, gv)
     }
-}
-
-/// [`SolveError::Unsupported`] for a model with spatial bodies whose `Phi_q` depends on time
-/// (an angle driver): the s = 2 term's spatial passes take every spatial row's Hessian as
-/// constant, and the derivation does not cover a time-dependent Jacobian.
-fn refuse_spatial_time_jacobian(sys: &System) -> Result<(), SolveError> {
-    if sys.has_spatial() && sys.jacobian_depends_on_time() {
-        return Err(SolveError::Unsupported(
-            "the s = 2 modified Lagrangian on spatial bodies: an angle driver makes Phi_q \
-             depend on time, which the derivation does not cover"
-                .into(),
-        ));
-    }
-    Ok(())
 }

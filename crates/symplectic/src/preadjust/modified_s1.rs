@@ -49,6 +49,9 @@ pub(crate) struct ModifiedS1 {
     /// `scale (sigma - mu0)`, `u - w`.
     zero_n: Vec<f64>,
     gc0: Vec<f64>,
+    /// Scratch for a model whose `Phi_q` depends on time: `-v` (n) and `gamma(q, -v, t)` (m).
+    neg_v: Vec<f64>,
+    gc_neg: Vec<f64>,
     zero_m: Vec<f64>,
     scaled_cm: Vec<f64>,
     uw: Vec<f64>,
@@ -75,6 +78,8 @@ impl ModifiedS1 {
             mv_stamp: 0,
             zero_n: vec![0.0; n],
             gc0: vec![0.0; m],
+            neg_v: vec![0.0; n],
+            gc_neg: vec![0.0; m],
             zero_m: vec![0.0; m],
             scaled_cm: vec![0.0; m],
             uw: vec![0.0; n],
@@ -121,11 +126,23 @@ impl ModifiedS1 {
             // gc = v^T Hess Phi_k v: from the rows, or gamma(q, v, t) = -(v^T Hess Phi_k v) +
             // time part (which cancels)
             if !rows {
-                sys.gamma(q, v, 0.0, gc);
+                let t = metric.t();
+                sys.gamma(q, v, t, gc);
                 // (gc no longer matches the rows)
                 along.stamp = 0;
-                if metric.rheonomic() {
-                    sys.gamma(q, &self.zero_n, 0.0, &mut self.gc0);
+                if metric.time_jacobian() {
+                    // gamma also holds -2 Phi_tq v (a spatial angle driver): its even part in v
+                    // is the quadratic form's
+                    for (a, &b) in self.neg_v.iter_mut().zip(v) {
+                        *a = -b;
+                    }
+                    sys.gamma(q, &self.neg_v, t, &mut self.gc_neg);
+                    sys.gamma(q, &self.zero_n, t, &mut self.gc0);
+                    for r in 0..m {
+                        gc[r] = self.gc0[r] - 0.5 * (gc[r] + self.gc_neg[r]);
+                    }
+                } else if metric.rheonomic() {
+                    sys.gamma(q, &self.zero_n, t, &mut self.gc0);
                     for r in 0..m {
                         gc[r] = self.gc0[r] - gc[r];
                     }
@@ -154,6 +171,7 @@ impl ModifiedS1 {
             passes::lagrangian_third(
                 sys,
                 q,
+                metric.t(),
                 v,
                 POTENTIAL_WEIGHT,
                 &self.zero_m,
@@ -166,6 +184,7 @@ impl ModifiedS1 {
             passes::lagrangian_third(
                 sys,
                 q,
+                metric.t(),
                 v,
                 POTENTIAL_WEIGHT,
                 &self.cm,
@@ -236,7 +255,7 @@ impl ModifiedS1 {
                 uw[k] = u[k] - minv[k] * acc;
             }
         }
-        passes::lagrangian_hessian_vector(sys, q, uw, 1.0, &self.cm, dq);
+        passes::lagrangian_hessian_vector(sys, q, metric.t(), uw, 1.0, &self.cm, dq);
         // third derivatives along v (exact, from evaluate)
         for k in 0..n {
             dq[k] += self.d3[k];
@@ -273,6 +292,7 @@ impl ModifiedS1 {
         add_lagrangian_hessian_pair(
             sys,
             q,
+            metric.t(),
             v,
             (
                 LagrangianWeights {
@@ -355,6 +375,7 @@ impl ModifiedS1 {
         add_lagrangian_hessian_pair_diagonals(
             sys,
             q,
+            metric.t(),
             (
                 LagrangianWeights {
                     potential: 1.0,
@@ -420,7 +441,7 @@ pub(crate) mod modlag_tests {
         // A already holds Hess V once: the weight left to add is POTENTIAL_WEIGHT - 1 = -3/2
         hs *= POTENTIAL_WEIGHT - 1.0;
         if p.metric.m() > 0 {
-            sys.add_constraint_hessian(q, 0.0, p.s1.sigma(), 1.0, &mut hs);
+            sys.add_constraint_hessian(q, p.metric.t(), p.s1.sigma(), 1.0, &mut hs);
         }
         let mut t = vec![0.0; n];
         crate::preadjust::stiffness::matvec(&hs, v, &mut t);

@@ -115,7 +115,16 @@ impl PaperTerm {
             // and two third-order passes
             self.av[0].copy_from_slice(metric.u());
             let (u, nmu0) = (metric.u(), metric.neg_mu0());
-            passes::lagrangian_third(sys, q, u, 1.0, nmu0, &mut self.bv[0], &mut self.d3);
+            passes::lagrangian_third(
+                sys,
+                q,
+                metric.t(),
+                u,
+                1.0,
+                nmu0,
+                &mut self.bv[0],
+                &mut self.d3,
+            );
             let (a, b) = (&mut self.av[1], &self.bv[0]);
             metric.apply_pi(b, a);
         } else {
@@ -191,7 +200,7 @@ impl PaperTerm {
                 for r in 0..m {
                     wts[r] = self.sig[l - j][r] - if j == 0 { h[r] } else { 0.0 };
                 }
-                passes::lagrangian_hessian_vector(sys, q, &self.av[j], 0.0, wts, t);
+                passes::lagrangian_hessian_vector(sys, q, metric.t(), &self.av[j], 0.0, wts, t);
                 for i in 0..n {
                     out[i] -= t[i];
                 }

@@ -56,7 +56,7 @@ impl TangentStiffness {
         sys.potential_hessian(q, &mut self.amat);
         if metric.m() > 0 {
             // (planar models: the constraint Hessian does not depend on t)
-            sys.add_constraint_hessian(q, 0.0, metric.mu0(), -1.0, &mut self.amat);
+            sys.add_constraint_hessian(q, metric.t(), metric.mu0(), -1.0, &mut self.amat);
         }
         self.stamp = metric.stamp();
     }

@@ -122,21 +122,23 @@ impl Adjoints {
 }
 
 /// What `Gb += c alpha beta^T` needs: the planar rows' local columns, and for the spatial rows
-/// (whose Hessians are constant) the model and `q` at which their share
-/// `sum_r c alpha_r Hess Phi_r beta` is applied at once.
+/// (whose Hessians are constant in `q`) the model, `q` and the time (an angle driver's Hessian
+/// turns with it) at which their share `sum_r c alpha_r Hess Phi_r beta` is applied at once.
 #[derive(Clone, Copy)]
 pub(super) struct GbCtx<'a> {
     sys: &'a System,
     q: &'a [f64],
+    t: f64,
     cols: &'a [Cols],
     spatial: bool,
 }
 
 impl<'a> GbCtx<'a> {
-    pub(super) fn new(sys: &'a System, q: &'a [f64], cols: &'a [Cols]) -> Self {
+    pub(super) fn new(sys: &'a System, q: &'a [f64], t: f64, cols: &'a [Cols]) -> Self {
         GbCtx {
             sys,
             q,
+            t,
             cols,
             spatial: sys.has_spatial(),
         }
@@ -154,7 +156,8 @@ pub(super) fn gbar_add(
     be: &[f64],
 ) {
     if cx.spatial {
-        cx.sys.add_spatial_hessian_vector(cx.q, 0.0, be, al, c, sgq);
+        cx.sys
+            .add_spatial_hessian_vector(cx.q, cx.t, be, al, c, sgq);
     }
     for ((g, cols), &a) in gbar.iter_mut().zip(cx.cols).zip(al) {
         if a == 0.0 {

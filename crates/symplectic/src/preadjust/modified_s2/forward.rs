@@ -157,7 +157,7 @@ impl ModifiedS2 {
         let m = metric.m();
         let f = &mut self.f;
         f.angles.update(sys, q);
-        f.sprows.update(sys, q);
+        f.sprows.update(sys, q, metric.t());
         f.u.copy_from_slice(metric.u());
         f.mu0.copy_from_slice(metric.mu0());
         // pass A along (v, u): gamma, beta, D^3 Phi(v^3), D^4 Phi(v^4), D^3 Phi(v, v, u), the

@@ -14,9 +14,10 @@
 //! row that is linear in the coordinates has none): [`SpatialRowSet`], evaluated once per
 //! `q`. Each pass keeps its directions ([`SpatialRows`]), and every product `H_r d_j` is formed
 //! from them where it is used, so a pass's memory is its directions, not
-//! `O(rows x directions x 24)`. The spatial model's time does not enter: the s = 2 term
-//! refuses spatial models whose Jacobian depends on time (an angle driver), and no term reads a
-//! degree-0 coefficient (left zero).
+//! `O(rows x directions x 24)`. The series are those at the evaluation's time `t`: `g_r` is
+//! taken at `t`, and an angle driver's Hessian, `cos theta(t) H_0 - sin theta(t) H_1`, is
+//! refreshed at every update (every other row's is constant); no term reads a degree-0
+//! coefficient (left zero).
 
 use mbd_model::{Basis, System, MAX_DIRS};
 
@@ -34,8 +35,10 @@ struct Row {
     cols: [usize; W],
     /// `g_r` in local columns.
     g: [f64; W],
-    /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)` (constant).
+    /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)` at the set's time.
     nz: Vec<(usize, usize, f64)>,
+    /// Whether `H_r` depends on time (an angle driver's row): refreshed at every update.
+    timed: bool,
 }
 
 impl Row {
@@ -83,10 +86,10 @@ fn splits<const K: usize, B: Basis<K>>() -> [(usize, usize, usize); K] {
     std::array::from_fn(|k| split(&B::EXP[k]))
 }
 
-/// The spatial rows at one `q`, shared by the passes of an evaluation (module doc): the row
-/// list, the columns and the constant Hessians are built at the first [`SpatialRowSet::update`]
-/// and kept; every update refreshes `g_r`. (A row whose Hessian is not constant, an angle
-/// driver's, is refused before: `Preadjustment`'s s = 2 methods.)
+/// The spatial rows at one `(q, t)`, shared by the passes of an evaluation (module doc): the
+/// row list, the columns and the constant Hessians are built at the first
+/// [`SpatialRowSet::update`] and kept; every update refreshes `g_r` and the Hessians that
+/// depend on time (an angle driver's), in place.
 #[derive(Debug, Default)]
 pub(super) struct SpatialRowSet {
     rows: Vec<Row>,
@@ -97,17 +100,22 @@ pub(super) struct SpatialRowSet {
 }
 
 impl SpatialRowSet {
-    /// `g_r` of every spatial row at `q` (nothing on a planar model).
-    pub(super) fn update(&mut self, sys: &System, q: &[f64]) {
+    /// `g_r` of every spatial row at `(q, t)`, and the Hessians that depend on time (nothing on
+    /// a planar model).
+    pub(super) fn update(&mut self, sys: &System, q: &[f64], t: f64) {
         if !sys.has_spatial() {
             return;
         }
         if !self.built {
-            self.build(sys, q);
+            self.build(sys, q, t);
             return;
         }
+        for row in self.rows.iter_mut().filter(|row| row.timed) {
+            row.nz.clear();
+            sys.spatial_row_hessian_at(q, t, row.r, |i, j, h| row.nz.push((i, j, h)));
+        }
         let (rows, slot) = (&mut self.rows, &self.slot);
-        sys.local_rows_gamma(q, None, 0.0, |r, sides, _| {
+        sys.local_rows_gamma(q, None, t, |r, sides, _| {
             let Some(row) = slot.get(r).and_then(|&k| rows.get_mut(k)) else {
                 return;
             };
@@ -120,12 +128,12 @@ impl SpatialRowSet {
         });
     }
 
-    /// The row list, columns, `g_r` and constant Hessians at `q`.
-    fn build(&mut self, sys: &System, q: &[f64]) {
+    /// The row list, columns, `g_r` and Hessians at `(q, t)`.
+    fn build(&mut self, sys: &System, q: &[f64], t: f64) {
         let planar = sys.bodies().len();
         let rows = &mut self.rows;
         rows.clear();
-        sys.local_rows_gamma(q, None, 0.0, |r, sides, _| {
+        sys.local_rows_gamma(q, None, t, |r, sides, _| {
             if !sides.iter().flatten().any(|s| s.0 >= planar) {
                 return;
             }
@@ -134,6 +142,7 @@ impl SpatialRowSet {
                 cols: [NONE; W],
                 g: [0.0; W],
                 nz: Vec::new(),
+                timed: false,
             };
             for (s, side) in sides.iter().enumerate() {
                 let Some((block, g)) = side else {
@@ -153,10 +162,9 @@ impl SpatialRowSet {
         self.slot.resize(sys.n_constraints(), NONE);
         for (k, row) in self.rows.iter_mut().enumerate() {
             self.slot[row.r] = k;
-            // (every row but an angle driver's has a constant Hessian, and the s = 2 term
-            // refuses angle drivers on spatial bodies)
-            row.nz
-                .extend_from_slice(sys.spatial_row_hessian(q, row.r).unwrap_or(&[]));
+            // (every row but an angle driver's has a constant Hessian)
+            row.timed = sys.spatial_row_hessian(q, row.r).is_none();
+            sys.spatial_row_hessian_at(q, t, row.r, |i, j, h| row.nz.push((i, j, h)));
         }
         self.built = true;
     }
