@@ -255,6 +255,7 @@ fn the_doc_example_loads() {
 fn every_example_loads_with_its_dof_and_a_consistent_state() {
     let expected = [
         ("bricard.toml", 1, false),
+        ("driven_arm.toml", 3, true),
         ("driven_three_link_arm.json", 1, true),
         ("four_bar.toml", 1, false),
         ("heavy_top.toml", 3, false),

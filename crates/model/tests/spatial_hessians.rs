@@ -4,40 +4,15 @@
 
 use mbd_model::System;
 use nalgebra::DMatrix;
-use std::path::Path;
 
-/// The turning arm of `examples/models` (an arm turned by a spatial angle driver from the
-/// ground, `theta = 3 t`, a pendulum on a ball joint at its tip) with a forearm on a hinge at
-/// the arm's tip, driven against the arm (`theta = 0.5 sin 2t`): a driver between two moving
-/// bodies, whose equation is bilinear in their directors.
-fn turning_arm() -> System {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/models/turning_arm.toml");
-    let base = std::fs::read_to_string(path).expect("the turning-arm example exists");
-    let extra = r#"
-[[spatial_bodies]]
-name = "forearm"
-mass = 1.0
-moments = [0.001, 0.02, 0.02]
-position = [0.75, 0.0, 0.0]
-
-[[spatial_joints]]
-type = "revolute"
-name = "elbow"
-body_a = "arm"
-point_a = [0.25, 0.0, 0.0]
-body_b = "forearm"
-point_b = [-0.25, 0.0, 0.0]
-
-[[spatial_joints]]
-type = "angle_driver"
-name = "elbow_motor"
-body_a = "arm"
-point_a = [0.25, 0.0, 0.0]
-body_b = "forearm"
-point_b = [-0.25, 0.0, 0.0]
-motion = { kind = "harmonic", amplitude = 0.5, omega = 2.0 }
-"#;
-    System::from_toml(&format!("{base}{extra}")).expect("the model builds")
+/// `examples/models/driven_arm.toml`: an arm turned by a spatial angle driver from the
+/// ground (`theta = 3 t`), a pendulum on a ball joint at its tip and a forearm on a hinge there,
+/// driven against the arm (`theta = 0.5 sin 2t`): a driver between two moving bodies, whose
+/// equation is bilinear in their directors.
+fn driven_arm() -> System {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/models/driven_arm.toml");
+    System::from_path(path).expect("the driven-arm example loads")
 }
 
 /// A configuration near the initial one (the Hessians are constant in `q`, so any point
@@ -52,7 +27,7 @@ fn perturbed(sys: &System) -> Vec<f64> {
 
 #[test]
 fn row_hessians_at_t_match_differences_of_phi_q() {
-    let sys = turning_arm();
+    let sys = driven_arm();
     assert!(sys.jacobian_depends_on_time());
     let q = perturbed(&sys);
     let (n, m) = (sys.n_coords(), sys.n_constraints());
@@ -94,7 +69,7 @@ fn row_hessians_at_t_match_differences_of_phi_q() {
 
 #[test]
 fn hessian_vector_products_at_t_match_the_assembled_hessian() {
-    let sys = turning_arm();
+    let sys = driven_arm();
     let q = perturbed(&sys);
     let (n, m) = (sys.n_coords(), sys.n_constraints());
     let w: Vec<f64> = (0..m).map(|r| 1.0 + 0.1 * r as f64).collect();

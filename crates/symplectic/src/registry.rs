@@ -139,7 +139,7 @@ fn rheonomic_caveat(sys: &System, s: usize) -> Option<String> {
     Some(format!(
         "the modified-Lagrangian terms are derived for constraints that do not depend on time, \
          and this model has drivers: expect symplectic:{s}:modified to keep only the plain \
-         (s,s) scheme's order {} there (not {}), with a smaller error constant",
+         (s,s) scheme's order {} (not {}) there, with a smaller error constant",
         2 * s,
         2 * s + 2
     ))

@@ -6,35 +6,11 @@ use mbd_model::System;
 use mbd_solve::State;
 use mbd_symplectic::Preadjustment;
 
+/// `examples/models/driven_arm.toml`: two spatial angle drivers, one between two moving bodies.
 fn model() -> System {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/models/turning_arm.toml");
-    let base = std::fs::read_to_string(path).unwrap();
-    let extra = r#"
-[[spatial_bodies]]
-name = "forearm"
-mass = 1.0
-moments = [0.001, 0.02, 0.02]
-position = [0.75, 0.0, 0.0]
-
-[[spatial_joints]]
-type = "revolute"
-name = "elbow"
-body_a = "arm"
-point_a = [0.25, 0.0, 0.0]
-body_b = "forearm"
-point_b = [-0.25, 0.0, 0.0]
-
-[[spatial_joints]]
-type = "angle_driver"
-name = "elbow_motor"
-body_a = "arm"
-point_a = [0.25, 0.0, 0.0]
-body_b = "forearm"
-point_b = [-0.25, 0.0, 0.0]
-motion = { kind = "harmonic", amplitude = 0.5, omega = 2.0 }
-"#;
-    System::from_toml(&format!("{base}{extra}")).unwrap()
+        .join("../../examples/models/driven_arm.toml");
+    System::from_path(path).expect("the driven-arm example loads")
 }
 
 /// The largest difference between `grad` and fourth-order central differences of `f` in
