@@ -191,6 +191,16 @@ impl Augmented {
         }
     }
 
+    /// `f(row, w)` for every internal row of a body block and its weight: the rows and
+    /// weights of [`Augmented::penalty`].
+    pub(super) fn for_each_penalty_row(&self, mut f: impl FnMut(usize, f64)) {
+        for b in &self.blocks {
+            for r in b.r0..b.r0 + 6 {
+                f(r, b.w);
+            }
+        }
+    }
+
     /// `c_int^T W c_int`: what `c^T S_W^-1 c` exceeds `c^T S^-1 c` by.
     pub(super) fn penalty(&self, c: &[f64]) -> f64 {
         self.blocks

@@ -366,6 +366,14 @@ impl ProjectedMetric {
         self.aug.as_ref().map_or(0.0, |aug| aug.penalty(c))
     }
 
+    /// `f(row, w)` for the rows and weights of [`ProjectedMetric::penalty`] (nothing without
+    /// spatial bodies): `penalty(c) = sum w c_row^2`.
+    pub(super) fn for_each_penalty_row(&self, f: impl FnMut(usize, f64)) {
+        if let Some(aug) = &self.aug {
+            aug.for_each_penalty_row(f);
+        }
+    }
+
     /// `out = M^-1 G^T x` (x of length m).
     pub(super) fn dgt_into(&self, x: &[f64], out: &mut [f64]) {
         out.fill(0.0);

@@ -337,6 +337,22 @@ impl ModifiedS1 {
                     }
                 }
             }
+            // The augmented metric's gamma_c^T S_W^-1 gamma_c exceeds the term's by
+            // penalty(gamma_c) = sum_r w_r gamma_c,r^2 over the internal rows (`evaluate`
+            // subtracts it, and corrects sigma by -W gamma_int, which H_sigma in B carries):
+            // the velocity Hessian of that difference, 2 sum_r w_r C_r C_r^T, comes off too.
+            // (C_r = Hess Phi_r v lives on the body's directors: a few nonzeros per row.)
+            let ct = self.ct.as_slice();
+            let nz = &mut self.ycols;
+            metric.for_each_penalty_row(|r, w| {
+                nz.clear();
+                nz.extend((0..n).filter(|&i| ct[i * m + r] != 0.0));
+                for &i in nz.iter() {
+                    for &l in nz.iter() {
+                        o[l * n + i] -= 2.0 * scale * w * ct[i * m + r] * ct[l * m + r];
+                    }
+                }
+            });
         }
     }
 
