@@ -313,6 +313,10 @@ impl SpatialPart {
         t: f64,
         mut visit: impl FnMut(usize, [Option<usize>; 2], &DirJetN<SW>),
     ) {
+        if self.m == 0 {
+            // a planar model (the residual passes call this at every evaluation)
+            return;
+        }
         for (item, sides, row, n) in self.items() {
             if let (Item::Internal, Some(k)) = (item, sides[0]) {
                 // in closed form: the generic jets spend most of a solve's time here
