@@ -2,8 +2,9 @@
 //!
 //! Helpers shared by the workspace's test binaries: [`CountingAlloc`], a global allocator that
 //! counts the heap allocations (and reallocations) of the current thread, for the tests that
-//! prove a step allocates nothing. Per thread, because the test harness allocates on its own
-//! threads meanwhile.
+//! prove a step allocates nothing (per thread, because the test harness allocates on its own
+//! threads meanwhile); and [`gradient_error`], exact gradients of a function of `(q, v)`
+//! against fourth-order central differences.
 //!
 //! ```
 //! // in a test binary:
@@ -59,4 +60,42 @@ pub fn allocations_during<F: FnOnce()>(f: F) -> usize {
     let before = allocations();
     f();
     allocations() - before
+}
+
+/// The largest difference between the gradients `gq`, `gv` of `f(q, v)` and fourth-order
+/// central differences of `f` with step `d` in each coordinate of `q` and of `v`, relative to
+/// the largest gradient entry (at least 1e-30).
+///
+/// ```
+/// // f = q0^2 v0: gradients (2 q0 v0, q0^2)
+/// let f = |q: &[f64], v: &[f64]| q[0] * q[0] * v[0];
+/// let err = mbd_testkit::gradient_error(f, &[1.5], &[2.0], &[6.0], &[2.25], 1e-3);
+/// assert!(err < 1e-10);
+/// ```
+pub fn gradient_error(
+    mut f: impl FnMut(&[f64], &[f64]) -> f64,
+    q: &[f64],
+    v: &[f64],
+    gq: &[f64],
+    gv: &[f64],
+    d: f64,
+) -> f64 {
+    let scale = gq.iter().chain(gv).fold(1e-30f64, |a, x| a.max(x.abs()));
+    let mut worst = 0.0f64;
+    for (wrt_q, grad) in [(true, gq), (false, gv)] {
+        for (l, &g) in grad.iter().enumerate() {
+            let mut acc = 0.0;
+            for (cf, k) in [(8.0, 1.0), (-8.0, -1.0), (-1.0, 2.0), (1.0, -2.0)] {
+                let (mut y, mut w) = (q.to_vec(), v.to_vec());
+                if wrt_q {
+                    y[l] += k * d;
+                } else {
+                    w[l] += k * d;
+                }
+                acc += cf * f(&y, &w);
+            }
+            worst = worst.max((acc / (12.0 * d) - g).abs());
+        }
+    }
+    worst / scale
 }

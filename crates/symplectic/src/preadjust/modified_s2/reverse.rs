@@ -436,28 +436,8 @@ mod tests {
             .unwrap();
         let e4b = p.modified_term_s2(sys, q, v).unwrap();
         assert!((e4 - e4b).abs() <= 1e-13 * e4.abs().max(1.0));
-        let d = 1e-4;
-        let mut fd = |wrt_q: bool, l: usize| -> f64 {
-            let mut acc = 0.0;
-            for (cf, k) in [(8.0, 1.0), (-8.0, -1.0), (-1.0, 2.0), (1.0, -2.0)] {
-                let (mut y, mut w) = (q.to_vec(), v.to_vec());
-                if wrt_q {
-                    y[l] += k * d;
-                } else {
-                    w[l] += k * d;
-                }
-                acc += cf * p.modified_term_s2(sys, &y, &w).unwrap();
-            }
-            acc / (12.0 * d)
-        };
-        let scale = gq.iter().chain(&gv).fold(1e-30f64, |a, x| a.max(x.abs()));
-        let mut worst = 0.0f64;
-        for l in 0..n {
-            worst = worst
-                .max((fd(true, l) - gq[l]).abs())
-                .max((fd(false, l) - gv[l]).abs());
-        }
-        worst / scale
+        let f = |y: &[f64], w: &[f64]| p.modified_term_s2(sys, y, w).unwrap();
+        mbd_testkit::gradient_error(f, q, v, &gq, &gv, 1e-4)
     }
 
     /// The spatial rows (quadratic, in natural coordinates) and the spatial force elements'
