@@ -141,11 +141,20 @@ impl PaperTerm {
         h.fill(0.0);
         if m > 0 {
             let g1 = &mut self.gam;
+            let t = metric.t();
+            // with a Jacobian that depends on time (a spatial angle driver) gamma also holds
+            // the odd -2 Phi_tq x: each polarisation pair is taken at +x and -x as well
+            let signs: &[f64] = if metric.time_jacobian() {
+                &[1.0, -1.0]
+            } else {
+                &[1.0]
+            };
+            let wgt = 0.125 / signs.len() as f64;
             for i in 0..=l {
                 if 2 * i == l && !metric.rheonomic() {
                     // a^T H_k a = -gamma_k(q, a) (no time part): one pass, not two (the
                     // polarisation's a - a = 0 gives nothing; gamma(2a) = 4 gamma(a) exactly)
-                    sys.gamma(q, &self.av[i], 0.0, g1);
+                    sys.gamma(q, &self.av[i], t, g1);
                     for r in 0..m {
                         h[r] -= 0.5 * g1[r];
                     }
@@ -153,19 +162,21 @@ impl PaperTerm {
                 }
                 let (ai, ac) = (&self.av[i], &self.av[l - i]);
                 let vp = &mut self.dir;
-                for k in 0..n {
-                    vp[k] = ai[k] + ac[k];
-                }
-                sys.gamma(q, vp, 0.0, g1);
-                for r in 0..m {
-                    h[r] -= 0.125 * g1[r];
-                }
-                for k in 0..n {
-                    vp[k] = ai[k] - ac[k];
-                }
-                sys.gamma(q, vp, 0.0, g1);
-                for r in 0..m {
-                    h[r] += 0.125 * g1[r];
+                for &sg in signs {
+                    for k in 0..n {
+                        vp[k] = sg * (ai[k] + ac[k]);
+                    }
+                    sys.gamma(q, vp, t, g1);
+                    for r in 0..m {
+                        h[r] -= wgt * g1[r];
+                    }
+                    for k in 0..n {
+                        vp[k] = sg * (ai[k] - ac[k]);
+                    }
+                    sys.gamma(q, vp, t, g1);
+                    for r in 0..m {
+                        h[r] += wgt * g1[r];
+                    }
                 }
             }
             // rho (S is factored densely: the W_s methods need the dense layout); with spatial
