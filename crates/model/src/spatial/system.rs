@@ -509,13 +509,7 @@ impl SpatialPart {
             if w == 0.0 {
                 continue;
             }
-            if let Some(nz) = cache.row(self, r) {
-                for &(i, j, h) in nz {
-                    out[i] += w * h * x[j];
-                }
-            } else {
-                cache.row_at(self, r, t, |i, j, h| out[i] += w * h * x[j]);
-            }
+            cache.row_at(self, r, t, |i, j, h| out[i] += w * h * x[j]);
         }
     }
 

@@ -3,7 +3,8 @@
 //! an angle driver's at every `t`: it is evaluated once, by one pass of Hessian jets, and kept as
 //! its nonzeros in global columns. An angle driver's equation `cos theta(t) E_0 - sin theta(t)
 //! E_1` combines two bilinear components with constant Hessians, kept side by side, so its
-//! Hessian at any `t` is `cos theta H_0 - sin theta H_1` ([`ConstantHessians::angle_row`]). The weighted Hessian `sum_r w_r Hess Phi_r` and the products
+//! Hessian at any `t` is `cos theta H_0 - sin theta H_1` ([`ConstantHessians::row_at`]). The
+//! weighted Hessian `sum_r w_r Hess Phi_r` and the products
 //! `sum_r w_r Hess Phi_r x` are then sums over those nonzeros, where each evaluation took a pass
 //! of 24-variable Hessian jets over every row (the dense symplectic Newton matrix and the
 //! preadjustments' passes call them at every iteration).
@@ -106,8 +107,10 @@ impl ConstantHessians {
             }
         } else if let Some(Some((j, nz))) = self.angle.get(k) {
             if let Some([theta, ..]) = part.angle(*j, t) {
+                // `angle_combine`'s first output, with sin and cos evaluated once for the row
+                let (sn, cs) = theta.sin_cos();
                 for &(r, c, h0, h1) in nz {
-                    f(r, c, super::angle_combine(theta, h0, h1).0);
+                    f(r, c, h0 * cs - h1 * sn);
                 }
             }
         }
