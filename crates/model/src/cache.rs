@@ -14,8 +14,8 @@ use crate::system::System;
 ///
 /// The same table serves repeated evaluations at nearby configurations (Newton iterations):
 /// [`BodyAngles::update_near`] rotates the stored values by each angle's increment `delta`
-/// (`|delta| <= 1e-3`, with `cos delta` and `sin delta` from their Taylor series, exact to
-/// rounding there) instead of calling `sin_cos`, and evaluates exactly after
+/// (`|delta| <=` [`BodyAngles::MAX_INCREMENT`], with `cos delta` and `sin delta` from their
+/// Taylor series, exact to rounding there) instead of calling `sin_cos`, and evaluates exactly after
 /// [`BodyAngles::MAX_ROTATIONS`] rotations, for a larger increment, or after
 /// [`BodyAngles::invalidate`]. Rotated values differ from exact ones by a few units in the last
 /// place; [`System::phi_and_phi_dot_cached`] uses them.
@@ -69,10 +69,15 @@ impl BodyAngles {
     /// [`BodyAngles::update_near`].
     pub const MAX_ROTATIONS: u32 = 8;
 
+    /// Largest angle increment rotated rather than evaluated exactly by
+    /// [`BodyAngles::update_near`]: its series for `sin` and `cos` are exact to rounding up to
+    /// here.
+    pub const MAX_INCREMENT: f64 = 1e-3;
+
     /// Brings the table to the configuration `q` from the one it holds: each angle that moved
-    /// by at most 1e-3 has its `sin`/`cos` rotated by the increment (at most
-    /// [`BodyAngles::MAX_ROTATIONS`] times in a row), the others are evaluated exactly. For
-    /// `|d| <= 1e-3` the truncated series `cos d = 1 - d^2/2 + d^4/24`,
+    /// by at most [`BodyAngles::MAX_INCREMENT`] has its `sin`/`cos` rotated by the increment
+    /// (at most [`BodyAngles::MAX_ROTATIONS`] times in a row), the others are evaluated
+    /// exactly. For `|d| <= 1e-3` the truncated series `cos d = 1 - d^2/2 + d^4/24`,
     /// `sin d = d - d^3/6 + d^5/120` are exact to rounding (the next terms are below 1.4e-21).
     pub fn update_near(&mut self, sys: &System, q: &[f64]) {
         let nb = sys.bodies.len();
@@ -86,7 +91,7 @@ impl BodyAngles {
         for (i, (e, r)) in self.sc.iter_mut().zip(&mut self.rotations).enumerate() {
             let theta = q[3 * i + 2];
             let d = theta - e[0];
-            if valid && d.abs() <= 1e-3 && *r < Self::MAX_ROTATIONS {
+            if valid && d.abs() <= Self::MAX_INCREMENT && *r < Self::MAX_ROTATIONS {
                 if d != 0.0 {
                     let d2 = d * d;
                     let cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
@@ -156,6 +161,51 @@ impl BodyAngles {
                 Frame::with_sin_cos(vars, s, c)
             }
             None => Frame::new(vars),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BodyAngles;
+    use crate::models;
+
+    /// Rotated values stay within a few units in the last place of `sin_cos` for increments
+    /// up to `MAX_INCREMENT` over `MAX_ROTATIONS` rotations in a row, and a larger increment or
+    /// the rotation cap falls back to the exact values, bit for bit.
+    #[test]
+    fn rotations_track_sin_cos_to_rounding_and_fall_back_exactly() {
+        let sys = models::manipulator().expect("model");
+        let mut q: Vec<f64> = sys.initial_guess().0.iter().copied().collect();
+        let mut table = BodyAngles::new(&sys, &q);
+        let mut worst = 0.0f64;
+        for k in 0..BodyAngles::MAX_ROTATIONS {
+            // increments of both signs up to the limit
+            q[2] += 0.9 * BodyAngles::MAX_INCREMENT;
+            q[5] -= 0.5 * BodyAngles::MAX_INCREMENT * f64::from(k % 3);
+            table.update_near(&sys, &q);
+            for (i, th) in [(0, q[2]), (1, q[5])] {
+                let [a, s, c] = table.sin_cos_of(i);
+                assert_eq!(a.to_bits(), th.to_bits());
+                let (se, ce) = th.sin_cos();
+                worst = worst.max((s - se).abs()).max((c - ce).abs());
+            }
+        }
+        assert!(
+            worst <= 4.0 * f64::EPSILON,
+            "rotated sin/cos off by {worst:e}"
+        );
+        // past the rotation cap, and for a larger increment: exact
+        for step in [1e-4, 1.5 * BodyAngles::MAX_INCREMENT] {
+            q[2] += step;
+            table.update_near(&sys, &q);
+            let (se, ce) = q[2].sin_cos();
+            let [_, s, c] = table.sin_cos_of(0);
+            assert_eq!(
+                (s.to_bits(), c.to_bits()),
+                (se.to_bits(), ce.to_bits()),
+                "{step}"
+            );
         }
     }
 }

@@ -306,17 +306,30 @@ impl SpatialPart {
     /// `Phi`, the gradient `Phi_q`, `Phi_q v + Phi_t` (`d1`) and
     /// `v^T H v + 2 Phi_qt v + Phi_tt` (`d2`, so that `gamma = -d2`) (`v = None`: zero
     /// velocities). `Phi_qt` is zero but on angle driver rows.
+    #[inline(always)]
     pub(crate) fn rows(
+        &self,
+        q: &[f64],
+        v: Option<&[f64]>,
+        t: f64,
+        visit: impl FnMut(usize, [Option<usize>; 2], &DirJetN<SW>),
+    ) {
+        // a planar model: the residual passes call this at every evaluation, so the test is
+        // inlined at the call site and the loop below stays out of line
+        if self.m != 0 {
+            self.rows_spatial(q, v, t, visit);
+        }
+    }
+
+    /// [`SpatialPart::rows`] on a model with spatial rows.
+    #[inline(never)]
+    fn rows_spatial(
         &self,
         q: &[f64],
         v: Option<&[f64]>,
         t: f64,
         mut visit: impl FnMut(usize, [Option<usize>; 2], &DirJetN<SW>),
     ) {
-        if self.m == 0 {
-            // a planar model (the residual passes call this at every evaluation)
-            return;
-        }
         for (item, sides, row, n) in self.items() {
             if let (Item::Internal, Some(k)) = (item, sides[0]) {
                 // in closed form: the generic jets spend most of a solve's time here
@@ -389,7 +402,23 @@ impl SpatialPart {
 
     /// For every spatial row at time `t`: `visit(row, sides, gradient, (Phi_q v + Phi_t)_q)`
     /// (`H v`, plus `Phi_tq` on angle driver rows).
+    #[inline(always)]
     pub(crate) fn rows_tan(
+        &self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        visit: impl FnMut(usize, [Option<usize>; 2], &[f64; SW], &[f64; SW]),
+    ) {
+        // as `rows`: the planar models' test inlined, the loop out of line
+        if self.m != 0 {
+            self.rows_tan_spatial(q, v, t, visit);
+        }
+    }
+
+    /// [`SpatialPart::rows_tan`] on a model with spatial rows.
+    #[inline(never)]
+    fn rows_tan_spatial(
         &self,
         q: &[f64],
         v: &[f64],
