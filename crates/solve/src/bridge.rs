@@ -54,6 +54,10 @@ pub const BRIDGE_DISAGREEMENT: f64 = 3.0;
 /// mechanism whose conditioning changes over its motion.
 pub const BRIDGE_MEMORY: usize = 64;
 
+/// The margin of [`SingularBridge::leaves_alone`]: the condition estimate of a solve near
+/// the point in question must lie this factor below the bridge's threshold.
+pub const BRIDGE_QUIET: f64 = 10.0;
+
 /// Most constraints for which the bridge works (it forms `S` densely, `O(m^3)` per bridged
 /// stage); larger models are solved as they are.
 pub const BRIDGE_MAX_CONSTRAINTS: usize = 400;
@@ -201,6 +205,30 @@ impl SingularBridge {
         self.pending_cond = condition;
         self.pending_a.copy_from_slice(&a[..self.n]);
         self.pending = true;
+    }
+
+    /// Sets the condition estimate held with the step start's accelerations when their solve
+    /// gave none (a solver that took them from another factorisation holds them with the
+    /// condition of its next stage solve, at a nearby point).
+    #[inline]
+    pub fn hold_condition(&mut self, condition: f64) {
+        self.pending_cond = condition;
+    }
+
+    /// Whether a stage solve with the condition estimate `condition` lies a factor
+    /// [`BRIDGE_QUIET`] below the threshold at which [`SingularBridge::correct`] would replace
+    /// a component of its accelerations (or the bridge has too few points to replace any): a
+    /// solver may then take the accelerations of a nearby point from a factorisation that
+    /// gives no estimate.
+    pub fn leaves_alone(&self, condition: f64) -> bool {
+        if self.len < BRIDGE_POINTS || condition * BRIDGE_QUIET <= BRIDGE_CONDITION {
+            return true;
+        }
+        let baseline = self.ring[..self.ring_len]
+            .iter()
+            .fold(f64::INFINITY, |b, &c| b.min(c))
+            .max(1.0);
+        condition * BRIDGE_QUIET <= BRIDGE_CONDITION * baseline
     }
 
     /// Records the held point of a step accepted with end time `t_end` and positions `q_end`.

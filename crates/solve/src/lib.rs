@@ -77,7 +77,7 @@ pub use accel::AccelerationSolver;
 pub use adaptive::{run_adaptive, AdaptiveConfig, AdaptiveIntegrator, StepAttempt};
 pub use bridge::{
     ConstraintRows, SingularBridge, BRIDGE_CONDITION, BRIDGE_DISAGREEMENT, BRIDGE_MAX_CONSTRAINTS,
-    BRIDGE_MEMORY, BRIDGE_POINTS,
+    BRIDGE_MEMORY, BRIDGE_POINTS, BRIDGE_QUIET,
 };
 pub use consistent::{
     consistent_state, initial_changes, project_state, ConsistentOptions, ConsistentState,

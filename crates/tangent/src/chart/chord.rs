@@ -221,18 +221,17 @@ impl TangentChart {
             if let Some(verdict) = lp.head() {
                 return verdict;
             }
+            if lp.it == 1 {
+                // a second correction: the first one's size bounds the travel (`travel_ok`;
+                // a map that stops after one needs no bound)
+                self.first_step = first_travel(x, &self.x0);
+            }
             with_codim!(mm, solve_rt(&self.a, nn, &self.rdinv, f, &mut self.u));
             for (w, (z, u)) in self.w.iter_mut().zip(zeta.iter_mut().zip(&self.u)) {
                 *w = -u;
                 *z -= u;
             }
             self.add_q1_w(x);
-            if lp.it == 0 {
-                self.first_step = x
-                    .iter()
-                    .zip(&self.x0)
-                    .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()));
-            }
             if let Some(ms) = lp.corrected() {
                 return Ok(ms);
             }
@@ -293,17 +292,15 @@ impl TangentChart {
                 }
                 gemv_cols(&self.k, &self.w, f);
             }
+            if lp.it == 1 {
+                // as in `chord_centre`: the first correction's size, before a second
+                self.first_step = first_travel(x, &self.x0);
+            }
             // f is overwritten by the next residual: negate it in place
             for fk in f.iter_mut() {
                 *fk = -*fk;
             }
             gemv_cols(&self.p0, f, x);
-            if lp.it == 0 {
-                self.first_step = x
-                    .iter()
-                    .zip(&self.x0)
-                    .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()));
-            }
             if let Some(ms) = lp.corrected() {
                 return Ok(ms);
             }
@@ -586,6 +583,14 @@ pub(crate) fn diverged(
         residual: res,
         iterations: it,
     })
+}
+
+/// `||x - x0||_inf`: the size of an iteration's first correction, taken at the point it led to.
+#[inline]
+fn first_travel(x: &[f64], x0: &[f64]) -> f64 {
+    x.iter()
+        .zip(x0)
+        .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()))
 }
 
 /// Whether an iteration that ended at `x` from `start` travelled at most [`TRAVEL_FACTOR`]

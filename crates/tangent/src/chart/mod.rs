@@ -19,6 +19,7 @@ pub const ROUNDOFF_FACTOR: f64 = 8.0;
 /// not contract, and its limit need not be the solution nearest to the predictor (near a
 /// singular configuration: another branch), so the map counts as failed.
 pub const TRAVEL_FACTOR: f64 = 4.0;
+mod accel;
 mod apply;
 mod chord;
 mod exact;
@@ -156,6 +157,8 @@ pub struct TangentChart {
     hv: Vec<f64>,
     /// Relative threshold on the diagonal of `R` below which `Df(x_c)` counts as rank deficient.
     pub singular_tol: f64,
+    /// Work space of the accelerations at the centre ([`TangentChart::centre_accelerations`]).
+    centre_acc: accel::CentreAccel,
     centred: bool,
     /// The constraint rows the chart works with (all of them without redundant equations).
     sel: rows::RowSelection,
@@ -190,6 +193,7 @@ impl TangentChart {
             qa[i * n + i] = 1.0;
         }
         TangentChart {
+            centre_acc: accel::CentreAccel::new(n, m),
             n,
             m,
             phi_q: DMatrix::zeros(m, n),

@@ -100,3 +100,48 @@ fn broyden_reaches_the_chord_point_in_fewer_iterations() {
     assert!(updates > 0);
     assert!(iters[1] < iters[0], "{iters:?}");
 }
+
+/// The accelerations at the centre from the chart's QR (null-space method) equal the general
+/// index-1 solve's, on planar mechanisms, a spatial thin disc (`E_2 = 0`: `M` singular, definite
+/// on the tangent space only), a spatial double pendulum and the Bricard linkage (a redundant
+/// equation: the chart's selected rows); and a chart without a centre declines.
+#[test]
+fn centre_accelerations_match_the_index1_solve() {
+    use mbd_model::models;
+    let disc = models::heavy_top([1.0, 2.0, 1.0], 0.3, 20.0).expect("model");
+    assert!(disc.mass_diag().iter().any(|&m| m == 0.0), "a zero E_i");
+    for (name, sys) in [
+        ("manipulator", models::manipulator().expect("model")),
+        ("four-bar", models::four_bar().expect("model")),
+        ("slider-crank", models::slider_crank().expect("model")),
+        ("thin disc top", disc),
+        (
+            "spatial double pendulum",
+            models::spatial_double_pendulum().expect("model"),
+        ),
+        ("Bricard", models::bricard().expect("model")),
+    ] {
+        let st = mbd_solve::State::consistent(&sys, 0.0).expect("state");
+        let (q, v) = (st.q.as_slice(), st.v.as_slice());
+        let n = q.len();
+        let mut chart = TangentChart::new(&sys);
+        let mut a = vec![0.0; n];
+        assert!(
+            !chart.centre_accelerations(&sys, &mut a),
+            "{name}: no centre yet"
+        );
+        chart.centre(&sys, q, v, 0.0).expect("centre");
+        assert!(chart.centre_accelerations(&sys, &mut a), "{name}");
+        let mut solver = mbd_solve::AccelerationSolver::new(&sys);
+        let (mut a_ref, mut lambda) = (vec![0.0; n], vec![0.0; sys.n_constraints()]);
+        solver
+            .solve_accelerations(&sys, q, v, 0.0, None, &mut a_ref, &mut lambda)
+            .expect("index-1 solve");
+        let scale = 1.0 + a_ref.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let diff = a
+            .iter()
+            .zip(&a_ref)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(diff <= 1e-11 * scale, "{name}: {diff:e} (scale {scale:e})");
+    }
+}

@@ -48,7 +48,7 @@ impl TangentRk {
                 if accepted {
                     std::mem::swap(&mut self.cur, &mut self.xnew);
                     self.bridge.accept(t + h, &self.cur[..self.n]);
-                    self.commit_history(h, t + h, w.end_initial_residual);
+                    self.commit_history(h, t + h, &w);
                     self.cur_t = t + h;
                     self.cur_ok = true;
                     self.stats.steps += 1;

@@ -47,6 +47,15 @@ impl TangentRk {
         // stage 0 at (t, xi = 0) is the centre itself when the centre is on the manifold
         let centre_ok = self.cur_ok && same_time(self.cur_t, t);
         let quadratic = !sys.is_rheonomic();
+        // ... and its accelerations may come from the chart's QR (scleronomic constraints)
+        // where the last step's stage solves were well conditioned: no index-1 matrix is
+        // factored there, so the bridge could not correct that stage, and takes the condition
+        // estimate it records with the step's start from stage 1
+        let centre_accel = centre_ok
+            && quadratic
+            && s >= 2
+            && same_time(self.hist.t, t)
+            && (!self.options.bridge || self.bridge.leaves_alone(self.last_condition));
         if !follows {
             self.hist.clear();
         }
@@ -63,6 +72,8 @@ impl TangentRk {
         let mut stage = 0usize;
         self.xi.fill(0.0);
         let mut bridge = self.options.bridge.then_some(&mut self.bridge);
+        // the step start's accelerations are held, their condition estimate not yet
+        let mut held_without_condition = false;
         if let Some(b) = bridge.as_deref_mut() {
             b.begin(t, &self.cur[..n]);
         }
@@ -70,7 +81,7 @@ impl TangentRk {
             let chart = &mut self.path;
             let zlast = &mut self.zeta;
             let (zplain, x, g, fx) = (&mut self.zplain, &mut self.x, &mut self.g, &mut self.fx);
-            let (acc_a, lambda) = (&mut self.acc_a, &mut self.lambda);
+            let lambda = &mut self.lambda;
             let (a_coef, c_coef) = (&self.a_coef, &self.c_coef);
             let fsal = self.fsal;
             let (eta_now, hist, eta_pred, eta_raw) = (
@@ -165,8 +176,20 @@ impl TangentRk {
                     }
                 }
                 let (q, v) = x.split_at(n);
-                let solved = chart.accel(sys, q, v, ti, acc_a, lambda);
-                if solved.is_ok() {
+                // F = (v, a): the accelerations are solved into its second half
+                let (fv, acc_a) = fx.split_at_mut(n);
+                let from_chart = at_centre && centre_accel && chart.centre_accel(sys, acc_a);
+                let solved = if from_chart {
+                    Ok(())
+                } else {
+                    chart.accel(sys, q, v, ti, acc_a, lambda)
+                };
+                if from_chart {
+                    if let Some(b) = bridge.as_deref_mut() {
+                        b.hold(ti, f64::NAN, acc_a);
+                        held_without_condition = true;
+                    }
+                } else if solved.is_ok() {
                     let c = chart.condition_estimate();
                     work.condition = work.condition.max(c);
                     if let Some(b) = bridge.as_deref_mut() {
@@ -177,6 +200,9 @@ impl TangentRk {
                         }
                         if i == 0 {
                             b.hold(ti, c, acc_a);
+                        } else if held_without_condition {
+                            b.hold_condition(c);
+                            held_without_condition = false;
                         }
                     }
                 }
@@ -187,8 +213,7 @@ impl TangentRk {
                     return Err(e);
                 }
                 work.rhs_evals += 1;
-                fx[..n].copy_from_slice(v);
-                fx[n..].copy_from_slice(acc_a);
+                fv.copy_from_slice(v);
                 chart.split(fx, &mut g[i * mm..(i + 1) * mm], dy);
                 stage += 1;
                 Ok(())
@@ -279,8 +304,11 @@ impl TangentRk {
         Ok(work)
     }
 
-    /// Records the accepted attempt's `eta` (a step of size `h` ending at `t_end`).
-    pub(super) fn commit_history(&mut self, h: f64, t_end: f64, end_initial_residual: f64) {
+    /// Records the accepted attempt's `eta` (a step of size `h` ending at `t_end`) and the
+    /// largest condition estimate of its stage solves.
+    pub(super) fn commit_history(&mut self, h: f64, t_end: f64, work: &AttemptWork) {
+        let end_initial_residual = work.end_initial_residual;
+        self.last_condition = work.condition;
         let (ratio, tol) = (self.options.stage_tol_ratio, self.options.newton.tol);
         self.stage_tol = if ratio > 0.0 && end_initial_residual.is_finite() {
             (ratio * end_initial_residual).max(tol)

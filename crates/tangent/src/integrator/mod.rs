@@ -115,6 +115,9 @@ pub struct TangentRk {
     failures_here: usize,
     /// The accelerations of the last step starts, for stages near a singular configuration.
     bridge: SingularBridge,
+    /// The largest condition estimate of the stage solves of the last accepted step (infinite
+    /// before one): whether the next step's start may take its accelerations from the chart.
+    last_condition: f64,
 }
 
 /// Largest factor by which [`TangentChart::rcond`] may differ between the current chart and
@@ -228,6 +231,7 @@ impl TangentRk {
             centred_at: f64::NAN,
             failures_here: 0,
             bridge: SingularBridge::new(sys),
+            last_condition: f64::INFINITY,
         })
     }
 
@@ -370,7 +374,7 @@ impl TangentRk {
         match self.attempt(sys, t, h) {
             Ok(w) => {
                 self.account(&w);
-                self.commit_history(h, t + h, w.end_initial_residual);
+                self.commit_history(h, t + h, &w);
                 std::mem::swap(&mut self.cur, &mut self.xnew);
                 self.bridge.accept(t + h, &self.cur[..self.n]);
                 self.cur_t = t + h;

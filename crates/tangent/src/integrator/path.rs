@@ -168,6 +168,17 @@ impl Path {
         }
     }
 
+    /// The index-1 accelerations at the dense chart's centre from its own QR
+    /// ([`TangentChart::centre_accelerations`]; scleronomic constraints); `false` where that
+    /// does not apply (the sparse path, or see there): solve with [`Path::accel`] then.
+    #[inline]
+    pub(super) fn centre_accel(&mut self, sys: &System, a: &mut [f64]) -> bool {
+        match self {
+            Path::Dense { chart, .. } => chart.centre_accelerations(sys, a),
+            Path::Sparse(_) => false,
+        }
+    }
+
     /// The constraint rows of the last index-1 solve (for the bridge).
     pub(super) fn rows(&self) -> &dyn ConstraintRows {
         match self {
