@@ -558,4 +558,31 @@ mod tests {
         assert!(!b.correct(&rows, &sys, t, 1e8, &mut a, &mut l));
         assert!(b.correct(&rows, &sys, t, 1e10, &mut a, &mut l));
     }
+
+    /// `leaves_alone` says yes while the bridge has too few points, and after that exactly up to
+    /// `BRIDGE_CONDITION * baseline / BRIDGE_QUIET` (the baseline at least 1); a start held
+    /// without a condition estimate is recorded with the one `hold_condition` gives it.
+    #[test]
+    fn leaves_alone_follows_the_threshold_and_the_held_condition() {
+        let sys = models::pendulum(1.0, 2.0, 0.1, 9.81).unwrap();
+        let b = SingularBridge::new(&sys);
+        assert!(b.leaves_alone(1e12), "no points yet");
+        let b = filled(&sys, cubic);
+        let limit = BRIDGE_CONDITION * 10.0 / BRIDGE_QUIET;
+        assert!(b.leaves_alone(limit));
+        assert!(!b.leaves_alone(limit * (1.0 + 1e-12)));
+        // a baseline below 1 counts as 1
+        let mut b = SingularBridge::new(&sys);
+        let q = [0.0; 3];
+        for k in 0..BRIDGE_POINTS {
+            let t = 0.1 * k as f64;
+            b.begin(t, &q);
+            b.hold(t, f64::NAN, &cubic(t));
+            b.hold_condition(if k == 2 { 0.5 } else { 10.0 });
+            b.accept(t + 0.1, &q);
+        }
+        let limit = BRIDGE_CONDITION / BRIDGE_QUIET;
+        assert!(b.leaves_alone(limit));
+        assert!(!b.leaves_alone(2.0 * limit));
+    }
 }
