@@ -129,7 +129,7 @@ fn solve_to(
 /// through the QR factors instead of the 2n x 2n Q, sin/cos carried between maps) brought it
 /// to 33,000 instructions, 3.50x; the rest is the index-1 solves and residual evaluations the
 /// step shares with the model and the solve crate, and the centre's QR.
-const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step; tangent-perf2: 42,600 -> 37,100; tangent-perf3: 37,700 -> 33,000, 3.50x plain RK4 at 9,430; tangent-perf4: 33,400 -> 31,000, 3.27x at 9,470; tangent-perf5: 30,838 -> 29,026, 2.98x at 9,732, 3.13x by wall clock, all at h = 1e-3); at this claim's h = 0.01 the chord maps take 15.5 iterations per step and set the cost: 5.5x in instructions, 4.25x by wall clock after tangent-perf5 (4.35x after tangent-perf4); see docs/report.md, expected misses";
+const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step; tangent-perf2: 42,600 -> 37,100; tangent-perf3: 37,700 -> 33,000, 3.50x plain RK4 at 9,430; tangent-perf4: 33,400 -> 31,000, 3.27x at 9,470; tangent-perf5: 30,838 -> 29,063, 2.99x at 9,732, 3.13x by wall clock, all at h = 1e-3); at this claim's h = 0.01 the chord maps take 15.5 iterations per step and set the cost: 5.5x in instructions, 4.25x by wall clock after tangent-perf5 (4.35x after tangent-perf4); see docs/report.md, expected misses";
 
 /// Errors of the order study within this of zero are at the reference's / round-off floor.
 const FLOOR: f64 = 1e-11;

@@ -224,11 +224,16 @@ impl SingularBridge {
         if self.len < BRIDGE_POINTS || condition * BRIDGE_QUIET <= BRIDGE_CONDITION {
             return true;
         }
-        let baseline = self.ring[..self.ring_len]
+        condition * BRIDGE_QUIET <= BRIDGE_CONDITION * self.baseline()
+    }
+
+    /// The mechanism's own conditioning: the smallest condition estimate of the recorded step
+    /// starts (the last [`BRIDGE_MEMORY`]), at least 1.
+    fn baseline(&self) -> f64 {
+        self.ring[..self.ring_len]
             .iter()
             .fold(f64::INFINITY, |b, &c| b.min(c))
-            .max(1.0);
-        condition * BRIDGE_QUIET <= BRIDGE_CONDITION * baseline
+            .max(1.0)
     }
 
     /// Records the held point of a step accepted with end time `t_end` and positions `q_end`.
@@ -307,12 +312,7 @@ impl SingularBridge {
         lambda: &mut [f64],
     ) -> bool {
         let (n, m) = (self.n, self.m);
-        // the mechanism's own conditioning over the last steps (at least 1)
-        let baseline = self.ring[..self.ring_len]
-            .iter()
-            .fold(f64::INFINITY, |b, &c| b.min(c))
-            .max(1.0);
-        let factor = BRIDGE_CONDITION * baseline;
+        let factor = BRIDGE_CONDITION * self.baseline();
         if condition <= factor || m == 0 || self.s.len() != m * m {
             return false;
         }

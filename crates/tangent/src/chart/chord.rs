@@ -10,7 +10,7 @@ use super::{ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTO
 const THETA_PRIOR_SAFETY: f64 = 2.0;
 use crate::kernels::{dot, gemv_cols, gemv_t_cols, rank_one_update, with_codim};
 use mbd_model::System;
-use mbd_solve::linalg::{max_abs, solve_rt};
+use mbd_solve::linalg::{max_abs, max_abs_diff, solve_rt};
 
 impl TangentChart {
     /// Evaluates `Df` at a second point `x_e` (typically the Euler prediction `x_c + h F(x_c)` of
@@ -224,7 +224,7 @@ impl TangentChart {
             if lp.it == 1 {
                 // a second correction: the first one's size bounds the travel (`travel_ok`;
                 // a map that stops after one needs no bound)
-                self.first_step = first_travel(x, &self.x0);
+                self.first_step = max_abs_diff(x, &self.x0);
             }
             with_codim!(mm, solve_rt(&self.a, nn, &self.rdinv, f, &mut self.u));
             for (w, (z, u)) in self.w.iter_mut().zip(zeta.iter_mut().zip(&self.u)) {
@@ -294,7 +294,7 @@ impl TangentChart {
             }
             if lp.it == 1 {
                 // as in `chord_centre`: the first correction's size, before a second
-                self.first_step = first_travel(x, &self.x0);
+                self.first_step = max_abs_diff(x, &self.x0);
             }
             // f is overwritten by the next residual: negate it in place
             for fk in f.iter_mut() {
@@ -583,14 +583,6 @@ pub(crate) fn diverged(
         residual: res,
         iterations: it,
     })
-}
-
-/// `||x - x0||_inf`: the size of an iteration's first correction, taken at the point it led to.
-#[inline]
-fn first_travel(x: &[f64], x0: &[f64]) -> f64 {
-    x.iter()
-        .zip(x0)
-        .fold(0.0f64, |d, (a, b)| fast_max(d, (a - b).abs()))
 }
 
 /// Whether an iteration that ended at `x` from `start` travelled at most [`TRAVEL_FACTOR`]
