@@ -1,8 +1,10 @@
 //! `own-spatial`, Newton mixing: the Anderson mixing of the symplectic stage equations' Newton
 //! updates (docs/symplectic.md, "Anderson mixing") on a chain of spatial rods, where the (1,1)
-//! modified scheme's sparse Newton blocks leave out the couplings through `S^-1` and its plain
-//! updates contract only linearly: Newton iterations per step with and without it, through the
-//! public run loop.
+//! modified scheme's plain updates contracted only linearly while its sparse position block
+//! was a diagonal (it cut them 1.29x at 1000 rods). With the exact block (docs/symplectic.md
+//! section 5a) they contract fast there and the mixing does not start: the claim is that it
+//! costs no iteration and leaves the end state where it was. Newton iterations per step with
+//! and without it, through the public run loop.
 
 use crate::report::{fmt_e, Claim, Ctx, Section};
 use mbd::model::models::spatial_chain;
@@ -10,8 +12,9 @@ use mbd::prelude::*;
 use mbd::solve::linalg::max_abs_diff;
 use mbd::symplectic::DEFAULT_ANDERSON_DEPTH;
 
-/// The smallest factor by which the mixing must lower the Newton iterations per step.
-const MIN_GAIN: f64 = 1.15;
+/// The smallest factor by which the mixing must lower the Newton iterations per step (1: it
+/// may not raise them).
+const MIN_GAIN: f64 = 1.0;
 
 /// How far apart the end states with and without the mixing may be (both converge each step to
 /// the Newton tolerance, about 1e-14 relative).
@@ -54,9 +57,9 @@ pub(crate) fn mixing(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     );
     sec.claims.push(Claim::check(
         format!(
-            "on a {n}-rod spatial chain at h = {h:e}, mixing the Newton updates lowers the \
-             (1,1) modified scheme's Newton iterations per step at least {MIN_GAIN}x, the end \
-             state the same to {SAME_STATE:e}"
+            "on a {n}-rod spatial chain at h = {h:e}, mixing the Newton updates does not raise \
+             the (1,1) modified scheme's Newton iterations per step (gain at least {MIN_GAIN}x), \
+             the end state the same to {SAME_STATE:e}"
         ),
         gain >= MIN_GAIN && dq <= SAME_STATE,
         format!(

@@ -93,7 +93,7 @@ pub struct Galerkin {
     mlhist: modlag::GradientHistory,
     /// Sparse path, s = 1 modified Lagrangian: the diagonals of its Newton blocks
     /// (`Preadjustment::modified_newton_diagonals`).
-    mldiag: [Vec<f64>; 2],
+    mldiag: [Vec<f64>; 3],
     tn: [Vec<f64>; 4],
     proj: DenseCholesky,
     vm: Vec<f64>,
@@ -172,7 +172,7 @@ impl Galerkin {
             ));
         }
         let sparse = if use_sparse {
-            Some(Box::new(SparseStage::new(sys, s)?))
+            Some(Box::new(SparseStage::new(sys, s, modlag)?))
         } else {
             None
         };
@@ -210,9 +210,9 @@ impl Galerkin {
             mlmid: vec![0.0; nl],
             mlvel: vec![0.0; nl],
             mldiag: if modlag && use_sparse && s == 1 {
-                [vec![0.0; n], vec![0.0; n]]
+                [vec![0.0; n], vec![0.0; n], vec![0.0; n]]
             } else {
-                [Vec::new(), Vec::new()]
+                [Vec::new(), Vec::new(), Vec::new()]
             },
             mlhist: modlag::GradientHistory::new(if modlag && options.s == 2 { n } else { 0 }),
             opts: options,
@@ -380,7 +380,11 @@ impl Galerkin {
     /// Solves the factored stage Jacobian in place.
     fn solve_stage(&mut self, b: &mut [f64]) {
         match &mut self.sparse {
-            Some(sp) => sp.lu.solve_in_place(b),
+            // (with the modified Lagrangian's position block: its augmented matrix)
+            Some(sp) => match sp.proj.as_deref_mut().filter(|p| p.is_active()) {
+                Some(p) => p.solve_in_place(b),
+                None => sp.lu.solve_in_place(b),
+            },
             None => self.lu.solve_in_place(b),
         }
     }

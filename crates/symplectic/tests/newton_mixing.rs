@@ -1,9 +1,9 @@
 //! Anderson mixing of the stage equations' simplified Newton updates
 //! (`SymplecticOptions::anderson_depth`): where the iteration matrix leaves out part of the
-//! Jacobian (the modified Lagrangian's diagonal Newton blocks on a spatial chain under
-//! tension), it cuts the iterations and leaves the solution where it was (to the Newton
-//! tolerance); where the plain iteration contracts fast it is never switched on, and the steps
-//! are bit for bit those without it.
+//! Jacobian it was meant to cut the iterations; the case it was measured on (the modified
+//! Lagrangian's diagonal position block on a spatial chain under tension) now takes the exact
+//! block and contracts fast. Where the plain iteration contracts fast the mixing is never
+//! switched on, and the steps are bit for bit those without it.
 mod common;
 use common::max_abs_diff;
 use mbd_model::{models, System};
@@ -24,9 +24,11 @@ fn run(sys: &System, o: SymplecticOptions, h: f64, n: usize) -> (State, usize) {
 }
 
 #[test]
-fn mixing_cuts_the_iterations_of_a_slow_chord_iteration() {
-    // 50 rods on ball joints at h = 0.015: the (1,1) modified scheme's sparse Newton blocks
-    // leave out the couplings through S^-1, and the plain updates contract by about 0.15
+fn the_exact_position_block_leaves_the_mixing_nothing_to_do() {
+    // 50 rods on ball joints at h = 0.015: with the diagonal position block the (1,1)
+    // modified scheme's updates contracted by about 0.15 and the mixing cut the iterations
+    // from 140 to 117 over 12 steps; the exact block (docs/symplectic.md section 5a) takes
+    // them to 86 with or without it, and the mixing does not start
     let sys = models::spatial_chain(50).unwrap();
     let o = SymplecticOptions::new(1).with_preadjust(PreadjustMode::ModifiedLagrangian);
     assert_eq!(o.anderson_depth, DEFAULT_ANDERSON_DEPTH);
@@ -37,15 +39,11 @@ fn mixing_cuts_the_iterations_of_a_slow_chord_iteration() {
     let (h, n) = (0.015, 12);
     let (a, its_on) = run(&sys, o, h, n);
     let (b, its_off) = run(&sys, off, h, n);
-    // measured 117 against 140
-    assert!(
-        (its_on as f64) < 0.9 * its_off as f64,
-        "{its_on} iterations with mixing, {its_off} without"
-    );
-    // the same solution to the Newton tolerance (measured 1.8e-14 in q, 5.2e-12 in v)
+    assert!(its_off <= 100, "{its_off} iterations without mixing");
+    assert_eq!(its_on, its_off);
     let dq = max_abs_diff(a.q.as_slice(), b.q.as_slice());
     let dv = max_abs_diff(a.v.as_slice(), b.v.as_slice());
-    assert!(dq < 1e-12 && dv < 1e-10, "q {dq:e}, v {dv:e}");
+    assert!(dq == 0.0 && dv == 0.0, "q {dq:e}, v {dv:e}");
     let mut phi = vec![0.0; sys.n_constraints()];
     sys.phi(a.q.as_slice(), a.t, &mut phi);
     assert!(phi.iter().all(|p| p.abs() < 1e-12), "{phi:?}");

@@ -153,13 +153,14 @@ impl Galerkin {
         // * the velocity part -(h^2 / 6) M^-1 E(qbar), E = 6 d^2 e / dv^2 = B + 2 C S^-1 C^T
         //   (B = A + H_sigma - 3/2 Hess V, C = [Hess Phi_k v]_k), where the residual evaluated
         //   e (its factors are reused);
-        // * the leading position part (h^4 / 4) M^-1 d^2 e_0 / dq^2 of the h^3 / 2 de/dq term,
-        //   e_0 = -1/24 f_T^T M^-1 f_T, with d^2 e_0 / dq^2 ~ -1/12 A Pi A (the Newton Hessian
-        //   of W_1 = 1/2 f_T^T M^-1 f_T): O((h^2 rho)^2) against the identity (rho the
-        //   spectral radius of M^-1 A), the one that slows Newton on stiff chains.
-        // The other position derivatives (O(h) relative to the velocity part and quadratic in
-        // v) are left out (docs/symplectic.md, section 5a); the converged solution does not
-        // depend on them.
+        // * the leading position part (h^4 / 4) M^-1 d^2 e / dq^2 of the h^3 / 2 de/dq term,
+        //   d^2 e / dq^2 ~ -1/12 A_s Pi A_s with A_s = A + H_sigma = Hess V + (sigma - mu0) .
+        //   Hess Phi, the stiffness of the whole multiplier (static and centripetal): O((h^2
+        //   rho)^2) against the identity (rho the spectral radius of M^-1 A_s), the one that
+        //   slows Newton on stiff chains, and on long swinging ones through sigma.
+        // The other position derivatives (O(h) relative to the velocity part, or linear in the
+        // third derivatives) are left out (docs/symplectic.md, section 5a); the converged
+        // solution does not depend on them.
         // Both blocks are dense on the coordinates K that enter V and the constraints
         // non-linearly (S^-1 and Pi are dense), which fills the stage LU there. Sparser
         // approximations of either block cost more Newton iterations than they save
@@ -175,7 +176,7 @@ impl Galerkin {
             ml.add_modified_velocity_hessian(sys, &self.mlmid, &self.mlvel, 2.0, &mut self.wh)
                 .map_err(|e| with_time(e, t))?;
             // (s = 1 has no interior control point: hc is free)
-            ml.approximate_hessian_1(sys, &self.mlmid, &mut self.hc)
+            ml.modified_position_hessian(sys, &self.mlmid, &self.mlvel, &mut self.hc)
                 .map_err(|e| with_time(e, t))?;
             let jm = &mut self.lu;
             let (cw, ch) = (-h2 / 12.0, -(h2 * h2) / 48.0);

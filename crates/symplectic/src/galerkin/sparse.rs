@@ -9,6 +9,7 @@
 use super::{with_time, Galerkin};
 
 mod curvature;
+pub(super) mod projected;
 use mbd_model::{BodyRef, System};
 use mbd_solve::linalg::LuError;
 use mbd_solve::sparse::{BlockRows, ConstraintSchur, SparseLu};
@@ -97,6 +98,9 @@ pub(super) struct SparseStage {
     gm: Vec<f64>,
     /// `Phi_q^T lambda` (scratch of the residual and the end momentum).
     pub(super) al: Vec<f64>,
+    /// The s = 1 modified Lagrangian's position Newton block, as `n + m` more unknowns
+    /// (`projected.rs`).
+    pub(super) proj: Option<Box<projected::ProjectedStiffness>>,
     /// `Phi_q v` (scratch of the projection).
     pub(super) pv: Vec<f64>,
 }
@@ -134,8 +138,9 @@ fn colour(
 
 impl SparseStage {
     /// Pattern and symbolic analysis of the stage Jacobian of the `(s,s)` scheme on `sys`
-    /// (allocates; once per integrator).
-    pub(super) fn new(sys: &System, s: usize) -> Result<Self, SolveError> {
+    /// (allocates; once per integrator); `modified`: with the s = 1 modified Lagrangian's
+    /// position block (`projected.rs`).
+    pub(super) fn new(sys: &System, s: usize, modified: bool) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let nblocks = sys.n_body_blocks();
         let blocks: Vec<(usize, usize)> = (0..nblocks)
@@ -248,6 +253,17 @@ impl SparseStage {
             }
         }
         let lu = SparseLu::new(dim, &entries)?;
+        let proj = if modified && s == 1 {
+            Some(Box::new(projected::ProjectedStiffness::new(
+                sys,
+                (&vcol, &rstart),
+                &fent,
+                &entries,
+                &lu,
+            )?))
+        } else {
+            None
+        };
         let slot = |r: usize, c: usize| lu.slot(r, c).unwrap_or(NONE);
         let mut k_slot = vec![NONE; s * s * n];
         for nu in 0..s {
@@ -383,6 +399,7 @@ impl SparseStage {
             gm: vec![0.0; n],
             al: vec![0.0; n],
             pv: vec![0.0; m],
+            proj,
             rows,
         })
     }
@@ -530,20 +547,6 @@ impl Galerkin {
             }
         }
         curvature::add(sp, sys, &self.qn, &self.x, tab, minv, (n, m), (t, h));
-        if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
-            // the s = 1 modified Lagrangian: the diagonals of the blocks of galerkin/dense.rs,
-            // -h^2/12 (2 B) and -h^4/48 A M^-1 A, on the entries (i, Z_1,i) (docs/symplectic.md
-            // section 5a: the dense parts through S^-1 are left out)
-            let [wd, ad] = &mut self.mldiag;
-            ml.set_time(t + 0.5 * h);
-            ml.modified_newton_diagonals(sys, &self.mlmid, &self.mlvel, wd, ad)
-                .map_err(|e| with_time(e, t))?;
-            let (cw, ch) = (-h2 / 12.0, -(h2 * h2) / 48.0);
-            let vals = sp.lu.values_mut();
-            for i in 0..n {
-                vals[sp.k_slot[i]] += minv[i] * (cw * 2.0 * wd[i] + ch * ad[i]);
-            }
-        }
         if !sp.diag_slot.is_empty() {
             // the equations dependent at the step's end configuration are left out: their
             // rows become the identity on their multipliers, which then stay put (Newton
@@ -587,9 +590,38 @@ impl Galerkin {
                 }
             }
         }
+        // the s = 1 modified Lagrangian (after the dependent rows are known): the diagonal of
+        // the velocity block of galerkin/dense.rs, -h^2/12 (2 B), on the entries (i, Z_1,i)
+        // (its dense part through S^-1 is left out), and the position block
+        // -h^4/48 A_s Pi A_s, exact through augmented unknowns where it is not small, else
+        // the diagonal of A M^-1 A (projected.rs; docs/symplectic.md section 5a)
+        let mut augmented = false;
+        if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
+            let [wd, sd, ad] = &mut self.mldiag;
+            ml.set_time(t + 0.5 * h);
+            ml.modified_newton_diagonals(sys, &self.mlmid, &self.mlvel, [wd, sd, ad])
+                .map_err(|e| with_time(e, t))?;
+            let (cw, c) = (-h2 / 12.0, -(h2 * h2) / 48.0);
+            let (cm, mass_inv) = ml.modified_stiffness_weights();
+            augmented = projected::takes_block(sp, sd, mass_inv, c);
+            let vals = sp.lu.values_mut();
+            for i in 0..n {
+                let pos = if augmented { 0.0 } else { c * ad[i] };
+                vals[sp.k_slot[i]] += minv[i] * (cw * 2.0 * wd[i] + pos);
+            }
+            if augmented {
+                let mid = (self.mlmid.as_slice(), t + 0.5 * h);
+                projected::fill(sp, sys, mid, cm, mass_inv, minv, &self.grads[s], c);
+            } else if let Some(p) = sp.proj.as_deref_mut() {
+                p.deactivate();
+            }
+        }
         self.jacobians += 1;
         self.jac_valid = false;
-        let res = sp.lu.factor();
+        let res = match sp.proj.as_deref_mut().filter(|_| augmented) {
+            Some(p) => p.factor(),
+            None => sp.lu.factor(),
+        };
         self.stage_error(sys, t, h, res)
     }
 

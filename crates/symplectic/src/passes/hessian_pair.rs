@@ -93,32 +93,32 @@ pub(crate) fn add_lagrangian_hessian_pair(
     }
 }
 
-/// The diagonals of the two weighted Lagrangian Hessians of
-/// [`add_lagrangian_hessian_pair`], added into `out_a` and `out_b` (length n), in
-/// `O(elements)` with nothing assembled (diagonal Newton blocks on a sparse path): every
-/// planar element and the spatial constraint rows (the spatial force elements are left out).
-pub(crate) fn add_lagrangian_hessian_pair_diagonals(
+/// The diagonals of weighted Lagrangian Hessians of [`add_lagrangian_hessian_pair`], each
+/// added into its `out` (length n), from one pass in `O(elements)` with nothing assembled
+/// (diagonal Newton blocks on a sparse path): every planar element and the spatial constraint
+/// rows (the spatial force elements are left out).
+pub(crate) fn add_lagrangian_hessian_diagonals<const K: usize>(
     sys: &System,
     q: &[f64],
     t: f64,
-    (a, out_a): (LagrangianWeights<'_>, &mut [f64]),
-    (b, out_b): (LagrangianWeights<'_>, &mut [f64]),
+    mut sets: [(LagrangianWeights<'_>, &mut [f64]); K],
 ) {
     // (the local diagonal h[l][l] of each of the element's bodies)
-    let scatter = |at: Attach, h: &[[f64; NV]; NV], w: f64, out: &mut [f64]| {
+    let scatter = |at: Attach, h: &[[f64; NV]; NV], wk: f64, out: &mut [f64]| {
         for (slot, body) in [(0, at.a), (3, at.b)] {
             if let Some(i) = body {
                 for l in 0..3 {
-                    out[3 * i + l] += w * h[slot + l][slot + l];
+                    out[3 * i + l] += wk * h[slot + l][slot + l];
                 }
             }
         }
     };
-    let forces = a.potential != 0.0 || b.potential != 0.0;
+    let forces = sets.iter().any(|(w, _)| w.potential != 0.0);
     sys.element_hessians(q, forces, |el| match el {
         ElementHessian::Force(at, h) => {
-            scatter(at, h, a.potential, out_a);
-            scatter(at, h, b.potential, out_b);
+            for (w, out) in sets.iter_mut() {
+                scatter(at, h, w.potential, out);
+            }
         }
         ElementHessian::Joint {
             attach: at,
@@ -127,19 +127,21 @@ pub(crate) fn add_lagrangian_hessian_pair_diagonals(
             ..
         } => {
             for (k, ek) in e.iter().enumerate() {
-                scatter(at, &ek.h, a.constraints[o + k], out_a);
-                scatter(at, &ek.h, b.constraints[o + k], out_b);
+                for (w, out) in sets.iter_mut() {
+                    scatter(at, &ek.h, w.constraints[o + k], out);
+                }
             }
         }
     });
     if sys.has_spatial() {
         // the spatial rows' constant Hessians (the spatial force elements' Hessians are left
         // out: these diagonals only shape a Newton matrix)
-        for (r, (&wa, &wb)) in a.constraints.iter().zip(b.constraints).enumerate() {
+        for r in 0..sys.n_constraints() {
             sys.spatial_row_hessian_at(q, t, r, |i, j, h| {
                 if i == j {
-                    out_a[i] += wa * h;
-                    out_b[i] += wb * h;
+                    for (w, out) in sets.iter_mut() {
+                        out[i] += w.constraints[r] * h;
+                    }
                 }
             });
         }
@@ -158,9 +160,7 @@ fn scaled(h: &[[f64; NV]; NV], w: f64) -> [[f64; NV]; NV] {
 
 #[cfg(test)]
 mod tests {
-    use super::{
-        add_lagrangian_hessian_pair, add_lagrangian_hessian_pair_diagonals, LagrangianWeights,
-    };
+    use super::{add_lagrangian_hessian_diagonals, add_lagrangian_hessian_pair, LagrangianWeights};
     use nalgebra::DMatrix;
 
     /// The pair equals two separate assemblies ([`System::potential_hessian`] and
@@ -214,24 +214,26 @@ mod tests {
             close(&ct, &ect, "ct");
             // the diagonals alone, added to what the buffers hold
             let (mut da, mut db) = (vec![0.5; n], vec![0.0; n]);
-            add_lagrangian_hessian_pair_diagonals(
+            add_lagrangian_hessian_diagonals(
                 &sys,
                 &q,
                 0.0,
-                (
-                    LagrangianWeights {
-                        potential: 1.0,
-                        constraints: &wa,
-                    },
-                    &mut da,
-                ),
-                (
-                    LagrangianWeights {
-                        potential: -0.5,
-                        constraints: &wb,
-                    },
-                    &mut db,
-                ),
+                [
+                    (
+                        LagrangianWeights {
+                            potential: 1.0,
+                            constraints: &wa,
+                        },
+                        &mut da,
+                    ),
+                    (
+                        LagrangianWeights {
+                            potential: -0.5,
+                            constraints: &wb,
+                        },
+                        &mut db,
+                    ),
+                ],
             );
             for i in 0..n {
                 let tol = 1e-13 * (1.0 + ea[(i, i)].abs() + eb[(i, i)].abs());

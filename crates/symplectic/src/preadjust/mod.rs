@@ -8,7 +8,7 @@
 //! | term | type (file) | value (forward) | gradient (adjoint) | Newton matrix | `docs/symplectic.md` |
 //! |---|---|---|---|---|---|
 //! | paper A's `W_s(q) = 1/2 u^T A (Pi A)^(s-2) u` (`W_1 = 1/2 u^T M u`), `gamma kappa_s h^(2s) W_s` at the Gauss points | [`PaperTerm`] (`paper.rs`) | `PaperTerm::value`: the Krylov vectors `a_i = (Pi A)^i u` | `PaperTerm::gradient`: by hand through the Krylov recursion, exact third derivatives | `A (Pi A)^s` ([`TangentStiffness::a_pi_a_power`]) | section 5 |
-//! | the s = 1 modified Lagrangian `e(q, v)`, `h^3 e` at the chord midpoint of a (1,1) step | [`ModifiedS1`] (`modified_s1.rs`) | `ModifiedS1::evaluate` | `ModifiedS1::gradients`: closed form, one Hessian-vector and one third-order pass | `ModifiedS1::add_velocity_hessian` and `A Pi A` ([`TangentStiffness::a_pi_a`]); diagonals on the sparse path (`ModifiedS1::newton_diagonals`) | section 5a |
+//! | the s = 1 modified Lagrangian `e(q, v)`, `h^3 e` at the chord midpoint of a (1,1) step | [`ModifiedS1`] (`modified_s1.rs`) | `ModifiedS1::evaluate` | `ModifiedS1::gradients`: closed form, one Hessian-vector and one third-order pass | `ModifiedS1::add_velocity_hessian` and `A_s Pi A_s`, `A_s = A + H_sigma` ([`TangentStiffness::a_pi_a`]); on the sparse path the blocks' diagonals (`ModifiedS1::newton_diagonals`) and `A_s Pi A_s` through augmented unknowns (`galerkin/sparse/projected.rs`) | section 5a |
 //! | the s = 2 modified Lagrangian `e4(q, v)`, 23 invariants ([`modified_s2::E4_TERMS`]), `h^5 e4` at the chord midpoint of a (2,2) step | [`modified_s2::ModifiedS2`] (`modified_s2/`) | `modified_s2/forward.rs`: jet passes A, B, C (`modified_s2/passes.rs`) | `modified_s2/reverse.rs`: reverse pass through the forward's intermediates (workspace `modified_s2/adjoints.rs`) | none (left out of the Newton matrix) | section 5b |
 //!
 //! Shared by the terms:
@@ -189,28 +189,33 @@ impl Preadjustment {
         Ok(())
     }
 
-    /// `A Pi A` into `out` (overwritten): [`Preadjustment::approximate_hessian`] with `s = 1`
-    /// whatever the workspace's `s`, in fewer operations (the modified Lagrangian's Newton
-    /// matrix, `galerkin/dense.rs`), the same matrix up to rounding and symmetric by
-    /// construction ([`TangentStiffness::a_pi_a`]).
-    pub(crate) fn approximate_hessian_1(
+    /// The leading position Hessian of [`Preadjustment::modified_term`] at `(q, v)`, up to its
+    /// factor `-1/12`: `(A + H_sigma) Pi (A + H_sigma)` into `out` (overwritten), with
+    /// `H_sigma = sum_k sigma_k Hess Phi_k`, `sigma = S^-1 gamma_c(q, v)` (the modified
+    /// Lagrangian's Newton matrix, `galerkin/dense.rs`; docs/symplectic.md section 5a). At
+    /// `v = 0` it is [`Preadjustment::approximate_hessian`] with `s = 1` to rounding; symmetric
+    /// by construction ([`TangentStiffness::a_pi_a`]).
+    pub(crate) fn modified_position_hessian(
         &mut self,
         sys: &System,
         q: &[f64],
+        v: &[f64],
         out: &mut DMatrix<f64>,
     ) -> Result<(), SolveError> {
         self.metric
-            .require_dense("Preadjustment::approximate_hessian_1")?;
+            .require_dense("Preadjustment::modified_position_hessian")?;
+        self.metric.check_v(v)?;
         let n = self.metric.n();
         if out.shape() != (n, n) {
             return Err(SolveError::Dimension {
-                what: "the approximate Hessian",
+                what: "the modified position Hessian",
                 expected: n,
                 got: out.nrows(),
             });
         }
-        self.metric.prepare(sys, q)?;
-        ModifiedS1::force_newton_hessian(&self.metric, &mut self.stiffness, sys, q, out);
+        self.s1.prepare(&mut self.metric, sys, q, v)?;
+        self.s1
+            .position_newton_hessian(&mut self.metric, &mut self.stiffness, sys, q, v, out);
         Ok(())
     }
 
@@ -302,24 +307,32 @@ impl Preadjustment {
         Ok(())
     }
 
-    /// Diagonal approximations of the `s = 1` Newton blocks at `(q, v)`, for the sparse stage
-    /// solve (`docs/symplectic.md` section 5a): `wd = diag(B)` (the velocity Hessian
-    /// `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` without its dense part) and
-    /// `ad_i = A_ii^2 / m_i` (the diagonal of `A M^-1 A`, the sparse part of `A Pi A`, with the
-    /// off-diagonal entries of `A` left out), both `O(N)`. Overwrites `wd` and `ad`.
+    /// Diagonals of the `s = 1` Newton blocks at `(q, v)`, for the sparse stage solve
+    /// (`docs/symplectic.md` section 5a), `O(N)`, overwritten: `wd = diag(B)` (the velocity
+    /// Hessian `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` without its dense part), `sd = diag(A_s)`
+    /// (`A_s = Hess V + (sigma - mu0) . Hess Phi`, the position block's stiffness) and
+    /// `ad_i = A_ii^2 / m_i` (the diagonal of `A M^-1 A`, the sparse part of `A Pi A`, with
+    /// the off-diagonal entries of `A = Hess V - mu0 . Hess Phi` left out).
     pub(crate) fn modified_newton_diagonals(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
-        wd: &mut [f64],
-        ad: &mut [f64],
+        diagonals: [&mut [f64]; 3],
     ) -> Result<(), SolveError> {
         self.metric.check_v(v)?;
         self.s1.prepare(&mut self.metric, sys, q, v)?;
         self.s1
-            .newton_diagonals(&mut self.metric, sys, q, v, wd, ad);
+            .newton_diagonals(&mut self.metric, sys, (q, v), diagonals);
         Ok(())
+    }
+
+    /// After [`Preadjustment::modified_newton_diagonals`] at `(q, v)`: the constraint weights
+    /// `sigma - mu0` of the stiffness `A_s = Hess V + (sigma - mu0) . Hess Phi` there, and the
+    /// diagonal of `M^-1` of the metric (a massless coordinate's regularised), for the sparse
+    /// position block `A_s Pi A_s` (`galerkin/sparse/projected.rs`).
+    pub(crate) fn modified_stiffness_weights(&self) -> (&[f64], &[f64]) {
+        (self.s1.stiffness_weights(), self.metric.minv())
     }
 
     /// The 23 terms of `e4(q, v)` (`E4_TERMS`, without their coefficients), at `q` with

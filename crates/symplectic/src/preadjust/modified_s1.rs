@@ -16,7 +16,7 @@ use super::metric::{ProjectedMetric, RowsAlong, Stamp};
 use super::stiffness::TangentStiffness;
 use crate::passes;
 use crate::passes::{
-    add_lagrangian_hessian_pair, add_lagrangian_hessian_pair_diagonals, LagrangianWeights,
+    add_lagrangian_hessian_diagonals, add_lagrangian_hessian_pair, LagrangianWeights,
 };
 use mbd_model::System;
 use mbd_solve::SolveError;
@@ -42,9 +42,11 @@ pub(crate) struct ModifiedS1 {
     cm: Vec<f64>,
     hv: Vec<f64>,
     d3: Vec<f64>,
-    /// The velocity and the metric's stamp of the last evaluation (0: none).
+    /// The velocity and the metric's stamp of the last evaluation (0: none), and a count of
+    /// the evaluations (the tag of `sigma` for the stiffness `A + H_sigma`).
     mv: Vec<f64>,
     mv_stamp: Stamp,
+    evaluations: u64,
     /// Scratch: n zeros (the velocity of `gamma`'s time part), `gamma(q, 0)`, m zero weights,
     /// `scale (sigma - mu0)`, `u - w`.
     zero_n: Vec<f64>,
@@ -76,6 +78,7 @@ impl ModifiedS1 {
             d3: vec![0.0; n],
             mv: vec![0.0; n],
             mv_stamp: 0,
+            evaluations: 0,
             zero_n: vec![0.0; n],
             gc0: vec![0.0; m],
             neg_v: vec![0.0; n],
@@ -194,6 +197,7 @@ impl ModifiedS1 {
         }
         self.mv.copy_from_slice(v);
         self.mv_stamp = metric.stamp();
+        self.evaluations += 1;
         // v^T (A - 3/2 Hess V) v = v^T B v - sigma . gamma_c
         let vav = dot(v, &self.hv) - gg;
         -uu / 24.0 + vav / 12.0 + gg / 24.0
@@ -269,8 +273,8 @@ impl ModifiedS1 {
     /// (`H_sigma = sum_k sigma_k Hess Phi_k`, `sigma = S^-1 gamma_c(q, v)`) and
     /// `C = [Hess Phi_k v]_k` (the derivative of `sigma` in `v`): `6 d^2 e / dv^2`, for the
     /// Newton Jacobian. One Hessian pass over the elements
-    /// ([`add_lagrangian_hessian_pair`]) also assembles `A = Hess V - mu0 . Hess Phi`
-    /// into `stiffness`, which the Newton Hessian of the force term then reuses.
+    /// ([`add_lagrangian_hessian_pair`]) also assembles `A + H_sigma` into `stiffness`, which
+    /// the position Newton block ([`ModifiedS1::position_newton_hessian`]) then reuses.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn add_velocity_hessian(
         &mut self,
@@ -283,8 +287,8 @@ impl ModifiedS1 {
         out: &mut DMatrix<f64>,
     ) {
         self.ensure_evaluated(metric, sys, q, v);
-        // one Hessian pass: out += scale B, A (kept for the force term's Newton Hessian) and
-        // C^T = (Phi_q v)_q
+        // one Hessian pass: out += scale B, A + H_sigma (kept for the position Newton block)
+        // and C^T = (Phi_q v)_q
         let (n, m) = (metric.n(), metric.m());
         for r in 0..m {
             self.scaled_cm[r] = scale * self.cm[r];
@@ -297,9 +301,9 @@ impl ModifiedS1 {
             (
                 LagrangianWeights {
                     potential: 1.0,
-                    constraints: metric.neg_mu0(),
+                    constraints: &self.cm,
                 },
-                stiffness.assemble_from_zero(metric),
+                stiffness.total_from_zero(metric, self.evaluations),
             ),
             (
                 LagrangianWeights {
@@ -356,60 +360,89 @@ impl ModifiedS1 {
         }
     }
 
-    /// The Newton Hessian of the force term `-1/24 f_T^T M^-1 f_T = -1/12 W_1`, up to its
-    /// factor: `A Pi A` at the metric's prepared point `q` into `out` (overwritten; dense
-    /// layout), with `A` from the velocity Hessian's pass when that ran at this point.
-    pub(super) fn force_newton_hessian(
-        metric: &ProjectedMetric,
+    /// The leading position Hessian of `e` at the metric's prepared point `q` and velocity `v`,
+    /// up to its factor `-1/12`: `(A + H_sigma) Pi (A + H_sigma)` into `out` (overwritten;
+    /// dense layout), with `A + H_sigma = Hess V + (sigma - mu0) . Hess Phi` from the velocity
+    /// Hessian's pass when that ran at this point. `d e / d q = 1/12 (A + H_sigma)(u - w) + ...`
+    /// and `d(u - w) = -Pi (A + H_sigma) dq + ...` (`u - w` is the acceleration;
+    /// docs/symplectic.md section 5a); the parts left out are linear in the third derivatives
+    /// of `V` and `Phi`, or in the acceleration rather than in the multipliers.
+    pub(super) fn position_newton_hessian(
+        &mut self,
+        metric: &mut ProjectedMetric,
         stiffness: &mut TangentStiffness,
         sys: &System,
         q: &[f64],
+        v: &[f64],
         out: &mut DMatrix<f64>,
     ) {
-        stiffness.ensure(metric, sys, q);
+        self.ensure_evaluated(metric, sys, q, v);
+        if !stiffness.holds_total(metric, self.evaluations) {
+            let a = stiffness.total_from_zero(metric, self.evaluations);
+            sys.potential_hessian(q, a);
+            if metric.m() > 0 {
+                sys.add_constraint_hessian(q, metric.t(), &self.cm, 1.0, a);
+            }
+        }
         stiffness.a_pi_a(metric, out);
     }
 
-    /// Diagonal approximations of the Newton blocks at the metric's point `q` (prepared by
+    /// Diagonals of the Newton blocks at the metric's point `q` (prepared by
     /// [`ModifiedS1::prepare`]) and velocity `v`, for the sparse stage solve
-    /// (`docs/symplectic.md` section 5a): `wd = diag(B)` (the velocity Hessian
-    /// `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` without its dense part) and `ad_i = A_ii^2 / m_i`
-    /// (the diagonal of `A M^-1 A`, the sparse part of `A Pi A`, with the off-diagonal entries
-    /// of `A` left out), both `O(N)`. Overwrites `wd` and `ad`.
+    /// (`docs/symplectic.md` section 5a), from one pass in `O(N)`; overwrites the three:
+    /// `wd = diag(B)` (the velocity Hessian `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` without its
+    /// dense part), `sd = diag(A_s)` of the stiffness `A_s = A + H_sigma` of the position
+    /// block, and `ad_i = A_ii^2 / m_i` (the diagonal of `A M^-1 A` with the off-diagonal
+    /// entries of `A = Hess V - mu0 . Hess Phi` left out), the position block where the exact
+    /// one does not pay (`galerkin/sparse/projected.rs`).
     pub(super) fn newton_diagonals(
         &mut self,
         metric: &mut ProjectedMetric,
         sys: &System,
-        q: &[f64],
-        v: &[f64],
-        wd: &mut [f64],
-        ad: &mut [f64],
+        (q, v): (&[f64], &[f64]),
+        [wd, sd, ad]: [&mut [f64]; 3],
     ) {
         self.ensure_evaluated(metric, sys, q, v);
         wd.fill(0.0);
+        sd.fill(0.0);
         ad.fill(0.0);
-        add_lagrangian_hessian_pair_diagonals(
+        add_lagrangian_hessian_diagonals(
             sys,
             q,
             metric.t(),
-            (
-                LagrangianWeights {
-                    potential: 1.0,
-                    constraints: metric.neg_mu0(),
-                },
-                ad,
-            ),
-            (
-                LagrangianWeights {
-                    potential: POTENTIAL_WEIGHT,
-                    constraints: &self.cm,
-                },
-                wd,
-            ),
+            [
+                (
+                    LagrangianWeights {
+                        potential: POTENTIAL_WEIGHT,
+                        constraints: &self.cm,
+                    },
+                    wd,
+                ),
+                (
+                    LagrangianWeights {
+                        potential: 1.0,
+                        constraints: &self.cm,
+                    },
+                    sd,
+                ),
+                (
+                    LagrangianWeights {
+                        potential: 1.0,
+                        constraints: metric.neg_mu0(),
+                    },
+                    &mut *ad,
+                ),
+            ],
         );
         for (a, mi) in ad.iter_mut().zip(metric.minv()) {
             *a = *a * *a * mi;
         }
+    }
+
+    /// The constraint weights `sigma - mu0` of the stiffness `A + H_sigma = Hess V +
+    /// (sigma - mu0) . Hess Phi` at the last evaluation.
+    pub(super) fn stiffness_weights(&self) -> &[f64] {
+        &self.cm
     }
 
     /// `sigma = S^-1 gamma_c` of the last evaluation (tests).
@@ -520,11 +553,12 @@ pub(crate) mod modlag_tests {
         }
     }
 
-    /// The fast `A Pi A` of the modified Lagrangian's Newton matrix
-    /// ([`Preadjustment::approximate_hessian_1`]) is the `s = 1` approximate Hessian to rounding,
-    /// and exactly symmetric.
+    /// The modified Lagrangian's position Newton block
+    /// ([`Preadjustment::modified_position_hessian`]) at `v = 0` is the `s = 1` approximate
+    /// Hessian `A Pi A` to rounding, and exactly symmetric; at a velocity it carries the
+    /// centripetal multipliers `sigma` (it differs from `A Pi A` by more than rounding).
     #[test]
-    fn approximate_hessian_1_matches_general() {
+    fn position_hessian_is_a_pi_a_at_rest() {
         for sys in [
             models::paper_a_double_pendulum().unwrap(),
             models::n_link_chain(4).unwrap(),
@@ -536,7 +570,8 @@ pub(crate) mod modlag_tests {
             let mut p = Preadjustment::new(&sys, 1).unwrap();
             let (mut a, mut b) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n));
             p.approximate_hessian(&sys, &q, &mut a).unwrap();
-            p.approximate_hessian_1(&sys, &q, &mut b).unwrap();
+            p.modified_position_hessian(&sys, &q, &vec![0.0; n], &mut b)
+                .unwrap();
             let scale = a.iter().fold(0.0f64, |x, &y| x.max(y.abs()));
             assert!(scale > 0.0);
             for i in 0..n {
@@ -550,6 +585,11 @@ pub(crate) mod modlag_tests {
                     assert_eq!(b[(i, l)], b[(l, i)]);
                 }
             }
+            // at a velocity the centripetal multipliers change the block
+            let v: Vec<f64> = (0..n).map(|i| 0.5 + 0.1 * i as f64).collect();
+            p.modified_position_hessian(&sys, &q, &v, &mut b).unwrap();
+            let diff = (&a - &b).amax();
+            assert!(diff > 1e-6 * scale, "{diff} against {scale}");
         }
     }
 

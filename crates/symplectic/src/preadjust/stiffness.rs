@@ -1,6 +1,7 @@
 //! The assembled tangential stiffness `A = Hess V - mu0 . Hess Phi` at the metric's point and
 //! the Newton matrices built from it (dense layout only): `A (Pi A)^s`, the Newton Hessian of
-//! paper A's `W_s`, and `A Pi A`, that of the s = 1 modified Lagrangian's force term.
+//! paper A's `W_s`, and `A Pi A`, which with `A + H_sigma` in place of `A` is the leading
+//! position Hessian of the s = 1 modified Lagrangian's term (docs/symplectic.md section 5a).
 //!
 //! `A` is symmetric, so its zero columns (coordinates that enter `V` and the constraints
 //! linearly, e.g. the positions of bodies with revolute joints under gravity) are zero rows
@@ -20,6 +21,11 @@ pub(crate) struct TangentStiffness {
     amat: DMatrix<f64>,
     /// The metric's stamp `amat` was assembled at (0: none).
     stamp: Stamp,
+    /// Whether `amat` holds `A + H_sigma` (the s = 1 term's stiffness along a velocity,
+    /// [`TangentStiffness::total_from_zero`]) rather than `A`, and the tag of the evaluation of
+    /// `sigma` it was assembled with.
+    with_sigma: bool,
+    sigma_tag: u64,
     /// The coordinates `K` where `A` has a nonzero column, and `|K| x |K|` blocks on them
     /// (column-major, `n x n` capacity): `A_KK`, `Pi_KK`, the running product, and `Y`
     /// (`m x |K|`) or a product.
@@ -39,6 +45,8 @@ impl TangentStiffness {
         TangentStiffness {
             amat: DMatrix::zeros(nd, nd),
             stamp: 0,
+            with_sigma: false,
+            sigma_tag: 0,
             kset: Vec::with_capacity(n),
             ka: vec![0.0; nd * nd],
             kpi: vec![0.0; nd * nd],
@@ -50,7 +58,7 @@ impl TangentStiffness {
 
     /// Assembles `A` at the metric's prepared point `q` (once per point).
     pub(super) fn ensure(&mut self, metric: &ProjectedMetric, sys: &System, q: &[f64]) {
-        if self.stamp == metric.stamp() {
+        if self.stamp == metric.stamp() && !self.with_sigma {
             return;
         }
         sys.potential_hessian(q, &mut self.amat);
@@ -59,14 +67,29 @@ impl TangentStiffness {
             sys.add_constraint_hessian(q, metric.t(), metric.mu0(), -1.0, &mut self.amat);
         }
         self.stamp = metric.stamp();
+        self.with_sigma = false;
     }
 
-    /// `A`, zeroed, for a caller that assembles it at the metric's prepared point (the s = 1
-    /// term's Hessian pass, which gives `A` with its own matrices); then kept for the point.
-    pub(super) fn assemble_from_zero(&mut self, metric: &ProjectedMetric) -> &mut DMatrix<f64> {
+    /// The matrix, zeroed, for a caller that assembles `A + H_sigma` in it at the metric's
+    /// prepared point (the s = 1 term's Hessian pass, which gives it with its own matrices);
+    /// then kept for the point, and [`TangentStiffness::ensure`] assembles `A` again.
+    /// `tag` names the evaluation of `sigma` (point and velocity) it is assembled with.
+    pub(super) fn total_from_zero(
+        &mut self,
+        metric: &ProjectedMetric,
+        tag: u64,
+    ) -> &mut DMatrix<f64> {
         self.amat.as_mut_slice().fill(0.0);
         self.stamp = metric.stamp();
+        self.with_sigma = true;
+        self.sigma_tag = tag;
         &mut self.amat
+    }
+
+    /// Whether the matrix holds `A + H_sigma` at the metric's prepared point for the
+    /// evaluation of `sigma` named `tag`.
+    pub(super) fn holds_total(&self, metric: &ProjectedMetric, tag: u64) -> bool {
+        self.with_sigma && self.stamp == metric.stamp() && self.sigma_tag == tag
     }
 
     /// A bound on the spectral radius of `M^-1 A` (Gershgorin: `max_i minv_i sum_l |A_il|`; the
@@ -171,7 +194,8 @@ impl TangentStiffness {
         }
     }
 
-    /// `A Pi A` into `out` (overwritten), after [`TangentStiffness::ensure`]:
+    /// `A Pi A` into `out` (overwritten), after [`TangentStiffness::ensure`] (or, with
+    /// `A + H_sigma` in place of `A`, after [`TangentStiffness::total_from_zero`]):
     /// [`TangentStiffness::a_pi_a_power`] with `s = 1` in fewer operations, the same matrix up
     /// to rounding and symmetric by construction. With `Z = Y A_KK` (`m x |K|`, zeros of `A_KK`
     /// skipped), `A_KK Pi_KK A_KK = A_KK M^-1_KK A_KK - Z^T Z`, so each entry of the upper
