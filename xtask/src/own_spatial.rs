@@ -509,12 +509,14 @@ fn director_drift(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
 }
 
 /// The solvers timed on the spatial chain, and whether each is expected to run there.
-const SCALING_SOLVERS: [(&str, bool); 7] = [
+const SCALING_SOLVERS: [(&str, bool); 9] = [
     ("rk4-projected", true),
     ("index1:dopri5", true),
     ("tangent:rk4", true),
     ("symplectic:2", true),
     ("symplectic:1", true),
+    ("symplectic:1:gamma=1", true),
+    ("symplectic:2:gamma=1", true),
     ("symplectic:1:modified", true),
     ("symplectic:2:modified", true),
 ];

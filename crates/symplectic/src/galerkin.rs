@@ -94,6 +94,9 @@ pub struct Galerkin {
     /// Sparse path, s = 1 modified Lagrangian: the diagonals of its Newton blocks
     /// (`Preadjustment::modified_newton_diagonals`).
     mldiag: [Vec<f64>; 3],
+    /// Sparse path with `W_s`: the diagonal stand-in for its Newton Hessian at a Gauss point
+    /// (`Preadjustment::newton_diagonal`).
+    wdiag: Vec<f64>,
     tn: [Vec<f64>; 4],
     proj: DenseCholesky,
     vm: Vec<f64>,
@@ -160,19 +163,16 @@ impl Galerkin {
                 elements.join(", ")
             )));
         }
-        // (W_s adds a dense block to the Newton matrix; the modified Lagrangian's blocks are
-        // diagonal on the sparse path: docs/symplectic.md, "Sparse stage solve")
-        let sparse_ok = options.gamma == 0.0;
-        let use_sparse = options.linear_solver.use_sparse(m) && m > 0 && sparse_ok;
-        if options.linear_solver == LinearSolver::Sparse && !sparse_ok {
-            return Err(SolveError::Unsupported(
-                "the sparse symplectic stage solve needs gamma = 0 (the Hessian of the paper's \
-                 W_s is dense); use LinearSolver::Dense or Auto"
-                    .into(),
-            ));
-        }
+        // (W_s and the modified Lagrangian add dense blocks to the Newton matrix; the sparse
+        // path takes diagonal or augmented stand-ins for them: docs/symplectic.md, "Sparse
+        // stage solve")
+        let use_sparse = options.linear_solver.use_sparse(m) && m > 0;
         let sparse = if use_sparse {
-            Some(Box::new(SparseStage::new(sys, s, modlag)?))
+            Some(Box::new(SparseStage::new(
+                sys,
+                s,
+                s == 1 && (modlag || options.gamma != 0.0),
+            )?))
         } else {
             None
         };
@@ -182,17 +182,13 @@ impl Galerkin {
         // each keeps its evaluation while its point does not move
         // (on the sparse path S is held sparse: O(N) per evaluation of the modified terms)
         let workspace = |degree: usize, sparse: bool| -> Result<Preadjustment, SolveError> {
-            let mut p = if sparse {
-                Preadjustment::new_sparse(sys)?
-            } else {
-                Preadjustment::new(sys, degree)?
-            };
+            let mut p = Preadjustment::with_layout(sys, degree, sparse)?;
             p.fd_step = options.fd_step;
             Ok(p)
         };
         let pre = if options.gamma != 0.0 {
             (0..s)
-                .map(|_| workspace(s, false))
+                .map(|_| workspace(s, use_sparse))
                 .collect::<Result<Vec<_>, _>>()?
         } else {
             Vec::new()
@@ -209,6 +205,11 @@ impl Galerkin {
             mlv: vec![0.0; nl],
             mlmid: vec![0.0; nl],
             mlvel: vec![0.0; nl],
+            wdiag: if options.gamma != 0.0 && use_sparse {
+                vec![0.0; n]
+            } else {
+                Vec::new()
+            },
             mldiag: if modlag && use_sparse && s == 1 {
                 [vec![0.0; n], vec![0.0; n], vec![0.0; n]]
             } else {

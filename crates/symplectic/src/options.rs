@@ -31,7 +31,7 @@ pub enum PreadjustMode {
     /// (`docs/symplectic.md` section 5a, derivation in `docs/modified-lagrangian.md`); for
     /// `s = 2` the `h^4` term `e4` of section 5b (23 invariant terms, exact gradients by a
     /// reverse pass; a (2,2) step costs 2.4x to 6x the plain one by instructions, more on small
-    /// models). Needs `s <= 2`, `gamma = 0`, a conservative model and the dense path.
+    /// models). Needs `s <= 2`, `gamma = 0` and a conservative model; either path.
     ModifiedLagrangian,
 }
 
@@ -82,11 +82,10 @@ pub struct SymplecticOptions {
     pub predictor_order: usize,
     /// Dense or sparse stage solve. [`LinearSolver::Auto`] (default) takes the sparse path
     /// (`O(N)` per step on a chain of `N` bodies; `docs/symplectic.md`, "Sparse stage solve")
-    /// above [`mbd_solve::SPARSE_THRESHOLD`] constraint equations when it is available: with
-    /// `gamma = 0` (the paper's `W_s` adds a dense block to the Newton matrix; the modified
-    /// Lagrangian takes the sparse path, its `s = 1` Newton blocks reduced to diagonals).
-    /// Forcing
-    /// [`LinearSolver::Sparse`] where it is not available is an error of [`crate::Galerkin::new`].
+    /// above [`mbd_solve::SPARSE_THRESHOLD`] constraint equations, with or without a
+    /// preadjustment (the dense Newton blocks of paper A's `W_s` and of the modified
+    /// Lagrangian are taken there by diagonal stand-ins or, for the (1,1) scheme where they
+    /// are not small, exactly through augmented unknowns).
     pub linear_solver: LinearSolver,
     /// Difference pairs kept by the Anderson mixing of the Newton updates (0 turns it off;
     /// default [`DEFAULT_ANDERSON_DEPTH`], at most [`MAX_ANDERSON_DEPTH`]). The mixing starts

@@ -25,7 +25,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 3.0,
-            refuses: "with gamma=G: spatial models of more than 600 equations",
+            refuses: "",
             compared: true,
         },
         SolverVariant {
@@ -36,7 +36,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: true,
             relative_cost: 8.0,
-            refuses: "with gamma=G: spatial models of more than 600 equations",
+            refuses: "",
             compared: true,
         },
         SolverVariant {

@@ -43,19 +43,21 @@ fn steps_allocate_nothing() {
 
 /// The sparse path (a 30-link chain, sparse stage LU, sparse projection): after the first
 /// steps (which size the LU's factor storage), no step allocates, with one Jacobian per step,
-/// with the Jacobian reused, and with the modified Lagrangian (s = 1, 2).
+/// with the Jacobian reused, and with the modified Lagrangian (s = 1, 2; s = 1 also at a step
+/// where its exact position block is taken, through the augmented LU).
 #[test]
 fn sparse_steps_allocate_nothing() {
     let sys = models::n_link_chain(30).unwrap();
     let s0 = State::consistent(&sys, 0.0).unwrap();
-    // (the last two: the modified Lagrangian, its workspace with S held sparse)
-    for (s, reuse, modified) in [
-        (1, false, false),
-        (2, false, false),
-        (3, false, false),
-        (2, true, false),
-        (1, false, true),
-        (2, false, true),
+    // (the last three: the modified Lagrangian, its workspace with S held sparse)
+    for (s, reuse, modified, h) in [
+        (1, false, false, 1e-3),
+        (2, false, false, 1e-3),
+        (3, false, false, 1e-3),
+        (2, true, false, 1e-3),
+        (1, false, true, 1e-3),
+        (2, false, true, 1e-3),
+        (1, false, true, 3e-2),
     ] {
         let mut opts = SymplecticOptions {
             linear_solver: LinearSolver::Sparse,
@@ -73,16 +75,16 @@ fn sparse_steps_allocate_nothing() {
         assert!(g.is_sparse());
         let mut st = s0.clone();
         for _ in 0..3 {
-            g.step(&sys, &mut st, 1e-3).unwrap();
+            g.step(&sys, &mut st, h).unwrap();
         }
         let before = mbd_testkit::allocations();
         for _ in 0..100 {
-            g.step(&sys, &mut st, 1e-3).unwrap();
+            g.step(&sys, &mut st, h).unwrap();
         }
         let n = mbd_testkit::allocations() - before;
         assert_eq!(
             n, 0,
-            "s={s} reuse={reuse} modified={modified}: {n} allocations in 100 steps"
+            "s={s} reuse={reuse} modified={modified} h={h}: {n} allocations in 100 steps"
         );
     }
     // force elements with damping: the coloured force differences allocate nothing either

@@ -103,8 +103,9 @@ fn typed_errors_s2() {
 
 /// `Preadjustment::new_sparse` (`S` held sparse) gives the dense workspace's `e4`, `e` (s = 1)
 /// and their gradients at a generic state, to round-off, on a 30-link chain, a chain of
-/// spatial rods and the spatial spring fixture (`S` over body blocks); its `W_s` methods are
-/// typed errors (the measured differences are in `docs/symplectic.md` section 5b).
+/// spatial rods and the spatial spring fixture (`S` over body blocks), and `W_s`'s value and
+/// gradient for s = 1, 2, 3 (`Preadjustment::with_layout`); its dense Hessians are typed errors
+/// (the measured differences are in `docs/symplectic.md` section 5b).
 #[test]
 fn sparse_workspace_matches_the_dense_one() {
     use mbd_model::{fixtures, models};
@@ -126,11 +127,28 @@ fn sparse_workspace_matches_the_dense_one() {
             de1 < 1e-12 && dg1 < 1e-12,
             "{name}: e {de1}, gradients {dg1}"
         );
-        let mut sparse = Preadjustment::new_sparse(&sys).unwrap();
-        let mut out = vec![0.0; q.len()];
-        match sparse.gradient(&sys, &q, &mut out) {
-            Err(SolveError::Unsupported(msg)) => assert!(msg.contains("gradient"), "{msg}"),
-            other => panic!("expected Unsupported, got {other:?}"),
+        // W_s on the sparse layout: its value and gradient are the dense workspace's
+        for s in [1, 2, 3] {
+            let mut sparse = Preadjustment::with_layout(&sys, s, true).unwrap();
+            let mut dense = Preadjustment::new(&sys, s).unwrap();
+            let (mut gs, mut gd) = (vec![0.0; q.len()], vec![0.0; q.len()]);
+            let ws = sparse.gradient(&sys, &q, &mut gs).unwrap();
+            let wd = dense.gradient(&sys, &q, &mut gd).unwrap();
+            let scale = gd.iter().fold(wd.abs(), |a, x| a.max(x.abs()));
+            let dw = (ws - wd).abs() / scale;
+            let dgr = gs
+                .iter()
+                .zip(&gd)
+                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()))
+                / scale;
+            eprintln!("{name}: W_{s} sparse - dense, relative: value {dw:.1e}, gradient {dgr:.1e}");
+            assert!(dw < 1e-10 && dgr < 1e-10, "{name}, s = {s}: {dw}, {dgr}");
+            // (the dense Hessians stay dense-only)
+            let mut h = nalgebra::DMatrix::zeros(q.len(), q.len());
+            match sparse.approximate_hessian(&sys, &q, &mut h) {
+                Err(SolveError::Unsupported(msg)) => assert!(msg.contains("dense layout"), "{msg}"),
+                other => panic!("expected Unsupported, got {other:?}"),
+            }
         }
     }
 }

@@ -242,8 +242,15 @@ fn large_spatial_models_take_the_sparse_layout() {
         let e = Galerkin::new(&sys, dense).unwrap_err().to_string();
         assert!(e.contains("600") && e.contains("dense"), "{e}");
     }
-    let e = Galerkin::new(&sys, SymplecticOptions::new(2).with_gamma(1.0))
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("600") && e.contains("W_s"), "{e}");
+    // paper A's W_s takes the sparse layout too
+    let mut g = Galerkin::new(&sys, SymplecticOptions::new(2).with_gamma(1.0)).unwrap();
+    assert!(g.is_sparse());
+    let mut st = State::consistent(&sys, 0.0).unwrap();
+    for _ in 0..2 {
+        g.step(&sys, &mut st, 1e-3).unwrap();
+    }
+    let mut phi = vec![0.0; sys.n_constraints()];
+    sys.phi(st.q.as_slice(), st.t, &mut phi);
+    let worst = phi.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    assert!(worst < 1e-12, "gamma: max |Phi| {worst}");
 }

@@ -9,7 +9,7 @@
 //! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
 //! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
 //! state in full (for comparing trajectories between builds). `MBD_LINEAR=dense|sparse` picks the symplectic scheme's
-//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off). The environment variable `MBD_H`
+//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off), `MBD_GAMMA=G` its paper-A preadjustment. The environment variable `MBD_H`
 //! overrides the step.
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
@@ -63,6 +63,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             if never {
                 o = o.with_jacobian_reuse(mbd::symplectic::JacobianReuse::Never);
+            }
+            // MBD_GAMMA=G: paper A's preadjustment W_s with gamma = G
+            if let Some(g) = std::env::var("MBD_GAMMA").ok().and_then(|g| g.parse().ok()) {
+                o = o.with_gamma(g);
             }
             // MBD_REUSE=always keeps the stage Jacobian across steps
             if std::env::var("MBD_REUSE").as_deref() == Ok("always") {

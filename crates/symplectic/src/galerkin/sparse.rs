@@ -138,9 +138,9 @@ fn colour(
 
 impl SparseStage {
     /// Pattern and symbolic analysis of the stage Jacobian of the `(s,s)` scheme on `sys`
-    /// (allocates; once per integrator); `modified`: with the s = 1 modified Lagrangian's
-    /// position block (`projected.rs`).
-    pub(super) fn new(sys: &System, s: usize, modified: bool) -> Result<Self, SolveError> {
+    /// (allocates; once per integrator); `projected`: with the (1,1) scheme's projected
+    /// stiffness block (`projected.rs`: the modified Lagrangian's position block, `W_1`'s).
+    pub(super) fn new(sys: &System, s: usize, projected: bool) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let nblocks = sys.n_body_blocks();
         let blocks: Vec<(usize, usize)> = (0..nblocks)
@@ -253,7 +253,7 @@ impl SparseStage {
             }
         }
         let lu = SparseLu::new(dim, &entries)?;
-        let proj = if modified && s == 1 {
+        let proj = if projected && s == 1 {
             Some(Box::new(projected::ProjectedStiffness::new(
                 sys,
                 (&vcol, &rstart),
@@ -546,6 +546,35 @@ impl Galerkin {
                 }
             }
         }
+        // paper A's W_s at the Gauss points: gk times the diagonal stand-in of its Newton
+        // Hessian A (Pi A)^s on the entries (momentum row (nu, i), Z_mu,i), as the force
+        // Hessians enter (the dense block would fill the LU: S^-1 couples every pair of bodies)
+        // (s = 1 with the projected block available: W_1's block A Pi A may be taken exactly
+        // below, once the dependent rows are known; its diagonal is added there otherwise)
+        let mut w1_rho = None;
+        for (j, pre) in self.pre.iter_mut().enumerate() {
+            let qj = &self.qj[j * n..(j + 1) * n];
+            pre.set_time(t + tab.c[j] * h);
+            let wd = &mut self.wdiag;
+            let rho = pre
+                .newton_diagonal(sys, qj, minv, wd)
+                .map_err(|e| with_time(e, t))?;
+            if s == 1 && sp.proj.is_some() {
+                w1_rho = Some(rho);
+                continue;
+            }
+            let vals = sp.lu.values_mut();
+            for nu in 0..s {
+                for mu in 1..=s {
+                    let ca = tab.b[j] * tab.a[j * s1 + nu] * tab.a[j * s1 + mu];
+                    let c = -h2 * ca * self.gk;
+                    let ks = &sp.k_slot[(nu * s + mu - 1) * n..(nu * s + mu) * n];
+                    for ((&k, &mi), &d) in ks.iter().zip(minv).zip(wd.iter()) {
+                        vals[k] += c * mi * d;
+                    }
+                }
+            }
+        }
         curvature::add(sp, sys, &self.qn, &self.x, tab, minv, (n, m), (t, h));
         if !sp.diag_slot.is_empty() {
             // the equations dependent at the step's end configuration are left out: their
@@ -596,6 +625,22 @@ impl Galerkin {
         // -h^4/48 A_s Pi A_s, exact through augmented unknowns where it is not small, else
         // the diagonal of A M^-1 A (projected.rs; docs/symplectic.md section 5a)
         let mut augmented = false;
+        if let (Some(rho), Some(pre)) = (w1_rho, self.pre.first_mut()) {
+            // paper A's W_1 (s = 1): gk A Pi A at the Gauss point, exact through the augmented
+            // unknowns where |c| rho^2 reaches the threshold, else its diagonal A_ii^2 / m_i
+            let c = -h2 * tab.b[0] * tab.a[0] * tab.a[1] * self.gk;
+            augmented = projected::takes_block_at(sp, rho, c);
+            if augmented {
+                let (nmu0, mass_inv) = pre.paper_stiffness_weights();
+                let at = (&self.qj[..n], t + tab.c[0] * h);
+                projected::fill(sp, sys, at, nmu0, mass_inv, minv, &self.grads[s], c);
+            } else {
+                let vals = sp.lu.values_mut();
+                for ((&k, &mi), &d) in sp.k_slot[..n].iter().zip(minv).zip(&self.wdiag) {
+                    vals[k] += c * mi * d;
+                }
+            }
+        }
         if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
             let [wd, sd, ad] = &mut self.mldiag;
             ml.set_time(t + 0.5 * h);

@@ -9,7 +9,7 @@ use mbd_solve::{ConstrainedSolve, LinearSolver, SolveError};
 /// What the symplectic scheme runs with spatial bodies: the plain (s,s) scheme on either
 /// path, singular mass matrices included (their massless coordinates' momentum rows are force
 /// balances, and the end velocity comes from the constrained solve); paper A's `W_s` (gamma)
-/// on the dense path and the modified Lagrangian on either path (a singular mass matrix
+/// and the modified Lagrangian on either path (a singular mass matrix
 /// included: the dense metric of `W_s` and the s = 1 term uses the augmented `M_W^-1`, the
 /// s = 2 term and the sparse layout a regularised diagonal on a massless director), angle
 /// drivers included (each term evaluated with the constraints frozen at its point's time;
@@ -29,8 +29,8 @@ pub(super) fn spatial_support(
     } else {
         "paper A's preadjustment W_s (gamma != 0)".to_string()
     };
-    if modlag && gamma == 0.0 && linear.use_sparse(sys.n_constraints()) {
-        // the modified Lagrangian's sparse layout: O(N), any size
+    if linear.use_sparse(sys.n_constraints()) {
+        // the sparse layout (W_s's and the modified Lagrangian's): O(N), any size
         return Ok(());
     }
     mbd_solve::refuse_large_spatial(sys, &scheme, linear)

@@ -245,8 +245,8 @@ impl ProjectedMetric {
     pub(super) fn require_dense(&self, what: &str) -> Result<(), SolveError> {
         if self.schur.is_some() {
             return Err(SolveError::Unsupported(format!(
-                "{what} needs the dense layout (Preadjustment::new); this workspace was built by \
-                 Preadjustment::new_sparse for the modified Lagrangian"
+                "{what} needs the dense layout (Preadjustment::new); this workspace holds S \
+                 sparse (Preadjustment::new_sparse, or with_layout with sparse = true)"
             )));
         }
         Ok(())

@@ -79,15 +79,17 @@ impl Preadjustment {
     /// held sparse ([`mbd_solve::sparse::ConstraintSchur`], or [`mbd_solve::sparse::BlockSchur`]
     /// with spatial bodies, whose `M^-1` is then regularised on a massless director as the
     /// s = 2 term's is on either layout): `O(N)` storage and work per evaluation on a chain of
-    /// `N` bodies (the symplectic scheme's sparse stage solve). The
-    /// `W_s` methods and the dense Hessians need the dense matrices and return
-    /// [`SolveError::Unsupported`] on it.
+    /// `N` bodies (the symplectic scheme's sparse stage solve). `W_s`'s value and gradient
+    /// ([`Preadjustment::value`], [`Preadjustment::gradient`]) work on it too, for `W_1`
+    /// (this constructor's degree; [`Preadjustment::with_layout`] for another); the dense
+    /// Hessians need the dense matrices and return [`SolveError::Unsupported`] on it.
     pub fn new_sparse(sys: &System) -> Result<Self, SolveError> {
-        // (the degree is that of W_s, which the modified Lagrangian does not use)
         Self::with_layout(sys, 1, true)
     }
 
-    fn with_layout(sys: &System, s: usize, sparse: bool) -> Result<Self, SolveError> {
+    /// A workspace for `W_s` of degree `s` (and the modified Lagrangian), with `S` held
+    /// sparse when `sparse` ([`Preadjustment::new_sparse`]) or dense ([`Preadjustment::new`]).
+    pub fn with_layout(sys: &System, s: usize, sparse: bool) -> Result<Self, SolveError> {
         if s == 0 {
             return Err(SolveError::InvalidParameter {
                 parameter: "s",
@@ -138,7 +140,6 @@ impl Preadjustment {
 
     /// `W_s(q)`.
     pub fn value(&mut self, sys: &System, q: &[f64]) -> Result<f64, SolveError> {
-        self.metric.require_dense("Preadjustment::value")?;
         self.metric.prepare(sys, q)?;
         Ok(self.paper.value(&mut self.metric, sys, q))
     }
@@ -152,7 +153,6 @@ impl Preadjustment {
         q: &[f64],
         out: &mut [f64],
     ) -> Result<f64, SolveError> {
-        self.metric.require_dense("Preadjustment::gradient")?;
         self.metric.prepare(sys, q)?;
         Ok(self.paper.gradient(&mut self.metric, sys, q, out))
     }
@@ -165,6 +165,30 @@ impl Preadjustment {
         self.metric.prepare(sys, q)?;
         self.stiffness.ensure(&self.metric, sys, q);
         Ok(self.stiffness.bound(&self.metric))
+    }
+
+    /// The diagonal stand-in for `W_s`'s Newton Hessian on the sparse stage solve at `q`
+    /// (either layout): `out_i = A_ii (w_i A_ii)^s`, the diagonal of `A (W A)^s` with `A`'s
+    /// off-diagonal entries left out and `Pi` replaced by the diagonal `w` (the caller's
+    /// inverse masses, finite on a massless coordinate), `O(N)`; returns `max_i w_i |A_ii|`, a
+    /// lower bound of the spectral radius of `W A`.
+    pub(crate) fn newton_diagonal(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        w: &[f64],
+        out: &mut [f64],
+    ) -> Result<f64, SolveError> {
+        self.metric.prepare(sys, q)?;
+        Ok(self.paper.newton_diagonal(&self.metric, sys, q, w, out))
+    }
+
+    /// After [`Preadjustment::newton_diagonal`] at `q`: the constraint weights `-mu0` of
+    /// `A = Hess V - mu0 . Hess Phi` there, and the diagonal of `M^-1` of the metric (a
+    /// massless coordinate's regularised), for `W_1`'s Newton Hessian `A Pi A` on the sparse
+    /// stage solve (`galerkin/sparse/projected.rs`).
+    pub(crate) fn paper_stiffness_weights(&self) -> (&[f64], &[f64]) {
+        (self.metric.neg_mu0(), self.metric.minv())
     }
 
     /// An approximate Hessian of `W_s` for Newton: `A (Pi A)^s` (exact at an equilibrium),

@@ -179,8 +179,8 @@ impl PaperTerm {
                     }
                 }
             }
-            // rho (S is factored densely: the W_s methods need the dense layout); with spatial
-            // bodies the augmented metric's, and h kept for its correction below
+            // rho; with spatial bodies on the dense layout the augmented metric's, and h kept
+            // for its correction below
             if metric.is_augmented() {
                 self.gam.copy_from_slice(h);
             }
@@ -196,10 +196,9 @@ impl PaperTerm {
                 metric.correct_multipliers(&self.gam, h);
             }
         } else {
-            let minv = metric.minv();
-            for k in 0..n {
-                let acc = metric.g_col_dot(k, h);
-                self.arg[k] = self.av[l + 1][k] + minv[k] * acc;
+            self.arg.copy_from_slice(&self.av[l + 1]);
+            if m > 0 {
+                metric.add_dgt_to(h, 1.0, &mut self.arg);
             }
         }
         metric.a_times(sys, q, &self.arg, out);
@@ -263,6 +262,42 @@ impl PaperTerm {
                 passes::add_constraint_third(sys, q, dir, metric.mu0(), -c, out);
             }
         }
+    }
+
+    /// The diagonal stand-in for the Newton Hessian on the sparse stage solve, at the metric's
+    /// prepared point `q`: `out_i = A_ii (w_i A_ii)^s` (the diagonal of `A (W A)^s` with the
+    /// off-diagonal entries of `A = Hess V - mu0 . Hess Phi` left out and `Pi` replaced by
+    /// the diagonal `W`: `M^-1`, or a finite stand-in on a massless coordinate), from one
+    /// diagonal pass in `O(N)`; returns `max_i w_i |A_ii|`, a lower bound of the spectral
+    /// radius of `W A` (Rayleigh quotients).
+    pub(super) fn newton_diagonal(
+        &self,
+        metric: &ProjectedMetric,
+        sys: &System,
+        q: &[f64],
+        w: &[f64],
+        out: &mut [f64],
+    ) -> f64 {
+        out.fill(0.0);
+        passes::add_lagrangian_hessian_diagonals(
+            sys,
+            q,
+            metric.t(),
+            [(
+                passes::LagrangianWeights {
+                    potential: 1.0,
+                    constraints: metric.neg_mu0(),
+                },
+                &mut *out,
+            )],
+        );
+        let mut rho = 0.0f64;
+        for (o, &wi) in out.iter_mut().zip(w) {
+            let r = wi * *o;
+            rho = rho.max(r.abs());
+            *o *= r.powi(self.s as i32);
+        }
+        rho
     }
 
     /// The Newton Hessian `A (Pi A)^s` at the metric's prepared point `q` into `out`

@@ -1,6 +1,8 @@
-//! The s = 1 modified Lagrangian's position Newton block on the sparse path, exactly and in
-//! `O(N)`: `c M^-1 A_s Pi A_s` (`A_s = Hess V + (sigma - mu0) . Hess Phi`, the stiffness of
-//! the whole multiplier; `Pi = M^-1 - M^-1 G^T S^-1 G M^-1`) is dense, but it is the Schur
+//! A projected-stiffness Newton block of the (1,1) scheme on the sparse path, exactly and in
+//! `O(N)`: `c M^-1 A_s Pi A_s`, the s = 1 modified Lagrangian's position block
+//! (`A_s = Hess V + (sigma - mu0) . Hess Phi`, the stiffness of the whole multiplier) or paper
+//! A's `W_1` Newton Hessian (`A_s = A = Hess V - mu0 . Hess Phi`, `c = -h^2 a b gk` of the
+//! one Gauss point), with `Pi = M^-1 - M^-1 G^T S^-1 G M^-1`. It is dense, but it is the Schur
 //! complement of a sparse block: with `n + m` more unknowns `y`, `z` the stage Jacobian gets
 //! the rows
 //!
@@ -15,17 +17,17 @@
 //! augmented matrix is as sparse as the stage Jacobian and its LU stays `O(N)` on chains.
 //!
 //! Its LU costs two to three times the stage Jacobian's, and the block only pays where it is
-//! not small against the identity: its norm is at most `c rho^2` (`c = h^4 / 48`, `rho` a
-//! Gershgorin bound of `M^-1 A_s`). A Jacobian whose bound is below
-//! [`PROJECTED_BLOCK_THRESHOLD`] factors the stage matrix alone, with the diagonal
-//! `c A_s,ii^2 / m_i` in the block's place.
+//! not small against the identity: its norm is `|c| rho^2` (`c = -h^4 / 48` for the modified
+//! Lagrangian, `rho` the spectral radius of `M^-1 A_s`). A Jacobian whose bound is below
+//! [`PROJECTED_BLOCK_THRESHOLD`] factors the stage matrix alone, with a diagonal in the
+//! block's place.
 
 use super::{SparseStage, NONE};
 use mbd_model::System;
 use mbd_solve::linalg::LuError;
 use mbd_solve::sparse::SparseLu;
 
-/// The bound `c rho^2` on the position block's norm (against the identity of the stage
+/// The bound `|c| rho^2` on the block's norm (against the identity of the stage
 /// Jacobian) from which a Jacobian takes the exact block. Below it the diagonal leaves a
 /// chord iteration that contracts by about this factor or better; measured (1000 steps of
 /// `h = 1e-3` and `1e-2`, docs/symplectic.md section 5a) the exact block saved no iteration
@@ -213,18 +215,21 @@ impl ProjectedStiffness {
     }
 }
 
-/// Whether a Jacobian takes the exact position block: `c rho^2 >= PROJECTED_BLOCK_THRESHOLD`
-/// with `rho = max_i mass_inv_i |A_s,ii|` from the diagonal `sd` of `A_s` (a lower bound of the
-/// spectral radius of `M^-1 A_s`: each term is a Rayleigh quotient of `M^-1/2 A_s M^-1/2`).
-pub(super) fn takes_block(sp: &SparseStage, sd: &[f64], mass_inv: &[f64], c: f64) -> bool {
-    if sp.proj.is_none() {
-        return false;
-    }
-    let rho = sd
+/// Whether a Jacobian takes the exact position block: `|c| rho^2 >= PROJECTED_BLOCK_THRESHOLD`
+/// with `rho = max_i w_i |A_ii|` from the diagonal `diag` of the block's stiffness and the
+/// inverse masses `w` (a lower bound of the spectral radius of `M^-1 A`: each term is a
+/// Rayleigh quotient of `M^-1/2 A M^-1/2`).
+pub(super) fn takes_block(sp: &SparseStage, diag: &[f64], w: &[f64], c: f64) -> bool {
+    let rho = diag
         .iter()
-        .zip(mass_inv)
-        .fold(0.0f64, |r, (&a, &mi)| r.max(a.abs() * mi));
-    c.abs() * rho * rho >= PROJECTED_BLOCK_THRESHOLD
+        .zip(w)
+        .fold(0.0f64, |r, (&a, &wi)| r.max(a.abs() * wi));
+    takes_block_at(sp, rho, c)
+}
+
+/// [`takes_block`] from the bound `rho` itself.
+pub(super) fn takes_block_at(sp: &SparseStage, rho: f64, c: f64) -> bool {
+    sp.proj.is_some() && c.abs() * rho * rho >= PROJECTED_BLOCK_THRESHOLD
 }
 
 /// The position block's stiffness `A_s = Hess V + cm . Hess Phi` at the chord midpoint `q`
@@ -250,8 +255,8 @@ fn assemble(sp: &mut SparseStage, sys: &System, (q, t): (&[f64], f64), cm: &[f64
 }
 
 /// Where [`takes_block`] holds: the stage Jacobian just filled in `sp.lu` (not factored) goes
-/// into the augmented matrix with `A_s` at the chord midpoint `q` (time `t`, constraint
-/// weights `cm`), `c minv_rows A_s` in the momentum rows, `-M` (`M = 1 / mass_inv`, the
+/// into the augmented matrix with `A_s = Hess V + cm . Hess Phi` at `q` (time `t`; the chord
+/// midpoint, which for s = 1 is the Gauss point), `c minv_rows A_s` in the momentum rows, `-M` (`M = 1 / mass_inv`, the
 /// metric's regularised inverse) and `G` (the end point's local gradients `grads`); a row
 /// dropped as dependent (`dep`) pins its `z`.
 #[allow(clippy::too_many_arguments)]
