@@ -214,19 +214,30 @@ fn a_stall_at_a_singular_configuration_does_not_advise_a_smaller_h() {
     assert!(stops > 0, "no run stopped: nothing was checked");
 }
 
-/// Above `DENSE_SPATIAL_LIMIT` equations a spatial model takes the modified Lagrangian on the
-/// sparse layout (a 70-rod chain, 630 equations: it builds, takes the sparse path and steps
-/// with the constraints at round-off), while paper A's `W_s`, whose Newton block is dense, and
-/// the modified Lagrangian forced onto the dense path are refused with the limit named.
+/// Above `DENSE_SPATIAL_LIMIT` equations a spatial model takes the modified Lagrangian and
+/// paper A's `W_s` on the sparse layout (a 70-rod chain, 630 equations: each builds, takes the
+/// sparse path and steps with the constraints at round-off), while either forced onto the
+/// dense path is refused with the limit named.
 #[test]
 fn large_spatial_models_take_the_sparse_layout() {
     use mbd_solve::LinearSolver;
     let sys = models::spatial_chain(70).unwrap();
     assert!(sys.n_constraints() > mbd_solve::DENSE_SPATIAL_LIMIT);
-    for s in [1, 2] {
-        let o = SymplecticOptions::new(s).with_preadjust(PreadjustMode::ModifiedLagrangian);
+    // the modified Lagrangian (s = 1, 2) and paper A's W_s (gamma) take the sparse layout
+    let ml = PreadjustMode::ModifiedLagrangian;
+    for (name, o) in [
+        (
+            "modified (1,1)",
+            SymplecticOptions::new(1).with_preadjust(ml),
+        ),
+        (
+            "modified (2,2)",
+            SymplecticOptions::new(2).with_preadjust(ml),
+        ),
+        ("(2,2) gamma = 1", SymplecticOptions::new(2).with_gamma(1.0)),
+    ] {
         let mut g = Galerkin::new(&sys, o).unwrap();
-        assert!(g.is_sparse(), "s = {s}");
+        assert!(g.is_sparse(), "{name}");
         let mut st = State::consistent(&sys, 0.0).unwrap();
         for _ in 0..2 {
             g.step(&sys, &mut st, 1e-3).unwrap();
@@ -234,23 +245,13 @@ fn large_spatial_models_take_the_sparse_layout() {
         let mut phi = vec![0.0; sys.n_constraints()];
         sys.phi(st.q.as_slice(), st.t, &mut phi);
         let worst = phi.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        assert!(worst < 1e-12, "s = {s}: max |Phi| {worst}");
+        assert!(worst < 1e-12, "{name}: max |Phi| {worst}");
+        // the dense layout refuses the size, naming it
         let dense = SymplecticOptions {
             linear_solver: LinearSolver::Dense,
             ..o
         };
         let e = Galerkin::new(&sys, dense).unwrap_err().to_string();
-        assert!(e.contains("600") && e.contains("dense"), "{e}");
+        assert!(e.contains("600") && e.contains("dense"), "{name}: {e}");
     }
-    // paper A's W_s takes the sparse layout too
-    let mut g = Galerkin::new(&sys, SymplecticOptions::new(2).with_gamma(1.0)).unwrap();
-    assert!(g.is_sparse());
-    let mut st = State::consistent(&sys, 0.0).unwrap();
-    for _ in 0..2 {
-        g.step(&sys, &mut st, 1e-3).unwrap();
-    }
-    let mut phi = vec![0.0; sys.n_constraints()];
-    sys.phi(st.q.as_slice(), st.t, &mut phi);
-    let worst = phi.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-    assert!(worst < 1e-12, "gamma: max |Phi| {worst}");
 }
