@@ -381,7 +381,7 @@ impl Galerkin {
     /// Solves the factored stage Jacobian in place.
     fn solve_stage(&mut self, b: &mut [f64]) {
         match &mut self.sparse {
-            // (with the modified Lagrangian's position block: its augmented matrix)
+            // (where the last Jacobian took the projected block: its augmented matrix)
             Some(sp) => match sp.proj.as_deref_mut().filter(|p| p.is_active()) {
                 Some(p) => p.solve_in_place(b),
                 None => sp.lu.solve_in_place(b),

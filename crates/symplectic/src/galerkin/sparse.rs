@@ -98,8 +98,8 @@ pub(super) struct SparseStage {
     gm: Vec<f64>,
     /// `Phi_q^T lambda` (scratch of the residual and the end momentum).
     pub(super) al: Vec<f64>,
-    /// The s = 1 modified Lagrangian's position Newton block, as `n + m` more unknowns
-    /// (`projected.rs`).
+    /// The (1,1) scheme's projected stiffness block (the modified Lagrangian's position block
+    /// or `W_1`'s Newton Hessian), as `n + m` more unknowns (`projected.rs`).
     pub(super) proj: Option<Box<projected::ProjectedStiffness>>,
     /// `Phi_q v` (scratch of the projection).
     pub(super) pv: Vec<f64>,
@@ -619,17 +619,17 @@ impl Galerkin {
                 }
             }
         }
-        // the s = 1 modified Lagrangian (after the dependent rows are known): the diagonal of
-        // the velocity block of galerkin/dense.rs, -h^2/12 (2 B), on the entries (i, Z_1,i)
-        // (its dense part through S^-1 is left out), and the position block
-        // -h^4/48 A_s Pi A_s, exact through augmented unknowns where it is not small, else
-        // the diagonal of A M^-1 A (projected.rs; docs/symplectic.md section 5a)
+        // the (1,1) scheme's projected blocks, after the dependent rows are known
+        // (projected.rs): this Jacobian factors the augmented matrix only if one takes it
         let mut augmented = false;
+        if let Some(p) = sp.proj.as_deref_mut() {
+            p.deactivate();
+        }
         if let (Some(rho), Some(pre)) = (w1_rho, self.pre.first_mut()) {
             // paper A's W_1 (s = 1): gk A Pi A at the Gauss point, exact through the augmented
             // unknowns where |c| rho^2 reaches the threshold, else its diagonal A_ii^2 / m_i
             let c = -h2 * tab.b[0] * tab.a[0] * tab.a[1] * self.gk;
-            augmented = projected::takes_block_at(sp, rho, c);
+            augmented = projected::takes_block(sp, rho, c);
             if augmented {
                 let (nmu0, mass_inv) = pre.paper_stiffness_weights();
                 let at = (&self.qj[..n], t + tab.c[0] * h);
@@ -642,13 +642,19 @@ impl Galerkin {
             }
         }
         if let Some(ml) = self.ml.first_mut().filter(|_| s == 1) {
+            // the s = 1 modified Lagrangian: the diagonal of the velocity block of
+            // galerkin/dense.rs, -h^2/12 (2 B), on the entries (i, Z_1,i) (its dense part
+            // through S^-1 is left out), and the position block -h^4/48 A_s Pi A_s, exact
+            // through the augmented unknowns where it is not small, else the diagonal of
+            // A M^-1 A (docs/symplectic.md section 5a)
             let [wd, sd, ad] = &mut self.mldiag;
             ml.set_time(t + 0.5 * h);
-            ml.modified_newton_diagonals(sys, &self.mlmid, &self.mlvel, [wd, sd, ad])
+            let rho = ml
+                .modified_newton_diagonals(sys, &self.mlmid, &self.mlvel, [wd, sd, ad])
                 .map_err(|e| with_time(e, t))?;
             let (cw, c) = (-h2 / 12.0, -(h2 * h2) / 48.0);
             let (cm, mass_inv) = ml.modified_stiffness_weights();
-            augmented = projected::takes_block(sp, sd, mass_inv, c);
+            augmented = projected::takes_block(sp, rho, c);
             let vals = sp.lu.values_mut();
             for i in 0..n {
                 let pos = if augmented { 0.0 } else { c * ad[i] };
@@ -657,8 +663,6 @@ impl Galerkin {
             if augmented {
                 let mid = (self.mlmid.as_slice(), t + 0.5 * h);
                 projected::fill(sp, sys, mid, cm, mass_inv, minv, &self.grads[s], c);
-            } else if let Some(p) = sp.proj.as_deref_mut() {
-                p.deactivate();
             }
         }
         self.jacobians += 1;

@@ -336,19 +336,21 @@ impl Preadjustment {
     /// Hessian `6 d^2 e / dv^2 = B + 2 C S^-1 C^T` without its dense part), `sd = diag(A_s)`
     /// (`A_s = Hess V + (sigma - mu0) . Hess Phi`, the position block's stiffness) and
     /// `ad_i = A_ii^2 / m_i` (the diagonal of `A M^-1 A`, the sparse part of `A Pi A`, with
-    /// the off-diagonal entries of `A = Hess V - mu0 . Hess Phi` left out).
+    /// the off-diagonal entries of `A = Hess V - mu0 . Hess Phi` left out). Returns
+    /// `max_i m_i^-1 |A_s,ii|` (the metric's `M^-1`), a lower bound of the spectral radius of
+    /// `M^-1 A_s`.
     pub(crate) fn modified_newton_diagonals(
         &mut self,
         sys: &System,
         q: &[f64],
         v: &[f64],
         diagonals: [&mut [f64]; 3],
-    ) -> Result<(), SolveError> {
+    ) -> Result<f64, SolveError> {
         self.metric.check_v(v)?;
         self.s1.prepare(&mut self.metric, sys, q, v)?;
-        self.s1
-            .newton_diagonals(&mut self.metric, sys, (q, v), diagonals);
-        Ok(())
+        Ok(self
+            .s1
+            .newton_diagonals(&mut self.metric, sys, (q, v), diagonals))
     }
 
     /// After [`Preadjustment::modified_newton_diagonals`] at `(q, v)`: the constraint weights

@@ -394,14 +394,14 @@ impl ModifiedS1 {
     /// dense part), `sd = diag(A_s)` of the stiffness `A_s = A + H_sigma` of the position
     /// block, and `ad_i = A_ii^2 / m_i` (the diagonal of `A M^-1 A` with the off-diagonal
     /// entries of `A = Hess V - mu0 . Hess Phi` left out), the position block where the exact
-    /// one does not pay (`galerkin/sparse/projected.rs`).
+    /// one does not pay (`galerkin/sparse/projected.rs`). Returns `max_i m_i^-1 |A_s,ii|`.
     pub(super) fn newton_diagonals(
         &mut self,
         metric: &mut ProjectedMetric,
         sys: &System,
         (q, v): (&[f64], &[f64]),
         [wd, sd, ad]: [&mut [f64]; 3],
-    ) {
+    ) -> f64 {
         self.ensure_evaluated(metric, sys, q, v);
         wd.fill(0.0);
         sd.fill(0.0);
@@ -423,7 +423,7 @@ impl ModifiedS1 {
                         potential: 1.0,
                         constraints: &self.cm,
                     },
-                    sd,
+                    &mut *sd,
                 ),
                 (
                     LagrangianWeights {
@@ -437,6 +437,9 @@ impl ModifiedS1 {
         for (a, mi) in ad.iter_mut().zip(metric.minv()) {
             *a = *a * *a * mi;
         }
+        sd.iter()
+            .zip(metric.minv())
+            .fold(0.0f64, |r, (&a, &mi)| r.max(a.abs() * mi))
     }
 
     /// The constraint weights `sigma - mu0` of the stiffness `A + H_sigma = Hess V +

@@ -215,20 +215,10 @@ impl ProjectedStiffness {
     }
 }
 
-/// Whether a Jacobian takes the exact position block: `|c| rho^2 >= PROJECTED_BLOCK_THRESHOLD`
-/// with `rho = max_i w_i |A_ii|` from the diagonal `diag` of the block's stiffness and the
-/// inverse masses `w` (a lower bound of the spectral radius of `M^-1 A`: each term is a
-/// Rayleigh quotient of `M^-1/2 A M^-1/2`).
-pub(super) fn takes_block(sp: &SparseStage, diag: &[f64], w: &[f64], c: f64) -> bool {
-    let rho = diag
-        .iter()
-        .zip(w)
-        .fold(0.0f64, |r, (&a, &wi)| r.max(a.abs() * wi));
-    takes_block_at(sp, rho, c)
-}
-
-/// [`takes_block`] from the bound `rho` itself.
-pub(super) fn takes_block_at(sp: &SparseStage, rho: f64, c: f64) -> bool {
+/// Whether a Jacobian takes the exact block: `|c| rho^2 >= PROJECTED_BLOCK_THRESHOLD`, with
+/// `rho = max_i w_i |A_ii|` from the diagonal pass of the block's stiffness (a lower bound of
+/// the spectral radius of `M^-1 A`: each term is a Rayleigh quotient of `M^-1/2 A M^-1/2`).
+pub(super) fn takes_block(sp: &SparseStage, rho: f64, c: f64) -> bool {
     sp.proj.is_some() && c.abs() * rho * rho >= PROJECTED_BLOCK_THRESHOLD
 }
 
@@ -256,8 +246,8 @@ fn assemble(sp: &mut SparseStage, sys: &System, (q, t): (&[f64], f64), cm: &[f64
 
 /// Where [`takes_block`] holds: the stage Jacobian just filled in `sp.lu` (not factored) goes
 /// into the augmented matrix with `A_s = Hess V + cm . Hess Phi` at `q` (time `t`; the chord
-/// midpoint, which for s = 1 is the Gauss point), `c minv_rows A_s` in the momentum rows, `-M` (`M = 1 / mass_inv`, the
-/// metric's regularised inverse) and `G` (the end point's local gradients `grads`); a row
+/// midpoint, which for s = 1 is the Gauss point), `c minv_rows A_s` in the momentum rows,
+/// `-M` (`M = 1 / mass_inv`, the metric's regularised inverse) and `G` (the end point's local gradients `grads`); a row
 /// dropped as dependent (`dep`) pins its `z`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn fill(
