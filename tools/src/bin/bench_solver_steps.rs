@@ -9,14 +9,14 @@
 //! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
 //! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
 //! state in full (for comparing trajectories between builds). `MBD_LINEAR=dense|sparse` picks the symplectic scheme's
-//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off), `MBD_GAMMA=G` its paper-A preadjustment. The environment variable `MBD_H`
+//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off), `MBD_GAMMA=G` its paper-A preadjustment, `MBD_TANGENT_MATRIX=interpolated|broyden` the tangent chart's chord matrix (default: the centre's). The environment variable `MBD_H`
 //! overrides the step.
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
 use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, State};
 use mbd::symplectic::{Galerkin, SymplecticOptions};
-use mbd::tangent::TangentRk;
+use mbd::tangent::{IterationMatrix, TangentRk};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -42,7 +42,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (mut integ, h): (Box<dyn Integrator>, f64) = match solver.as_str() {
         "rk4" => (Box::new(Rk4::new(&sys, Rk4Options::plain())?), 1e-3),
         "rk4-projected" => (Box::new(Rk4::new(&sys, Rk4Options::projected())?), 1e-3),
-        "tangent-rk4" => (Box::new(TangentRk::rk4(&sys)?), 1e-3),
+        "tangent-rk4" => {
+            // MBD_TANGENT_MATRIX=interpolated|broyden picks the chord iteration's matrix
+            let mut opts = mbd::tangent::TangentOptions::default();
+            match std::env::var("MBD_TANGENT_MATRIX").as_deref() {
+                Ok("interpolated") => opts.iteration_matrix = IterationMatrix::Interpolated,
+                Ok("broyden") => opts.iteration_matrix = IterationMatrix::Broyden,
+                _ => {}
+            }
+            let t = TangentRk::new(&sys, ButcherTableau::rk4(), opts)?;
+            (Box::new(t), 1e-3)
+        }
         other if other.starts_with("symplectic") || other.starts_with("modified") => {
             // symplecticS / modifiedS, `-never`: a new stage Jacobian at every step
             let (name, never) = match other.strip_suffix("-never") {

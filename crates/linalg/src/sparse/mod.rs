@@ -10,4 +10,4 @@ mod cholesky;
 mod lu;
 
 pub use cholesky::SparseCholesky;
-pub use lu::{SparseLu, SPARSE_PIVOT_TOL};
+pub use lu::{ColumnOrder, SparseLu, SPARSE_PIVOT_TOL};

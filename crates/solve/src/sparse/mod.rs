@@ -27,7 +27,7 @@ pub(crate) use bodies::SparseBodySchur;
 pub use accel::SparseAccelerationSolver;
 pub use block_rows::{BlockRows, RowSide};
 pub use block_schur::BlockSchur;
-pub use mbd_linalg::{SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};
+pub use mbd_linalg::{ColumnOrder, SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};
 pub use schur::{ConstraintSchur, RowIncidence};
 
 /// Constraint count above which [`LinearSolver::Auto`] picks the sparse path (index-1 solve,

@@ -25,7 +25,7 @@
 use super::{SparseStage, NONE};
 use mbd_model::System;
 use mbd_solve::linalg::LuError;
-use mbd_solve::sparse::SparseLu;
+use mbd_solve::sparse::{ColumnOrder, SparseLu};
 
 /// The bound `|c| rho^2` on the block's norm (against the identity of the stage
 /// Jacobian) from which a Jacobian takes the exact block. Below it the diagonal leaves a
@@ -153,7 +153,7 @@ impl ProjectedStiffness {
                 all.push((z0 + r, z0 + r));
             }
         }
-        let lu = SparseLu::new(2 * (n + m), &all)?;
+        let lu = SparseLu::with_order(2 * (n + m), &all, ColumnOrder::SymmetricAmd)?;
         let mut map = vec![NONE; base.nnz()];
         for &(r, c) in entries {
             if let (Some(k), Some(ka)) = (base.slot(r, c), lu.slot(r, c)) {
