@@ -1,7 +1,7 @@
 //! # mbd
 //!
-//! Planar rigid multibody systems as differential-algebraic equations, with the solvers of three
-//! papers and the analysis that measures them. This facade holds the front door
+//! Planar and spatial rigid multibody systems as differential-algebraic equations, with the
+//! solvers of three papers and the analysis that measures them. This facade holds the front door
 //! ([`Simulation`]) and the solver registry ([`registry`]) and re-exports the workspace's
 //! crates; depend on a single crate (e.g. `mbd-model` + `mbd-rk4`) if you need only part of it.
 //!

@@ -52,7 +52,7 @@ point; drag to orbit, wheel to zoom, double-click to reset the view). Open the p
 browser; append #t=1.25 to its address to open it paused at t = 1.25 s, and on the 3D page
 &az=30&el=20&zoom=1.5 to set the camera (degrees).";
 
-/// `mbd`: simulate planar rigid multibody systems from model files.
+/// `mbd`: simulate planar and spatial rigid multibody systems from model files.
 #[derive(Debug, Parser)]
 #[command(name = "mbd", version, about, after_help = MAIN_EXAMPLE)]
 pub struct Cli {

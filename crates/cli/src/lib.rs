@@ -1,6 +1,6 @@
 //! # mbd-cli
 //!
-//! The `mbd` command-line program: simulate planar rigid multibody models from model files
+//! The `mbd` command-line program: simulate planar and spatial rigid multibody models from model files
 //! (`docs/model-files.md`) with any solver of the workspace, and look at the results.
 //!
 //! * `mbd run MODEL --solver SOLVER --t-end T (--h H | --tol TOL) [--out FILE.csv|FILE.json]

@@ -1,6 +1,7 @@
 //! # mbd-model
 //!
-//! Planar rigid multibody systems in absolute Cartesian coordinates, ready for DAE solvers.
+//! Planar and spatial rigid multibody systems in absolute Cartesian coordinates, ready for DAE
+//! solvers.
 //!
 //! Body `i` has coordinates `q_i = (x_i, y_i, theta_i)` (centre of mass and rotation); spatial
 //! bodies ([`spatial`]) follow the planar ones with 12 natural coordinates each

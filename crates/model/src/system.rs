@@ -101,7 +101,9 @@ pub struct JointElement<'a> {
     pub row: usize,
 }
 
-/// A validated planar multibody system in absolute coordinates `q = (x_i, y_i, theta_i)_i`.
+/// A validated multibody system in absolute coordinates: `(x_i, y_i, theta_i)` per planar body,
+/// then the centre of mass and three unit directors (12 coordinates) per spatial body and the
+/// position (3) per spatial point mass (docs/spatial.md).
 ///
 /// All evaluation methods take slices of length [`System::n_coords`] (`q`, `v`) or
 /// [`System::n_constraints`] (`lambda`) and write into caller-provided buffers, so hot loops

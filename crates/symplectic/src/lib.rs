@@ -1,7 +1,7 @@
 //! # mbd-symplectic
 //!
-//! Paper A's parameter-preadjusted symplectic algorithm for planar rigid multibody systems in
-//! absolute coordinates: the (s,s) constrained Galerkin variational integrator, the preadjusted
+//! Paper A's parameter-preadjusted symplectic algorithm for planar and spatial rigid multibody
+//! systems in absolute coordinates: the (s,s) constrained Galerkin variational integrator, the preadjusted
 //! Lagrangian `L_gamma = T - V - gamma kappa_s h^(2s) W_s(q)`, and the calibration of
 //! `gamma_opt` (`docs/symplectic.md` in the repository gives the stage equations in section 2,
 //! `W_s` in section 5 and the calibration in section 6).

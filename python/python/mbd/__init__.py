@@ -1,4 +1,4 @@
-"""mbd: planar rigid multibody dynamics as DAEs, from Python.
+"""mbd: planar and spatial rigid multibody dynamics as DAEs, from Python.
 
 The Rust library ``mbd`` (the solvers of three papers and an RK4 baseline) behind a small API:
 
