@@ -24,6 +24,11 @@ use mbd_model::System;
 use nalgebra::DMatrix;
 
 /// The workspace of the body-eliminated solve (see the module documentation).
+///
+/// `Phi_q` is dense, but each of its rows acts on a few body blocks (at most two for a joint), and
+/// `C` is block-diagonal: the products below visit only the blocks a row acts on, in the
+/// order of their columns, so they add the same nonzero terms in the same order as the dense
+/// products they replace (and give the same bits) at the cost of the blocks alone.
 #[derive(Debug)]
 pub(crate) struct BodySchur {
     n: usize,
@@ -31,19 +36,27 @@ pub(crate) struct BodySchur {
     pub(crate) phi_q: DMatrix<f64>,
     /// The external rows (all but the spatial internal constraints).
     rows: Vec<usize>,
+    /// Each external row's blocks as (first column, width, block), in column order.
+    row_blocks: Vec<Vec<(usize, usize, usize)>>,
+    /// Per body block, the external rows acting on it (ascending).
+    block_rows: Vec<Vec<usize>>,
+    /// Every body block as (first column, width, block).
+    blocks: Vec<(usize, usize, usize)>,
     /// The internal constraints' rows `r0..r0 + 6 ns`, the spatial bodies' coordinates
-    /// `q0..qp` and the point masses' `qp..n`.
+    /// `q0..qp` and the point masses' `qp..n`, and the first spatial body's block.
     r0: usize,
     q0: usize,
     qp: usize,
+    spatial_block: usize,
     /// Each spatial body's elimination at the last factorisation.
     rigid: Vec<RigidSolve>,
-    /// `C Phi_e^T` (column `e`: `C` applied to external row `e`).
-    c_rows: DMatrix<f64>,
+    /// `Phi_e^T` and `C Phi_e^T` (`n x me`, column-major: column `e` is external row `e`
+    /// contiguous, and `C` applied to it; both zero outside the row's blocks).
+    pe: Vec<f64>,
+    c_rows: Vec<f64>,
     /// The factorisation of `S`.
     pub(crate) chol: DenseCholesky,
     x: Vec<f64>,
-    y: Vec<f64>,
     /// The external multipliers.
     le: Vec<f64>,
 }
@@ -54,21 +67,63 @@ impl BodySchur {
         let (m, n) = (sys.n_constraints(), sys.n_coords());
         let internal = sys.spatial_internal_rows();
         let rows: Vec<usize> = (0..m).filter(|r| !internal.contains(r)).collect();
+        // each row's blocks from its element-local form; a row whose blocks could not be
+        // matched to the model's (which a validated model does not have) acts on all of them
+        let all: Vec<(usize, usize, usize)> = (0..sys.n_body_blocks())
+            .filter_map(|b| sys.body_block(b).map(|(c, w)| (c, w, b)))
+            .collect();
+        let mut of_row: Vec<Option<Vec<(usize, usize, usize)>>> = vec![None; m];
+        let q = sys.initial_guess().0;
+        sys.local_rows_gamma(q.as_slice(), None, 0.0, |r, sides, _| {
+            let blocks: Option<Vec<_>> = sides
+                .iter()
+                .flatten()
+                .map(|&(b, g)| {
+                    sys.body_block(b)
+                        .filter(|&(_, w)| w == g.len())
+                        .map(|(c, w)| (c, w, b))
+                })
+                .collect();
+            if let Some(slot) = of_row.get_mut(r) {
+                *slot = blocks;
+            }
+        });
+        let row_blocks: Vec<Vec<(usize, usize, usize)>> = rows
+            .iter()
+            .map(|&r| {
+                let mut b = of_row[r].take().unwrap_or_else(|| all.clone());
+                b.sort_unstable();
+                b.dedup();
+                b
+            })
+            .collect();
+        let mut block_rows = vec![Vec::new(); sys.n_body_blocks()];
+        for (e, blocks) in row_blocks.iter().enumerate() {
+            for &(_, _, b) in blocks {
+                block_rows[b].push(e);
+            }
+        }
         let mut chol = DenseCholesky::new(rows.len());
         chol.set_max_dependent(sys.n_redundant());
+        let q0 = sys.spatial_offset();
         BodySchur {
             n,
             phi_q: DMatrix::zeros(m, n),
-            c_rows: DMatrix::zeros(n, rows.len()),
+            pe: vec![0.0; n * rows.len()],
+            c_rows: vec![0.0; n * rows.len()],
             le: vec![0.0; rows.len()],
             rows,
+            row_blocks,
+            block_rows,
+            blocks: all,
             r0: internal.start,
-            q0: sys.spatial_offset(),
+            q0,
             qp: sys.spatial_point_mass_offset(),
+            // planar bodies' blocks (3 coordinates each) come first
+            spatial_block: q0 / 3,
             rigid: Vec::with_capacity(sys.spatial_bodies().len()),
             chol,
             x: vec![0.0; n],
-            y: vec![0.0; n],
         }
     }
 
@@ -102,26 +157,51 @@ impl BodySchur {
                 .map_err(|e| BodyFactorError::Body(b.name.clone(), e.to_string()))?;
             self.rigid.push(r);
         }
-        let me = self.rows.len();
-        let mut row = std::mem::take(&mut self.x);
-        let mut crow = std::mem::take(&mut self.y);
-        for e in 0..me {
-            for (k, x) in row.iter_mut().enumerate() {
-                *x = self.phi_q[(self.rows[e], k)];
-            }
-            self.apply_c(w, &row, &mut crow);
-            self.c_rows.column_mut(e).copy_from_slice(&crow);
-        }
-        (self.x, self.y) = (row, crow);
-        let s = self.chol.values_mut();
-        for j in 0..me {
-            for i in 0..me {
-                let ri = self.rows[i];
-                let mut acc = 0.0;
-                for k in 0..self.n {
-                    acc += self.phi_q[(ri, k)] * self.c_rows[(k, j)];
+        let (n, me) = (self.n, self.rows.len());
+        // Phi_e^T and C Phi_e^T on each row's blocks (C is block-diagonal; the rest of each
+        // column stays 0)
+        for (e, blocks) in self.row_blocks.iter().enumerate() {
+            let re = self.rows[e];
+            let (pe, ce) = (
+                &mut self.pe[e * n..(e + 1) * n],
+                &mut self.c_rows[e * n..(e + 1) * n],
+            );
+            for &(col, width, _) in blocks {
+                for k in col..col + width {
+                    pe[k] = self.phi_q[(re, k)];
                 }
-                s[i + j * me] = acc;
+                if (self.q0..self.qp).contains(&col) {
+                    let fb: [f64; 12] = std::array::from_fn(|l| pe[col + l]);
+                    let cb = self.rigid[(col - self.q0) / 12].apply_inverse_mass(&fb);
+                    ce[col..col + 12].copy_from_slice(&cb);
+                } else {
+                    for k in col..col + width {
+                        ce[k] = w[k] * pe[k];
+                    }
+                }
+            }
+        }
+        // S = Phi_e C Phi_e^T: rows i and j meet only on the blocks both act on, visited in
+        // column order (the order of the dense product's nonzero terms)
+        let s = self.chol.values_mut();
+        s[..me * me].fill(0.0);
+        for (b, rows) in self.block_rows.iter().enumerate() {
+            if rows.is_empty() {
+                continue;
+            }
+            let Some(&(col, width, _)) = self.blocks.iter().find(|x| x.2 == b) else {
+                continue;
+            };
+            for &j in rows {
+                let cj = &self.c_rows[j * n + col..j * n + col + width];
+                for &i in rows {
+                    let pi = &self.pe[i * n + col..i * n + col + width];
+                    let mut acc = s[i + j * me];
+                    for (p, c) in pi.iter().zip(cj) {
+                        acc += p * c;
+                    }
+                    s[i + j * me] = acc;
+                }
             }
         }
         self.chol.factor_in_place().map_err(|e| {
@@ -160,11 +240,14 @@ impl BodySchur {
         }
         // S lambda_e = Phi_e x - r_e
         let mut le = std::mem::take(&mut self.le);
+        let n = self.n;
         for (e, le) in le.iter_mut().enumerate() {
-            let re = self.rows[e];
-            let mut acc = -r[re];
-            for k in 0..self.n {
-                acc += self.phi_q[(re, k)] * x[k];
+            let mut acc = -r[self.rows[e]];
+            let pe = &self.pe[e * n..(e + 1) * n];
+            for &(col, width, _) in &self.row_blocks[e] {
+                for (p, xk) in pe[col..col + width].iter().zip(&x[col..col + width]) {
+                    acc += p * xk;
+                }
             }
             *le = acc;
         }
@@ -173,21 +256,31 @@ impl BodySchur {
         for (e, &l) in le.iter().enumerate() {
             lambda[self.rows[e]] = l;
         }
-        for k in 0..self.n {
-            let mut acc = x[k];
-            for (e, &l) in le.iter().enumerate() {
-                acc -= self.c_rows[(k, e)] * l;
+        // a = x - C Phi_e^T lambda_e: on each block, the rows acting on it
+        a[..self.n].copy_from_slice(&x[..self.n]);
+        for (b, rows) in self.block_rows.iter().enumerate() {
+            if rows.is_empty() {
+                continue;
             }
-            a[k] = acc;
+            let Some(&(col, width, _)) = self.blocks.iter().find(|x| x.2 == b) else {
+                continue;
+            };
+            for (k, ak) in a.iter_mut().enumerate().skip(col).take(width) {
+                let mut acc = *ak;
+                for &e in rows {
+                    acc -= self.c_rows[k + e * n] * le[e];
+                }
+                *ak = acc;
+            }
         }
         // each body's internal multipliers from its own rows: G^T mu = f - Phi_e^T lambda_e - M a
         for (b, rigid) in self.rigid.iter().enumerate() {
             let o = self.q0 + 12 * b;
             let mut g: [f64; 12] = std::array::from_fn(|l| f[o + l]);
-            for (e, &l) in le.iter().enumerate() {
-                let re = self.rows[e];
-                for (k, gk) in g.iter_mut().enumerate() {
-                    *gk -= self.phi_q[(re, o + k)] * l;
+            for &e in &self.block_rows[self.spatial_block + b] {
+                let (pe, l) = (&self.pe[e * n + o..e * n + o + 12], le[e]);
+                for (gk, p) in g.iter_mut().zip(pe) {
+                    *gk -= p * l;
                 }
             }
             let ab: [f64; 12] = std::array::from_fn(|l| a[o + l]);
