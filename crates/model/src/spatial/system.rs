@@ -13,7 +13,7 @@
 
 use super::body::{SpatialBody, SpatialBodyRef};
 use super::forces::SpatialForce;
-use super::joints::{SpatialFrame, SpatialJoint};
+use super::joints::{MarkerAt, SpatialFrame, SpatialJoint};
 use super::point_mass::{as_side, SpatialPointMass};
 use hessians::ConstantHessians;
 use mbd_jet::{DirJetN, Scalar};
@@ -330,10 +330,14 @@ impl SpatialPart {
         t: f64,
         mut visit: impl FnMut(usize, [Option<usize>; 2], &DirJetN<SW>),
     ) {
+        // scratch for every element: the rows' jets and the markers'
+        let mut e = [DirJetN::<SW>::cst(0.0); 6];
+        let mut markers = [MarkerAt::ZERO_JETS; 2];
         for (item, sides, row, n) in self.items() {
             if let (Item::Internal, Some(k)) = (item, sides[0]) {
                 // in closed form: the generic jets spend most of a solve's time here
-                for (r, jet) in self.internal_jets(q, v, k).iter().enumerate() {
+                self.internal_jets_into(q, v, k, &mut e);
+                for (r, jet) in e.iter().enumerate() {
                     visit(row + r, sides, jet);
                 }
                 continue;
@@ -342,8 +346,7 @@ impl SpatialPart {
                 continue;
             };
             let [la, lb] = sides.map(|k| k.map(|k| self.local_state(k, q, v)));
-            let mut e = [DirJetN::<SW>::cst(0.0); 6];
-            self.lowered[j].eval_jets(as_side(&la), as_side(&lb), &mut e);
+            self.lowered[j].eval_jets_with(as_side(&la), as_side(&lb), &mut markers, &mut e);
             if let Some([theta, dth, ddth]) = self.angle(j, t) {
                 // Phi = E(q, theta(t)): d/dt = E_q v + E_theta theta', and the second
                 // derivative v^T E_qq v + 2 theta' E_theta,q v + theta'^2 E_theta,theta +
@@ -369,6 +372,19 @@ impl SpatialPart {
     /// `d1 = d_i . d_i'`, `d2 = |d_i'|^2`; `d_i . d_j` has gradient `d_j` on `i` and `d_i` on
     /// `j`, `d1 = d_i' . d_j + d_i . d_j'`, `d2 = 2 d_i' . d_j'`.
     fn internal_jets(&self, q: &[f64], v: Option<&[f64]>, k: usize) -> [DirJetN<SW>; 6] {
+        let mut out = [DirJetN::<SW>::cst(0.0); 6];
+        self.internal_jets_into(q, v, k, &mut out);
+        out
+    }
+
+    /// [`SpatialPart::internal_jets`] written into `out`.
+    fn internal_jets_into(
+        &self,
+        q: &[f64],
+        v: Option<&[f64]>,
+        k: usize,
+        out: &mut [DirJetN<SW>; 6],
+    ) {
         let o = self.q0 + 12 * k;
         let d: [[f64; 3]; 3] =
             std::array::from_fn(|i| std::array::from_fn(|c| q[o + 3 + 3 * i + c]));
@@ -377,27 +393,21 @@ impl SpatialPart {
         });
         let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
         const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
-        PAIRS.map(|(i, j)| {
-            let mut g = [0.0; SW];
+        for (jet, (i, j)) in out.iter_mut().zip(PAIRS) {
+            jet.g = [0.0; SW];
             if i == j {
-                g[3 + 3 * i..6 + 3 * i].copy_from_slice(&d[i]);
-                DirJetN {
-                    v: 0.5 * (dot(&d[i], &d[i]) - 1.0),
-                    g,
-                    d1: dot(&d[i], &dd[i]),
-                    d2: dot(&dd[i], &dd[i]),
-                }
+                jet.g[3 + 3 * i..6 + 3 * i].copy_from_slice(&d[i]);
+                jet.v = 0.5 * (dot(&d[i], &d[i]) - 1.0);
+                jet.d1 = dot(&d[i], &dd[i]);
+                jet.d2 = dot(&dd[i], &dd[i]);
             } else {
-                g[3 + 3 * i..6 + 3 * i].copy_from_slice(&d[j]);
-                g[3 + 3 * j..6 + 3 * j].copy_from_slice(&d[i]);
-                DirJetN {
-                    v: dot(&d[i], &d[j]),
-                    g,
-                    d1: dot(&dd[i], &d[j]) + dot(&d[i], &dd[j]),
-                    d2: 2.0 * dot(&dd[i], &dd[j]),
-                }
+                jet.g[3 + 3 * i..6 + 3 * i].copy_from_slice(&d[j]);
+                jet.g[3 + 3 * j..6 + 3 * j].copy_from_slice(&d[i]);
+                jet.v = dot(&d[i], &d[j]);
+                jet.d1 = dot(&dd[i], &d[j]) + dot(&d[i], &dd[j]);
+                jet.d2 = 2.0 * dot(&dd[i], &dd[j]);
             }
-        })
+        }
     }
 
     /// For every spatial row at time `t`: `visit(row, sides, gradient, (Phi_q v + Phi_t)_q)`
@@ -481,9 +491,14 @@ impl SpatialPart {
         g: &[f64; SW],
         out: &mut DMatrix<f64>,
     ) {
-        for (l, &x) in g.iter().enumerate() {
-            if let Some(c) = self.col(sides, l) {
-                out[(row, c)] += x;
+        // per side: its block's columns (the first `w` of the side's 12 local variables)
+        for (side, k) in sides.iter().enumerate() {
+            let Some(k) = *k else {
+                continue;
+            };
+            let (o, w) = self.slot_block(k);
+            for (l, &x) in g[12 * side..12 * side + w].iter().enumerate() {
+                out[(row, o + l)] += x;
             }
         }
     }

@@ -146,53 +146,46 @@ impl Marker {
 impl Marker {
     /// [`Marker::on`] with the jets of an element's 24 local variables, in closed form (the
     /// point and axes are linear in the side's coordinates, so the generic jet arithmetic is
-    /// not needed): side `side` (0 or 1) with local coordinates and velocities `qv`, or ground
-    /// (`None`).
-    pub(crate) fn on_jets(
+    /// not needed), written into `out`: side `side` (0 or 1) with local coordinates and
+    /// velocities `qv`, or ground (`None`). Without `axes` only the point is written (the
+    /// joints that read no axis take no time over them).
+    pub(crate) fn on_jets_into(
         &self,
         side: usize,
         qv: Option<(&[f64], &[f64])>,
         axes: bool,
-    ) -> MarkerAt<DirJetN<24>> {
+        out: &mut MarkerAt<DirJetN<24>>,
+    ) {
         // the global vector `c0 x + sum_i u_i d_i` as three jets
-        let linear = |c0: f64, u: [f64; 3]| -> [DirJetN<24>; 3] {
-            std::array::from_fn(|c| match qv {
-                // ground: the origin and the global axes
-                None => DirJetN::cst(u[c]),
-                Some((q, v)) => {
-                    let o = 12 * side;
-                    let mut g = [0.0; 24];
-                    g[o + c] = c0;
-                    let (mut val, mut d1) = (c0 * q[c], c0 * v[c]);
-                    for i in 0..3 {
-                        g[o + 3 + 3 * i + c] = u[i];
-                        val += u[i] * q[3 + 3 * i + c];
-                        d1 += u[i] * v[3 + 3 * i + c];
-                    }
-                    DirJetN {
-                        v: val,
-                        g,
-                        d1,
-                        d2: 0.0,
+        let linear = |c0: f64, u: [f64; 3], out: &mut [DirJetN<24>; 3]| {
+            for (c, jet) in out.iter_mut().enumerate() {
+                match qv {
+                    // ground: the origin and the global axes
+                    None => *jet = DirJetN::cst(u[c]),
+                    Some((q, v)) => {
+                        let o = 12 * side;
+                        jet.g = [0.0; 24];
+                        jet.g[o + c] = c0;
+                        let (mut val, mut d1) = (c0 * q[c], c0 * v[c]);
+                        for i in 0..3 {
+                            jet.g[o + 3 + 3 * i + c] = u[i];
+                            val += u[i] * q[3 + 3 * i + c];
+                            d1 += u[i] * v[3 + 3 * i + c];
+                        }
+                        (jet.v, jet.d1, jet.d2) = (val, d1, 0.0);
                     }
                 }
-            })
+            }
         };
-        let axis = |k: usize| {
-            if axes {
+        linear(1.0, self.point, &mut out.p);
+        if axes {
+            for (k, axis) in [&mut out.x, &mut out.y, &mut out.z].into_iter().enumerate() {
                 linear(
                     0.0,
                     [self.axes[(0, k)], self.axes[(1, k)], self.axes[(2, k)]],
-                )
-            } else {
-                [DirJetN::cst(0.0); 3]
+                    axis,
+                );
             }
-        };
-        MarkerAt {
-            p: linear(1.0, self.point),
-            x: axis(0),
-            y: axis(1),
-            z: axis(2),
         }
     }
 }
@@ -204,6 +197,24 @@ pub(crate) struct MarkerAt<T> {
     pub(crate) x: [T; 3],
     pub(crate) y: [T; 3],
     pub(crate) z: [T; 3],
+}
+
+impl MarkerAt<DirJetN<24>> {
+    /// Every component the zero constant (scratch for [`SpatialJoint::eval_jets_with`]).
+    pub(crate) const ZERO_JETS: Self = {
+        let z = DirJetN {
+            v: 0.0,
+            g: [0.0; 24],
+            d1: 0.0,
+            d2: 0.0,
+        };
+        MarkerAt {
+            p: [z; 3],
+            x: [z; 3],
+            y: [z; 3],
+            z: [z; 3],
+        }
+    };
 }
 
 /// The kinds of spatial joint (see the module documentation for their equations).
@@ -422,9 +433,25 @@ impl SpatialJoint {
         b: Option<(&[f64], &[f64])>,
         out: &mut [DirJetN<24>; 6],
     ) {
+        let mut markers = [MarkerAt::ZERO_JETS; 2];
+        self.eval_jets_with(a, b, &mut markers, out);
+    }
+
+    /// [`SpatialJoint::eval_jets`] with the markers' jets in `markers` (scratch a caller that
+    /// evaluates many joints keeps, so that they are not built anew for each): a joint that
+    /// reads no axis writes only the points, and its equations read only those.
+    pub(crate) fn eval_jets_with(
+        &self,
+        a: Option<(&[f64], &[f64])>,
+        b: Option<(&[f64], &[f64])>,
+        markers: &mut [MarkerAt<DirJetN<24>>; 2],
+        out: &mut [DirJetN<24>; 6],
+    ) {
         let axes = self.uses_axes();
-        let (ma, mb) = (self.a.on_jets(0, a, axes), self.b.on_jets(1, b, axes));
-        self.eval_at(&ma, &mb, out);
+        let [ma, mb] = markers;
+        self.a.on_jets_into(0, a, axes, ma);
+        self.b.on_jets_into(1, b, axes, mb);
+        self.eval_at(ma, mb, out);
     }
 
     /// The equations at the markers `ma`, `mb` (global components).
