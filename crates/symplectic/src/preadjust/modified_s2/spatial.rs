@@ -23,7 +23,7 @@ use mbd_model::{Basis, System, MAX_DIRS};
 
 /// The element-local width of a spatial row: twelve columns per side (a point mass uses three).
 const W: usize = 24;
-/// A local column that no coordinate fills.
+/// The `slot` of a constraint row that is not a spatial row.
 const NONE: usize = usize::MAX;
 
 /// One spatial row at the set's `q`.
@@ -31,8 +31,9 @@ const NONE: usize = usize::MAX;
 struct Row {
     /// The row's index in `Phi`.
     r: usize,
-    /// The coordinate of each local column ([`NONE`] where the side is ground or narrower).
-    cols: [usize; W],
+    /// Each side's first coordinate and width (0 for ground): local column `12 s + l` is
+    /// coordinate `o + l` for `l < width`, and no coordinate past it.
+    sides: [(usize, usize); 2],
     /// `g_r` in local columns.
     g: [f64; W],
     /// `H_r`'s nonzeros `(row coordinate, column coordinate, value)` at the set's time.
@@ -42,23 +43,25 @@ struct Row {
 }
 
 impl Row {
+    /// `x . d` over the row's local columns (side by side, in column order).
     fn dot(&self, x: &[f64; W], d: &[f64]) -> f64 {
         let mut s = 0.0;
-        for (l, &c) in self.cols.iter().enumerate() {
-            if c != NONE {
-                s += x[l] * d[c];
+        for (side, &(o, w)) in self.sides.iter().enumerate() {
+            for (xl, dl) in x[12 * side..12 * side + w].iter().zip(&d[o..o + w]) {
+                s += xl * dl;
             }
         }
         s
     }
 
+    /// `out += c x` on the row's coordinates.
     fn scatter(&self, c: f64, x: &[f64; W], out: &mut [f64]) {
         if c == 0.0 {
             return;
         }
-        for (l, &k) in self.cols.iter().enumerate() {
-            if k != NONE {
-                out[k] += c * x[l];
+        for (side, &(o, w)) in self.sides.iter().enumerate() {
+            for (ol, xl) in out[o..o + w].iter_mut().zip(&x[12 * side..12 * side + w]) {
+                *ol += c * xl;
             }
         }
     }
@@ -139,7 +142,7 @@ impl SpatialRowSet {
             }
             let mut row = Row {
                 r,
-                cols: [NONE; W],
+                sides: [(0, 0); 2],
                 g: [0.0; W],
                 nz: Vec::new(),
                 timed: false,
@@ -151,10 +154,9 @@ impl SpatialRowSet {
                 let Some((o, _)) = sys.body_block(*block) else {
                     continue;
                 };
-                for l in 0..g.len().min(12) {
-                    row.cols[12 * s + l] = o + l;
-                    row.g[12 * s + l] = g[l];
-                }
+                let w = g.len().min(12);
+                row.sides[s] = (o, w);
+                row.g[12 * s..12 * s + w].copy_from_slice(&g[..w]);
             }
             rows.push(row);
         });
