@@ -8,8 +8,8 @@
 //! `manipulator` (the default), `slider_crank`, `four_bar`, `chainK` (a K-link chain: above 24
 //! links the index-1 solve takes the sparse path), `spatialK` (a chain of K spatial rods on
 //! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
-//! state in full (for comparing trajectories between builds). `MBD_LINEAR=dense|sparse` picks the symplectic scheme's
-//! path (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off), `MBD_GAMMA=G` its paper-A preadjustment, `MBD_TANGENT_MATRIX=interpolated|broyden` the tangent chart's chord matrix (default: the centre's). The environment variable `MBD_H`
+//! state in full (for comparing trajectories between builds). `MBD_LINEAR=dense|sparse` picks the
+//! linear-algebra path of RK4, tangent RK4 and the symplectic scheme (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off), `MBD_GAMMA=G` its paper-A preadjustment, `MBD_TANGENT_MATRIX=interpolated|broyden` the tangent chart's chord matrix (default: the centre's). The environment variable `MBD_H`
 //! overrides the step.
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
@@ -17,6 +17,15 @@ use mbd::rk4::{Rk4, Rk4Options};
 use mbd::solve::{ButcherTableau, Index1Options, Index1Rk, Integrator, State};
 use mbd::symplectic::{Galerkin, SymplecticOptions};
 use mbd::tangent::{IterationMatrix, TangentRk};
+
+/// The linear-algebra path `MBD_LINEAR=dense|sparse` asks for (default: automatic).
+fn linear() -> mbd::solve::LinearSolver {
+    match std::env::var("MBD_LINEAR").as_deref() {
+        Ok("dense") => mbd::solve::LinearSolver::Dense,
+        Ok("sparse") => mbd::solve::LinearSolver::Sparse,
+        _ => mbd::solve::LinearSolver::Auto,
+    }
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -40,11 +49,32 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let s0 = State::consistent(&sys, 0.0)?;
     let (mut integ, h): (Box<dyn Integrator>, f64) = match solver.as_str() {
-        "rk4" => (Box::new(Rk4::new(&sys, Rk4Options::plain())?), 1e-3),
-        "rk4-projected" => (Box::new(Rk4::new(&sys, Rk4Options::projected())?), 1e-3),
+        "rk4" => (
+            Box::new(Rk4::new(
+                &sys,
+                Rk4Options {
+                    linear: linear(),
+                    ..Rk4Options::plain()
+                },
+            )?),
+            1e-3,
+        ),
+        "rk4-projected" => (
+            Box::new(Rk4::new(
+                &sys,
+                Rk4Options {
+                    linear: linear(),
+                    ..Rk4Options::projected()
+                },
+            )?),
+            1e-3,
+        ),
         "tangent-rk4" => {
             // MBD_TANGENT_MATRIX=interpolated|broyden picks the chord iteration's matrix
-            let mut opts = mbd::tangent::TangentOptions::default();
+            let mut opts = mbd::tangent::TangentOptions {
+                linear_solver: linear(),
+                ..Default::default()
+            };
             match std::env::var("MBD_TANGENT_MATRIX").as_deref() {
                 Ok("interpolated") => opts.iteration_matrix = IterationMatrix::Interpolated,
                 Ok("broyden") => opts.iteration_matrix = IterationMatrix::Broyden,
