@@ -189,7 +189,7 @@ impl BodySchur {
             if rows.is_empty() {
                 continue;
             }
-            let Some(&(col, width, _)) = self.blocks.iter().find(|x| x.2 == b) else {
+            let Some(&(col, width, _)) = block_of(&self.blocks, b) else {
                 continue;
             };
             for &j in rows {
@@ -262,7 +262,7 @@ impl BodySchur {
             if rows.is_empty() {
                 continue;
             }
-            let Some(&(col, width, _)) = self.blocks.iter().find(|x| x.2 == b) else {
+            let Some(&(col, width, _)) = block_of(&self.blocks, b) else {
                 continue;
             };
             for (k, ak) in a.iter_mut().enumerate().skip(col).take(width) {
@@ -290,6 +290,15 @@ impl BodySchur {
         self.x = x;
         self.le = le;
     }
+}
+
+/// Body block `b` of `blocks` (the model's blocks as (first column, width, block), in order, so
+/// block `b` is normally at `b`).
+fn block_of(blocks: &[(usize, usize, usize)], b: usize) -> Option<&(usize, usize, usize)> {
+    blocks
+        .get(b)
+        .filter(|x| x.2 == b)
+        .or_else(|| blocks.iter().find(|x| x.2 == b))
 }
 
 /// Why [`BodySchur::factor`] failed.
