@@ -367,17 +367,10 @@ impl SpatialPart {
         }
     }
 
-    /// Body `k`'s six internal constraints as the jets [`SpatialPart::rows`] gives (local
+    /// Body `k`'s six internal constraints, written into `out` as the jets [`SpatialPart::rows`] gives (local
     /// variables `0..12`): `1/2 (|d_i|^2 - 1)` has gradient `d_i` on director `i`,
     /// `d1 = d_i . d_i'`, `d2 = |d_i'|^2`; `d_i . d_j` has gradient `d_j` on `i` and `d_i` on
     /// `j`, `d1 = d_i' . d_j + d_i . d_j'`, `d2 = 2 d_i' . d_j'`.
-    fn internal_jets(&self, q: &[f64], v: Option<&[f64]>, k: usize) -> [DirJetN<SW>; 6] {
-        let mut out = [DirJetN::<SW>::cst(0.0); 6];
-        self.internal_jets_into(q, v, k, &mut out);
-        out
-    }
-
-    /// [`SpatialPart::internal_jets`] written into `out`.
     fn internal_jets_into(
         &self,
         q: &[f64],
@@ -436,15 +429,17 @@ impl SpatialPart {
         mut visit: impl FnMut(usize, [Option<usize>; 2], &[f64; SW], &[f64; SW]),
     ) {
         const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+        // scratch for every element (as in `rows_spatial`)
+        let (mut e, mut es) = ([DirJetN::<SW>::cst(0.0); 6], [DirJetN::<SW>::cst(0.0); 6]);
+        let mut markers = [MarkerAt::ZERO_JETS; 2];
         for (item, sides, row, n) in self.items() {
             if let (Item::Internal, Some(k)) = (item, sides[0]) {
-                // in closed form (see `internal_jets`): the Hessian of 1/2 |d_i|^2 is the
+                // in closed form (see `internal_jets_into`): the Hessian of 1/2 |d_i|^2 is the
                 // identity on director i, that of d_i . d_j pairs directors i and j
                 let o = self.q0 + 12 * k;
                 let dv = |i: usize| &v[o + 3 + 3 * i..o + 6 + 3 * i];
-                for (r, (jet, (i, j))) in
-                    self.internal_jets(q, None, k).iter().zip(PAIRS).enumerate()
-                {
+                self.internal_jets_into(q, None, k, &mut e);
+                for (r, (jet, (i, j))) in e.iter().zip(PAIRS).enumerate() {
                     let mut dg = [0.0; SW];
                     dg[3 + 3 * i..6 + 3 * i].copy_from_slice(dv(j));
                     if i != j {
@@ -464,9 +459,9 @@ impl SpatialPart {
                 l.map(|(ql, vl)| (std::array::from_fn(|i| ql[i] + vl[i]), [0.0; 12]))
             };
             let (sa, sb) = (shift(&la), shift(&lb));
-            let (mut e, mut es) = ([DirJetN::<SW>::cst(0.0); 6], [DirJetN::<SW>::cst(0.0); 6]);
-            self.lowered[j].eval_jets(as_side(&la), as_side(&lb), &mut e);
-            self.lowered[j].eval_jets(as_side(&sa), as_side(&sb), &mut es);
+            let joint = &self.lowered[j];
+            joint.eval_jets_with(as_side(&la), as_side(&lb), &mut markers, &mut e);
+            joint.eval_jets_with(as_side(&sa), as_side(&sb), &mut markers, &mut es);
             self.combine_angle(j, t, &mut e);
             self.combine_angle(j, t, &mut es);
             // an angle driver's Phi_tq = theta' E_theta,q (e[1] after the combination)

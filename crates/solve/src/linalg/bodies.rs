@@ -40,8 +40,8 @@ pub(crate) struct BodySchur {
     row_blocks: Vec<Vec<(usize, usize, usize)>>,
     /// Per body block, the external rows acting on it (ascending).
     block_rows: Vec<Vec<usize>>,
-    /// Every body block as (first column, width, block).
-    blocks: Vec<(usize, usize, usize)>,
+    /// Every body block's first column and width, by block.
+    blocks: Vec<(usize, usize)>,
     /// The internal constraints' rows `r0..r0 + 6 ns`, the spatial bodies' coordinates
     /// `q0..qp` and the point masses' `qp..n`, and the first spatial body's block.
     r0: usize,
@@ -69,8 +69,13 @@ impl BodySchur {
         let rows: Vec<usize> = (0..m).filter(|r| !internal.contains(r)).collect();
         // each row's blocks from its element-local form; a row whose blocks could not be
         // matched to the model's (which a validated model does not have) acts on all of them
-        let all: Vec<(usize, usize, usize)> = (0..sys.n_body_blocks())
-            .filter_map(|b| sys.body_block(b).map(|(c, w)| (c, w, b)))
+        let blocks: Vec<(usize, usize)> = (0..sys.n_body_blocks())
+            .map(|b| sys.body_block(b).unwrap_or((0, 0)))
+            .collect();
+        let all: Vec<(usize, usize, usize)> = blocks
+            .iter()
+            .enumerate()
+            .map(|(b, &(c, w))| (c, w, b))
             .collect();
         let mut of_row: Vec<Option<Vec<(usize, usize, usize)>>> = vec![None; m];
         let q = sys.initial_guess().0;
@@ -115,7 +120,7 @@ impl BodySchur {
             rows,
             row_blocks,
             block_rows,
-            blocks: all,
+            blocks,
             r0: internal.start,
             q0,
             qp: sys.spatial_point_mass_offset(),
@@ -186,12 +191,7 @@ impl BodySchur {
         let s = self.chol.values_mut();
         s[..me * me].fill(0.0);
         for (b, rows) in self.block_rows.iter().enumerate() {
-            if rows.is_empty() {
-                continue;
-            }
-            let Some(&(col, width, _)) = block_of(&self.blocks, b) else {
-                continue;
-            };
+            let (col, width) = self.blocks[b];
             for &j in rows {
                 let cj = &self.c_rows[j * n + col..j * n + col + width];
                 for &i in rows {
@@ -259,12 +259,7 @@ impl BodySchur {
         // a = x - C Phi_e^T lambda_e: on each block, the rows acting on it
         a[..self.n].copy_from_slice(&x[..self.n]);
         for (b, rows) in self.block_rows.iter().enumerate() {
-            if rows.is_empty() {
-                continue;
-            }
-            let Some(&(col, width, _)) = block_of(&self.blocks, b) else {
-                continue;
-            };
+            let (col, width) = self.blocks[b];
             for (k, ak) in a.iter_mut().enumerate().skip(col).take(width) {
                 let mut acc = *ak;
                 for &e in rows {
@@ -290,15 +285,6 @@ impl BodySchur {
         self.x = x;
         self.le = le;
     }
-}
-
-/// Body block `b` of `blocks` (the model's blocks as (first column, width, block), in order, so
-/// block `b` is normally at `b`).
-fn block_of(blocks: &[(usize, usize, usize)], b: usize) -> Option<&(usize, usize, usize)> {
-    blocks
-        .get(b)
-        .filter(|x| x.2 == b)
-        .or_else(|| blocks.iter().find(|x| x.2 == b))
 }
 
 /// Why [`BodySchur::factor`] failed.
