@@ -69,7 +69,7 @@ pub use error::{FactorError, LinalgError, LuError};
 pub use householder::{form_q_padded, mul_r, qr_padded, reflect, solve_r, solve_rt};
 pub use lu::{DenseLu, PIVOT_THRESHOLD, PIVOT_TOL};
 pub use semidefinite::DEPENDENT_PIVOT_TOL;
-pub use sparse::{ColumnOrder, SparseCholesky, SparseLu, SPARSE_PIVOT_TOL};
+pub use sparse::{ColumnOrder, SparseCholesky, SparseLu, REFACTOR_PIVOT_RATIO, SPARSE_PIVOT_TOL};
 
 use faer::dyn_stack::MemBuffer;
 

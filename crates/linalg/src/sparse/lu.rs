@@ -2,18 +2,18 @@
 //! pivoting, columns in a COLAMD order), with power-of-two equilibration and a scale-invariant
 //! pivot test.
 
+use super::lu_factors::LuFactors;
+pub use super::lu_factors::REFACTOR_PIVOT_RATIO;
 use crate::{pow2_inverse, LinalgError, LuError, Scratch};
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::lu::simplicial::{
-    factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
-    solve_in_place_scratch, SimplicialLu,
+    factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch, SimplicialLu,
 };
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams};
 use faer::sparse::linalg::{LuError as FaerLuError, SupernodalThreshold};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par};
 
 /// A pivot of the equilibrated matrix at most this (times the dimension) counts as zero.
 pub const SPARSE_PIVOT_TOL: f64 = 1e-14;
@@ -28,10 +28,15 @@ const EQUILIBRATION_SWEEPS: usize = 1;
 /// The pattern is given once to [`SparseLu::new`], which computes a fill-reducing column order
 /// (COLAMD) and allocates every buffer. A caller then writes values through
 /// [`SparseLu::slot`] / [`SparseLu::values_mut`], calls [`SparseLu::factor`] and
-/// [`SparseLu::solve_in_place`]. The numeric factorisation is faer's simplicial left-looking LU
-/// with partial pivoting; its factors live in storage that is reused from one factorisation to
-/// the next, so after the first factorisation neither `factor` nor `solve_in_place` allocates
-/// (unless a different pivot sequence needs more fill than any earlier one).
+/// [`SparseLu::solve_in_place`]. The first numeric factorisation is faer's simplicial
+/// left-looking LU with partial pivoting. Every later one first refactors the new values along
+/// that pivot sequence (no pivot search and no search for the pattern, which the pivot sequence
+/// and the pattern of `A` fix); a pivot below [`REFACTOR_PIVOT_RATIO`] times the largest entry
+/// under it in its column, or below the singularity floor, rejects the refactorisation, and the
+/// matrix is factored afresh with partial pivoting (whose pivot sequence the next
+/// refactorisation follows). The factors live in storage that is reused from one factorisation
+/// to the next, so after the first factorisation neither `factor` nor `solve_in_place`
+/// allocates (unless a new pivot sequence fills more than twice the first one).
 ///
 /// **Equilibration and singularity test.** The matrix factored is `D_r A D_c`: every row,
 /// then every column of the row-scaled matrix, is scaled by the power of two that brings its
@@ -76,9 +81,15 @@ pub struct SparseLu {
     row_perm: Vec<usize>,
     row_perm_inv: Vec<usize>,
     lu: SimplicialLu<usize, f64>,
+    /// The factors in this type's storage (solves and refactorisations along the last pivot
+    /// sequence, `lu_factors.rs`), and the permuted right-hand side of a solve.
+    factors: LuFactors,
+    y: Vec<f64>,
     mem: Scratch,
     factored: bool,
     factorizations: usize,
+    /// Factorisations done afresh with partial pivoting (the rest were refactorisations).
+    pivoted: usize,
     /// Relative pivot threshold of the equilibrated matrix (default [`SPARSE_PIVOT_TOL`]).
     pub pivot_tol: f64,
 }
@@ -132,6 +143,13 @@ impl SparseLu {
         entries: &[(usize, usize)],
         order: ColumnOrder,
     ) -> Result<Self, LinalgError> {
+        if u32::try_from(n).is_err() {
+            // (the factors store their row indices as u32, half the memory traffic of a solve)
+            return Err(LinalgError::Analysis(format!(
+                "sparse LU: dimension {n} above the largest supported, {}",
+                u32::MAX
+            )));
+        }
         let mut e: Vec<(usize, usize)> = Vec::with_capacity(entries.len());
         for &(r, c) in entries {
             if r >= n || c >= n {
@@ -179,10 +197,7 @@ impl SparseLu {
                 ColumnOrder::SymmetricAmd => symmetric_amd(sym.as_ref())?,
             }
         };
-        let req = StackReq::any_of(&[
-            factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n),
-            solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
-        ]);
+        let req = factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n);
         let nnz = row_idx.len();
         Ok(SparseLu {
             n,
@@ -198,9 +213,12 @@ impl SparseLu {
             row_perm: (0..n).collect(),
             row_perm_inv: (0..n).collect(),
             lu: SimplicialLu::new(),
+            factors: LuFactors::new(n),
+            y: vec![0.0; n],
             mem: Scratch(MemBuffer::new(req)),
             factored: false,
             factorizations: 0,
+            pivoted: 0,
             pivot_tol: SPARSE_PIVOT_TOL,
         })
     }
@@ -217,10 +235,7 @@ impl SparseLu {
 
     /// Entries of `L` and `U` of the last successful factorisation (0 before it).
     pub fn factor_nnz(&self) -> usize {
-        if self.lu.nrows() == 0 {
-            return 0;
-        }
-        self.lu.l_factor_unsorted().compute_nnz() + self.lu.u_factor_unsorted().compute_nnz()
+        self.factors.nnz()
     }
 
     /// Number of numeric factorisations attempted.
@@ -335,6 +350,19 @@ impl SparseLu {
                 self.scaled[k] = values[k] * rs[row_idx[k]] * sc;
             }
         }
+        let tol = self.pivot_tol * n as f64;
+        // along the last pivot sequence if its pivots still pass (no pivot search, no
+        // pattern search); else afresh with partial pivoting
+        if self.factors.refactor(
+            (&self.col_ptr, &self.row_idx, &self.scaled),
+            &self.col_perm,
+            &self.row_perm_inv,
+            tol,
+        ) {
+            self.factored = true;
+            return Ok(());
+        }
+        self.pivoted += 1;
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         let mat = SparseColMatRef::new(sym, &self.scaled);
         let cp = PermRef::new_checked(&self.col_perm, &self.col_perm_inv, n);
@@ -365,7 +393,6 @@ impl SparseLu {
                 });
             }
         }
-        let tol = self.pivot_tol * n as f64;
         let u = self.lu.u_factor_unsorted();
         for j in 0..n {
             let (ri, vals) = (u.row_idx_of_col_raw(j), u.val_of_col(j));
@@ -381,6 +408,7 @@ impl SparseLu {
                 });
             }
         }
+        self.factors.copy_from(&self.lu);
         self.factored = true;
         Ok(())
     }
@@ -392,22 +420,13 @@ impl SparseLu {
         if !self.factored || b.len() != n || n == 0 {
             return;
         }
-        for (x, s) in b.iter_mut().zip(&self.rscale) {
-            *x *= s;
+        // P A Q = L U of the equilibrated matrix D_r A D_c: y = P D_r b, L U z = y, x = D_c Q z
+        for (y, &r) in self.y.iter_mut().zip(&self.row_perm) {
+            *y = b[r] * self.rscale[r];
         }
-        let rp = PermRef::new_checked(&self.row_perm, &self.row_perm_inv, n);
-        let cp = PermRef::new_checked(&self.col_perm, &self.col_perm_inv, n);
-        let stack = MemStack::new(&mut self.mem.0);
-        self.lu.solve_in_place_with_conj(
-            rp,
-            cp,
-            Conj::No,
-            MatMut::from_column_major_slice_mut(b, n, 1),
-            Par::Seq,
-            stack,
-        );
-        for (x, s) in b.iter_mut().zip(&self.cscale) {
-            *x *= s;
+        self.factors.solve_in_place(&mut self.y);
+        for (&y, &c) in self.y.iter().zip(&self.col_perm) {
+            b[c] = y * self.cscale[c];
         }
     }
 }
@@ -457,6 +476,95 @@ mod tests {
             lu.values_mut()[k] = a[r * n + c];
         }
         lu
+    }
+
+    /// New values on the same pattern are factored along the last pivot sequence (no new
+    /// pivoted factorisation) and solve as accurately as a fresh factorisation, also where the
+    /// pattern holds explicit zeros; the factors keep their size.
+    #[test]
+    fn a_refactorisation_solves_like_a_fresh_factorisation() {
+        let n = 40;
+        let a = random(n, 7);
+        let mut lu = load(&a, n);
+        lu.factor().unwrap();
+        assert_eq!(lu.pivoted, 1);
+        let nnz = lu.factor_nnz();
+        let mut rnd = rng(11);
+        for round in 0..3 {
+            // perturb every stored value by up to 4%, and zero a few of those off each row's
+            // dominant entry (which keeps the pivots of the first factorisation good)
+            let mut a2 = a.clone();
+            for (k, x) in a2.iter_mut().enumerate() {
+                if *x != 0.0 {
+                    *x *= 1.0 + 0.08 * rnd();
+                    let (i, j) = (k / n, k % n);
+                    if k % 17 == round && j != (i * 7 + 3) % n {
+                        *x = 0.0;
+                    }
+                }
+            }
+            for r in 0..n {
+                for c in 0..n {
+                    if let Some(k) = lu.slot(r, c) {
+                        lu.values_mut()[k] = a2[r * n + c];
+                    }
+                }
+            }
+            lu.factor().unwrap();
+            assert_eq!(
+                lu.pivoted, 1,
+                "round {round}: refactored along the old pivots"
+            );
+            assert_eq!(lu.factor_nnz(), nnz);
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+            let mut x = b.clone();
+            lu.solve_in_place(&mut x);
+            let res = residual(&a2, n, &x, &b);
+            assert!(res < 1e-12, "round {round}: residual {res:e}");
+        }
+    }
+
+    /// A pivot that the new values make small fails the threshold test: the matrix is factored
+    /// afresh with partial pivoting and solves to round-off.
+    #[test]
+    fn a_small_pivot_falls_back_to_partial_pivoting() {
+        let n = 3;
+        // partial pivoting takes row 1 (3.0) for column 0
+        let a = [1.0, 2.0, 0.0, 3.0, 4.0, 1.0, 0.0, 1.0, 5.0];
+        let mut lu = load(&a, n);
+        lu.factor().unwrap();
+        assert_eq!(lu.pivoted, 1);
+        // now row 1's entry in column 0 is 1e-9 of row 0's: along the old pivots it would
+        // be a pivot of 1e-9 against 1 below it
+        let a2 = [1.0, 2.0, 0.0, 1e-9, 4.0, 1.0, 0.0, 1.0, 5.0];
+        for r in 0..n {
+            for c in 0..n {
+                if let Some(k) = lu.slot(r, c) {
+                    lu.values_mut()[k] = a2[r * n + c];
+                }
+            }
+        }
+        lu.factor().unwrap();
+        assert_eq!(lu.pivoted, 2, "the refactorisation was rejected");
+        let b = [1.0, -2.0, 0.5];
+        let mut x = b;
+        lu.solve_in_place(&mut x);
+        let res = residual(&a2, n, &x, &b);
+        assert!(res < 1e-14, "residual {res:e}");
+        // and the next values refactor along the new pivots
+        lu.values_mut()[0] *= 1.01;
+        lu.factor().unwrap();
+        assert_eq!(lu.pivoted, 2);
+    }
+
+    #[test]
+    fn the_docs_state_the_refactorisation_threshold() {
+        let doc = include_str!("../../../../docs/architecture.md");
+        let stated = format!("`REFACTOR_PIVOT_RATIO = {REFACTOR_PIVOT_RATIO}`");
+        assert!(
+            doc.contains(&stated),
+            "docs/architecture.md lacks '{stated}'"
+        );
     }
 
     fn residual(a: &[f64], n: usize, x: &[f64], b: &[f64]) -> f64 {

@@ -8,6 +8,7 @@
 
 mod cholesky;
 mod lu;
+mod lu_factors;
 
 pub use cholesky::SparseCholesky;
-pub use lu::{ColumnOrder, SparseLu, SPARSE_PIVOT_TOL};
+pub use lu::{ColumnOrder, SparseLu, REFACTOR_PIVOT_RATIO, SPARSE_PIVOT_TOL};
