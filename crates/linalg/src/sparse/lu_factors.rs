@@ -36,7 +36,7 @@ pub(crate) struct LuFactors {
     u_val: Vec<f64>,
     work: Vec<f64>,
     /// Whether the storage holds the factors of a successful factorisation.
-    pub(crate) valid: bool,
+    valid: bool,
 }
 
 impl LuFactors {
@@ -113,27 +113,24 @@ impl LuFactors {
             let pivot = w[j];
             w[j] = 0.0;
             let (l0, l1) = (self.l_ptr[j] + 1, self.l_ptr[j + 1]);
-            let mut below = 0.0f64;
-            for &i in &self.l_idx[l0..l1] {
-                below = below.max(w[i as usize].abs());
-            }
-            let ok = pivot.is_finite()
-                && below.is_finite()
-                && pivot.abs() > pivot_floor
-                && pivot.abs() >= REFACTOR_PIVOT_RATIO * below;
-            if !ok {
-                // leave the work vector clean for the next use
-                for &i in &self.l_idx[l0..l1] {
-                    w[i as usize] = 0.0;
-                }
-                return false;
-            }
-            self.u_val[u1 - 1] = pivot;
+            // one pass: L's column divided by the pivot, the work vector cleared, and the
+            // largest multiplier, which the threshold test bounds by 1 / REFACTOR_PIVOT_RATIO
+            // (|l_ij| <= 1 / ratio is |pivot| >= ratio |w_i|)
             let inv = pivot.recip();
+            let mut largest = 0.0f64;
             for (&i, l) in self.l_idx[l0..l1].iter().zip(&mut self.l_val[l0..l1]) {
                 *l = w[i as usize] * inv;
                 w[i as usize] = 0.0;
+                largest = largest.max(l.abs());
             }
+            let ok = pivot.is_finite()
+                && pivot.abs() > pivot_floor
+                && largest.is_finite()
+                && largest * REFACTOR_PIVOT_RATIO <= 1.0;
+            if !ok {
+                return false;
+            }
+            self.u_val[u1 - 1] = pivot;
         }
         self.valid = true;
         true
