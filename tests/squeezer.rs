@@ -160,3 +160,49 @@ fn symplectic_and_tangent_agree_with_projected_rk4() {
         assert!(err < 1e-7, "{name}: {err:e} from the reference");
     }
 }
+
+/// `examples/models/andrews_squeezer.toml` builds the model in code: the same coordinates and
+/// equations, initial guess (to 1e-15), masses, constraint values at a configuration off the
+/// constraints (to 1e-13 m) and applied forces (the spring and the drive torque) at a moving
+/// state (to 1e-12 relative).
+#[test]
+fn the_example_file_is_the_model() {
+    let code = squeezer();
+    let file = System::from_path(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/models/andrews_squeezer.toml"),
+    )
+    .unwrap();
+    assert_eq!(file.n_coords(), code.n_coords());
+    assert_eq!(file.n_constraints(), code.n_constraints());
+    assert_eq!(file.dof(), code.dof());
+    assert_eq!(file.coordinate_names(), code.coordinate_names());
+    let (qf, vf) = file.initial_guess();
+    let (qc, vc) = code.initial_guess();
+    let (dq, dv) = ((&qf - &qc).amax(), (&vf - &vc).amax());
+    assert!(dq < 1e-15 && dv < 1e-15, "q {dq:e}, v {dv:e}");
+    assert!((file.mass_diag() - code.mass_diag()).amax() < 1e-18);
+    let off = qc.map_with_location(|i, _, x| x + 0.01 * ((i as f64) * 0.7).sin());
+    let v = qc.map_with_location(|i, _, _| ((i as f64) * 1.3).cos());
+    let n = code.n_constraints();
+    let (mut pf, mut pc) = (vec![0.0; n], vec![0.0; n]);
+    file.phi(off.as_slice(), 0.0, &mut pf);
+    code.phi(off.as_slice(), 0.0, &mut pc);
+    let d = pf
+        .iter()
+        .zip(&pc)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(d < 1e-13, "Phi differs by {d:e}");
+    let (mut ff, mut fc) = (vec![0.0; code.n_coords()], vec![0.0; code.n_coords()]);
+    file.forces_into(off.as_slice(), v.as_slice(), 0.01, &mut ff);
+    code.forces_into(off.as_slice(), v.as_slice(), 0.01, &mut fc);
+    let scale = fc.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let d = ff
+        .iter()
+        .zip(&fc)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        scale > 1.0 && d <= 1e-12 * scale,
+        "forces differ by {d:e} of {scale:e}"
+    );
+}

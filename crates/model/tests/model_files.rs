@@ -254,6 +254,7 @@ fn the_doc_example_loads() {
 #[test]
 fn every_example_loads_with_its_dof_and_a_consistent_state() {
     let expected = [
+        ("andrews_squeezer.toml", 1, false),
         ("bricard.toml", 1, false),
         ("driven_arm.toml", 3, true),
         ("driven_three_link_arm.json", 1, true),
