@@ -206,3 +206,25 @@ fn the_example_file_is_the_model() {
         "forces differ by {d:e} of {scale:e}"
     );
 }
+
+/// A step far too long for the squeezer (h = 0.05 s: the crank turns about 8 rad in it) fails
+/// in the tangent chart as a Newton failure, whose advice is a smaller step, and not as a
+/// "singular configuration": the mechanism is regular there, its lever arms (1 to 40 mm) are
+/// just small numbers in metres, which the chart's rank report weighs by the bodies' radii of
+/// gyration (`System::rank_weights`). Before the weights it reported "rank 19 of 20".
+#[test]
+fn a_too_long_step_is_a_newton_failure_not_a_singular_configuration() {
+    use mbd::solve::SolveError;
+    let sys = squeezer();
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let mut integ = TangentRk::rk4(&sys).unwrap();
+    let err = run(
+        &mut integ,
+        &sys,
+        &mut s,
+        RunConfig::new(0.1, 0.05),
+        &mut NoObserver,
+    )
+    .unwrap_err();
+    assert!(matches!(err, SolveError::Newton { .. }), "{err}");
+}

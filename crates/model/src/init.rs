@@ -90,17 +90,43 @@ impl System {
         Ok(self.redundant_dense(&jac, 1e-9))
     }
 
+    /// Positive weights, one per coordinate, scaled like `M^-1`, for rank tests of `Phi_q`
+    /// that do not depend on the units of the coordinates: `M^-1` for planar bodies and point
+    /// masses; for a spatial body, whose `M` may be singular (a zero `E_i`), `1/m` on its
+    /// centre and `1/J_max` on its directors. `Phi_q W Phi_q^T` has the rank of `Phi_q` for any
+    /// positive `W`; with these, a relative tolerance on `Phi_q W^(1/2)` compares a joint's
+    /// angle columns with its position columns as the bodies' inertia does (an angle column
+    /// is a lever arm, which counts against the body's radius of gyration), so a mechanism
+    /// measured in millimetres is not "near singular" because its lever arms are small
+    /// numbers in metres. Allocates.
+    pub fn rank_weights(&self) -> Vec<f64> {
+        let mut w = self.inv_mass.as_slice().to_vec();
+        for (k, b) in self.spatial.bodies.iter().enumerate() {
+            let o = self.spatial.q0 + 12 * k;
+            let j = b.inertia.moments();
+            let jmax = j[0].max(j[1]).max(j[2]);
+            w[o..o + 3].fill(1.0 / b.inertia.mass());
+            w[o + 3..o + 12].fill(1.0 / jmax);
+        }
+        w
+    }
+
     /// The equations of `Phi_q(q)` nearest to dependence, for a report at a near-singular
     /// configuration: those whose part outside the span of the earlier rows is below `rel_tol`
-    /// of the largest row norm (Gram-Schmidt, as [`System::redundant_at`]), without the ones
-    /// found redundant at build time. Empty above [`SPARSE_RANK_THRESHOLD`] equations (the
-    /// sparse factorisation reports exact dependence only).
+    /// of the largest row norm (Gram-Schmidt, as [`System::redundant_at`]), with the columns
+    /// weighted by the square roots of [`System::rank_weights`] (so the test does not depend on
+    /// the units of lengths), without the ones found redundant at build time. Empty above
+    /// [`SPARSE_RANK_THRESHOLD`] equations (the sparse factorisation reports exact dependence
+    /// only).
     pub fn nearly_dependent_at(&self, q: &[f64], t: f64, rel_tol: f64) -> Vec<RedundantEquation> {
         if q.len() != self.n || self.m == 0 || self.m > SPARSE_RANK_THRESHOLD {
             return Vec::new();
         }
         let mut jac = DMatrix::zeros(self.m, self.n);
         self.phi_q(q, t, &mut jac);
+        for (k, w) in self.rank_weights().iter().enumerate() {
+            jac.column_mut(k).scale_mut(w.sqrt());
+        }
         let mut found = self.redundant_dense(&jac, rel_tol);
         found.retain(|e| !self.redundant.iter().any(|r| r.row == e.row));
         found
@@ -189,14 +215,7 @@ impl System {
     /// positive weight gives `S` the rank of `Phi_q`, and these keep it scaled like `M^-1`.
     fn redundant_sparse(&self, q: &[f64], t: f64) -> Result<Vec<RedundantEquation>, ModelError> {
         let m = self.m;
-        let mut w = self.inv_mass.as_slice().to_vec();
-        for (k, b) in self.spatial.bodies.iter().enumerate() {
-            let o = self.spatial.q0 + 12 * k;
-            let j = b.inertia.moments();
-            let jmax = j[0].max(j[1]).max(j[2]);
-            w[o..o + 3].fill(1.0 / b.inertia.mass());
-            w[o + 3..o + 12].fill(1.0 / jmax);
-        }
+        let w = self.rank_weights();
         // each row's sides: (block, first coordinate, offset of its gradient in `grads`)
         let mut sides: Vec<[Option<(usize, usize, usize)>; 2]> = vec![[None; 2]; m];
         let mut grads: Vec<f64> = Vec::new();

@@ -152,6 +152,8 @@ pub struct TangentChart {
     /// Work space of the rank report: `Phi_q^T` (`n x m`) and its pivoted QR, the column
     /// permutation, the column norms and a Householder vector.
     rr: Vec<f64>,
+    /// Square roots of [`System::rank_weights`]: the rank report's column weights.
+    rank_w: Vec<f64>,
     perm: Vec<usize>,
     norms: Vec<f64>,
     hv: Vec<f64>,
@@ -248,6 +250,7 @@ impl TangentChart {
             exact_maps: 0,
             rcond: 1.0,
             rr: vec![0.0; n * m],
+            rank_w: sys.rank_weights().iter().map(|w| w.sqrt()).collect(),
             perm: vec![0; m],
             norms: vec![0.0; m],
             hv: vec![0.0; n],

@@ -9,7 +9,9 @@ use mbd_solve::SolveError;
 
 impl TangentChart {
     /// A singular configuration at the last centre: the numerical rank of `Phi_q(q_c)` (`m x n`)
-    /// from a column-pivoted Householder QR of `Phi_q^T` (rank `r`: the pivots
+    /// from a column-pivoted Householder QR of `(Phi_q W^(1/2))^T`, `W` the model's
+    /// [`System::rank_weights`] (so the threshold does not depend on the units of lengths; rank
+    /// `r`: the pivots
     /// `|R_kk| > rel_tol |R_00|`), the dependent equations (the pivots after `r`) and the
     /// joints involved in the dependency (the rows with a weight above `1e-6` of the largest in
     /// a left null vector `z`, `Phi_q^T z ~ 0`, of each dependent equation:
@@ -52,8 +54,8 @@ impl TangentChart {
         let pq = self.pq_x.as_slice();
         let a = &mut self.rr;
         for j in 0..m {
-            for c in 0..n {
-                a[j * n + c] = pq[c * m + j];
+            for (c, w) in self.rank_w.iter().enumerate() {
+                a[j * n + c] = pq[c * m + j] * w;
             }
         }
         let perm = &mut self.perm;

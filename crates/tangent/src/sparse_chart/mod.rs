@@ -33,13 +33,15 @@ struct Contribution {
     vv: usize,
 }
 
-/// One contribution of a shared block to `Phi_q Phi_q^T` (rank report): gradient offsets,
+/// One contribution of a shared block to `Phi_q W Phi_q^T` (rank report): gradient offsets,
 /// width, value slot.
 #[derive(Clone, Copy, Debug)]
 struct PosContribution {
     o1: usize,
     o2: usize,
     w: usize,
+    /// The block's first coordinate (its weights in `rank_w`).
+    col: usize,
     idx: usize,
 }
 
@@ -82,9 +84,11 @@ pub struct SparseChart {
     contributions: Vec<Contribution>,
     /// `G = Df Df^T` (`2m x 2m`; index `r` position equation `r`, `m + r` velocity equation `r`).
     chol: SparseCholesky,
-    /// `Phi_q Phi_q^T` at a configuration (rank report), its contributions and rows of `Phi_q`.
+    /// `Phi_q W Phi_q^T` at a configuration (rank report), its contributions and rows of `Phi_q`.
     pos_chol: SparseCholesky,
     pos_contributions: Vec<PosContribution>,
+    /// [`System::rank_weights`]: the rank report factors `Phi_q W Phi_q^T`.
+    rank_w: Vec<f64>,
     grads_x: Vec<f64>,
     /// The centre `(q_c, v_c)` and its time.
     xc: Vec<f64>,
@@ -106,7 +110,7 @@ pub struct SparseChart {
 
 impl SparseChart {
     /// A sparse chart workspace for `sys`: analyses the patterns of `G` and of
-    /// `Phi_q Phi_q^T` (allocates once).
+    /// `Phi_q W Phi_q^T` (allocates once).
     pub fn new(sys: &System) -> Result<Self, SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let rows = BlockRows::new(sys, |_| true)?;
@@ -153,6 +157,7 @@ impl SparseChart {
                 o1,
                 o2,
                 w,
+                col: s1.col,
                 idx: slot(&pos_chol, r1, r2)?,
             });
         }
@@ -168,6 +173,7 @@ impl SparseChart {
             chol,
             pos_chol,
             pos_contributions,
+            rank_w: sys.rank_weights(),
             grads_x: vec![0.0; nv],
             xc: vec![0.0; 2 * n],
             tc: 0.0,

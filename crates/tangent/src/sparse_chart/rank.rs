@@ -1,5 +1,6 @@
 //! The rank report of the sparse chart: the sparse Cholesky factorisation of
-//! `Phi_q Phi_q^T` at a configuration names the dependent equation (an error path).
+//! `Phi_q W Phi_q^T` (`W` the model's [`System::rank_weights`], so the test does not depend on
+//! the units of lengths) at a configuration names the dependent equation (an error path).
 
 use super::SparseChart;
 use mbd_model::System;
@@ -8,7 +9,7 @@ use mbd_solve::SolveError;
 
 impl SparseChart {
     /// A singular configuration at the last centre: the sparse Cholesky factorisation of
-    /// `Phi_q Phi_q^T` fails (pivot test) or its condition estimate exceeds `1 / rel_tol^2`,
+    /// `Phi_q W Phi_q^T` fails (pivot test) or its condition estimate exceeds `1 / rel_tol^2`,
     /// as [`SolveError::Singular`] naming the dependent equation and its joint (`None` if it
     /// factors well). Allocates only for the report.
     pub fn singular_error(&mut self, sys: &System, t: f64, rel_tol: f64) -> Option<SolveError> {
@@ -42,7 +43,13 @@ impl SparseChart {
                 &self.grads_x[c.o1..c.o1 + c.w],
                 &self.grads_x[c.o2..c.o2 + c.w],
             );
-            vals[c.idx] += a1.iter().zip(a2).map(|(a, b)| a * b).sum::<f64>();
+            let w = &self.rank_w[c.col..c.col + c.w];
+            vals[c.idx] += a1
+                .iter()
+                .zip(a2)
+                .zip(w)
+                .map(|((a, b), w)| a * b * w)
+                .sum::<f64>();
         }
         let what = "configuration (rank-deficient constraint Jacobian Phi_q)";
         match self.pos_chol.factor() {
@@ -53,7 +60,7 @@ impl SparseChart {
                         t,
                         what,
                         detail: format!(
-                            "condition estimate {cond:.3e} of Phi_q Phi_q^T (sparse Cholesky)"
+                            "condition estimate {cond:.3e} of Phi_q W Phi_q^T (sparse Cholesky, W ~ M^-1)"
                         ),
                     })
                 } else {
@@ -70,7 +77,7 @@ impl SparseChart {
                     t,
                     what,
                     detail: format!(
-                        "dependent equation {} (sparse Cholesky pivot of Phi_q Phi_q^T); joint {joint}",
+                        "dependent equation {} (sparse Cholesky pivot of Phi_q W Phi_q^T); joint {joint}",
                         sys.equation_name(i)
                     ),
                 })
