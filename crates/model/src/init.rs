@@ -112,12 +112,12 @@ impl System {
     }
 
     /// The equations of `Phi_q(q)` nearest to dependence, for a report at a near-singular
-    /// configuration: those whose part outside the span of the earlier rows is below `rel_tol`
-    /// of the largest row norm (Gram-Schmidt, as [`System::redundant_at`]), with the columns
-    /// weighted by the square roots of [`System::rank_weights`] (so the test does not depend on
-    /// the units of lengths), without the ones found redundant at build time. Empty above
-    /// [`SPARSE_RANK_THRESHOLD`] equations (the sparse factorisation reports exact dependence
-    /// only).
+    /// configuration: those whose gradient lies within an angle `asin(rel_tol)` of the span of
+    /// the earlier ones (Gram-Schmidt, as [`System::redundant_at`], on the rows scaled to unit
+    /// norm), with the columns weighted by the square roots of [`System::rank_weights`]: the
+    /// test depends neither on the units of lengths nor on those of the equations. Without the
+    /// equations found redundant at build time. Empty above [`SPARSE_RANK_THRESHOLD`]
+    /// equations (the sparse factorisation reports exact dependence only).
     pub fn nearly_dependent_at(&self, q: &[f64], t: f64, rel_tol: f64) -> Vec<RedundantEquation> {
         if q.len() != self.n || self.m == 0 || self.m > SPARSE_RANK_THRESHOLD {
             return Vec::new();
@@ -126,6 +126,13 @@ impl System {
         self.phi_q(q, t, &mut jac);
         for (k, w) in self.rank_weights().iter().enumerate() {
             jac.column_mut(k).scale_mut(w.sqrt());
+        }
+        // each equation in its own unit: a dependence is an angle, not a small row
+        for mut row in jac.row_iter_mut() {
+            let norm = row.norm();
+            if norm > 0.0 {
+                row /= norm;
+            }
         }
         let mut found = self.redundant_dense(&jac, rel_tol);
         found.retain(|e| !self.redundant.iter().any(|r| r.row == e.row));

@@ -92,45 +92,65 @@ impl Galerkin {
         let qscale = 1.0 + norm_inf(&self.qk);
         let tol = o.tol * pscale + 4.0 * f64::EPSILON * qscale;
         let sn = self.tab.s * self.n;
-        self.residual(sys, t, h)?;
+        self.residual(sys, t, h).map_err(|e| {
+            iterate_fault(
+                sys,
+                t,
+                h,
+                self.tab.s,
+                e,
+                f64::INFINITY,
+                0,
+                &self.qk,
+                &self.hvk,
+            )
+        })?;
         let mut res = norm_inf(&self.r);
         let mut evals = 1;
         if self.mlhist.lagged && res <= tol {
             // the predictor passes with extrapolated modified-Lagrangian gradients
             // (`modlag.rs`): decide on evaluated ones
-            self.residual(sys, t, h)?;
+            self.residual(sys, t, h).map_err(|e| {
+                iterate_fault(
+                    sys,
+                    t,
+                    h,
+                    self.tab.s,
+                    e,
+                    f64::INFINITY,
+                    0,
+                    &self.qk,
+                    &self.hvk,
+                )
+            })?;
             res = norm_inf(&self.r);
             evals += 1;
         }
         let mut it = 0;
         let fail = |res: f64, it: usize, s: usize, qk: &[f64], hvk: &[f64]| {
-            // (an error path: the rank report allocates) the configurations the step passes:
-            // its start and, along the start velocity, its middle and end (a step that crosses
-            // a singular configuration fails there, not at its start)
-            let near = if res.is_finite() && res <= 1e3 * tol {
-                Vec::new()
-            } else {
-                [0.0, 0.5, 1.0]
-                    .iter()
-                    .map(|&th| {
-                        let q: Vec<f64> = qk.iter().zip(hvk).map(|(q, d)| q + th * d).collect();
-                        sys.nearly_dependent_at(&q, t + th * h, 1e-2)
-                    })
-                    .find(|near| !near.is_empty())
-                    .unwrap_or_default()
+            let near = near_rank_loss(sys, t, h, qk, hvk);
+            let stalled = res.is_finite() && res <= 1e3 * tol;
+            let named = || {
+                near.iter()
+                    .map(|e| format!("{} (joints {})", e.equation, e.joints.join(", ")))
+                    .collect::<Vec<_>>()
+                    .join("; ")
             };
-            if res.is_finite() && res <= 1e3 * tol {
-                // stalled a few digits above the tolerance: the iteration cannot contract, as
-                // where the stage Jacobian is near-singular (a singular configuration), and a
-                // smaller h does not change that
+            if stalled && !near.is_empty() {
+                // stalled a few digits above the tolerance where the step passes within 1e-2 of
+                // rank loss: the stage Jacobian is near-singular there, and a smaller h does
+                // not change that
                 SolveError::Singular {
                     t,
                     what: "configuration (the stage Jacobian near-singular)",
                     detail: format!(
                         "symplectic ({s},{s}) stage equations, h = {h}: Newton stalled near \
                          round-off, residual {res:.2e} after {it} iterations (tolerance \
-                         {tol:.1e}), as at a singular configuration of the mechanism, where a \
-                         smaller h does not help (`mbd solvers` lists the other solvers)"
+                         {tol:.1e}), at a singular configuration of the mechanism, where a \
+                         smaller h does not help: rank deficiency {} (equations within 1e-2 of \
+                         dependence: {}) (`mbd solvers` lists the other solvers)",
+                        near.len(),
+                        named()
                     ),
                 }
             } else if !near.is_empty() {
@@ -144,10 +164,20 @@ impl Galerkin {
                          after {it} iterations; rank deficiency {} (equations within 1e-2 of \
                          dependence: {}) (`mbd solvers` lists the other solvers)",
                         near.len(),
-                        near.iter()
-                            .map(|e| format!("{} (joints {})", e.equation, e.joints.join(", ")))
-                            .collect::<Vec<_>>()
-                            .join("; ")
+                        named()
+                    ),
+                }
+            } else if stalled {
+                // stalled a few digits above the tolerance at a regular configuration: the
+                // stage Jacobian is ill-conditioned at this step length
+                SolveError::Newton {
+                    t,
+                    residual: res,
+                    iterations: it,
+                    context: format!(
+                        "symplectic ({s},{s}) stage equations, h = {h}: stalled near round-off \
+                         (tolerance {tol:.1e}) at a regular configuration, where the stage \
+                         Jacobian is ill-conditioned for this step; a smaller h may converge"
                     ),
                 }
             } else {
@@ -206,7 +236,9 @@ impl Galerkin {
             }
             // (while the mixed updates contract, the iteration matrix is kept)
             if need_jacobian || (since_jacobian >= o.jacobian_every && !aa_on) {
-                self.jacobian(sys, t, h)?;
+                self.jacobian(sys, t, h).map_err(|e| {
+                    iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
+                })?;
                 self.jac_valid = true;
                 self.jac_h = h;
                 self.jac_gk = self.gk;
@@ -274,7 +306,9 @@ impl Galerkin {
                     for (x, d) in self.x.iter_mut().zip(&self.dx) {
                         *x += d;
                     }
-                    self.kinematics_with(sys, t, h, false)?;
+                    self.kinematics_with(sys, t, h, false).map_err(|e| {
+                        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
+                    })?;
                     self.constraint_rows(sys, t, h);
                     evals += 1;
                     it += 1;
@@ -291,7 +325,9 @@ impl Galerkin {
                     }
                     // the constraints are not met yet: complete the residual (with the
                     // preadjustment terms here) and go on
-                    self.kinematics(sys, t, h)?;
+                    self.kinematics(sys, t, h).map_err(|e| {
+                        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
+                    })?;
                     self.momentum_rows(sys, t, h);
                     res = norm_inf(&self.r);
                     prev_step = dz;
@@ -309,7 +345,9 @@ impl Galerkin {
                 for i in 0..self.dim {
                     self.x[i] = self.xt[i] + lambda * self.dx[i];
                 }
-                self.residual(sys, t, h)?;
+                self.residual(sys, t, h).map_err(|e| {
+                    iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
+                })?;
                 evals += 1;
                 let rn = norm_inf(&self.r);
                 if (rn.is_finite() && rn < res) || halvings >= o.max_halvings {
@@ -342,7 +380,9 @@ impl Galerkin {
                 if !res.is_finite() || worse {
                     last_dz = f64::INFINITY;
                     self.x.copy_from_slice(&self.xt);
-                    self.residual(sys, t, h)?;
+                    self.residual(sys, t, h).map_err(|e| {
+                        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
+                    })?;
                     evals += 1;
                     res = norm_inf(&self.r);
                 }
@@ -402,4 +442,86 @@ fn position_scale(q: &[f64]) -> f64 {
         m = m.max(a);
     }
     m
+}
+
+/// The equations within 1e-2 of dependence (`System::nearly_dependent_at`, weighted like
+/// `M^-1`) at the configurations a step from `qk` passes: its start and, along the start
+/// velocity `hvk` (`h v_k`), its middle and end (a step that crosses a singular configuration
+/// fails there, not at its start). A point of that line that has left the constraints by more
+/// than [`OFF_MANIFOLD`] of an equation's natural unit (`System::equation_scale`) is skipped:
+/// the step is then too long for a straight line to say where it goes (the rank of `Phi_q`
+/// there says nothing about the mechanism; unit directors of a spatial body extrapolated
+/// along their velocity, for one, are neither unit nor orthogonal). Empty for a step through
+/// regular configurations. An error path: allocates.
+fn near_rank_loss(
+    sys: &System,
+    t: f64,
+    h: f64,
+    qk: &[f64],
+    hvk: &[f64],
+) -> Vec<mbd_model::RedundantEquation> {
+    let scales = sys.equation_scales();
+    let mut phi = vec![0.0; sys.n_constraints()];
+    [0.0, 0.5, 1.0]
+        .iter()
+        .filter_map(|&th| {
+            let q: Vec<f64> = qk.iter().zip(hvk).map(|(q, d)| q + th * d).collect();
+            let tt = t + th * h;
+            if th > 0.0 {
+                sys.phi(&q, tt, &mut phi);
+                let off = phi
+                    .iter()
+                    .zip(&scales)
+                    .any(|(p, s)| !(p.abs() <= OFF_MANIFOLD * s));
+                if off {
+                    return None;
+                }
+            }
+            Some(sys.nearly_dependent_at(&q, tt, 1e-2))
+        })
+        .find(|near| !near.is_empty())
+        .unwrap_or_default()
+}
+
+/// How far (relative to an equation's natural unit) a point on a step's straight line may
+/// have left the constraints for its rank to say something about the step ([`near_rank_loss`]).
+const OFF_MANIFOLD: f64 = 0.1;
+
+/// A singular matrix met at a Newton iterate (the stage Jacobian, the preadjustment's
+/// projected metric) of a step through regular configurations ([`near_rank_loss`] empty,
+/// which leaves out the redundant equations found at build time): the iterate is far from any
+/// solution, i.e. the step is too long for the motion, so the error is Newton's, with that
+/// advice. Near rank loss it stays the singular error.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn iterate_fault(
+    sys: &System,
+    t: f64,
+    h: f64,
+    s: usize,
+    e: SolveError,
+    res: f64,
+    it: usize,
+    qk: &[f64],
+    hvk: &[f64],
+) -> SolveError {
+    let at = if it == 0 {
+        "the predictor"
+    } else {
+        "an iterate"
+    };
+    match e {
+        SolveError::Singular { what, .. } if near_rank_loss(sys, t, h, qk, hvk).is_empty() => {
+            SolveError::Newton {
+                t,
+                residual: res,
+                iterations: it,
+                context: format!(
+                    "symplectic ({s},{s}) stage equations, h = {h}: singular {what} at {at}, \
+                     at a regular configuration; a smaller h may converge (the step may be too \
+                     long for the model's fastest motion)"
+                ),
+            }
+        }
+        e => e,
+    }
 }

@@ -9,9 +9,9 @@ use mbd_solve::SolveError;
 
 impl TangentChart {
     /// A singular configuration at the last centre: the numerical rank of `Phi_q(q_c)` (`m x n`)
-    /// from a column-pivoted Householder QR of `(Phi_q W^(1/2))^T`, `W` the model's
-    /// [`System::rank_weights`] (so the threshold does not depend on the units of lengths; rank
-    /// `r`: the pivots
+    /// from a column-pivoted Householder QR of `(D Phi_q W^(1/2))^T`, `W` the model's
+    /// [`System::rank_weights`] and `D` scaling each row to unit norm (so the threshold depends
+    /// neither on the units of lengths nor on those of the equations; rank `r`: the pivots
     /// `|R_kk| > rel_tol |R_00|`), the dependent equations (the pivots after `r`) and the
     /// joints involved in the dependency (the rows with a weight above `1e-6` of the largest in
     /// a left null vector `z`, `Phi_q^T z ~ 0`, of each dependent equation:
@@ -56,6 +56,12 @@ impl TangentChart {
         for j in 0..m {
             for (c, w) in self.rank_w.iter().enumerate() {
                 a[j * n + c] = pq[c * m + j] * w;
+            }
+            // each equation in its own unit: the pivots measure angles between the gradients
+            let col = &mut a[j * n..(j + 1) * n];
+            let norm = dot(col, col).sqrt();
+            if norm > 0.0 {
+                col.iter_mut().for_each(|x| *x /= norm);
             }
         }
         let perm = &mut self.perm;
