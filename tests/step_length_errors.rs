@@ -1,6 +1,7 @@
 //! A step far too long for a mechanism is a Newton failure whose advice (a smaller step) is
-//! right, not a "singular configuration" or "redundant constraints": the mechanisms below are
-//! regular where these steps fail, and the same solvers run them at a smaller step.
+//! right, not a "singular configuration", "redundant constraints" or an "unsupported model":
+//! the mechanisms below are regular where these steps fail, and the same solvers run them at a
+//! smaller step.
 
 use mbd::model::models::{andrews_squeezer, sprung_rod};
 use mbd::model::System;
@@ -18,7 +19,10 @@ fn run(sys: &System, spec: &str, t_end: f64, h: f64) -> Result<(), mbd::Error> {
 fn assert_newton(r: Result<(), mbd::Error>, what: &str) {
     match r {
         Err(mbd::Error::Solve(SolveError::Newton { context, .. })) => {
-            assert!(context.contains("a smaller h may converge"), "{what}: {context}");
+            assert!(
+                context.contains("a smaller h may converge"),
+                "{what}: {context}"
+            );
         }
         other => panic!("{what}: expected a Newton failure, got {other:?}"),
     }
@@ -44,6 +48,25 @@ fn the_squeezer_at_a_too_long_step() {
 #[test]
 fn a_stall_at_a_regular_configuration_advises_a_smaller_step() {
     let sys = sprung_rod([0.05, 0.05, 0.002]).unwrap();
-    assert_newton(run(&sys, "symplectic:2", 1.0, 0.3), "symplectic:2 at h = 0.3");
+    assert_newton(
+        run(&sys, "symplectic:2", 1.0, 0.3),
+        "symplectic:2 at h = 0.3",
+    );
     run(&sys, "symplectic:2", 1.0, 0.05).unwrap();
+}
+
+/// The heavy top file's model at h = 0.3: FA-DAE finds no feasible candidate in its search
+/// box (its predictor leaves the reach of the dependent coordinates). That was an
+/// "unsupported model" error pointing at `mbd solvers`; the same solver runs it at h = 0.05.
+#[test]
+fn fa_dae_without_a_feasible_candidate_advises_a_smaller_step() {
+    let sys = System::from_path(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/heavy_top.toml"),
+    )
+    .unwrap();
+    assert_newton(
+        run(&sys, "firefly-gauss", 0.6, 0.3),
+        "firefly-gauss at h = 0.3",
+    );
+    run(&sys, "firefly-gauss", 0.6, 0.05).unwrap();
 }

@@ -91,6 +91,20 @@ impl From<FaDaeError> for SolveError {
             },
             // (the refusal's own words: SolveError's display adds "unsupported model")
             FaDaeError::Unsupported(reason) => SolveError::Unsupported(reason),
+            // not a refusal of the model: the search box around the predicted end state holds
+            // no point whose dependent coordinates Newton can complete, which is what a step
+            // too long for the motion does (the box follows the step's motion; the models
+            // that fail so at h = 0.3 run at h = 0.05)
+            FaDaeError::NoFeasibleCandidate { t } => SolveError::Newton {
+                t,
+                residual: f64::INFINITY,
+                iterations: 0,
+                context: "FA-DAE: no feasible candidate in the search box, the predicted end \
+                          state included (the dependent coordinates could not be completed \
+                          by Newton anywhere in it); a smaller h may converge (the step may be \
+                          too long for the motion)"
+                    .into(),
+            },
             other => SolveError::Unsupported(other.to_string()),
         }
     }
