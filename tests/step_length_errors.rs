@@ -70,3 +70,24 @@ fn fa_dae_without_a_feasible_candidate_advises_a_smaller_step() {
     );
     run(&sys, "firefly-gauss", 0.6, 0.05).unwrap();
 }
+
+/// The spatial slider-crank's file at h = 0.3 with projected RK4: a stage point of a step that
+/// long has its crank's directors nearly dependent. That was a "singular spatial body" error
+/// with the advice for singular configurations; on the constraints the directors are
+/// orthonormal, so the error is now the one that says the coordinates are far off them (and
+/// the CLI's advice is a smaller step). The same solver runs the model at h = 0.01.
+#[test]
+fn dependent_directors_are_coordinates_far_off_the_constraints() {
+    let sys = System::from_path(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/models/spatial_slider_crank.toml"),
+    )
+    .unwrap();
+    match run(&sys, "rk4-projected", 1.0, 0.3) {
+        Err(mbd::Error::Solve(SolveError::DegenerateDirectors { body, .. })) => {
+            assert_eq!(body, "crank");
+        }
+        other => panic!("expected dependent directors, got {other:?}"),
+    }
+    run(&sys, "rk4-projected", 1.0, 0.01).unwrap();
+}

@@ -199,6 +199,9 @@ fn solve_failure(e: &SolveError) -> Failure {
                 None,
                 vec![("t", Num(*t)), ("residual", Num(*residual))],
             ),
+            SolveError::DegenerateDirectors { t, body } => {
+                ("SolveError", Some(body.clone()), vec![("t", Num(*t))])
+            }
             SolveError::NonFinite { t, what } => (
                 "SolveError",
                 None,

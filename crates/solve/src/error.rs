@@ -181,6 +181,21 @@ pub enum SolveError {
         /// Its tolerance.
         tolerance: f64,
     },
+    /// A spatial body's directors are (nearly) dependent at a state or a stage point: on the
+    /// constraints they are orthonormal, so the coordinates there are far off them (a step too
+    /// long for the motion, or drift of a solver that does not keep the constraints). Not a
+    /// singular configuration of the mechanism.
+    #[error(
+        "the directors of spatial body '{body}' are (nearly) dependent at t = {t}: a state or a \
+         stage point of the step is far off the constraints, on which they are orthonormal (the \
+         step is too long for the motion, or the solver lets the constraints drift)"
+    )]
+    DegenerateDirectors {
+        /// Time of the step (its start).
+        t: f64,
+        /// The body.
+        body: String,
+    },
     /// The state became NaN or infinite.
     #[error("non-finite {what} at t = {t}")]
     NonFinite {

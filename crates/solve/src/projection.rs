@@ -299,7 +299,8 @@ impl Projector {
 }
 
 /// A failed body-eliminated factorisation as the solver's error: a degenerate spatial body
-/// (named) or a singular constraint matrix (the equation named).
+/// (named; dependent directors, which only coordinates far off the constraints have, are
+/// [`SolveError::DegenerateDirectors`]) or a singular constraint matrix (the equation named).
 pub(crate) fn bodies_error(sys: &System, t: f64, e: BodyFactorError) -> SolveError {
     match e {
         BodyFactorError::Body(body, reason) => SolveError::Singular {
@@ -307,6 +308,7 @@ pub(crate) fn bodies_error(sys: &System, t: f64, e: BodyFactorError) -> SolveErr
             what: "spatial body",
             detail: format!("'{body}': {reason}"),
         },
+        BodyFactorError::Directors(body) => SolveError::DegenerateDirectors { t, body },
         BodyFactorError::Row(i) => SolveError::Singular {
             t,
             what: "constraint matrix Phi_e C Phi_e^T",

@@ -51,6 +51,13 @@ pub enum SpatialInertiaError {
     /// why).
     #[error("degenerate {0}")]
     Degenerate(&'static str),
+    /// The directors are (nearly) dependent at a configuration, so the internal constraints
+    /// lose rank. On the constraints they are orthonormal: only coordinates far off them
+    /// (drift, or a stage point of a step too long for the motion) have this.
+    #[error(
+        "degenerate directors: they are (nearly) dependent, so the internal constraints lose rank"
+    )]
+    DependentDirectors,
 }
 
 /// A spatial body's mass, principal moments of inertia about its centre of mass and principal

@@ -106,9 +106,7 @@ impl RigidSolve {
         let gg = gg
             .cholesky()
             .filter(|c| (0..6).all(|k| c.l()[(k, k)].powi(2) > 1e-12 * scale))
-            .ok_or(SpatialInertiaError::Degenerate(
-                "directors: they are (nearly) dependent, so the internal constraints lose rank",
-            ))?;
+            .ok_or(SpatialInertiaError::DependentDirectors)?;
         Ok(RigidSolve {
             mass: inertia.mass(),
             e,

@@ -19,7 +19,7 @@
 //! `mu = (G G^T)^-1 G (f - Phi_e^T lambda_e - M a)`.
 
 use super::{DenseCholesky, FactorError};
-use mbd_model::spatial::RigidSolve;
+use mbd_model::spatial::{RigidSolve, SpatialInertiaError};
 use mbd_model::System;
 use nalgebra::DMatrix;
 
@@ -158,8 +158,12 @@ impl BodySchur {
         for (k, b) in sys.spatial_bodies().iter().enumerate() {
             let o = self.q0 + 12 * k;
             let qb: [f64; 12] = std::array::from_fn(|l| q[o + l]);
-            let r = RigidSolve::new(&b.inertia, &qb)
-                .map_err(|e| BodyFactorError::Body(b.name.clone(), e.to_string()))?;
+            let r = RigidSolve::new(&b.inertia, &qb).map_err(|e| match e {
+                SpatialInertiaError::DependentDirectors => {
+                    BodyFactorError::Directors(b.name.clone())
+                }
+                e => BodyFactorError::Body(b.name.clone(), e.to_string()),
+            })?;
             self.rigid.push(r);
         }
         let (n, me) = (self.n, self.rows.len());
@@ -292,6 +296,9 @@ impl BodySchur {
 pub(crate) enum BodyFactorError {
     /// A spatial body's elimination (its name, the reason).
     Body(String, String),
+    /// A spatial body's directors are (nearly) dependent (its name): coordinates far off the
+    /// constraints.
+    Directors(String),
     /// `S` is singular at this row of `Phi`.
     Row(usize),
 }

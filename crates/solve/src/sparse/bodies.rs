@@ -16,7 +16,7 @@
 use super::{BlockRows, SparseCholesky};
 use crate::error::SolveError;
 use crate::linalg::{BodyFactorError, FactorError};
-use mbd_model::spatial::RigidSolve;
+use mbd_model::spatial::{RigidSolve, SpatialInertiaError};
 use mbd_model::System;
 
 /// One contribution to `S`: a side of external row `e1` and one of `e2` share a block
@@ -130,8 +130,12 @@ impl SparseBodySchur {
         self.rigid.clear();
         for (k, b) in sys.spatial_bodies().iter().enumerate() {
             let qb: [f64; 12] = std::array::from_fn(|l| self.qs[12 * k + l]);
-            let r = RigidSolve::new(&b.inertia, &qb)
-                .map_err(|e| BodyFactorError::Body(b.name.clone(), e.to_string()))?;
+            let r = RigidSolve::new(&b.inertia, &qb).map_err(|e| match e {
+                SpatialInertiaError::DependentDirectors => {
+                    BodyFactorError::Directors(b.name.clone())
+                }
+                e => BodyFactorError::Body(b.name.clone(), e.to_string()),
+            })?;
             self.rigid.push(r);
         }
         let mut cg = std::mem::take(&mut self.cg);
