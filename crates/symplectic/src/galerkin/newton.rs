@@ -472,7 +472,7 @@ fn near_rank_loss(
                 let off = phi
                     .iter()
                     .zip(&scales)
-                    .any(|(p, s)| !(p.abs() <= OFF_MANIFOLD * s));
+                    .any(|(p, s)| p.is_nan() || p.abs() > OFF_MANIFOLD * s);
                 if off {
                     return None;
                 }
