@@ -228,3 +228,40 @@ fn a_too_long_step_is_a_newton_failure_not_a_singular_configuration() {
     .unwrap_err();
     assert!(matches!(err, SolveError::Newton { .. }), "{err}");
 }
+
+/// Later in its run the squeezer's crank is wound up to thousands of radians and turns at
+/// about 1e4 rad/s (4.1e3 rad and 1.05e4 rad/s at t = 0.82 s), so its `sin`/`cos` carry
+/// `eps |theta|` ~ 1e-12 and the velocity constraints cannot be evaluated below about
+/// `eps |theta| |omega| L` ~ 2e-11. Tangent RK4's chart maps must accept a stall there as
+/// convergence: with a round-off floor of `eps (1 + |x|)` alone they failed ("Newton failed at
+/// t = 0.8203: residual 2.07e-11 after 100 iterations"), and adaptive tangent DOPRI5 failed at
+/// every tolerance. Starts from projected RK4's state at t = 0.8 (h = 2e-5).
+#[test]
+fn tangent_rk4_runs_with_the_crank_wound_up() {
+    let sys = squeezer();
+    let mut s = State::consistent(&sys, 0.0).unwrap();
+    let mut rk4 = Rk4::new(&sys, Rk4Options::projected()).unwrap();
+    run(
+        &mut rk4,
+        &sys,
+        &mut s,
+        RunConfig::new(0.8, 2e-5),
+        &mut NoObserver,
+    )
+    .unwrap();
+    assert!(
+        s.q[2] > 3e3 && s.v[2] > 5e3,
+        "{} rad, {} rad/s",
+        s.q[2],
+        s.v[2]
+    );
+    let mut integ = TangentRk::rk4(&sys).unwrap();
+    run(
+        &mut integ,
+        &sys,
+        &mut s,
+        RunConfig::new(0.84, 1e-5),
+        &mut NoObserver,
+    )
+    .unwrap();
+}

@@ -214,7 +214,7 @@ impl TangentChart {
         predicted: bool,
     ) -> Result<MapStats, ChartFailure> {
         let (nn, mm) = (2 * self.n, 2 * self.m);
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
         lp.theta_prior = self.theta_prior;
         let floor = self.floor;
         loop {
@@ -275,7 +275,7 @@ impl TangentChart {
         predicted: bool,
     ) -> Result<MapStats, ChartFailure> {
         let s = self.s;
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
         loop {
             if let Some(verdict) = lp.head() {
                 return verdict;
@@ -330,7 +330,7 @@ impl TangentChart {
     ) -> Result<MapStats, ChartFailure> {
         let tol = newton.tol;
         self.form_p0();
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
         // whether `wx` holds `Q1 H f` for the current `f` and `H`
         let mut have_w = false;
         loop {
@@ -449,17 +449,16 @@ impl ChordLoop {
         res0: f64,
         newton: &NewtonSettings,
         predicted: bool,
+        floor: &RoundoffFloor,
     ) -> Self {
         let tol = newton.tol;
-        // (a NaN entry is skipped, as by f64::max)
-        let xmax = x.iter().fold(0.0f64, |m, v| fast_max(m, v.abs()));
         ChordLoop {
             t,
             tol,
             max_iter: newton.max_iter,
             divergence: newton.divergence,
             predicted,
-            stall_cap: (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax)),
+            stall_cap: floor.stall_cap(x, tol),
             res0,
             res: res0,
             prev: f64::INFINITY,
@@ -549,6 +548,53 @@ pub(crate) fn predicted_stop(
         initial_residual: res0,
         exact: false,
     })
+}
+
+/// The round-off floor of evaluating `f(x) = (Phi, Phi_q v + Phi_t)` at a chart point: below
+/// it a stall (no progress) is convergence as far as `f` can be evaluated, not a failure.
+///
+/// `f` carries the rounding of its terms, about `eps (|r| + |v|)`, and that of the bodies'
+/// `sin`/`cos`: an angle `theta` is known to `eps |theta|`, so a body point `R(theta) p` is off
+/// by `eps |theta| |p|` and its velocity `omega R'(theta) p` by `eps |theta| |omega| |p|`. On a
+/// crank wound up to thousands of radians at thousands of rad/s (Andrews' squeezer at
+/// `t = 0.8 s`: 4.1e3 rad, 1.05e4 rad/s) the last term dominates: the velocity rows stall at
+/// 2e-11, where `eps (1 + |x|)` alone is 2.3e-12. So the floor is
+/// `ROUNDOFF_FACTOR eps (1 + |x|_inf + L max_i (1 + |theta_i|) (1 + |omega_i|))`, `L` the
+/// mechanism's length scale (`System::length_scale`) and `i` over the planar bodies (a spatial
+/// body's directors do not wind up).
+#[derive(Clone, Debug)]
+pub(crate) struct RoundoffFloor {
+    /// Index of each planar body's angle in `q` (its rate is `n` further on in `x`).
+    angles: Vec<usize>,
+    /// The number of coordinates `n`.
+    n: usize,
+    /// The mechanism's length scale.
+    length: f64,
+}
+
+impl RoundoffFloor {
+    /// The floor's terms for `sys` (allocates: at construction).
+    pub(crate) fn new(sys: &System) -> Self {
+        RoundoffFloor {
+            angles: (0..sys.bodies().len()).map(|i| 3 * i + 2).collect(),
+            n: sys.n_coords(),
+            length: sys.length_scale(),
+        }
+    }
+
+    /// `max(10 tol, ROUNDOFF_FACTOR eps (1 + |x|_inf + L max_i (1 + |theta_i|)(1 + |omega_i|)))`
+    /// at `x = (q, v)` (a NaN entry is skipped, as by `f64::max`).
+    pub(crate) fn stall_cap(&self, x: &[f64], tol: f64) -> f64 {
+        let xmax = x.iter().fold(0.0f64, |m, v| fast_max(m, v.abs()));
+        let wound = if x.len() == 2 * self.n {
+            self.angles.iter().fold(0.0f64, |m, &i| {
+                fast_max(m, (1.0 + x[i].abs()) * (1.0 + x[self.n + i].abs()))
+            })
+        } else {
+            0.0
+        };
+        (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax + self.length * wound))
+    }
 }
 
 /// A stall at the round-off floor (no progress below `stall_cap`, not slow convergence): the

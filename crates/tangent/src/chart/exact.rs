@@ -1,6 +1,6 @@
 //! The exact-Newton fallback of a failed chord iteration near a singular configuration.
 
-use super::{loop_head, ChartFailure, MapStats, NewtonSettings, TangentChart, ROUNDOFF_FACTOR};
+use super::{loop_head, ChartFailure, MapStats, NewtonSettings, TangentChart};
 use crate::kernels::{gemv_cols, gemv_t_cols};
 use mbd_model::System;
 use mbd_solve::linalg::{max_abs, max_abs_diff};
@@ -68,8 +68,7 @@ impl TangentChart {
             return Err(failure);
         }
         let tol = newton.tol;
-        let xmax = max_abs(x);
-        let stall_cap = (10.0 * tol).max(ROUNDOFF_FACTOR * f64::EPSILON * (1.0 + xmax));
+        let stall_cap = self.roundoff.stall_cap(x, tol);
         let res0 = self.residual(sys, x, t, f);
         let mut res = res0;
         let mut it = failure.iterations;

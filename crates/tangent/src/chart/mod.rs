@@ -8,9 +8,11 @@ use mbd_solve::linalg::{form_q_padded, mul_r, qr_padded, solve_r};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
-/// Multiple of `eps (1 + ||x||_inf)` taken as the round-off floor of evaluating `f(x)`: a chord
-/// iteration that stalls (no progress) below `max(10 tol, ROUNDOFF_FACTOR eps (1 + ||x||_inf))`
-/// has converged as far as `f` can be evaluated.
+/// Multiple of the rounding estimate `eps (1 + ||x||_inf + L max_i (1 + |theta_i|)(1 + |omega_i|))`
+/// taken as the round-off floor of evaluating `f(x)` (`L` the length scale, `theta_i`,
+/// `omega_i` the planar bodies' angles and rates): a chord iteration that stalls (no progress)
+/// below `max(10 tol, ROUNDOFF_FACTOR` times that estimate) has converged as far as `f` can be
+/// evaluated.
 pub const ROUNDOFF_FACTOR: f64 = 8.0;
 
 /// Largest ratio of the distance a chart map's iteration (chord or exact Newton) moved its
@@ -29,7 +31,7 @@ mod settings;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use chord::{fast_max, loop_head, travel_within, ChordLoop};
+pub(crate) use chord::{fast_max, loop_head, travel_within, ChordLoop, RoundoffFloor};
 pub use settings::{ChartFailure, MapStats, NewtonSettings};
 
 /// A chart of the manifold `f(x, t) = (Phi(q, t), Phi_q v + Phi_t) = 0` at a centre
@@ -154,6 +156,8 @@ pub struct TangentChart {
     rr: Vec<f64>,
     /// Square roots of [`System::rank_weights`]: the rank report's column weights.
     rank_w: Vec<f64>,
+    /// The round-off floor below which a stalled map has converged.
+    roundoff: RoundoffFloor,
     perm: Vec<usize>,
     norms: Vec<f64>,
     hv: Vec<f64>,
@@ -251,6 +255,7 @@ impl TangentChart {
             rcond: 1.0,
             rr: vec![0.0; n * m],
             rank_w: sys.rank_weights().iter().map(|w| w.sqrt()).collect(),
+            roundoff: RoundoffFloor::new(sys),
             perm: vec![0; m],
             norms: vec![0.0; m],
             hv: vec![0.0; n],

@@ -2,7 +2,7 @@
 //! the projector `P = I - Df^T G^-1 Df` and the chord iteration on `eta`, all through one sparse
 //! Cholesky factorisation of `G = Df(x_c) Df(x_c)^T` per centre (`docs/tangent.md` section 9).
 
-use crate::chart::{fast_max, travel_within, ChordLoop};
+use crate::chart::{fast_max, travel_within, ChordLoop, RoundoffFloor};
 use crate::chart::{ChartFailure, MapStats, NewtonSettings};
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::max_abs;
@@ -89,6 +89,8 @@ pub struct SparseChart {
     pos_contributions: Vec<PosContribution>,
     /// [`System::rank_weights`]: the rank report factors `Phi_q W Phi_q^T`.
     rank_w: Vec<f64>,
+    /// The round-off floor below which a stalled map has converged.
+    roundoff: RoundoffFloor,
     grads_x: Vec<f64>,
     /// The centre `(q_c, v_c)` and its time.
     xc: Vec<f64>,
@@ -174,6 +176,7 @@ impl SparseChart {
             pos_chol,
             pos_contributions,
             rank_w: sys.rank_weights(),
+            roundoff: RoundoffFloor::new(sys),
             grads_x: vec![0.0; nv],
             xc: vec![0.0; 2 * n],
             tc: 0.0,
@@ -545,7 +548,7 @@ impl SparseChart {
         self.x0.copy_from_slice(x);
         self.first_step = 0.0;
         let res0 = self.residual_cached(sys, x, t, f);
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted);
+        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
         loop {
             if let Some(verdict) = lp.head() {
                 return verdict;
