@@ -214,7 +214,7 @@ impl TangentChart {
         predicted: bool,
     ) -> Result<MapStats, ChartFailure> {
         let (nn, mm) = (2 * self.n, 2 * self.m);
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
+        let mut lp = ChordLoop::new(t, res0, newton, predicted);
         lp.theta_prior = self.theta_prior;
         let floor = self.floor;
         loop {
@@ -236,7 +236,7 @@ impl TangentChart {
                 return Ok(ms);
             }
             let res = self.residual_cached(sys, x, t, f);
-            let stop = lp.evaluated(res);
+            let stop = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol));
             if let Some(theta) = lp.observed_theta(floor) {
                 self.theta_seen = fast_max(self.theta_seen, theta);
             }
@@ -275,7 +275,7 @@ impl TangentChart {
         predicted: bool,
     ) -> Result<MapStats, ChartFailure> {
         let s = self.s;
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
+        let mut lp = ChordLoop::new(t, res0, newton, predicted);
         loop {
             if let Some(verdict) = lp.head() {
                 return verdict;
@@ -305,7 +305,7 @@ impl TangentChart {
                 return Ok(ms);
             }
             let res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = lp.evaluated(res) {
+            if let Some(ms) = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol)) {
                 return Ok(ms);
             }
             if let Some(e) = lp.diverged() {
@@ -330,7 +330,7 @@ impl TangentChart {
     ) -> Result<MapStats, ChartFailure> {
         let tol = newton.tol;
         self.form_p0();
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
+        let mut lp = ChordLoop::new(t, res0, newton, predicted);
         // whether `wx` holds `Q1 H f` for the current `f` and `H`
         let mut have_w = false;
         loop {
@@ -355,7 +355,7 @@ impl TangentChart {
             }
             self.fprev.copy_from_slice(f);
             let res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = lp.evaluated(res) {
+            if let Some(ms) = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol)) {
                 return Ok(ms);
             }
             if self.pb_active && (lp.res.is_nan() || lp.res >= lp.prev) {
@@ -424,9 +424,6 @@ pub(crate) struct ChordLoop {
     max_iter: usize,
     divergence: f64,
     predicted: bool,
-    /// `f` cannot be evaluated more accurately than about `eps |Phi_q| |v|` (and `eps |theta|`
-    /// in `sin theta`): a stall below this cap is the round-off floor, not slow convergence.
-    stall_cap: f64,
     /// The residual at the start.
     pub(crate) res0: f64,
     /// The current residual.
@@ -443,14 +440,7 @@ pub(crate) struct ChordLoop {
 impl ChordLoop {
     /// An iteration at time `t` from `x` with residual `res0`; `predicted` for a stage map
     /// ([`TangentChart::map_predicted`]).
-    pub(crate) fn new(
-        t: f64,
-        x: &[f64],
-        res0: f64,
-        newton: &NewtonSettings,
-        predicted: bool,
-        floor: &RoundoffFloor,
-    ) -> Self {
+    pub(crate) fn new(t: f64, res0: f64, newton: &NewtonSettings, predicted: bool) -> Self {
         let tol = newton.tol;
         ChordLoop {
             t,
@@ -458,7 +448,6 @@ impl ChordLoop {
             max_iter: newton.max_iter,
             divergence: newton.divergence,
             predicted,
-            stall_cap: floor.stall_cap(x, tol),
             res0,
             res: res0,
             prev: f64::INFINITY,
@@ -503,18 +492,17 @@ impl ChordLoop {
     }
 
     /// Records the residual `res` of the corrected point and accepts a stall at the round-off
-    /// floor ([`stalled`]).
-    pub(crate) fn evaluated(&mut self, res: f64) -> Option<MapStats> {
+    /// floor ([`stalled`]); `stall_cap` gives that floor (`f` cannot be evaluated more
+    /// accurately, [`RoundoffFloor`]), evaluated only when the iteration stalled above the
+    /// tolerance.
+    pub(crate) fn evaluated(
+        &mut self,
+        res: f64,
+        stall_cap: impl FnOnce() -> f64,
+    ) -> Option<MapStats> {
         self.prev = self.res;
         self.res = res;
-        stalled(
-            self.res,
-            self.prev,
-            self.tol,
-            self.stall_cap,
-            self.it,
-            self.res0,
-        )
+        stalled(self.res, self.prev, self.tol, stall_cap, self.it, self.res0)
     }
 
     /// Divergence over the last correction ([`diverged`]).
@@ -603,11 +591,11 @@ pub(crate) fn stalled(
     res: f64,
     prev: f64,
     tol: f64,
-    stall_cap: f64,
+    stall_cap: impl FnOnce() -> f64,
     it: usize,
     res0: f64,
 ) -> Option<MapStats> {
-    (res > tol && res <= stall_cap && res >= 0.9 * prev).then_some(MapStats {
+    (res > tol && res >= 0.9 * prev && res <= stall_cap()).then_some(MapStats {
         iterations: it,
         residual: res,
         initial_residual: res0,

@@ -548,7 +548,7 @@ impl SparseChart {
         self.x0.copy_from_slice(x);
         self.first_step = 0.0;
         let res0 = self.residual_cached(sys, x, t, f);
-        let mut lp = ChordLoop::new(t, x, res0, newton, predicted, &self.roundoff);
+        let mut lp = ChordLoop::new(t, res0, newton, predicted);
         loop {
             if let Some(verdict) = lp.head() {
                 return verdict;
@@ -571,7 +571,7 @@ impl SparseChart {
                 return Ok(ms);
             }
             let res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = lp.evaluated(res) {
+            if let Some(ms) = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol)) {
                 return Ok(ms);
             }
             if let Some(e) = lp.diverged() {
