@@ -133,3 +133,27 @@ fn rk4_runs_alike_on_both_paths() {
     eprintln!("dense and sparse end states {diff:.1e} apart");
     assert!(diff < 1e-12, "{diff:e}");
 }
+
+/// Velocities so large that the velocity terms `gamma` overflow (a state far off any solution,
+/// as after a step too long for the motion) give non-finite multipliers in the sparse solve:
+/// that is `SolveError::NonFinite`, not a singular matrix (it was reported as "singular sparse
+/// constraint matrix ... non-finite multipliers"), on both sparse kernels (planar rows, spatial
+/// bodies).
+#[test]
+fn overflowing_velocity_terms_are_non_finite_not_singular() {
+    for (name, sys) in [
+        ("planar chain", mbd_model::models::n_link_chain(30).unwrap()),
+        ("spatial chain", spatial_chain(6).unwrap()),
+    ] {
+        let (q, _) = sys.initial_guess();
+        let v = vec![1e200; sys.n_coords()];
+        let mut sparse = SparseAccelerationSolver::new(&sys).unwrap();
+        let (mut a, mut l) = (vec![0.0; sys.n_coords()], vec![0.0; sys.n_constraints()]);
+        match sparse.solve(&sys, q.as_slice(), &v, 0.0, &mut a, &mut l) {
+            Err(mbd_solve::SolveError::NonFinite { what, .. }) => {
+                assert!(what.contains("velocity terms"), "{name}: {what}");
+            }
+            other => panic!("{name}: expected a non-finite error, got {other:?}"),
+        }
+    }
+}

@@ -150,7 +150,7 @@ impl SparseAccelerationSolver {
                 b.factor(sys, minv)
                     .map_err(|e| crate::projection::bodies_error(sys, t, e))?;
                 b.solve(minv, &self.forces, &self.gamma, a, lambda);
-                return Self::check_finite(t, lambda);
+                return Self::check_finite(t, lambda, &self.forces, &self.gamma);
             }
         };
         schur.factor(minv).map_err(|e| {
@@ -172,11 +172,25 @@ impl SparseAccelerationSolver {
         // a = M^-1 (Q - Phi_q^T lambda)
         a.copy_from_slice(&self.w);
         schur.add_weighted_transpose(-1.0, minv, lambda, a);
-        Self::check_finite(t, lambda)
+        Self::check_finite(t, lambda, &self.forces, &self.gamma)
     }
 
-    fn check_finite(t: f64, lambda: &[f64]) -> Result<(), SolveError> {
+    /// Non-finite multipliers: from non-finite forces or velocity terms `gamma` (a state far
+    /// off any solution, e.g. after a step too long for the motion) they are
+    /// [`SolveError::NonFinite`]; from finite ones the factorisation was numerically singular.
+    fn check_finite(
+        t: f64,
+        lambda: &[f64],
+        forces: &[f64],
+        gamma: &[f64],
+    ) -> Result<(), SolveError> {
         if !lambda.iter().all(|x| x.is_finite()) {
+            if !forces.iter().chain(gamma).all(|x| x.is_finite()) {
+                return Err(SolveError::NonFinite {
+                    t,
+                    what: "forces or velocity terms of the index-1 solve",
+                });
+            }
             return Err(SolveError::Singular {
                 t,
                 what: "sparse constraint matrix Phi_q M^-1 Phi_q^T",
