@@ -248,3 +248,22 @@ fn a_kept_stage_factorisation_is_refreshed_where_newton_stalls() {
     let stats = sim.run(RunConfig::new(9.2, 1e-3)).unwrap();
     assert!((sim.state().t - 9.2).abs() < 1e-9, "{stats:?}");
 }
+
+/// Index-1 DOPRI5 stopped by the run guard near the parallelogram four-bar's flat
+/// configuration (condition estimate just above the limit) names the nearest equations and
+/// their loop, also where none is within 1e-2 of dependence once the equations are scaled to
+/// unit norm (the condition estimate carries their scaling): the report then tries wider
+/// angles. (The Python package's error test expects `B0` there.)
+#[test]
+fn the_run_guard_names_the_loop_it_stops_at() {
+    use mbd::prelude::*;
+    let sys = mbd::model::models::parallelogram_four_bar(1.0, 2.0, 0.5, 6.0, false).unwrap();
+    let mut sim = Simulation::new(sys, "index1:dopri5").unwrap();
+    match sim.run(RunConfig::new(1.5, 1e-3)) {
+        Err(mbd::Error::Solve(SolveError::Singular { t, detail, .. })) => {
+            assert!((1.0..1.5).contains(&t), "{t}");
+            assert!(detail.contains("B0") && detail.contains("of dependence"), "{detail}");
+        }
+        other => panic!("expected the singular stop, got {other:?}"),
+    }
+}

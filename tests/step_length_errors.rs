@@ -15,6 +15,16 @@ fn run(sys: &System, spec: &str, t_end: f64, h: f64) -> Result<(), mbd::Error> {
     Ok(())
 }
 
+/// The example model file `examples/models/<name>`.
+fn example(name: &str) -> System {
+    System::from_path(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/models")
+            .join(name),
+    )
+    .unwrap()
+}
+
 /// Asserts that a run failed with Newton's error (and says so).
 fn assert_newton(r: Result<(), mbd::Error>, what: &str) {
     match r {
@@ -60,10 +70,7 @@ fn a_stall_at_a_regular_configuration_advises_a_smaller_step() {
 /// "unsupported model" error pointing at `mbd solvers`; the same solver runs it at h = 0.05.
 #[test]
 fn fa_dae_without_a_feasible_candidate_advises_a_smaller_step() {
-    let sys = System::from_path(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/heavy_top.toml"),
-    )
-    .unwrap();
+    let sys = example("heavy_top.toml");
     assert_newton(
         run(&sys, "firefly-gauss", 0.6, 0.3),
         "firefly-gauss at h = 0.3",
@@ -78,11 +85,7 @@ fn fa_dae_without_a_feasible_candidate_advises_a_smaller_step() {
 /// the CLI's advice is a smaller step). The same solver runs the model at h = 0.01.
 #[test]
 fn dependent_directors_are_coordinates_far_off_the_constraints() {
-    let sys = System::from_path(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("examples/models/spatial_slider_crank.toml"),
-    )
-    .unwrap();
+    let sys = example("spatial_slider_crank.toml");
     match run(&sys, "rk4-projected", 1.0, 0.3) {
         Err(mbd::Error::Solve(SolveError::DegenerateDirectors { body, .. })) => {
             assert_eq!(body, "crank");

@@ -92,37 +92,15 @@ impl Galerkin {
         let qscale = 1.0 + norm_inf(&self.qk);
         let tol = o.tol * pscale + 4.0 * f64::EPSILON * qscale;
         let sn = self.tab.s * self.n;
-        self.residual(sys, t, h).map_err(|e| {
-            iterate_fault(
-                sys,
-                t,
-                h,
-                self.tab.s,
-                e,
-                f64::INFINITY,
-                0,
-                &self.qk,
-                &self.hvk,
-            )
-        })?;
+        self.residual(sys, t, h)
+            .map_err(|e| self.fault(sys, t, h, e, f64::INFINITY, 0))?;
         let mut res = norm_inf(&self.r);
         let mut evals = 1;
         if self.mlhist.lagged && res <= tol {
             // the predictor passes with extrapolated modified-Lagrangian gradients
             // (`modlag.rs`): decide on evaluated ones
-            self.residual(sys, t, h).map_err(|e| {
-                iterate_fault(
-                    sys,
-                    t,
-                    h,
-                    self.tab.s,
-                    e,
-                    f64::INFINITY,
-                    0,
-                    &self.qk,
-                    &self.hvk,
-                )
-            })?;
+            self.residual(sys, t, h)
+                .map_err(|e| self.fault(sys, t, h, e, f64::INFINITY, 0))?;
             res = norm_inf(&self.r);
             evals += 1;
         }
@@ -236,9 +214,8 @@ impl Galerkin {
             }
             // (while the mixed updates contract, the iteration matrix is kept)
             if need_jacobian || (since_jacobian >= o.jacobian_every && !aa_on) {
-                self.jacobian(sys, t, h).map_err(|e| {
-                    iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
-                })?;
+                self.jacobian(sys, t, h)
+                    .map_err(|e| self.fault(sys, t, h, e, res, it))?;
                 self.jac_valid = true;
                 self.jac_h = h;
                 self.jac_gk = self.gk;
@@ -306,9 +283,8 @@ impl Galerkin {
                     for (x, d) in self.x.iter_mut().zip(&self.dx) {
                         *x += d;
                     }
-                    self.kinematics_with(sys, t, h, false).map_err(|e| {
-                        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
-                    })?;
+                    self.kinematics_with(sys, t, h, false)
+                        .map_err(|e| self.fault(sys, t, h, e, res, it))?;
                     self.constraint_rows(sys, t, h);
                     evals += 1;
                     it += 1;
@@ -325,9 +301,8 @@ impl Galerkin {
                     }
                     // the constraints are not met yet: complete the residual (with the
                     // preadjustment terms here) and go on
-                    self.kinematics(sys, t, h).map_err(|e| {
-                        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
-                    })?;
+                    self.kinematics(sys, t, h)
+                        .map_err(|e| self.fault(sys, t, h, e, res, it))?;
                     self.momentum_rows(sys, t, h);
                     res = norm_inf(&self.r);
                     prev_step = dz;
@@ -345,9 +320,8 @@ impl Galerkin {
                 for i in 0..self.dim {
                     self.x[i] = self.xt[i] + lambda * self.dx[i];
                 }
-                self.residual(sys, t, h).map_err(|e| {
-                    iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
-                })?;
+                self.residual(sys, t, h)
+                    .map_err(|e| self.fault(sys, t, h, e, res, it))?;
                 evals += 1;
                 let rn = norm_inf(&self.r);
                 if (rn.is_finite() && rn < res) || halvings >= o.max_halvings {
@@ -380,9 +354,8 @@ impl Galerkin {
                 if !res.is_finite() || worse {
                     last_dz = f64::INFINITY;
                     self.x.copy_from_slice(&self.xt);
-                    self.residual(sys, t, h).map_err(|e| {
-                        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
-                    })?;
+                    self.residual(sys, t, h)
+                        .map_err(|e| self.fault(sys, t, h, e, res, it))?;
                     evals += 1;
                     res = norm_inf(&self.r);
                 }
@@ -487,13 +460,28 @@ fn near_rank_loss(
 /// have left the constraints for its rank to say something about the step ([`near_rank_loss`]).
 const OFF_MANIFOLD: f64 = 0.1;
 
+impl Galerkin {
+    /// [`iterate_fault`] for this step (its start `q_k` and `h v_k`).
+    fn fault(
+        &self,
+        sys: &System,
+        t: f64,
+        h: f64,
+        e: SolveError,
+        res: f64,
+        it: usize,
+    ) -> SolveError {
+        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
+    }
+}
+
 /// A singular matrix met at a Newton iterate (the stage Jacobian, the preadjustment's
 /// projected metric) of a step through regular configurations ([`near_rank_loss`] empty,
 /// which leaves out the redundant equations found at build time): the iterate is far from any
 /// solution, i.e. the step is too long for the motion, so the error is Newton's, with that
 /// advice. Near rank loss it stays the singular error.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn iterate_fault(
+fn iterate_fault(
     sys: &System,
     t: f64,
     h: f64,
