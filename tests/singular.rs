@@ -262,7 +262,10 @@ fn the_run_guard_names_the_loop_it_stops_at() {
     match sim.run(RunConfig::new(1.5, 1e-3)) {
         Err(mbd::Error::Solve(SolveError::Singular { t, detail, .. })) => {
             assert!((1.0..1.5).contains(&t), "{t}");
-            assert!(detail.contains("B0") && detail.contains("of dependence"), "{detail}");
+            assert!(
+                detail.contains("B0") && detail.contains("of dependence"),
+                "{detail}"
+            );
         }
         other => panic!("expected the singular stop, got {other:?}"),
     }
