@@ -461,7 +461,11 @@ fn near_rank_loss(
 const OFF_MANIFOLD: f64 = 0.1;
 
 impl Galerkin {
-    /// [`iterate_fault`] for this step (its start `q_k` and `h v_k`).
+    /// A singular matrix met at a Newton iterate (the stage Jacobian, the preadjustment's
+    /// projected metric) of a step through regular configurations ([`near_rank_loss`] empty,
+    /// which leaves out the redundant equations found at build time): the iterate is far from
+    /// any solution, i.e. the step is too long for the motion, so the error is Newton's, with
+    /// that advice. Near rank loss it stays the singular error.
     fn fault(
         &self,
         sys: &System,
@@ -471,45 +475,28 @@ impl Galerkin {
         res: f64,
         it: usize,
     ) -> SolveError {
-        iterate_fault(sys, t, h, self.tab.s, e, res, it, &self.qk, &self.hvk)
-    }
-}
-
-/// A singular matrix met at a Newton iterate (the stage Jacobian, the preadjustment's
-/// projected metric) of a step through regular configurations ([`near_rank_loss`] empty,
-/// which leaves out the redundant equations found at build time): the iterate is far from any
-/// solution, i.e. the step is too long for the motion, so the error is Newton's, with that
-/// advice. Near rank loss it stays the singular error.
-#[allow(clippy::too_many_arguments)]
-fn iterate_fault(
-    sys: &System,
-    t: f64,
-    h: f64,
-    s: usize,
-    e: SolveError,
-    res: f64,
-    it: usize,
-    qk: &[f64],
-    hvk: &[f64],
-) -> SolveError {
-    let at = if it == 0 {
-        "the predictor"
-    } else {
-        "an iterate"
-    };
-    match e {
-        SolveError::Singular { what, .. } if near_rank_loss(sys, t, h, qk, hvk).is_empty() => {
-            SolveError::Newton {
-                t,
-                residual: res,
-                iterations: it,
-                context: format!(
-                    "symplectic ({s},{s}) stage equations, h = {h}: singular {what} at {at}, \
-                     at a regular configuration; a smaller h may converge (the step may be too \
-                     long for the model's fastest motion)"
-                ),
+        let s = self.tab.s;
+        let at = if it == 0 {
+            "the predictor"
+        } else {
+            "an iterate"
+        };
+        match e {
+            SolveError::Singular { what, .. }
+                if near_rank_loss(sys, t, h, &self.qk, &self.hvk).is_empty() =>
+            {
+                SolveError::Newton {
+                    t,
+                    residual: res,
+                    iterations: it,
+                    context: format!(
+                        "symplectic ({s},{s}) stage equations, h = {h}: singular {what} at \
+                         {at}, at a regular configuration; a smaller h may converge (the step \
+                         may be too long for the model's fastest motion)"
+                    ),
+                }
             }
+            e => e,
         }
-        e => e,
     }
 }
