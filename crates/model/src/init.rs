@@ -122,21 +122,73 @@ impl System {
         if q.len() != self.n || self.m == 0 || self.m > SPARSE_RANK_THRESHOLD {
             return Vec::new();
         }
+        let jac = self.unit_free_jacobian(q, t);
+        let mut found = self.redundant_dense(&jac, rel_tol);
+        found.retain(|e| !self.redundant.iter().any(|r| r.row == e.row));
+        found
+    }
+
+    /// The condition of `Phi_q(q)` in the unit-free measure of [`System::nearly_dependent_at`]:
+    /// `1 / sin^2` of the smallest angle between an equation's gradient and the span of the
+    /// earlier ones (columns weighted by [`System::rank_weights`], rows scaled to unit norm),
+    /// without the equations found redundant at build time; infinite when an equation depends
+    /// on the earlier ones. The same quantity as the index-1 solves' condition estimate
+    /// (`max_j S_jj / L_jj^2` of `S = Phi_q M^-1 Phi_q^T`) on planar models, whose weights
+    /// are `M^-1`; on spatial bodies it weighs the directors by `1/J_max` instead of the
+    /// inverse director masses `1/E_i`, which a slender or flat body (a small `E_i`) makes
+    /// large without any joint being near dependence. `None` without constraints or above
+    /// [`SPARSE_RANK_THRESHOLD`] equations (a dense `O(m^2 n)` test). Allocates.
+    pub fn dependence_condition(&self, q: &[f64], t: f64) -> Option<f64> {
+        if q.len() != self.n || self.m == 0 || self.m > SPARSE_RANK_THRESHOLD {
+            return None;
+        }
+        let jac = self.unit_free_jacobian(q, t);
+        // modified Gram-Schmidt, twice per row; the known redundant rows are left out
+        let mut basis: Vec<DVector<f64>> = Vec::new();
+        let mut smallest = 1.0f64;
+        for r in 0..self.m {
+            if self.redundant.iter().any(|e| e.row == r) {
+                continue;
+            }
+            let mut w: DVector<f64> = jac.row(r).transpose();
+            if w.norm() == 0.0 {
+                continue;
+            }
+            for _ in 0..2 {
+                for b in &basis {
+                    let p = b.dot(&w);
+                    w -= b * p;
+                }
+            }
+            let norm = w.norm();
+            smallest = smallest.min(norm);
+            if norm > 0.0 {
+                basis.push(w / norm);
+            }
+        }
+        Some(if smallest > 0.0 {
+            1.0 / (smallest * smallest)
+        } else {
+            f64::INFINITY
+        })
+    }
+
+    /// `Phi_q(q)` with its columns weighted by the square roots of [`System::rank_weights`]
+    /// and its rows scaled to unit norm (each equation in its own unit: a dependence is an
+    /// angle, not a small row).
+    fn unit_free_jacobian(&self, q: &[f64], t: f64) -> DMatrix<f64> {
         let mut jac = DMatrix::zeros(self.m, self.n);
         self.phi_q(q, t, &mut jac);
         for (k, w) in self.rank_weights().iter().enumerate() {
             jac.column_mut(k).scale_mut(w.sqrt());
         }
-        // each equation in its own unit: a dependence is an angle, not a small row
         for mut row in jac.row_iter_mut() {
             let norm = row.norm();
             if norm > 0.0 {
                 row /= norm;
             }
         }
-        let mut found = self.redundant_dense(&jac, rel_tol);
-        found.retain(|e| !self.redundant.iter().any(|r| r.row == e.row));
-        found
+        jac
     }
 
     /// Checks that `Phi_q(q)` has no more dependent rows than the mechanism's redundant

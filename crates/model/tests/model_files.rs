@@ -258,6 +258,7 @@ fn every_example_loads_with_its_dof_and_a_consistent_state() {
         ("bricard.toml", 1, false),
         ("driven_arm.toml", 3, true),
         ("driven_three_link_arm.json", 1, true),
+        ("flyball_governor.toml", 4, false),
         ("four_bar.toml", 1, false),
         ("heavy_top.toml", 3, false),
         ("manipulator.json", 2, false),

@@ -262,6 +262,65 @@ pub(crate) struct RunChecks {
     /// Whether the integrator keeps the constraints itself (else a near-singular step stops
     /// the run).
     keeps_constraints: bool,
+    /// Models with spatial bodies: the steps' condition estimates brought to the unit-free
+    /// measure of the constraint geometry (see [`GeometryGate`]).
+    geometry: Option<GeometryGate>,
+}
+
+/// How far the index-1 solve's condition estimate may move from the one at which the gate
+/// last measured the geometry before it measures again: a factor of 4 up (the estimate grows
+/// like the inverse square of the distance to a singular configuration: half the distance)
+/// or of 64 down.
+pub const GEOMETRY_REMEASURE: f64 = 4.0;
+
+/// The condition estimate of the index-1 solves (`max_j S_jj / L_jj^2` of
+/// `S = Phi_q M^-1 Phi_q^T`) measures how nearly the constraint gradients depend on each other
+/// in the metric of the inverse mass. On a spatial body `M^-1` weighs the directors by the
+/// inverse director masses `1 / E_i`, large on a slender or flat body (`E_i = (J_j + J_k -
+/// J_i) / 2`: a 1 mm shaft's is 1e4 times below its `J_max`): its joints' gradients then look
+/// nearly parallel in that metric at every configuration (the estimate of a flyball governor
+/// with such a shaft is about 1e7 everywhere), while `Phi_q` is far from losing rank. The gate
+/// scales the estimate by `min(1, g / c)`, `g` the unit-free condition
+/// [`System::dependence_condition`] (directors weighed by `1 / J_max`) and `c` the estimate, both
+/// at the step where it last measured; it measures again when the estimate has moved by
+/// [`GEOMETRY_REMEASURE`] from there (so an approach to a real singular configuration, where
+/// both grow, is followed), and never below [`BRANCH_ARM_CONDITION`], where every decision
+/// reads the step as regular anyway. Planar models (whose `g` is the estimate itself) and
+/// models above [`mbd_model::SPARSE_RANK_THRESHOLD`] equations go without it.
+pub(crate) struct GeometryGate {
+    /// `min(1, g / c)` at the last measurement (1 before the first).
+    ratio: f64,
+    /// The estimate `c` at the last measurement (0: none yet).
+    at: f64,
+}
+
+impl GeometryGate {
+    fn new(sys: &System) -> Option<Self> {
+        (sys.has_spatial()
+            && sys.n_constraints() > 0
+            && sys.n_constraints() <= mbd_model::SPARSE_RANK_THRESHOLD)
+            .then_some(GeometryGate {
+                ratio: 1.0,
+                at: 0.0,
+            })
+    }
+
+    /// The estimate `c` of a step ending in `state`, in the unit-free measure.
+    fn effective(&mut self, sys: &System, state: &State, c: f64) -> f64 {
+        if !(c > BRANCH_ARM_CONDITION) {
+            return c;
+        }
+        let moved = self.at == 0.0
+            || c > GEOMETRY_REMEASURE * self.at
+            || c * GEOMETRY_REMEASURE.powi(3) < self.at;
+        if moved {
+            if let Some(g) = sys.dependence_condition(state.q.as_slice(), state.t) {
+                self.ratio = if g < c { g / c } else { 1.0 };
+                self.at = c;
+            }
+        }
+        c * self.ratio
+    }
 }
 
 impl RunChecks {
@@ -287,6 +346,7 @@ impl RunChecks {
             guard,
             condition_limit,
             keeps_constraints,
+            geometry: GeometryGate::new(sys),
         })
     }
 }
@@ -332,6 +392,11 @@ impl RunChecks {
                 what: "state after step",
             });
         }
+        let condition = match self.geometry.as_mut() {
+            Some(gate) => gate.effective(sys, state, s.condition),
+            None => s.condition,
+        };
+        let s = &StepStats { condition, ..*s };
         if let Some(g) = self.guard.as_mut() {
             if s.condition > BRANCH_WATCH_CONDITION {
                 g.passage = Some((state.t, s.condition));

@@ -382,11 +382,15 @@ pub struct RunStats {
     pub stop: StopReason,
     /// Steps whose index-1 condition estimate exceeded [`RunConfig::condition_limit`]: the run
     /// passed close to a singular configuration, where accelerations and multipliers lose
-    /// digits (see [`RunStats::warning`]).
+    /// digits (see [`RunStats::warning`]). On models with spatial bodies the estimate is taken
+    /// in the unit-free measure of the constraint geometry (a slender or flat body's small
+    /// director masses do not count as nearness to a singular configuration; see
+    /// `docs/architecture.md`, "Slender bodies and the condition estimate").
     pub near_singular_steps: usize,
     /// Time at the end of the first such step.
     pub first_near_singular: Option<f64>,
-    /// Largest condition estimate met (0 if the solver does not estimate it).
+    /// Largest condition estimate met, in the measure of
+    /// [`RunStats::near_singular_steps`] (0 if the solver does not estimate it).
     pub max_condition: f64,
     /// Smallest step taken (accepted steps of an adaptive run; the shortened last step counts);
     /// 0 before the first step.

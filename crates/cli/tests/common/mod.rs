@@ -110,13 +110,18 @@ pub fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 
 /// `mbd run MODEL --solver SOLVER --t-end 0.02 STEP.. --out OUT`.
 pub fn run_model(model: &Path, solver: &str, step: &[&str], out: &Path) -> Out {
+    run_model_until(model, solver, step, out, "0.02")
+}
+
+/// [`run_model`] to the end time `t_end`.
+pub fn run_model_until(model: &Path, solver: &str, step: &[&str], out: &Path, t_end: &str) -> Out {
     let mut a: Vec<std::ffi::OsString> = vec![
         "run".into(),
         model.into(),
         "--solver".into(),
         solver.into(),
         "--t-end".into(),
-        "0.02".into(),
+        t_end.into(),
     ];
     a.extend(step.iter().map(Into::into));
     a.extend(["--out".into(), out.into()]);
