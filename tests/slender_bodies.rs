@@ -141,3 +141,32 @@ fn on_planar_models_the_unit_free_condition_is_the_index1_estimate() {
     }
     assert!(largest > 1e4, "{largest}");
 }
+
+/// Plain RK4 on the governor at h = 1e-3, beyond its stability on the stiff dampers, blows up
+/// within three steps: a drift error that says so, not a "singular configuration" read off
+/// the blown-up state's condition estimate (1.4e9 there). At h = 1e-4 it runs.
+#[test]
+fn a_blow_up_on_stiff_dampers_is_not_a_singular_configuration() {
+    let sys = System::from_toml(GOVERNOR).unwrap();
+    let err = run_to(&sys, "rk4", 0.05, 1e-3).unwrap_err();
+    let text = err.to_string();
+    eprintln!("{text}");
+    match &err {
+        mbd::Error::Solve(SolveError::ConstraintDrift {
+            residual,
+            tolerance,
+            joint,
+            ..
+        }) => {
+            assert!(*residual > mbd::solve::BLOWUP_RATIO * tolerance, "{text}");
+            assert!(joint.starts_with("arm"), "{joint}");
+        }
+        other => panic!("expected a drift error, got {other:?}"),
+    }
+    assert!(
+        text.contains("blew up") && text.contains("smaller step"),
+        "{text}"
+    );
+    assert!(!text.contains("singular"), "{text}");
+    run_to(&sys, "rk4", 0.05, 1e-4).unwrap();
+}

@@ -177,6 +177,13 @@ fn open_sink(args: &RunArgs, sys: &System, every: usize) -> Result<Sink, CliErro
 
 fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
     let hint = match &source {
+        SolveError::ConstraintDrift {
+            residual,
+            tolerance,
+            ..
+        } if *residual > mbd_solve::BLOWUP_RATIO * *tolerance => {
+            " (--h, or --tol with index1:dopri5 or tangent:dopri5; symplectic:S is implicit)"
+        }
         SolveError::ConstraintDrift { .. } => {
             " (solvers that hold them: rk4-projected, symplectic:S, tangent:rk4; --drift-tol \
              loosens the guard, default 0.01, and --no-drift-guard turns it off)"

@@ -244,10 +244,10 @@ impl System {
                 let cmax = max_abs(coef.as_slice()).max(1e-300);
                 // (the owning element of a row, planar or spatial: `eq_joint` covers the planar
                 // joints' rows only)
-                let mut joints: Vec<String> = vec![self.row_element(r)];
+                let mut joints: Vec<String> = vec![self.equation_element(r)];
                 for j in 0..m {
                     if coef[j].abs() > 1e-8 * cmax {
-                        let name = self.row_element(j);
+                        let name = self.equation_element(j);
                         if !joints.contains(&name) {
                             joints.push(name);
                         }
@@ -340,10 +340,10 @@ impl System {
         let mut found: Vec<RedundantEquation> = dependent
             .into_iter()
             .map(|r| {
-                let mut joints: Vec<String> = vec![self.row_element(r)];
+                let mut joints: Vec<String> = vec![self.equation_element(r)];
                 for (block, _, _) in sides[r].iter().flatten() {
                     for &(s, _) in &touching[*block] {
-                        let name = self.row_element(s);
+                        let name = self.equation_element(s);
                         if !joints.contains(&name) {
                             joints.push(name);
                         }
@@ -362,7 +362,10 @@ impl System {
 
     /// The element that owns equation `row`: its joint's name (planar or spatial), or the
     /// spatial body of an internal constraint.
-    fn row_element(&self, row: usize) -> String {
+    /// The element equation `row` of `Phi` belongs to: its planar or spatial joint, or the
+    /// spatial body whose internal (director) constraint it is (the part of
+    /// [`System::equation_name`] before its last dot).
+    pub fn equation_element(&self, row: usize) -> String {
         match self.eq_joint.get(row) {
             Some(&ji) => self.joints[ji].name.clone(),
             None => {

@@ -160,12 +160,25 @@ pub enum SolveError {
         got: usize,
     },
     /// The constraints drifted beyond the run's drift guard (`RunConfig::drift_guard`,
-    /// `AdaptiveConfig::drift_guard`; `mbd run --drift-tol`, `--no-drift-guard`).
+    /// `AdaptiveConfig::drift_guard`; `mbd run --drift-tol`, `--no-drift-guard`). A residual
+    /// beyond `BLOWUP_RATIO` (100) times the tolerance is reported as a blow-up: the solution
+    /// left the constraints by more than the mechanism's size within a few steps, the growth of
+    /// a step beyond the solver's stability (stiff springs or dampers, light parts, with an
+    /// explicit solver), which only a smaller step (or an implicit solver) cures. (Drift that
+    /// grew from a near-singular step is [`SolveError::Singular`] instead.)
     #[error(
-        "constraint drift at t = {t}: {level} residual of {equation} (joint '{joint}') is \
-         {residual:e}, beyond the drift guard's {tolerance:e}; the solver has left the \
-         constraint manifold: take a smaller step, use a solver that keeps the constraints \
-         (projection, symplectic, tangent), or relax the drift guard"
+        "constraint drift at t = {t}: {level} residual of {equation} is {residual:e}, beyond \
+         the drift guard's {tolerance:e}; {}",
+        if *residual > crate::guard::BLOWUP_RATIO * *tolerance {
+            "the solution blew up within a few steps (more than 100 times the tolerance), a \
+             step beyond this solver's stability on the model's fastest motion (stiff springs \
+             or dampers, light parts): take a smaller step, an adaptive run or an implicit \
+             solver"
+        } else {
+            "the solver has left the constraint manifold: take a smaller step, use a solver \
+             that keeps the constraints (projection, symplectic, tangent), or relax the drift \
+             guard"
+        }
     )]
     ConstraintDrift {
         /// Time at the end of the step.
@@ -174,7 +187,8 @@ pub enum SolveError {
         level: &'static str,
         /// The equation with the largest residual relative to its tolerance, e.g. `"pin2.x"`.
         equation: String,
-        /// Its joint.
+        /// The element the equation belongs to ([`mbd_model::System::equation_element`]): its
+        /// joint, or the spatial body of an internal (director) constraint.
         joint: String,
         /// Its residual.
         residual: f64,

@@ -206,10 +206,7 @@ impl GuardState {
         if ratio <= 1.0 {
             return Ok(ratio);
         }
-        let joint = sys
-            .equation_joint(row)
-            .map(|j| sys.joints()[j.index()].name.clone())
-            .unwrap_or_default();
+        let joint = sys.equation_element(row);
         Err(SolveError::ConstraintDrift {
             t,
             level,
@@ -236,6 +233,12 @@ pub const GUARD_STRIDE: usize = 8;
 /// See [`GUARD_STRIDE`]: residuals below this fraction of their limits let the guard skip
 /// steps.
 pub const GUARD_QUIET_RATIO: f64 = 1e-2;
+
+/// A drift residual above this multiple of the guard's tolerance (the mechanism's size with
+/// the default `1e-2`) is a blow-up, not the drift of a singular passage (which the guard,
+/// checking every step near one, meets just above its tolerance): see
+/// [`SolveError::ConstraintDrift`].
+pub const BLOWUP_RATIO: f64 = 100.0;
 
 /// The default of [`DriftGuard::branch_tol`]: a step whose end velocity breaks the
 /// trapezoidal relation with its displacement by more than this fraction of the distance
@@ -271,7 +274,7 @@ pub(crate) struct RunChecks {
 /// last measured the geometry before it measures again: a factor of 4 up (the estimate grows
 /// like the inverse square of the distance to a singular configuration: half the distance)
 /// or of 64 down.
-pub const GEOMETRY_REMEASURE: f64 = 4.0;
+pub(crate) const GEOMETRY_REMEASURE: f64 = 4.0;
 
 /// The condition estimate of the index-1 solves (`max_j S_jj / L_jj^2` of
 /// `S = Phi_q M^-1 Phi_q^T`) measures how nearly the constraint gradients depend on each other
@@ -398,6 +401,8 @@ impl RunChecks {
         };
         let s = &StepStats { condition, ..*s };
         if let Some(g) = self.guard.as_mut() {
+            // whether a step before this one came near a singular configuration
+            let near_before = g.passage.is_some();
             if s.condition > BRANCH_WATCH_CONDITION {
                 g.passage = Some((state.t, s.condition));
             }
@@ -413,6 +418,7 @@ impl RunChecks {
                     s.condition,
                     g.guard.branch_tol.is_some(),
                     passage,
+                    near_before,
                 ));
             }
         }
@@ -492,6 +498,13 @@ impl RunChecks {
 /// there (a solver on the constraints does not drift by 1%); drift of a solver that does not
 /// keep the constraints, after it passed near one at `passage` (end time and condition of that
 /// step), grew from the error of that passage (a well-posed mechanism never comes near).
+///
+/// A residual beyond [`BLOWUP_RATIO`] times the guard's tolerance on a run that met no
+/// near-singular step before this one (`near_before` false) is left as the drift error: the
+/// state has left the constraints by more than the mechanism's size (with the default
+/// tolerance) within the few steps since the last check, from regular configurations, the
+/// growth of an unstable step (an explicit solver on stiff springs or dampers beyond its
+/// stability), and the condition estimate at such a state says nothing about the mechanism.
 #[cold]
 #[inline(never)]
 fn drift_error(
@@ -500,17 +513,42 @@ fn drift_error(
     condition: f64,
     branch_check: bool,
     passage: Option<(f64, f64)>,
+    near_before: bool,
 ) -> SolveError {
+    if let SolveError::ConstraintDrift {
+        residual,
+        tolerance,
+        ..
+    } = &e
+    {
+        if !near_before && *residual > BLOWUP_RATIO * *tolerance {
+            return e;
+        }
+    }
     if !branch_check {
         return e;
     }
+    // the drift itself, without the drift error's advice (the singular error gives its own)
+    let drift = match &e {
+        SolveError::ConstraintDrift {
+            level,
+            equation,
+            residual,
+            tolerance,
+            ..
+        } => format!(
+            "{level} residual of {equation} is {residual:e}, beyond the drift guard's \
+             {tolerance:e}"
+        ),
+        other => other.to_string(),
+    };
     if condition > BRANCH_WATCH_CONDITION {
         SolveError::Singular {
             t,
             what: "configuration passed onto another branch",
             detail: format!(
                 "the step ending at t = {t} (condition estimate {condition:.1e}) left the \
-                 constraints: {e}"
+                 constraints: {drift}"
             ),
         }
     } else if let Some((tp, cp)) = passage {
@@ -519,8 +557,8 @@ fn drift_error(
             what: "configuration passed with growing drift",
             detail: format!(
                 "the run passed near a singular configuration at t = {tp} (condition estimate \
-                 {cp:.1e}) and its constraints have drifted since: {e}; this solver does not \
-                 keep the constraints: use one that does (a projection, symplectic or \
+                 {cp:.1e}) and its constraints have drifted since: {drift}; this solver does \
+                 not keep the constraints: use one that does (a projection, symplectic or \
                  tangent: `mbd solvers`)"
             ),
         }

@@ -4,8 +4,8 @@ use crate::adaptive::AdaptiveIntegrator;
 use crate::error::SolveError;
 use crate::guard::RunChecks;
 pub use crate::guard::{
-    DriftGuard, BRANCH_ARM_CONDITION, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION, GUARD_QUIET_RATIO,
-    GUARD_STRIDE,
+    DriftGuard, BLOWUP_RATIO, BRANCH_ARM_CONDITION, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION,
+    GUARD_QUIET_RATIO, GUARD_STRIDE,
 };
 use crate::state::State;
 use mbd_model::System;

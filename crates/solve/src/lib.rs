@@ -92,8 +92,8 @@ pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTraject
 pub use integrator::{
     observe, observer, run, step_count, DriftGuard, Every, Flow, FnObserver, Integrator,
     NoObserver, Observer, Recorder, RunConfig, RunStats, StateFn, StepStats, StopReason,
-    BRANCH_ARM_CONDITION, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION, GUARD_QUIET_RATIO, GUARD_STRIDE,
-    MAX_FIXED_STEPS,
+    BLOWUP_RATIO, BRANCH_ARM_CONDITION, BRANCH_JUMP_TOL, BRANCH_WATCH_CONDITION, GUARD_QUIET_RATIO,
+    GUARD_STRIDE, MAX_FIXED_STEPS,
 };
 pub use newton::{Newton, NewtonOptions, NewtonProblem, NewtonStats};
 pub use output_solve::OutputSolve;
