@@ -1,9 +1,12 @@
-//! Slender spatial bodies are not singular configurations: a flyball governor whose shaft is a
-//! 1 mm rod has constraint gradients that look nearly parallel in the inverse-mass metric of the
-//! index-1 solve (its condition estimate is 2.5e5 at the start and passes 1e7 within a step), while `Phi_q` is
-//! far from losing rank. The run checks read the estimate in the unit-free measure of the
-//! geometry, so the solvers that do not keep the constraints run it, and a real near-singular
-//! configuration of a spatial model still stops them.
+//! What is not a singular configuration. A flyball governor whose shaft is a 1 mm rod has
+//! constraint gradients that look nearly parallel in the inverse-mass metric of the index-1
+//! solve (its condition estimate is 2.5e5 at the start and passes 1e7 within a step), while
+//! `Phi_q` is far from losing rank: the run checks read the estimate in the unit-free measure of
+//! the geometry, so the solvers that do not keep the constraints run it, and a real
+//! near-singular configuration of a spatial model still stops them. The governor's stiff
+//! dampers at a step beyond an explicit solver's stability blow the state up, and a first step
+//! from its regular start that misses the smooth relation of displacement and velocities is
+//! too long: both are reported as such, not as a branch jump at a singular configuration.
 
 use mbd::model::System;
 use mbd::prelude::*;
@@ -169,4 +172,25 @@ fn a_blow_up_on_stiff_dampers_is_not_a_singular_configuration() {
     );
     assert!(!text.contains("singular"), "{text}");
     run_to(&sys, "rk4", 0.05, 1e-4).unwrap();
+}
+
+/// Projected RK4 on the governor at h = 0.01, a hundred times its stable step: the first step
+/// from the regular initial configuration (unit-free condition 51) misses the smooth relation
+/// between displacement and velocities, which the branch check used to report as a jump onto
+/// another branch at a singular configuration. The run now fails on what the step did to the
+/// state, with the advice of a too-long step.
+#[test]
+fn a_too_long_first_step_from_a_regular_start_is_not_a_branch_jump() {
+    let sys = System::from_toml(GOVERNOR).unwrap();
+    let err = run_to(&sys, "rk4-projected", 0.2, 1e-2).unwrap_err();
+    let text = err.to_string();
+    eprintln!("{text}");
+    assert!(
+        !matches!(err, mbd::Error::Solve(SolveError::Singular { .. })),
+        "{text}"
+    );
+    assert!(
+        text.contains("too long") || text.contains("smaller step"),
+        "{text}"
+    );
 }

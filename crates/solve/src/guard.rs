@@ -96,6 +96,11 @@ pub(crate) struct GuardState {
     /// and condition): drift that appears later in the run of a solver that does not keep the
     /// constraints grew from there.
     passage: Option<(f64, f64)>,
+    /// The condition estimate of the last accepted step (NaN before the first): the start of
+    /// the next one.
+    last_condition: f64,
+    /// Whether the branch check has seen a step.
+    started: bool,
     /// Accepted steps left before the next residual check (see [`GUARD_STRIDE`]).
     skip: usize,
 }
@@ -112,21 +117,40 @@ impl GuardState {
             prev_v: state.v.as_slice().to_vec(),
             weight: sys.mass_diag().as_slice().to_vec(),
             passage: None,
+            last_condition: f64::NAN,
+            started: false,
             skip: 0,
         }
     }
 
     /// The branch check after an accepted step of size `h` with condition estimate
     /// `condition` (see [`DriftGuard::branch_tol`]); remembers the state for the next one.
-    fn branch(&mut self, state: &State, h: f64, condition: f64) -> Result<(), SolveError> {
+    fn branch(
+        &mut self,
+        sys: &System,
+        state: &State,
+        h: f64,
+        condition: f64,
+    ) -> Result<(), SolveError> {
         let Some(tol) = self.guard.branch_tol else {
             return Ok(());
         };
-        // the state before this step is at hand only if the last step was remembered
+        // the state before this step is at hand only if the last step was remembered (its
+        // condition estimate above BRANCH_ARM_CONDITION), or this is the first step
         let fresh = (state.t - h - self.prev_t).abs() <= 1e-12 * state.t.abs().max(h);
+        let first = !self.started;
+        self.started = true;
         if condition > BRANCH_WATCH_CONDITION && fresh {
             let dev = self.branch_deviation(state, h);
-            if !(dev <= tol) {
+            // a first step from a regular configuration (unit-free condition at most
+            // BRANCH_ARM_CONDITION) passed no singular one: a step that misses the smooth
+            // relation from there is too long for the motion (what follows says so)
+            let regular_start = first
+                && sys
+                    .dependence_condition(&self.prev_q, self.prev_t)
+                    .is_some_and(|c| c <= BRANCH_ARM_CONDITION);
+            let jumped = !(dev <= tol) && !regular_start;
+            if jumped {
                 return Err(SolveError::Singular {
                     t: state.t,
                     what: "configuration passed onto another branch",
@@ -401,12 +425,22 @@ impl RunChecks {
         };
         let s = &StepStats { condition, ..*s };
         if let Some(g) = self.guard.as_mut() {
-            // whether a step before this one came near a singular configuration
-            let near_before = g.passage.is_some();
+            let (passed_before, start) = (g.passage.is_some(), g.last_condition);
+            g.last_condition = s.condition;
             if s.condition > BRANCH_WATCH_CONDITION {
                 g.passage = Some((state.t, s.condition));
             }
             if let Err(e) = g.check(sys, state, s.condition) {
+                // whether the run came near a singular configuration before this step, or
+                // this step started near one (the first step: the initial state's unit-free
+                // condition, which the guard still holds in `prev_q`; unknown counts as near)
+                let near_before = passed_before
+                    || if start.is_nan() {
+                        sys.dependence_condition(&g.prev_q, g.prev_t)
+                            .map_or(true, |c| c > BRANCH_ARM_CONDITION)
+                    } else {
+                        start > BRANCH_ARM_CONDITION
+                    };
                 let passage = if self.keeps_constraints {
                     None
                 } else {
@@ -426,7 +460,7 @@ impl RunChecks {
             return Err(self.singular_stop(sys, state, s.condition));
         }
         if let Some(g) = self.guard.as_mut() {
-            g.branch(state, h, s.condition)?;
+            g.branch(sys, state, h, s.condition)?;
         }
         stats.steps += 1;
         stats.min_step = if stats.max_step == 0.0 {
@@ -499,8 +533,12 @@ impl RunChecks {
 /// keep the constraints, after it passed near one at `passage` (end time and condition of that
 /// step), grew from the error of that passage (a well-posed mechanism never comes near).
 ///
-/// A residual beyond [`BLOWUP_RATIO`] times the guard's tolerance on a run that met no
-/// near-singular step before this one (`near_before` false) is left as the drift error: the
+/// A run that met no near-singular step before this one and whose step started at a regular
+/// configuration (`near_before` false: the last step's condition estimate at most
+/// [`BRANCH_ARM_CONDITION`]) gets the drift error itself: a step from there that ends off the
+/// constraints did not pass a singular configuration (a motion approaching one shows a
+/// growing estimate first). A residual beyond [`BLOWUP_RATIO`] times the guard's tolerance
+/// there is a blow-up: the
 /// state has left the constraints by more than the mechanism's size (with the default
 /// tolerance) within the few steps since the last check, from regular configurations, the
 /// growth of an unstable step (an explicit solver on stiff springs or dampers beyond its
@@ -515,17 +553,9 @@ fn drift_error(
     passage: Option<(f64, f64)>,
     near_before: bool,
 ) -> SolveError {
-    if let SolveError::ConstraintDrift {
-        residual,
-        tolerance,
-        ..
-    } = &e
-    {
-        if !near_before && *residual > BLOWUP_RATIO * *tolerance {
-            return e;
-        }
-    }
-    if !branch_check {
+    // a step from a regular configuration that ends off the constraints did not pass a
+    // singular one: its end state's condition estimate says nothing about the mechanism
+    if !near_before || !branch_check {
         return e;
     }
     // the drift itself, without the drift error's advice (the singular error gives its own)
