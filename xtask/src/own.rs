@@ -118,18 +118,9 @@ fn solve_to(
     Ok((s.q.as_slice().to_vec(), t.elapsed().as_secs_f64()))
 }
 
-/// Why the tangent RK4 step is more than 4x a plain RK4 step: the everyday passes and the
-/// index-1 solve they share became about 2x cheaper (plain RK4 on the manipulator from 22,200
-/// to 9,300 instructions), while the tangent chart's own work (the QR of `Df^T`, the chord
-/// maps, the eta history) did not change (about 40,800 of its 56,100 instructions). Two rounds
-/// on the chart's own code (tangent-perf, tangent-perf2) brought it to 37,100 instructions,
-/// 3.93x in instructions but about 4.3x by wall clock (latency-bound trigonometry, divisions and
-/// triangular solves). A third (tangent-perf3: fewer chord iterations from an adaptive-order
-/// eta history and a predicted stop after a stage map's first correction, chart products
-/// through the QR factors instead of the 2n x 2n Q, sin/cos carried between maps) brought it
-/// to 33,000 instructions, 3.50x; the rest is the index-1 solves and residual evaluations the
-/// step shares with the model and the solve crate, and the centre's QR.
-const TANGENT_RATIO_MISS: &str = "the plain RK4 step it is compared with became 2.4x cheaper in instructions (22,200 -> 9,300); the tangent chart's own work was cut since (tangent-perf: 56,100 -> 42,300 instructions per step; tangent-perf2: 42,600 -> 37,100; tangent-perf3: 37,700 -> 33,000, 3.50x plain RK4 at 9,430; tangent-perf4: 33,400 -> 31,000, 3.27x at 9,470; tangent-perf5: 30,838 -> 29,063, 2.99x at 9,732, 3.13x by wall clock, all at h = 1e-3); at this claim's h = 0.01 the chord maps take 15.5 iterations per step and set the cost: 5.5x in instructions, 4.25x by wall clock after tangent-perf5 (4.35x after tangent-perf4); see docs/report.md, expected misses";
+/// The reason the tangent RK4 step-cost claim misses (its measurements and the cuts made are
+/// in docs/report.md, "Expected misses", and docs/tangent.md).
+const TANGENT_RATIO_MISS: &str = "at this claim's h = 0.01 the tangent chart's chord maps (three stage points and the end point, the end point to 1e-13) take 15.5 iterations per step and set the cost: 5.5x plain RK4 in instructions under run, 4.25x by wall clock; at h = 1e-3, 2.99x in instructions and 3.13x by wall clock; see docs/report.md, expected misses";
 
 /// Errors of the order study within this of zero are at the reference's / round-off floor.
 const FLOOR: f64 = 1e-11;
