@@ -144,3 +144,16 @@ def test_exceptions_pickle_with_their_attributes():
         assert type(again) is mbd.ModelError
         assert (again.kind, again.element, again.details, str(again)) == (
             e.kind, e.element, e.details, str(e))
+
+
+def test_a_blow_up_is_a_drift_error_not_a_singular_configuration():
+    # plain RK4 on the flyball governor's stiff dampers at ten times its stable step
+    m = mbd.Model.from_file(MODELS / "flyball_governor.toml")
+    with pytest.raises(mbd.ConstraintDriftError) as e:
+        m.run("rk4", t_end=0.05, h=1e-3)
+    d = e.value.details
+    assert d["residual"] > 100 * d["tolerance"]
+    assert e.value.element.startswith("arm")
+    assert "blew up" in str(e.value)
+    # at its stable step it runs
+    m.run("rk4", t_end=0.01, h=1e-4)
