@@ -423,14 +423,13 @@ impl RunChecks {
             Some(gate) => gate.effective(sys, state, s.condition),
             None => s.condition,
         };
-        let s = &StepStats { condition, ..*s };
         if let Some(g) = self.guard.as_mut() {
             let (passed_before, start) = (g.passage.is_some(), g.last_condition);
-            g.last_condition = s.condition;
-            if s.condition > BRANCH_WATCH_CONDITION {
-                g.passage = Some((state.t, s.condition));
+            g.last_condition = condition;
+            if condition > BRANCH_WATCH_CONDITION {
+                g.passage = Some((state.t, condition));
             }
-            if let Err(e) = g.check(sys, state, s.condition) {
+            if let Err(e) = g.check(sys, state, condition) {
                 // whether the run came near a singular configuration before this step, or
                 // this step started near one (the first step: the initial state's unit-free
                 // condition, which the guard still holds in `prev_q`; unknown counts as near)
@@ -449,18 +448,18 @@ impl RunChecks {
                 return Err(drift_error(
                     e,
                     state.t,
-                    s.condition,
+                    condition,
                     g.guard.branch_tol.is_some(),
                     passage,
                     near_before,
                 ));
             }
         }
-        if s.condition > self.condition_limit && !self.keeps_constraints {
-            return Err(self.singular_stop(sys, state, s.condition));
+        if condition > self.condition_limit && !self.keeps_constraints {
+            return Err(self.singular_stop(sys, state, condition));
         }
         if let Some(g) = self.guard.as_mut() {
-            g.branch(sys, state, h, s.condition)?;
+            g.branch(sys, state, h, condition)?;
         }
         stats.steps += 1;
         stats.min_step = if stats.max_step == 0.0 {
@@ -470,8 +469,8 @@ impl RunChecks {
         };
         stats.max_step = stats.max_step.max(h);
         stats.max_residual = stats.max_residual.max(s.residual);
-        stats.max_condition = stats.max_condition.max(s.condition);
-        if s.condition > self.condition_limit {
+        stats.max_condition = stats.max_condition.max(condition);
+        if condition > self.condition_limit {
             stats.near_singular_steps += 1;
             stats.first_near_singular.get_or_insert(state.t);
         }
