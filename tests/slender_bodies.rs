@@ -30,6 +30,15 @@ fn run_to(sys: &System, spec: &str, t_end: f64, h: f64) -> Result<(State, RunSta
     Ok((sim.state().clone(), stats))
 }
 
+/// The error of a run of the example governor that must fail, and its message.
+fn governor_failure(spec: &str, t_end: f64, h: f64) -> (mbd::Error, String) {
+    let sys = System::from_toml(GOVERNOR).unwrap();
+    let err = run_to(&sys, spec, t_end, h).unwrap_err();
+    let text = err.to_string();
+    eprintln!("{spec} at h = {h}: {text}");
+    (err, text)
+}
+
 /// The unit-free condition of the thin governor's `Phi_q` is small, the index-1 solve's
 /// estimate is not: the difference is the shaft's director masses alone.
 #[test]
@@ -150,10 +159,7 @@ fn on_planar_models_the_unit_free_condition_is_the_index1_estimate() {
 /// the blown-up state's condition estimate (1.4e9 there). At h = 1e-4 it runs.
 #[test]
 fn a_blow_up_on_stiff_dampers_is_not_a_singular_configuration() {
-    let sys = System::from_toml(GOVERNOR).unwrap();
-    let err = run_to(&sys, "rk4", 0.05, 1e-3).unwrap_err();
-    let text = err.to_string();
-    eprintln!("{text}");
+    let (err, text) = governor_failure("rk4", 0.05, 1e-3);
     match &err {
         mbd::Error::Solve(SolveError::ConstraintDrift {
             residual,
@@ -181,10 +187,7 @@ fn a_blow_up_on_stiff_dampers_is_not_a_singular_configuration() {
 /// state, with the advice of a too-long step.
 #[test]
 fn a_too_long_first_step_from_a_regular_start_is_not_a_branch_jump() {
-    let sys = System::from_toml(GOVERNOR).unwrap();
-    let err = run_to(&sys, "rk4-projected", 0.2, 1e-2).unwrap_err();
-    let text = err.to_string();
-    eprintln!("{text}");
+    let (err, text) = governor_failure("rk4-projected", 0.2, 1e-2);
     assert!(
         !matches!(err, mbd::Error::Solve(SolveError::Singular { .. })),
         "{text}"
