@@ -177,7 +177,7 @@ fn a_blow_up_on_stiff_dampers_is_not_a_singular_configuration() {
         "{text}"
     );
     assert!(!text.contains("singular"), "{text}");
-    run_to(&sys, "rk4", 0.05, 1e-4).unwrap();
+    run_to(&System::from_toml(GOVERNOR).unwrap(), "rk4", 0.05, 1e-4).unwrap();
 }
 
 /// Projected RK4 on the governor at h = 0.01, a hundred times its stable step: the first step
