@@ -143,7 +143,7 @@ impl System {
             return None;
         }
         let jac = self.unit_free_jacobian(q, t);
-        // modified Gram-Schmidt, twice per row; the known redundant rows are left out
+        // Gram-Schmidt as the dependence test's; the known redundant rows are left out
         let mut basis: Vec<DVector<f64>> = Vec::new();
         let mut smallest = 1.0f64;
         for r in 0..self.m {
@@ -154,12 +154,7 @@ impl System {
             if w.norm() == 0.0 {
                 continue;
             }
-            for _ in 0..2 {
-                for b in &basis {
-                    let p = b.dot(&w);
-                    w -= b * p;
-                }
-            }
+            orthogonalise(&basis, &mut w, |_, _| {});
             let norm = w.norm();
             smallest = smallest.min(norm);
             if norm > 0.0 {
@@ -226,14 +221,10 @@ impl System {
             let mut c = DVector::zeros(m);
             c[r] = 1.0;
             let mut proj = vec![0.0; basis.len()];
-            for _ in 0..2 {
-                for (k, b) in basis.iter().enumerate() {
-                    let p = b.dot(&w);
-                    proj[k] += p;
-                    w -= b * p;
-                    c -= &combo[k] * p;
-                }
-            }
+            orthogonalise(&basis, &mut w, |k, p| {
+                proj[k] += p;
+                c -= &combo[k] * p;
+            });
             let norm = w.norm();
             if norm <= tol {
                 // row r = sum_k proj_k basis_k = sum_k proj_k sum_j combo_k[j] row_j
@@ -412,5 +403,22 @@ impl System {
         let d: Vec<f64> = (0..self.m).map(|i| l[(i, i)].abs()).collect();
         let dmax = d.iter().cloned().fold(0.0, f64::max);
         d.iter().all(|&x| x > 1e-7 * dmax)
+    }
+}
+
+/// Removes from `w` its components along the orthonormal `basis`, twice over (modified
+/// Gram-Schmidt with reorthogonalisation, for the rank tests' accuracy), reporting each
+/// projection `(k, w . basis_k)` removed to `removed`.
+fn orthogonalise(
+    basis: &[DVector<f64>],
+    w: &mut DVector<f64>,
+    mut removed: impl FnMut(usize, f64),
+) {
+    for _ in 0..2 {
+        for (k, b) in basis.iter().enumerate() {
+            let p = b.dot(w);
+            *w -= b * p;
+            removed(k, p);
+        }
     }
 }

@@ -99,8 +99,6 @@ pub(crate) struct GuardState {
     /// The condition estimate of the last accepted step (NaN before the first): the start of
     /// the next one.
     last_condition: f64,
-    /// Whether the branch check has seen a step.
-    started: bool,
     /// Accepted steps left before the next residual check (see [`GUARD_STRIDE`]).
     skip: usize,
 }
@@ -118,19 +116,33 @@ impl GuardState {
             weight: sys.mass_diag().as_slice().to_vec(),
             passage: None,
             last_condition: f64::NAN,
-            started: false,
             skip: 0,
         }
     }
 
+    /// Whether a step that started with condition estimate `start` (the last accepted step's,
+    /// NaN for the first step) started near a singular configuration: above
+    /// [`BRANCH_ARM_CONDITION`]; for the first step, the initial state's unit-free condition
+    /// (still in `prev_q`; an error path only), unknown counting as near.
+    fn started_near(&self, sys: &System, start: f64) -> bool {
+        if start.is_nan() {
+            sys.dependence_condition(&self.prev_q, self.prev_t)
+                .map_or(true, |c| c > BRANCH_ARM_CONDITION)
+        } else {
+            start > BRANCH_ARM_CONDITION
+        }
+    }
+
     /// The branch check after an accepted step of size `h` with condition estimate
-    /// `condition` (see [`DriftGuard::branch_tol`]); remembers the state for the next one.
+    /// `condition`, started with estimate `start` (see [`DriftGuard::branch_tol`]); remembers
+    /// the state for the next one.
     fn branch(
         &mut self,
         sys: &System,
         state: &State,
         h: f64,
         condition: f64,
+        start: f64,
     ) -> Result<(), SolveError> {
         let Some(tol) = self.guard.branch_tol else {
             return Ok(());
@@ -138,19 +150,11 @@ impl GuardState {
         // the state before this step is at hand only if the last step was remembered (its
         // condition estimate above BRANCH_ARM_CONDITION), or this is the first step
         let fresh = (state.t - h - self.prev_t).abs() <= 1e-12 * state.t.abs().max(h);
-        let first = !self.started;
-        self.started = true;
         if condition > BRANCH_WATCH_CONDITION && fresh {
             let dev = self.branch_deviation(state, h);
-            // a first step from a regular configuration (unit-free condition at most
-            // BRANCH_ARM_CONDITION) passed no singular one: a step that misses the smooth
-            // relation from there is too long for the motion (what follows says so)
-            let regular_start = first
-                && sys
-                    .dependence_condition(&self.prev_q, self.prev_t)
-                    .is_some_and(|c| c <= BRANCH_ARM_CONDITION);
-            let jumped = !(dev <= tol) && !regular_start;
-            if jumped {
+            // a step from a regular configuration passed no singular one: one that misses the
+            // smooth relation from there is too long for the motion (what follows says so)
+            if !(dev <= tol) && self.started_near(sys, start) {
                 return Err(SolveError::Singular {
                     t: state.t,
                     what: "configuration passed onto another branch",
@@ -423,23 +427,18 @@ impl RunChecks {
             Some(gate) => gate.effective(sys, state, s.condition),
             None => s.condition,
         };
+        // the estimate at this step's start (the last step's; NaN before the first)
+        let start = self.guard.as_ref().map_or(f64::NAN, |g| g.last_condition);
         if let Some(g) = self.guard.as_mut() {
-            let (passed_before, start) = (g.passage.is_some(), g.last_condition);
+            let passed_before = g.passage.is_some();
             g.last_condition = condition;
             if condition > BRANCH_WATCH_CONDITION {
                 g.passage = Some((state.t, condition));
             }
             if let Err(e) = g.check(sys, state, condition) {
                 // whether the run came near a singular configuration before this step, or
-                // this step started near one (the first step: the initial state's unit-free
-                // condition, which the guard still holds in `prev_q`; unknown counts as near)
-                let near_before = passed_before
-                    || if start.is_nan() {
-                        sys.dependence_condition(&g.prev_q, g.prev_t)
-                            .map_or(true, |c| c > BRANCH_ARM_CONDITION)
-                    } else {
-                        start > BRANCH_ARM_CONDITION
-                    };
+                // this step started near one
+                let near_before = passed_before || g.started_near(sys, start);
                 let passage = if self.keeps_constraints {
                     None
                 } else {
@@ -459,7 +458,7 @@ impl RunChecks {
             return Err(self.singular_stop(sys, state, condition));
         }
         if let Some(g) = self.guard.as_mut() {
-            g.branch(sys, state, h, condition)?;
+            g.branch(sys, state, h, condition, start)?;
         }
         stats.steps += 1;
         stats.min_step = if stats.max_step == 0.0 {
