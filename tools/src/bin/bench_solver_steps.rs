@@ -10,7 +10,8 @@
 //! ball joints, `mbd_model::models::spatial_chain`). A fourth argument `state` prints the final
 //! state in full (for comparing trajectories between builds). `MBD_LINEAR=dense|sparse` picks the
 //! linear-algebra path of RK4, tangent RK4 and the symplectic scheme (default: automatic), `MBD_REUSE=always` keeps its stage Jacobian across steps, `MBD_ANDERSON=K` sets the Anderson depth of its Newton iteration (0: off), `MBD_GAMMA=G` its paper-A preadjustment, `MBD_TANGENT_MATRIX=interpolated|broyden` the tangent chart's chord matrix (default: the centre's). The environment variable `MBD_H`
-//! overrides the step.
+//! overrides the step; `MBD_RUN=1` runs the steps through the public run loop (`mbd_solve::run`,
+//! default drift guard) in runs of at most 500 steps.
 use mbd::firefly_gauss::{FaDaeOptions, FireflyGauss};
 use mbd::model::{models, System};
 use mbd::rk4::{Rk4, Rk4Options};
@@ -154,12 +155,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut s = s0.clone();
     let mut its = 0usize;
     let t = std::time::Instant::now();
-    for _ in 0..n {
-        // restart every 10 s of model time so that long runs stay in the same regime
-        if s.t > 10.0 {
+    if std::env::var("MBD_RUN").as_deref() == Ok("1") {
+        // through the public run loop (default drift guard), in runs of at most 500 steps
+        let mut left = n;
+        while left > 0 {
+            let k = left.min(500);
             s = s0.clone();
+            let cfg = mbd::solve::RunConfig::new(k as f64 * h, h);
+            mbd::solve::run(
+                integ.as_mut(),
+                &sys,
+                &mut s,
+                cfg,
+                &mut mbd::solve::NoObserver,
+            )?;
+            left -= k;
         }
-        its += integ.step(&sys, &mut s, h)?.newton_iterations;
+    } else {
+        for _ in 0..n {
+            // restart every 10 s of model time so that long runs stay in the same regime
+            if s.t > 10.0 {
+                s = s0.clone();
+            }
+            its += integ.step(&sys, &mut s, h)?.newton_iterations;
+        }
     }
     let dt = t.elapsed().as_secs_f64();
     println!(

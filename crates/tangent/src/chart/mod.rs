@@ -4,7 +4,7 @@
 use crate::kernels::{all_finite, gemv_cols, max_abs_finite, with_codim, with_len, with_rows};
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
-use mbd_solve::linalg::{form_q_padded, mul_r, qr_padded, solve_r};
+use mbd_solve::linalg::{form_q_padded, qr_padded};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -588,20 +588,24 @@ impl TangentChart {
         self.run_chord(sys, t, zeta, x, newton, true)
     }
 
-    /// The paper's normal coefficients `eta = R^-1 zeta` of a normal part `Q1 zeta =
-    /// Df(x_c)^T eta` (both of length `2m`). Unlike `zeta`, `eta` does not depend on the
-    /// choice of the orthonormal basis `Q1` (`eta = (Df Df^T)^-1 Df (x - x_c)`), so it varies
-    /// smoothly from one chart to the next along a trajectory.
-    pub fn eta_from_zeta(&self, zeta: &[f64], eta: &mut [f64]) {
-        let (nn, mm) = (2 * self.n, 2 * self.m);
-        with_codim!(mm, solve_r(&self.a, nn, &self.rdinv, zeta, eta));
+    /// The normal coordinates `zeta` (in the basis `Q1`) as coordinates in the chart's
+    /// canonical normal basis: `Q1` with each column's sign chosen so that the diagonal of `R`
+    /// is positive. `Df(x_c)^T = Q1 R` with a positive diagonal is the unique thin QR, a smooth
+    /// function of the centre where `Df` has full rank, so these coordinates vary smoothly from
+    /// one chart to the next along a trajectory, whatever signs the Householder reflectors
+    /// chose. Unlike the paper's coefficients `eta = R^-1 zeta` of `Df^T eta`, they measure the
+    /// normal offset itself (`|canonical| = |Q1 zeta|`): extrapolating them loses nothing to the
+    /// conditioning of `R` (badly balanced units, such as a model in millimetres with unitless
+    /// directors, make `R` ill-conditioned and `eta` the small difference of large terms).
+    pub(crate) fn canonical_from_zeta(&self, zeta: &[f64], out: &mut [f64]) {
+        for ((o, z), d) in out.iter_mut().zip(zeta).zip(&self.rdinv) {
+            *o = if *d < 0.0 { -z } else { *z };
+        }
     }
 
-    /// `zeta = R eta`: the normal coordinates in the basis `Q1` of the paper's `Df(x_c)^T eta`
-    /// (the inverse of [`TangentChart::eta_from_zeta`]).
-    pub fn zeta_from_eta(&self, eta: &[f64], zeta: &mut [f64]) {
-        let (nn, mm) = (2 * self.n, 2 * self.m);
-        with_codim!(mm, mul_r(&self.a, nn, eta, zeta));
+    /// The inverse of [`TangentChart::canonical_from_zeta`] (the same sign flips).
+    pub(crate) fn zeta_from_canonical(&self, canonical: &[f64], zeta: &mut [f64]) {
+        self.canonical_from_zeta(canonical, zeta);
     }
 }
 

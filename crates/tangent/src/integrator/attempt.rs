@@ -10,9 +10,11 @@ impl TangentRk {
     ///
     /// Newton starting points (they change only where the chord iteration starts, never its
     /// limit). After accepted fixed steps of the same size, each stage map starts from the
-    /// paper's normal coefficients `eta` (`Df(x_c)^T eta`, independent of the basis `Q1`) of
-    /// the same stage in the last up to three steps, extrapolated by a polynomial in the step
-    /// index (`eta` is a smooth function of the step's start point along the trajectory), and
+    /// normal coordinates of the same stage in the last steps, taken in a basis that does not
+    /// depend on how the chart was factored (the dense chart's canonical `Q1`, the signs that
+    /// make `R`'s diagonal positive, `TangentChart::canonical_from_zeta`; the sparse chart's
+    /// `eta`, the coefficients of `Df(x_c)^T eta`), extrapolated by a polynomial in the step
+    /// index (they are smooth functions of the step's start point along the trajectory), and
     /// corrected by the extrapolation error the latest earlier stage `j` of this step showed,
     /// scaled by `|Y_i|^2 / |Y_j|^2`. Without such history: for scleronomic constraints,
     /// stage `i` starts from the normal coordinates the latest earlier stage `j` with
@@ -125,7 +127,7 @@ impl TangentRk {
                             *p += r * (e - x);
                         }
                     }
-                    chart.zeta_from_eta(eta_pred, zplain);
+                    chart.zeta_from_canonical(eta_pred, zplain);
                 } else if quadratic && ylast_sq > 0.0 {
                     // scleronomic: the normal offset of the manifold above Y grows like |Y|^2
                     let r = ysq / ylast_sq;
@@ -157,7 +159,7 @@ impl TangentRk {
                         ylast_sq = ysq;
                         jlast = i;
                     }
-                    chart.eta_from_zeta(zplain, &mut eta_now[i * mm..(i + 1) * mm]);
+                    chart.canonical_from_zeta(zplain, &mut eta_now[i * mm..(i + 1) * mm]);
                 }
                 match mapped {
                     Ok(ms) => {

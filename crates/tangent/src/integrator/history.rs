@@ -1,7 +1,8 @@
-//! The history of the paper's normal coefficients `eta` of every map of the last accepted
-//! fixed steps, from which [`TangentRk`](super::TangentRk) extrapolates the Newton starting
-//! points of the next step, with the extrapolation order chosen per map from the errors the
-//! orders showed on the latest step.
+//! The history of the normal coordinates of every map of the last accepted fixed steps (called
+//! `eta` here: in the dense chart's canonical basis, or the sparse chart's `eta`; see
+//! `Path::canonical_from_zeta`), from which [`TangentRk`](super::TangentRk) extrapolates the
+//! Newton starting points of the next step, with the extrapolation order chosen per map from
+//! the errors the orders showed on the latest step.
 
 use crate::kernels::with_codim;
 

@@ -105,22 +105,24 @@ impl Path {
         }
     }
 
-    /// Normal coordinates from the paper's `eta` (the sparse chart's normal coordinates are
-    /// `eta` itself).
+    /// The chart's normal coordinates from coordinates in a basis that does not depend on how
+    /// the chart was factored, the quantity the step history extrapolates: the dense chart's
+    /// canonical basis (`TangentChart::canonical_from_zeta`), the sparse chart's `eta` (its
+    /// normal coordinates are the coefficients of `Df(x_c)^T eta` themselves).
     #[inline]
-    pub(super) fn zeta_from_eta(&self, eta: &[f64], zeta: &mut [f64]) {
+    pub(super) fn zeta_from_canonical(&self, canonical: &[f64], zeta: &mut [f64]) {
         match self {
-            Path::Dense { chart, .. } => chart.zeta_from_eta(eta, zeta),
-            Path::Sparse(_) => zeta.copy_from_slice(eta),
+            Path::Dense { chart, .. } => chart.zeta_from_canonical(canonical, zeta),
+            Path::Sparse(_) => zeta.copy_from_slice(canonical),
         }
     }
 
-    /// The paper's `eta` from normal coordinates.
+    /// The inverse of [`Path::zeta_from_canonical`].
     #[inline]
-    pub(super) fn eta_from_zeta(&self, zeta: &[f64], eta: &mut [f64]) {
+    pub(super) fn canonical_from_zeta(&self, zeta: &[f64], canonical: &mut [f64]) {
         match self {
-            Path::Dense { chart, .. } => chart.eta_from_zeta(zeta, eta),
-            Path::Sparse(_) => eta.copy_from_slice(zeta),
+            Path::Dense { chart, .. } => chart.canonical_from_zeta(zeta, canonical),
+            Path::Sparse(_) => canonical.copy_from_slice(zeta),
         }
     }
 

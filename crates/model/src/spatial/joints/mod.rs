@@ -19,7 +19,7 @@
 //! | [`SpatialJointKind::Prismatic`] | the cylindrical four, `X_a . Y_b` | slide along `Z` |
 //! | [`SpatialJointKind::Planar`] | `Z_b . X_a`, `Z_b . Y_a`, `(P_b - P_a) . Z_a` | slides in `X`-`Y`, rotation about `Z` |
 //! | [`SpatialJointKind::Weld`] | `P_a - P_b` (3), `X_a . Y_b`, `X_a . Z_b`, `Y_a . Z_b` | nothing |
-//! | [`SpatialJointKind::Distance`] | `1/2 (|P_b - P_a|^2 - L^2)` | everything but the distance |
+//! | [`SpatialJointKind::Distance`] | `(|P_b - P_a|^2 - L^2) / (2 L)` | everything but the distance |
 //! | [`SpatialJointKind::SlideDriver`] | `(P_b - P_a) . Z_a - s(t)` | everything but the slide along `Z_a` |
 //! | [`SpatialJointKind::DistanceDriver`] | `1/2 (|P_b - P_a|^2 - L(t)^2)` | everything but the distance |
 //! | [`SpatialJointKind::AngleDriver`] | `cos theta(t) X_b . Y_a - sin theta(t) X_b . X_a` | everything but the turn of `X_b` about `Z_a` |
@@ -379,8 +379,9 @@ impl SpatialJoint {
     }
 
     /// The physical dimension of equation `k` as a power of length: 0 for the orientation
-    /// equations (dot products of unit axes), 1 for positions, 2 for the distance joint's
-    /// `1/2 (|r|^2 - L^2)`. Scales tolerances on the equation.
+    /// equations (dot products of unit axes), 1 for positions (the distance joint's
+    /// `(|r|^2 - L^2) / (2 L)` among them), 2 for the distance driver's `1/2 (|r|^2 - L(t)^2)`.
+    /// Scales tolerances on the equation.
     pub fn length_power(&self, k: usize) -> i32 {
         use SpatialJointKind::*;
         match self.kind {
@@ -389,7 +390,8 @@ impl SpatialJoint {
             Planar => i32::from(k == 2),
             AngleDriver => 0,
             SlideDriver => 1,
-            Distance { .. } | DistanceDriver => 2,
+            Distance { .. } => 1,
+            DistanceDriver => 2,
         }
     }
 
@@ -467,7 +469,7 @@ impl SpatialJoint {
             SpatialJointKind::Distance { length } => distance::eval(ma, mb, length, out),
             SpatialJointKind::SlideDriver => slide_driver::eval(ma, mb, out),
             // the system subtracts 1/2 L(t)^2
-            SpatialJointKind::DistanceDriver => distance::eval(ma, mb, 0.0, out),
+            SpatialJointKind::DistanceDriver => distance::eval_driver(ma, mb, out),
             SpatialJointKind::AngleDriver => angle_driver::eval(ma, mb, out),
         }
     }
