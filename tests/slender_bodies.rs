@@ -127,11 +127,11 @@ length = 1.000000005
     run_to(&sys, "rk4-projected", 0.01, 1e-3).unwrap();
 }
 
-/// On a planar model the unit-free condition is the index-1 solve's estimate itself (the same
-/// metric `M^-1`, the same row scaling): a parallelogram four-bar approaching its flat
-/// configuration, where both grow past 1e4.
+/// On a planar model of equal masses the unit-free condition is the index-1 solve's estimate
+/// itself (the same metric `M^-1` up to a factor, the same row scaling): a parallelogram
+/// four-bar of three 1 kg rods approaching its flat configuration, where both grow past 1e4.
 #[test]
-fn on_planar_models_the_unit_free_condition_is_the_index1_estimate() {
+fn on_a_planar_model_of_equal_masses_the_unit_free_condition_is_the_index1_estimate() {
     let sys = mbd::model::models::parallelogram_four_bar(1.0, 2.0, 0.5, 6.0, true).unwrap();
     let mut state = State::consistent(&sys, 0.0).unwrap();
     let mut sim = Simulation::new(sys.clone(), "rk4-projected").unwrap();

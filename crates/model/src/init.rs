@@ -90,23 +90,31 @@ impl System {
         Ok(self.redundant_dense(&jac, 1e-9))
     }
 
-    /// Positive weights, one per coordinate, scaled like `M^-1`, for rank tests of `Phi_q`
-    /// that do not depend on the units of the coordinates: `M^-1` for planar bodies and point
-    /// masses; for a spatial body, whose `M` may be singular (a zero `E_i`), `1/m` on its
-    /// centre and `1/J_max` on its directors. `Phi_q W Phi_q^T` has the rank of `Phi_q` for any
-    /// positive `W`; with these, a relative tolerance on `Phi_q W^(1/2)` compares a joint's
-    /// angle columns with its position columns as the bodies' inertia does (an angle column
-    /// is a lever arm, which counts against the body's radius of gyration), so a mechanism
-    /// measured in millimetres is not "near singular" because its lever arms are small
-    /// numbers in metres. Allocates.
+    /// Positive weights, one per coordinate, for rank tests of `Phi_q` that depend neither on
+    /// the units of the coordinates nor on how the mass is shared between the bodies: 1 on a
+    /// body's (or point mass's) position coordinates, `m / J` on a planar body's angle and
+    /// `m / J_max` on a spatial body's directors (`M^-1` of each body scaled by its mass; for
+    /// a spatial body, whose `M` may be singular with a zero `E_i`, the largest moment stands
+    /// in for the director masses). `Phi_q W Phi_q^T` has the rank of `Phi_q` for any positive
+    /// `W`; with these, a relative tolerance on `Phi_q W^(1/2)` compares a joint's angle
+    /// columns with its position columns as the body's radius of gyration does (an angle
+    /// column is a lever arm), so a mechanism measured in millimetres is not "near singular"
+    /// because its lever arms are small numbers in metres, and a gram-light link carrying a
+    /// tonne is not because `M^-1` would weigh its columns a million times above the load's.
+    /// Allocates.
     pub fn rank_weights(&self) -> Vec<f64> {
-        let mut w = self.inv_mass.as_slice().to_vec();
+        let mut w = vec![1.0; self.n];
+        for (i, b) in self.bodies.iter().enumerate() {
+            w[3 * i + 2] = b.mass / b.inertia;
+        }
         for (k, b) in self.spatial.bodies.iter().enumerate() {
             let o = self.spatial.q0 + 12 * k;
             let j = b.inertia.moments();
             let jmax = j[0].max(j[1]).max(j[2]);
-            w[o..o + 3].fill(1.0 / b.inertia.mass());
-            w[o + 3..o + 12].fill(1.0 / jmax);
+            // a point mass has no directors (and no moments)
+            if jmax > 0.0 && o + 12 <= w.len() {
+                w[o + 3..o + 12].fill(b.inertia.mass() / jmax);
+            }
         }
         w
     }
@@ -133,10 +141,12 @@ impl System {
     /// earlier ones (columns weighted by [`System::rank_weights`], rows scaled to unit norm),
     /// without the equations found redundant at build time; infinite when an equation depends
     /// on the earlier ones. The same quantity as the index-1 solves' condition estimate
-    /// (`max_j S_jj / L_jj^2` of `S = Phi_q M^-1 Phi_q^T`) on planar models, whose weights
-    /// are `M^-1`; on spatial bodies it weighs the directors by `1/J_max` instead of the
-    /// inverse director masses `1/E_i`, which a slender or flat body (a small `E_i`) makes
-    /// large without any joint being near dependence. `None` without constraints or above
+    /// (`max_j S_jj / L_jj^2` of `S = Phi_q M^-1 Phi_q^T`) on a planar model whose bodies
+    /// have equal masses (the weights are then `M^-1` up to a common factor); unlike the
+    /// estimate it does not grow with the ratio of the bodies' masses, and on spatial bodies
+    /// it weighs the directors by `m / J_max` instead of the inverse director masses `1/E_i`,
+    /// which a slender or flat body (a small `E_i`) makes large without any joint being near
+    /// dependence. `None` without constraints or above
     /// [`SPARSE_RANK_THRESHOLD`] equations (a dense `O(m^2 n)` test). Allocates.
     pub fn dependence_condition(&self, q: &[f64], t: f64) -> Option<f64> {
         if q.len() != self.n || self.m == 0 || self.m > SPARSE_RANK_THRESHOLD {
@@ -260,9 +270,9 @@ impl System {
     /// The sparse test of [`System::redundant_at`]: `S = Phi_q W Phi_q^T` from the
     /// element-local rows over the body blocks (planar and spatial), its pattern from the
     /// blocks the rows share (O(m) entries for a chain), factored by [`SparseCholesky`]
-    /// allowing every row to be dropped. `W` is `M^-1` for planar bodies; for a spatial body,
-    /// whose `M` may be singular, `1/m` on its centre and `1/J_max` on its directors: any
-    /// positive weight gives `S` the rank of `Phi_q`, and these keep it scaled like `M^-1`.
+    /// allowing every row to be dropped. `W` is [`System::rank_weights`]: any positive weight
+    /// gives `S` the rank of `Phi_q`, and these make its scaling independent of the units and
+    /// of the bodies' masses.
     fn redundant_sparse(&self, q: &[f64], t: f64) -> Result<Vec<RedundantEquation>, ModelError> {
         let m = self.m;
         let w = self.rank_weights();

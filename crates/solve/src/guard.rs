@@ -312,7 +312,7 @@ pub(crate) const GEOMETRY_REMEASURE: f64 = 4.0;
 /// nearly parallel in that metric at every configuration (the estimate of a flyball governor
 /// with such a shaft is about 1e7 everywhere), while `Phi_q` is far from losing rank. The gate
 /// scales the estimate by `min(1, g / c)`, `g` the unit-free condition
-/// [`System::dependence_condition`] (directors weighed by `1 / J_max`) and `c` the estimate, both
+/// [`System::dependence_condition`] (directors weighed by `m / J_max`) and `c` the estimate, both
 /// at the step where it last measured; it measures again when the estimate has moved by
 /// [`GEOMETRY_REMEASURE`] from there (so an approach to a real singular configuration, where
 /// both grow, is followed), and never below [`BRANCH_ARM_CONDITION`], where every decision
