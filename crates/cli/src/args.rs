@@ -110,6 +110,12 @@ pub struct RunArgs {
     /// solvers` marks them adaptive).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_tol)]
     pub tol: Option<f64>,
+    /// Absolute part of the adaptive error tolerance, in the model's units (default: --tol).
+    /// The error of coordinate `y` may be `atol + tol |y|`: for a mechanism much smaller than
+    /// its unit of length (millimetre parts in metres) give an atol scaled to it, e.g.
+    /// --tol 1e-10 --atol 1e-13.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_atol, requires = "tol")]
+    pub atol: Option<f64>,
     /// Output file: .csv or .json, or - (or none) for CSV on standard output; a device such as
     /// /dev/null takes CSV.
     #[arg(long, short)]
@@ -246,6 +252,17 @@ fn parse_h(s: &str) -> Result<f64, String> {
     } else {
         Err(format!(
             "the step size must be a positive number of seconds, e.g. --h 1e-3 (got {s})"
+        ))
+    }
+}
+
+fn parse_atol(s: &str) -> Result<f64, String> {
+    let t = parse_number(s)?;
+    if t.is_finite() && t > 0.0 {
+        Ok(t)
+    } else {
+        Err(format!(
+            "the absolute tolerance must be positive and finite, e.g. --atol 1e-13 (got {s})"
         ))
     }
 }

@@ -312,6 +312,9 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
     let plan: mbd::Plan = match (args.h, args.tol) {
         (_, Some(tol)) => {
             let mut cfg = AdaptiveConfig::new(args.t_end, tol);
+            if let Some(atol) = args.atol {
+                cfg.controller.atol = atol;
+            }
             cfg.drift_guard = guard;
             cfg.max_steps = max_steps;
             cfg.into()
@@ -431,6 +434,7 @@ fn finish(
                 "solver": args.solver.to_string(),
                 "h": args.h,
                 "tol": args.tol,
+                "atol": args.atol,
                 "t_end": args.t_end,
                 "every": args.every,
                 "columns": columns,

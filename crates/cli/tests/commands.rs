@@ -692,3 +692,49 @@ fn run_creates_the_output_folder() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text.lines().count(), 12, "{text}");
 }
+
+/// `--atol` sets the absolute part of the adaptive tolerance: it needs `--tol`, must be
+/// positive, and is recorded in the JSON output; a tighter one takes more steps.
+#[test]
+fn atol_sets_the_absolute_tolerance_of_adaptive_runs() {
+    let dir = scratch("atol");
+    let model = common::repo().join("examples/models/pendulum.toml");
+    let json = dir.join("p.json");
+    let run = |extra: &[&str]| {
+        let mut args: Vec<&std::ffi::OsStr> = vec![
+            "run".as_ref(),
+            model.as_os_str(),
+            "--solver".as_ref(),
+            "index1:dopri5".as_ref(),
+            "--t-end".as_ref(),
+            "1".as_ref(),
+            "--out".as_ref(),
+            json.as_os_str(),
+        ];
+        args.extend(extra.iter().map(|a| std::ffi::OsStr::new(*a)));
+        mbd(&args)
+    };
+    let without = run(&["--atol", "1e-12"]);
+    assert_ne!(without.code, 0, "--atol without --tol ran");
+    assert!(without.stderr.contains("--tol"), "{}", without.stderr);
+    let negative = run(&["--tol", "1e-6", "--atol", "-1"]);
+    assert_ne!(negative.code, 0);
+    assert!(
+        negative.stderr.contains("absolute tolerance"),
+        "{}",
+        negative.stderr
+    );
+    let steps = |extra: &[&str]| {
+        let out = run(extra);
+        assert_eq!(out.code, 0, "{extra:?}: {}", out.stderr);
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let rows: Vec<Vec<f64>> = serde_json::from_value(v["rows"].clone()).unwrap();
+        (rows.len(), v["atol"].clone())
+    };
+    let (loose, none) = steps(&["--tol", "1e-4"]);
+    assert!(none.is_null());
+    let (tight, atol) = steps(&["--tol", "1e-4", "--atol", "1e-10"]);
+    assert_eq!(atol, 1e-10);
+    assert!(tight > loose, "{tight} rows against {loose}");
+}
