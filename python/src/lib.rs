@@ -118,7 +118,7 @@ impl CoreModel {
 
     /// Runs the model; returns `(columns, data, n_coordinates, stats)` or raises.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (solver, t_end, h=None, tol=None, every=1, reactions=false, drift_tol=None, drift_guard=true, max_steps=1_000_000_000))]
+    #[pyo3(signature = (solver, t_end, h=None, tol=None, every=1, reactions=false, drift_tol=None, drift_guard=true, max_steps=1_000_000_000, atol=None))]
     fn run<'py>(
         &self,
         py: Python<'py>,
@@ -131,12 +131,14 @@ impl CoreModel {
         drift_tol: Option<f64>,
         drift_guard: bool,
         max_steps: usize,
+        atol: Option<f64>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let opts = RunOptions {
             solver,
             t_end,
             h,
             tol,
+            atol,
             every,
             reactions,
             drift_tol,
@@ -195,6 +197,7 @@ fn run_many<'py>(
             t_end: get("t_end")?.map_or(Ok(f64::NAN), |v| v.extract())?,
             h: get("h")?.map_or(Ok(None), |v| v.extract())?,
             tol: get("tol")?.map_or(Ok(None), |v| v.extract())?,
+            atol: get("atol")?.map_or(Ok(None), |v| v.extract())?,
             every: get("every")?.map_or(Ok(1), |v| v.extract())?,
             reactions: get("reactions")?.map_or(Ok(false), |v| v.extract())?,
             drift_tol: get("drift_tol")?.map_or(Ok(None), |v| v.extract())?,

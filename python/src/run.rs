@@ -22,6 +22,8 @@ pub struct RunOptions {
     pub h: Option<f64>,
     /// The tolerance of adaptive steps.
     pub tol: Option<f64>,
+    /// The absolute part of the adaptive tolerance (`None`: `tol`).
+    pub atol: Option<f64>,
     /// Keep every k-th step (and always the first and the last state).
     pub every: usize,
     /// Add the joint reactions.
@@ -141,8 +143,19 @@ pub fn run_model(sys: &System, opts: &RunOptions) -> Result<RunData, Failure> {
     });
     let plan: mbd::Plan = match (opts.h, opts.tol) {
         (Some(_), Some(_)) => return Err(Failure::argument("give h or tol, not both")),
+        (_, None) if opts.atol.is_some() => {
+            return Err(Failure::argument("atol needs tol (adaptive steps)"))
+        }
         (None, Some(tol)) => {
             let mut cfg = AdaptiveConfig::new(opts.t_end, tol);
+            if let Some(atol) = opts.atol {
+                if !(atol.is_finite() && atol > 0.0) {
+                    return Err(Failure::argument(format!(
+                        "atol must be positive and finite, got {atol}"
+                    )));
+                }
+                cfg.controller.atol = atol;
+            }
             cfg.drift_guard = guard;
             cfg.max_steps = opts.max_steps;
             cfg.into()

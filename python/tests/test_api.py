@@ -55,6 +55,18 @@ def test_adaptive_run_reports_rejections_and_steps():
     assert r.stats.min_step > 0 and r.stats.max_step >= r.stats.min_step
 
 
+def test_atol_is_the_absolute_part_of_the_adaptive_tolerance():
+    m = mbd.Model.from_file(MODELS / "pendulum.toml")
+    loose = m.run("index1:dopri5", t_end=1.0, tol=1e-4)
+    tight = m.run("index1:dopri5", t_end=1.0, tol=1e-4, atol=1e-10)
+    assert tight.stats.steps > loose.stats.steps
+    assert tight.options.atol == 1e-10
+    with pytest.raises(mbd.InvalidArgumentError, match="atol needs tol"):
+        m.run("index1:dopri5", t_end=1.0, h=1e-3, atol=1e-10)
+    with pytest.raises(mbd.InvalidArgumentError, match="atol must be positive"):
+        m.run("index1:dopri5", t_end=1.0, tol=1e-4, atol=-1.0)
+
+
 def test_solvers_lists_the_registry():
     s = mbd.solvers()
     specs = [x["spec"] for x in s]

@@ -28,6 +28,8 @@ CASES = [
      ["--t-end", "0.05", "--h", "1e-2"]),
     ("point_mass_pendulum.toml", "index1:dopri5", dict(t_end=0.5, h=1e-2, drift_guard=False),
      ["--t-end", "0.5", "--h", "1e-2", "--no-drift-guard"]),
+    ("pendulum.toml", "index1:dopri5", dict(t_end=1.0, tol=1e-4, atol=1e-10),
+     ["--t-end", "1", "--tol", "1e-4", "--atol", "1e-10"]),
 ]
 
 

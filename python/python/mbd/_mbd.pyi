@@ -30,6 +30,7 @@ class CoreModel:
         drift_tol: Optional[float] = None,
         drift_guard: bool = True,
         max_steps: int = 1_000_000_000,
+        atol: Optional[float] = None,
     ) -> RunTuple: ...
 
 def run_many(

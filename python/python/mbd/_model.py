@@ -171,6 +171,7 @@ class Model:
         drift_tol: Optional[float] = None,
         drift_guard: bool = True,
         max_steps: int = 1_000_000_000,
+        atol: Optional[float] = None,
         warn: bool = True,
     ) -> Result:
         """Runs the model from its consistent initial state at ``t = 0`` to ``t_end``, exactly
@@ -179,6 +180,8 @@ class Model:
 
         ``every`` keeps every k-th step (and the last state); ``reactions`` adds the joint
         reactions; ``drift_tol`` / ``drift_guard=False`` loosen or turn off the drift guard;
+        ``atol`` (with ``tol``) is the absolute part of the adaptive tolerance, in the model's
+        units (``--atol``; default ``tol``);
         ``warn`` issues the warnings ``mbd run`` prints (initial values changed by the
         consistent-state projection, redundant equations, what the solver does not deliver on
         this model, e.g. the modified-Lagrangian schemes' plain order with drivers) as
@@ -203,6 +206,7 @@ class Model:
             drift_tol=None if drift_tol is None else float(drift_tol),
             drift_guard=bool(drift_guard),
             max_steps=int(max_steps),
+            atol=None if atol is None else float(atol),
         )
         return self.run_with(opts, warn=warn)
 
@@ -294,6 +298,10 @@ def _check_options(o: RunOptions) -> None:
         raise InvalidArgumentError("give h or tol, not both")
     if o.tol is not None and not o.tol > 0:
         raise InvalidArgumentError(f"tol must be positive, got {o.tol}")
+    if o.atol is not None and o.tol is None:
+        raise InvalidArgumentError("atol needs tol (adaptive steps)")
+    if o.atol is not None and not (o.atol > 0 and o.atol < float("inf")):
+        raise InvalidArgumentError(f"atol must be positive and finite, got {o.atol}")
     if o.drift_tol is not None and not o.drift_tol > 0:
         raise InvalidArgumentError(f"drift_tol must be positive, got {o.drift_tol}")
 

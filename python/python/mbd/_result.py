@@ -16,7 +16,8 @@ class RunOptions:
     :func:`mbd.solvers`); ``every`` keeps every k-th step (and always the first and the last
     state); ``reactions`` adds each joint's ``JOINT.fx``, ``JOINT.fy``, ``JOINT.mz``;
     ``drift_tol`` / ``drift_guard`` set or turn off the drift guard; ``max_steps`` is the step
-    budget.
+    budget; ``atol`` (with ``tol``) the absolute part of the adaptive tolerance in the model's
+    units (default ``tol``: a coordinate ``y`` may err by ``atol + tol |y|``).
 
     >>> RunOptions("rk4", t_end=1.0, h=0.01).every
     1
@@ -31,6 +32,7 @@ class RunOptions:
     drift_tol: Optional[float] = None
     drift_guard: bool = True
     max_steps: int = 1_000_000_000
+    atol: Optional[float] = None
 
     def to_dict(self) -> Dict[str, Any]:
         """The options as a dict (the keyword arguments of :meth:`mbd.Model.run`)."""
