@@ -700,20 +700,7 @@ fn atol_sets_the_absolute_tolerance_of_adaptive_runs() {
     let dir = scratch("atol");
     let model = common::repo().join("examples/models/pendulum.toml");
     let json = dir.join("p.json");
-    let run = |extra: &[&str]| {
-        let mut args: Vec<&std::ffi::OsStr> = vec![
-            "run".as_ref(),
-            model.as_os_str(),
-            "--solver".as_ref(),
-            "index1:dopri5".as_ref(),
-            "--t-end".as_ref(),
-            "1".as_ref(),
-            "--out".as_ref(),
-            json.as_os_str(),
-        ];
-        args.extend(extra.iter().map(|a| std::ffi::OsStr::new(*a)));
-        mbd(&args)
-    };
+    let run = |extra: &[&str]| run_model_until(&model, "index1:dopri5", extra, &json, "1");
     let without = run(&["--atol", "1e-12"]);
     assert_ne!(without.code, 0, "--atol without --tol ran");
     assert!(without.stderr.contains("--tol"), "{}", without.stderr);
