@@ -361,8 +361,6 @@ impl System {
         Ok(found)
     }
 
-    /// The element that owns equation `row`: its joint's name (planar or spatial), or the
-    /// spatial body of an internal constraint.
     /// The element equation `row` of `Phi` belongs to: its planar or spatial joint, or the
     /// spatial body whose internal (director) constraint it is (the part of
     /// [`System::equation_name`] before its last dot).

@@ -316,8 +316,9 @@ pub(crate) const GEOMETRY_REMEASURE: f64 = 4.0;
 /// at the step where it last measured; it measures again when the estimate has moved by
 /// [`GEOMETRY_REMEASURE`] from there (so an approach to a real singular configuration, where
 /// both grow, is followed), and never below [`BRANCH_ARM_CONDITION`], where every decision
-/// reads the step as regular anyway. Planar models (whose `g` is the estimate itself) and
-/// models above [`mbd_model::SPARSE_RANK_THRESHOLD`] equations go without it.
+/// reads the step as regular anyway. Planar models (whose estimate has no director masses;
+/// with bodies of equal masses `g` is the estimate itself) and models above
+/// [`mbd_model::SPARSE_RANK_THRESHOLD`] equations go without it.
 pub(crate) struct GeometryGate {
     /// `min(1, g / c)` at the last measurement (1 before the first).
     ratio: f64,

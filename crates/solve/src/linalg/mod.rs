@@ -6,9 +6,9 @@
 //! body).
 
 pub use mbd_linalg::{
-    axpy, dot, form_q_padded, max_abs, max_abs_diff, mul_r, pow2_inverse, qr_padded, reflect,
-    solve_r, solve_rt, symmetric_eigen, Anderson, DenseCholesky, DenseLu, FactorError, LinalgError,
-    LuError, CHOLESKY_PIVOT_TOL, FIXED_CHOLESKY, PIVOT_THRESHOLD, PIVOT_TOL, SMALL_CHOLESKY,
+    axpy, dot, form_q_padded, max_abs, max_abs_diff, pow2_inverse, qr_padded, reflect, solve_rt,
+    symmetric_eigen, Anderson, DenseCholesky, DenseLu, FactorError, LinalgError, LuError,
+    CHOLESKY_PIVOT_TOL, FIXED_CHOLESKY, PIVOT_THRESHOLD, PIVOT_TOL, SMALL_CHOLESKY,
     SMALL_CHOLESKY_SOLVE,
 };
 
