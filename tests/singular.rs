@@ -233,6 +233,27 @@ fn a_newton_failure_on_a_step_across_rank_loss_is_the_singular_error() {
     }
 }
 
+/// Symplectic (2,2) on the driven 10-four-bar at h = 1e-3 fails 2.2 steps before the flat
+/// configuration at t = 0.357 (the crank 0.013 rad from it, no equation yet within 1e-2 of
+/// dependence along the step itself): configurations a few steps either side of a failing
+/// step are checked too, so the error is the typed singular one, not a Newton failure
+/// advising a shorter step.
+#[test]
+fn a_newton_failure_steps_before_rank_loss_is_the_singular_error() {
+    use mbd::model::models::ClosedLoop;
+    use mbd::prelude::*;
+    let cl = ClosedLoop::n_four_bar(10, 0.4, 1.0).unwrap();
+    let sys = cl.system(1.0, 6.0, true).unwrap();
+    let mut sim = Simulation::new(sys, "symplectic:2").unwrap();
+    match sim.run(RunConfig::new(0.4, 1e-3)) {
+        Err(mbd::Error::Solve(SolveError::Singular { t, detail, .. })) => {
+            assert!((0.35..0.357).contains(&t), "{t}");
+            assert!(detail.contains("rank deficiency"), "{detail}");
+        }
+        other => panic!("expected the singular error, got {other:?}"),
+    }
+}
+
 /// Symplectic (1,1) on the free 10-four-bar (sparse path, whose stage factorisation is kept
 /// across steps) at h = 1e-3 reaches t = 9.2: near a flat configuration a kept factorisation
 /// can stall Newton at round-off short of the solution (it stopped at t = 9.115 with

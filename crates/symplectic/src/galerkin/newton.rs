@@ -115,9 +115,9 @@ impl Galerkin {
                     .join("; ")
             };
             if stalled && !near.is_empty() {
-                // stalled a few digits above the tolerance where the step passes within 1e-2 of
-                // rank loss: the stage Jacobian is near-singular there, and a smaller h does
-                // not change that
+                // stalled a few digits above the tolerance where the step passes, or is a few
+                // steps from, a configuration within 1e-2 of rank loss: the stage Jacobian is
+                // near-singular there, and a smaller h does not change that
                 SolveError::Singular {
                     t,
                     what: "configuration (the stage Jacobian near-singular)",
@@ -132,8 +132,8 @@ impl Galerkin {
                     ),
                 }
             } else if !near.is_empty() {
-                // no convergence at a step that passes within 1e-2 of rank loss: the singular
-                // configuration, not the step length, is the cause
+                // no convergence at a step that passes (or nearly reaches) rank loss: the
+                // singular configuration, not the step length, is the cause
                 SolveError::Singular {
                     t,
                     what: "configuration (Phi_q near rank loss: the stage equations failed there)",
@@ -418,9 +418,11 @@ fn position_scale(q: &[f64]) -> f64 {
 }
 
 /// The equations within 1e-2 of dependence (`System::nearly_dependent_at`, weighted like
-/// `M^-1`) at the configurations a step from `qk` passes: its start and, along the start
-/// velocity `hvk` (`h v_k`), its middle and end (a step that crosses a singular configuration
-/// fails there, not at its start). A point of that line that has left the constraints by more
+/// `M^-1`) at the configurations a step from `qk` passes or is about to pass: its start and,
+/// along the start velocity `hvk` (`h v_k`), its middle, its end and the points up to three
+/// steps ahead and behind ([`NEAR_STEP_FRACTIONS`]; a step that crosses a singular
+/// configuration fails there, not at its start, and one a few steps short of it can fail
+/// too). A point of that line that has left the constraints by more
 /// than [`OFF_MANIFOLD`] of an equation's natural unit (`System::equation_scale`) is skipped:
 /// the step is then too long for a straight line to say where it goes (the rank of `Phi_q`
 /// there says nothing about the mechanism; unit directors of a spatial body extrapolated
@@ -435,7 +437,7 @@ fn near_rank_loss(
 ) -> Vec<mbd_model::RedundantEquation> {
     let scales = sys.equation_scales();
     let mut phi = vec![0.0; sys.n_constraints()];
-    [0.0, 0.5, 1.0]
+    NEAR_STEP_FRACTIONS
         .iter()
         .filter_map(|&th| {
             let q: Vec<f64> = qk.iter().zip(hvk).map(|(q, d)| q + th * d).collect();
@@ -455,6 +457,13 @@ fn near_rank_loss(
         .find(|near| !near.is_empty())
         .unwrap_or_default()
 }
+
+/// The points of a step's straight line `q_k + th h v_k` that [`near_rank_loss`] tests, nearest
+/// first: the step itself (`th` = 0, 1/2, 1) and up to three steps on either side. The stage
+/// equations lose their conditioning over a neighbourhood of a singular configuration that
+/// spans a few steps (docs/symplectic.md, section 1), so a failure that close is the
+/// configuration's, not the step length's.
+const NEAR_STEP_FRACTIONS: [f64; 9] = [0.0, 0.5, 1.0, 2.0, -1.0, 3.0, -2.0, 4.0, -3.0];
 
 /// How far (relative to an equation's natural unit) a point on a step's straight line may
 /// have left the constraints for its rank to say something about the step ([`near_rank_loss`]).
