@@ -24,6 +24,20 @@ pub enum SpatialInertiaError {
         /// `|I_rc - I_cr|`.
         difference: f64,
     },
+    /// A principal moment is negative, zero or vanishing against the largest (below `1e-12`
+    /// times it): the body's spin about that axis would be undetermined.
+    #[error(
+        "principal moment J{} = {j:e} must be positive (and above 1e-12 times the largest): a \
+         body without inertia about an axis has an undetermined spin about it (an ideal \
+         slender rod: give it a small moment about its axis, or model it with point masses)",
+        index + 1
+    )]
+    Moment {
+        /// The principal axis (from 0).
+        index: usize,
+        /// Its moment.
+        j: f64,
+    },
     /// A principal moment exceeds the sum of the other two (no rigid body has it): the second
     /// moment `E_i = (J_j + J_k - J_i) / 2` would be negative.
     #[error(
@@ -89,7 +103,9 @@ impl SpatialInertia {
         Self::principal_with_axes(mass, moments, Matrix3::identity())
     }
 
-    /// Mass, principal moments and principal axes (the columns of `axes`, a rotation).
+    /// Mass, principal moments and principal axes (the columns of `axes`, a rotation). The
+    /// moments must be positive (above `1e-12` times the largest) and satisfy the triangle
+    /// inequalities `J_i <= J_j + J_k`.
     pub fn principal_with_axes(
         mass: f64,
         moments: [f64; 3],
@@ -110,6 +126,12 @@ impl SpatialInertia {
             return Err(SpatialInertiaError::Axes { deviation, det });
         }
         let scale = moments.iter().fold(0.0f64, |m, j| m.max(j.abs()));
+        if let Some(index) = (0..3).find(|&i| moments[i] <= TOL * scale) {
+            return Err(SpatialInertiaError::Moment {
+                index,
+                j: moments[index],
+            });
+        }
         for i in 0..3 {
             let excess = moments[i] - moments[(i + 1) % 3] - moments[(i + 2) % 3];
             if excess > TOL * scale {

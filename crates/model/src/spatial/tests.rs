@@ -80,13 +80,20 @@ fn points_ride_on_the_directors() {
 /// axes that diagonalise it.
 #[test]
 fn tensors_are_moved_to_the_centre_and_diagonalised() {
-    let (m, l) = (2.0, 3.0);
-    let end = Matrix3::from_diagonal(&Vector3::new(0.0, m * l * l / 3.0, m * l * l / 3.0));
+    let (m, l, axial) = (2.0, 3.0, 1e-3);
+    let end = Matrix3::from_diagonal(&Vector3::new(axial, m * l * l / 3.0, m * l * l / 3.0));
     let rod = SpatialInertia::from_tensor(m, end, Vector3::new(l / 2.0, 0.0, 0.0)).unwrap();
     let j = rod.moments();
     assert!(
-        j[0].abs() < 1e-14 && (j[1] - m * l * l / 12.0).abs() < 1e-13,
+        (j[0] - axial).abs() < 1e-14 && (j[1] - m * l * l / 12.0).abs() < 1e-13,
         "{j:?}"
+    );
+    // an ideal rod (no axial moment) has an undetermined spin: refused when built
+    let ideal = Matrix3::from_diagonal(&Vector3::new(0.0, m * l * l / 3.0, m * l * l / 3.0));
+    let e = SpatialInertia::from_tensor(m, ideal, Vector3::new(l / 2.0, 0.0, 0.0)).unwrap_err();
+    assert!(
+        matches!(e, SpatialInertiaError::Moment { index: 0, .. }),
+        "{e}"
     );
     assert!((j[2] - m * l * l / 12.0).abs() < 1e-13, "{j:?}");
     let r = rotation();
@@ -229,14 +236,13 @@ fn force_free_directors_follow_eulers_equations() {
     }
 }
 
-/// A zero principal moment (a slender rod) and dependent directors are refused by name.
+/// A zero principal moment (a slender rod) is refused when the inertia is built, dependent
+/// directors by the rigid solve, each by name.
 #[test]
 fn the_rigid_solve_refuses_degenerate_bodies() {
-    let rod = SpatialInertia::principal(1.0, [0.0, 1.0, 1.0]).unwrap();
-    let q = natural_coordinates(Vector3::zeros(), &Matrix3::identity());
-    let e = RigidSolve::new(&rod, &q).unwrap_err().to_string();
-    assert!(e.contains("principal moment is zero"), "{e}");
-    let mut q = q;
+    let e = SpatialInertia::principal(1.0, [0.0, 1.0, 1.0]).unwrap_err();
+    assert!(e.to_string().contains("J1 = 0e0 must be positive"), "{e}");
+    let mut q = natural_coordinates(Vector3::zeros(), &Matrix3::identity());
     q[6..9].copy_from_slice(&[1.0, 0.0, 0.0]); // d_2 = d_1
     let e = RigidSolve::new(&top_like(), &q).unwrap_err().to_string();
     assert!(e.contains("directors"), "{e}");
@@ -250,6 +256,24 @@ fn bad_inertias_and_orientations_are_refused() {
             .contains("J3 = 3e0 exceeds the sum of the other two"),
         "{e}"
     );
+    // a negative moment is named as such, not as a triangle violation of another one
+    let e = SpatialInertia::principal(1.0, [2.2e-4, 1.0e-4, -4.0e-5]).unwrap_err();
+    assert!(e.to_string().contains("J3 = -4e-5 must be positive"), "{e}");
+    // an ideal slender rod (no axial moment) and moments all zero are refused when built
+    for (moments, name) in [([1.0, 1.0, 0.0], "J3 = 0e0"), ([0.0; 3], "J1 = 0e0")] {
+        let e = SpatialInertia::principal(1.0, moments)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(name) && e.contains("slender rod"), "{e}");
+    }
+    let e = SpatialInertia::principal(1.0, [1.0, 1.0, 1e-13]).unwrap_err();
+    assert!(
+        matches!(e, SpatialInertiaError::Moment { index: 2, .. }),
+        "{e}"
+    );
+    // a thin disc (E_i = 0) and a thin but solid rod stay valid
+    SpatialInertia::principal(1.0, [0.5, 1.0, 0.5]).unwrap();
+    SpatialInertia::principal(1.0, [1.0, 1.0, 1e-9]).unwrap();
     let e = SpatialInertia::principal(0.0, [1.0, 1.0, 1.0]).unwrap_err();
     assert_eq!(e.to_string(), "mass 0 must be positive and finite");
     let e = SpatialInertia::principal(1.0, [1.0, f64::NAN, 1.0]).unwrap_err();
