@@ -242,11 +242,22 @@ fn warn_initial_changes(sys: &System, state: &State) {
     } else {
         String::new()
     };
+    // `inputs` exist for planar bodies only: a change on a spatial body gets other advice
+    let planar = changes.iter().any(|c| {
+        let name = c.name.strip_prefix("d_").unwrap_or(&c.name);
+        name.rsplit_once('.')
+            .is_some_and(|(body, _)| sys.body_handle(body).is_some())
+    });
+    let advice = if planar {
+        "to keep a value, mark it an input of its body (inputs = [\"d_theta\"] in the model \
+         file, Body::input_velocity in code) and the others are solved for"
+    } else {
+        "spatial bodies have no inputs: to keep the values, give positions, orientations and \
+         velocities that satisfy the joints"
+    };
     eprintln!(
         "warning: the initial state was made consistent with the constraints, which changed \
-         given values: {}{more}; to keep a value, mark it an input of its body (inputs = \
-         [\"d_theta\"] in the model file, Body::input_velocity in code) and the others are \
-         solved for",
+         given values: {}{more}; {advice}",
         shown.join("; ")
     );
 }

@@ -484,6 +484,33 @@ fn run_reactions_adds_three_columns_per_joint() {
     assert_eq!(cols, want);
 }
 
+/// A spatial model whose given velocity leaves its joint (a radial component on the spherical
+/// pendulum) gets the warning with advice that fits spatial bodies, which take no `inputs`.
+#[test]
+fn the_initial_change_warning_on_spatial_bodies_does_not_advise_inputs() {
+    let dir = scratch("spatial_inputs");
+    let text =
+        std::fs::read_to_string(common::repo().join("examples/models/spherical_pendulum.toml"))
+            .unwrap();
+    let pushed = text.replacen(
+        "velocity = [0.0, 1.5, 0.0]",
+        "velocity = [0.3, 1.5, 0.0]",
+        1,
+    );
+    assert_ne!(pushed, text);
+    let model = dir.join("pushed.toml");
+    std::fs::write(&model, pushed).unwrap();
+    let o = run_model(&model, "rk4", &["--h", "0.005"], &dir.join("pushed.csv"));
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("d_bob.x given 0.3 used")
+            && o.stderr.contains("spatial bodies have no inputs")
+            && !o.stderr.contains("inputs = ["),
+        "{}",
+        o.stderr
+    );
+}
+
 /// A slider-crank file that gives only the crank's 6 rad/s: `mbd run` warns that the
 /// consistent state changed it, naming the value given and used and how to keep it; with
 /// `inputs = ["d_theta"]` on the crank the run starts at exactly 6 rad/s, without the warning.
