@@ -442,7 +442,8 @@ fn near_rank_loss(
         .filter_map(|&th| {
             let q: Vec<f64> = qk.iter().zip(hvk).map(|(q, d)| q + th * d).collect();
             let tt = t + th * h;
-            if th > 0.0 {
+            // the start is on the constraints; every other point is extrapolated
+            if th != 0.0 {
                 sys.phi(&q, tt, &mut phi);
                 let off = phi
                     .iter()
