@@ -245,26 +245,28 @@ fn parse_number(s: &str) -> Result<f64, String> {
         .map_err(|_| format!("'{s}' is not a number"))
 }
 
-fn parse_h(s: &str) -> Result<f64, String> {
-    let h = parse_number(s)?;
-    if h.is_finite() && h > 0.0 {
-        Ok(h)
+/// `s` as a positive finite number, else the error `what` followed by ` (got {s})`.
+fn parse_positive(s: &str, what: &str) -> Result<f64, String> {
+    let x = parse_number(s)?;
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
     } else {
-        Err(format!(
-            "the step size must be a positive number of seconds, e.g. --h 1e-3 (got {s})"
-        ))
+        Err(format!("{what} (got {s})"))
     }
 }
 
+fn parse_h(s: &str) -> Result<f64, String> {
+    parse_positive(
+        s,
+        "the step size must be a positive number of seconds, e.g. --h 1e-3",
+    )
+}
+
 fn parse_atol(s: &str) -> Result<f64, String> {
-    let t = parse_number(s)?;
-    if t.is_finite() && t > 0.0 {
-        Ok(t)
-    } else {
-        Err(format!(
-            "the absolute tolerance must be positive and finite, e.g. --atol 1e-13 (got {s})"
-        ))
-    }
+    parse_positive(
+        s,
+        "the absolute tolerance must be positive and finite, e.g. --atol 1e-13",
+    )
 }
 
 fn parse_tol(s: &str) -> Result<f64, String> {
@@ -296,24 +298,16 @@ fn parse_count(s: &str) -> Result<u64, String> {
 }
 
 fn parse_drift_tol(s: &str) -> Result<f64, String> {
-    let t = parse_number(s)?;
-    if t.is_finite() && t > 0.0 {
-        Ok(t)
-    } else {
-        Err(format!(
-            "the drift tolerance must be a positive fraction of the equations' scale, e.g. \
-             --drift-tol 0.05 (got {s})"
-        ))
-    }
+    parse_positive(
+        s,
+        "the drift tolerance must be a positive fraction of the equations' scale, e.g. \
+         --drift-tol 0.05",
+    )
 }
 
 fn parse_t_end(s: &str) -> Result<f64, String> {
-    let t = parse_number(s)?;
-    if t.is_finite() && t > 0.0 {
-        Ok(t)
-    } else {
-        Err(format!(
-            "the end time must be after the start time t0 = 0, e.g. --t-end 5 (got {s})"
-        ))
-    }
+    parse_positive(
+        s,
+        "the end time must be after the start time t0 = 0, e.g. --t-end 5",
+    )
 }
