@@ -15,21 +15,27 @@ use mbd::tangent::TangentRk;
 
 type Make = fn(&System) -> Box<dyn Integrator>;
 
-fn solvers() -> Vec<(&'static str, u32, Make)> {
+/// Each solver with its order and the step of its first run (the second halves it): in the
+/// asymptotic range of its error. (Tangent RK4's leading error term is small in the
+/// step-weighted chart, so the next one still shows at h = 0.0025: it takes h = 0.001;
+/// docs/tangent.md, "The chart's metric".)
+fn solvers() -> Vec<(&'static str, u32, f64, Make)> {
     vec![
-        ("RK4", 4, |s| {
+        ("RK4", 4, 0.0025, |s| {
             Box::new(Rk4::new(s, Rk4Options::plain()).unwrap())
         }),
-        ("RK4+projection", 4, |s| {
+        ("RK4+projection", 4, 0.0025, |s| {
             Box::new(Rk4::new(s, Rk4Options::projected()).unwrap())
         }),
-        ("symplectic (1,1)", 2, |s| {
+        ("symplectic (1,1)", 2, 0.00125, |s| {
             Box::new(Galerkin::new(s, SymplecticOptions::new(1)).unwrap())
         }),
-        ("symplectic (2,2)", 4, |s| {
+        ("symplectic (2,2)", 4, 0.0025, |s| {
             Box::new(Galerkin::new(s, SymplecticOptions::new(2)).unwrap())
         }),
-        ("tangent RK4", 4, |s| Box::new(TangentRk::rk4(s).unwrap())),
+        ("tangent RK4", 4, 0.001, |s| {
+            Box::new(TangentRk::rk4(s).unwrap())
+        }),
     ]
 }
 
@@ -53,8 +59,7 @@ fn solvers_agree_on_the_manipulator_at_two_seconds() {
         reference_trajectory(&sys, &s0, 1e-4, 20_000, 1, ButcherTableau::dopri5()).unwrap();
     let qref = reference.q.last().unwrap().clone();
     let mut finals = Vec::new();
-    for (name, p, make) in solvers() {
-        let h = if p == 2 { 0.00125 } else { 0.0025 };
+    for (name, p, h, make) in solvers() {
         let e1 = dist(&final_q(&sys, make(&sys).as_mut(), h), &qref);
         let q2 = final_q(&sys, make(&sys).as_mut(), h / 2.0);
         let e2 = dist(&q2, &qref);

@@ -14,6 +14,8 @@ fn spec_strings_round_trip_and_bad_ones_say_what_to_use() {
         "index1:dopri5",
         "tangent:rk4",
         "tangent:dopri5",
+        "tangent:rk4:euclidean",
+        "tangent:dopri5:euclidean",
         "firefly-gauss",
         "firefly-gauss:polish:seed=7",
     ] {
@@ -41,6 +43,8 @@ fn spec_strings_round_trip_and_bad_ones_say_what_to_use() {
         ),
         ("rk4:fast", "takes no options"),
         ("tangent:rk5", "tangent:rk4 or tangent:dopri5"),
+        ("tangent:rk4:metric", "unknown option 'metric'"),
+        ("tangent:rk4:euclidean:x", "at most one option"),
         ("index1:rk4", "index1:dopri5"),
         ("firefly-gauss:seed=-1", "seed must be a whole number"),
         ("firefly-gauss:polish:polish", "given twice"),

@@ -227,17 +227,23 @@ fn firefly_gauss_runs_spatial_tops() {
 }
 
 /// The tangent-space solvers (paper B) on the heavy top, solid and disc (`E_3 = 0`): order 4
-/// (tangent RK4) and 5 (tangent DOPRI5, fixed steps) at t = 0.5 for h = 4e-3 .. 1e-3 against
-/// an RK4 reference (h = 1.25e-4), slopes within 0.3, constraints at 1e-12.
+/// (tangent RK4, h = 1e-3 .. 2.5e-4) and 5 (tangent DOPRI5, fixed steps, h = 2e-3 .. 5e-4) at
+/// t = 0.5 against an index-1 DOPRI5 reference (h = 1.25e-4), slopes within 0.3, constraints
+/// at 1e-12. (Tangent RK4's leading error term is small in the step-weighted chart: at
+/// h = 4e-3 .. 2e-3 the next terms still show, slopes 3.0 and 5.3; docs/tangent.md, "The chart's
+/// metric".)
 #[test]
 fn the_tangent_solvers_reach_their_orders_on_spatial_tops() {
     for moments in [[0.3, 0.3, 0.1], [0.25, 0.25, 0.5]] {
         let sys = heavy_top(moments, 0.3, 20.0).unwrap();
         let end = |spec: &str, h: f64| common::end_state(&sys, spec, RunConfig::new(0.5, h));
-        let reference = end("rk4", 1.25e-4);
-        for (spec, order) in [("tangent:rk4", 4.0), ("tangent:dopri5", 5.0)] {
+        let reference = end("index1:dopri5", 1.25e-4);
+        for (spec, order, hs) in [
+            ("tangent:rk4", 4.0, [1e-3, 5e-4, 2.5e-4]),
+            ("tangent:dopri5", 5.0, [2e-3, 1e-3, 5e-4]),
+        ] {
             let mut errs = Vec::new();
-            for h in [4e-3, 2e-3, 1e-3] {
+            for h in hs {
                 let s = end(spec, h);
                 errs.push((&s.q - &reference.q).amax());
                 assert!(

@@ -70,7 +70,7 @@ mod registry;
 mod sparse_chart;
 
 pub use chart::{NewtonSettings, ROUNDOFF_FACTOR};
-pub use integrator::{IterationMatrix, TangentOptions, TangentRk, TangentStats};
+pub use integrator::{ChartMetric, IterationMatrix, TangentOptions, TangentRk, TangentStats};
 pub use mbd_solve::LinearSolver;
 pub use registry::SOLVERS;
 

@@ -66,7 +66,7 @@ impl TangentChart {
             return false;
         }
         let d = n - m;
-        let (q, v) = self.xc.split_at(n);
+        let (q, v) = self.xc_user.split_at(n);
         let ws = &mut self.centre_acc;
         sys.forces_into(q, v, self.tc, &mut ws.force);
         let mass = sys.mass_diag().as_slice();

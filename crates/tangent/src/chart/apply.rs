@@ -45,14 +45,29 @@ impl TangentChart {
 
     /// `[Q1 U]^T y` for a vector `y` of length `2n`, in two parts: its normal components
     /// `normal = Q1^T y` (`2m`) and its tangent components `tangent = U^T y` (`2(n - m)`).
+    ///
+    /// `y` is a vector of the model's `(q, v)` space (a velocity `F = (v, a)`); it is split in
+    /// the chart's coordinates `(q, tau v)` ([`TangentChart::set_velocity_weight`]).
     pub fn split_coordinates(&mut self, y: &[f64], normal: &mut [f64], tangent: &mut [f64]) {
         let (n, m) = (self.n, self.m);
+        let y = if self.vs == 1.0 {
+            y
+        } else {
+            let (yq, yv) = y.split_at(n);
+            let (bq, bv) = self.sbuf.split_at_mut(n);
+            bq.copy_from_slice(yq);
+            for (b, &v) in bv.iter_mut().zip(yv) {
+                *b = self.vs * v;
+            }
+            &self.sbuf[..]
+        };
         let (qa, qb, buf) = (&self.qa, &self.qb, &mut self.nbuf);
         with_len!(n, split_n(qa, qb, y, normal, tangent, buf, m));
     }
 
     /// `out = U e` for tangent coordinates `e` (`2 (n - m)`): a chart-coordinate vector in the
-    /// ambient space.
+    /// ambient space, returned in the model's `(q, v)` (the velocity half divided by the
+    /// chart's velocity weight).
     pub(crate) fn tangent_to_ambient(&mut self, e: &[f64], out: &mut [f64]) {
         out.fill(0.0);
         // (the zero normal part borrows a work vector, moved out for the call)
@@ -60,6 +75,7 @@ impl TangentChart {
         zeta.fill(0.0);
         self.add_q(&zeta, e, out);
         self.w = zeta;
+        self.unweight(out);
     }
 
     /// `x += Q1 w` for the work vector `w` (`2m`): a chord correction.

@@ -40,6 +40,10 @@ impl TangentChart {
         // Delta Df = [[dP, 0], [dX, dP]] with dP = Phi_q(e) - Phi_q(c), dX likewise
         self.pq_e -= &self.phi_q;
         self.dphi_e -= &self.dphi;
+        // the chart's velocity coordinates are tau v: dX enters weighted (as X at the centre)
+        if self.vs != 1.0 {
+            self.dphi_e *= self.vs;
+        }
         // column k of E: (dP cq, dX cq + dP cv) for Q1_k = (cq, cv); dP, dX column-major m x n
         let (dp, dx) = (self.pq_e.as_slice(), self.dphi_e.as_slice());
         self.e.fill(0.0);
@@ -236,7 +240,7 @@ impl TangentChart {
                 return Ok(ms);
             }
             let res = self.residual_cached(sys, x, t, f);
-            let stop = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol));
+            let stop = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol, self.vinv));
             if let Some(theta) = lp.observed_theta(floor) {
                 self.theta_seen = fast_max(self.theta_seen, theta);
             }
@@ -305,7 +309,9 @@ impl TangentChart {
                 return Ok(ms);
             }
             let res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol)) {
+            if let Some(ms) =
+                lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol, self.vinv))
+            {
                 return Ok(ms);
             }
             if let Some(e) = lp.diverged() {
@@ -355,7 +361,9 @@ impl TangentChart {
             }
             self.fprev.copy_from_slice(f);
             let res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol)) {
+            if let Some(ms) =
+                lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol, self.vinv))
+            {
                 return Ok(ms);
             }
             if self.pb_active && (lp.res.is_nan() || lp.res >= lp.prev) {
@@ -571,12 +579,20 @@ impl RoundoffFloor {
     }
 
     /// `max(10 tol, ROUNDOFF_FACTOR eps (1 + |x|_inf + L max_i (1 + |theta_i|)(1 + |omega_i|)))`
-    /// at `x = (q, v)` (a NaN entry is skipped, as by `f64::max`).
-    pub(crate) fn stall_cap(&self, x: &[f64], tol: f64) -> f64 {
-        let xmax = x.iter().fold(0.0f64, |m, v| fast_max(m, v.abs()));
-        let wound = if x.len() == 2 * self.n {
+    /// at `x = (q, v)` (a NaN entry is skipped, as by `f64::max`), for a chart point held as
+    /// `(q, tau v)`: `vinv = 1 / tau` restores the velocities (1 for the model's own `x`).
+    pub(crate) fn stall_cap(&self, x: &[f64], tol: f64, vinv: f64) -> f64 {
+        let n = self.n;
+        let xmax = if x.len() == 2 * n && vinv != 1.0 {
+            let (q, v) = x.split_at(n);
+            let qm = q.iter().fold(0.0f64, |m, v| fast_max(m, v.abs()));
+            v.iter().fold(qm, |m, v| fast_max(m, (v * vinv).abs()))
+        } else {
+            x.iter().fold(0.0f64, |m, v| fast_max(m, v.abs()))
+        };
+        let wound = if x.len() == 2 * n {
             self.angles.iter().fold(0.0f64, |m, &i| {
-                fast_max(m, (1.0 + x[i].abs()) * (1.0 + x[self.n + i].abs()))
+                fast_max(m, (1.0 + x[i].abs()) * (1.0 + (x[n + i] * vinv).abs()))
             })
         } else {
             0.0

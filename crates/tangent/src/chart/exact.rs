@@ -44,23 +44,14 @@ impl TangentChart {
             // (the residual borrows the chart mutably: the point is moved out for the call,
             // which does not allocate)
             let step = std::mem::take(&mut self.step);
-            if self.residual(sys, &step, t, f).is_finite() {
+            if self.residual_weighted(sys, &step, t, f).is_finite() {
                 x.copy_from_slice(&step);
             }
             self.step = step;
         }
         self.wx.copy_from_slice(x);
         self.first_step = 0.0;
-        self.sel.jacobian(
-            sys,
-            &x[..n],
-            None,
-            &x[n..],
-            t,
-            &mut self.pq_x,
-            &mut self.dphi_x,
-            false,
-        );
+        self.jacobian_weighted(sys, x, t);
         let scale = max_abs(self.phi_q.as_slice()).max(max_abs(self.dphi.as_slice()));
         let change = max_abs_diff(self.pq_x.as_slice(), self.phi_q.as_slice())
             .max(max_abs_diff(self.dphi_x.as_slice(), self.dphi.as_slice()));
@@ -68,8 +59,8 @@ impl TangentChart {
             return Err(failure);
         }
         let tol = newton.tol;
-        let stall_cap = self.roundoff.stall_cap(x, tol);
-        let res0 = self.residual(sys, x, t, f);
+        let stall_cap = self.roundoff.stall_cap(x, tol, self.vinv);
+        let res0 = self.residual_weighted(sys, x, t, f);
         let mut res = res0;
         let mut it = failure.iterations;
         let max_iter = failure.iterations + newton.max_iter;
@@ -88,19 +79,14 @@ impl TangentChart {
                 return verdict.map(|_| done(it, res));
             }
             if !first {
-                self.sel.jacobian(
-                    sys,
-                    &x[..n],
-                    None,
-                    &x[n..],
-                    t,
-                    &mut self.pq_x,
-                    &mut self.dphi_x,
-                    false,
-                );
+                self.jacobian_weighted(sys, x, t);
             }
             first = false;
-            // J = Df(x) Q1: column k = (Phi_q cq, X cq + Phi_q cv) for Q1_k = (cq, cv)
+            // J = Df(x) Q1: column k = (Phi_q cq, tau X cq + Phi_q cv) for Q1_k = (cq, cv)
+            // (the chart's coordinates (q, tau v), its velocity rows weighted by tau)
+            if self.vs != 1.0 {
+                self.dphi_x *= self.vs;
+            }
             let (dp, dx) = (self.pq_x.as_slice(), self.dphi_x.as_slice());
             self.jn.fill(0.0);
             for k in 0..mm {
@@ -145,7 +131,7 @@ impl TangentChart {
                 self.first_step = max_abs_diff(x, &self.wx);
             }
             let prev = res;
-            res = self.residual(sys, x, t, f);
+            res = self.residual_weighted(sys, x, t, f);
             if res > tol && res <= stall_cap && res >= 0.9 * prev {
                 self.exact_maps += 1;
                 return Ok(done(it, res));
@@ -162,5 +148,25 @@ impl TangentChart {
                 return Ok(done(it, res));
             }
         }
+    }
+
+    /// `Phi_q` and `(Phi_q v)_q` at the chart point `x = (q, tau v)` into `pq_x` and `dphi_x`
+    /// (unweighted).
+    fn jacobian_weighted(&mut self, sys: &System, x: &[f64], t: f64) {
+        let n = self.n;
+        let (q, v) = x.split_at(n);
+        for (b, &vi) in self.vbuf.iter_mut().zip(v) {
+            *b = vi * self.vinv;
+        }
+        self.sel.jacobian(
+            sys,
+            q,
+            None,
+            &self.vbuf,
+            t,
+            &mut self.pq_x,
+            &mut self.dphi_x,
+            false,
+        );
     }
 }

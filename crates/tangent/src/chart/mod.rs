@@ -93,8 +93,19 @@ pub struct TangentChart {
     q_ready: bool,
     /// Work space of the factored products (`4n`).
     nbuf: Vec<f64>,
-    /// The centre `(q_c, v_c)`.
+    /// The centre in the chart's coordinates `(q_c, tau v_c)` (see
+    /// [`TangentChart::set_velocity_weight`]), and as given, `(q_c, v_c)`.
     xc: Vec<f64>,
+    xc_user: Vec<f64>,
+    /// The velocity weight `tau` of the current centre, `1 / tau`, and the weight the next
+    /// centre takes.
+    vs: f64,
+    vinv: f64,
+    vs_next: f64,
+    /// Work vectors: the velocities `v = tau v / tau` of a residual evaluation (`n`) and a
+    /// weighted copy of a vector to split (`2n`).
+    vbuf: Vec<f64>,
+    sbuf: Vec<f64>,
     /// Time of the centre.
     tc: f64,
     /// Residual buffer `f` (`2m`).
@@ -219,6 +230,12 @@ impl TangentChart {
             q_ready: false,
             nbuf: vec![0.0; 4 * n],
             xc: vec![0.0; nn],
+            xc_user: vec![0.0; nn],
+            vs: 1.0,
+            vinv: 1.0,
+            vs_next: 1.0,
+            vbuf: vec![0.0; n],
+            sbuf: vec![0.0; nn],
             tc: 0.0,
             f: vec![0.0; mm],
             pq_e: DMatrix::zeros(m, n),
@@ -288,7 +305,20 @@ impl TangentChart {
 
     /// The centre `x_c = (q_c, v_c)` (length `2n`).
     pub fn centre_point(&self) -> &[f64] {
-        &self.xc
+        &self.xc_user
+    }
+
+    /// Sets the weight `tau > 0` of the velocities in the chart's metric from the next
+    /// [`TangentChart::centre`] on: the chart is built in the coordinates `(q, tau v)`, so its
+    /// tangent and normal directions are orthogonal in `|dq|^2 + tau^2 |dv|^2`. `tau = 1` is
+    /// the Euclidean metric of `(q, v)` in the model's units (paper B); a step-sized `tau`
+    /// measures a velocity change by the displacement it makes over a step (docs/tangent.md,
+    /// "The chart's metric"). Every input and output of the chart stays in `(q, v)`. A
+    /// non-finite or non-positive `tau` is ignored.
+    pub fn set_velocity_weight(&mut self, tau: f64) {
+        if tau.is_finite() && tau > 0.0 {
+            self.vs_next = tau;
+        }
     }
 
     #[cfg(test)]
@@ -362,10 +392,20 @@ impl TangentChart {
                 got: if q.len() != n { q.len() } else { v.len() },
             });
         }
+        self.vs = self.vs_next;
+        self.vinv = 1.0 / self.vs;
+        self.xc_user[..n].copy_from_slice(q);
+        self.xc_user[n..].copy_from_slice(v);
         self.xc[..n].copy_from_slice(q);
-        self.xc[n..].copy_from_slice(v);
-        self.floor =
-            f64::EPSILON * (1.0 + self.xc.iter().fold(0.0f64, |m, v| fast_max(m, v.abs())));
+        for (c, &vi) in self.xc[n..].iter_mut().zip(v) {
+            *c = self.vs * vi;
+        }
+        self.floor = f64::EPSILON
+            * (1.0
+                + self
+                    .xc_user
+                    .iter()
+                    .fold(0.0f64, |m, v| fast_max(m, v.abs())));
         self.tc = t;
         self.rcond = 1.0;
         if m == 0 {
@@ -513,7 +553,8 @@ impl TangentChart {
     /// (NaN if any entry is not finite).
     pub fn residual(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
         let m = self.m;
-        self.sel.residual(sys, x, t, &mut out[..2 * m], None);
+        let (q, v) = x.split_at(self.n);
+        self.sel.residual(sys, q, v, t, &mut out[..2 * m], None);
         let mut r = 0.0f64;
         for &e in out[..2 * m].iter() {
             if !e.is_finite() {
@@ -534,15 +575,77 @@ impl TangentChart {
     /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous
     /// evaluation ([`BodyAngles::update_near`]: a few ulps from the exact values; the chord's iterates move
     /// by small angles).
+    ///
+    /// `x` is a chart point `(q, tau v)`; the velocity rows come back weighted like the chart's
+    /// coordinates, `tau (Phi_q v + Phi_t)` (the rows of `Df` the chart factored), and the norm
+    /// returned is that of the unweighted residual, the quantity the tolerances bound.
     fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
-        let m = self.m;
-        self.sel
-            .residual(sys, x, t, &mut out[..2 * m], Some(&mut self.angles));
-        with_codim!(2 * m, max_abs_finite(out))
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        if self.vs == 1.0 {
+            self.sel
+                .residual(sys, q, v, t, &mut out[..2 * m], Some(&mut self.angles));
+            return with_codim!(2 * m, max_abs_finite(out));
+        }
+        for (b, &vi) in self.vbuf.iter_mut().zip(v) {
+            *b = vi * self.vinv;
+        }
+        self.sel.residual(
+            sys,
+            q,
+            &self.vbuf,
+            t,
+            &mut out[..2 * m],
+            Some(&mut self.angles),
+        );
+        let r = with_codim!(2 * m, max_abs_finite(out));
+        for o in out[m..2 * m].iter_mut() {
+            *o *= self.vs;
+        }
+        r
     }
 
-    /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton).
-    pub fn point(&mut self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
+    /// [`TangentChart::residual`] at a chart point `(q, tau v)`, weighted as
+    /// [`TangentChart::residual_cached`] (without the rotated `sin`/`cos`).
+    pub(super) fn residual_weighted(
+        &mut self,
+        sys: &System,
+        x: &[f64],
+        t: f64,
+        out: &mut [f64],
+    ) -> f64 {
+        let (n, m) = (self.n, self.m);
+        let (q, v) = x.split_at(n);
+        for (b, &vi) in self.vbuf.iter_mut().zip(v) {
+            *b = vi * self.vinv;
+        }
+        self.sel
+            .residual(sys, q, &self.vbuf, t, &mut out[..2 * m], None);
+        let mut r = 0.0f64;
+        for &e in out[..2 * m].iter() {
+            if !e.is_finite() {
+                return f64::NAN;
+            }
+            r = r.max(e.abs());
+        }
+        for o in out[m..2 * m].iter_mut() {
+            *o *= self.vs;
+        }
+        r
+    }
+
+    /// `(q, tau v)` of the chart to the model's `(q, v)`, in place.
+    fn unweight(&self, x: &mut [f64]) {
+        if self.vs != 1.0 {
+            for xv in x[self.n..].iter_mut() {
+                *xv *= self.vinv;
+            }
+        }
+    }
+
+    /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton) in the chart's coordinates
+    /// `(q, tau v)`.
+    fn point_weighted(&mut self, xi: &[f64], zeta: &[f64], x: &mut [f64]) {
         x.copy_from_slice(&self.xc);
         self.add_q(zeta, xi, x);
     }
@@ -561,8 +664,10 @@ impl TangentChart {
         x: &mut [f64],
         newton: &NewtonSettings,
     ) -> Result<MapStats, ChartFailure> {
-        self.point(xi, zeta, x);
-        self.run_chord(sys, t, zeta, x, newton, false)
+        self.point_weighted(xi, zeta, x);
+        let out = self.run_chord(sys, t, zeta, x, newton, false);
+        self.unweight(x);
+        out
     }
 
     /// [`TangentChart::map`] for a Runge-Kutta stage point, whose constraint residual only
@@ -584,8 +689,10 @@ impl TangentChart {
         x: &mut [f64],
         newton: &NewtonSettings,
     ) -> Result<MapStats, ChartFailure> {
-        self.point(xi, zeta, x);
-        self.run_chord(sys, t, zeta, x, newton, true)
+        self.point_weighted(xi, zeta, x);
+        let out = self.run_chord(sys, t, zeta, x, newton, true);
+        self.unweight(x);
+        out
     }
 
     /// The normal coordinates `zeta` (in the basis `Q1`) as coordinates in the chart's
@@ -628,11 +735,13 @@ fn factor_blocks(ch: &mut TangentChart, n: usize) {
 fn factor_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
     let (nn, mm, nm) = (2 * n, 2 * m, n - m);
     let (pq, xs) = (ch.phi_q.as_slice(), ch.dphi.as_slice()); // (r, c) at c m + r
+                                                              // the chart's velocity coordinates are tau v: Df's block X enters weighted, tau X
+    let vs = ch.vs;
     for k in 0..m {
         let (ca, cx) = ch.aq[k * n..].split_at_mut(m * n);
         for c in 0..n {
             ca[c] = pq[c * m + k];
-            cx[c] = xs[c * m + k];
+            cx[c] = vs * xs[c * m + k];
         }
     }
     qr_padded(&mut ch.aq, m, mm, &mut ch.va, &mut ch.tau, n);

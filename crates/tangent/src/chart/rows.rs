@@ -131,18 +131,18 @@ impl RowSelection {
         true
     }
 
-    /// `Phi` and `Phi_q v + Phi_t` at `x = (q, v)` and `t`, kept rows, into the two halves of
+    /// `Phi` and `Phi_q v + Phi_t` at `(q, v)` and `t`, kept rows, into the two halves of
     /// `out` (the rotations from `angles` near the previous evaluation when given).
     #[inline]
     pub(crate) fn residual(
         &mut self,
         sys: &System,
-        x: &[f64],
+        q: &[f64],
+        v: &[f64],
         t: f64,
         out: &mut [f64],
         angles: Option<&mut BodyAngles>,
     ) {
-        let (q, v) = x.split_at(x.len() / 2);
         let (p, pd) = out.split_at_mut(out.len() / 2);
         if self.k == 0 {
             match angles {

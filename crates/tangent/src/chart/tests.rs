@@ -145,3 +145,54 @@ fn centre_accelerations_match_the_index1_solve() {
         assert!(diff <= 1e-11 * scale, "{name}: {diff:e} (scale {scale:e})");
     }
 }
+
+/// A chart with a velocity weight `tau` is the chart of the coordinates `(q, tau v)`: its maps
+/// land on the manifold, their derivative along a chart coordinate is the tangent vector
+/// `tangent_to_ambient(e_k)` (checked by central differences), and splitting that vector
+/// gives back `e_k` with a zero normal part.
+#[test]
+fn a_weighted_chart_maps_and_splits_consistently() {
+    for tau in [1.0, 0.01, 1e-4] {
+        let sys = mbd_model::models::manipulator().expect("model");
+        let st = mbd_solve::State::consistent(&sys, 0.0).expect("state");
+        let mut chart = TangentChart::new(&sys);
+        chart.set_velocity_weight(tau);
+        chart
+            .centre(&sys, st.q.as_slice(), st.v.as_slice(), 0.0)
+            .expect("centre");
+        let (dim, mm, nn) = (chart.dim(), chart.codim(), chart.ambient_dim());
+        let newton = NewtonSettings::default();
+        let eps = 1e-4;
+        let mut f = vec![0.0; mm];
+        for k in 0..dim {
+            let mut e = vec![0.0; dim];
+            e[k] = 1.0;
+            let mut u = vec![0.0; nn];
+            chart.tangent_to_ambient(&e, &mut u);
+            let mut pts = [vec![0.0; nn], vec![0.0; nn]];
+            for (s, x) in [eps, -eps].iter().zip(pts.iter_mut()) {
+                let xi: Vec<f64> = e.iter().map(|v| s * v).collect();
+                let mut zeta = vec![0.0; mm];
+                chart
+                    .map(&sys, &xi, 0.0, &mut zeta, x, &newton)
+                    .expect("map");
+                assert!(chart.residual(&sys, x, 0.0, &mut f) <= 1e-12, "tau {tau}");
+            }
+            let scale = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for i in 0..nn {
+                let d = (pts[0][i] - pts[1][i]) / (2.0 * eps);
+                assert!(
+                    (d - u[i]).abs() <= 1e-6 * scale,
+                    "tau {tau}, coordinate {k}, component {i}: {d} against {}",
+                    u[i]
+                );
+            }
+            let (mut g, mut back) = (vec![0.0; mm], vec![0.0; dim]);
+            chart.split_coordinates(&u, &mut g, &mut back);
+            for (i, b) in back.iter().enumerate() {
+                assert!((b - e[i]).abs() < 1e-12, "tau {tau}: {back:?}");
+            }
+            assert!(g.iter().all(|v| v.abs() < 1e-12), "tau {tau}: {g:?}");
+        }
+    }
+}

@@ -21,7 +21,7 @@ impl TangentRk {
     ) -> Result<Result<StepAttempt, SolveError>, SolveError> {
         let t = state.t;
         if recentre {
-            self.centre(sys, t)?;
+            self.centre(sys, t, h)?;
         }
         match self.attempt(sys, t, h) {
             Ok(w) => {

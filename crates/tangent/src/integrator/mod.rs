@@ -18,7 +18,7 @@ mod path;
 use history::EtaHistory;
 use path::{Path, SparseParts};
 
-pub use options::{IterationMatrix, TangentOptions, TangentStats};
+pub use options::{ChartMetric, IterationMatrix, TangentOptions, TangentStats};
 
 /// Why an attempted step failed.
 enum Attempt {
@@ -346,9 +346,13 @@ impl TangentRk {
         state.v.as_mut_slice().copy_from_slice(&self.cur[n..]);
     }
 
-    fn centre(&mut self, sys: &System, t: f64) -> Result<(), SolveError> {
+    /// Centres the chart at the current state for a step of size `h` (which sets the
+    /// chart's metric, [`ChartMetric::velocity_weight`]).
+    fn centre(&mut self, sys: &System, t: f64, h: f64) -> Result<(), SolveError> {
         let n = self.n;
         let (q, v) = self.cur.split_at(n);
+        self.path
+            .set_velocity_weight(self.options.metric.velocity_weight(h));
         self.path.centre(sys, q, v, t)?;
         self.stats.charts += 1;
         Ok(())
@@ -370,7 +374,7 @@ impl TangentRk {
         depth: u32,
         out: &mut StepStats,
     ) -> Result<(), SolveError> {
-        self.centre(sys, t)?;
+        self.centre(sys, t, h)?;
         match self.attempt(sys, t, h) {
             Ok(w) => {
                 self.account(&w);

@@ -27,6 +27,36 @@ pub enum IterationMatrix {
     Broyden,
 }
 
+/// The metric of the state space `x = (q, v)` in which the chart's tangent and normal
+/// directions are orthogonal (`docs/tangent.md`, "The chart's metric"). The chart's manifold and
+/// the constraints kept are the same for both; the tangent coordinates the Runge-Kutta method
+/// integrates differ, and with them the error constant.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[non_exhaustive]
+pub enum ChartMetric {
+    /// `|dq|^2 + h^2 |dv|^2` for a step of size `h` (the default): a velocity change counts
+    /// as the displacement it makes over one step, so the metric does not depend on the
+    /// model's unit of time, and the velocity constraints' curvature `(Phi_q v)_q`, which grows
+    /// with the speed, is weighted by `h`. The chart is built for the first attempt's `h` at
+    /// each centre.
+    #[default]
+    StepWeighted,
+    /// `|dq|^2 + |dv|^2` in the model's units: paper B's chart as published. Its error
+    /// constant depends on the unit of time, and on fast motion (a whipping chain of slender
+    /// rods) it is hundreds of times larger than [`ChartMetric::StepWeighted`]'s.
+    Euclidean,
+}
+
+impl ChartMetric {
+    /// The velocity weight `tau` of the metric `|dq|^2 + tau^2 |dv|^2` for a step `h`.
+    pub fn velocity_weight(self, h: f64) -> f64 {
+        match self {
+            ChartMetric::StepWeighted => h.abs(),
+            ChartMetric::Euclidean => 1.0,
+        }
+    }
+}
+
 /// Settings of [`TangentRk`](crate::TangentRk).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TangentOptions {
@@ -78,6 +108,8 @@ pub struct TangentOptions {
     /// ([`mbd_solve::SingularBridge`]; default on). Off, a stage near a singular
     /// configuration takes the index-1 solve's accelerations as they are.
     pub bridge: bool,
+    /// The chart's metric (default [`ChartMetric::StepWeighted`]).
+    pub metric: ChartMetric,
 }
 
 impl Default for TangentOptions {
@@ -93,6 +125,7 @@ impl Default for TangentOptions {
             chart_shrink: 0.25,
             max_chart_failures: 8,
             bridge: true,
+            metric: ChartMetric::StepWeighted,
         }
     }
 }

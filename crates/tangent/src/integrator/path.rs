@@ -64,6 +64,15 @@ impl Path {
         }
     }
 
+    /// The velocity weight `tau` of the chart's metric from the next centre on.
+    #[inline]
+    pub(super) fn set_velocity_weight(&mut self, tau: f64) {
+        match self {
+            Path::Dense { chart, .. } => chart.set_velocity_weight(tau),
+            Path::Sparse(p) => p.chart.set_velocity_weight(tau),
+        }
+    }
+
     #[inline]
     pub(crate) fn rcond(&self) -> f64 {
         match self {
@@ -208,11 +217,12 @@ impl Path {
         }
     }
 
-    /// A vector in chart coordinates mapped to `x` (dense: `U e`; sparse: `e` itself).
+    /// A vector in chart coordinates mapped to `x` (dense: `U e`; sparse: `e` itself; both
+    /// with the velocity half divided by the chart's velocity weight).
     pub(super) fn tangent_to_ambient(&mut self, e: &[f64], out: &mut [f64]) {
         match self {
             Path::Dense { chart, .. } => chart.tangent_to_ambient(e, out),
-            Path::Sparse(_) => out.copy_from_slice(e),
+            Path::Sparse(p) => p.chart.tangent_to_ambient(e, out),
         }
     }
 

@@ -92,9 +92,17 @@ pub struct SparseChart {
     /// The round-off floor below which a stalled map has converged.
     roundoff: RoundoffFloor,
     grads_x: Vec<f64>,
-    /// The centre `(q_c, v_c)` and its time.
+    /// The centre in the chart's coordinates `(q_c, tau v_c)` (see
+    /// [`SparseChart::set_velocity_weight`]) and as given, `(q_c, v_c)`, and its time.
     xc: Vec<f64>,
+    xc_user: Vec<f64>,
     tc: f64,
+    /// The velocity weight `tau` of the current centre, `1 / tau`, and the next centre's.
+    vs: f64,
+    vinv: f64,
+    vs_next: f64,
+    /// The velocities `v` of a residual evaluation at a chart point (`n`).
+    vbuf: Vec<f64>,
     /// Residual and correction buffers (`2m`).
     f: Vec<f64>,
     d: Vec<f64>,
@@ -179,7 +187,12 @@ impl SparseChart {
             roundoff: RoundoffFloor::new(sys),
             grads_x: vec![0.0; nv],
             xc: vec![0.0; 2 * n],
+            xc_user: vec![0.0; 2 * n],
             tc: 0.0,
+            vs: 1.0,
+            vinv: 1.0,
+            vs_next: 1.0,
+            vbuf: vec![0.0; n],
             f: vec![0.0; 2 * m],
             d: vec![0.0; 2 * m],
             x0: vec![0.0; 2 * n],
@@ -215,7 +228,33 @@ impl SparseChart {
 
     /// The centre `x_c = (q_c, v_c)` (length `2n`).
     pub fn centre_point(&self) -> &[f64] {
-        &self.xc
+        &self.xc_user
+    }
+
+    /// Sets the weight `tau > 0` of the velocities in the chart's metric from the next
+    /// [`SparseChart::centre`] on, as [`crate::TangentChart::set_velocity_weight`]: the chart
+    /// works in `(q, tau v)` (its `y`, `eta`, `Df` and `G`), its inputs and outputs in
+    /// `(q, v)`. A non-finite or non-positive `tau` is ignored.
+    pub fn set_velocity_weight(&mut self, tau: f64) {
+        if tau.is_finite() && tau > 0.0 {
+            self.vs_next = tau;
+        }
+    }
+
+    /// A vector `e` of chart coordinates `y` in the model's `(q, v)` (the velocity half divided
+    /// by the velocity weight).
+    pub fn tangent_to_ambient(&self, e: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(e);
+        self.unweight(out);
+    }
+
+    /// `(q, tau v)` of the chart to the model's `(q, v)`, in place.
+    fn unweight(&self, x: &mut [f64]) {
+        if self.vs != 1.0 {
+            for xv in x[self.n..].iter_mut() {
+                *xv *= self.vinv;
+            }
+        }
     }
 
     /// `1 / sqrt(cond(G))` of the last centre, from the sparse Cholesky's condition estimate
@@ -237,8 +276,14 @@ impl SparseChart {
                 got: if q.len() != n { q.len() } else { v.len() },
             });
         }
+        self.vs = self.vs_next;
+        self.vinv = 1.0 / self.vs;
+        self.xc_user[..n].copy_from_slice(q);
+        self.xc_user[n..].copy_from_slice(v);
         self.xc[..n].copy_from_slice(q);
-        self.xc[n..].copy_from_slice(v);
+        for (c, &vi) in self.xc[n..].iter_mut().zip(v) {
+            *c = self.vs * vi;
+        }
         self.tc = t;
         self.rcond = 1.0;
         if m == 0 {
@@ -257,6 +302,13 @@ impl SparseChart {
                 t,
                 what: "constraint Jacobian at the chart centre",
             });
+        }
+        // the chart's velocity coordinates are tau v: Df's block X enters weighted, tau X (and
+        // the velocity rows of the residual by tau)
+        if self.vs != 1.0 {
+            for d in self.dgrads.iter_mut() {
+                *d *= self.vs;
+            }
         }
         if self.independent() > n {
             return Err(SolveError::Singular {
@@ -432,18 +484,26 @@ impl SparseChart {
     /// Splits `F` (length `2n`) into its normal coefficients `g = G^-1 Df F` (length `2m`:
     /// `F = P F + Df^T g`) and its tangent part `dy = P F = F - Df^T g` (length `2n`), the
     /// right-hand side of the state equation `y' = P F`.
+    ///
+    /// `fx` is in the model's `(q, v)`; `g` and `dy` are in the chart's `(q, tau v)`.
     pub fn split(&mut self, fx: &[f64], g: &mut [f64], dy: &mut [f64]) {
         dy.copy_from_slice(fx);
+        if self.vs != 1.0 {
+            for d in dy[self.n..].iter_mut() {
+                *d *= self.vs;
+            }
+        }
         if self.m == 0 {
             return;
         }
-        self.apply_df(fx, g);
+        self.apply_df(dy, g);
         self.chol.solve_in_place(g);
         self.add_df_t(-1.0, g, dy);
     }
 
-    /// Writes `x = x_c + y + Df(x_c)^T eta` into `x` (no Newton).
-    pub fn point(&self, y: &[f64], eta: &[f64], x: &mut [f64]) {
+    /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton) in the chart's coordinates
+    /// `(q, tau v)`.
+    fn point_weighted(&self, y: &[f64], eta: &[f64], x: &mut [f64]) {
         for ((xv, c), yv) in x.iter_mut().zip(&self.xc).zip(y) {
             *xv = c + yv;
         }
@@ -463,12 +523,25 @@ impl SparseChart {
     }
 
     /// [`SparseChart::residual`] with rotated `sin`/`cos` ([`BodyAngles::update_near`]).
+    /// At a chart point `x = (q, tau v)`: the velocity rows come back weighted,
+    /// `tau (Phi_q v + Phi_t)`, and the norm returned is the unweighted residual's.
     fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
         let (n, m) = (self.n, self.m);
         let (q, v) = x.split_at(n);
         let (p, pd) = out[..2 * m].split_at_mut(m);
-        sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
-        max_abs(&out[..2 * m])
+        if self.vs == 1.0 {
+            sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
+            return max_abs(&out[..2 * m]);
+        }
+        for (b, &vi) in self.vbuf.iter_mut().zip(v) {
+            *b = vi * self.vinv;
+        }
+        sys.phi_and_phi_dot_cached(q, &self.vbuf, t, p, pd, &mut self.angles);
+        let r = max_abs(&out[..2 * m]);
+        for o in out[m..2 * m].iter_mut() {
+            *o *= self.vs;
+        }
+        r
     }
 
     /// Maps `y` (length `2n`, in `ker Df(x_c)`) to the point `x` of the manifold at time `t`:
@@ -484,8 +557,10 @@ impl SparseChart {
         x: &mut [f64],
         newton: &NewtonSettings,
     ) -> Result<MapStats, ChartFailure> {
-        self.point(y, eta, x);
-        self.chord(sys, t, eta, x, newton, false)
+        self.point_weighted(y, eta, x);
+        let out = self.chord(sys, t, eta, x, newton, false);
+        self.unweight(x);
+        out
     }
 
     /// [`SparseChart::map`] for a Runge-Kutta stage point: may stop on the predicted residual
@@ -499,8 +574,10 @@ impl SparseChart {
         x: &mut [f64],
         newton: &NewtonSettings,
     ) -> Result<MapStats, ChartFailure> {
-        self.point(y, eta, x);
-        self.chord(sys, t, eta, x, newton, true)
+        self.point_weighted(y, eta, x);
+        let out = self.chord(sys, t, eta, x, newton, true);
+        self.unweight(x);
+        out
     }
 
     /// The chord iteration `G d = -f(x)`, `x <- x + Df^T d`, `eta <- eta + d` from `x`.
@@ -571,7 +648,9 @@ impl SparseChart {
                 return Ok(ms);
             }
             let res = self.residual_cached(sys, x, t, f);
-            if let Some(ms) = lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol)) {
+            if let Some(ms) =
+                lp.evaluated(res, || self.roundoff.stall_cap(x, newton.tol, self.vinv))
+            {
                 return Ok(ms);
             }
             if let Some(e) = lp.diverged() {
