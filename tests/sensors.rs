@@ -231,3 +231,31 @@ fn build_error(text: &str) -> String {
         .unwrap_err()
         .to_string()
 }
+
+/// Planar and spatial elements mixed up in a model file are errors that say which is which: a
+/// joint sensor on a spatial joint, a planar joint naming a spatial body, and a spatial joint
+/// naming an unknown body (its name quoted once).
+#[test]
+fn mixing_planar_and_spatial_elements_is_an_error_that_says_so() {
+    let spatial = include_str!("../examples/models/spherical_pendulum.toml");
+    let with = |extra: &str| format!("{spatial}\n{extra}");
+    let e = build_error(&with(
+        "[[sensors]]\ntype = \"joint\"\nname = \"swing\"\njoint = \"rod\"\n",
+    ));
+    assert!(
+        e.contains("sensor 'swing'")
+            && e.contains("'rod' is a spatial joint")
+            && e.contains("reaction sensor"),
+        "{e}"
+    );
+    let e = build_error(&with(
+        "[[joints]]\ntype = \"revolute\"\nname = \"pin\"\nbody_a = \"ground\"\n\
+         point_a = [0.0, 0.0]\nbody_b = \"bob\"\npoint_b = [0.0, 0.0]\n",
+    ));
+    assert!(
+        e.contains("'bob' is a spatial body") && e.contains("[[spatial_joints]]"),
+        "{e}"
+    );
+    let e = build_error(&spatial.replace("body_b = \"bob\"", "body_b = \"bub\""));
+    assert!(e.contains("'bub'") && !e.contains("''"), "{e}");
+}

@@ -20,6 +20,8 @@ struct Resolver<'a> {
     /// The bodies as the file gives them (frame-origin poses; a point mass's inertia is set by
     /// the builder).
     bodies: Vec<Body>,
+    /// The spatial bodies' names (a planar element naming one gets an error saying so).
+    spatial: std::collections::HashSet<&'a str>,
 }
 
 impl<'a> Resolver<'a> {
@@ -97,20 +99,37 @@ impl<'a> Resolver<'a> {
         for (i, b) in file.bodies.iter().enumerate() {
             index.entry(b.name.as_str()).or_insert(i);
         }
-        Ok(Resolver { index, bodies })
+        let spatial = file
+            .spatial_bodies
+            .iter()
+            .map(|b| b.name.as_str())
+            .collect();
+        Ok(Resolver {
+            index,
+            bodies,
+            spatial,
+        })
     }
 
     fn find(&self, element: &str, name: &str) -> Result<BodyRef, ModelError> {
         if name.eq_ignore_ascii_case("ground") {
             return Ok(BodyRef::Ground);
         }
-        self.index
-            .get(name)
-            .map(|&i| BodyRef::Body(BodyHandle(i)))
-            .ok_or_else(|| ModelError::UnknownBody {
+        match self.index.get(name) {
+            Some(&i) => Ok(BodyRef::Body(BodyHandle(i))),
+            None if self.spatial.contains(name) => Err(invalid(
+                element.to_string(),
+                format!(
+                    "'{name}' is a spatial body: planar elements ([[joints]], [[forces]], \
+                     point and joint sensors) join planar bodies; join it with \
+                     [[spatial_joints]] and [[spatial_forces]]"
+                ),
+            )),
+            None => Err(ModelError::UnknownBody {
                 element: element.to_string(),
                 body: name.to_string(),
-            })
+            }),
+        }
     }
 }
 
@@ -165,9 +184,18 @@ impl ModelFile {
         }
         let sensor_joint = |name: &str, joint: &str| {
             joints.get(joint).copied().ok_or_else(|| {
+                let spatial = self.spatial_joints.iter().any(|j| j.name == joint);
                 invalid(
                     format!("sensor '{name}'"),
-                    format!("refers to unknown joint '{joint}'"),
+                    if spatial {
+                        format!(
+                            "'{joint}' is a spatial joint: joint sensors read a planar joint's \
+                             coordinate and rate; for a spatial joint use a reaction sensor, or \
+                             spatial_point and angular_velocity sensors on its bodies"
+                        )
+                    } else {
+                        format!("refers to unknown joint '{joint}'")
+                    },
                 )
             })
         };

@@ -450,7 +450,7 @@ pub(crate) fn add_spatial(
             )),
             None => Err(ModelError::UnknownBody {
                 element: element.to_string(),
-                body: format!("'{name}'"),
+                body: name.to_string(),
             }),
         }
     };
