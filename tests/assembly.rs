@@ -79,6 +79,53 @@ fn a_closed_loop_keeps_the_given_crank_angle_and_rate() {
     assert!((plain.q[2] - 1.1).abs() > 0.1);
 }
 
+/// A crank angle given without a rate keeps the crank's rate from the bodies' stored velocities
+/// (consistent at another angle), not the rate the velocity projection would pick: the
+/// slider-crank with consistent velocities at its stored angle (crank rate 1.68 rad/s),
+/// re-assembled at a crank angle 0.7 rad further on, starts at that crank rate (before: 1.34,
+/// the projection spread the rod's and the slider's now inconsistent velocities over the
+/// crank too). A given rate still wins.
+#[test]
+fn a_crank_angle_without_a_rate_keeps_the_bodies_crank_rate() {
+    let sys = models::slider_crank().unwrap();
+    let x = consistent_state(&sys, 0.0).unwrap();
+    let mut base = sys.to_model_file();
+    // consistent velocities at the stored angle: the projection of a 30 rad/s crank rate
+    let crank_angle = x.q[2];
+    let w = 30.0;
+    let (qs, vs) = {
+        let mut v = x.v.clone();
+        v.fill(0.0);
+        v[2] = w;
+        let p = mbd::solve::project_state(
+            &sys,
+            x.q.as_slice(),
+            v.as_slice(),
+            0.0,
+            mbd::solve::ConsistentOptions::default(),
+        )
+        .unwrap();
+        (p.q, p.v)
+    };
+    for (i, b) in base.bodies.iter_mut().enumerate() {
+        b.position = [qs[3 * i], qs[3 * i + 1], qs[3 * i + 2]];
+        b.velocity = [vs[3 * i], vs[3 * i + 1], vs[3 * i + 2]];
+    }
+    let given_w = vs[2];
+    for (rate, want) in [(None, given_w), (Some(-4.0), -4.0)] {
+        let file = with_assembly(&base, &[("crank_pin", Some(crank_angle + 0.7), rate)]);
+        let sys = file.build().unwrap();
+        let c = consistent_state(&sys, 0.0).unwrap();
+        assert!((c.q[2] - crank_angle - 0.7).abs() < 1e-14, "{}", c.q[2]);
+        assert!(
+            (c.v[2] - want).abs() < 1e-12 * want.abs(),
+            "rate {rate:?}: {} against {want}",
+            c.v[2]
+        );
+        assert!(c.residual < 1e-13 && c.velocity_residual < 1e-12, "{c:?}");
+    }
+}
+
 /// A prismatic joint's slide and rate: a slider placed on its guide at s = 0.35 moving at
 /// -0.2 m/s, read back as the guide's coordinate.
 #[test]

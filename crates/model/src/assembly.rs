@@ -31,6 +31,9 @@ use serde::{Deserialize, Serialize};
 ///    temporary driver per given coordinate (an angle or slide driver, constant at the given
 ///    value) and then per given rate (a driver with that rate), so the given values are kept
 ///    exactly and the other coordinates take up the correction ([`System::with_joint_drivers`]).
+///    A joint given a coordinate but no rate keeps the rate of the bodies' stored velocities
+///    (zero where none are given) in this projection too, unless the held rates would then
+///    outnumber the degrees of freedom.
 ///    More given coordinates (or rates) than degrees of freedom are refused, naming the
 ///    joints; a coordinate the constraints already fix makes its driver redundant, and the
 ///    projection's rank check names it.
@@ -280,6 +283,31 @@ impl System {
         placed
     }
 
+    /// The rate the velocity projection holds for each entry of `joint_initials`: the given
+    /// rate; for an entry that gives a coordinate but no rate, the joint's rate in the bodies'
+    /// stored velocities (zero where none are given), as long as the held rates do not
+    /// outnumber the degrees of freedom (else only the given ones are held).
+    fn held_rates(&self) -> Vec<Option<f64>> {
+        let given: Vec<Option<f64>> = self.joint_initials.iter().map(|(_, i)| i.rate).collect();
+        let (qs, vs) = self.stored_state();
+        let implied: Vec<Option<f64>> = self
+            .joint_initials
+            .iter()
+            .map(|&(j, init)| {
+                init.rate.or_else(|| {
+                    init.coordinate?;
+                    let (relative, slide) = self.joint_coordinates(j, &qs, &vs)?;
+                    Some(slide.unwrap_or(relative)[1])
+                })
+            })
+            .collect();
+        if implied.iter().flatten().count() <= self.dof() {
+            implied
+        } else {
+            given
+        }
+    }
+
     /// This model with a driver per given joint coordinate (`rates = false`: the given
     /// angles and slides, constant) or per given rate (`rates = true`: a driver through the
     /// joint's coordinate at `(q, t)` with the given rate), the bodies placed at `q`: the
@@ -288,11 +316,13 @@ impl System {
     /// than the model's degrees of freedom is an error naming the joints.
     pub fn with_joint_drivers(&self, q: &[f64], t: f64, rates: bool) -> Result<System, ModelError> {
         self.check_len("q", q, self.n)?;
+        let held_rates = self.held_rates();
         let held: Vec<&str> = self
             .joint_initials
             .iter()
-            .filter(|(_, init)| if rates { init.rate } else { init.coordinate }.is_some())
-            .map(|&(j, _)| self.joints[j].name.as_str())
+            .zip(&held_rates)
+            .filter(|((_, init), rate)| if rates { **rate } else { init.coordinate }.is_some())
+            .map(|(&(j, _), _)| self.joints[j].name.as_str())
             .collect();
         if held.len() > self.dof() {
             let what = if rates { "rates" } else { "coordinates" };
@@ -318,13 +348,13 @@ impl System {
             b.add_joint(joint.clone());
         }
         let zero = vec![0.0; self.n];
-        for &(j, init) in &self.joint_initials {
+        for (&(j, init), &held_rate) in self.joint_initials.iter().zip(&held_rates) {
             let joint = &self.joints[j];
             let Some(g) = geometry(&joint.kind) else {
                 continue;
             };
             let f = if rates {
-                let Some(rate) = init.rate else { continue };
+                let Some(rate) = held_rate else { continue };
                 let Some((relative, slide)) = self.joint_coordinates(j, q, &zero) else {
                     continue;
                 };
