@@ -107,7 +107,7 @@ pub struct RunArgs {
     #[arg(long, allow_hyphen_values = true, value_parser = parse_h, conflicts_with = "tol")]
     pub h: Option<f64>,
     /// Error tolerance for adaptive steps (solvers with an embedded error estimate: `mbd
-    /// solvers` marks them adaptive).
+    /// solvers` marks them adaptive), from 1e-14 to below 1.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_tol)]
     pub tol: Option<f64>,
     /// Absolute part of the adaptive error tolerance, in the model's units (default: --tol).
@@ -269,10 +269,20 @@ fn parse_atol(s: &str) -> Result<f64, String> {
     )
 }
 
+/// The smallest relative tolerance `--tol` takes: about 45 units of round-off, below which
+/// the error test of an adaptive step can fail on rounding alone.
+const MIN_TOL: f64 = 1e-14;
+
 fn parse_tol(s: &str) -> Result<f64, String> {
     let t = parse_number(s)?;
-    if t.is_finite() && t > 0.0 && t < 1.0 {
+    if t.is_finite() && (MIN_TOL..1.0).contains(&t) {
         Ok(t)
+    } else if t > 0.0 && t < MIN_TOL {
+        Err(format!(
+            "the tolerance {s} is below what double precision can deliver (the error test \
+             would fail on rounding alone); use --tol {MIN_TOL:e} or more, and --atol for a \
+             small absolute error"
+        ))
     } else {
         Err(format!(
             "the tolerance must lie in (0, 1), e.g. --tol 1e-8 (got {s})"

@@ -342,6 +342,16 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
                     args.max_steps
                 )));
             }
+            let span = args.t_end - state.t;
+            if h > span {
+                eprintln!(
+                    "warning: --h {} is longer than the run ({} s): it is one step of {} s; \
+                     give a smaller --h for a trajectory",
+                    mbd_model::format_number(h),
+                    mbd_model::format_number(span),
+                    mbd_model::format_number(span)
+                );
+            }
             let mut cfg = RunConfig::new(args.t_end, h);
             cfg.drift_guard = guard;
             cfg.into()

@@ -53,6 +53,44 @@ fn negative_and_zero_step() {
     assert_fails(&out, 2, &["'abc' is not a number"]);
 }
 
+/// A step longer than the run is one step of the run's length, with a warning saying so.
+#[test]
+fn a_step_longer_than_the_run_warns() {
+    let out = run_with(&[
+        "--solver",
+        "rk4",
+        "--t-end",
+        "0.01",
+        "--h",
+        "5",
+        "--out",
+        "/dev/null",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("warning: --h 5 is longer than the run (0.01 s)")
+            && out.stderr.contains("1 steps"),
+        "{}",
+        out.stderr
+    );
+    let out = run_with(&[
+        "--solver",
+        "rk4",
+        "--t-end",
+        "1",
+        "--h",
+        "0.5",
+        "--out",
+        "/dev/null",
+    ]);
+    assert!(
+        !out.stderr.contains("longer than the run"),
+        "{}",
+        out.stderr
+    );
+}
+
 #[test]
 fn end_time_not_after_start() {
     for t in ["0", "-1"] {
@@ -105,6 +143,28 @@ fn index1_dopri5_with_a_bad_tolerance() {
         let out = run_with(&["--solver", "index1:dopri5", "--t-end", "1", "--tol", tol]);
         assert_fails(&out, 2, &["--tol", "tolerance must lie in (0, 1)"]);
     }
+    for tol in ["1e-30", "9e-15"] {
+        let out = run_with(&["--solver", "index1:dopri5", "--t-end", "1", "--tol", tol]);
+        assert_fails(
+            &out,
+            2,
+            &["--tol", "below what double precision can deliver"],
+        );
+    }
+    // the smallest tolerance the help states runs
+    let help = mbd(["run", "--help"]).stdout;
+    assert!(help.contains("from 1e-14 to below 1"), "{help}");
+    let out = run_with(&[
+        "--solver",
+        "index1:dopri5",
+        "--t-end",
+        "0.01",
+        "--tol",
+        "1e-14",
+        "--out",
+        "/dev/null",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
     let out = run_with(&["--solver", "index1:dopri5", "--t-end", "1", "--tol", "abc"]);
     assert_fails(&out, 2, &["'abc' is not a number"]);
     let out = run_with(&["--solver", "index1:rk45", "--t-end", "1", "--tol", "1e-6"]);

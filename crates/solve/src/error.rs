@@ -56,7 +56,7 @@ pub enum SolveError {
     #[error(
         "adaptive step size h = {h:e} at t = {t} fell below h_min = {h_min:e}: the error test \
          keeps failing there (a singularity, stiffness, or a tolerance below round-off); \
-         loosen the tolerance or lower StepController::h_min"
+         loosen the tolerance (or, through the library, lower StepController::h_min)"
     )]
     StepSizeTooSmall {
         /// Time of the step.
