@@ -267,6 +267,16 @@ fn a_motor_turns_a_rod_through_its_angle_with_every_solver() {
         .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(e.contains("no degree of freedom"), "{e}");
+    // ... and the registry's table says so
+    let (_, v) = mbd::registry()
+        .variants()
+        .find(|(_, v)| v.spec == "firefly-gauss")
+        .expect("registered");
+    assert!(
+        v.refuses.contains("without a degree of freedom"),
+        "{}",
+        v.refuses
+    );
     let opts = mbd::tangent::TangentOptions {
         linear_solver: mbd::solve::LinearSolver::Sparse,
         ..Default::default()

@@ -20,7 +20,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: false,
             relative_cost: 300.0,
-            refuses: "spatial models above 600 equations (its acceleration solves are dense)",
+            refuses: "mechanisms without a degree of freedom (fully driven: nothing to optimise); spatial models above 600 equations (its acceleration solves are dense)",
             compared: false,
         },
         SolverVariant {
@@ -31,7 +31,7 @@ pub static SOLVERS: SolverFamily = SolverFamily {
             adaptive: false,
             scales: false,
             relative_cost: 300.0,
-            refuses: "spatial models above 600 equations (its acceleration solves are dense)",
+            refuses: "mechanisms without a degree of freedom (fully driven: nothing to optimise); spatial models above 600 equations (its acceleration solves are dense)",
             compared: true,
         },
     ],
