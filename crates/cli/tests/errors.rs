@@ -541,3 +541,121 @@ fn structural_refusals_name_the_cause() {
     );
     assert!(!out.stderr.contains("smaller --h"), "{}", out.stderr);
 }
+
+/// A double parallelogram with a third crank (one redundant equation) swung through its flat
+/// position: at h = 1e-4 a step lands close enough to it to stop symplectic (2,2), which passes
+/// such positions at other steps (h = 1e-3 reaches the end). The message says so and suggests
+/// the other solvers that pass, not the one that stopped.
+#[test]
+fn a_singular_stop_of_a_passing_solver_suggests_another_step_or_solver() {
+    let dir = scratch("singular_hint");
+    let model = dir.join("double_parallelogram_3.toml");
+    std::fs::write(&model, DOUBLE_PARALLELOGRAM_3).unwrap();
+    let model = model.to_str().unwrap();
+    let out = mbd([
+        "run",
+        model,
+        "--solver",
+        "symplectic:2",
+        "--t-end",
+        "1",
+        "--h",
+        "1e-4",
+        "--out",
+        "/dev/null",
+    ]);
+    assert_fails(
+        &out,
+        1,
+        &[
+            "singular",
+            "this solver usually passes",
+            "another --h may pass",
+            "rk4-projected or symplectic:1",
+        ],
+    );
+    let out = mbd([
+        "run",
+        model,
+        "--solver",
+        "symplectic:2",
+        "--t-end",
+        "1",
+        "--h",
+        "1e-3",
+        "--out",
+        "/dev/null",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
+
+/// Three cranks of 0.5 m on a 2 m coupler, released at 1 rad turning at 3 rad/s.
+const DOUBLE_PARALLELOGRAM_3: &str = r#"gravity = [0.0, -9.81]
+[[bodies]]
+name = "crank0"
+mass = 1.0
+inertia = 0.020833333333333332
+com = [0.25, 0.0]
+position = [0.0, 0.0, 1.0]
+velocity = [0.0, 0.0, 3.0]
+[[bodies]]
+name = "crank1"
+mass = 1.0
+inertia = 0.020833333333333332
+com = [0.25, 0.0]
+position = [1.0, 0.0, 1.0]
+velocity = [0.0, 0.0, 3.0]
+[[bodies]]
+name = "crank2"
+mass = 1.0
+inertia = 0.020833333333333332
+com = [0.25, 0.0]
+position = [2.0, 0.0, 1.0]
+velocity = [0.0, 0.0, 3.0]
+[[bodies]]
+name = "coupler"
+mass = 4.0
+inertia = 1.3333333333333333
+com = [1.0, 0.0]
+position = [0.2701511529340699, 0.42073549240394825, 0.0]
+velocity = [-1.2622064772118446, 0.8104534588022096, 0.0]
+[[joints]]
+type = "revolute"
+name = "pivot0"
+body_a = "ground"
+point_a = [0.0, 0.0]
+body_b = "crank0"
+[[joints]]
+type = "revolute"
+name = "pin0"
+body_a = "crank0"
+point_a = [0.5, 0.0]
+body_b = "coupler"
+point_b = [0.0, 0.0]
+[[joints]]
+type = "revolute"
+name = "pivot1"
+body_a = "ground"
+point_a = [1.0, 0.0]
+body_b = "crank1"
+[[joints]]
+type = "revolute"
+name = "pin1"
+body_a = "crank1"
+point_a = [0.5, 0.0]
+body_b = "coupler"
+point_b = [1.0, 0.0]
+[[joints]]
+type = "revolute"
+name = "pivot2"
+body_a = "ground"
+point_a = [2.0, 0.0]
+body_b = "crank2"
+[[joints]]
+type = "revolute"
+name = "pin2"
+body_a = "crank2"
+point_a = [0.5, 0.0]
+body_b = "coupler"
+point_b = [2.0, 0.0]
+"#;
