@@ -25,12 +25,35 @@ pub struct RunMeasures {
     pub mre_h: f64,
     /// Max absolute energy error.
     pub max_abs_dh: f64,
+    /// Largest kinetic energy seen.
+    pub max_kinetic: f64,
     /// Max position-constraint residual.
     pub e_phi: f64,
     /// Max velocity-constraint residual.
     pub e_phidot: f64,
     /// Max acceleration-constraint residual (NaN if accelerations were not evaluated).
     pub e_phiddot: f64,
+}
+
+impl RunMeasures {
+    /// The energy scale of the run, `max(|H_0|, max_k T_k)`: `|H_0|` depends on the datum of the
+    /// potential (zero for a pendulum released level with its pivot), the largest kinetic
+    /// energy does not.
+    pub fn energy_scale(&self) -> f64 {
+        self.h0.abs().max(self.max_kinetic)
+    }
+
+    /// `max_k |H_k - H_0|` relative to [`RunMeasures::energy_scale`] (the absolute error where
+    /// the scale is zero: a model at rest with `H_0 = 0`). Unlike paper C's `e_h`, it stays
+    /// meaningful when `H_0` is near zero.
+    pub fn e_h_scaled(&self) -> f64 {
+        let scale = self.energy_scale();
+        if scale > 0.0 {
+            self.max_abs_dh / scale
+        } else {
+            self.max_abs_dh
+        }
+    }
 }
 
 /// An [`Observer`] that accumulates [`RunMeasures`] without storing the trajectory.
@@ -91,6 +114,7 @@ impl MeasureObserver {
         self.m.samples += 1;
         self.m.e_h = self.m.e_h.max(rel);
         self.m.max_abs_dh = self.m.max_abs_dh.max(dh);
+        self.m.max_kinetic = self.m.max_kinetic.max(sys.kinetic(v));
         self.sum_rel += rel;
         self.m.mre_h = self.sum_rel / self.m.samples as f64;
         sys.phi(q, s.t, &mut self.phi);
@@ -142,4 +166,42 @@ pub fn measure_trajectory(
         obs.add(sys, &s)?;
     }
     Ok(obs.measures())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mbd_solve::{run, RunConfig};
+
+    /// A pendulum released level with its pivot has `H_0 = 0` (the potential's datum at the
+    /// pivot): paper C's `e_h` is then the absolute error, while `e_h_scaled` divides by the
+    /// largest kinetic energy (`m g l / 2` at the bottom) and is of the order of the relative
+    /// error of a pendulum released 1 rad from the vertical.
+    #[test]
+    fn the_scaled_energy_error_does_not_depend_on_the_potential_datum() {
+        let mut scaled = Vec::new();
+        for angle in [std::f64::consts::FRAC_PI_2, 1.0] {
+            let sys = mbd_model::models::pendulum(1.0, 1.0, angle, 9.81).expect("model");
+            let mut s = State::consistent(&sys, 0.0).expect("state");
+            let mut integ = mbd_solve::Index1Rk::new(
+                &sys,
+                mbd_solve::ButcherTableau::rk4(),
+                mbd_solve::Index1Options::default(),
+            )
+            .expect("solver");
+            let mut obs = MeasureObserver::new(&sys, false);
+            run(&mut integ, &sys, &mut s, RunConfig::new(1.0, 0.01), &mut obs).expect("run");
+            let m = obs.measures();
+            assert!(m.max_kinetic > 1.0 && m.max_abs_dh > 0.0, "{m:?}");
+            assert_eq!(m.e_h_scaled(), m.max_abs_dh / m.energy_scale());
+            if angle == std::f64::consts::FRAC_PI_2 {
+                assert!(m.h0.abs() < 1e-12, "{m:?}");
+                assert_eq!(m.e_h, m.max_abs_dh, "absolute where H0 = 0");
+            }
+            scaled.push(m.e_h_scaled());
+        }
+        // the same kind of swing: relative errors of one order of magnitude
+        let r = scaled[0] / scaled[1];
+        assert!((0.1..10.0).contains(&r), "{scaled:?}");
+    }
 }

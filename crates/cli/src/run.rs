@@ -38,7 +38,7 @@ impl RunSummary {
     /// The one-line summary printed on standard error.
     pub fn line(&self, solver: &SolverSpec) -> String {
         let energy = match &self.not_conserved {
-            None => format!("e(H) = {:.3e}", self.measures.e_h),
+            None => format!("e(H) = {:.3e}", self.measures.e_h_scaled()),
             Some(why) => format!(
                 "H not conserved ({why}): max |H - H0| / |H0| = {:.3e}, energy balance \
                  residual {:.3e} of max |H|",
@@ -480,7 +480,8 @@ fn finish(
                 "summary": {
                     "steps": stats.steps,
                     "rejected_steps": stats.rejected_steps,
-                    "e_h": m.e_h,
+                    "e_h": m.e_h_scaled(),
+                    "energy_scale": m.energy_scale(),
                     "e_phi": m.e_phi,
                     "e_phidot": m.e_phidot,
                     "wall_time_s": wall_time,
