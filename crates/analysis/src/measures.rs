@@ -190,7 +190,14 @@ mod tests {
             )
             .expect("solver");
             let mut obs = MeasureObserver::new(&sys, false);
-            run(&mut integ, &sys, &mut s, RunConfig::new(1.0, 0.01), &mut obs).expect("run");
+            run(
+                &mut integ,
+                &sys,
+                &mut s,
+                RunConfig::new(1.0, 0.01),
+                &mut obs,
+            )
+            .expect("run");
             let m = obs.measures();
             assert!(m.max_kinetic > 1.0 && m.max_abs_dh > 0.0, "{m:?}");
             assert_eq!(m.e_h_scaled(), m.max_abs_dh / m.energy_scale());

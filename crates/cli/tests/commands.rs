@@ -588,12 +588,20 @@ fn plot_reads_the_json_of_run() {
 }
 
 /// `--save-state` writes the final state and `--initial-state` restarts from it: RUN 0 -> 1 s
-/// then 1 -> 2 s ends where one run 0 -> 2 s ends, bit for bit (RK4 on the pendulum, whose
-/// steps do not depend on t). A state of another model is refused naming the difference, and
-/// an end time before the saved time is a usage error.
+/// then 1 -> 2 s ends where one run 0 -> 2 s ends, bit for bit, at h = 1e-3 and 0.01 (RK4 on
+/// the pendulum; at 0.01 the first run's last step was 1 - 0.99 = 0.010000000000000009 until
+/// the run loop kept the nominal h there, and the restart differed by 5.6e-17). A state of
+/// another model is refused naming the difference, and an end time before the saved time is a
+/// usage error.
 #[test]
 fn save_and_restart_from_a_state() {
-    let dir = scratch("restart");
+    for h in ["1e-3", "0.01"] {
+        save_and_restart_bit_for_bit(h);
+    }
+}
+
+fn save_and_restart_bit_for_bit(h: &str) {
+    let dir = scratch(&format!("restart_{h}"));
     let model = common::repo().join("examples/models/pendulum.toml");
     let arg = |p: &Path| p.as_os_str().to_owned();
     let run = |t_end: &str, extra: Vec<std::ffi::OsString>| {
@@ -605,7 +613,7 @@ fn save_and_restart_from_a_state() {
             "--t-end".into(),
             t_end.into(),
             "--h".into(),
-            "1e-3".into(),
+            h.into(),
             "--out".into(),
             "/dev/null".into(),
         ];

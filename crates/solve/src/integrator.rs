@@ -492,9 +492,12 @@ pub const MAX_FIXED_STEPS: f64 = 1e12;
 /// Integrates from `state.t` to `cfg.t_end` with steps of `cfg.h`, calling `observer` with the
 /// initial state (step 0) and after every step.
 ///
-/// Every step but the last is given exactly the nominal `cfg.h` (solvers that keep a history
-/// see one step size); the last step is shortened if `h` does not divide the interval. Times
-/// are set to `t0 + k h` after each step, so they do not accumulate round-off. A non-finite
+/// Every step is given exactly the nominal `cfg.h` (solvers that keep a history see one step
+/// size), except the last where `h` does not divide the interval (to 1e-9 relative): it is
+/// shortened to end at `cfg.t_end`. Times are set to `t0 + k h` after each step, so they do
+/// not accumulate round-off, and to `(K + k) h` where `t0` is (to 1e-9 h) the multiple `K h`:
+/// a run restarted from a state it saved at such a time steps through the same times and step
+/// sizes as the run that went on, so it ends at the same state bit for bit. A non-finite
 /// state after a step is an error; so is constraint drift beyond `cfg.drift_guard`
 /// ([`SolveError::ConstraintDrift`]). Steps that pass near a singular configuration are
 /// counted in [`RunStats::near_singular_steps`].
@@ -524,9 +527,24 @@ where
         stats.stopped_by(observer);
         return Ok(stats);
     }
+    // the step times lie on the grid of multiples of h when the run starts on it (to rounding):
+    // a run restarted from a saved state at t = K h then steps through the same times as one
+    // that went on from 0 (and so, for time-dependent models too, through the same states)
+    let k0 = (t0 / cfg.h).round();
+    let on_grid = (t0 - k0 * cfg.h).abs() <= 1e-9 * cfg.h && k0.abs() < MAX_FIXED_STEPS;
     for k in 1..=n {
         let (t_next, h) = if k == n {
-            (cfg.t_end, cfg.t_end - state.t)
+            // the last step: the nominal h where it divides the interval (to the rounding of
+            // the times), shortened only where it does not
+            let rest = cfg.t_end - state.t;
+            let h = if (rest - cfg.h).abs() <= 1e-9 * cfg.h {
+                cfg.h
+            } else {
+                rest
+            };
+            (cfg.t_end, h)
+        } else if on_grid {
+            ((k0 + k as f64) * cfg.h, cfg.h)
         } else {
             (t0 + k as f64 * cfg.h, cfg.h)
         };
