@@ -283,7 +283,7 @@ pub fn animate(args: &AnimateArgs) -> Result<(), CliError> {
     if sys.has_spatial() {
         crate::animate3d::check_trace(&sys, args.trace.as_ref())?;
         if !sys.bodies().is_empty() {
-            eprintln!(
+            note!(
                 "note: the model's {} planar bod{} drawn as centres of mass in the plane z = 0",
                 sys.bodies().len(),
                 if sys.bodies().len() == 1 {

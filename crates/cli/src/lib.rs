@@ -27,6 +27,22 @@
 //! ```
 #![warn(missing_docs)]
 
+/// Writes a line to standard error like `eprintln!`, but ignores a failed write: a closed
+/// pipe (`mbd run ... 2>&1 | head`) must not turn a finished run into a panic (exit 101).
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
+/// Writes `text` to standard output, ignoring a failed write (a reader that closed the pipe,
+/// `mbd solvers | head -1`, is not an error of the command).
+fn out(text: &str) {
+    use std::io::Write as _;
+    let _ = std::io::stdout().write_all(text.as_bytes());
+}
+
 pub mod animate;
 pub mod animate3d;
 pub mod args;
@@ -47,34 +63,34 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Run(args) => {
             let summary = run::run(&args)?;
-            eprintln!("{}", summary.line(&args.solver));
+            note!("{}", summary.line(&args.solver));
             if let Some(w) = summary.stats.warning() {
-                eprintln!("warning: {w}");
+                note!("warning: {w}");
             }
             if let Some(out) = &args.out {
-                eprintln!("wrote {}", out.display());
+                note!("wrote {}", out.display());
             }
             Ok(())
         }
         Command::Check(args) => {
-            print!("{}", check::check(&args)?);
+            out(&check::check(&args)?);
             Ok(())
         }
         Command::Plot(args) => {
             let out = plot::plot(&args)?;
-            eprintln!("wrote {}", out.display());
+            note!("wrote {}", out.display());
             Ok(())
         }
         Command::Animate(args) => {
             animate::animate(&args)?;
-            eprintln!("wrote {}", args.out.display());
+            note!("wrote {}", args.out.display());
             Ok(())
         }
         Command::Solvers(args) => {
             if args.markdown {
-                print!("{}", mbd::registry().markdown_table());
+                out(&mbd::registry().markdown_table());
             } else {
-                print!("{}", solvers::table());
+                out(&solvers::table());
             }
             Ok(())
         }

@@ -9,7 +9,9 @@ fn main() -> ExitCode {
     match mbd_cli::execute(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // (a failed write, e.g. to a closed pipe, must not panic: the exit code says it)
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stderr(), "error: {e}");
             ExitCode::from(e.exit_code())
         }
     }

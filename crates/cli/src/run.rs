@@ -272,7 +272,7 @@ fn warn_initial_changes(sys: &System, state: &State) {
         "spatial bodies have no inputs: to keep the values, give positions, orientations and \
          velocities that satisfy the joints"
     };
-    eprintln!(
+    note!(
         "warning: the initial state was made consistent with the constraints, which changed \
          given values: {}{more}; {advice}",
         shown.join("; ")
@@ -301,7 +301,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
             .iter()
             .map(|e| e.equation.as_str())
             .collect();
-        eprintln!(
+        note!(
             "warning: {} redundant constraint equation(s) ({}): combinations of the others, \
              carrying no multiplier (`mbd check` lists them; redundant_constraints = \"reject\" \
              in the model file refuses them)",
@@ -361,7 +361,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
             }
             let span = args.t_end - state.t;
             if h > span {
-                eprintln!(
+                note!(
                     "warning: --h {} is longer than the run ({} s): it is one step of {} s; \
                      give a smaller --h for a trajectory",
                     mbd_model::format_number(h),
@@ -384,7 +384,7 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
         .build(&sys)
         .map_err(|e| solve_error(&args.solver, mbd::registry().with_advice(&sys, e)))?;
     if let Some(c) = args.solver.caveat(&sys) {
-        eprintln!("warning: {c}");
+        note!("warning: {c}");
     }
     let every = usize::try_from(args.every).unwrap_or(usize::MAX);
     let why_not_conserved = not_conserved(&sys);

@@ -659,3 +659,22 @@ point_a = [0.5, 0.0]
 body_b = "coupler"
 point_b = [2.0, 0.0]
 "#;
+
+/// A reader that closes the pipe early (`mbd ... 2>&1 | true`) does not turn a finished run
+/// into a panic: the messages are dropped and the exit code is the run's (it was 101).
+#[test]
+fn a_closed_pipe_is_not_a_panic() {
+    let bin = env!("CARGO_BIN_EXE_mbd");
+    let script = format!(
+        "cd '{}' && '{bin}' run {PENDULUM} --solver rk4 --t-end 0.5 --h 1e-4 --out /dev/null \
+         2>&1 | true; echo \"code ${{PIPESTATUS[0]}}\"; '{bin}' solvers | true; \
+         echo \"code ${{PIPESTATUS[0]}}\"",
+        common::repo().display()
+    );
+    let o = std::process::Command::new("bash")
+        .args(["-c", &script])
+        .output()
+        .expect("bash");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(text.matches("code 0").count(), 2, "{text}");
+}
