@@ -543,6 +543,7 @@ impl System {
         };
         sys.joint_initials = crate::assembly::validate(&sys.joints, &joint_initials)?;
         sys.check_inertia_scale()?;
+        sys.check_mass_ratio()?;
         let (q0, _) = sys.initial_guess();
         let redundant = sys.redundant_at(q0.as_slice(), 0.0)?;
         if policy == RedundantConstraints::Reject {

@@ -37,6 +37,26 @@ pub enum ModelError {
         /// `mass * lever^2 / inertia`.
         ratio: f64,
     },
+    /// The heaviest and the lightest body differ in mass beyond what double precision can
+    /// hold in one constraint matrix ([`crate::MAX_MASS_RATIO`]).
+    #[error(
+        "body '{light}': mass {light_mass:e} is negligible against the mass {heavy_mass:e} of \
+         body '{heavy}', a ratio of {ratio:.1e} (limit 1e12): the constraint matrix \
+         Phi_q M^-1 Phi_q^T would be singular in double precision; give the bodies their real \
+         masses (a part too light to matter can be left out, or welded to its neighbour)"
+    )]
+    MassRatio {
+        /// The lightest body.
+        light: String,
+        /// Its mass.
+        light_mass: f64,
+        /// The heaviest body.
+        heavy: String,
+        /// Its mass.
+        heavy_mass: f64,
+        /// `heavy_mass / light_mass`.
+        ratio: f64,
+    },
     /// Two bodies, joints or forces share a name.
     #[error("duplicate {kind} name '{name}'")]
     DuplicateName {

@@ -94,7 +94,7 @@ pub use init::{RedundantConstraints, RedundantEquation, SPARSE_RANK_THRESHOLD};
 pub use jet::{Basis, PolyJet, MAX_DIRS};
 pub use joints::RevoluteSide;
 pub use joints::{Coordinate, Joint, JointKind};
-pub use scale::MAX_INERTIA_RATIO;
+pub use scale::{MAX_INERTIA_RATIO, MAX_MASS_RATIO};
 pub use sensors::{Sensor, SensorKind, SensorSpec};
 pub use system::{Attach, ForceHandle, JointElement, JointHandle, System};
 pub use timefn::{

@@ -11,7 +11,56 @@ use crate::system::System;
 /// most four significant digits, and near `1e14` every solver reports a singular matrix.
 pub const MAX_INERTIA_RATIO: f64 = 1e12;
 
+/// Largest ratio of two bodies' masses (planar bodies, spatial bodies and spatial point masses;
+/// see [`ModelError::MassRatio`]). The Schur complement `Phi_q M^-1 Phi_q^T` of two joined
+/// bodies has condition about the ratio of their masses: beyond `1e12` an index-1 solve keeps at
+/// most four significant digits, and the consistent initial state's projection reports a
+/// singular matrix.
+pub const MAX_MASS_RATIO: f64 = 1e12;
+
 impl System {
+    /// Rejects a model whose heaviest and lightest bodies' masses differ by more than
+    /// [`MAX_MASS_RATIO`] (a mass of 1e-300 kg beside one of 2 kg: the projection of the
+    /// initial state failed with "singular projection matrix ... check the initial positions").
+    pub(crate) fn check_mass_ratio(&self) -> Result<(), ModelError> {
+        let masses = self
+            .bodies
+            .iter()
+            .map(|b| (b.name.as_str(), b.mass))
+            .chain(
+                self.spatial
+                    .bodies
+                    .iter()
+                    .map(|b| (b.name.as_str(), b.inertia.mass())),
+            )
+            .chain(
+                self.spatial
+                    .points
+                    .iter()
+                    .map(|p| (p.name.as_str(), p.mass)),
+            );
+        let (mut light, mut heavy) = (("", f64::INFINITY), ("", 0.0f64));
+        for (name, m) in masses {
+            if m < light.1 {
+                light = (name, m);
+            }
+            if m > heavy.1 {
+                heavy = (name, m);
+            }
+        }
+        let ratio = heavy.1 / light.1;
+        if ratio > MAX_MASS_RATIO {
+            return Err(ModelError::MassRatio {
+                light: light.0.to_string(),
+                light_mass: light.1,
+                heavy: heavy.0.to_string(),
+                heavy_mass: heavy.1,
+                ratio,
+            });
+        }
+        Ok(())
+    }
+
     /// Body points of joint `j` as `(body index, lever arm from the centre of mass)` pairs.
     fn joint_lever_arms(&self, ji: usize) -> [(Option<usize>, f64); 2] {
         let at = self.joint_attach[ji];

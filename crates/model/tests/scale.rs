@@ -1,7 +1,9 @@
 //! The mechanism's scales and the build-time check of negligible inertias.
 
 use mbd_model::models::pendulum;
-use mbd_model::{Body, BodyRef, Joint, ModelError, SystemBuilder, MAX_INERTIA_RATIO};
+use mbd_model::{
+    Body, BodyRef, Joint, ModelError, SystemBuilder, MAX_INERTIA_RATIO, MAX_MASS_RATIO,
+};
 
 fn pinned_rod(mass: f64, inertia: f64, half: f64) -> SystemBuilder {
     let mut b = SystemBuilder::new();
@@ -83,4 +85,63 @@ fn length_scale_and_equation_scales() {
     assert_eq!(all.len(), sys.n_constraints());
     assert!((0..all.len()).all(|r| all[r] == sys.equation_scale(r)));
     assert_eq!(sys.equation_scale(2), 1.0);
+}
+
+/// Two rods pinned end to end, of masses `m1` and `m2` (inertias m l^2 / 12, l = 1).
+fn two_rods(m1: f64, m2: f64) -> SystemBuilder {
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, -9.81]);
+    let r1 = b.add_body(
+        Body::new("link1")
+            .mass(m1)
+            .inertia(m1 / 12.0)
+            .position(0.5, 0.0, 0.0),
+    );
+    let r2 = b.add_body(
+        Body::new("link2")
+            .mass(m2)
+            .inertia(m2 / 12.0)
+            .position(1.5, 0.0, 0.0),
+    );
+    b.add_joint(Joint::revolute(
+        "shoulder",
+        BodyRef::Ground,
+        [0.0, 0.0],
+        r1,
+        [-0.5, 0.0],
+    ));
+    b.add_joint(Joint::revolute("elbow", r1, [0.5, 0.0], r2, [-0.5, 0.0]));
+    b
+}
+
+/// A body whose mass is negligible against another's is refused at build, naming both (a
+/// 1e-300 kg link beside a 2 kg one failed later, at the consistent initial state, with
+/// "singular projection matrix ... check the initial positions"); a gram on a tonne and ratios
+/// up to the limit build; the message's limit is the constant's.
+#[test]
+fn a_negligible_mass_is_rejected_at_build_naming_both_bodies() {
+    let e = two_rods(1e-300, 2.0).build().expect_err("mass ratio 2e300");
+    match &e {
+        ModelError::MassRatio {
+            light,
+            heavy,
+            ratio,
+            ..
+        } => {
+            assert_eq!((light.as_str(), heavy.as_str()), ("link1", "link2"));
+            assert!((ratio / 2e300 - 1.0).abs() < 1e-12, "{ratio}");
+        }
+        other => panic!("expected MassRatio, got {other:?}"),
+    }
+    let msg = e.to_string();
+    assert!(
+        msg.contains("'link1'") && msg.contains("'link2'") && msg.contains("limit 1e12"),
+        "{msg}"
+    );
+    assert_eq!(MAX_MASS_RATIO, 1e12);
+    two_rods(1e-3, 1e3).build().expect("a gram on a tonne");
+    two_rods(1.0, 0.5 * MAX_MASS_RATIO)
+        .build()
+        .expect("half the limit");
+    assert!(two_rods(1.0, 2.0 * MAX_MASS_RATIO).build().is_err());
 }
