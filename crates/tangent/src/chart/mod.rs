@@ -106,6 +106,9 @@ pub struct TangentChart {
     /// weighted copy of a vector to split (`2n`).
     vbuf: Vec<f64>,
     sbuf: Vec<f64>,
+    /// Whether the constraints are scleronomic (`Phi_t = 0`): then `Phi_q v` is linear in `v`
+    /// and the weighted velocity rows are evaluated at `(q, tau v)` directly.
+    scleronomic: bool,
     /// Time of the centre.
     tc: f64,
     /// Residual buffer `f` (`2m`).
@@ -236,6 +239,7 @@ impl TangentChart {
             vs_next: 1.0,
             vbuf: vec![0.0; n],
             sbuf: vec![0.0; nn],
+            scleronomic: !sys.is_rheonomic(),
             tc: 0.0,
             f: vec![0.0; mm],
             pq_e: DMatrix::zeros(m, n),
@@ -586,6 +590,19 @@ impl TangentChart {
             self.sel
                 .residual(sys, q, v, t, &mut out[..2 * m], Some(&mut self.angles));
             return with_codim!(2 * m, max_abs_finite(out));
+        }
+        if self.scleronomic {
+            // Phi_q v is linear in v: at (q, tau v) it is the weighted row tau Phi_q v itself
+            self.sel
+                .residual(sys, q, v, t, &mut out[..2 * m], Some(&mut self.angles));
+            let (p, pd) = out.split_at(m);
+            let a = with_rows!(m, max_abs_finite(p));
+            let b = with_rows!(m, max_abs_finite(pd)) * self.vinv;
+            return if a.is_nan() || b.is_nan() {
+                f64::NAN
+            } else {
+                fast_max(a, b)
+            };
         }
         for (b, &vi) in self.vbuf.iter_mut().zip(v) {
             *b = vi * self.vinv;

@@ -103,6 +103,9 @@ pub struct SparseChart {
     vs_next: f64,
     /// The velocities `v` of a residual evaluation at a chart point (`n`).
     vbuf: Vec<f64>,
+    /// Whether the constraints are scleronomic: the weighted velocity rows are then evaluated
+    /// at `(q, tau v)` directly (`Phi_q v` is linear in `v`).
+    scleronomic: bool,
     /// Residual and correction buffers (`2m`).
     f: Vec<f64>,
     d: Vec<f64>,
@@ -193,6 +196,7 @@ impl SparseChart {
             vinv: 1.0,
             vs_next: 1.0,
             vbuf: vec![0.0; n],
+            scleronomic: !sys.is_rheonomic(),
             f: vec![0.0; 2 * m],
             d: vec![0.0; 2 * m],
             x0: vec![0.0; 2 * n],
@@ -532,6 +536,16 @@ impl SparseChart {
         if self.vs == 1.0 {
             sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
             return max_abs(&out[..2 * m]);
+        }
+        if self.scleronomic {
+            // Phi_q v is linear in v: at (q, tau v) it is the weighted row tau Phi_q v itself
+            sys.phi_and_phi_dot_cached(q, v, t, p, pd, &mut self.angles);
+            let (a, b) = (max_abs(p), max_abs(pd) * self.vinv);
+            return if a.is_nan() || b.is_nan() {
+                f64::NAN
+            } else {
+                fast_max(a, b)
+            };
         }
         for (b, &vi) in self.vbuf.iter_mut().zip(v) {
             *b = vi * self.vinv;
