@@ -550,7 +550,7 @@ fn structural_refusals_name_the_cause() {
 fn a_singular_stop_of_a_passing_solver_suggests_another_step_or_solver() {
     let dir = scratch("singular_hint");
     let model = dir.join("double_parallelogram_3.toml");
-    std::fs::write(&model, DOUBLE_PARALLELOGRAM_3).unwrap();
+    std::fs::write(&model, double_parallelogram_3()).unwrap();
     let model = model.to_str().unwrap();
     let out = mbd([
         "run",
@@ -589,76 +589,34 @@ fn a_singular_stop_of_a_passing_solver_suggests_another_step_or_solver() {
     assert_eq!(out.code, 0, "{}", out.stderr);
 }
 
-/// Three cranks of 0.5 m on a 2 m coupler, released at 1 rad turning at 3 rad/s.
-const DOUBLE_PARALLELOGRAM_3: &str = r#"gravity = [0.0, -9.81]
-[[bodies]]
-name = "crank0"
-mass = 1.0
-inertia = 0.020833333333333332
-com = [0.25, 0.0]
-position = [0.0, 0.0, 1.0]
-velocity = [0.0, 0.0, 3.0]
-[[bodies]]
-name = "crank1"
-mass = 1.0
-inertia = 0.020833333333333332
-com = [0.25, 0.0]
-position = [1.0, 0.0, 1.0]
-velocity = [0.0, 0.0, 3.0]
-[[bodies]]
-name = "crank2"
-mass = 1.0
-inertia = 0.020833333333333332
-com = [0.25, 0.0]
-position = [2.0, 0.0, 1.0]
-velocity = [0.0, 0.0, 3.0]
-[[bodies]]
-name = "coupler"
-mass = 4.0
-inertia = 1.3333333333333333
-com = [1.0, 0.0]
-position = [0.2701511529340699, 0.42073549240394825, 0.0]
-velocity = [-1.2622064772118446, 0.8104534588022096, 0.0]
-[[joints]]
-type = "revolute"
-name = "pivot0"
-body_a = "ground"
-point_a = [0.0, 0.0]
-body_b = "crank0"
-[[joints]]
-type = "revolute"
-name = "pin0"
-body_a = "crank0"
-point_a = [0.5, 0.0]
-body_b = "coupler"
-point_b = [0.0, 0.0]
-[[joints]]
-type = "revolute"
-name = "pivot1"
-body_a = "ground"
-point_a = [1.0, 0.0]
-body_b = "crank1"
-[[joints]]
-type = "revolute"
-name = "pin1"
-body_a = "crank1"
-point_a = [0.5, 0.0]
-body_b = "coupler"
-point_b = [1.0, 0.0]
-[[joints]]
-type = "revolute"
-name = "pivot2"
-body_a = "ground"
-point_a = [2.0, 0.0]
-body_b = "crank2"
-[[joints]]
-type = "revolute"
-name = "pin2"
-body_a = "crank2"
-point_a = [0.5, 0.0]
-body_b = "coupler"
-point_b = [2.0, 0.0]
-"#;
+/// Three cranks of 0.5 m pinned at x = 0, 1, 2 to a 2 m coupler, released at 1 rad turning at
+/// 3 rad/s (the coupler's velocity follows from the cranks': a parallelogram translates it).
+fn double_parallelogram_3() -> String {
+    let (a, w) = (1.0f64, 3.0);
+    let mut text = String::from("gravity = [0.0, -9.81]\n");
+    for k in 0..3 {
+        text += &format!(
+            "[[bodies]]\nname = \"crank{k}\"\nmass = 1.0\ninertia = 0.020833333333333332\n\
+             com = [0.25, 0.0]\nposition = [{k}.0, 0.0, {a:?}]\nvelocity = [0.0, 0.0, {w:?}]\n"
+        );
+    }
+    let (s, c) = (0.5 * a.sin(), 0.5 * a.cos());
+    text += &format!(
+        "[[bodies]]\nname = \"coupler\"\nmass = 4.0\ninertia = 1.3333333333333333\n\
+         com = [1.0, 0.0]\nposition = [{c:e}, {s:e}, 0.0]\nvelocity = [{:e}, {:e}, 0.0]\n",
+        -w * s,
+        w * c
+    );
+    for k in 0..3 {
+        text += &format!(
+            "[[joints]]\ntype = \"revolute\"\nname = \"pivot{k}\"\nbody_a = \"ground\"\n\
+             point_a = [{k}.0, 0.0]\nbody_b = \"crank{k}\"\n\
+             [[joints]]\ntype = \"revolute\"\nname = \"pin{k}\"\nbody_a = \"crank{k}\"\n\
+             point_a = [0.5, 0.0]\nbody_b = \"coupler\"\npoint_b = [{k}.0, 0.0]\n"
+        );
+    }
+    text
+}
 
 /// A reader that closes the pipe early (`mbd ... 2>&1 | true`) does not turn a finished run
 /// into a panic: the messages are dropped and the exit code is the run's (it was 101).
