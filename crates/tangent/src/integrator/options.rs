@@ -204,3 +204,25 @@ pub struct TangentStats {
     /// iteration failed ([`NewtonSettings::fallback_change`]: near-singular charts).
     pub exact_maps: usize,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defaults the field docs state, and the metric's weights.
+    #[test]
+    fn the_documented_defaults() {
+        let o = TangentOptions::default();
+        assert_eq!(o.iteration_matrix, IterationMatrix::Centre);
+        assert_eq!(o.max_halvings, 4);
+        assert_eq!((o.singular_tol, o.consistency_tol), (1e-8, 1e-8));
+        assert_eq!(o.stage_tol_ratio, 1e-2);
+        assert_eq!(o.linear_solver, LinearSolver::Auto);
+        assert_eq!((o.chart_shrink, o.max_chart_failures), (0.25, 8));
+        assert!(o.bridge);
+        assert_eq!(o.metric, ChartMetric::StepWeighted);
+        assert_eq!(ChartMetric::StepWeighted.velocity_weight(-2e-3), 2e-3);
+        assert_eq!(ChartMetric::Euclidean.velocity_weight(2e-3), 1.0);
+        assert!(o.validate().is_ok());
+    }
+}
