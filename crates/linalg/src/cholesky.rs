@@ -150,6 +150,9 @@ pub struct DenseCholesky {
     max_dependent: usize,
     /// The rows dropped by the last factorisation (capacity `m`).
     dependent: Vec<usize>,
+    /// The matrix before a semidefinite factorisation's strict pass (allocated by
+    /// [`DenseCholesky::set_max_dependent`] for `k > 0`).
+    backup: Vec<f64>,
 }
 
 /// Smallest accepted pivot of [`DenseCholesky`], relative to the matrix's own diagonal entry:
@@ -179,6 +182,7 @@ impl DenseCholesky {
             factored: false,
             max_dependent: 0,
             dependent: Vec::new(),
+            backup: Vec::new(),
         }
     }
 
@@ -222,6 +226,7 @@ impl DenseCholesky {
             factored: false,
             max_dependent: 0,
             dependent: Vec::new(),
+            backup: Vec::new(),
         })
     }
 
@@ -254,6 +259,11 @@ impl DenseCholesky {
     pub fn set_max_dependent(&mut self, k: usize) {
         self.max_dependent = k.min(self.m);
         self.dependent = Vec::with_capacity(self.m);
+        self.backup = if k > 0 {
+            vec![0.0; self.m * self.m]
+        } else {
+            Vec::new()
+        };
         self.factored = false;
     }
 
@@ -377,9 +387,38 @@ impl DenseCholesky {
         }
         self.condition = f64::INFINITY;
         if self.max_dependent > 0 {
+            // a strict pass first (only round-off-dependent rows dropped: a nearly dependent
+            // row near a singular configuration is kept), the tolerant one where it finds
+            // fewer dependent rows than allowed (semidefinite::ROUNDOFF_DEPENDENT_TOL)
+            self.backup.copy_from_slice(&self.a);
             let (a, diag, inv) = (&mut self.a, &mut self.diag, &mut self.inv);
-            self.condition =
-                semidefinite::factor(a, diag, inv, m, self.max_dependent, &mut self.dependent)?;
+            let k = self.max_dependent;
+            let strict = semidefinite::factor(
+                a,
+                diag,
+                inv,
+                m,
+                k,
+                &mut self.dependent,
+                semidefinite::ROUNDOFF_DEPENDENT_TOL,
+            );
+            self.condition = match strict {
+                Ok(c) if self.dependent.len() == k => c,
+                Err(e) => return Err(e),
+                Ok(_) => {
+                    self.a.copy_from_slice(&self.backup);
+                    let (a, diag, inv) = (&mut self.a, &mut self.diag, &mut self.inv);
+                    semidefinite::factor(
+                        a,
+                        diag,
+                        inv,
+                        m,
+                        k,
+                        &mut self.dependent,
+                        semidefinite::DEPENDENT_PIVOT_TOL,
+                    )?
+                }
+            };
             self.factored = true;
             return Ok(());
         }
@@ -495,6 +534,54 @@ impl DenseCholesky {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The Gram matrix of the rows `g` (each of length 3).
+    fn gram(c: &mut DenseCholesky, g: &[[f64; 3]]) {
+        let mut a = c.matrix_mut();
+        for (i, gi) in g.iter().enumerate() {
+            for (j, gj) in g.iter().enumerate() {
+                a[(i, j)] = gi.iter().zip(gj).map(|(x, y)| x * y).sum();
+            }
+        }
+    }
+
+    /// One redundant row beside one that is independent but nearly dependent (an angle of
+    /// 3e-6 rad to the first row: a mechanism near a singular configuration): the semidefinite
+    /// factorisation drops the redundant row and keeps the other, with a condition estimate
+    /// near `1 / (3e-6)^2`. With the single tolerant pass (pivot ratio 1e-10) the nearly
+    /// dependent row took the budget of one and the redundant row failed the factorisation.
+    /// A row nearly dependent within round-off (1e-7 rad) beside the redundant one still fails.
+    #[test]
+    fn a_nearly_dependent_row_is_not_taken_for_the_redundant_one() {
+        let d = 3e-6f64;
+        let mut c = DenseCholesky::new(3);
+        c.set_max_dependent(1);
+        let g0 = [1.0, 0.0, 0.0];
+        gram(&mut c, &[g0, [d.cos(), d.sin(), 0.0], g0]);
+        c.factor_in_place().expect("one redundant row");
+        assert_eq!(c.dependent(), &[2]);
+        let cond = c.condition_estimate();
+        assert!(cond > 0.5 / (d * d) && cond < 2.0 / (d * d), "{cond:e}");
+        // the basic solution of a consistent system: x_2 = 0
+        let mut b = [1.0, d.cos(), 1.0];
+        c.solve_in_place(&mut b);
+        assert!(
+            b[2] == 0.0 && (b[0] - 1.0).abs() < 1e-6 && b[1].abs() < 1e-6,
+            "{b:?}"
+        );
+        // without a redundant row the tolerant pass takes the nearly dependent one
+        let mut c = DenseCholesky::new(2);
+        c.set_max_dependent(1);
+        gram(&mut c, &[g0, [d.cos(), d.sin(), 0.0]]);
+        c.factor_in_place().expect("tolerant pass");
+        assert_eq!(c.dependent(), &[1]);
+        // two dependencies at round-off with a budget of one: singular
+        let e = 1e-7f64;
+        let mut c = DenseCholesky::new(3);
+        c.set_max_dependent(1);
+        gram(&mut c, &[g0, [e.cos(), e.sin(), 0.0], g0]);
+        assert!(c.factor_in_place().is_err());
+    }
     #[test]
     fn cholesky_solves_and_detects_indefinite() {
         let mut c = DenseCholesky::new(2);

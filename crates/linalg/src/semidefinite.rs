@@ -17,7 +17,9 @@
 //!
 //! At most `max_dependent` rows may be dropped: one more is an error, as a zero pivot is for
 //! the ordinary factorisation (a configuration that loses rank beyond the mechanism's known
-//! redundancy is singular).
+//! redundancy is singular). [`crate::DenseCholesky`] factors with
+//! [`ROUNDOFF_DEPENDENT_TOL`] first and with [`DEPENDENT_PIVOT_TOL`] only where that strict
+//! pass dropped fewer than `max_dependent` rows.
 
 use crate::FactorError;
 
@@ -27,8 +29,18 @@ use crate::FactorError;
 /// to the span of the others.
 pub const DEPENDENT_PIVOT_TOL: f64 = 1e-10;
 
+/// The first, strict pass of [`crate::DenseCholesky`]'s semidefinite factorisation drops only
+/// rows whose pivot ratio is below this (dependent to round-off). Near a singular configuration
+/// of a mechanism with redundant constraints a row that is independent but nearly dependent
+/// (angle `delta` to the others: ratio `delta^2`) would otherwise be taken for one of the
+/// redundant rows and, with the budget spent, fail the factorisation within `1e-5` rad of the
+/// singular configuration; the strict pass keeps it (a large condition estimate, which the
+/// run's near-singular handling sees) and fails only within `1e-6` rad.
+pub const ROUNDOFF_DEPENDENT_TOL: f64 = 1e-12;
+
 /// Factors the column-major `m x m` matrix `a` (lower triangle read) in place, dropping at most
-/// `max_dependent` dependent rows (recorded in `dependent`, which must have capacity `m`).
+/// `max_dependent` rows whose pivot ratio is below `tol` (recorded in `dependent`, which must
+/// have capacity `m`).
 /// Writes `L` into both triangles (every solve path of [`crate::DenseCholesky`] reads one of
 /// them), the inverse pivots into `inv` (zero for a dropped row) and the original diagonal into
 /// `diag`; returns the condition estimate over the kept rows.
@@ -39,6 +51,7 @@ pub(crate) fn factor(
     m: usize,
     max_dependent: usize,
     dependent: &mut Vec<usize>,
+    tol: f64,
 ) -> Result<f64, FactorError> {
     dependent.clear();
     for j in 0..m {
@@ -56,7 +69,7 @@ pub(crate) fn factor(
             d -= l * l;
         }
         let ratio = d / diag[j];
-        if !(ratio >= DEPENDENT_PIVOT_TOL) {
+        if !(ratio >= tol) {
             // (a zero row gives 0 / 0: dependent too)
             if dependent.len() == max_dependent || ratio < -DEPENDENT_PIVOT_TOL.sqrt() {
                 return Err(FactorError::NotPositiveDefinite(j));
