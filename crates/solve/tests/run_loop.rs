@@ -409,6 +409,16 @@ fn documented_defaults_match_the_code() {
         doc.contains("default `1e6`"),
         "architecture.md: condition limit"
     );
+    assert_eq!(mbd_linalg::ROUNDOFF_DEPENDENT_TOL, 1e-12);
+    assert!(
+        doc.contains("`ROUNDOFF_DEPENDENT_TOL = 1e-12`"),
+        "architecture.md: the strict semidefinite pass"
+    );
+    assert_eq!(mbd_model::MAX_MASS_RATIO, 1e12);
+    assert!(
+        doc.contains("`MAX_MASS_RATIO = 1e12`"),
+        "architecture.md: the mass-ratio check"
+    );
     assert_eq!(mbd_solve::linalg::CHOLESKY_PIVOT_TOL, 1e-14);
     assert!(
         doc.contains("`L_jj^2 >= 1e-14 S_jj`"),
