@@ -552,18 +552,21 @@ fn a_singular_stop_of_a_passing_solver_suggests_another_step_or_solver() {
     let model = dir.join("double_parallelogram_3.toml");
     std::fs::write(&model, double_parallelogram_3()).unwrap();
     let model = model.to_str().unwrap();
-    let out = mbd([
-        "run",
-        model,
-        "--solver",
-        "symplectic:2",
-        "--t-end",
-        "1",
-        "--h",
-        "1e-4",
-        "--out",
-        "/dev/null",
-    ]);
+    let run = |h: &str| {
+        mbd([
+            "run",
+            model,
+            "--solver",
+            "symplectic:2",
+            "--t-end",
+            "1",
+            "--h",
+            h,
+            "--out",
+            "/dev/null",
+        ])
+    };
+    let out = run("1e-4");
     assert_fails(
         &out,
         1,
@@ -574,18 +577,7 @@ fn a_singular_stop_of_a_passing_solver_suggests_another_step_or_solver() {
             "rk4-projected or symplectic:1",
         ],
     );
-    let out = mbd([
-        "run",
-        model,
-        "--solver",
-        "symplectic:2",
-        "--t-end",
-        "1",
-        "--h",
-        "1e-3",
-        "--out",
-        "/dev/null",
-    ]);
+    let out = run("1e-3");
     assert_eq!(out.code, 0, "{}", out.stderr);
 }
 

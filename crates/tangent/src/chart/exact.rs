@@ -153,11 +153,8 @@ impl TangentChart {
     /// `Phi_q` and `(Phi_q v)_q` at the chart point `x = (q, tau v)` into `pq_x` and `dphi_x`
     /// (unweighted).
     fn jacobian_weighted(&mut self, sys: &System, x: &[f64], t: f64) {
-        let n = self.n;
-        let (q, v) = x.split_at(n);
-        for (b, &vi) in self.vbuf.iter_mut().zip(v) {
-            *b = vi * self.vinv;
-        }
+        let (q, v) = x.split_at(self.n);
+        self.fill_velocities(v);
         self.sel.jacobian(
             sys,
             q,

@@ -1,10 +1,9 @@
 //! The local chart of the constraint manifold at an accepted point (paper B's "local
 //! parameterisation"), allocation-free after [`TangentChart::new`].
 
-use crate::kernels::{all_finite, gemv_cols, max_abs_finite, with_codim, with_len, with_rows};
+use crate::kernels::{all_finite, gemv_cols, with_len};
 use mbd_model::{BodyAngles, System};
 use mbd_solve::linalg::DenseLu;
-use mbd_solve::linalg::{form_q_padded, qr_padded};
 use mbd_solve::SolveError;
 use nalgebra::DMatrix;
 
@@ -23,9 +22,12 @@ pub const ROUNDOFF_FACTOR: f64 = 8.0;
 pub const TRAVEL_FACTOR: f64 = 4.0;
 mod accel;
 mod apply;
+mod blocks;
+use blocks::{factor_blocks, form_factors, form_q_blocks};
 mod chord;
 mod exact;
 mod rank;
+mod residual;
 mod rows;
 mod settings;
 #[cfg(test)]
@@ -553,111 +555,11 @@ impl TangentChart {
         self.rcond
     }
 
-    /// `f(x, t) = (Phi(q, t), Phi_q v + Phi_t)` into `out` (length `2m`); returns its max-norm
-    /// (NaN if any entry is not finite).
-    pub fn residual(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
-        let m = self.m;
-        let (q, v) = x.split_at(self.n);
-        self.sel.residual(sys, q, v, t, &mut out[..2 * m], None);
-        let mut r = 0.0f64;
-        for &e in out[..2 * m].iter() {
-            if !e.is_finite() {
-                return f64::NAN;
-            }
-            r = r.max(e.abs());
-        }
-        r
-    }
-
     /// The chart's angle table, holding the angles of its last residual evaluation: for the
     /// index-1 solve at a point the chart has just mapped, whose angles moved by the last
     /// correction only (the solve rotates it there, [`mbd_model::BodyAngles::update_near`]).
     pub(crate) fn angles_mut(&mut self) -> &mut mbd_model::BodyAngles {
         &mut self.angles
-    }
-
-    /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous
-    /// evaluation ([`BodyAngles::update_near`]: a few ulps from the exact values; the chord's iterates move
-    /// by small angles).
-    ///
-    /// `x` is a chart point `(q, tau v)`; the velocity rows come back weighted like the chart's
-    /// coordinates, `tau (Phi_q v + Phi_t)` (the rows of `Df` the chart factored), and the norm
-    /// returned is that of the unweighted residual, the quantity the tolerances bound.
-    fn residual_cached(&mut self, sys: &System, x: &[f64], t: f64, out: &mut [f64]) -> f64 {
-        let (n, m) = (self.n, self.m);
-        let (q, v) = x.split_at(n);
-        if self.vs == 1.0 {
-            self.sel
-                .residual(sys, q, v, t, &mut out[..2 * m], Some(&mut self.angles));
-            return with_codim!(2 * m, max_abs_finite(out));
-        }
-        if self.scleronomic {
-            // Phi_q v is linear in v: at (q, tau v) it is the weighted row tau Phi_q v itself
-            self.sel
-                .residual(sys, q, v, t, &mut out[..2 * m], Some(&mut self.angles));
-            let (p, pd) = out.split_at(m);
-            let a = with_rows!(m, max_abs_finite(p));
-            let b = with_rows!(m, max_abs_finite(pd)) * self.vinv;
-            return if a.is_nan() || b.is_nan() {
-                f64::NAN
-            } else {
-                fast_max(a, b)
-            };
-        }
-        for (b, &vi) in self.vbuf.iter_mut().zip(v) {
-            *b = vi * self.vinv;
-        }
-        self.sel.residual(
-            sys,
-            q,
-            &self.vbuf,
-            t,
-            &mut out[..2 * m],
-            Some(&mut self.angles),
-        );
-        let r = with_codim!(2 * m, max_abs_finite(out));
-        for o in out[m..2 * m].iter_mut() {
-            *o *= self.vs;
-        }
-        r
-    }
-
-    /// [`TangentChart::residual`] at a chart point `(q, tau v)`, weighted as
-    /// [`TangentChart::residual_cached`] (without the rotated `sin`/`cos`).
-    pub(super) fn residual_weighted(
-        &mut self,
-        sys: &System,
-        x: &[f64],
-        t: f64,
-        out: &mut [f64],
-    ) -> f64 {
-        let (n, m) = (self.n, self.m);
-        let (q, v) = x.split_at(n);
-        for (b, &vi) in self.vbuf.iter_mut().zip(v) {
-            *b = vi * self.vinv;
-        }
-        self.sel
-            .residual(sys, q, &self.vbuf, t, &mut out[..2 * m], None);
-        let mut r = 0.0f64;
-        for &e in out[..2 * m].iter() {
-            if !e.is_finite() {
-                return f64::NAN;
-            }
-            r = r.max(e.abs());
-        }
-        for o in out[m..2 * m].iter_mut() {
-            *o *= self.vs;
-        }
-        r
-    }
-
-    /// `(q, tau v)` of the chart to the model's `(q, v)`, in place.
-    fn unweight(&self, x: &mut [f64]) {
-        if self.vs != 1.0 {
-            for xv in x[self.n..].iter_mut() {
-                *xv *= self.vinv;
-            }
-        }
     }
 
     /// Writes `x = x_c + U xi + Q1 zeta` into `x` (no Newton) in the chart's coordinates
@@ -730,111 +632,5 @@ impl TangentChart {
     /// The inverse of [`TangentChart::canonical_from_zeta`] (the same sign flips).
     pub(crate) fn zeta_from_canonical(&self, canonical: &[f64], zeta: &mut [f64]) {
         self.canonical_from_zeta(canonical, zeta);
-    }
-}
-
-/// Steps 1 and 2 of [`TangentChart::centre`] for `n` coordinates (`with_len!` passes the
-/// planar mechanisms' `n` as a literal, so the copies and loops over `n` are unrolled).
-///
-/// 1. `[Phi_q^T | X^T]` (`n x 2m`), `X = (Phi_q v)_q`: the QR of its first `m` columns,
-///    `Phi_q^T = Qa [Ra; 0]` (`Qa = [Qa1 Na]`), leaves `Qa^T X^T` in the last `m` columns: its
-///    first `m` rows are the block `C` of `R`, the other `n - m` rows (`D = Na^T X^T`) stacked
-///    on `Ra` form `B = [D; Ra]` (`n x m`).
-/// 2. `B = Qb [Rb; 0]`.
-#[inline(always)]
-fn factor_blocks(ch: &mut TangentChart, n: usize) {
-    with_rows!(ch.m, factor_blocks_mn(ch, n));
-}
-
-/// [`factor_blocks`] for `m` constraints (a literal for the common counts through
-/// `with_rows!`).
-#[inline(always)]
-fn factor_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
-    let (nn, mm, nm) = (2 * n, 2 * m, n - m);
-    let (pq, xs) = (ch.phi_q.as_slice(), ch.dphi.as_slice()); // (r, c) at c m + r
-                                                              // the chart's velocity coordinates are tau v: Df's block X enters weighted, tau X
-    let vs = ch.vs;
-    for k in 0..m {
-        let (ca, cx) = ch.aq[k * n..].split_at_mut(m * n);
-        for c in 0..n {
-            ca[c] = pq[c * m + k];
-            cx[c] = vs * xs[c * m + k];
-        }
-    }
-    qr_padded(&mut ch.aq, m, mm, &mut ch.va, &mut ch.tau, n);
-    for j in 0..m {
-        let (ra, g) = (
-            &ch.aq[j * n..(j + 1) * n],
-            &ch.aq[(m + j) * n..(m + j + 1) * n],
-        );
-        let bj = &mut ch.bq[j * n..(j + 1) * n];
-        // column j of R's leading block Ra (zero below its diagonal), column m + j of C
-        let (left, right) = ch.a.split_at_mut((m + j) * nn);
-        let (ar, ac) = (&mut left[j * nn..], right);
-        ac[..m].copy_from_slice(&g[..m]);
-        ar[..m].copy_from_slice(&ra[..m]);
-        bj[nm..].copy_from_slice(&ra[..m]);
-        bj[..nm].copy_from_slice(&g[m..]);
-    }
-    qr_padded(&mut ch.bq, m, m, &mut ch.vb, &mut ch.tau_b, n);
-    for j in 0..m {
-        let (col, b) = (&mut ch.a[(m + j) * nn + m..], &ch.bq[j * n..]);
-        col[..=j].copy_from_slice(&b[..=j]);
-    }
-}
-
-/// Step 3 of [`TangentChart::centre`] for `n` coordinates (literal through `with_len!`): the
-/// orthogonal factors `Qa` and `Qb` (`n x n`) explicit from their reflectors.
-#[inline(always)]
-fn form_factors(ch: &mut TangentChart, n: usize) {
-    let m = ch.m;
-    form_q_padded(&ch.va, &ch.tau[..m], &mut ch.qa, n);
-    form_q_padded(&ch.vb, &ch.tau_b[..m], &mut ch.qb, n);
-}
-
-/// [`TangentChart::form_q`] for `n` coordinates (literal through `with_len!`): from `Qa` and
-/// `Qb` (`n x n`, formed by the centre), `Q = [[Qa1, W Qb, 0], [0, ., Na]]` with `W y = (Na y[..n-m], Qa1 y[n-m..])`: columns
-/// `0..m` are `(Qa1, 0)`, `m..m+n` are `W Qb` (the last `n - m` of them tangent), `m+n..2n`
-/// are `(0, Na)`. The products `W Qb_j` accumulate column by column from zero, as
-/// [`gemv_cols`] does.
-#[inline(always)]
-fn form_q_blocks(ch: &mut TangentChart, n: usize) {
-    with_rows!(ch.m, form_q_blocks_mn(ch, n));
-}
-
-/// [`form_q_blocks`] for `m` constraints (a literal for the common counts through
-/// `with_rows!`).
-#[inline(always)]
-fn form_q_blocks_mn(ch: &mut TangentChart, n: usize, m: usize) {
-    let (nn, nm) = (2 * n, n - m);
-    let (qa, qb) = (&ch.qa[..n * n], &ch.qb[..n * n]);
-    for k in 0..m {
-        let col = &mut ch.q[k * nn..(k + 1) * nn];
-        col[..n].copy_from_slice(&qa[k * n..(k + 1) * n]);
-        col[n..].fill(0.0);
-    }
-    for j in 0..n {
-        let y = &qb[j * n..(j + 1) * n];
-        let col = &mut ch.q[(m + j) * nn..(m + j + 1) * nn];
-        let (cq, cv) = col.split_at_mut(n);
-        cq.fill(0.0);
-        cv.fill(0.0);
-        for (k, &yk) in y[..nm].iter().enumerate() {
-            let c = &qa[(m + k) * n..(m + k + 1) * n];
-            for i in 0..n {
-                cq[i] += yk * c[i];
-            }
-        }
-        for (k, &yk) in y[nm..].iter().enumerate() {
-            let c = &qa[k * n..(k + 1) * n];
-            for i in 0..n {
-                cv[i] += yk * c[i];
-            }
-        }
-    }
-    for l in 0..nm {
-        let col = &mut ch.q[(m + n + l) * nn..(m + n + l + 1) * nn];
-        col[..n].fill(0.0);
-        col[n..].copy_from_slice(&qa[(m + l) * n..(m + l + 1) * n]);
     }
 }
