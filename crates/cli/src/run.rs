@@ -175,6 +175,10 @@ fn open_sink(args: &RunArgs, sys: &System, every: usize) -> Result<Sink, CliErro
     })
 }
 
+/// The solvers that pass singular configurations on their branch (the report's
+/// `own-singular` experiment): the advice after a singular stop.
+const PASSES_SINGULAR: [&str; 3] = ["rk4-projected", "symplectic:1", "symplectic:2"];
+
 fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
     let hint = match &source {
         SolveError::ConstraintDrift {
@@ -192,26 +196,34 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
         SolveError::Observer { .. } => "; check the output path and the free disk space",
         // a singular configuration: a smaller step does not help a solver that cannot pass
         SolveError::Singular { .. } => {
-            let passing = ["rk4-projected", "symplectic:1", "symplectic:2"];
             let this = solver.spec();
-            if passing.contains(&this) {
-                let others: Vec<&str> = passing.iter().copied().filter(|s| *s != this).collect();
-                return CliError::Solve {
-                    solver: solver.to_string(),
-                    source: Box::new(source),
-                    hint: format!(
-                        "; the mechanism is at or near a singular configuration: this solver \
-                         usually passes such configurations on its branch (the report's \
-                         own-singular experiment), but a step that lands within rounding of \
-                         one can stop it, more often where redundant constraints lower the rank \
-                         further: another --h may pass (the steps land elsewhere), or {}",
-                        others.join(" or ")
-                    ),
-                };
-            }
-            "; the mechanism is at or near a singular configuration: the solvers that keep the \
-             constraints pass such configurations on their branch (rk4-projected, symplectic:1, \
-             symplectic:2; see the report's own-singular experiment), the others stop there"
+            let hint = if PASSES_SINGULAR.contains(&this) {
+                let others: Vec<&str> = PASSES_SINGULAR
+                    .iter()
+                    .copied()
+                    .filter(|s| *s != this)
+                    .collect();
+                format!(
+                    "; the mechanism is at or near a singular configuration: this solver \
+                     usually passes such configurations on its branch (the report's \
+                     own-singular experiment), but a step that lands within rounding of one \
+                     can stop it, more often where redundant constraints lower the rank \
+                     further: another --h may pass (the steps land elsewhere), or {}",
+                    others.join(" or ")
+                )
+            } else {
+                format!(
+                    "; the mechanism is at or near a singular configuration: the solvers that \
+                     keep the constraints pass such configurations on their branch ({}; see \
+                     the report's own-singular experiment), the others stop there",
+                    PASSES_SINGULAR.join(", ")
+                )
+            };
+            return CliError::Solve {
+                solver: solver.to_string(),
+                source: Box::new(source),
+                hint,
+            };
         }
         // a refusal of the model or the setting: no step size helps
         SolveError::Unsupported(_)
