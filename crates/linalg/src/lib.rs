@@ -68,7 +68,7 @@ pub use eigen::{symmetric_eigen, JACOBI_MAX_SWEEPS};
 pub use error::{FactorError, LinalgError, LuError};
 pub use householder::{form_q_padded, qr_padded, reflect, solve_rt};
 pub use lu::{DenseLu, PIVOT_THRESHOLD, PIVOT_TOL};
-pub use semidefinite::{DEPENDENT_PIVOT_TOL, ROUNDOFF_DEPENDENT_TOL};
+pub use semidefinite::{DEPENDENT_PIVOT_TOL, PIVOTING_RATIO, ROUNDOFF_DEPENDENT_TOL};
 pub use sparse::{ColumnOrder, SparseCholesky, SparseLu, REFACTOR_PIVOT_RATIO, SPARSE_PIVOT_TOL};
 
 use faer::dyn_stack::MemBuffer;

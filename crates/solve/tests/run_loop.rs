@@ -414,6 +414,11 @@ fn documented_defaults_match_the_code() {
         doc.contains("`ROUNDOFF_DEPENDENT_TOL = 1e-12`"),
         "architecture.md: the strict semidefinite pass"
     );
+    assert_eq!(mbd_linalg::PIVOTING_RATIO, 1e-8);
+    assert!(
+        doc.contains("`PIVOTING_RATIO = 1e-8`"),
+        "architecture.md: the pivoted semidefinite factorisation"
+    );
     assert_eq!(mbd_model::MAX_MASS_RATIO, 1e12);
     assert!(
         doc.contains("`MAX_MASS_RATIO = 1e12`"),
