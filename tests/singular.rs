@@ -162,18 +162,6 @@ fn the_singular_stop_names_time_rank_deficiency_and_joints() {
     }
 }
 
-/// Runs `spec` on the free 2-four-bar (released at 6 rad/s from 1 rad, turning over through
-/// its flat configurations) with step `h` to `t_end`.
-fn free_two_four_bar(spec: &str, h: f64, t_end: f64) -> Result<(), mbd::Error> {
-    use mbd::model::models::ClosedLoop;
-    use mbd::prelude::*;
-    let cl = ClosedLoop::n_four_bar(2, 0.4, 1.0).unwrap();
-    let sys = cl.system(1.0, 6.0, false).unwrap();
-    let mut sim = Simulation::new(sys, spec)?;
-    sim.run(RunConfig::new(t_end, h))?;
-    Ok(())
-}
-
 /// Plain RK4 at h = 1e-2 without the acceleration bridge passes the free mechanism's flat
 /// configurations without landing near enough to stop, but its drift grows from a passage (at
 /// t = 1.41) until the guard stops it (t = 1.91): that is reported as the singular
@@ -217,41 +205,86 @@ fn drift_grown_from_a_singular_passage_is_the_singular_error() {
     }
 }
 
+/// Steps `spec` on `sys` with `h` up to `t_end` by the integrator itself, through the run
+/// loop's grid times but without its stepping over a failed step: the first error.
+fn step_until_error(sys: &mbd::model::System, spec: &str, h: f64, t_end: f64) -> SolveError {
+    let mut integ = mbd::registry().parse(spec).unwrap().build(sys).unwrap();
+    let mut s = State::consistent(sys, 0.0).unwrap();
+    // the times of the run loop's grid
+    for k in 1..=(t_end / h).round() as usize {
+        if let Err(e) = integ.step(sys, &mut s, h) {
+            return e;
+        }
+        s.t = k as f64 * h;
+    }
+    panic!("{spec}: no error up to t = {t_end}");
+}
+
+/// The distance of the tracked point of the 2- or 10-four-bar `cl` in `q` from `want`.
+fn tracked_error(
+    cl: &mbd::model::models::ClosedLoop,
+    sys: &mbd::model::System,
+    q: &[f64],
+    want: [f64; 2],
+) -> f64 {
+    let body = sys.body_handle(&cl.tracked_body()).unwrap().index();
+    let (x, y, a) = (q[3 * body], q[3 * body + 1], q[3 * body + 2]);
+    (x + 0.2 * a.cos() - want[0]).hypot(y + 0.2 * a.sin() - want[1])
+}
+
 /// The (2,2) modified-Lagrangian scheme at h = 1e-2 fails on the step that crosses a flat
 /// configuration at t = 7.24 (it starts 0.046 rad before it, where the preadjustment's
 /// projected metric degenerates): the configurations along the step, not only its start, are
 /// checked for rank loss, so the error is the typed singular one naming the loops' equations.
+/// The run loop steps over that step (docs/singular.md, section 5) and ends on the exact free
+/// motion (1.0e-10 off at t = 7.3).
 #[test]
 fn a_newton_failure_on_a_step_across_rank_loss_is_the_singular_error() {
-    match free_two_four_bar("symplectic:2:modified", 1e-2, 7.3) {
-        Err(mbd::Error::Solve(SolveError::Singular { t, detail, .. })) => {
+    use mbd::model::models::{ClosedLoop, CrankMotion};
+    use mbd::prelude::*;
+    let cl = ClosedLoop::n_four_bar(2, 0.4, 1.0).unwrap();
+    let sys = cl.system(1.0, 6.0, false).unwrap();
+    match step_until_error(&sys, "symplectic:2:modified", 1e-2, 7.3) {
+        SolveError::Singular { t, detail, .. } => {
             assert!((7.2..7.3).contains(&t), "{t}");
             assert!(detail.contains("rank deficiency 2"), "{detail}");
             assert!(detail.contains("G1.x"), "{detail}");
         }
         other => panic!("expected the singular error, got {other:?}"),
     }
+    let mut sim = Simulation::new(sys.clone(), "symplectic:2:modified").unwrap();
+    let stats = sim.run(RunConfig::new(7.3, 1e-2)).unwrap();
+    assert_eq!(stats.stepped_over, 1);
+    let motion = CrankMotion::n_four_bar(2, 0.4, 1.0, 1.0, 6.0).unwrap();
+    let want = cl.tracked_point(motion.at(7.3)[0]);
+    let err = tracked_error(&cl, &sys, sim.state().q.as_slice(), want);
+    assert!(err < 1e-8, "{err:e}");
 }
 
 /// Symplectic (2,2) on the driven 10-four-bar at h = 1e-3 fails 2.2 steps before the flat
 /// configuration at t = 0.357 (the crank 0.013 rad from it, no equation yet within 1e-2 of
 /// dependence along the step itself): configurations a few steps either side of a failing
 /// step are checked too, so the error is the typed singular one, not a Newton failure
-/// advising a shorter step.
+/// advising a shorter step. The run loop steps over it and stays on the driven motion.
 #[test]
 fn a_newton_failure_steps_before_rank_loss_is_the_singular_error() {
-    use mbd::model::models::ClosedLoop;
+    use mbd::model::models::{ClosedLoop, CrankMotion};
     use mbd::prelude::*;
     let cl = ClosedLoop::n_four_bar(10, 0.4, 1.0).unwrap();
     let sys = cl.system(1.0, 6.0, true).unwrap();
-    let mut sim = Simulation::new(sys, "symplectic:2").unwrap();
-    match sim.run(RunConfig::new(0.4, 1e-3)) {
-        Err(mbd::Error::Solve(SolveError::Singular { t, detail, .. })) => {
+    match step_until_error(&sys, "symplectic:2", 1e-3, 0.4) {
+        SolveError::Singular { t, detail, .. } => {
             assert!((0.35..0.357).contains(&t), "{t}");
             assert!(detail.contains("rank deficiency"), "{detail}");
         }
         other => panic!("expected the singular error, got {other:?}"),
     }
+    let mut sim = Simulation::new(sys.clone(), "symplectic:2").unwrap();
+    let stats = sim.run(RunConfig::new(0.4, 1e-3)).unwrap();
+    assert_eq!(stats.stepped_over, 1);
+    let want = cl.tracked_point(CrankMotion::driven(1.0, 6.0).unwrap().at(0.4)[0]);
+    let err = tracked_error(&cl, &sys, sim.state().q.as_slice(), want);
+    assert!(err < 1e-10, "{err:e}");
 }
 
 /// Symplectic (1,1) on the free 10-four-bar (sparse path, whose stage factorisation is kept
@@ -289,5 +322,65 @@ fn the_run_guard_names_the_loop_it_stops_at() {
             );
         }
         other => panic!("expected the singular stop, got {other:?}"),
+    }
+}
+
+/// An isosceles slider-crank (crank and rod 0.5 m) driven at 2 pi rad/s from 0 reaches its dead
+/// points, where the rod folds onto the crank and `Phi_q` loses a rank, at t = 0.25 and 0.75 s:
+/// on the grid of h = 1e-3, so a step lands exactly on them. Every solver that keeps the
+/// constraints steps over both (three steps that straddle each, `RunStats::stepped_over`) and
+/// stays on the slider's motion `x = 2 r cos(theta)` to 1e-9, where before every one of them
+/// stopped with the singular error there; the grid times at the dead points themselves have no
+/// state where the step onto them failed (`skipped_outputs`). Off the grid (h = 1.1e-3) nothing
+/// is stepped over. Plain RK4, which does not keep the constraints, still stops there.
+#[test]
+fn a_step_onto_a_singular_configuration_is_stepped_over() {
+    use mbd::model::models::{slider_crank_with, SliderCrankParams};
+    use mbd::prelude::*;
+    let (r, speed) = (0.5, std::f64::consts::TAU);
+    let sys = slider_crank_with(&SliderCrankParams {
+        crank: r,
+        rod: r,
+        angle: 0.0,
+        speed,
+        driven: true,
+    })
+    .unwrap();
+    let slider = sys.body_handle("slider").unwrap().index();
+    for spec in [
+        "rk4-projected",
+        "symplectic:1",
+        "symplectic:2",
+        "tangent:rk4",
+        "tangent:dopri5",
+    ] {
+        for (h, over) in [(1e-3, 2), (1.1e-3, 0)] {
+            let mut sim = Simulation::new(sys.clone(), spec).unwrap();
+            let mut rec = Recorder::new();
+            let stats = sim
+                .run_observed(RunConfig::new(1.0, h), &mut rec)
+                .unwrap_or_else(|e| panic!("{spec} at h = {h}: {e}"));
+            assert_eq!(stats.stepped_over, over, "{spec} at h = {h}");
+            assert!(stats.skipped_outputs <= over, "{spec} at h = {h}");
+            let steps = (1.0 / h).ceil() as usize;
+            assert_eq!(rec.t.len(), steps + 1 - stats.skipped_outputs, "{spec}");
+            let worst = rec
+                .q
+                .iter()
+                .zip(&rec.t)
+                .map(|(q, &t)| (q[3 * slider] - 2.0 * r * (speed * t).cos()).abs())
+                .fold(0.0f64, f64::max);
+            assert!(worst < 1e-9, "{spec} at h = {h}: slider {worst:e} off");
+            if over > 0 {
+                let first = stats.first_stepped_over.unwrap();
+                assert!((first - 0.25).abs() < 2e-3, "{spec}: first at {first}");
+                assert!(stats.warning().unwrap().contains("stepped over"), "{spec}");
+            }
+        }
+    }
+    let mut sim = Simulation::new(sys, "rk4").unwrap();
+    match sim.run(RunConfig::new(1.0, 1e-3)) {
+        Err(mbd::Error::Solve(SolveError::Singular { t, .. })) => assert!((t - 0.25).abs() < 2e-3),
+        other => panic!("plain RK4: {other:?}"),
     }
 }

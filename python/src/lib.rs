@@ -164,6 +164,8 @@ fn to_python(py: Python<'_>, r: RunData) -> PyResult<Bound<'_, PyAny>> {
     stats.set_item("newton_iterations", r.stats.newton_iterations)?;
     stats.set_item("rhs_evals", r.stats.rhs_evals)?;
     stats.set_item("near_singular_steps", r.stats.near_singular_steps)?;
+    stats.set_item("stepped_over", r.stats.stepped_over)?;
+    stats.set_item("skipped_outputs", r.stats.skipped_outputs)?;
     stats.set_item("min_step", r.stats.min_step)?;
     stats.set_item("max_step", r.stats.max_step)?;
     stats.set_item("e_h", r.measures.e_h)?;

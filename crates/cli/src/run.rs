@@ -206,9 +206,10 @@ fn solve_error(solver: &SolverSpec, source: SolveError) -> CliError {
                 format!(
                     "; the mechanism is at or near a singular configuration: this solver \
                      usually passes such configurations on its branch (the report's \
-                     own-singular experiment), but a step that lands within rounding of one \
-                     can stop it, more often where redundant constraints lower the rank \
-                     further: another --h may pass (the steps land elsewhere), or {}",
+                     own-singular experiment) and steps over a step that lands on one, but \
+                     it stops where it cannot: a run that ends or starts on the configuration \
+                     (a --t-end or initial state a little off it passes), or one it cannot \
+                     pass at this step: another --h may pass, or {}",
                     others.join(" or ")
                 )
             } else {

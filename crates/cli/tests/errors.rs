@@ -543,9 +543,10 @@ fn structural_refusals_name_the_cause() {
 }
 
 /// A double parallelogram with a third crank (one redundant equation) turning without gravity
-/// through its flat position at t = 0.25 s: at h = 1e-4 a step lands on it and stops symplectic
-/// (2,2), which passes such positions at other steps (h = 3e-3 reaches the end). The message
-/// says so and suggests the other solvers that pass, not the one that stopped.
+/// through its flat position at t = 0.25 s: a run of symplectic (2,2) that ends there stops
+/// (the state there cannot be computed), while one that goes on steps over it (h = 1e-4 to
+/// 0.5 s) or does not land on it (h = 3e-3). The message says so and suggests the other
+/// solvers that pass, not the one that stopped.
 #[test]
 fn a_singular_stop_of_a_passing_solver_suggests_another_step_or_solver() {
     let dir = scratch("singular_hint");
@@ -554,33 +555,38 @@ fn a_singular_stop_of_a_passing_solver_suggests_another_step_or_solver() {
     let flat_at_quarter = double_parallelogram_3(0.0, std::f64::consts::PI - 1.0, 4.0);
     std::fs::write(&model, flat_at_quarter).unwrap();
     let model = model.to_str().unwrap();
-    let run = |h: &str| {
+    let run = |h: &str, t_end: &str| {
         mbd([
             "run",
             model,
             "--solver",
             "symplectic:2",
             "--t-end",
-            "0.5",
+            t_end,
             "--h",
             h,
             "--out",
             "/dev/null",
         ])
     };
-    let out = run("1e-4");
+    let out = run("1e-4", "0.25");
     assert_fails(
         &out,
         1,
         &[
             "singular",
             "this solver usually passes",
+            "ends or starts on the configuration",
             "another --h may pass",
             "rk4-projected or symplectic:1",
         ],
     );
-    let out = run("3e-3");
+    let out = run("1e-4", "0.5");
     assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stderr.contains("stepped over"), "{}", out.stderr);
+    let out = run("3e-3", "0.5");
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(!out.stderr.contains("stepped over"), "{}", out.stderr);
 }
 
 /// Three cranks of 0.5 m pinned at x = 0, 1, 2 to a 2 m coupler, released at `a` rad turning

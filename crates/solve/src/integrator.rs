@@ -8,6 +8,7 @@ pub use crate::guard::{
     GUARD_QUIET_RATIO, GUARD_STRIDE,
 };
 use crate::state::State;
+use crate::step_over;
 use mbd_model::System;
 
 /// What one step did (for diagnostics and work counts).
@@ -400,6 +401,17 @@ pub struct RunStats {
     /// Stages whose accelerations [`crate::SingularBridge`] bridged through a singular
     /// configuration (summed over steps and attempts).
     pub bridged_stages: usize,
+    /// Grid times a fixed-step [`run`] stepped over because a step from or onto the
+    /// configuration there failed as singular (three steps around it whose ends and stages
+    /// miss it; only for solvers that keep the constraints, see
+    /// `crates/solve/src/step_over.rs`).
+    pub stepped_over: usize,
+    /// The first such grid time.
+    pub first_stepped_over: Option<f64>,
+    /// Of those, the grid times the observer saw no state at (the step *onto* the grid time
+    /// failed, as onto a singular configuration, so the run has no state there; otherwise
+    /// the state there was reached and only a step from it failed).
+    pub skipped_outputs: usize,
 }
 
 impl RunStats {
@@ -421,7 +433,26 @@ impl RunStats {
     /// A warning to show the user when the run passed near a singular configuration, `None`
     /// otherwise.
     pub fn warning(&self) -> Option<String> {
-        let t = self.first_near_singular?;
+        let over = self.first_stepped_over.map(|t| {
+            let skipped = if self.skipped_outputs > 0 {
+                format!(
+                    " ({} of them without an output: the step onto that time failed, as \
+                     onto a singular configuration itself)",
+                    self.skipped_outputs
+                )
+            } else {
+                String::new()
+            };
+            format!(
+                "{} grid time(s) at a singular configuration were stepped over by steps that \
+                 straddle it (first at t = {t}){skipped}",
+                self.stepped_over
+            )
+        });
+        let Some(t) = self.first_near_singular else {
+            return over;
+        };
+        let over = over.map(|o| format!("; {o}")).unwrap_or_default();
         let bridged = if self.bridged_stages > 0 {
             format!(
                 "; {} stage(s) took the ill-determined part of their accelerations from the \
@@ -434,7 +465,7 @@ impl RunStats {
         Some(format!(
             "{} step(s) passed near a singular configuration (index-1 condition estimate up to \
              {:.1e}, first at t = {t}): accelerations and multipliers there may have lost digits; \
-             check the mechanism's geometry or take a smaller step{bridged}",
+             check the mechanism's geometry or take a smaller step{bridged}{over}",
             self.near_singular_steps, self.max_condition
         ))
     }
@@ -500,7 +531,11 @@ pub const MAX_FIXED_STEPS: f64 = 1e12;
 /// sizes as the run that went on, so it ends at the same state bit for bit. A non-finite
 /// state after a step is an error; so is constraint drift beyond `cfg.drift_guard`
 /// ([`SolveError::ConstraintDrift`]). Steps that pass near a singular configuration are
-/// counted in [`RunStats::near_singular_steps`].
+/// counted in [`RunStats::near_singular_steps`]. Where a step of an integrator that keeps the
+/// constraints fails with [`SolveError::Singular`] because it starts or ends on a singular
+/// configuration, two grid intervals around it are covered by three steps that miss that
+/// grid time ([`RunStats::stepped_over`]; `docs/singular.md`, section 5): the observer is then
+/// not called at a grid time where the run has no state ([`RunStats::skipped_outputs`]).
 pub fn run<I, O>(
     integrator: &mut I,
     sys: &System,
@@ -532,30 +567,80 @@ where
     // that went on from 0 (and so, for time-dependent models too, through the same states)
     let k0 = (t0 / cfg.h).round();
     let on_grid = (t0 - k0 * cfg.h).abs() <= 1e-9 * cfg.h && k0.abs() < MAX_FIXED_STEPS;
-    for k in 1..=n {
-        let (t_next, h) = if k == n {
+    // the time after step k and the step's size
+    let grid = |k: usize| -> (f64, f64) {
+        let at = |k: usize| {
+            if on_grid {
+                (k0 + k as f64) * cfg.h
+            } else {
+                t0 + k as f64 * cfg.h
+            }
+        };
+        if k == n {
             // the last step: the nominal h where it divides the interval (to the rounding of
             // the times), shortened only where it does not
-            let rest = cfg.t_end - state.t;
+            let rest = cfg.t_end - if k == 1 { t0 } else { at(k - 1) };
             let h = if (rest - cfg.h).abs() <= 1e-9 * cfg.h {
                 cfg.h
             } else {
                 rest
             };
             (cfg.t_end, h)
-        } else if on_grid {
-            ((k0 + k as f64) * cfg.h, cfg.h)
         } else {
-            (t0 + k as f64 * cfg.h, cfg.h)
+            (at(k), cfg.h)
+        }
+    };
+    // the states before the current step and before the last one (`step_over`)
+    let keeps = integrator.keeps_constraints();
+    // (allocated once per run; copied into per step only for the solvers that keep the
+    // constraints, whose failures at a singular configuration are stepped over)
+    let (mut start, mut before) = (state.clone(), state.clone());
+    let mut have_before = false;
+    let mut k = 1;
+    while k <= n {
+        let (t_next, h) = grid(k);
+        if keeps {
+            step_over::copy_state(&mut start, state);
+        }
+        let failure = match integrator.step(sys, state, h) {
+            Ok(s) => {
+                state.t = t_next;
+                stats.add_work(&s);
+                checks.accepted(sys, state, h, &s, &mut stats)?;
+                if keeps {
+                    std::mem::swap(&mut start, &mut before);
+                    have_before = true;
+                }
+                None
+            }
+            Err(e @ SolveError::Singular { .. }) if keeps => Some(e),
+            Err(e) => return Err(e),
         };
-        let s = integrator.step(sys, state, h)?;
-        state.t = t_next;
-        stats.add_work(&s);
-        checks.accepted(sys, state, h, &s, &mut stats)?;
+        if let Some(e) = failure {
+            // a step from or onto a singular configuration: cover two grid intervals with
+            // steps that straddle the grid time between them (`step_over`)
+            let nominal = |k: usize| k <= n && grid(k).1 == cfg.h;
+            let window = step_over::Window {
+                h: cfg.h,
+                start: &start,
+                t_k: t_next,
+                after: (nominal(k) && nominal(k + 1)).then(|| grid(k + 1).0),
+                before: (have_before && k >= 2 && nominal(k)).then_some(&before),
+            };
+            match step_over::step_over(integrator, sys, state, &window, &mut checks, &mut stats) {
+                // grid time k, the singular configuration itself, has no state
+                Some(step_over::Covered::After) => k += 1,
+                Some(step_over::Covered::Before) => {}
+                None => return Err(e),
+            }
+            // the grid state before this one was stepped over
+            have_before = false;
+        }
         if observer.observe(sys, state, k)? == Flow::Stop {
             stats.stopped_by(observer);
             break;
         }
+        k += 1;
     }
     Ok(stats)
 }

@@ -71,6 +71,7 @@ pub mod registry;
 mod sensors;
 pub mod sparse;
 mod state;
+mod step_over;
 mod tableau;
 
 pub use accel::AccelerationSolver;

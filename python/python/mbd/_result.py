@@ -45,8 +45,10 @@ class RunStats:
     ``"observer"`` or ``"event"``), ``wall_time`` (s, the integration alone), ``rows`` kept,
     the energy error ``e_h`` (max ``|H - H0| / |H0|``), the constraint errors ``e_phi`` and
     ``e_phidot`` (max over every step), ``not_conserved`` (why ``H`` is not conserved, or
-    ``None``), ``energy_balance`` (its residual relative to ``max |H|`` where it is not), and the
-    warnings ``mbd run`` prints."""
+    ``None``), ``energy_balance`` (its residual relative to ``max |H|`` where it is not),
+    ``stepped_over`` (grid times at a singular configuration that fixed steps stepped over) and
+    ``skipped_outputs`` (of those, the ones without a row), and the warnings ``mbd run``
+    prints.""""""
 
     steps: int
     rejected: int
@@ -56,6 +58,8 @@ class RunStats:
     newton_iterations: int = 0
     rhs_evals: int = 0
     near_singular_steps: int = 0
+    stepped_over: int = 0
+    skipped_outputs: int = 0
     min_step: float = 0.0
     max_step: float = 0.0
     e_h: float = 0.0
