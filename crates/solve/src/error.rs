@@ -243,6 +243,36 @@ pub enum SolveError {
 /// analysis refuses the model's structure), anything else [`SolveError::LinearAlgebra`]. The
 /// solvers turn a failed factorisation at a time `t` into [`SolveError::Singular`] themselves,
 /// with the equation at fault.
+/// [`SolveError::Singular::what`] of a symplectic step whose Newton iteration failed on a step
+/// that passes, or comes within a few steps of, a configuration within `1e-2` of rank loss
+/// (not one that is singular to rounding at the step's start or end).
+pub const STAGES_NEAR_RANK_LOSS: &str =
+    "configuration (Phi_q near rank loss: the stage equations failed there)";
+
+/// [`SolveError::Singular::what`] of a symplectic step whose Newton iteration stalled a few
+/// digits above its tolerance where the step passes, or comes within a few steps of, a
+/// configuration within `1e-2` of rank loss.
+pub const STAGES_STALLED_NEAR_RANK_LOSS: &str = "configuration (the stage Jacobian near-singular)";
+
+/// [`SolveError::Singular::what`] of a tangent chart map that failed at every halving at a
+/// centre within `1e-2` of rank loss.
+pub const CHART_NEAR_RANK_LOSS: &str =
+    "configuration (Phi_q near rank loss: the chart's map failed there)";
+
+impl SolveError {
+    /// Whether this is the singular error of a Newton iteration that failed *near* a
+    /// singular configuration ([`STAGES_NEAR_RANK_LOSS`], [`STAGES_STALLED_NEAR_RANK_LOSS`],
+    /// [`CHART_NEAR_RANK_LOSS`]): the
+    /// solver cannot pass the configuration at this step size, so a fixed-step run does not
+    /// step over it (it does over a step that starts or ends *on* one, where a factorisation
+    /// is singular to rounding; `docs/singular.md`, section 5).
+    pub fn is_newton_near_rank_loss(&self) -> bool {
+        matches!(self, SolveError::Singular { what, .. }
+            if [STAGES_NEAR_RANK_LOSS, STAGES_STALLED_NEAR_RANK_LOSS, CHART_NEAR_RANK_LOSS]
+                .contains(what))
+    }
+}
+
 impl From<LinalgError> for SolveError {
     fn from(e: LinalgError) -> Self {
         match e {

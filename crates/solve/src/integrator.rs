@@ -533,8 +533,8 @@ pub const MAX_FIXED_STEPS: f64 = 1e12;
 /// ([`SolveError::ConstraintDrift`]). Steps that pass near a singular configuration are
 /// counted in [`RunStats::near_singular_steps`]. Where a step of an integrator that keeps the
 /// constraints fails with [`SolveError::Singular`] because it starts or ends on a singular
-/// configuration, two grid intervals around it are covered by three steps that miss that
-/// grid time ([`RunStats::stepped_over`]; `docs/singular.md`, section 5): the observer is then
+/// configuration (not a Newton failure near one, [`SolveError::is_newton_near_rank_loss`]),
+/// two grid intervals around it are covered by three steps that miss that grid time ([`RunStats::stepped_over`]; `docs/singular.md`, section 5): the observer is then
 /// not called at a grid time where the run has no state ([`RunStats::skipped_outputs`]).
 pub fn run<I, O>(
     integrator: &mut I,
@@ -613,7 +613,9 @@ where
                 }
                 None
             }
-            Err(e @ SolveError::Singular { .. }) if keeps => Some(e),
+            Err(e @ SolveError::Singular { .. }) if keeps && !e.is_newton_near_rank_loss() => {
+                Some(e)
+            }
             Err(e) => return Err(e),
         };
         if let Some(e) = failure {

@@ -87,7 +87,8 @@ pub use consistent::{
 pub use constrained::ConstrainedSolve;
 pub use dense::{Crossing, DenseOutput, Event, EventFn, EventHit};
 pub use error::{
-    refuse_large_spatial, refuse_redundant, refuse_spatial, SolveError, DENSE_SPATIAL_LIMIT,
+    refuse_large_spatial, refuse_redundant, refuse_spatial, SolveError, CHART_NEAR_RANK_LOSS,
+    DENSE_SPATIAL_LIMIT, STAGES_NEAR_RANK_LOSS, STAGES_STALLED_NEAR_RANK_LOSS,
 };
 pub use index1::{reference_trajectory, Index1Options, Index1Rk, ReferenceTrajectory};
 pub use integrator::{

@@ -120,7 +120,7 @@ impl Galerkin {
                 // near-singular there, and a smaller h does not change that
                 SolveError::Singular {
                     t,
-                    what: "configuration (the stage Jacobian near-singular)",
+                    what: mbd_solve::STAGES_STALLED_NEAR_RANK_LOSS,
                     detail: format!(
                         "symplectic ({s},{s}) stage equations, h = {h}: Newton stalled near \
                          round-off, residual {res:.2e} after {it} iterations (tolerance \
@@ -136,7 +136,7 @@ impl Galerkin {
                 // singular configuration, not the step length, is the cause
                 SolveError::Singular {
                     t,
-                    what: "configuration (Phi_q near rank loss: the stage equations failed there)",
+                    what: mbd_solve::STAGES_NEAR_RANK_LOSS,
                     detail: format!(
                         "symplectic ({s},{s}) stage equations, h = {h}: Newton residual {res:.2e} \
                          after {it} iterations; rank deficiency {} (equations within 1e-2 of \

@@ -420,7 +420,7 @@ impl TangentRk {
         match self.path.singular_error(sys, t, NEAR_SINGULAR_TOL) {
             Some(SolveError::Singular { detail, .. }) => SolveError::Singular {
                 t,
-                what: "configuration (Phi_q near rank loss: the chart's map failed there)",
+                what: mbd_solve::CHART_NEAR_RANK_LOSS,
                 detail: format!("{detail} (pivots below {NEAR_SINGULAR_TOL:.0e}); {e}"),
             },
             _ => e,
