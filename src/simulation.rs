@@ -188,8 +188,9 @@ impl Simulation {
     }
 
     /// Runs from the current state to the plan's end time, calling `observer` with the
-    /// initial state and after every (accepted) step. On error the state is where the failing
-    /// step started (or the last accepted point).
+    /// initial state and after every (accepted) step (a fixed-step run that steps over a grid
+    /// time at a singular configuration has no state there: [`RunStats::skipped_outputs`]).
+    /// On error the state is where the failing step started (or the last accepted point).
     pub fn run_observed<O: Observer + ?Sized>(
         &mut self,
         plan: impl Into<Plan>,

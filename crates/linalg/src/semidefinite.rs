@@ -103,7 +103,7 @@ pub(crate) fn factor(
 
 /// A kept pivot ratio below this marks a factorisation in natural order as ill-conditioned
 /// (a configuration within about `1e-4` rad of a singular one): [`crate::DenseCholesky`] then
-/// factors again with diagonal pivoting ([`factor_pivoted`]) and keeps that result.
+/// factors again with diagonal pivoting (`factor_pivoted`) and keeps that result.
 pub const PIVOTING_RATIO: f64 = 1e-8;
 
 /// [`factor`] with diagonal pivoting: at each step the row with the largest pivot ratio left
