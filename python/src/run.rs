@@ -58,7 +58,8 @@ pub struct RunData {
     /// Where `H` is not conserved: the energy balance's largest residual relative to `max |H|`.
     pub balance: Option<f64>,
     /// Warnings `mbd run` prints (initial values the consistent state changed, redundant
-    /// equations, the solver's caveat for this model).
+    /// equations, the solver's caveat for this model, the run's passages near or over
+    /// singular configurations).
     pub warnings: Vec<String>,
 }
 
@@ -192,6 +193,9 @@ pub fn run_model(sys: &System, opts: &RunOptions) -> Result<RunData, Failure> {
     let result = sim.run_observed(plan, &mut obs);
     let wall_time = started.elapsed().as_secs_f64();
     let stats = result?;
+    // the run's own warning, as `mbd run` prints it (passages near or over singular
+    // configurations)
+    warnings.extend(stats.warning());
     let (measures, mut rows) = obs;
     rows.finish(sim.system(), sim.state())?;
     let balance = rows

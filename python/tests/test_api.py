@@ -188,3 +188,38 @@ def test_a_solver_caveat_is_a_warning():
         "symplectic:1:modified", t_end=0.05, h=1e-2, warn=False
     )
     assert r.stats.warnings == []
+
+
+def test_a_grid_time_on_a_singular_configuration_is_stepped_over(tmp_path):
+    # an isosceles slider-crank (crank and rod 0.5 m) driven at 2 pi rad/s from 0: its dead
+    # point (rod folded onto the crank) at t = 0.25 s lies on the grid of h = 1e-3
+    w = 2 * np.pi
+    body = (
+        '[[bodies]]\nname = "{}"\nmass = {}\ninertia = {}\n'
+        "position = [{!r}, 0.0, 0.0]\nvelocity = [0.0, {!r}, {!r}]\n"
+    )
+    text = "gravity = [0.0, -9.81]\n"
+    text += body.format("crank", 1.0, 1 / 48, 0.25, 0.25 * w, w)
+    text += body.format("rod", 1.0, 1 / 48, 0.75, 0.25 * w, -w)
+    text += body.format("slider", 0.5, 0.001, 1.0, 0.0, 0.0)
+    joint = '[[joints]]\ntype = "{}"\nname = "{}"\nbody_a = "{}"\npoint_a = [{}, 0.0]\n'
+    joint += 'body_b = "{}"\npoint_b = [{}, 0.0]\n'
+    text += joint.format("revolute", "pivot", "ground", 0.0, "crank", -0.25)
+    text += joint.format("revolute", "pin", "crank", 0.25, "rod", -0.25)
+    text += joint.format("revolute", "wrist", "rod", 0.25, "slider", 0.0)
+    text += joint.format("prismatic", "guide", "ground", 0.0, "slider", 0.0)
+    text += "axis = [1.0, 0.0]\nangle = 0.0\n"
+    text += '[[joints]]\ntype = "angle_driver"\nname = "motor"\nbody_a = "ground"\n'
+    text += 'body_b = "crank"\nf = {{ kind = "polynomial", coeffs = [0.0, {!r}] }}\n'.format(w)
+    path = tmp_path / "isosceles_slider_crank.toml"
+    path.write_text(text)
+    m = mbd.Model.from_file(path)
+    r = m.run("tangent:rk4", t_end=0.5, h=1e-3, warn=False)
+    assert (r.stats.stepped_over, r.stats.skipped_outputs) == (1, 1)
+    # no row at the dead point itself; every other one on the exact motion
+    assert len(r) == 500 and not np.any(np.isclose(r.t, 0.25, rtol=0, atol=1e-12))
+    assert np.abs(r["slider.x"] - np.cos(w * r.t)).max() < 1e-9
+    assert any("stepped over" in s for s in r.stats.warnings)
+    # off the grid nothing is stepped over
+    r = m.run("tangent:rk4", t_end=0.5, h=1.1e-3, warn=False)
+    assert (r.stats.stepped_over, r.stats.skipped_outputs) == (0, 0)

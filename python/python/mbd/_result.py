@@ -48,7 +48,7 @@ class RunStats:
     ``None``), ``energy_balance`` (its residual relative to ``max |H|`` where it is not),
     ``stepped_over`` (grid times at a singular configuration that fixed steps stepped over) and
     ``skipped_outputs`` (of those, the ones without a row), and the warnings ``mbd run``
-    prints.""""""
+    prints."""
 
     steps: int
     rejected: int
