@@ -54,13 +54,7 @@ pub(crate) fn factor(
     tol: f64,
 ) -> Result<f64, FactorError> {
     dependent.clear();
-    for j in 0..m {
-        let d = a[j + j * m];
-        if !(d >= 0.0 && d.is_finite()) {
-            return Err(FactorError::NotPositiveDefinite(j));
-        }
-        diag[j] = d;
-    }
+    read_diagonal(a, diag, m)?;
     let mut worst = 1.0f64;
     for j in 0..m {
         let mut d = a[j + j * m];
@@ -101,6 +95,20 @@ pub(crate) fn factor(
     Ok(worst)
 }
 
+/// Copies the diagonal of the `m x m` matrix `a` into `diag`; a negative or non-finite entry
+/// is an error (a semidefinite matrix has none).
+#[inline]
+fn read_diagonal(a: &[f64], diag: &mut [f64], m: usize) -> Result<(), FactorError> {
+    for j in 0..m {
+        let d = a[j + j * m];
+        if !(d >= 0.0 && d.is_finite()) {
+            return Err(FactorError::NotPositiveDefinite(j));
+        }
+        diag[j] = d;
+    }
+    Ok(())
+}
+
 /// A kept pivot ratio below this marks a factorisation in natural order as ill-conditioned
 /// (a configuration within about `1e-4` rad of a singular one): [`crate::DenseCholesky`] then
 /// factors again with diagonal pivoting (`factor_pivoted`) and keeps that result.
@@ -135,12 +143,8 @@ pub(crate) fn factor_pivoted(
     tol: f64,
 ) -> Result<f64, FactorError> {
     dependent.clear();
+    read_diagonal(a, diag, m)?;
     for j in 0..m {
-        let d = a[j + j * m];
-        if !(d >= 0.0 && d.is_finite()) {
-            return Err(FactorError::NotPositiveDefinite(j));
-        }
-        diag[j] = d;
         perm[j] = j;
         // the full symmetric matrix: the exchanges move rows and columns
         for i in j + 1..m {
