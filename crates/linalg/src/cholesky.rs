@@ -363,11 +363,13 @@ impl DenseCholesky {
         if m == 0 || !self.factored {
             return;
         }
-        if self.pivoted {
-            self.exchange(b, true);
-            self.forward_natural(b);
-            return;
-        }
+        self.exchange(b, true);
+        self.forward_unpivoted(b);
+    }
+
+    /// `b <- L^-1 b` (the row exchanges of a pivoted factorisation already applied).
+    fn forward_unpivoted(&self, b: &mut [f64]) {
+        let m = self.m;
         let a = &self.a;
         by_dimension!(m, forward_fixed(a, &self.inv, b), ());
         if m <= FIXED_CHOLESKY {
@@ -561,38 +563,8 @@ impl DenseCholesky {
         }
     }
 
-    /// `b <- L^-1 b` by columns from the lower triangle (any factorisation path).
-    fn forward_natural(&self, b: &mut [f64]) {
-        let m = self.m;
-        for k in 0..m {
-            let x = b[k] * self.inv[k];
-            b[k] = x;
-            if x != 0.0 {
-                for (bi, &l) in b[k + 1..m]
-                    .iter_mut()
-                    .zip(&self.a[k * m + k + 1..(k + 1) * m])
-                {
-                    *bi -= l * x;
-                }
-            }
-        }
-    }
-
-    /// `b <- L^-T b` from the lower triangle (row `i` of `L^T` is column `i` of `L`).
-    fn backward_natural(&self, b: &mut [f64]) {
-        let m = self.m;
-        for i in (0..m).rev() {
-            let (head, tail) = b.split_at_mut(i + 1);
-            let mut acc = 0.0;
-            for (&l, &x) in self.a[i * m + i + 1..(i + 1) * m].iter().zip(tail.iter()) {
-                acc += l * x;
-            }
-            head[i] = (head[i] - acc) * self.inv[i];
-        }
-    }
-
     /// Applies the row exchanges of a pivoted factorisation to `b` (`forward`), or undoes
-    /// them.
+    /// them (nothing after an unpivoted factorisation).
     #[inline]
     fn exchange(&self, b: &mut [f64], forward: bool) {
         if !self.pivoted {
@@ -615,13 +587,15 @@ impl DenseCholesky {
         if m == 0 || !self.factored {
             return;
         }
-        if self.pivoted {
-            self.exchange(b, true);
-            self.forward_natural(b);
-            self.backward_natural(b);
-            self.exchange(b, false);
-            return;
-        }
+        // a pivoted factor solves the exchanged system (its L is stored as the others')
+        self.exchange(b, true);
+        self.solve_unpivoted(b);
+        self.exchange(b, false);
+    }
+
+    /// [`DenseCholesky::solve_in_place`] with the row exchanges already applied.
+    fn solve_unpivoted(&mut self, b: &mut [f64]) {
+        let m = self.m;
         if m <= FIXED_CHOLESKY {
             let (a, inv) = (&self.a, &self.inv);
             by_dimension!(m, forward_fixed(a, inv, b), ());
@@ -630,7 +604,7 @@ impl DenseCholesky {
         }
         if m <= SMALL_CHOLESKY_SOLVE || self.max_dependent > 0 {
             // L y = b, then L^T x = y (row i of L^T is column i of L: contiguous)
-            self.forward_in_place(b);
+            self.forward_unpivoted(b);
             let a = &self.a;
             for i in (0..m).rev() {
                 let (head, tail) = b.split_at_mut(i + 1);

@@ -353,33 +353,19 @@ mod tests {
     fn pivoted_factorisation_refuses_more_dependent_rows_than_allowed() {
         let m = 12;
         let s = triple_parallelogram(std::f64::consts::PI);
-        let (mut diag, mut inv, mut dep) = (vec![0.0; m], vec![0.0; m], Vec::with_capacity(m));
-        let (mut piv, mut perm) = (vec![0; m], vec![0; m]);
-        let mut a = s.clone();
-        let r = factor_pivoted(
-            &mut a,
-            &mut diag,
-            &mut inv,
-            &mut piv,
-            &mut perm,
-            m,
-            1,
-            &mut dep,
-            ROUNDOFF_DEPENDENT_TOL,
-        );
+        // the pivoted factorisation with a budget of `k` dependent rows
+        let pivoted = |k: usize| {
+            let (mut a, mut diag, mut inv) = (s.clone(), vec![0.0; m], vec![0.0; m]);
+            let (mut piv, mut perm, mut dep) = (vec![0; m], vec![0; m], Vec::with_capacity(m));
+            let tol = ROUNDOFF_DEPENDENT_TOL;
+            let r = factor_pivoted(
+                &mut a, &mut diag, &mut inv, &mut piv, &mut perm, m, k, &mut dep, tol,
+            );
+            (r, dep)
+        };
+        let (r, dep) = pivoted(1);
         assert!(r.is_err(), "{r:?} {dep:?}");
-        let mut a = s.clone();
-        let r = factor_pivoted(
-            &mut a,
-            &mut diag,
-            &mut inv,
-            &mut piv,
-            &mut perm,
-            m,
-            2,
-            &mut dep,
-            ROUNDOFF_DEPENDENT_TOL,
-        );
+        let (r, dep) = pivoted(2);
         assert!(r.is_ok() && dep.len() == 2, "{r:?} {dep:?}");
     }
 }

@@ -13,7 +13,7 @@ impl TangentChart {
         let (q, v) = x.split_at(self.n);
         self.sel
             .residual(sys, q, v, t, &mut out[..2 * self.m], None);
-        finite_max(&out[..2 * self.m])
+        with_codim!(2 * self.m, max_abs_finite(out))
     }
 
     /// [`TangentChart::residual`] with the bodies' `sin`/`cos` rotated from the previous
@@ -50,18 +50,7 @@ impl TangentChart {
                 fast_max(a, b)
             };
         }
-        self.fill_velocities(v);
-        self.sel.residual(
-            sys,
-            q,
-            &self.vbuf,
-            t,
-            &mut out[..2 * m],
-            Some(&mut self.angles),
-        );
-        let r = with_codim!(2 * m, max_abs_finite(out));
-        self.weight_rows(out);
-        r
+        self.residual_at_weighted(sys, q, v, t, out, true)
     }
 
     /// [`TangentChart::residual`] at a chart point `(q, tau v)`, weighted as
@@ -74,10 +63,27 @@ impl TangentChart {
         out: &mut [f64],
     ) -> f64 {
         let (q, v) = x.split_at(self.n);
+        self.residual_at_weighted(sys, q, v, t, out, false)
+    }
+
+    /// The residual at `(q, tau v)` with the velocity rows weighted (`cached`: the `sin`/`cos`
+    /// rotated from the last evaluation); returns the norm of the unweighted residual.
+    #[inline(always)]
+    fn residual_at_weighted(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        out: &mut [f64],
+        cached: bool,
+    ) -> f64 {
+        let m = self.m;
         self.fill_velocities(v);
+        let angles = cached.then_some(&mut self.angles);
         self.sel
-            .residual(sys, q, &self.vbuf, t, &mut out[..2 * self.m], None);
-        let r = finite_max(&out[..2 * self.m]);
+            .residual(sys, q, &self.vbuf, t, &mut out[..2 * m], angles);
+        let r = with_codim!(2 * m, max_abs_finite(out));
         self.weight_rows(out);
         r
     }
@@ -105,16 +111,4 @@ impl TangentChart {
             }
         }
     }
-}
-
-/// `max |x_i|`, NaN if an entry is not finite.
-fn finite_max(x: &[f64]) -> f64 {
-    let mut r = 0.0f64;
-    for &e in x {
-        if !e.is_finite() {
-            return f64::NAN;
-        }
-        r = r.max(e.abs());
-    }
-    r
 }
