@@ -89,6 +89,7 @@ fn warnings(sys: &System, state: &State) -> Vec<String> {
             names.join(", ")
         ));
     }
+    out.extend(sys.singular_start_note());
     let changes = mbd::solve::initial_changes(sys, state.q.as_slice(), state.v.as_slice());
     if !changes.is_empty() {
         let shown: Vec<String> = changes

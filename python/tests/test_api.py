@@ -223,3 +223,32 @@ def test_a_grid_time_on_a_singular_configuration_is_stepped_over(tmp_path):
     # off the grid nothing is stepped over
     r = m.run("tangent:rk4", t_end=0.5, h=1.1e-3, warn=False)
     assert (r.stats.stepped_over, r.stats.skipped_outputs) == (0, 0)
+
+
+def test_a_singular_start_is_named_and_not_taken_for_redundancy(tmp_path):
+    # a parallelogram four-bar driven from its flat position: one equation depends on the
+    # others at the start only, so the mechanism has no redundant equation and no freedom
+    w = np.pi
+    body = (
+        '[[bodies]]\nname = "{}"\nmass = {}\ninertia = {}\n'
+        "position = [{!r}, 0.0, 0.0]\nvelocity = [0.0, {!r}, {!r}]\n"
+    )
+    text = "gravity = [0.0, -9.81]\n"
+    text += body.format("crank0", 1.0, 1 / 48, 0.25, 0.25 * w, w)
+    text += body.format("crank1", 1.0, 1 / 48, 1.25, 0.25 * w, w)
+    text += body.format("coupler", 2.0, 1 / 6, 1.0, 0.5 * w, 0.0)
+    joint = '[[joints]]\ntype = "revolute"\nname = "{}"\nbody_a = "{}"\npoint_a = [{}, 0.0]\n'
+    joint += 'body_b = "{}"\npoint_b = [{}, 0.0]\n'
+    text += joint.format("pivot0", "ground", 0.0, "crank0", -0.25)
+    text += joint.format("pin0", "crank0", 0.25, "coupler", -0.5)
+    text += joint.format("pivot1", "ground", 1.0, "crank1", -0.25)
+    text += joint.format("pin1", "crank1", 0.25, "coupler", 0.5)
+    text += '[[joints]]\ntype = "angle_driver"\nname = "motor"\nbody_a = "ground"\n'
+    text += 'body_b = "crank0"\nf = {{ kind = "polynomial", coeffs = [0.0, {!r}] }}\n'.format(w)
+    path = tmp_path / "flat_four_bar.toml"
+    path.write_text(text)
+    m = mbd.Model.from_file(path)
+    r = m.run("rk4-projected", t_end=0.5, h=1e-3, warn=False)
+    assert any("initial configuration is singular" in s for s in r.stats.warnings)
+    assert not any("redundant" in s for s in r.stats.warnings)
+    assert np.abs(r["crank1.theta"] - w * r.t).max() < 1e-9

@@ -47,6 +47,12 @@ pub struct EnergyBalance {
     phi_t: Vec<f64>,
     /// The last [`SAMPLES`] samples `(t, external + driver power, dissipation)`, oldest first.
     samples: Vec<[f64; 3]>,
+    /// Whether each sample's power is known: not at a singular configuration
+    /// ([`OutputSolve::indeterminate`]: a start on one, or a run that passes one on a step's
+    /// end), where the multipliers and so the drivers' power are not determined. The
+    /// power's interpolation leaves such samples out (the polynomial through the others
+    /// stands in for them).
+    known: Vec<bool>,
     h0: Option<f64>,
     h: f64,
     work: f64,
@@ -62,6 +68,7 @@ impl EnergyBalance {
             solve: None,
             phi_t: vec![0.0; sys.n_constraints()],
             samples: Vec::with_capacity(SAMPLES),
+            known: Vec::with_capacity(SAMPLES),
             h0: None,
             h: 0.0,
             work: 0.0,
@@ -78,40 +85,33 @@ impl EnergyBalance {
             Some(x) => x,
             None => OutputSolve::new(sys)?,
         };
-        let result = match solve.at(sys, s) {
-            Ok((_, lambda)) => self.advance_with(sys, s, lambda),
-            Err(e) => Err(e),
-        };
+        let result = self.advance_with(sys, s, &mut solve);
         self.solve = Some(solve);
         result
     }
 
-    /// [`EnergyBalance::advance`] with the multipliers `lambda` at `s` solved elsewhere (an
-    /// [`OutputSolve`] shared with the other outputs of a row).
+    /// [`EnergyBalance::advance`] with the multipliers at `s` from `solve` (an
+    /// [`OutputSolve`] shared with the other outputs of a row: solved once per state).
     pub fn advance_with(
         &mut self,
         sys: &System,
         s: &State,
-        lambda: &[f64],
+        solve: &mut OutputSolve,
     ) -> Result<(), SolveError> {
-        s.check(sys)?;
-        if lambda.len() != sys.n_constraints() {
-            return Err(SolveError::Dimension {
-                what: "lambda",
-                expected: sys.n_constraints(),
-                got: lambda.len(),
-            });
-        }
         let (q, v) = (s.q.as_slice(), s.v.as_slice());
+        let (_, lambda) = solve.at(sys, s)?;
         sys.phi_t(q, s.t, &mut self.phi_t);
         let drivers: f64 = lambda.iter().zip(&self.phi_t).map(|(l, p)| l * p).sum();
+        let known = !solve.indeterminate();
         let (dissipation, external) = sys.nonconservative_power(q, v, s.t);
         let sample = [s.t, external + drivers, dissipation];
         if let Some(last) = self.samples.last() {
             if s.t > last[0] {
                 if self.samples.len() == SAMPLES {
                     self.samples.remove(0);
+                    self.known.remove(0);
                     self.samples.push(sample);
+                    self.known.push(known);
                     let k = self.samples.len();
                     let [w, d] = self.integral(self.samples[k - 2][0], self.samples[k - 1][0]);
                     self.work += w;
@@ -120,6 +120,7 @@ impl EnergyBalance {
                     // the first intervals: integrated again over the whole start with each
                     // new sample, so that they too are exact for a quintic once six are in
                     self.samples.push(sample);
+                    self.known.push(known);
                     let [w, d] = self.integral(self.samples[0][0], sample[0]);
                     self.work = w;
                     self.dissipated = d;
@@ -127,6 +128,7 @@ impl EnergyBalance {
             }
         } else {
             self.samples.push(sample);
+            self.known.push(known);
         }
         self.h = sys.energy(q, v);
         let h0 = *self.h0.get_or_insert(self.h);
@@ -160,18 +162,14 @@ impl EnergyBalance {
         let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
         let g = half * (0.6f64).sqrt();
         let mut out = [0.0; 2];
+        // the power through the samples where it is known (all of them if none is)
+        let all = |_: usize| true;
+        let known = |i: usize| self.known[i];
+        let some_known = self.known.iter().any(|k| *k);
         for (x, w) in [(mid - g, 5.0 / 9.0), (mid, 8.0 / 9.0), (mid + g, 5.0 / 9.0)] {
-            // Lagrange interpolation through the samples at x
-            for (i, si) in self.samples.iter().enumerate() {
-                let mut l = 1.0;
-                for (j, sj) in self.samples.iter().enumerate() {
-                    if i != j {
-                        l *= (x - sj[0]) / (si[0] - sj[0]);
-                    }
-                }
-                out[0] += w * half * l * si[1];
-                out[1] += w * half * l * si[2];
-            }
+            out[0] +=
+                w * half * lagrange(&self.samples, x, 1, if some_known { &known } else { &all });
+            out[1] += w * half * lagrange(&self.samples, x, 2, &all);
         }
         out
     }
@@ -202,6 +200,22 @@ impl EnergyBalance {
     pub fn max_energy(&self) -> f64 {
         self.max_energy
     }
+}
+
+/// The polynomial through column `col` of the samples `i` with `used(i)` (abscissae in
+/// column 0) at `x`.
+fn lagrange(samples: &[[f64; 3]], x: f64, col: usize, used: &dyn Fn(usize) -> bool) -> f64 {
+    let mut sum = 0.0;
+    for (i, si) in samples.iter().enumerate().filter(|(i, _)| used(*i)) {
+        let mut l = 1.0;
+        for (j, sj) in samples.iter().enumerate().filter(|(j, _)| used(*j)) {
+            if i != j {
+                l *= (x - sj[0]) / (si[0] - sj[0]);
+            }
+        }
+        sum += l * si[col];
+    }
+    sum
 }
 
 impl Observer for EnergyBalance {

@@ -204,8 +204,7 @@ impl<W: Write> CsvObserver<W> {
                 Some(b) => b,
                 None => self.balance.insert(EnergyBalance::new(sys)?),
             };
-            let (_, lambda) = OutputSolve::lazy(&mut self.solve, sys)?.at(sys, s)?;
-            b.advance_with(sys, s, lambda)?;
+            b.advance_with(sys, s, OutputSolve::lazy(&mut self.solve, sys)?)?;
         }
         Ok(())
     }

@@ -156,6 +156,9 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
             let _ = writeln!(s, "  {:<16} joints {}", e.equation, e.joints.join(", "));
         }
     }
+    if let Some(note) = sys.singular_start_note() {
+        let _ = writeln!(s, "{note}");
+    }
     sensors(&mut s, sys);
     assembly(&mut s, sys);
     let _ = writeln!(s, "consistent initial state at t = 0:");

@@ -322,6 +322,9 @@ pub fn run(args: &RunArgs) -> Result<RunSummary, CliError> {
             names.join(", ")
         );
     }
+    if let Some(note) = sys.singular_start_note() {
+        note!("warning: {note}");
+    }
     let state = match &args.initial_state {
         None => {
             let state = State::consistent(&sys, 0.0).map_err(|source| CliError::Initial {

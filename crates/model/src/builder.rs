@@ -538,6 +538,7 @@ impl System {
             eq_joint,
             gravity_forces,
             redundant: Vec::new(),
+            singular_start: Vec::new(),
             joint_initials: Vec::new(),
             spatial,
         };
@@ -545,17 +546,19 @@ impl System {
         sys.check_inertia_scale()?;
         sys.check_mass_ratio()?;
         let (q0, _) = sys.initial_guess();
-        let redundant = sys.redundant_at(q0.as_slice(), 0.0)?;
+        let found = sys.redundant_at(q0.as_slice(), 0.0)?;
+        let split = sys.split_dependence(q0.as_slice(), 0.0, found)?;
         if policy == RedundantConstraints::Reject {
-            if let Some(e) = redundant.into_iter().next() {
+            if let Some(e) = split.redundant.into_iter().next() {
                 return Err(ModelError::Redundant {
                     equation: e.equation,
                     joints: e.joints,
                 });
             }
         } else {
-            sys.redundant = redundant;
+            sys.redundant = split.redundant;
         }
+        sys.singular_start = split.singular;
         Ok(sys)
     }
 

@@ -54,17 +54,58 @@ impl RedundantEquation {
 }
 
 impl System {
-    /// The equations found dependent at build time, in row order (empty for a mechanism whose
-    /// equations are independent). The solvers allow this many dependent rows in each
-    /// factorisation of `Phi_q M^-1 Phi_q^T` (or of their own systems with `Phi_q`) and no
-    /// more: a configuration where the rank falls further is singular.
+    /// The redundant equations, in row order (empty for a mechanism whose equations are
+    /// independent): those that depend on earlier ones at the build configuration and still
+    /// do at configurations of the manifold near it (a structural dependence, which holds
+    /// along the motion). An equation dependent at the build configuration only is not
+    /// redundant: the mechanism starts on a singular configuration
+    /// ([`System::singular_start_equations`]).
     pub fn redundant_equations(&self) -> &[RedundantEquation] {
         &self.redundant
     }
 
-    /// The number of redundant equations, `m - rank(Phi_q)` at build time.
+    /// The number of redundant equations, `m - rank(Phi_q)` near the build configuration.
     pub fn n_redundant(&self) -> usize {
         self.redundant.len()
+    }
+
+    /// The equations that depend on the others at the build configuration but not near it on
+    /// the manifold: the mechanism starts on a singular configuration (a parallelogram
+    /// four-bar with its cranks in line with the ground). Empty when the build configuration
+    /// is regular, and above [`SPARSE_RANK_THRESHOLD`] equations (the test is dense).
+    pub fn singular_start_equations(&self) -> &[RedundantEquation] {
+        &self.singular_start
+    }
+
+    /// A note on a singular initial configuration for the user (`None` on a regular one):
+    /// which equations depend on the others there, and what that means for the solvers and
+    /// the outputs at the start.
+    pub fn singular_start_note(&self) -> Option<String> {
+        if self.singular_start.is_empty() {
+            return None;
+        }
+        let names: Vec<&str> = self
+            .singular_start
+            .iter()
+            .map(|e| e.equation.as_str())
+            .collect();
+        Some(format!(
+            "the initial configuration is singular: {} equation(s) ({}) depend on the others \
+             there but not along the motion; the solvers that keep the constraints pass it, the \
+             tangent-chart and FA-DAE solvers cannot start on it, and the multipliers (reactions, \
+             drivers' torques) at the start are not determined",
+            names.len(),
+            names.join(", ")
+        ))
+    }
+
+    /// The dependent rows a solver's factorisation may drop: the redundant equations and, on a
+    /// singular initial configuration, the equations dependent there only, so that the solvers
+    /// that factor `Phi_q M^-1 Phi_q^T` (or their own systems with `Phi_q`) pass the start
+    /// (the accelerations are determined there; the multipliers are not). A configuration
+    /// where the rank falls further is singular.
+    pub fn dependency_budget(&self) -> usize {
+        self.redundant.len() + self.singular_start.len()
     }
 
     /// The equations of `Phi_q(q, t)` that depend on the ones before them, in row order (the rows
@@ -196,16 +237,22 @@ impl System {
         jac
     }
 
-    /// Checks that `Phi_q(q)` has no more dependent rows than the mechanism's redundant
-    /// equations ([`System::n_redundant`]): full row rank for a mechanism without redundancy.
+    /// Checks that `Phi_q(q)` has no more dependent rows than the solvers may drop
+    /// ([`System::dependency_budget`]): full row rank for a mechanism without redundancy that
+    /// does not start on a singular configuration.
     /// On failure returns [`ModelError::Redundant`] naming a dependent equation (the first one
     /// not found at build time) and the joints whose equations it combines.
     pub fn check_rank(&self, q: &[f64], t: f64) -> Result<(), ModelError> {
         let found = self.redundant_at(q, t)?;
-        if found.len() <= self.redundant.len() {
+        if found.len() <= self.dependency_budget() {
             return Ok(());
         }
-        let known = |r: usize| self.redundant.iter().any(|e| e.row == r);
+        let known = |r: usize| {
+            self.redundant
+                .iter()
+                .chain(&self.singular_start)
+                .any(|e| e.row == r)
+        };
         let pick = found.iter().position(|e| !known(e.row)).unwrap_or(0);
         match found.into_iter().nth(pick) {
             Some(e) => Err(e.into_error()),
@@ -215,7 +262,11 @@ impl System {
 
     /// Gram-Schmidt on the rows (twice for stability), tracking each basis vector as a
     /// combination of the original rows so a dependency can be traced to its joints.
-    fn redundant_dense(&self, jac: &DMatrix<f64>, rel_tol: f64) -> Vec<RedundantEquation> {
+    pub(crate) fn redundant_dense(
+        &self,
+        jac: &DMatrix<f64>,
+        rel_tol: f64,
+    ) -> Vec<RedundantEquation> {
         let m = self.m;
         let scale = (0..m)
             .map(|r| jac.row(r).norm())

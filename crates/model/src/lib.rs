@@ -63,6 +63,7 @@ mod file;
 #[cfg(any(test, feature = "fixtures"))]
 pub mod fixtures;
 pub mod forces;
+mod generic_rank;
 mod init;
 pub mod jet;
 pub mod joints;

@@ -126,8 +126,11 @@ pub struct System {
     /// The generalized gravity forces `(m_i g_x, m_i g_y, 0)` per body: constant, evaluated
     /// once at build instead of at every force evaluation.
     pub(crate) gravity_forces: Vec<f64>,
-    /// The equations found dependent on earlier ones at build time.
+    /// The equations dependent on earlier ones at build time and near it on the manifold.
     pub(crate) redundant: Vec<RedundantEquation>,
+    /// Further equations dependent at the build configuration only (a singular initial
+    /// configuration, `generic_rank`).
+    pub(crate) singular_start: Vec<RedundantEquation>,
     /// Initial joint coordinates (joint index, values) for assembly.
     pub(crate) joint_initials: Vec<(usize, crate::JointInitial)>,
     /// The spatial bodies and joints (after the planar coordinates and rows).
@@ -143,8 +146,9 @@ impl System {
     pub fn n_constraints(&self) -> usize {
         self.m
     }
-    /// Degrees of freedom `n - rank(Phi_q) = n - m + ` [`System::n_redundant`] (the rank at
-    /// the build configuration).
+    /// Degrees of freedom `n - rank(Phi_q) = n - m + ` [`System::n_redundant`] (the rank near
+    /// the build configuration on the manifold: a singular initial configuration, where the
+    /// rank is lower, does not add a degree of freedom).
     pub fn dof(&self) -> usize {
         (self.n + self.redundant.len()).saturating_sub(self.m)
     }

@@ -67,6 +67,15 @@ impl AccelerationSolver {
         }
     }
 
+    /// How many dependent rows the last factorisation dropped (at most
+    /// [`System::dependency_budget`]).
+    pub(crate) fn dropped(&self) -> usize {
+        match &self.bodies {
+            Some(b) => b.chol.dependent().len(),
+            None => self.schur.chol.dependent().len(),
+        }
+    }
+
     /// The element-local rows of the last solve (planar models).
     pub(crate) fn schur_rows(&self) -> &DenseSchur {
         &self.schur
@@ -380,6 +389,14 @@ impl Accel {
         match self {
             Accel::Dense(acc) => acc,
             Accel::Sparse(sp) => sp.as_ref(),
+        }
+    }
+
+    /// How many dependent rows the last factorisation dropped.
+    pub(crate) fn dropped(&self) -> usize {
+        match self {
+            Accel::Dense(acc) => acc.dropped(),
+            Accel::Sparse(sp) => sp.dropped(),
         }
     }
 

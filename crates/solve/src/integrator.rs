@@ -596,22 +596,34 @@ where
     // constraints, whose failures at a singular configuration are stepped over)
     let (mut start, mut before) = (state.clone(), state.clone());
     let mut have_before = false;
+    let mut landing = step_over::Landing::new(sys, keeps)?;
+    let nominal = |k: usize| k <= n && grid(k).1 == cfg.h;
     let mut k = 1;
     while k <= n {
         let (t_next, h) = grid(k);
         if keeps {
             step_over::copy_state(&mut start, state);
         }
+        let mut landed = false;
         let failure = match integrator.step(sys, state, h) {
             Ok(s) => {
                 state.t = t_next;
                 stats.add_work(&s);
-                checks.accepted(sys, state, h, &s, &mut stats)?;
-                if keeps {
-                    std::mem::swap(&mut start, &mut before);
-                    have_before = true;
+                landed = landing.on_singular(sys, state);
+                if landed {
+                    Some(SolveError::Singular {
+                        t: t_next,
+                        what: step_over::LANDED_ON_SINGULAR,
+                        detail: "the step's end".into(),
+                    })
+                } else {
+                    checks.accepted(sys, state, h, &s, &mut stats)?;
+                    if keeps {
+                        std::mem::swap(&mut start, &mut before);
+                        have_before = true;
+                    }
+                    None
                 }
-                None
             }
             Err(e @ SolveError::Singular { .. }) if keeps && !e.is_newton_near_rank_loss() => {
                 Some(e)
@@ -621,13 +633,13 @@ where
         if let Some(e) = failure {
             // a step from or onto a singular configuration: cover two grid intervals with
             // steps that straddle the grid time between them (`step_over`)
-            let nominal = |k: usize| k <= n && grid(k).1 == cfg.h;
+            // (a landing is left out only by the window after it: the one before ends on it)
             let window = step_over::Window {
                 h: cfg.h,
                 start: &start,
                 t_k: t_next,
                 after: (nominal(k) && nominal(k + 1)).then(|| grid(k + 1).0),
-                before: (have_before && k >= 2 && nominal(k)).then_some(&before),
+                before: (!landed && have_before && k >= 2 && nominal(k)).then_some(&before),
             };
             match step_over::step_over(integrator, sys, state, &window, &mut checks, &mut stats) {
                 // grid time k, the singular configuration itself, has no state

@@ -32,6 +32,9 @@ pub struct OutputSolve {
     key: Option<f64>,
     key_qv: Vec<f64>,
     solves: usize,
+    /// The model's redundant equations, and whether the last solve dropped more rows.
+    redundant: usize,
+    indeterminate: bool,
 }
 
 impl OutputSolve {
@@ -45,6 +48,8 @@ impl OutputSolve {
             key: None,
             key_qv: vec![0.0; 2 * n],
             solves: 0,
+            redundant: sys.n_redundant(),
+            indeterminate: false,
         })
     }
 
@@ -63,6 +68,7 @@ impl OutputSolve {
             self.key = None;
             self.acc
                 .solve(sys, q, v, state.t, &mut self.a, &mut self.lambda)?;
+            self.indeterminate = self.acc.dropped() > self.redundant;
             self.key_qv[..n].copy_from_slice(q);
             self.key_qv[n..].copy_from_slice(v);
             self.key = Some(state.t);
@@ -81,6 +87,16 @@ impl OutputSolve {
             Some(s) => Ok(s),
             None => Ok(slot.insert(OutputSolve::new(sys)?)),
         }
+    }
+
+    /// Whether the multipliers of the last [`OutputSolve::at`] are not determined by its
+    /// state: its factorisation dropped more dependent rows than the model's redundant
+    /// equations, so the state is a singular configuration (a start on one:
+    /// [`System::singular_start_equations`]). The accelerations are determined there; the
+    /// multipliers are one solution of many, not the limit along the motion, and the
+    /// reactions and drivers' power from them are not the motion's.
+    pub fn indeterminate(&self) -> bool {
+        self.indeterminate
     }
 
     /// How many index-1 solves [`OutputSolve::at`] has made.

@@ -30,7 +30,7 @@
 //! [`run`]: crate::run
 
 use crate::guard::RunChecks;
-use crate::{Integrator, RunStats, SolveError, State};
+use crate::{Integrator, OutputSolve, RunStats, SolveError, State};
 use mbd_model::System;
 
 /// The grid times around a step of a fixed-step run that failed as singular.
@@ -137,6 +137,45 @@ fn cover<I: Integrator + ?Sized>(
     }
     Ok(())
 }
+
+/// Detects a step that ended on a singular configuration although its factorisations
+/// passed. On a mechanism that starts on a singular configuration the solvers may drop the
+/// start's extra dependent equations at every factorisation ([`System::dependency_budget`]),
+/// so a later step that lands exactly on a singular configuration does not fail; but its
+/// end state is not the motion's (the velocities there may take a component along the other
+/// branch, which the velocity constraints no longer exclude). The run treats it as a
+/// failing step and steps over it (by the window after it only: the one before ends on it),
+/// so a run that ends on a singular configuration stops there, as on any mechanism. Only for
+/// such mechanisms: an index-1 solve at each step's
+/// end ([`OutputSolve::indeterminate`]), the workspace allocated once per run.
+pub(crate) struct Landing {
+    solve: Option<OutputSolve>,
+}
+
+impl Landing {
+    /// The check for a run of `sys` (nothing unless the integrator keeps the constraints and
+    /// the mechanism starts on a singular configuration).
+    pub(crate) fn new(sys: &System, keeps: bool) -> Result<Self, SolveError> {
+        let solve = if keeps && sys.dependency_budget() > sys.n_redundant() {
+            Some(OutputSolve::new(sys)?)
+        } else {
+            None
+        };
+        Ok(Landing { solve })
+    }
+
+    /// Whether `state` (a step's end) is a singular configuration.
+    pub(crate) fn on_singular(&mut self, sys: &System, state: &State) -> bool {
+        match &mut self.solve {
+            Some(s) => s.at(sys, state).is_ok() && s.indeterminate(),
+            None => false,
+        }
+    }
+}
+
+/// What a step that landed on a singular configuration fails with ([`Landing`]).
+pub(crate) const LANDED_ON_SINGULAR: &str =
+    "index-1 matrix at a step's end (a singular configuration, passed only by the allowance of the singular start)";
 
 /// Copies `from` into `to` (same sizes: no allocation).
 #[inline]

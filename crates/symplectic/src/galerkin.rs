@@ -255,7 +255,7 @@ impl Galerkin {
             lu: if use_sparse {
                 DenseLu::with_ordering(Vec::new(), Vec::new())
             } else {
-                stage_lu(n, m, s, sys.n_redundant())
+                stage_lu(n, m, s, sys.dependency_budget())
             },
             qk: vec![0.0; n],
             hvk: vec![0.0; n],
@@ -284,7 +284,7 @@ impl Galerkin {
             tn: std::array::from_fn(|_| vec![0.0; n]),
             proj: {
                 let mut c = DenseCholesky::new(md);
-                c.set_max_dependent(sys.n_redundant());
+                c.set_max_dependent(sys.dependency_budget());
                 c
             },
             vm: vec![0.0; n],

@@ -109,7 +109,7 @@ impl BodySchur {
             }
         }
         let mut chol = DenseCholesky::new(rows.len());
-        chol.set_max_dependent(sys.n_redundant());
+        chol.set_max_dependent(sys.dependency_budget());
         let q0 = sys.spatial_offset();
         BodySchur {
             n,

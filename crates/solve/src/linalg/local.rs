@@ -63,7 +63,7 @@ impl DenseSchur {
         let mut chol = DenseCholesky::new(m);
         // a mechanism with redundant equations: each factorisation drops that many dependent
         // rows (their multipliers zero), and no more
-        chol.set_max_dependent(sys.n_redundant());
+        chol.set_max_dependent(sys.dependency_budget());
         DenseSchur {
             m,
             cols,

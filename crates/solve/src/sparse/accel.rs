@@ -72,6 +72,14 @@ impl SparseAccelerationSolver {
         }
     }
 
+    /// How many dependent rows the last factorisation dropped.
+    pub(crate) fn dropped(&self) -> usize {
+        match &self.schur {
+            Kernel::Rows(s) => s.dependent().len(),
+            Kernel::Bodies(b) => b.dropped(),
+        }
+    }
+
     /// The constraint Jacobian and Schur complement of the last solve (`None` for a model
     /// with spatial bodies, whose rows are held per body block).
     pub fn schur(&self) -> Option<&ConstraintSchur> {

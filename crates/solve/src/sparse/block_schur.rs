@@ -83,7 +83,7 @@ impl BlockSchur {
                 rows.len()
             )));
         }
-        let (chol, pairs) = shared_pair_pattern(&rows, sys.n_redundant())?;
+        let (chol, pairs) = shared_pair_pattern(&rows, sys.dependency_budget())?;
         let contributions = pairs
             .into_iter()
             .map(|(s1, s2, slot)| Contribution {

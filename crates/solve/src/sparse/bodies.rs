@@ -66,7 +66,8 @@ impl SparseBodySchur {
         let nblocks = sys.n_body_blocks();
         let rows = BlockRows::new(sys, |r| !internal.contains(&r))?;
         let me = rows.len();
-        let (chol, pairs) = super::block_schur::shared_pair_pattern(&rows, sys.n_redundant())?;
+        let (chol, pairs) =
+            super::block_schur::shared_pair_pattern(&rows, sys.dependency_budget())?;
         let contributions = pairs
             .into_iter()
             .map(|(s1, s2, slot)| Contribution {
@@ -181,6 +182,11 @@ impl SparseBodySchur {
         } else {
             self.chol.condition_estimate()
         }
+    }
+
+    /// How many rows the last factorisation dropped as dependent on earlier ones.
+    pub(crate) fn dropped(&self) -> usize {
+        self.chol.dependent().len()
     }
 
     /// The model rows (equations) the last factorisation dropped as dependent on earlier

@@ -94,7 +94,7 @@ impl ConstraintSchur {
         let mut chol = SparseCholesky::new(m, &pattern)?;
         // a mechanism with redundant equations: each factorisation drops that many dependent
         // rows (their multipliers zero), and no more
-        chol.set_max_dependent(sys.n_redundant());
+        chol.set_max_dependent(sys.dependency_budget());
         let mut contributions = Vec::new();
         for (body, rows) in by_body.iter().enumerate() {
             for &(r1, o1) in rows {

@@ -243,7 +243,7 @@ impl SparseStage {
         }
         // a model with redundant equations: each constraint row (nu, r) pairs with its
         // multiplier (nu - 1, r) on a diagonal entry, which a dropped row sets to 1
-        let redundant = sys.n_redundant() > 0;
+        let redundant = sys.dependency_budget() > 0;
         if redundant {
             for nu in 1..=s {
                 for r in 0..m {
@@ -381,7 +381,7 @@ impl SparseStage {
             color_blocks,
             max_width,
             blocks,
-            dep: Vec::with_capacity(sys.n_redundant()),
+            dep: Vec::with_capacity(sys.dependency_budget()),
             vdir: vec![0.0; n],
             zero: vec![0.0; n],
             gscratch: vec![0.0; nv],

@@ -121,7 +121,7 @@ impl ProjectedMetric {
         }
         let (nd, md) = if sparse { (0, 0) } else { (n, m) };
         let mut chol = DenseCholesky::new(md);
-        chol.set_max_dependent(sys.n_redundant());
+        chol.set_max_dependent(sys.dependency_budget());
         Ok(ProjectedMetric {
             n,
             m,

@@ -147,7 +147,7 @@ impl ProjectedStiffness {
                 all.push((z0 + r, y0 + c));
             }
         }
-        let redundant = sys.n_redundant() > 0;
+        let redundant = sys.dependency_budget() > 0;
         if redundant {
             for r in 0..m {
                 all.push((z0 + r, z0 + r));
