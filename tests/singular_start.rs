@@ -138,3 +138,52 @@ fn the_tangent_solvers_stop_at_a_singular_start() {
         }
     }
 }
+
+/// A rough guess that looks singular (the cranks' angles given as 0, their centres of mass
+/// where cranks at 0.5 rad put them) is neither: the build judges the start from the guess
+/// projected onto the constraints, where the four-bar is regular.
+#[test]
+fn a_guess_that_only_looks_singular_is_neither() {
+    let (l, a) = (0.5, 0.5f64);
+    let (s, c) = a.sin_cos();
+    let mut b = SystemBuilder::new();
+    b.set_gravity([0.0, -9.81]);
+    let mut cranks = Vec::new();
+    for k in 0..2 {
+        let x0 = k as f64;
+        cranks.push(
+            b.add_body(Body::new(format!("crank{k}")).rod(1.0, l).position(
+                x0 + 0.5 * l * c,
+                0.5 * l * s,
+                0.0,
+            )),
+        );
+    }
+    let coupler = b.add_body(
+        Body::new("coupler")
+            .rod(2.0, 1.0)
+            .position(l * c + 0.5, l * s, 0.0),
+    );
+    for (k, &cr) in cranks.iter().enumerate() {
+        let x0 = k as f64;
+        b.add_joint(Joint::revolute(
+            format!("pivot{k}"),
+            BodyRef::Ground,
+            [x0, 0.0],
+            cr,
+            [-0.5 * l, 0.0],
+        ));
+        b.add_joint(Joint::revolute(
+            format!("pin{k}"),
+            cr,
+            [0.5 * l, 0.0],
+            coupler,
+            [x0 - 0.5, 0.0],
+        ));
+    }
+    let sys = b.build().unwrap();
+    let q = sys.initial_guess().0;
+    assert_eq!(sys.redundant_at(q.as_slice(), 0.0).unwrap().len(), 1);
+    assert_eq!((sys.n_redundant(), sys.dof()), (0, 1));
+    assert!(sys.singular_start_equations().is_empty());
+}

@@ -52,10 +52,12 @@ pub(crate) struct DependenceSplit {
 
 impl System {
     /// Splits `found`, the equations dependent at `q0` (time `t`), into the redundant ones and
-    /// those dependent at `q0` only (see the module documentation). Where no probe point can
-    /// be reached (no free direction, a projection that does not converge, or more than
-    /// [`crate::SPARSE_RANK_THRESHOLD`] equations, where the dense test is not run) every
-    /// equation of `found` counts as redundant.
+    /// those dependent at the start only (see the module documentation). `q0` may be a rough
+    /// guess off the manifold (an assembly finds the consistent configuration later): the start
+    /// is then `q0` projected onto it, and rows dependent at the guess only are neither. Where
+    /// no probe point can be reached (no free direction, a projection that does not converge,
+    /// or more than [`crate::SPARSE_RANK_THRESHOLD`] equations, where the dense test is not
+    /// run) every equation of `found` counts as redundant.
     pub(crate) fn split_dependence(
         &self,
         q0: &[f64],
@@ -90,11 +92,22 @@ impl System {
                 fewest = Some(there);
             }
         }
-        let Some(redundant) = fewest.filter(|f| f.len() < found.len()) else {
+        let Some(redundant) = fewest else {
             return keep(found);
         };
-        let extra = found.len() - redundant.len();
-        let singular = found
+        // the rows dependent at the start itself (the guess, if it was on the manifold)
+        let at_start = if base == q0 {
+            found
+        } else {
+            self.redundant_at(&base, t)?
+        };
+        // (the rank near a point is at least the rank there: more rows dependent at a probe
+        // than at the start are the probe's tolerance, and the start's count stands)
+        if redundant.len() >= at_start.len() {
+            return keep(at_start);
+        }
+        let extra = at_start.len() - redundant.len();
+        let singular = at_start
             .into_iter()
             .filter(|e| redundant.iter().all(|r| r.row != e.row))
             .take(extra)
