@@ -148,8 +148,9 @@ fn report(path: &str, sys: &System, c: &mbd_solve::ConsistentState) -> String {
     if !red.is_empty() {
         let _ = writeln!(
             s,
-            "redundant equations ({}; combinations of the others at the initial configuration, \
-             carrying no multiplier; redundant_constraints = \"reject\" refuses them):",
+            "redundant equations ({}; combinations of the others at and near the initial \
+             configuration, carrying no multiplier; redundant_constraints = \"reject\" refuses \
+             them):",
             red.len()
         );
         for e in red {
