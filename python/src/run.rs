@@ -58,8 +58,8 @@ pub struct RunData {
     /// Where `H` is not conserved: the energy balance's largest residual relative to `max |H|`.
     pub balance: Option<f64>,
     /// Warnings `mbd run` prints (initial values the consistent state changed, redundant
-    /// equations, the solver's caveat for this model, the run's passages near or over
-    /// singular configurations).
+    /// equations, a singular initial configuration, the solver's caveat for this model, the
+    /// run's passages near or over singular configurations).
     pub warnings: Vec<String>,
 }
 
