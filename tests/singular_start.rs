@@ -77,6 +77,11 @@ fn a_singular_start_is_told_from_a_redundant_equation() {
         let note = sys.singular_start_note().unwrap();
         assert!(note.contains("initial configuration is singular"), "{note}");
     }
+    // fully driven, where no configuration near the start satisfies the driver at t = 0: the
+    // probes move the driven crank too (as the motion does)
+    let sys = mbd::model::models::parallelogram_four_bar(0.4, 1.0, 0.0, 6.0, true).unwrap();
+    assert_eq!((sys.n_redundant(), sys.dof()), (0, 0));
+    assert_eq!(sys.singular_start_equations().len(), 1);
     // 1e-3 rad off the flat position: a regular start
     let mut sys = flat_parallelogram(2, PI, false);
     let mut q = sys.initial_guess().0;

@@ -13,6 +13,13 @@
 //! manifold). So the test moves from `q0` along a generic direction of the tangent cone
 //! (the null space of `Phi_q(q0)`), projects back onto `Phi = 0`, and counts the dependent
 //! equations there; the fewest found over two directions are the redundant ones.
+//!
+//! The probes move on the manifold of the scleronomic equations: a driver's equation (one
+//! that depends on time) is left out of the projection and of the null space, so the driven
+//! coordinates move too, as they do along the motion. A fully driven mechanism has no free
+//! direction at a fixed time, and a singular configuration of it is passed in time, not in
+//! space. The rank test at a probe takes every row (a driver's gradient does not depend on
+//! the value its function takes).
 
 use crate::init::RedundantEquation;
 use crate::system::System;
@@ -73,20 +80,19 @@ impl System {
         if found.is_empty() || self.m > crate::SPARSE_RANK_THRESHOLD {
             return keep(found);
         }
-        let sqrt_w: Vec<f64> = self.rank_weights().iter().map(|w| w.sqrt()).collect();
-        let length = self.length_scale();
-        let Some(base) = self.project_onto_manifold(q0, t, &sqrt_w, length) else {
+        let probe = Probe::new(self, q0, t);
+        let Some(base) = probe.project(q0) else {
             return keep(found);
         };
         let mut fewest: Option<Vec<RedundantEquation>> = None;
         // two generic directions (Weyl sequences of the golden ratio and of the plastic
         // number): a structural dependence holds along both, a singular one along neither
         for ratio in [0.618_033_988_749_894_9, 0.754_877_666_246_692_8] {
-            let Some(probe) = self.probe_point(&base, t, &sqrt_w, length, ratio) else {
+            let Some(point) = probe.point(&base, ratio) else {
                 continue;
             };
             let mut jac = DMatrix::zeros(self.m, self.n);
-            self.phi_q(&probe, t, &mut jac);
+            self.phi_q(&point, t, &mut jac);
             let there = self.redundant_dense(&jac, PROBE_RANK_TOL);
             if fewest.as_ref().map_or(true, |f| there.len() < f.len()) {
                 fewest = Some(there);
@@ -117,21 +123,49 @@ impl System {
             singular,
         })
     }
+}
 
-    /// A point of the manifold at about [`PROBE_DISTANCE`] times `length` from `base` (on it)
-    /// along the part of the generic vector `g_i = frac((i + 1) ratio) - 1/2` (unit-free
-    /// coordinates) in the null space of `Phi_q(base)`; `None` if that part vanishes or the
-    /// projection fails.
-    fn probe_point(
-        &self,
-        base: &[f64],
-        t: f64,
-        sqrt_w: &[f64],
-        length: f64,
-        ratio: f64,
-    ) -> Option<Vec<f64>> {
-        let n = self.n;
-        let jac = self.scaled_jacobian(base, t, sqrt_w);
+/// What the probes of a system share: the time, the unit-free scaling of the coordinates, the
+/// length scale and the scleronomic rows they move on.
+struct Probe<'a> {
+    sys: &'a System,
+    t: f64,
+    /// Square roots of [`System::rank_weights`].
+    sqrt_w: Vec<f64>,
+    length: f64,
+    /// The rows whose equation does not depend on time.
+    rows: Vec<usize>,
+}
+
+impl<'a> Probe<'a> {
+    fn new(sys: &'a System, q0: &[f64], t: f64) -> Self {
+        // a row depends on time where its value changes with `t` at fixed `q` (two offsets:
+        // a periodic driver does not hide behind one of them)
+        let value = |t: f64| {
+            let mut phi = vec![0.0; sys.m];
+            sys.phi(q0, t, &mut phi);
+            phi
+        };
+        let (now, later, other) = (value(t), value(t + 0.37), value(t + 1.91));
+        let rows = (0..sys.m)
+            .filter(|&r| now[r] == later[r] && now[r] == other[r])
+            .collect();
+        Probe {
+            sys,
+            t,
+            sqrt_w: sys.rank_weights().iter().map(|w| w.sqrt()).collect(),
+            length: sys.length_scale(),
+            rows,
+        }
+    }
+
+    /// A point of the manifold at about [`PROBE_DISTANCE`] times the length scale from `base`
+    /// (on it) along the part of the generic vector `g_i = frac((i + 1) ratio) - 1/2`
+    /// (unit-free coordinates) in the null space of the scleronomic rows of `Phi_q(base)`;
+    /// `None` if that part vanishes or the projection fails.
+    fn point(&self, base: &[f64], ratio: f64) -> Option<Vec<f64>> {
+        let n = self.sys.n;
+        let jac = self.jacobian(base);
         let g: Vec<f64> = (0..n)
             .map(|i| ((i + 1) as f64 * ratio).fract() - 0.5)
             .collect();
@@ -144,48 +178,48 @@ impl System {
         if dmax.is_nan() || dmax <= 1e-6 {
             return None;
         }
-        let scale = PROBE_DISTANCE * length / dmax;
-        let start: Vec<f64> = (0..n).map(|i| base[i] + scale * d[i] / sqrt_w[i]).collect();
-        self.project_onto_manifold(&start, t, sqrt_w, length)
+        let scale = PROBE_DISTANCE * self.length / dmax;
+        let start: Vec<f64> = (0..n)
+            .map(|i| base[i] + scale * d[i] / self.sqrt_w[i])
+            .collect();
+        self.project(&start)
     }
 
-    /// Gauss-Newton from `q` onto `Phi(q, t) = 0` with minimum-norm corrections in the
-    /// unit-free coordinates (rank-deficient `Phi_q` allowed); `None` if it does not reach
-    /// `|Phi| <= 1e-12 (1 + length)` within [`MAX_PROJECTION_ITER`] corrections.
-    fn project_onto_manifold(
-        &self,
-        q: &[f64],
-        t: f64,
-        sqrt_w: &[f64],
-        length: f64,
-    ) -> Option<Vec<f64>> {
-        let tol = 1e-12 * (1.0 + length);
+    /// Gauss-Newton from `q` onto the scleronomic equations with minimum-norm corrections in
+    /// the unit-free coordinates (rank-deficient `Phi_q` allowed); `None` if it does not reach
+    /// `|Phi| <= 1e-12 (1 + length)` on those rows within [`MAX_PROJECTION_ITER`] corrections.
+    fn project(&self, q: &[f64]) -> Option<Vec<f64>> {
+        let tol = 1e-12 * (1.0 + self.length);
         let mut q = q.to_vec();
-        let mut phi = vec![0.0; self.m];
+        let mut phi = vec![0.0; self.sys.m];
         for _ in 0..=MAX_PROJECTION_ITER {
-            self.phi(&q, t, &mut phi);
-            let res = phi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if !res.is_finite() {
+            self.sys.phi(&q, self.t, &mut phi);
+            let res: DVector<f64> =
+                DVector::from_iterator(self.rows.len(), self.rows.iter().map(|&r| phi[r]));
+            let size = res.amax();
+            if !size.is_finite() {
                 return None;
             }
-            if res <= tol {
+            if size <= tol {
                 return Some(q);
             }
-            let jac = self.scaled_jacobian(&q, t, sqrt_w);
-            let dz = min_norm_solve(jac, &DVector::from_column_slice(&phi))?;
+            let dz = min_norm_solve(self.jacobian(&q), &res)?;
             for (i, qi) in q.iter_mut().enumerate() {
-                *qi -= dz[i] * sqrt_w[i];
+                *qi -= dz[i] * self.sqrt_w[i];
             }
         }
         None
     }
 
-    /// `Phi_q(q, t) W^(1/2)` (the unit-free coordinates' Jacobian).
-    fn scaled_jacobian(&self, q: &[f64], t: f64, sqrt_w: &[f64]) -> DMatrix<f64> {
-        let mut jac = DMatrix::zeros(self.m, self.n);
-        self.phi_q(q, t, &mut jac);
-        for (k, w) in sqrt_w.iter().enumerate() {
-            jac.column_mut(k).scale_mut(*w);
+    /// The scleronomic rows of `Phi_q(q, t) W^(1/2)` (the unit-free coordinates' Jacobian).
+    fn jacobian(&self, q: &[f64]) -> DMatrix<f64> {
+        let mut full = DMatrix::zeros(self.sys.m, self.sys.n);
+        self.sys.phi_q(q, self.t, &mut full);
+        let mut jac = DMatrix::zeros(self.rows.len(), self.sys.n);
+        for (i, &r) in self.rows.iter().enumerate() {
+            for k in 0..self.sys.n {
+                jac[(i, k)] = full[(r, k)] * self.sqrt_w[k];
+            }
         }
         jac
     }

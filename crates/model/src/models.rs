@@ -384,7 +384,8 @@ pub fn four_bar() -> Result<System, ModelError> {
 /// closing loop's equations become dependent) and the parallelogram branch crosses the crossed
 /// (anti-parallelogram) branch. Free, released at `speed`, the crank turns through them if its
 /// kinetic energy `(2/3 + 1) crank^2 speed^2 / 2` exceeds the potential rise
-/// `2 g crank (1 - sin(angle))` to the top.
+/// `2 g crank (1 - sin(angle))` to the top. Started flat (`angle` 0 or `pi`), the mechanism
+/// starts on a singular configuration (`System::singular_start_equations`).
 pub fn parallelogram_four_bar(
     crank: f64,
     ground: f64,
@@ -412,13 +413,6 @@ pub fn parallelogram_four_bar(
         }
     }
     let (s, c) = th.sin_cos();
-    if s.abs() < 1e-6 {
-        return bad(
-            "angle",
-            th,
-            "is a flat configuration (all links collinear, Phi_q rank deficient)",
-        );
-    }
     let a = [l * c, l * s];
     // crank and rocker: centre of mass velocity (-l/2 sin, l/2 cos) w; coupler translates with A
     let vh = [-0.5 * l * s * w, 0.5 * l * c * w];

@@ -30,9 +30,6 @@ pub const LOOP_GRAVITY: f64 = 9.81;
 /// The most loops [`n_four_bar`] accepts (a model of `6 N + 3` coordinates).
 pub const MAX_LOOPS: usize = 100_000;
 
-/// Below this `|sin(angle)|` an initial angle is a flat configuration and is rejected.
-const FLAT_SIN: f64 = 1e-6;
-
 /// The mass of every rod (kg).
 const ROD_MASS: f64 = 1.0;
 
@@ -331,22 +328,15 @@ impl ClosedLoop {
     /// and crank speed `speed` (rad/s) ([`ClosedLoop::branch_state`], consistent as built);
     /// `driven` adds the angle driver `crank_drive` on `crank0`,
     /// `theta = angle + speed t` (rheonomic). Errors ([`ModelError::InvalidParameter`]):
-    /// `angle` or `speed` not finite, `angle` flat (`|sin(angle)| < 1e-6`); and whatever
-    /// [`SystemBuilder::build`] rejects.
+    /// `angle` or `speed` not finite; and whatever [`SystemBuilder::build`] rejects. A flat
+    /// `angle` (0 or `pi`: all links collinear) starts the mechanism on a singular
+    /// configuration ([`System::singular_start_equations`]).
     pub fn system(&self, angle: f64, speed: f64, driven: bool) -> Result<System, ModelError> {
         let element = self.element();
         for (name, v) in [("angle", angle), ("speed", speed)] {
             if !v.is_finite() {
                 return Err(bad(element, name, v, "must be finite"));
             }
-        }
-        if angle.sin().abs() < FLAT_SIN {
-            return Err(bad(
-                element,
-                "angle",
-                angle,
-                "is a flat configuration (all links collinear, Phi_q rank deficient)",
-            ));
         }
         let (q, v) = self.branch_state(angle, speed);
         let mut b = SystemBuilder::new();
