@@ -12,8 +12,15 @@ use std::f64::consts::PI;
 /// each, all horizontal at t = 0 and turning at `speed`; with `driven`, crank 0 is driven at
 /// that speed (`theta = speed t`).
 fn flat_parallelogram(cranks: usize, speed: f64, driven: bool) -> System {
+    parallelogram(cranks, 0.0, 0.0, speed, driven)
+}
+
+/// [`flat_parallelogram`] with the bodies placed where cranks at `placed` (rad) put them and
+/// the cranks' angles given as `given` (a guess off the constraints where they differ).
+fn parallelogram(cranks: usize, placed: f64, given: f64, speed: f64, driven: bool) -> System {
     let (l, d) = (0.5, 1.0);
     let width = (cranks - 1) as f64 * d;
+    let (s, c) = placed.sin_cos();
     let mut b = SystemBuilder::new();
     b.set_gravity([0.0, -9.81]);
     let mut handles = Vec::new();
@@ -23,16 +30,16 @@ fn flat_parallelogram(cranks: usize, speed: f64, driven: bool) -> System {
             b.add_body(
                 Body::new(format!("crank{k}"))
                     .rod(1.0, l)
-                    .position(x0 + 0.5 * l, 0.0, 0.0)
-                    .velocity(0.0, 0.5 * l * speed, speed),
+                    .position(x0 + 0.5 * l * c, 0.5 * l * s, given)
+                    .velocity(-0.5 * l * s * speed, 0.5 * l * c * speed, speed),
             ),
         );
     }
     let coupler = b.add_body(
         Body::new("coupler")
             .rod(2.0, width)
-            .position(l + 0.5 * width, 0.0, 0.0)
-            .velocity(0.0, l * speed, 0.0),
+            .position(l * c + 0.5 * width, l * s, 0.0)
+            .velocity(-l * s * speed, l * c * speed, 0.0),
     );
     for (k, &cr) in handles.iter().enumerate() {
         let x0 = k as f64 * d;
@@ -149,44 +156,7 @@ fn the_tangent_solvers_stop_at_a_singular_start() {
 /// projected onto the constraints, where the four-bar is regular.
 #[test]
 fn a_guess_that_only_looks_singular_is_neither() {
-    let (l, a) = (0.5, 0.5f64);
-    let (s, c) = a.sin_cos();
-    let mut b = SystemBuilder::new();
-    b.set_gravity([0.0, -9.81]);
-    let mut cranks = Vec::new();
-    for k in 0..2 {
-        let x0 = k as f64;
-        cranks.push(
-            b.add_body(Body::new(format!("crank{k}")).rod(1.0, l).position(
-                x0 + 0.5 * l * c,
-                0.5 * l * s,
-                0.0,
-            )),
-        );
-    }
-    let coupler = b.add_body(
-        Body::new("coupler")
-            .rod(2.0, 1.0)
-            .position(l * c + 0.5, l * s, 0.0),
-    );
-    for (k, &cr) in cranks.iter().enumerate() {
-        let x0 = k as f64;
-        b.add_joint(Joint::revolute(
-            format!("pivot{k}"),
-            BodyRef::Ground,
-            [x0, 0.0],
-            cr,
-            [-0.5 * l, 0.0],
-        ));
-        b.add_joint(Joint::revolute(
-            format!("pin{k}"),
-            cr,
-            [0.5 * l, 0.0],
-            coupler,
-            [x0 - 0.5, 0.0],
-        ));
-    }
-    let sys = b.build().unwrap();
+    let sys = parallelogram(2, 0.5, 0.0, 0.0, false);
     let q = sys.initial_guess().0;
     assert_eq!(sys.redundant_at(q.as_slice(), 0.0).unwrap().len(), 1);
     assert_eq!((sys.n_redundant(), sys.dof()), (0, 1));

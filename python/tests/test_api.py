@@ -190,24 +190,34 @@ def test_a_solver_caveat_is_a_warning():
     assert r.stats.warnings == []
 
 
+def _body(name, mass, inertia, x, vy, w):
+    """A planar body's TOML table, on the x axis at rest but for the velocity (0, vy, w)."""
+    return (
+        '[[bodies]]\nname = "{}"\nmass = {}\ninertia = {}\n'
+        "position = [{!r}, 0.0, 0.0]\nvelocity = [0.0, {!r}, {!r}]\n"
+    ).format(name, mass, inertia, x, vy, w)
+
+
+def _joint(kind, name, a, xa, b, xb):
+    """A joint's TOML table between points on the x axes of bodies `a` and `b`."""
+    return (
+        '[[joints]]\ntype = "{}"\nname = "{}"\nbody_a = "{}"\npoint_a = [{}, 0.0]\n'
+        'body_b = "{}"\npoint_b = [{}, 0.0]\n'
+    ).format(kind, name, a, xa, b, xb)
+
+
 def test_a_grid_time_on_a_singular_configuration_is_stepped_over(tmp_path):
     # an isosceles slider-crank (crank and rod 0.5 m) driven at 2 pi rad/s from 0: its dead
     # point (rod folded onto the crank) at t = 0.25 s lies on the grid of h = 1e-3
     w = 2 * np.pi
-    body = (
-        '[[bodies]]\nname = "{}"\nmass = {}\ninertia = {}\n'
-        "position = [{!r}, 0.0, 0.0]\nvelocity = [0.0, {!r}, {!r}]\n"
-    )
     text = "gravity = [0.0, -9.81]\n"
-    text += body.format("crank", 1.0, 1 / 48, 0.25, 0.25 * w, w)
-    text += body.format("rod", 1.0, 1 / 48, 0.75, 0.25 * w, -w)
-    text += body.format("slider", 0.5, 0.001, 1.0, 0.0, 0.0)
-    joint = '[[joints]]\ntype = "{}"\nname = "{}"\nbody_a = "{}"\npoint_a = [{}, 0.0]\n'
-    joint += 'body_b = "{}"\npoint_b = [{}, 0.0]\n'
-    text += joint.format("revolute", "pivot", "ground", 0.0, "crank", -0.25)
-    text += joint.format("revolute", "pin", "crank", 0.25, "rod", -0.25)
-    text += joint.format("revolute", "wrist", "rod", 0.25, "slider", 0.0)
-    text += joint.format("prismatic", "guide", "ground", 0.0, "slider", 0.0)
+    text += _body("crank", 1.0, 1 / 48, 0.25, 0.25 * w, w)
+    text += _body("rod", 1.0, 1 / 48, 0.75, 0.25 * w, -w)
+    text += _body("slider", 0.5, 0.001, 1.0, 0.0, 0.0)
+    text += _joint("revolute", "pivot", "ground", 0.0, "crank", -0.25)
+    text += _joint("revolute", "pin", "crank", 0.25, "rod", -0.25)
+    text += _joint("revolute", "wrist", "rod", 0.25, "slider", 0.0)
+    text += _joint("prismatic", "guide", "ground", 0.0, "slider", 0.0)
     text += "axis = [1.0, 0.0]\nangle = 0.0\n"
     text += '[[joints]]\ntype = "angle_driver"\nname = "motor"\nbody_a = "ground"\n'
     text += 'body_b = "crank"\nf = {{ kind = "polynomial", coeffs = [0.0, {!r}] }}\n'.format(w)
@@ -229,20 +239,14 @@ def test_a_singular_start_is_named_and_not_taken_for_redundancy(tmp_path):
     # a parallelogram four-bar driven from its flat position: one equation depends on the
     # others at the start only, so the mechanism has no redundant equation and no freedom
     w = np.pi
-    body = (
-        '[[bodies]]\nname = "{}"\nmass = {}\ninertia = {}\n'
-        "position = [{!r}, 0.0, 0.0]\nvelocity = [0.0, {!r}, {!r}]\n"
-    )
     text = "gravity = [0.0, -9.81]\n"
-    text += body.format("crank0", 1.0, 1 / 48, 0.25, 0.25 * w, w)
-    text += body.format("crank1", 1.0, 1 / 48, 1.25, 0.25 * w, w)
-    text += body.format("coupler", 2.0, 1 / 6, 1.0, 0.5 * w, 0.0)
-    joint = '[[joints]]\ntype = "revolute"\nname = "{}"\nbody_a = "{}"\npoint_a = [{}, 0.0]\n'
-    joint += 'body_b = "{}"\npoint_b = [{}, 0.0]\n'
-    text += joint.format("pivot0", "ground", 0.0, "crank0", -0.25)
-    text += joint.format("pin0", "crank0", 0.25, "coupler", -0.5)
-    text += joint.format("pivot1", "ground", 1.0, "crank1", -0.25)
-    text += joint.format("pin1", "crank1", 0.25, "coupler", 0.5)
+    text += _body("crank0", 1.0, 1 / 48, 0.25, 0.25 * w, w)
+    text += _body("crank1", 1.0, 1 / 48, 1.25, 0.25 * w, w)
+    text += _body("coupler", 2.0, 1 / 6, 1.0, 0.5 * w, 0.0)
+    text += _joint("revolute", "pivot0", "ground", 0.0, "crank0", -0.25)
+    text += _joint("revolute", "pin0", "crank0", 0.25, "coupler", -0.5)
+    text += _joint("revolute", "pivot1", "ground", 1.0, "crank1", -0.25)
+    text += _joint("revolute", "pin1", "crank1", 0.25, "coupler", 0.5)
     text += '[[joints]]\ntype = "angle_driver"\nname = "motor"\nbody_a = "ground"\n'
     text += 'body_b = "crank0"\nf = {{ kind = "polynomial", coeffs = [0.0, {!r}] }}\n'.format(w)
     path = tmp_path / "flat_four_bar.toml"
