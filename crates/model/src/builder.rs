@@ -539,10 +539,12 @@ impl System {
             gravity_forces,
             redundant: Vec::new(),
             singular_start: Vec::new(),
+            revolute_rows: Vec::new(),
             joint_initials: Vec::new(),
             spatial,
         };
         sys.joint_initials = crate::assembly::validate(&sys.joints, &joint_initials)?;
+        sys.revolute_rows = crate::constraints::RevoluteRow::table(&sys);
         sys.check_inertia_scale()?;
         sys.check_mass_ratio()?;
         let (q0, _) = sys.initial_guess();

@@ -88,8 +88,10 @@ impl BodyAngles {
             self.valid = false;
         }
         let valid = self.valid;
-        for (i, (e, r)) in self.sc.iter_mut().zip(&mut self.rotations).enumerate() {
-            let theta = q[3 * i + 2];
+        // (the coordinates by body: no index checks in the loop)
+        let bodies = q[..3 * nb].chunks_exact(3);
+        for ((e, r), qi) in self.sc.iter_mut().zip(&mut self.rotations).zip(bodies) {
+            let theta = qi[2];
             let d = theta - e[0];
             if valid && d.abs() <= Self::MAX_INCREMENT && *r < Self::MAX_ROTATIONS {
                 if d != 0.0 {

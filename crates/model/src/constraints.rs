@@ -343,6 +343,10 @@ impl System {
     ) {
         angles.update_near(self, q);
         let angles = &*angles;
+        if !self.revolute_rows.is_empty() {
+            revolute_residuals(&self.revolute_rows, angles, q, v, phi, phi_dot);
+            return;
+        }
         for ji in 0..self.joints.len() {
             let at = self.joint_attach[ji];
             let j = &self.joints[ji];
@@ -492,6 +496,72 @@ impl System {
     }
 
     // ---------------------------------------------------------------- forces and energy
+}
+
+/// A revolute joint of a model whose joints are all planar revolute ones: its bodies
+/// (`GROUND` for the ground), points and first row.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RevoluteRow {
+    a: usize,
+    b: usize,
+    pa: [f64; 2],
+    pb: [f64; 2],
+    row: usize,
+}
+
+impl RevoluteRow {
+    /// The ground's index in [`RevoluteRow::a`] and [`RevoluteRow::b`].
+    const GROUND: usize = usize::MAX;
+
+    /// The table of `sys`'s joints if they are all planar revolute ones (and there is no
+    /// spatial part), else empty.
+    pub(crate) fn table(sys: &System) -> Vec<Self> {
+        if sys.has_spatial() {
+            return Vec::new();
+        }
+        let mut out = Vec::with_capacity(sys.joints.len());
+        for (ji, j) in sys.joints.iter().enumerate() {
+            let JointKind::Revolute(Revolute { pa, pb, .. }) = &j.kind else {
+                return Vec::new();
+            };
+            let at = sys.joint_attach[ji];
+            out.push(RevoluteRow {
+                a: at.a.unwrap_or(Self::GROUND),
+                b: at.b.unwrap_or(Self::GROUND),
+                pa: *pa,
+                pb: *pb,
+                row: sys.row_offset[ji],
+            });
+        }
+        out
+    }
+}
+
+/// `Phi` and `Phi_q v` of the all-revolute model `rows` (the values of the joint loop of
+/// [`System::phi_and_phi_dot_cached`], operation for operation).
+#[inline]
+fn revolute_residuals(
+    rows: &[RevoluteRow],
+    angles: &BodyAngles,
+    q: &[f64],
+    v: &[f64],
+    phi: &mut [f64],
+    phi_dot: &mut [f64],
+) {
+    let side = |i: usize, p: [f64; 2]| {
+        if i == RevoluteRow::GROUND {
+            revolute_point(angles, q, v, None, p)
+        } else {
+            revolute_point(angles, q, v, Some(i), p)
+        }
+    };
+    for r in rows {
+        let (xa, va) = side(r.a, r.pa);
+        let (xb, vb) = side(r.b, r.pb);
+        let (p, pd) = (&mut phi[r.row..r.row + 2], &mut phi_dot[r.row..r.row + 2]);
+        (p[0], p[1]) = (xa[0] - xb[0], xa[1] - xb[1]);
+        (pd[0], pd[1]) = (va[0] - vb[0], va[1] - vb[1]);
+    }
 }
 
 /// The point `r + R(theta) p` of body `i` (ground for `None`) and its velocity

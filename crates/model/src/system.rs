@@ -135,6 +135,9 @@ pub struct System {
     pub(crate) joint_initials: Vec<(usize, crate::JointInitial)>,
     /// The spatial bodies and joints (after the planar coordinates and rows).
     pub(crate) spatial: crate::spatial::system::SpatialPart,
+    /// A planar model whose joints are all revolute: each joint's bodies, points and first
+    /// row, for the residual loop of [`System::phi_and_phi_dot_cached`] (empty otherwise).
+    pub(crate) revolute_rows: Vec<crate::constraints::RevoluteRow>,
 }
 
 impl System {
