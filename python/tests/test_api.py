@@ -205,6 +205,14 @@ def _joint(kind, name, a, xa, b, xb):
         'body_b = "{}"\npoint_b = [{}, 0.0]\n'
     ).format(kind, name, a, xa, b, xb)
 
+def _motor(body, w):
+    """An angle driver turning `body` at `w` rad/s from 0 against the ground, as TOML."""
+    return (
+        '[[joints]]\ntype = "angle_driver"\nname = "motor"\nbody_a = "ground"\n'
+        'body_b = "{}"\nf = {{ kind = "polynomial", coeffs = [0.0, {!r}] }}\n'
+    ).format(body, w)
+
+
 
 def test_a_grid_time_on_a_singular_configuration_is_stepped_over(tmp_path):
     # an isosceles slider-crank (crank and rod 0.5 m) driven at 2 pi rad/s from 0: its dead
@@ -219,8 +227,7 @@ def test_a_grid_time_on_a_singular_configuration_is_stepped_over(tmp_path):
     text += _joint("revolute", "wrist", "rod", 0.25, "slider", 0.0)
     text += _joint("prismatic", "guide", "ground", 0.0, "slider", 0.0)
     text += "axis = [1.0, 0.0]\nangle = 0.0\n"
-    text += '[[joints]]\ntype = "angle_driver"\nname = "motor"\nbody_a = "ground"\n'
-    text += 'body_b = "crank"\nf = {{ kind = "polynomial", coeffs = [0.0, {!r}] }}\n'.format(w)
+    text += _motor("crank", w)
     path = tmp_path / "isosceles_slider_crank.toml"
     path.write_text(text)
     m = mbd.Model.from_file(path)
@@ -247,8 +254,7 @@ def test_a_singular_start_is_named_and_not_taken_for_redundancy(tmp_path):
     text += _joint("revolute", "pin0", "crank0", 0.25, "coupler", -0.5)
     text += _joint("revolute", "pivot1", "ground", 1.0, "crank1", -0.25)
     text += _joint("revolute", "pin1", "crank1", 0.25, "coupler", 0.5)
-    text += '[[joints]]\ntype = "angle_driver"\nname = "motor"\nbody_a = "ground"\n'
-    text += 'body_b = "crank0"\nf = {{ kind = "polynomial", coeffs = [0.0, {!r}] }}\n'.format(w)
+    text += _motor("crank0", w)
     path = tmp_path / "flat_four_bar.toml"
     path.write_text(text)
     m = mbd.Model.from_file(path)

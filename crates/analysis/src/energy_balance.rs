@@ -162,14 +162,20 @@ impl EnergyBalance {
         let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
         let g = half * (0.6f64).sqrt();
         let mut out = [0.0; 2];
-        // the power through the samples where it is known (all of them if none is)
-        let all = |_: usize| true;
-        let known = |i: usize| self.known[i];
-        let some_known = self.known.iter().any(|k| *k);
+        // the power through the samples where it is known (all of them if none is): the
+        // Lagrange basis is shared by both columns unless a sample's power is unknown
+        let skip = self.known.iter().any(|k| *k) && self.known.iter().any(|k| !*k);
         for (x, w) in [(mid - g, 5.0 / 9.0), (mid, 8.0 / 9.0), (mid + g, 5.0 / 9.0)] {
-            out[0] +=
-                w * half * lagrange(&self.samples, x, 1, if some_known { &known } else { &all });
-            out[1] += w * half * lagrange(&self.samples, x, 2, &all);
+            if skip {
+                out[0] += w * half * lagrange(&self.samples, x, 1, |i| self.known[i]);
+                out[1] += w * half * lagrange(&self.samples, x, 2, |_| true);
+                continue;
+            }
+            for (i, si) in self.samples.iter().enumerate() {
+                let l = basis(&self.samples, x, i, |_| true);
+                out[0] += w * half * l * si[1];
+                out[1] += w * half * l * si[2];
+            }
         }
         out
     }
@@ -204,18 +210,25 @@ impl EnergyBalance {
 
 /// The polynomial through column `col` of the samples `i` with `used(i)` (abscissae in
 /// column 0) at `x`.
-fn lagrange(samples: &[[f64; 3]], x: f64, col: usize, used: &dyn Fn(usize) -> bool) -> f64 {
+fn lagrange(samples: &[[f64; 3]], x: f64, col: usize, used: impl Fn(usize) -> bool + Copy) -> f64 {
     let mut sum = 0.0;
     for (i, si) in samples.iter().enumerate().filter(|(i, _)| used(*i)) {
-        let mut l = 1.0;
-        for (j, sj) in samples.iter().enumerate().filter(|(j, _)| used(*j)) {
-            if i != j {
-                l *= (x - sj[0]) / (si[0] - sj[0]);
-            }
-        }
-        sum += l * si[col];
+        sum += basis(samples, x, i, used) * si[col];
     }
     sum
+}
+
+/// The Lagrange basis polynomial of sample `i` over the samples `j` with `used(j)`, at `x`.
+#[inline]
+fn basis(samples: &[[f64; 3]], x: f64, i: usize, used: impl Fn(usize) -> bool) -> f64 {
+    let ti = samples[i][0];
+    let mut l = 1.0;
+    for (j, sj) in samples.iter().enumerate().filter(|(j, _)| used(*j)) {
+        if i != j {
+            l *= (x - sj[0]) / (ti - sj[0]);
+        }
+    }
+    l
 }
 
 impl Observer for EnergyBalance {

@@ -146,8 +146,8 @@ fn cover<I: Integrator + ?Sized>(
 /// branch, which the velocity constraints no longer exclude). The run treats it as a
 /// failing step and steps over it (by the window after it only: the one before ends on it),
 /// so a run that ends on a singular configuration stops there, as on any mechanism. Only for
-/// such mechanisms: an index-1 solve at each step's
-/// end ([`OutputSolve::indeterminate`]), the workspace allocated once per run.
+/// such mechanisms: an index-1 solve at each step's end ([`OutputSolve::indeterminate`]), the
+/// workspace allocated once per run.
 pub(crate) struct Landing {
     solve: Option<OutputSolve>,
 }
@@ -174,8 +174,8 @@ impl Landing {
 }
 
 /// What a step that landed on a singular configuration fails with ([`Landing`]).
-pub(crate) const LANDED_ON_SINGULAR: &str =
-    "index-1 matrix at a step's end (a singular configuration, passed only by the allowance of the singular start)";
+pub(crate) const LANDED_ON_SINGULAR: &str = "index-1 matrix at a step's end (a singular \
+     configuration, passed only by the allowance of the singular start)";
 
 /// Copies `from` into `to` (same sizes: no allocation).
 #[inline]
