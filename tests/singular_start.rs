@@ -12,12 +12,20 @@ use std::f64::consts::PI;
 /// each, all horizontal at t = 0 and turning at `speed`; with `driven`, crank 0 is driven at
 /// that speed (`theta = speed t`).
 fn flat_parallelogram(cranks: usize, speed: f64, driven: bool) -> System {
-    parallelogram(cranks, 0.0, 0.0, speed, driven)
+    parallelogram(cranks, 0.0, 0.0, speed, None, driven)
 }
 
 /// [`flat_parallelogram`] with the bodies placed where cranks at `placed` (rad) put them and
-/// the cranks' angles given as `given` (a guess off the constraints where they differ).
-fn parallelogram(cranks: usize, placed: f64, given: f64, speed: f64, driven: bool) -> System {
+/// the cranks' angles given as `given` (a guess off the constraints where they differ); with
+/// `rate`, only crank 0 is given a velocity (that angular rate), the other bodies none.
+fn parallelogram(
+    cranks: usize,
+    placed: f64,
+    given: f64,
+    speed: f64,
+    rate: Option<f64>,
+    driven: bool,
+) -> System {
     let (l, d) = (0.5, 1.0);
     let width = (cranks - 1) as f64 * d;
     let (s, c) = placed.sin_cos();
@@ -26,20 +34,26 @@ fn parallelogram(cranks: usize, placed: f64, given: f64, speed: f64, driven: boo
     let mut handles = Vec::new();
     for k in 0..cranks {
         let x0 = k as f64 * d;
+        let w = match rate {
+            None => speed,
+            Some(r) if k == 0 => r,
+            Some(_) => 0.0,
+        };
         handles.push(
             b.add_body(
                 Body::new(format!("crank{k}"))
                     .rod(1.0, l)
                     .position(x0 + 0.5 * l * c, 0.5 * l * s, given)
-                    .velocity(-0.5 * l * s * speed, 0.5 * l * c * speed, speed),
+                    .velocity(-0.5 * l * s * w, 0.5 * l * c * w, w),
             ),
         );
     }
+    let w_coupler = if rate.is_some() { 0.0 } else { speed };
     let coupler = b.add_body(
         Body::new("coupler")
             .rod(2.0, width)
             .position(l * c + 0.5 * width, l * s, 0.0)
-            .velocity(-l * s * speed, l * c * speed, 0.0),
+            .velocity(-l * s * w_coupler, l * c * w_coupler, 0.0),
     );
     for (k, &cr) in handles.iter().enumerate() {
         let x0 = k as f64 * d;
@@ -156,9 +170,63 @@ fn the_tangent_solvers_stop_at_a_singular_start() {
 /// projected onto the constraints, where the four-bar is regular.
 #[test]
 fn a_guess_that_only_looks_singular_is_neither() {
-    let sys = parallelogram(2, 0.5, 0.0, 0.0, false);
+    let sys = parallelogram(2, 0.5, 0.0, 0.0, None, false);
     let q = sys.initial_guess().0;
     assert_eq!(sys.redundant_at(q.as_slice(), 0.0).unwrap().len(), 1);
     assert_eq!((sys.n_redundant(), sys.dof()), (0, 1));
     assert!(sys.singular_start_equations().is_empty());
+}
+
+/// Without the motion's velocities, the consistent state at the flat start takes its velocity
+/// on the nearest branch of the motion (the velocity constraints alone leave one direction
+/// free there, and the projection's choice is on no branch: the projecting solvers stopped at
+/// the first step). Driven with every body given at rest: the parallelogram branch, the
+/// coupler not turning, the second crank at the motor's rate, and the runs keep the driven
+/// kinematics and close the balance. Free with only crank 0 given a rate: both cranks at one
+/// rate (the parallelogram branch, the nearer one), and the energy is kept.
+#[test]
+fn a_singular_start_takes_its_velocity_on_the_nearest_branch() {
+    let driven = parallelogram(2, 0.0, 0.0, PI, Some(0.0), true);
+    let free = parallelogram(2, 0.0, 0.0, PI, Some(30.0), false);
+    let rate =
+        |sys: &System, s: &State, body: &str| s.v[3 * sys.body_handle(body).unwrap().index() + 2];
+    for (sys, driven) in [(&driven, true), (&free, false)] {
+        let s0 = State::consistent(sys, 0.0).unwrap();
+        let (w0, w1, wc) = (
+            rate(sys, &s0, "crank0"),
+            rate(sys, &s0, "crank1"),
+            rate(sys, &s0, "coupler"),
+        );
+        assert!(
+            (w0 - w1).abs() < 1e-12 && wc.abs() < 1e-12,
+            "{w0} {w1} {wc}"
+        );
+        if driven {
+            assert!((w0 - PI).abs() < 1e-12, "{w0}");
+        } else {
+            assert!(w0 > 0.1, "{w0}");
+        }
+        for spec in ["rk4-projected", "symplectic:2"] {
+            let mut eb = EnergyBalance::new(sys).unwrap();
+            let mut sim = Simulation::new(sys.clone(), spec).unwrap();
+            sim.run_observed(RunConfig::new(0.5, 1e-3), &mut eb)
+                .unwrap_or_else(|e| panic!("{spec}: {e}"));
+            let rel = eb.max_residual() / eb.max_energy();
+            assert!(
+                rel < 1e-9,
+                "{spec} (driven {driven}): energy balance {rel:e} of max |H|"
+            );
+            // on the parallelogram branch: the cranks turn together, the coupler does not
+            let s = sim.state();
+            let (w0, w1) = (rate(sys, s, "crank0"), rate(sys, s, "crank1"));
+            let coupler = s.q[3 * sys.body_handle("coupler").unwrap().index() + 2];
+            assert!(
+                (w0 - w1).abs() < 1e-9 && coupler.abs() < 1e-9,
+                "{spec}: {w0} {w1} {coupler}"
+            );
+            if driven {
+                assert!((w0 - PI).abs() < 1e-9, "{spec}: {w0}");
+            }
+        }
+    }
 }

@@ -93,7 +93,12 @@ pub fn consistent_state(sys: &System, t: f64) -> Result<ConsistentState, SolveEr
 /// Projects a guess `(q, v)` onto the constraint manifold at time `t`: positions by Newton with
 /// the minimum `M`-norm correction `dq = -M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T)^-1 Phi`, then
 /// velocities by the `M`-orthogonal projection onto `Phi_q v + Phi_t = 0` (twice, so the
-/// velocity residual is at round-off). The model's inputs ([`mbd_model::Inputs`],
+/// velocity residual is at round-off). On a singular configuration (more equations dependent
+/// than the model's redundant ones, at most [`mbd_model::SPARSE_RANK_THRESHOLD`] equations)
+/// that projection leaves `v` free along the extra null directions, and the velocity is then
+/// moved onto the nearest branch of the motion, where the accelerations exist
+/// (`y^T gamma(q, v, t) = 0` for the left null vectors `y` of `Phi_q`; docs/singular.md
+/// section 7). The model's inputs ([`mbd_model::Inputs`],
 /// [`System::initial_inputs`]) are kept: their entries of `M^-1` are zero in both corrections,
 /// so the other coordinates take up the whole correction (the smallest change of them, in
 /// their mass metric).
@@ -167,6 +172,13 @@ pub fn project_state(
             sys.check_rank(&q, t)?;
             return Err(inputs.explain(e, "velocity", &keep_v));
         }
+    }
+    // on a singular configuration: the velocity onto the nearest branch of the motion, then
+    // once more onto the velocity constraints (round-off)
+    if crate::branch::onto_branch(sys, &q, &mut v, t, &keep_v)?.is_some() {
+        projector
+            .project_velocities(sys, &q, &mut v, t)
+            .map_err(|e| inputs.explain(e, "velocity", &keep_v))?;
     }
     let mut phi = vec![0.0; m];
     let mut phid = vec![0.0; m];

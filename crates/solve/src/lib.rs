@@ -53,6 +53,7 @@
 
 mod accel;
 mod adaptive;
+mod branch;
 mod bridge;
 mod consistent;
 mod constrained;
