@@ -230,3 +230,38 @@ fn a_singular_start_takes_its_velocity_on_the_nearest_branch() {
         }
     }
 }
+
+/// Two loops flat at once (the driven 2-loop N-four-bar started flat): two singular
+/// equations, two solvability conditions, and the velocity from rest in the model on the
+/// parallelogram branch of both loops (the Gauss-Newton path of several conditions).
+#[test]
+fn two_loops_flat_at_once_start_on_the_parallelogram_branch() {
+    let sys = mbd::model::models::ClosedLoop::n_four_bar(2, 0.4, 1.0)
+        .unwrap()
+        .system(0.0, 6.0, true)
+        .unwrap();
+    assert_eq!(sys.singular_start_equations().len(), 2);
+    let q = sys.initial_guess().0;
+    let zero = vec![0.0; q.len()];
+    let x = mbd::solve::project_state(&sys, q.as_slice(), &zero, 0.0, Default::default()).unwrap();
+    let names = sys.coordinate_names();
+    let rates: Vec<(&String, f64)> = names
+        .iter()
+        .zip(x.v.iter().copied())
+        .filter(|(n, _)| n.ends_with(".theta"))
+        .collect();
+    assert_eq!(rates.len(), 5);
+    for (name, w) in rates {
+        let want = if name.starts_with("crank") { 6.0 } else { 0.0 };
+        assert!((w - want).abs() < 1e-12, "{name}: {w}");
+    }
+    let mut sim = Simulation::new(sys.clone(), "rk4-projected").unwrap();
+    sim.set_state(State::new(&sys, 0.0, x.q, x.v).unwrap())
+        .unwrap();
+    sim.run(RunConfig::new(0.3, 1e-3)).unwrap();
+    for k in [1, 2] {
+        let c = sys.body_handle(&format!("coupler{k}")).unwrap().index();
+        let turn = sim.state().q[3 * c + 2];
+        assert!(turn.abs() < 1e-9, "coupler{k} turned by {turn}");
+    }
+}
