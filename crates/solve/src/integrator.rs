@@ -644,7 +644,13 @@ where
             match step_over::step_over(integrator, sys, state, &window, &mut checks, &mut stats) {
                 // grid time k, the singular configuration itself, has no state
                 Some(step_over::Covered::After) => k += 1,
-                Some(step_over::Covered::Before) => {}
+                // (the window before ends on grid time k: on the singular configuration if the
+                // step failed landing there, which a run may not end on)
+                Some(step_over::Covered::Before) => {
+                    if landing.on_singular(sys, state) {
+                        return Err(e);
+                    }
+                }
                 None => return Err(e),
             }
             // the grid state before this one was stepped over

@@ -164,10 +164,15 @@ impl Landing {
         Ok(Landing { solve })
     }
 
-    /// Whether `state` (a step's end) is a singular configuration.
+    /// Whether `state` (a step's end) is a singular configuration: the index-1 solve there
+    /// dropped more rows than the redundant equations, or found none of the rows it may drop
+    /// enough (a velocity off every branch leaves the accelerations without a solution).
     pub(crate) fn on_singular(&mut self, sys: &System, state: &State) -> bool {
         match &mut self.solve {
-            Some(s) => s.at(sys, state).is_ok() && s.indeterminate(),
+            Some(s) => match s.at(sys, state) {
+                Ok(_) => s.indeterminate(),
+                Err(e) => matches!(e, SolveError::Singular { .. }),
+            },
             None => false,
         }
     }
