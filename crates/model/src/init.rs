@@ -92,7 +92,8 @@ impl System {
         Some(format!(
             "the initial configuration is singular: {} equation(s) ({}) depend on the others \
              there but not along the motion; the solvers that keep the constraints pass it, the \
-             tangent-chart and FA-DAE solvers cannot start on it, the consistent start velocity \
+             tangent-chart solvers take their first step by projected RK of their tableau, FA-DAE \
+             cannot start on it, the consistent start velocity \
              is the nearest on a branch of the motion (give the motion's velocities to choose \
              the branch), and the multipliers (reactions, drivers' torques) at the start are not \
              determined",

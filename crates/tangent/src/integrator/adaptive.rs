@@ -215,7 +215,14 @@ impl AdaptiveIntegrator for TangentRk {
         let t = state.t;
         let recentre = self.centred_at != t;
         self.centred_at = t;
-        match self.attempt_adaptive(sys, state, h, ctrl, recentre)? {
+        let attempt = match self.attempt_adaptive(sys, state, h, ctrl, recentre) {
+            Err(e) if recentre && Self::singular_at_start(&e, t) => {
+                self.centred_at = f64::NAN;
+                return self.starter_attempt(sys, state, h, ctrl, e);
+            }
+            r => r?,
+        };
+        match attempt {
             Ok(a) => {
                 self.failures_here = 0;
                 if a.accepted {
@@ -254,7 +261,12 @@ impl AdaptiveIntegrator for TangentRk {
     ) -> Result<Option<(f64, StepStats)>, SolveError> {
         self.check_sizes(sys, state)?;
         self.load(sys, state)?;
-        let h0 = self.estimate_initial_step(sys, state.t, span, &cfg.controller, cfg.h_max)?;
+        let h0 = match self.estimate_initial_step(sys, state.t, span, &cfg.controller, cfg.h_max) {
+            Ok(h0) => h0,
+            // a singular start: the run loop's own first step (the starter takes it)
+            Err(e) if Self::singular_at_start(&e, state.t) => return Ok(None),
+            Err(e) => return Err(e),
+        };
         let work = StepStats {
             rhs_evals: 2,
             ..Default::default()

@@ -14,6 +14,7 @@ mod attempt;
 mod history;
 mod options;
 mod path;
+mod starter;
 
 use history::EtaHistory;
 use path::{Path, SparseParts};
@@ -118,6 +119,9 @@ pub struct TangentRk {
     /// The largest condition estimate of the stage solves of the last accepted step (infinite
     /// before one): whether the next step's start may take its accelerations from the chart.
     last_condition: f64,
+    /// Projected RK of the same tableau for a step from a singular configuration, built on
+    /// first use (`starter.rs`).
+    starter: Option<Box<mbd_solve::Index1Rk>>,
 }
 
 /// Largest factor by which [`TangentChart::rcond`] may differ between the current chart and
@@ -232,6 +236,7 @@ impl TangentRk {
             failures_here: 0,
             bridge: SingularBridge::new(sys),
             last_condition: f64::INFINITY,
+            starter: None,
         })
     }
 
@@ -494,7 +499,13 @@ impl Integrator for TangentRk {
         self.centred_at = f64::NAN;
         let mut out = StepStats::default();
         let t = state.t;
-        self.advance(sys, t, h, 0, &mut out)?;
+        match self.advance(sys, t, h, 0, &mut out) {
+            Ok(()) => {}
+            Err(e) if Self::singular_at_start(&e, t) => {
+                return self.starter_step(sys, state, h, e);
+            }
+            Err(e) => return Err(e),
+        }
         self.store(state);
         state.t = t + h;
         Ok(out)

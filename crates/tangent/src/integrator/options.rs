@@ -203,6 +203,9 @@ pub struct TangentStats {
     /// Chart maps of the accepted steps completed by the exact Newton fallback after the chord
     /// iteration failed ([`NewtonSettings::fallback_change`]: near-singular charts).
     pub exact_maps: usize,
+    /// Steps from a singular configuration, where no chart can be centred, taken by projected
+    /// RK of the same tableau on the index-1 form (counted in `steps` too).
+    pub starter_steps: usize,
 }
 
 #[cfg(test)]
