@@ -8,12 +8,14 @@
 //! `y^T gamma(q, v, t) = 0` (`docs/singular.md`, section 7). For holonomic constraints `gamma`
 //! is quadratic in `v`, so on the affine set `v = v_0 + S N alpha` (`N` an orthonormal basis of
 //! the null space of `Phi_q S`, `S` the square root of the rank test's unit-free weights) the
-//! conditions are `k` quadratics in `alpha`; their zero set is the union of the branches'
-//! velocity spaces (for a mechanism without a degree of freedom: one velocity per branch). A
-//! Gauss-Newton iteration with minimum-norm steps from `alpha = 0` (the projection's choice)
-//! moves `v` onto the nearest of them. A structural redundancy's left null vectors give
-//! conditions that hold identically; their rows of the Jacobian vanish and the truncated
-//! pseudo-inverse leaves them out.
+//! conditions are quadratics in `alpha`; their zero set is the union of the branches' velocity
+//! spaces (for a mechanism without a degree of freedom: one velocity per branch). A structural
+//! redundancy's left null vectors give conditions that hold identically, mixed by the left null
+//! basis with the others: an SVD of the conditions' coefficient rows keeps their independent
+//! combinations. One condition (one singular equation): the nearest zero to `alpha = 0` (the
+//! projection's choice), from the monotone derivative of the dual function
+//! (`Quadratics::nearest_root`); several: Gauss-Newton with minimum-norm steps from
+//! `alpha = 0`, a zero near it.
 
 use crate::error::SolveError;
 use crate::linalg::max_abs;
@@ -36,16 +38,9 @@ const MAX_ITER: usize = 50;
 /// part times the velocity scale, and of their value at the projection's choice).
 const BRANCH_TOL: f64 = 1e-9;
 
-/// How the start velocity was moved onto a branch (see [`onto_branch`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct BranchMove {
-    /// Max-norm of the change of `v`.
-    pub change: f64,
-}
-
 /// Moves the consistent velocity `v` at a singular configuration `q` onto the nearest branch
 /// of the motion (module docs). `keep` marks velocities held as given (inputs): they do not
-/// move. Returns `None` where nothing moved: a regular configuration (or one with only the
+/// move. Returns whether `v` moved; it does not on a regular configuration (or one with only the
 /// structural redundancy), above [`SPARSE_RANK_THRESHOLD`] equations (the test is dense),
 /// a velocity already on a branch, or conditions with no real solution near it (no branch
 /// passes the configuration with these drivers: the solvers report that configuration).
@@ -55,14 +50,14 @@ pub(crate) fn onto_branch(
     v: &mut [f64],
     t: f64,
     keep: &[bool],
-) -> Result<Option<BranchMove>, SolveError> {
+) -> Result<bool, SolveError> {
     let (n, m) = (sys.n_coords(), sys.n_constraints());
     if m == 0 || m > SPARSE_RANK_THRESHOLD {
-        return Ok(None);
+        return Ok(false);
     }
     // the cheap test first: a well-conditioned or structurally redundant configuration
     if sys.redundant_at(q, t)?.len() <= sys.n_redundant() {
-        return Ok(None);
+        return Ok(false);
     }
     let s: Vec<f64> = sys
         .rank_weights()
@@ -77,7 +72,7 @@ pub(crate) fn onto_branch(
     }
     let y = null_space(&a.transpose(), NULL_TOL);
     if y.ncols() <= sys.n_redundant() {
-        return Ok(None);
+        return Ok(false);
     }
     let mut dirs = null_space(&a, NULL_TOL);
     for (i, &si) in s.iter().enumerate() {
@@ -85,7 +80,7 @@ pub(crate) fn onto_branch(
     }
     let d = dirs.ncols();
     if d == 0 {
-        return Ok(None);
+        return Ok(false);
     }
     let v0 = DVector::from_column_slice(v);
     let mut cond = Conditions {
@@ -99,7 +94,7 @@ pub(crate) fn onto_branch(
         gamma: vec![0.0; m],
     };
     let Some(quad) = Quadratics::of(&mut cond, max_abs(v).max(1.0)) else {
-        return Ok(None);
+        return Ok(false);
     };
     let alpha = match quad.c.len() {
         1 => quad.nearest_root(),
@@ -107,13 +102,13 @@ pub(crate) fn onto_branch(
     };
     // the exact conditions at the result (the quadratic model is exact up to round-off)
     let Some(alpha) = alpha.filter(|a| cond.eval(a).amax() <= BRANCH_TOL * quad.scale) else {
-        return Ok(None);
+        return Ok(false);
     };
     let dv = &dirs * &alpha;
     for (vi, dvi) in v.iter_mut().zip(dv.iter()) {
         *vi += dvi;
     }
-    Ok(Some(BranchMove { change: dv.amax() }))
+    Ok(true)
 }
 
 /// The independent solvability conditions as quadratics in `alpha`:

@@ -175,7 +175,7 @@ pub fn project_state(
     }
     // on a singular configuration: the velocity onto the nearest branch of the motion, then
     // once more onto the velocity constraints (round-off)
-    if crate::branch::onto_branch(sys, &q, &mut v, t, &keep_v)?.is_some() {
+    if crate::branch::onto_branch(sys, &q, &mut v, t, &keep_v)? {
         projector
             .project_velocities(sys, &q, &mut v, t)
             .map_err(|e| inputs.explain(e, "velocity", &keep_v))?;
