@@ -480,6 +480,9 @@ impl Integrator for TangentRk {
         self.centred_at = f64::NAN;
         self.failures_here = 0;
         self.bridge.clear();
+        if let Some(s) = self.starter.as_deref_mut() {
+            s.reset();
+        }
     }
 
     fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {
