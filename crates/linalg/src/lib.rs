@@ -12,6 +12,8 @@
 //!   (faer's simplicial factorisations), analysed once and refactored in place;
 //! * [`symmetric_eigen`]: the cyclic Jacobi eigen-decomposition of a small symmetric matrix
 //!   (its near-null space, accurately);
+//! * [`min_norm_solve`] and [`null_space`]: the minimum-norm least-squares solution and the
+//!   null space of a small dense matrix that may lose rank, by the SVD with a relative rank cut;
 //! * [`Anderson`]: Anderson acceleration of a linearly converging fixed-point iteration (the
 //!   simplified Newton iterations whose iteration matrix leaves out part of the Jacobian);
 //! * small kernels: [`max_abs`] and [`max_abs_diff`] (max-norms that never lose a NaN),
@@ -59,6 +61,7 @@ mod householder;
 mod lu;
 mod semidefinite;
 mod sparse;
+mod svd;
 
 pub use anderson::Anderson;
 pub use cholesky::{
@@ -70,6 +73,7 @@ pub use householder::{form_q_padded, qr_padded, reflect, solve_rt};
 pub use lu::{DenseLu, PIVOT_THRESHOLD, PIVOT_TOL};
 pub use semidefinite::{DEPENDENT_PIVOT_TOL, PIVOTING_RATIO, ROUNDOFF_DEPENDENT_TOL};
 pub use sparse::{ColumnOrder, SparseCholesky, SparseLu, REFACTOR_PIVOT_RATIO, SPARSE_PIVOT_TOL};
+pub use svd::{min_norm_solve, null_space};
 
 use faer::dyn_stack::MemBuffer;
 

@@ -23,6 +23,7 @@
 
 use crate::init::RedundantEquation;
 use crate::system::System;
+use mbd_linalg::min_norm_solve;
 use nalgebra::{DMatrix, DVector};
 
 /// Distance of the probe points from the build configuration, relative to the mechanism's
@@ -171,7 +172,7 @@ impl<'a> Probe<'a> {
             .collect();
         let g = DVector::from_vec(g);
         // d = g - J^+ J g: the minimum-norm solution removes g's part in the row space
-        let row_part = min_norm_solve(jac.clone(), &(&jac * &g))?;
+        let row_part = min_norm_solve(jac.clone(), &(&jac * &g), RANK_CUTOFF)?;
         let d = g - row_part;
         let dmax = d.amax();
         // (a NaN is no direction either)
@@ -203,7 +204,7 @@ impl<'a> Probe<'a> {
             if size <= tol {
                 return Some(q);
             }
-            let dz = min_norm_solve(self.jacobian(&q), &res)?;
+            let dz = min_norm_solve(self.jacobian(&q), &res, RANK_CUTOFF)?;
             for (i, qi) in q.iter_mut().enumerate() {
                 *qi -= dz[i] * self.sqrt_w[i];
             }
@@ -223,15 +224,4 @@ impl<'a> Probe<'a> {
         }
         jac
     }
-}
-
-/// The minimum-norm least-squares solution of `a x = b`, singular values below
-/// [`RANK_CUTOFF`] of the largest dropped; `None` if the SVD fails or `a` is zero.
-fn min_norm_solve(a: DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
-    let svd = a.svd(true, true);
-    let smax = svd.singular_values.amax();
-    if smax.is_nan() || smax <= 0.0 {
-        return None;
-    }
-    svd.solve(b, RANK_CUTOFF * smax).ok()
 }

@@ -19,6 +19,7 @@
 
 use crate::error::SolveError;
 use crate::linalg::max_abs;
+use mbd_linalg::{min_norm_solve, null_space};
 use mbd_model::{System, SPARSE_RANK_THRESHOLD};
 use nalgebra::{DMatrix, DVector};
 
@@ -295,12 +296,7 @@ impl Quadratics {
                 let grad = &self.b[l] + 2.0 * ha;
                 jac.row_mut(l).copy_from(&grad.transpose());
             }
-            let svd = jac.svd(true, true);
-            let smax = svd.singular_values.amax();
-            if smax == 0.0 {
-                return None;
-            }
-            let step = svd.solve(&g, STEP_RANK_TOL * smax).ok()?;
+            let step = min_norm_solve(jac, &g, STEP_RANK_TOL)?;
             alpha -= &step;
             if step.amax() <= 8.0 * f64::EPSILON * (alpha.amax() + 1.0) {
                 break;
@@ -331,52 +327,9 @@ impl Conditions<'_> {
     }
 }
 
-/// An orthonormal basis (columns) of the null space of `b`: the right singular vectors whose
-/// singular values are below `tol` times the largest (those beyond the rank when `b` has fewer
-/// rows than columns, from the SVD of `b` padded with zero rows to a square).
-fn null_space(b: &DMatrix<f64>, tol: f64) -> DMatrix<f64> {
-    let (r, c) = b.shape();
-    let p = if r < c {
-        let mut p = DMatrix::zeros(c, c);
-        p.rows_mut(0, r).copy_from(b);
-        p
-    } else {
-        b.clone()
-    };
-    let svd = p.svd(false, true);
-    let Some(vt) = svd.v_t else {
-        return DMatrix::zeros(c, 0);
-    };
-    let sv = &svd.singular_values;
-    let smax = sv.amax();
-    let keep: Vec<usize> = (0..sv.len())
-        .filter(|&i| smax == 0.0 || sv[i] <= tol * smax)
-        .collect();
-    let mut out = DMatrix::zeros(c, keep.len());
-    for (k, &i) in keep.iter().enumerate() {
-        out.set_column(k, &vt.row(i).transpose());
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The null space of a rank-deficient wide matrix: orthonormal, annihilated, of the right
-    /// dimension.
-    #[test]
-    fn null_space_of_a_wide_rank_deficient_matrix() {
-        let b = DMatrix::from_row_slice(2, 4, &[1.0, 2.0, 0.0, -1.0, 2.0, 4.0, 0.0, -2.0]);
-        let nb = null_space(&b, 1e-9);
-        assert_eq!(nb.ncols(), 3);
-        assert!((&b * &nb).amax() < 1e-14);
-        let g = nb.tr_mul(&nb) - DMatrix::identity(3, 3);
-        assert!(g.amax() < 1e-14);
-        let nt = null_space(&b.transpose(), 1e-9);
-        assert_eq!(nt.ncols(), 1);
-        assert!((b.transpose() * &nt).amax() < 1e-14);
-    }
 
     /// `g(alpha) = (alpha + p)^T H (alpha + p)` with `H = diag(1, -1)`: the zero set is the two
     /// lines `z_1 = +-z_2` through `-p`.
