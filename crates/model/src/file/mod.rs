@@ -214,6 +214,7 @@ pub const MAX_MODEL_FILE_BYTES: u64 = 64 << 20;
 /// assert_eq!(mbd_model::read_text(&p, 100)?, "gravity = [0.0, -9.81]");
 /// let e = mbd_model::read_text(&p, 10).unwrap_err();
 /// assert!(e.to_string().contains("more than 10 bytes"));
+/// # std::fs::remove_dir_all(&dir)?;
 /// # Ok::<(), std::io::Error>(())
 /// ```
 pub fn read_text(path: &std::path::Path, limit: u64) -> std::io::Result<String> {
