@@ -114,22 +114,26 @@ fn a_singular_start_is_told_from_a_redundant_equation() {
     assert!(sys.singular_start_note().is_some());
 }
 
-/// The driven four-bar started flat, to t = 1.5: projected RK4, symplectic (2,2) and the
-/// tangent solvers keep the driven kinematics, step over t = 1 (flat again; a step landing
+/// The driven four-bar started flat, to t = 1.5: projected RK4, symplectic (1,1), plain and
+/// modified, and (2,2), and the tangent solvers keep the driven kinematics, step over t = 1 (flat again; a step landing
 /// there would take a velocity along the other branch), and close the energy balance to 1e-9 of
 /// max |H| (5.6e-4 when the driver's power at the start came from the undetermined multipliers
 /// there, and 2.9e-4 with the landing at t = 1 accepted). No chart can be centred on the
 /// singular start: the tangent solvers take the first step by projected RK of their own
 /// tableau and the chart takes over at its end (they stopped at `t = 0` with the typed singular
-/// error before). A run that ends on the flat position (t = 2) stops there with the singular
-/// error, as any mechanism's does (tangent RK4 ended there with the coupler turning at
-/// -1.4e-3 rad/s, off the branch, when a window of steps before the last grid time covered it).
+/// error before), and so does symplectic (1,1), whose own step has no solution there (it
+/// stopped at `t = 0` with its Newton residual stalled at `O(h^3)`). A run that ends on the
+/// flat position (t = 2) stops there with the singular error, as any mechanism's does (tangent
+/// RK4 ended there with the coupler turning at -1.4e-3 rad/s, off the branch, when a window of
+/// steps before the last grid time covered it).
 #[test]
 fn the_solvers_that_keep_the_constraints_pass_a_singular_start_and_close_the_balance() {
     let sys = flat_parallelogram(2, PI, true);
     let crank1 = sys.body_handle("crank1").unwrap().index();
     for spec in [
         "rk4-projected",
+        "symplectic:1",
+        "symplectic:1:modified",
         "symplectic:2",
         "tangent:rk4",
         "tangent:dopri5",

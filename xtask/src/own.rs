@@ -120,7 +120,7 @@ fn solve_to(
 
 /// The reason the tangent RK4 step-cost claim misses (its measurements and the cuts made are
 /// in docs/report.md, "Expected misses", and docs/tangent.md).
-const TANGENT_RATIO_MISS: &str = "at this claim's h = 0.01 the tangent chart's maps (three stage points and the end point, the end point to 1e-13) set the cost: 9.5 chord iterations per step in the step-weighted chart (14.6 in paper B's Euclidean one), 3.31x plain RK4 in instructions under run (3.77x before the weighted chart), 3.53x by wall clock in a full run with --jobs 1 on the development machine (3.99x before); at h = 1e-3, 2.77x in instructions under run; see docs/report.md, expected misses";
+const TANGENT_RATIO_MISS: &str = "at this claim's h = 0.01 the tangent chart's maps (three stage points and the end point, the end point to 1e-13) set the cost: 9.45 chord iterations per step in the step-weighted chart (14.6 in paper B's Euclidean one), 3.23x plain RK4 in instructions under run (34,458 against 10,666; 3.77x before the weighted chart), 3.55x by wall clock in a full run with --jobs 1 on the development machine (3.99x before); at h = 1e-3, 2.73x in instructions under run; see docs/report.md, expected misses";
 
 /// Errors of the order study within this of zero are at the reference's / round-off floor.
 const FLOOR: f64 = 1e-11;

@@ -71,6 +71,7 @@ mod reactions;
 pub mod registry;
 mod sensors;
 pub mod sparse;
+mod starter;
 mod state;
 mod step_over;
 mod tableau;
@@ -104,6 +105,7 @@ pub use projection::{ProjectionSettings, ProjectionStats, Projector, PROJECTION_
 pub use reactions::{JointReaction, ReactionSolver};
 pub use sensors::SensorSolver;
 pub use sparse::{LinearSolver, SparseAccelerationSolver, SPARSE_THRESHOLD};
+pub use starter::SingularStarter;
 pub use state::State;
 pub use tableau::{ButcherTableau, ExplicitRk, StepController};
 

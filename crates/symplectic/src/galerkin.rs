@@ -7,7 +7,8 @@ use dense::stage_lu;
 use mbd_model::System;
 use mbd_solve::linalg::{Anderson, DenseCholesky, DenseLu};
 use mbd_solve::{
-    AccelerationSolver, ConstrainedSolve, Integrator, LinearSolver, SolveError, State, StepStats,
+    AccelerationSolver, ButcherTableau, ConstrainedSolve, Integrator, LinearSolver,
+    SingularStarter, SolveError, State, StepStats,
 };
 use nalgebra::DMatrix;
 use sparse::{add_transpose, SparseStage};
@@ -91,6 +92,9 @@ pub struct Galerkin {
     mlvel: Vec<f64>,
     /// The `s = 2` gradients of the last steps, extrapolated at the predictor (`modlag.rs`).
     mlhist: modlag::GradientHistory,
+    /// The first step from a singular configuration where the stage equations have no
+    /// solution (`step.rs`).
+    starter: SingularStarter,
     /// Sparse path, s = 1 modified Lagrangian: the diagonals of its Newton blocks
     /// (`Preadjustment::modified_newton_diagonals`).
     mldiag: [Vec<f64>; 3],
@@ -216,6 +220,9 @@ impl Galerkin {
                 [Vec::new(), Vec::new(), Vec::new()]
             },
             mlhist: modlag::GradientHistory::new(if modlag && options.s == 2 { n } else { 0 }),
+            // (DOPRI5: one step's local error O(h^6), below the scheme's global error for
+            // the orders up to 6)
+            starter: SingularStarter::new(ButcherTableau::dopri5()),
             opts: options,
             tab,
             n,

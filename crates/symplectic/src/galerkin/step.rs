@@ -36,6 +36,68 @@ impl Integrator for Galerkin {
     }
 
     fn reset(&mut self) {
+        self.forget();
+        self.starter.reset();
+    }
+
+    /// A step of the scheme; from a singular initial configuration where its stage equations
+    /// have no solution, the step is taken by projected DOPRI5 instead
+    /// ([`SingularStarter`]) and the scheme takes over at its end point. The (1,1) scheme's
+    /// end point `q_1` must satisfy `Phi(q_1) = 0` with constraint forces along
+    /// `Phi_q(q_0)^T` alone, which at a singular `q_0` lacks one direction per dependent
+    /// equation: its Newton residual stalls at `O(h^3)` (at small `h` below the Newton's
+    /// acceptance, with an `O(h^3)` constraint error that the energy balance shows), so
+    /// (1,1) always hands such a step to the starter. The (s,s) schemes with `s >= 2` have
+    /// interior control points off the singular configuration and take the step themselves
+    /// (the starter only where their Newton iteration fails there).
+    fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
+        let t = state.t;
+        if self.tab.s == 1 && self.starts_singular(sys, state)? {
+            let refused = SolveError::Singular {
+                t,
+                what: mbd_solve::STAGES_NEAR_RANK_LOSS,
+                detail: "symplectic (1,1) from a singular configuration".into(),
+            };
+            let stats = self.starter.step(sys, state, h, refused)?;
+            self.forget();
+            return Ok(stats);
+        }
+        match self.scheme_step(sys, state, h) {
+            Err(e)
+                if SingularStarter::refused_at_start(&e, t)
+                    && !sys.singular_start_equations().is_empty() =>
+            {
+                let stats = self.starter.step(sys, state, h, e)?;
+                // the histories (predictor, reused Jacobians) belong to the scheme's steps
+                self.forget();
+                Ok(stats)
+            }
+            r => r,
+        }
+    }
+}
+
+impl Galerkin {
+    /// Whether `state` is a singular configuration of a model that starts on one
+    /// (`System::singular_start_equations`) and does not continue this integrator's last
+    /// step (a run's first step, or a state handed in): `Phi_q` there has more dependent
+    /// rows than the model's redundant ones.
+    fn starts_singular(&self, sys: &System, state: &State) -> Result<bool, SolveError> {
+        if sys.singular_start_equations().is_empty() {
+            return Ok(false);
+        }
+        let continues = self.hist_valid
+            && self.hist_t == state.t
+            && self.hist_q.as_slice() == state.q.as_slice();
+        if continues || state.q.len() != self.n {
+            return Ok(false);
+        }
+        Ok(sys.redundant_at(state.q.as_slice(), state.t)?.len() > sys.n_redundant())
+    }
+
+    /// Forgets what the steps carry over (the predictor's history, the reused end `Phi_q` and
+    /// stage Jacobian, the acceleration and gradient histories).
+    fn forget(&mut self) {
         self.hist_valid = false;
         self.hist_len = 0;
         self.end_phiq_valid = false;
@@ -45,7 +107,13 @@ impl Integrator for Galerkin {
         self.mlhist.clear();
     }
 
-    fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
+    /// One step of the scheme itself.
+    fn scheme_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+    ) -> Result<StepStats, SolveError> {
         if !(h.is_finite() && h > 0.0) {
             return Err(SolveError::InvalidStep { h });
         }

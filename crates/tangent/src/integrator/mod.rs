@@ -119,9 +119,9 @@ pub struct TangentRk {
     /// The largest condition estimate of the stage solves of the last accepted step (infinite
     /// before one): whether the next step's start may take its accelerations from the chart.
     last_condition: f64,
-    /// Projected RK of the same tableau for a step from a singular configuration, built on
-    /// first use (`starter.rs`).
-    starter: Option<Box<mbd_solve::Index1Rk>>,
+    /// Projected RK of the same tableau for a step from a singular configuration (its
+    /// integrator built on first use; `starter.rs`).
+    starter: mbd_solve::SingularStarter,
 }
 
 /// Largest factor by which [`TangentChart::rcond`] may differ between the current chart and
@@ -197,6 +197,7 @@ impl TangentRk {
         let fsal = s > 0
             && tableau.c[s - 1] == 1.0
             && (0..s).all(|j| tableau.a[(s - 1) * s + j] == tableau.b[j]);
+        let starter = mbd_solve::SingularStarter::new(tableau.clone());
         let rk = ExplicitRk::new(tableau, dim)?;
         Ok(TangentRk {
             path,
@@ -236,7 +237,7 @@ impl TangentRk {
             failures_here: 0,
             bridge: SingularBridge::new(sys),
             last_condition: f64::INFINITY,
-            starter: None,
+            starter,
         })
     }
 
@@ -480,9 +481,7 @@ impl Integrator for TangentRk {
         self.centred_at = f64::NAN;
         self.failures_here = 0;
         self.bridge.clear();
-        if let Some(s) = self.starter.as_deref_mut() {
-            s.reset();
-        }
+        self.starter.reset();
     }
 
     fn as_adaptive(&mut self) -> Option<&mut dyn AdaptiveIntegrator> {

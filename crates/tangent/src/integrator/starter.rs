@@ -1,34 +1,18 @@
 //! The first step from a singular configuration. A chart cannot be centred where `Phi_q` loses
 //! rank (its dimension would change), but a mechanism may start there (a parallelogram
 //! four-bar with its cranks in line with the ground): such a step is taken by projected RK of
-//! the integrator's own tableau on the index-1 form ([`Index1Rk`] with post-step projection,
-//! whose acceleration solve drops the rows dependent at the start, see
-//! `System::dependency_budget`), of the same order, and the chart takes over at its end point,
-//! off the singular configuration (docs/singular.md section 6).
+//! the integrator's own tableau on the index-1 form ([`mbd_solve::SingularStarter`]), of the
+//! same order, and the chart takes over at its end point, off the singular configuration
+//! (docs/singular.md section 6).
 
 use super::*;
-use mbd_solve::{Index1Options, Index1Rk, ProjectionSettings};
+use mbd_solve::SingularStarter;
 
 impl TangentRk {
     /// Whether `e`, returned by a step from `t`, is the chart's refusal of a singular
     /// configuration at the step's start (its centre), which the starter can take.
     pub(super) fn singular_at_start(e: &SolveError, t: f64) -> bool {
-        matches!(e, SolveError::Singular { t: at, .. } if *at == t)
-    }
-
-    /// The starter integrator, built on first use.
-    fn starter(&mut self, sys: &System) -> Result<&mut Index1Rk, SolveError> {
-        if self.starter.is_none() {
-            let opts = Index1Options {
-                projection: Some(ProjectionSettings::default()),
-                ..Index1Options::default()
-            };
-            self.starter = Some(Box::new(Index1Rk::new(sys, self.rk.tableau.clone(), opts)?));
-        }
-        self.starter.as_deref_mut().ok_or(SolveError::NonFinite {
-            t: f64::NAN,
-            what: "tangent starter",
-        })
+        SingularStarter::refused_at_start(e, t)
     }
 
     /// A fixed step of size `h` from the singular configuration `state` by the starter; the
@@ -41,12 +25,7 @@ impl TangentRk {
         h: f64,
         refused: SolveError,
     ) -> Result<StepStats, SolveError> {
-        let mut trial = state.clone();
-        let stats = match self.starter(sys)?.step(sys, &mut trial, h) {
-            Ok(s) => s,
-            Err(_) => return Err(refused),
-        };
-        *state = trial;
+        let stats = self.starter.step(sys, state, h, refused)?;
         self.after_starter();
         Ok(stats)
     }
@@ -62,13 +41,8 @@ impl TangentRk {
         ctrl: &StepController,
         refused: SolveError,
     ) -> Result<StepAttempt, SolveError> {
-        let mut trial = state.clone();
-        let a = match self.starter(sys)?.attempt_step(sys, &mut trial, h, ctrl) {
-            Ok(a) => a,
-            Err(_) => return Err(refused),
-        };
+        let a = self.starter.attempt(sys, state, h, ctrl, refused)?;
         if a.accepted {
-            *state = trial;
             self.after_starter();
         }
         Ok(a)

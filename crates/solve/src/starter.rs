@@ -1,0 +1,108 @@
+//! The first step from a singular configuration, for integrators whose own step cannot be
+//! taken there.
+//!
+//! A mechanism may start where `Phi_q` loses rank (a parallelogram four-bar with its cranks in
+//! line with the ground, `System::singular_start_equations`). Some methods cannot step from
+//! such a point: a tangent chart cannot be centred where the manifold's dimension changes, and
+//! the (1,1) symplectic scheme's end-point equations `Phi(q_1) = 0` get their constraint forces
+//! along `Phi_q(q_0)^T` only, one direction short per dependent equation, so they have no
+//! solution (the residual stalls at `O(h^3)`). Projected RK on the index-1 form can: its
+//! acceleration solve drops the rows dependent at the start (`System::dependency_budget`)
+//! and the projection puts the end point back on the constraints. [`SingularStarter`] takes
+//! that one step with a tableau the integrator chooses (of at least its own order), and the
+//! integrator takes over at its end point, off the singular configuration (docs/singular.md
+//! section 6).
+
+use crate::adaptive::{AdaptiveIntegrator, StepAttempt};
+use crate::error::SolveError;
+use crate::index1::{Index1Options, Index1Rk};
+use crate::integrator::{Integrator, StepStats};
+use crate::projection::ProjectionSettings;
+use crate::state::State;
+use crate::tableau::{ButcherTableau, StepController};
+use mbd_model::System;
+
+/// Projected RK of a given tableau for the first step from a singular configuration (see the
+/// module doc); the index-1 integrator is built on first use, so an integrator that never
+/// starts on one pays nothing.
+#[derive(Debug)]
+pub struct SingularStarter {
+    tableau: ButcherTableau,
+    rk: Option<Box<Index1Rk>>,
+}
+
+impl SingularStarter {
+    /// A starter that steps with `tableau` (projection after every step, default settings).
+    pub fn new(tableau: ButcherTableau) -> Self {
+        SingularStarter { tableau, rk: None }
+    }
+
+    /// Whether `e`, returned by a step from time `t`, is a refusal of a singular configuration
+    /// at the step's start ([`SolveError::Singular`] at `t` itself), which the starter may
+    /// take.
+    pub fn refused_at_start(e: &SolveError, t: f64) -> bool {
+        matches!(e, SolveError::Singular { t: at, .. } if *at == t)
+    }
+
+    /// Forgets the state of the index-1 integrator (a run starts afresh).
+    pub fn reset(&mut self) {
+        if let Some(rk) = self.rk.as_deref_mut() {
+            rk.reset();
+        }
+    }
+
+    fn integrator(&mut self, sys: &System) -> Result<&mut Index1Rk, SolveError> {
+        if self.rk.is_none() {
+            let opts = Index1Options {
+                projection: Some(ProjectionSettings::default()),
+                ..Index1Options::default()
+            };
+            self.rk = Some(Box::new(Index1Rk::new(sys, self.tableau.clone(), opts)?));
+        }
+        self.rk.as_deref_mut().ok_or(SolveError::NonFinite {
+            t: f64::NAN,
+            what: "singular starter",
+        })
+    }
+
+    /// A fixed step of size `h` from `state`. On failure `state` is unchanged and `refused`
+    /// (the integrator's own refusal, which says more to the user than the starter's) is
+    /// returned.
+    pub fn step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        refused: SolveError,
+    ) -> Result<StepStats, SolveError> {
+        let mut trial = state.clone();
+        let stats = match self.integrator(sys)?.step(sys, &mut trial, h) {
+            Ok(s) => s,
+            Err(_) => return Err(refused),
+        };
+        *state = trial;
+        Ok(stats)
+    }
+
+    /// An adaptive attempt of size `h` from `state`, judged by the tableau's embedded error
+    /// estimate (the tableau must have one); `state` moves only if the attempt is accepted.
+    /// On failure `refused` is returned, as by [`SingularStarter::step`].
+    pub fn attempt(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+        ctrl: &StepController,
+        refused: SolveError,
+    ) -> Result<StepAttempt, SolveError> {
+        let mut trial = state.clone();
+        let a = match self.integrator(sys)?.attempt_step(sys, &mut trial, h, ctrl) {
+            Ok(a) => a,
+            Err(_) => return Err(refused),
+        };
+        if a.accepted {
+            *state = trial;
+        }
+        Ok(a)
+    }
+}
