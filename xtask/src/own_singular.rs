@@ -515,6 +515,8 @@ fn singular_start(ctx: &Ctx, sec: &mut Section) -> Result<(), String> {
     let coupler = sys.body_handle("coupler").ok_or("no coupler")?.index();
     for spec in [
         "rk4-projected",
+        "symplectic:1",
+        "symplectic:1:modified",
         "symplectic:2",
         "symplectic:2:modified",
         "tangent:rk4",
