@@ -100,6 +100,27 @@ impl Partition {
         }
     }
 
+    /// The partition [`Partition::auto`] chooses, on a singular configuration of a model that
+    /// starts on one (`System::singular_start_equations`): the elimination takes its last
+    /// pivots, one per equation dependent at the start only, without the rank test (the
+    /// largest entries left, at round-off there). The dependent block is singular at `q` but
+    /// not an instant later, where the solver's repartitioning test replaces it by the best
+    /// block if it is poor; the step from `q` itself is taken by the singular starter.
+    /// `None` where the model does not start on a singular configuration, or the
+    /// elimination fails anyway.
+    pub(crate) fn at_singular_start(sys: &System, q: &[f64], t: f64) -> Option<Partition> {
+        let extra = sys.singular_start_equations().len();
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        if extra == 0 || sys.dof() == 0 || q.len() != n {
+            return None;
+        }
+        let mut j = DMatrix::zeros(m, n);
+        sys.phi_q(q, t, &mut j);
+        let mut piv = Pivoting::new(m, n, sys.n_redundant());
+        piv.waive = extra;
+        piv.eliminate(&j).ok().map(|_| piv.partition())
+    }
+
     /// A partition with the given independent coordinates; checks the indices and that the
     /// dependent block of `Phi_q(q, t)` is invertible. With `k > 0` redundant equations the `r`
     /// equations are chosen by Gaussian elimination with complete pivoting of `Phi_q(q)` with
@@ -216,6 +237,9 @@ pub(crate) struct Pivoting {
     cols: Vec<usize>,
     /// The number `k` of rows expected to be dependent.
     redundant: usize,
+    /// The last pivots taken without the rank test (0 but on a singular start, see
+    /// [`Partition::at_singular_start`]).
+    waive: usize,
 }
 
 impl Pivoting {
@@ -226,6 +250,7 @@ impl Pivoting {
             rows: (0..m).collect(),
             cols: (0..n).collect(),
             redundant: redundant.min(m),
+            waive: 0,
         }
     }
 
@@ -290,15 +315,24 @@ impl Pivoting {
                     }
                 }
             }
-            if best.is_nan() || best <= tol {
+            if best.is_nan() || (best <= tol && k + self.waive < r) {
                 return Err(RankError::Deficient(k));
             }
+            // (a waived pivot at round-off or zero: the column and row are kept, the
+            // determinant's logarithm gets the tolerance)
+            let best_ln = best.max(tol).ln();
             self.rows.swap(k, pr);
             self.cols.swap(k, pc);
-            log_det += best.ln();
+            log_det += best_ln;
             let (r0, c0) = (self.rows[k], self.cols[k]);
             let p = j[(r0, c0)];
-            for &row in &self.rows[k + 1..] {
+            // (a waived pivot may be exactly zero: nothing to eliminate with)
+            let rest = if p == 0.0 {
+                &[][..]
+            } else {
+                &self.rows[k + 1..]
+            };
+            for &row in rest {
                 let l = j[(row, c0)] / p;
                 if l != 0.0 {
                     for &c in &self.cols[k..] {

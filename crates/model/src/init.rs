@@ -91,9 +91,9 @@ impl System {
             .collect();
         Some(format!(
             "the initial configuration is singular: {} equation(s) ({}) depend on the others \
-             there but not along the motion; the solvers that keep the constraints pass it, the \
-             tangent-chart solvers take their first step by projected RK of their tableau, FA-DAE \
-             cannot start on it, the consistent start velocity \
+             there but not along the motion; the solvers that keep the constraints pass it (the \
+             tangent-chart solvers, symplectic (1,1) and FA-DAE by a first step of projected RK, \
+             their own steps having no solution there), the consistent start velocity \
              is the nearest on a branch of the motion (give the motion's velocities to choose \
              the branch), and the multipliers (reactions, drivers' torques) at the start are not \
              determined",

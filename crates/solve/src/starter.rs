@@ -44,6 +44,17 @@ impl SingularStarter {
         matches!(e, SolveError::Singular { t: at, .. } if *at == t)
     }
 
+    /// Whether `state` is a singular configuration of a model that starts on one
+    /// (`System::singular_start_equations`): `Phi_q` there has more dependent rows than the
+    /// model's redundant equations (`System::redundant_at`, a rank test; the caller gates it
+    /// to the steps that may start there).
+    pub fn at_singular_start(sys: &System, state: &State) -> Result<bool, SolveError> {
+        if sys.singular_start_equations().is_empty() || state.q.len() != sys.n_coords() {
+            return Ok(false);
+        }
+        Ok(sys.redundant_at(state.q.as_slice(), state.t)?.len() > sys.n_redundant())
+    }
+
     /// Forgets the state of the index-1 integrator (a run starts afresh).
     pub fn reset(&mut self) {
         if let Some(rk) = self.rk.as_deref_mut() {

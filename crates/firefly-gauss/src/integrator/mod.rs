@@ -10,7 +10,9 @@ use mbd_firefly::{Bounds, Firefly, Objective, SyncObjective};
 use mbd_model::System;
 use mbd_solve::linalg::DenseLu;
 use mbd_solve::linalg::{max_abs, max_abs_diff};
-use mbd_solve::{AccelerationSolver, Integrator, SolveError, State, StepStats};
+use mbd_solve::{
+    AccelerationSolver, ButcherTableau, Integrator, SingularStarter, SolveError, State, StepStats,
+};
 use std::sync::Mutex;
 
 mod predict;
@@ -119,6 +121,9 @@ pub struct FireflyGauss {
     step_index: u64,
     last: StepInfo,
     stats: FaDaeStats,
+    /// The first step from a singular configuration, where the dependent block of every
+    /// partition is singular.
+    starter: SingularStarter,
 }
 
 impl FireflyGauss {
@@ -137,7 +142,12 @@ impl FireflyGauss {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
         let (q0, _) = sys.initial_guess();
         let partition = match &options.partition {
-            PartitionChoice::Auto => Partition::auto(sys, q0.as_slice(), 0.0)?,
+            PartitionChoice::Auto => match Partition::auto(sys, q0.as_slice(), 0.0) {
+                Ok(p) => p,
+                // a model that starts on a singular configuration: the first step is the
+                // starter's, and the partition is checked at its end
+                Err(e) => Partition::at_singular_start(sys, q0.as_slice(), 0.0).ok_or(e)?,
+            },
             PartitionChoice::Given(ind) => Partition::given(sys, q0.as_slice(), 0.0, ind)?,
         };
         let dof = partition.dof();
@@ -189,6 +199,8 @@ impl FireflyGauss {
             step_index: 0,
             last: StepInfo::default(),
             stats: FaDaeStats::new(),
+            // (DOPRI5: one step's local error O(h^6), below the method's order 4)
+            starter: SingularStarter::new(ButcherTableau::dopri5()),
             opts: options,
         })
     }
@@ -483,8 +495,21 @@ impl Integrator for FireflyGauss {
         s
     }
 
+    /// [`FireflyGauss::try_step`]; from a singular configuration of a model that starts on
+    /// one (every dependent block singular there), the step is taken by projected DOPRI5
+    /// ([`SingularStarter`]; one step's local error `O(h^6)`, below the method's order 4) and
+    /// the solver takes over at its end point, where its partition is checked as at every step.
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
-        self.try_step(sys, state, h).map_err(SolveError::from)
+        let t = state.t;
+        match self.try_step(sys, state, h).map_err(SolveError::from) {
+            Err(e)
+                if SingularStarter::refused_at_start(&e, t)
+                    && SingularStarter::at_singular_start(sys, state)? =>
+            {
+                self.starter.step(sys, state, h, e)
+            }
+            r => r,
+        }
     }
 
     fn keeps_constraints(&self) -> bool {
@@ -495,6 +520,7 @@ impl Integrator for FireflyGauss {
         self.n_corr = 0;
         self.stats = FaDaeStats::new();
         self.last = StepInfo::default();
+        self.starter.reset();
     }
 
     fn order(&self) -> Option<u32> {

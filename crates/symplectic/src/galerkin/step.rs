@@ -86,13 +86,14 @@ impl Galerkin {
         if sys.singular_start_equations().is_empty() {
             return Ok(false);
         }
+        // (the rank test only where a step may start on it)
         let continues = self.hist_valid
             && self.hist_t == state.t
             && self.hist_q.as_slice() == state.q.as_slice();
-        if continues || state.q.len() != self.n {
+        if continues {
             return Ok(false);
         }
-        Ok(sys.redundant_at(state.q.as_slice(), state.t)?.len() > sys.n_redundant())
+        SingularStarter::at_singular_start(sys, state)
     }
 
     /// Forgets what the steps carry over (the predictor's history, the reused end `Phi_q` and
