@@ -218,7 +218,11 @@ impl AdaptiveIntegrator for TangentRk {
         let attempt = match self.attempt_adaptive(sys, state, h, ctrl, recentre) {
             Err(e) if recentre && Self::singular_at_start(&e, t) => {
                 self.centred_at = f64::NAN;
-                return self.starter_attempt(sys, state, h, ctrl, e);
+                let a = self.starter.attempt(sys, state, h, ctrl, e)?;
+                if a.accepted {
+                    self.after_starter();
+                }
+                return Ok(a);
             }
             r => r?,
         };

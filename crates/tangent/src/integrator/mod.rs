@@ -504,7 +504,9 @@ impl Integrator for TangentRk {
         match self.advance(sys, t, h, 0, &mut out) {
             Ok(()) => {}
             Err(e) if Self::singular_at_start(&e, t) => {
-                return self.starter_step(sys, state, h, e);
+                let stats = self.starter.step(sys, state, h, e)?;
+                self.after_starter();
+                return Ok(stats);
             }
             Err(e) => return Err(e),
         }

@@ -3,7 +3,9 @@
 //! four-bar with its cranks in line with the ground): such a step is taken by projected RK of
 //! the integrator's own tableau on the index-1 form ([`mbd_solve::SingularStarter`]), of the
 //! same order, and the chart takes over at its end point, off the singular configuration
-//! (docs/singular.md section 6).
+//! (docs/singular.md section 6). A step or an adaptive attempt that the chart refuses at its
+//! start ([`TangentRk::singular_at_start`]) goes to `self.starter` (its failure returns the
+//! chart's refusal), and an accepted one to [`TangentRk::after_starter`].
 
 use super::*;
 use mbd_solve::SingularStarter;
@@ -15,42 +17,9 @@ impl TangentRk {
         SingularStarter::refused_at_start(e, t)
     }
 
-    /// A fixed step of size `h` from the singular configuration `state` by the starter; the
-    /// chart's refusal `refused` is returned if the starter fails too (a configuration where
-    /// the accelerations are not determined either).
-    pub(super) fn starter_step(
-        &mut self,
-        sys: &System,
-        state: &mut State,
-        h: f64,
-        refused: SolveError,
-    ) -> Result<StepStats, SolveError> {
-        let stats = self.starter.step(sys, state, h, refused)?;
-        self.after_starter();
-        Ok(stats)
-    }
-
-    /// An adaptive attempt of size `h` from the singular configuration `state` by the
-    /// starter (its embedded error estimate judges it); `refused` as in
-    /// [`TangentRk::starter_step`].
-    pub(super) fn starter_attempt(
-        &mut self,
-        sys: &System,
-        state: &mut State,
-        h: f64,
-        ctrl: &StepController,
-        refused: SolveError,
-    ) -> Result<StepAttempt, SolveError> {
-        let a = self.starter.attempt(sys, state, h, ctrl, refused)?;
-        if a.accepted {
-            self.after_starter();
-        }
-        Ok(a)
-    }
-
     /// The chart takes over at the starter's end point: loaded and checked at the next step
     /// like a state handed in.
-    fn after_starter(&mut self) {
+    pub(super) fn after_starter(&mut self) {
         self.cur_ok = false;
         self.hist.clear();
         self.centred_at = f64::NAN;
