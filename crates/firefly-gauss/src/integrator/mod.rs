@@ -133,7 +133,10 @@ impl FireflyGauss {
     /// Invalid options ([`FaDaeError::InvalidOption`], [`FaDaeError::Firefly`]), invalid
     /// independent coordinates ([`FaDaeError::InvalidPartition`]), a system without degrees of
     /// freedom or whose `Phi_q` at the initial guess does not have the rank `m - k` the build
-    /// found (`k` redundant equations; [`FaDaeError::Unsupported`]).
+    /// found (`k` redundant equations; [`FaDaeError::Unsupported`]), unless the model starts
+    /// on a singular configuration (`System::singular_start_equations`) and the partition is
+    /// automatic: then it is
+    /// provisional and the first step is the singular starter's ([`Integrator::step`]).
     pub fn new(sys: &System, options: FaDaeOptions) -> Result<Self, FaDaeError> {
         options.validate()?;
         // its acceleration solves are dense
