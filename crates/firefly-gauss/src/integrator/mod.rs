@@ -135,8 +135,8 @@ impl FireflyGauss {
     /// freedom or whose `Phi_q` at the initial guess does not have the rank `m - k` the build
     /// found (`k` redundant equations; [`FaDaeError::Unsupported`]), unless the model starts
     /// on a singular configuration (`System::singular_start_equations`) and the partition is
-    /// automatic: then it is
-    /// provisional and the first step is the singular starter's ([`Integrator::step`]).
+    /// automatic: then it is provisional and the first step is the singular starter's
+    /// ([`Integrator::step`]).
     pub fn new(sys: &System, options: FaDaeOptions) -> Result<Self, FaDaeError> {
         options.validate()?;
         // its acceleration solves are dense
