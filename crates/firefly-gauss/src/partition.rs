@@ -373,3 +373,26 @@ impl Pivoting {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mbd_model::models::parallelogram_four_bar;
+
+    /// On the flat start every dependent block is singular: `auto` refuses it, the
+    /// provisional partition has the shape `auto` gives a step later (9 coordinates, 8
+    /// equations: 1 independent); a model that does not start flat has none.
+    #[test]
+    fn a_flat_start_gets_a_provisional_partition_of_the_right_shape() {
+        let sys = parallelogram_four_bar(0.4, 1.0, 0.0, 6.0, false).unwrap();
+        let (q0, _) = sys.initial_guess();
+        assert!(Partition::auto(&sys, q0.as_slice(), 0.0).is_err());
+        let p = Partition::at_singular_start(&sys, q0.as_slice(), 0.0).unwrap();
+        assert_eq!((p.independent.len(), p.dependent.len()), (1, 8));
+        assert_eq!(p.equations, (0..8).collect::<Vec<_>>());
+        let regular = parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, false).unwrap();
+        let (r0, _) = regular.initial_guess();
+        assert!(Partition::at_singular_start(&regular, r0.as_slice(), 0.0).is_none());
+        assert!(Partition::auto(&regular, r0.as_slice(), 0.0).is_ok());
+    }
+}

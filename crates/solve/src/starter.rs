@@ -117,3 +117,41 @@ impl SingularStarter {
         Ok(a)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mbd_model::models::parallelogram_four_bar;
+
+    #[test]
+    fn only_a_singular_refusal_at_the_step_start_goes_to_the_starter() {
+        let singular = |t| SolveError::Singular {
+            t,
+            what: "x",
+            detail: String::new(),
+        };
+        assert!(SingularStarter::refused_at_start(&singular(0.5), 0.5));
+        assert!(!SingularStarter::refused_at_start(&singular(0.6), 0.5));
+        assert!(!SingularStarter::refused_at_start(
+            &SolveError::InvalidStep { h: 0.0 },
+            0.5
+        ));
+    }
+
+    #[test]
+    fn the_flat_start_is_singular_and_the_state_a_step_later_is_not() {
+        let sys = parallelogram_four_bar(0.4, 1.0, 0.0, 6.0, false).unwrap();
+        let s0 = State::consistent(&sys, 0.0).unwrap();
+        assert!(SingularStarter::at_singular_start(&sys, &s0).unwrap());
+        let mut starter = SingularStarter::new(ButcherTableau::dopri5());
+        let mut s1 = s0.clone();
+        let refused = SolveError::InvalidStep { h: 1e-3 };
+        starter.step(&sys, &mut s1, 1e-3, refused).unwrap();
+        assert!((s1.t - 1e-3).abs() < 1e-15);
+        assert!(!SingularStarter::at_singular_start(&sys, &s1).unwrap());
+        // a model that does not start on a singular configuration: never
+        let regular = parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, false).unwrap();
+        let r0 = State::consistent(&regular, 0.0).unwrap();
+        assert!(!SingularStarter::at_singular_start(&regular, &r0).unwrap());
+    }
+}
