@@ -307,3 +307,22 @@ fn fa_dae_passes_a_singular_start_on_the_branch() {
         assert!(turn < 1e-9, "{spec}: coupler turned by {turn:e}");
     }
 }
+
+/// A bad step size on a singular start is an invalid step, not the starter's refusal (the
+/// (1,1) scheme hands such a step to the starter before its own checks would run).
+#[test]
+fn a_bad_step_from_a_singular_start_is_an_invalid_step() {
+    let sys = flat_parallelogram(2, PI, true);
+    let mut integ = Galerkin::new(&sys, SymplecticOptions::new(1)).unwrap();
+    let s0 = State::consistent(&sys, 0.0).unwrap();
+    for h in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+        let mut s = s0.clone();
+        match integ.step(&sys, &mut s, h) {
+            Err(SolveError::InvalidStep { .. }) => {}
+            other => panic!("h = {h}: {other:?}"),
+        }
+        assert_eq!(s.q, s0.q);
+    }
+    let mut s = s0.clone();
+    integ.step(&sys, &mut s, 1e-3).unwrap();
+}

@@ -53,6 +53,11 @@ impl Integrator for Galerkin {
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
         let t = state.t;
         if self.tab.s == 1 && self.starts_singular(sys, state)? {
+            // (bad input is reported as such, not as the starter's refusal)
+            if !(h.is_finite() && h > 0.0) {
+                return Err(SolveError::InvalidStep { h });
+            }
+            state.check(sys)?;
             let refused = SolveError::Singular {
                 t,
                 what: mbd_solve::STAGES_NEAR_RANK_LOSS,
