@@ -5,6 +5,7 @@
 use super::{short, CRANK, FLOOR, GROUND, SPEED};
 use crate::report::{fmt_e, Claim, Ctx, Section, Table};
 use mbd::prelude::*;
+use std::fmt::Display;
 
 /// The energy balance the projecting solvers close on the driven four-bar started flat, of
 /// max |H|: 5.6e-4 when the drivers' power at the start came from the multipliers there
@@ -61,11 +62,12 @@ pub(super) fn singular_start(ctx: &Ctx, sec: &mut Section) -> Result<(), String>
         let run = sim.run_observed(RunConfig::new(t_end, h), &mut eb);
         let turn = sim.state().q[3 * coupler + 2].abs();
         let balance = eb.max_residual() / eb.max_energy();
-        let outcome = match &run {
-            Ok(_) => "reached the end".to_string(),
-            Err(e) => short(&e.to_string()),
-        };
-        table.row(vec![spec.into(), outcome, fmt_e(turn), fmt_e(balance)]);
+        table.row(vec![
+            spec.into(),
+            outcome(&run),
+            fmt_e(turn),
+            fmt_e(balance),
+        ]);
         sec.claims.push(Claim::check(
             format!(
                 "{spec} passes the flat start: the coupler stays on the parallelogram branch \
@@ -126,11 +128,7 @@ fn free_start(h: f64, sec: &mut Section) -> Result<(), String> {
         let s = sim.state();
         let turn = s.q[3 * coupler + 2].abs();
         let off = (&s.q - &r.q).amax().max((&s.v - &r.v).amax());
-        let outcome = match &run {
-            Ok(_) => "reached the end".to_string(),
-            Err(e) => short(&e.to_string()),
-        };
-        table.row(vec![spec.into(), outcome, fmt_e(turn), fmt_e(off)]);
+        table.row(vec![spec.into(), outcome(&run), fmt_e(turn), fmt_e(off)]);
         sec.claims.push(Claim::check(
             format!(
                 "{spec} passes the free four-bar's flat start on the parallelogram branch \
@@ -180,13 +178,9 @@ fn at_rest_start(
         let run = sim.run_observed(RunConfig::new(t_end, h), &mut eb);
         let turn = sim.state().q[3 * coupler + 2].abs();
         let balance = eb.max_residual() / eb.max_energy();
-        let outcome = match &run {
-            Ok(_) => "reached the end".to_string(),
-            Err(e) => short(&e.to_string()),
-        };
         table.row(vec![
             format!("{spec}, at rest in the model"),
-            outcome,
+            outcome(&run),
             fmt_e(turn),
             fmt_e(balance),
         ]);
@@ -205,4 +199,12 @@ fn at_rest_start(
         ));
     }
     Ok(())
+}
+
+/// A run's outcome for the tables: "reached the end", or its error (shortened).
+fn outcome<T, E: Display>(run: &Result<T, E>) -> String {
+    match run {
+        Ok(_) => "reached the end".to_string(),
+        Err(e) => short(&e.to_string()),
+    }
 }
