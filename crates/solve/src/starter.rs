@@ -55,6 +55,13 @@ impl SingularStarter {
         Ok(sys.redundant_at(state.q.as_slice(), state.t)?.len() > sys.n_redundant())
     }
 
+    /// Whether a step from `state` that failed with `e` is the starter's to take: a refusal at
+    /// the step's start ([`SingularStarter::refused_at_start`]) on a singular configuration of
+    /// a model that starts on one ([`SingularStarter::at_singular_start`], run only then).
+    pub fn takes(e: &SolveError, sys: &System, state: &State) -> Result<bool, SolveError> {
+        Ok(Self::refused_at_start(e, state.t) && Self::at_singular_start(sys, state)?)
+    }
+
     /// Forgets the state of the index-1 integrator (a run starts afresh).
     pub fn reset(&mut self) {
         if let Some(rk) = self.rk.as_deref_mut() {
@@ -63,17 +70,17 @@ impl SingularStarter {
     }
 
     fn integrator(&mut self, sys: &System) -> Result<&mut Index1Rk, SolveError> {
-        if self.rk.is_none() {
-            let opts = Index1Options {
-                projection: Some(ProjectionSettings::default()),
-                ..Index1Options::default()
-            };
-            self.rk = Some(Box::new(Index1Rk::new(sys, self.tableau.clone(), opts)?));
-        }
-        self.rk.as_deref_mut().ok_or(SolveError::NonFinite {
-            t: f64::NAN,
-            what: "singular starter",
-        })
+        let rk = match self.rk.take() {
+            Some(rk) => rk,
+            None => {
+                let opts = Index1Options {
+                    projection: Some(ProjectionSettings::default()),
+                    ..Index1Options::default()
+                };
+                Box::new(Index1Rk::new(sys, self.tableau.clone(), opts)?)
+            }
+        };
+        Ok(self.rk.insert(rk))
     }
 
     /// A fixed step of size `h` from `state`. On failure `state` is unchanged and `refused`
@@ -143,6 +150,13 @@ mod tests {
         let sys = parallelogram_four_bar(0.4, 1.0, 0.0, 6.0, false).unwrap();
         let s0 = State::consistent(&sys, 0.0).unwrap();
         assert!(SingularStarter::at_singular_start(&sys, &s0).unwrap());
+        let refusal = |t| SolveError::Singular {
+            t,
+            what: "x",
+            detail: String::new(),
+        };
+        assert!(SingularStarter::takes(&refusal(0.0), &sys, &s0).unwrap());
+        assert!(!SingularStarter::takes(&refusal(1.0), &sys, &s0).unwrap());
         let mut starter = SingularStarter::new(ButcherTableau::dopri5());
         let mut s1 = s0.clone();
         let refused = SolveError::InvalidStep { h: 1e-3 };
@@ -153,5 +167,6 @@ mod tests {
         let regular = parallelogram_four_bar(0.4, 1.0, 1.0, 6.0, false).unwrap();
         let r0 = State::consistent(&regular, 0.0).unwrap();
         assert!(!SingularStarter::at_singular_start(&regular, &r0).unwrap());
+        assert!(!SingularStarter::takes(&refusal(0.0), &regular, &r0).unwrap());
     }
 }

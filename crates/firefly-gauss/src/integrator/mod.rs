@@ -503,12 +503,8 @@ impl Integrator for FireflyGauss {
     /// ([`SingularStarter`]; one step's local error `O(h^6)`, below the method's order 4) and
     /// the solver takes over at its end point, where its partition is checked as at every step.
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
-        let t = state.t;
         match self.try_step(sys, state, h).map_err(SolveError::from) {
-            Err(e)
-                if SingularStarter::refused_at_start(&e, t)
-                    && SingularStarter::at_singular_start(sys, state)? =>
-            {
+            Err(e) if SingularStarter::takes(&e, sys, state)? => {
                 self.starter.step(sys, state, h, e)
             }
             r => r,

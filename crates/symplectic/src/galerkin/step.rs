@@ -68,10 +68,7 @@ impl Integrator for Galerkin {
             return Ok(stats);
         }
         match self.scheme_step(sys, state, h) {
-            Err(e)
-                if SingularStarter::refused_at_start(&e, t)
-                    && !sys.singular_start_equations().is_empty() =>
-            {
+            Err(e) if SingularStarter::takes(&e, sys, state)? => {
                 let stats = self.starter.step(sys, state, h, e)?;
                 // the histories (predictor, reused Jacobians) belong to the scheme's steps
                 self.forget();

@@ -216,7 +216,7 @@ impl AdaptiveIntegrator for TangentRk {
         let recentre = self.centred_at != t;
         self.centred_at = t;
         let attempt = match self.attempt_adaptive(sys, state, h, ctrl, recentre) {
-            Err(e) if recentre && Self::singular_at_start(&e, t) => {
+            Err(e) if recentre && mbd_solve::SingularStarter::refused_at_start(&e, t) => {
                 self.centred_at = f64::NAN;
                 let a = self.starter.attempt(sys, state, h, ctrl, e)?;
                 if a.accepted {
@@ -268,7 +268,7 @@ impl AdaptiveIntegrator for TangentRk {
         let h0 = match self.estimate_initial_step(sys, state.t, span, &cfg.controller, cfg.h_max) {
             Ok(h0) => h0,
             // a singular start: the run loop's own first step (the starter takes it)
-            Err(e) if Self::singular_at_start(&e, state.t) => return Ok(None),
+            Err(e) if mbd_solve::SingularStarter::refused_at_start(&e, state.t) => return Ok(None),
             Err(e) => return Err(e),
         };
         let work = StepStats {

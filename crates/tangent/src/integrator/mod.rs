@@ -503,7 +503,7 @@ impl Integrator for TangentRk {
         let t = state.t;
         match self.advance(sys, t, h, 0, &mut out) {
             Ok(()) => {}
-            Err(e) if Self::singular_at_start(&e, t) => {
+            Err(e) if mbd_solve::SingularStarter::refused_at_start(&e, t) => {
                 let stats = self.starter.step(sys, state, h, e)?;
                 self.after_starter();
                 return Ok(stats);

@@ -4,19 +4,12 @@
 //! the integrator's own tableau on the index-1 form ([`mbd_solve::SingularStarter`]), of the
 //! same order, and the chart takes over at its end point, off the singular configuration
 //! (docs/singular.md section 6). A step or an adaptive attempt that the chart refuses at its
-//! start ([`TangentRk::singular_at_start`]) goes to `self.starter` (its failure returns the
+//! start (`SingularStarter::refused_at_start`: no chart can be centred there) goes to `self.starter` (its failure returns the
 //! chart's refusal), and an accepted one to [`TangentRk::after_starter`].
 
 use super::*;
-use mbd_solve::SingularStarter;
 
 impl TangentRk {
-    /// Whether `e`, returned by a step from `t`, is the chart's refusal of a singular
-    /// configuration at the step's start (its centre), which the starter can take.
-    pub(super) fn singular_at_start(e: &SolveError, t: f64) -> bool {
-        SingularStarter::refused_at_start(e, t)
-    }
-
     /// The chart takes over at the starter's end point: loaded and checked at the next step
     /// like a state handed in.
     pub(super) fn after_starter(&mut self) {
