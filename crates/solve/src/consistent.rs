@@ -153,6 +153,9 @@ pub fn project_state(
         },
         opts.linear,
     )?;
+    // a guess on a singular configuration slightly off the constraints is projected by the
+    // pseudo-inverse where the factorisation refuses
+    projector.set_min_norm_fallback(true);
     // the model's inputs: weight zero, so the projections leave them as given
     let (keep_q, keep_v) = sys.initial_inputs();
     let inputs = Inputs::new(sys, &keep_q, &keep_v);

@@ -67,7 +67,23 @@ pub struct Projector {
     /// The weights of the corrections in place of `M^-1` (zero: a coordinate the projections
     /// keep), if set.
     weights: Option<Vec<f64>>,
+    /// Whether a correction whose factorisation refuses `S` (a dependent row: the guess lies
+    /// on or next to a singular configuration) is taken by the truncated pseudo-inverse
+    /// instead ([`Projector::set_min_norm_fallback`]).
+    min_norm_fallback: bool,
 }
+
+/// The rank cut of the minimum-norm fallback correction, relative to the largest singular
+/// value of `Phi_q W^(1/2)`: the directions the factorisations refuse (a pivot ratio
+/// `L_jj^2 / S_jj` below [`mbd_linalg::CHOLESKY_PIVOT_TOL`] is a sine of `1e-7` between a row
+/// and the span of the others) are left out of the correction.
+const FALLBACK_RANK_CUT: f64 = 1e-7;
+
+/// The smallest sine of the angle between an equation's gradient and the span of the others
+/// (unit-free, [`System::nearly_dependent_at`]) at the end of a projection that took the
+/// minimum-norm fallback: the angle below which the factorisations may take a row for a
+/// dependent one ([`mbd_linalg::DEPENDENT_PIVOT_TOL`], a pivot ratio of `1e-10`).
+const FALLBACK_END_ANGLE: f64 = 1e-5;
 
 /// What a projection did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -110,6 +126,7 @@ impl Projector {
             kernel,
             r: vec![0.0; m],
             weights: None,
+            min_norm_fallback: false,
         })
     }
 
@@ -120,6 +137,18 @@ impl Projector {
     /// the equation).
     pub(crate) fn set_weights(&mut self, w: Option<Vec<f64>>) {
         self.weights = w;
+    }
+
+    /// Lets a correction that the factorisation of `S = Phi_q W Phi_q^T` refuses (a singular
+    /// `S`: the constraint gradients are dependent where the correction is computed) be taken
+    /// as the minimum-`W`-norm correction of the truncated pseudo-inverse of `Phi_q W^(1/2)`
+    /// instead (dense planar models up to [`mbd_model::SPARSE_RANK_THRESHOLD`] equations; it
+    /// allocates). For consistent initial states: a guess on a singular configuration that
+    /// is slightly off the constraints (a flat four-bar with a coordinate rounded) is projected
+    /// onto them instead of being refused. Off by default: during a run a singular `S` is the
+    /// run's singular-configuration handling's to see.
+    pub(crate) fn set_min_norm_fallback(&mut self, on: bool) {
+        self.min_norm_fallback = on;
     }
 
     /// Whether the sparse kernel is in use.
@@ -190,6 +219,67 @@ impl Projector {
         }
     }
 
+    /// The end of a position projection at `q`: where the minimum-norm fallback stood in for
+    /// a refused factorisation (`refused`), the end configuration must be regular, every
+    /// equation's gradient at least [`FALLBACK_END_ANGLE`] from the span of the others (from
+    /// there the velocity projection and the solvers start as from any regular
+    /// configuration); one that is not (the constraints have their solution on or next to a
+    /// singular configuration: a driven crank held in line with the ground) is the first
+    /// refusal, as without the fallback.
+    fn regular_end(
+        &mut self,
+        sys: &System,
+        q: &[f64],
+        t: f64,
+        refused: Option<SolveError>,
+        stats: ProjectionStats,
+    ) -> Result<ProjectionStats, SolveError> {
+        match refused {
+            Some(e)
+                if self.factor(sys, q, t).is_err()
+                    || !sys.nearly_dependent_at(q, t, FALLBACK_END_ANGLE).is_empty() =>
+            {
+                Err(e)
+            }
+            _ => Ok(stats),
+        }
+    }
+
+    /// The fallback of a refused factorisation ([`Projector::set_min_norm_fallback`]):
+    /// `q -= W^(1/2) (Phi_q(q) W^(1/2))^+ r` with the residual `r` in `self.r`; `refused` is
+    /// returned where the fallback is off or does not apply (spatial bodies, the sparse size,
+    /// an SVD that fails).
+    fn min_norm_correct(
+        &mut self,
+        sys: &System,
+        q: &mut [f64],
+        t: f64,
+        refused: SolveError,
+    ) -> Result<(), SolveError> {
+        let (n, m) = (sys.n_coords(), sys.n_constraints());
+        if !self.min_norm_fallback || sys.has_spatial() || m > mbd_model::SPARSE_RANK_THRESHOLD {
+            return Err(refused);
+        }
+        let root: Vec<f64> = self
+            .weights
+            .as_deref()
+            .unwrap_or(sys.inv_mass_diag().as_slice())
+            .iter()
+            .map(|w| w.max(0.0).sqrt())
+            .collect();
+        let mut a = nalgebra::DMatrix::zeros(m, n);
+        sys.phi_q(q, t, &mut a);
+        for (k, w) in root.iter().enumerate() {
+            a.column_mut(k).scale_mut(*w);
+        }
+        let r = nalgebra::DVector::from_column_slice(&self.r);
+        let y = mbd_linalg::min_norm_solve(a, &r, FALLBACK_RANK_CUT).ok_or(refused)?;
+        for ((qi, w), yi) in q.iter_mut().zip(&root).zip(y.iter()) {
+            *qi -= w * yi;
+        }
+        Ok(())
+    }
+
     fn check_len(&self, sys: &System, what: &'static str, x: &[f64]) -> Result<(), SolveError> {
         if x.len() != sys.n_coords() || self.r.len() != sys.n_constraints() {
             return Err(SolveError::Dimension {
@@ -214,6 +304,8 @@ impl Projector {
             return Ok(ProjectionStats::default());
         }
         let mut stats = ProjectionStats::default();
+        // the first refusal of the factorisation that the minimum-norm fallback stood in for
+        let mut refused: Option<SolveError> = None;
         // The residual of `Phi` cannot fall below the round-off of evaluating it at coordinates
         // of size |q|: a far-out or long mechanism (a 100-link chain reaches 100 m) has a floor
         // above a fixed 1e-14, and Newton would otherwise iterate to `max_iter` there. The floor
@@ -238,18 +330,23 @@ impl Projector {
                 });
             }
             if res <= tol {
-                return Ok(stats);
+                return self.regular_end(sys, q, t, refused, stats);
             }
             if it == self.settings.max_iter {
                 break;
             }
-            self.factor(sys, q, t)?;
-            self.correct(sys, q);
+            match self.factor(sys, q, t) {
+                Ok(()) => self.correct(sys, q),
+                Err(e) => {
+                    self.min_norm_correct(sys, q, t, e.clone())?;
+                    refused.get_or_insert(e);
+                }
+            }
             stats.iterations += 1;
         }
         // accept a residual at the round-off floor of the configuration
         if stats.residual <= 1e3 * self.settings.tol.max(floor(q)) {
-            return Ok(stats);
+            return self.regular_end(sys, q, t, refused, stats);
         }
         let worst = (0..self.r.len())
             .max_by(|&a, &b| self.r[a].abs().total_cmp(&self.r[b].abs()))

@@ -127,12 +127,14 @@ pub struct FireflyGauss {
 }
 
 impl FireflyGauss {
-    /// A solver for `sys`. The partition is chosen (or checked) at the system's initial guess.
+    /// A solver for `sys`. The partition is chosen (or checked) at the system's consistent
+    /// initial configuration (`State::consistent` at `t = 0`; the initial guess where it has
+    /// none).
     ///
     /// # Errors
     /// Invalid options ([`FaDaeError::InvalidOption`], [`FaDaeError::Firefly`]), invalid
     /// independent coordinates ([`FaDaeError::InvalidPartition`]), a system without degrees of
-    /// freedom or whose `Phi_q` at the initial guess does not have the rank `m - k` the build
+    /// freedom or whose `Phi_q` at that configuration does not have the rank `m - k` the build
     /// found (`k` redundant equations; [`FaDaeError::Unsupported`]), unless the model starts
     /// on a singular configuration (`System::singular_start_equations`) and the partition is
     /// automatic: then it is provisional and the first step is the singular starter's
@@ -143,7 +145,13 @@ impl FireflyGauss {
         mbd_solve::refuse_large_spatial(sys, "the FA-DAE solver", mbd_solve::LinearSolver::Auto)
             .map_err(FaDaeError::Solve)?;
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        let (q0, _) = sys.initial_guess();
+        // the start's configuration: the guess projected onto the constraints (a guess off
+        // them, on a singular configuration, may have a rank the start does not), the guess
+        // itself where it has no consistent state (the run reports that)
+        let q0 = match State::consistent(sys, 0.0) {
+            Ok(s) => s.q,
+            Err(_) => sys.initial_guess().0,
+        };
         let partition = match &options.partition {
             PartitionChoice::Auto => match Partition::auto(sys, q0.as_slice(), 0.0) {
                 Ok(p) => p,
