@@ -4,6 +4,9 @@
 //! ```text
 //! cargo run --release -p mbd-tools --bin singular_probe -- <spec> <N> <driven|free> <h> [t_end]
 //! ```
+//!
+//! `WATCH=c` prints the steps whose condition estimate exceeds `c` (default 1e3), `EVERY=k`
+//! also every `k`-th step (the tracked crank's error against the exact motion over time).
 use mbd::model::models::ClosedLoop;
 use mbd::solve::State;
 
@@ -34,6 +37,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .ok_or("no body")?
         .index();
     let c1 = sys.body_handle("coupler1").ok_or("no coupler")?.index();
+    let every: usize = std::env::var("EVERY")
+        .ok()
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(0);
     let steps = (t_end / h).round() as usize;
     let mut phi = vec![0.0; sys.n_constraints()];
     for k in 0..steps {
@@ -47,7 +55,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         s.t = (k + 1) as f64 * h;
         sys.phi(s.q.as_slice(), s.t, &mut phi);
         let r = phi.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        if st.condition > watch || !r.is_finite() || r > 1e-3 {
+        let periodic = every > 0 && (k + 1) % every == 0;
+        if st.condition > watch || !r.is_finite() || r > 1e-3 || periodic {
             let want = exact.at(s.t)[0];
             println!(
                 "step {k} t = {:.4} cond {:.2e} |phi| {r:.2e} crank_err {:.3e} coupler {:.2e} newton {}",
