@@ -219,36 +219,36 @@ impl Projector {
         }
     }
 
-    /// The end of a position projection at `q`: where the minimum-norm fallback stood in for
-    /// a refused factorisation (`refused`), the end configuration must be regular, every
-    /// equation's gradient at least [`FALLBACK_END_ANGLE`] from the span of the others (from
-    /// there the velocity projection and the solvers start as from any regular
-    /// configuration); one that is not (the constraints have their solution on or next to a
-    /// singular configuration: a driven crank held in line with the ground) is the first
-    /// refusal, as without the fallback.
+    /// The end of a position projection at `q` that took the minimum-norm fallback for a
+    /// refused factorisation (`refused`, the first refusal): the end configuration must be
+    /// regular, every equation's gradient at least [`FALLBACK_END_ANGLE`] from the span of
+    /// the others (from there the velocity projection and the solvers start as from any
+    /// regular configuration); one that is not (the constraints have their solution on or
+    /// next to a singular configuration: a driven crank held in line with the ground) is the
+    /// first refusal, as without the fallback.
+    #[cold]
+    #[inline(never)]
     fn regular_end(
-        &mut self,
+        &self,
         sys: &System,
         q: &[f64],
         t: f64,
-        refused: Option<SolveError>,
+        refused: SolveError,
         stats: ProjectionStats,
     ) -> Result<ProjectionStats, SolveError> {
-        match refused {
-            Some(e)
-                if self.factor(sys, q, t).is_err()
-                    || !sys.nearly_dependent_at(q, t, FALLBACK_END_ANGLE).is_empty() =>
-            {
-                Err(e)
-            }
-            _ => Ok(stats),
+        if sys.nearly_dependent_at(q, t, FALLBACK_END_ANGLE).is_empty() {
+            Ok(stats)
+        } else {
+            Err(refused)
         }
     }
 
     /// The fallback of a refused factorisation ([`Projector::set_min_norm_fallback`]):
     /// `q -= W^(1/2) (Phi_q(q) W^(1/2))^+ r` with the residual `r` in `self.r`; `refused` is
-    /// returned where the fallback is off or does not apply (spatial bodies, the sparse size,
-    /// an SVD that fails).
+    /// returned where the fallback does not apply (spatial bodies, the sparse size, an SVD
+    /// that fails).
+    #[cold]
+    #[inline(never)]
     fn min_norm_correct(
         &mut self,
         sys: &System,
@@ -257,7 +257,7 @@ impl Projector {
         refused: SolveError,
     ) -> Result<(), SolveError> {
         let (n, m) = (sys.n_coords(), sys.n_constraints());
-        if !self.min_norm_fallback || sys.has_spatial() || m > mbd_model::SPARSE_RANK_THRESHOLD {
+        if sys.has_spatial() || m > mbd_model::SPARSE_RANK_THRESHOLD {
             return Err(refused);
         }
         let root: Vec<f64> = self
@@ -298,6 +298,22 @@ impl Projector {
         q: &mut [f64],
         t: f64,
     ) -> Result<ProjectionStats, SolveError> {
+        // (the fallback's bookkeeping in its own instance: the steps' projections stay as lean
+        // as without it)
+        if self.min_norm_fallback {
+            self.positions::<true>(sys, q, t)
+        } else {
+            self.positions::<false>(sys, q, t)
+        }
+    }
+
+    /// [`Projector::project_positions`], with the minimum-norm fallback where `FALLBACK`.
+    fn positions<const FALLBACK: bool>(
+        &mut self,
+        sys: &System,
+        q: &mut [f64],
+        t: f64,
+    ) -> Result<ProjectionStats, SolveError> {
         self.check_len(sys, "q", q)?;
         let m = sys.n_constraints();
         if m == 0 {
@@ -330,23 +346,30 @@ impl Projector {
                 });
             }
             if res <= tol {
-                return self.regular_end(sys, q, t, refused, stats);
+                return match refused {
+                    None => Ok(stats),
+                    Some(e) => self.regular_end(sys, q, t, e, stats),
+                };
             }
             if it == self.settings.max_iter {
                 break;
             }
             match self.factor(sys, q, t) {
                 Ok(()) => self.correct(sys, q),
-                Err(e) => {
+                Err(e) if FALLBACK => {
                     self.min_norm_correct(sys, q, t, e.clone())?;
                     refused.get_or_insert(e);
                 }
+                Err(e) => return Err(e),
             }
             stats.iterations += 1;
         }
         // accept a residual at the round-off floor of the configuration
         if stats.residual <= 1e3 * self.settings.tol.max(floor(q)) {
-            return self.regular_end(sys, q, t, refused, stats);
+            return match refused {
+                None => Ok(stats),
+                Some(e) => self.regular_end(sys, q, t, e, stats),
+            };
         }
         let worst = (0..self.r.len())
             .max_by(|&a, &b| self.r[a].abs().total_cmp(&self.r[b].abs()))

@@ -77,6 +77,7 @@ impl DenseSchur {
 
     /// Assembles `S = Phi_q W Phi_q^T` (`w` the diagonal of `W`, length n) from
     /// [`DenseSchur::grads`] and factors it; an error names the row at the failing pivot.
+    #[inline]
     pub(crate) fn factor(&mut self, w: &[f64]) -> Result<(), FactorError> {
         self.factor_impl(w, None)
     }
