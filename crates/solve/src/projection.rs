@@ -74,9 +74,10 @@ pub struct Projector {
 }
 
 /// The rank cut of the minimum-norm fallback correction, relative to the largest singular
-/// value of `Phi_q W^(1/2)`: the directions the factorisations refuse (a pivot ratio
-/// `L_jj^2 / S_jj` below [`mbd_linalg::CHOLESKY_PIVOT_TOL`] is a sine of `1e-7` between a row
-/// and the span of the others) are left out of the correction.
+/// value of `Phi_q W^(1/2)` (the square roots of `S`'s eigenvalues): the scale of the pivot
+/// ratio `L_jj^2 / S_jj` below which the factorisations refuse
+/// ([`mbd_linalg::CHOLESKY_PIVOT_TOL`], a sine of `1e-7` between a row and the span of the
+/// others). The directions below it are left out of the correction.
 const FALLBACK_RANK_CUT: f64 = 1e-7;
 
 /// The smallest sine of the angle between an equation's gradient and the span of the others
