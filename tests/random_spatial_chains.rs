@@ -12,6 +12,8 @@
 //! wrong constraint Jacobian, a wrong `gamma` term of one joint or a wrong director mass
 //! changes the motion by O(1) within the run.
 
+mod common;
+use common::end_state;
 use mbd::prelude::*;
 
 /// A small deterministic generator (xorshift64*), so the test needs no random-number crate.
@@ -151,12 +153,6 @@ fn energy(sys: &System, s: &State) -> f64 {
     sys.energy(s.q.as_slice(), s.v.as_slice())
 }
 
-fn run(sys: &System, spec: &str, plan: Plan) -> State {
-    let mut sim = Simulation::new(sys.clone(), spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
-    sim.run(plan).unwrap_or_else(|e| panic!("{spec}: {e}"));
-    sim.state().clone()
-}
-
 /// Every solver on six random chains (each joint kind at each place of the chain once).
 #[test]
 fn every_solver_agrees_on_random_spatial_chains_with_every_joint_kind() {
@@ -204,10 +200,10 @@ fn every_solver_agrees_on_random_spatial_chains_with_every_joint_kind() {
         let h0 = energy(&sys, &start);
         // the energy's scale: kinetic energy and the potential's range over the chain
         let scale = h0.abs().max(sys.kinetic(start.v.as_slice())).max(1.0);
-        let reference = run(&sys, "rk4-projected", RunConfig::new(T, 1e-4).into());
-        let reference_fa = run(&sys, "rk4-projected", RunConfig::new(T_FA, 1e-4).into());
+        let reference = end_state(&sys, "rk4-projected", RunConfig::new(T, 1e-4));
+        let reference_fa = end_state(&sys, "rk4-projected", RunConfig::new(T_FA, 1e-4));
         for (i, (spec, plan, q_bound, e_bound)) in solvers.iter().enumerate() {
-            let end = run(&sys, spec, *plan);
+            let end = end_state(&sys, spec, *plan);
             let reference = if spec.starts_with("firefly") {
                 &reference_fa
             } else {

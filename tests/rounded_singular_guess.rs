@@ -7,6 +7,8 @@
 //! solution is the singular configuration itself (the same four-bar with its crank driven flat)
 //! is still refused.
 
+mod common;
+use common::{max_phi_at, max_phi_dot_at};
 use mbd::prelude::*;
 
 /// The parallelogram four-bar (cranks 0.4 m, coupler 1 m, ground pivots 1 m apart), drawn flat
@@ -51,21 +53,12 @@ position = [1.2, 0.0, 0.0]
     s
 }
 
-fn phi_max(sys: &System, s: &State) -> (f64, f64) {
-    let m = sys.n_constraints();
-    let (mut phi, mut phid) = (vec![0.0; m], vec![0.0; m]);
-    sys.phi(s.q.as_slice(), s.t, &mut phi);
-    sys.phi_dot(s.q.as_slice(), s.v.as_slice(), s.t, &mut phid);
-    let max = |x: &[f64]| x.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-    (max(&phi), max(&phid))
-}
-
 #[test]
 fn a_rounded_guess_on_a_singular_configuration_projects_onto_the_regular_one_beside_it() {
     for lift in [1e-3, 1e-5, 3e-6] {
         let sys = System::from_toml(&four_bar(lift, false)).unwrap();
         let start = State::consistent(&sys, 0.0).unwrap_or_else(|e| panic!("lift {lift}: {e}"));
-        let (phi, phid) = phi_max(&sys, &start);
+        let (phi, phid) = (max_phi_at(&sys, &start), max_phi_dot_at(&sys, &start));
         assert!(
             phi < 1e-14 && phid < 1e-13,
             "lift {lift}: {phi:.1e} {phid:.1e}"
@@ -99,7 +92,7 @@ fn a_rounded_guess_on_a_singular_configuration_projects_onto_the_regular_one_bes
                 .unwrap_or_else(|e| panic!("lift {lift}, {spec}: {e}"));
             assert_eq!(stats.stop, StopReason::ReachedEnd);
             let coupler = rec.q.iter().fold(0.0f64, |m, q| m.max(q[5].abs()));
-            let (phi, _) = phi_max(&sys, sim.state());
+            let phi = max_phi_at(&sys, sim.state());
             assert!(
                 coupler < 1e-8 && phi < 1e-10,
                 "lift {lift}, {spec}: coupler turned {coupler:.1e}, |Phi| {phi:.1e}"

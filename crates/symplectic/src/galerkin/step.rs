@@ -52,12 +52,10 @@ impl Integrator for Galerkin {
     /// (the starter only where their Newton iteration fails there).
     fn step(&mut self, sys: &System, state: &mut State, h: f64) -> Result<StepStats, SolveError> {
         let t = state.t;
+        // (bad input is reported as such, also on a singular start, not as the starter's
+        // refusal)
+        self.check_step(sys, state, h)?;
         if self.tab.s == 1 && self.starts_singular(sys, state)? {
-            // (bad input is reported as such, not as the starter's refusal)
-            if !(h.is_finite() && h > 0.0) {
-                return Err(SolveError::InvalidStep { h });
-            }
-            state.check(sys)?;
             let refused = SolveError::Singular {
                 t,
                 what: mbd_solve::STAGES_NEAR_RANK_LOSS,
@@ -110,13 +108,9 @@ impl Galerkin {
         self.mlhist.clear();
     }
 
-    /// One step of the scheme itself.
-    fn scheme_step(
-        &mut self,
-        sys: &System,
-        state: &mut State,
-        h: f64,
-    ) -> Result<StepStats, SolveError> {
+    /// The checks of a step's input: the step size, the state's sizes and finiteness, the
+    /// model the integrator was built for.
+    fn check_step(&self, sys: &System, state: &State, h: f64) -> Result<(), SolveError> {
         if !(h.is_finite() && h > 0.0) {
             return Err(SolveError::InvalidStep { h });
         }
@@ -134,6 +128,16 @@ impl Galerkin {
                 what: "state before step",
             });
         }
+        Ok(())
+    }
+
+    /// One step of the scheme itself (on input [`Galerkin::check_step`] passed).
+    fn scheme_step(
+        &mut self,
+        sys: &System,
+        state: &mut State,
+        h: f64,
+    ) -> Result<StepStats, SolveError> {
         let (n, m, s) = (self.n, self.m, self.tab.s);
         let t = state.t;
         self.qk.copy_from_slice(state.q.as_slice());

@@ -4,8 +4,9 @@
 //! the integrator's own tableau on the index-1 form ([`mbd_solve::SingularStarter`]), of the
 //! same order, and the chart takes over at its end point, off the singular configuration
 //! (docs/singular.md section 6). A step or an adaptive attempt that the chart refuses at its
-//! start (`SingularStarter::refused_at_start`: no chart can be centred there) goes to `self.starter` (its failure returns the
-//! chart's refusal), and an accepted one to [`TangentRk::after_starter`].
+//! start (`SingularStarter::refused_at_start`: no chart can be centred there) goes to
+//! `self.starter` (its failure returns the chart's refusal), and an accepted one to
+//! [`TangentRk::after_starter`].
 
 use super::*;
 
