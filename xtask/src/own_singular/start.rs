@@ -57,11 +57,7 @@ pub(super) fn singular_start(ctx: &Ctx, sec: &mut Section) -> Result<(), String>
         "tangent:rk4",
         "tangent:dopri5",
     ] {
-        let mut eb = mbd_analysis::EnergyBalance::new(&sys).map_err(|e| e.to_string())?;
-        let mut sim = Simulation::new(sys.clone(), spec).map_err(|e| e.to_string())?;
-        let run = sim.run_observed(RunConfig::new(t_end, h), &mut eb);
-        let turn = sim.state().q[3 * coupler + 2].abs();
-        let balance = eb.max_residual() / eb.max_energy();
+        let (run, turn, balance) = balanced_run(&sys, spec, None, t_end, h, coupler)?;
         table.row(vec![
             spec.into(),
             outcome(&run),
@@ -172,12 +168,7 @@ fn at_rest_start(
     ));
     let start = State::new(sys, 0.0, x.q, x.v).map_err(|e| e.to_string())?;
     for spec in ["rk4-projected", "symplectic:2"] {
-        let mut eb = mbd_analysis::EnergyBalance::new(sys).map_err(|e| e.to_string())?;
-        let mut sim = Simulation::new(sys.clone(), spec).map_err(|e| e.to_string())?;
-        sim.set_state(start.clone()).map_err(|e| e.to_string())?;
-        let run = sim.run_observed(RunConfig::new(t_end, h), &mut eb);
-        let turn = sim.state().q[3 * coupler + 2].abs();
-        let balance = eb.max_residual() / eb.max_energy();
+        let (run, turn, balance) = balanced_run(sys, spec, Some(&start), t_end, h, coupler)?;
         table.row(vec![
             format!("{spec}, at rest in the model"),
             outcome(&run),
@@ -199,6 +190,27 @@ fn at_rest_start(
         ));
     }
     Ok(())
+}
+
+/// A run of `spec` on `sys` to `t_end` with steps of `h` (from `start`, or the consistent
+/// state), with its energy balance observed: the run's result, the coupler's turn at the end
+/// and the balance's largest residual relative to max |H|.
+fn balanced_run(
+    sys: &System,
+    spec: &str,
+    start: Option<&State>,
+    t_end: f64,
+    h: f64,
+    coupler: usize,
+) -> Result<(Result<RunStats, mbd::Error>, f64, f64), String> {
+    let mut eb = mbd_analysis::EnergyBalance::new(sys).map_err(|e| e.to_string())?;
+    let mut sim = Simulation::new(sys.clone(), spec).map_err(|e| e.to_string())?;
+    if let Some(s) = start {
+        sim.set_state(s.clone()).map_err(|e| e.to_string())?;
+    }
+    let run = sim.run_observed(RunConfig::new(t_end, h), &mut eb);
+    let turn = sim.state().q[3 * coupler + 2].abs();
+    Ok((run, turn, eb.max_residual() / eb.max_energy()))
 }
 
 /// A run's outcome for the tables: "reached the end", or its error (shortened).
